@@ -1,0 +1,50 @@
+//! The command line: one file per subcommand, each with its clap arguments and an `execute`.
+//!
+//! `main.rs` only parses and dispatches; the work lives here so integration tests can call it.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+pub mod check;
+pub mod receive;
+
+/// Exit codes of the command-line contract (DESIGN.md).
+pub mod exit {
+    /// The program ended normally (or the check found nothing).
+    pub const OK: u8 = 0;
+    /// A channel error (or a check found errors).
+    pub const CHANNEL_ERROR: u8 = 1;
+    /// Bad usage or bad parameter lists.
+    pub const USAGE: u8 = 2;
+    /// `--max-ticks` reached before the program ended.
+    pub const MAX_TICKS: u8 = 3;
+}
+
+#[derive(Debug, Parser)]
+#[command(name = "ncchannel", version, about = "An emulated TwinCAT 3 CNC / ISG channel")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Check NC programs and parameter lists; errors as file:line:col.
+    Check(check::CheckArgs),
+    /// Split received NC data into programs by start/end markers.
+    Receive(receive::ReceiveArgs),
+}
+
+impl Cli {
+    pub fn execute(self) -> ExitCode {
+        match self.command {
+            Some(Command::Check(args)) => check::execute(args),
+            Some(Command::Receive(args)) => receive::execute(args),
+            None => {
+                eprintln!("ncchannel: no subcommand (the demo needs `run`, not built yet)");
+                ExitCode::from(exit::USAGE)
+            }
+        }
+    }
+}

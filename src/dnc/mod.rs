@@ -1,0 +1,1 @@
+//! Receiving NC data split into programs by start/end markers (SINUMERIK style).

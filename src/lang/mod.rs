@@ -1,0 +1,1 @@
+//! The NC language: one NC line → `Block`, expressions and their evaluation.

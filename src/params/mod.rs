@@ -1,0 +1,1 @@
+//! Parameter lists: the ISG list format, typed start-up and channel lists, runtime.toml.
