@@ -5,6 +5,7 @@
 //! README's architecture section for who may talk to whom.
 
 pub mod cli;
+pub mod diag;
 pub mod dnc;
 pub mod lang;
 pub mod params;

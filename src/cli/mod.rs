@@ -22,7 +22,11 @@ pub mod exit {
 }
 
 #[derive(Debug, Parser)]
-#[command(name = "ncchannel", version, about = "An emulated TwinCAT 3 CNC / ISG channel")]
+#[command(
+    name = "ncchannel",
+    version,
+    about = "An emulated TwinCAT 3 CNC / ISG channel"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
