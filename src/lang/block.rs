@@ -1,0 +1,259 @@
+//! One NC block as the parser produces it and the decoder interprets it (REFERENCE §4).
+//!
+//! The parser is pure: one line in, one `Block` out. Nothing here knows about channels,
+//! frames or files; the decoder gives these types their meaning. Columns are 1-based
+//! character columns into the line, kept so that errors found later (an unknown label,
+//! an undefined parameter) can still point at the right place.
+
+/// A parsed NC line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Block {
+    /// Block skip level: `/` is level 1, `/1`…`/10` as written. `None` = never skipped.
+    pub skip_level: Option<u8>,
+    /// The block number `N<n>` if present.
+    pub n: Option<u32>,
+    /// A jump target defined on this line: `N40:` or `[LABEL_1]`.
+    pub label: Option<Label>,
+    pub body: Body,
+}
+
+/// A jump target: `N40:` defines `Label::Number(40)`, `[LOOP_1]` defines `Label::Name`.
+/// Names are stored upper-case: labels are case-insensitive.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Label {
+    Number(u32),
+    Name(String),
+}
+
+/// What the block does. `#` commands, `$` statements, calls and program heads stand alone
+/// in their block (only `/`, `N` and a label may precede them).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Body {
+    /// An ordinary block: words and assignments in written order. Empty for a blank or
+    /// comment-only line.
+    Items(Vec<Item>),
+    /// A `$` control statement.
+    Control(Control),
+    /// A `#` command.
+    Command(Command),
+    /// `L file`, `LL name`, `L CYCLE [...]`.
+    Call(Call),
+    /// `%name` (main program head) or `%L name` (local subroutine head).
+    ProgramHead { name: String, local: bool },
+}
+
+/// One element of an ordinary block.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    Word(Word),
+    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`.
+    Assign { target: VarRef, value: Expr, col: u32 },
+}
+
+/// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Word {
+    /// Upper-case ASCII address letter (G M H F S T D X Y Z A B C I J K R E).
+    pub letter: u8,
+    pub value: Value,
+    /// Column of the letter.
+    pub col: u32,
+}
+
+/// A word's value: a literal (the common case, no allocation) or an expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Num(f64),
+    Expr(Expr),
+}
+
+/// A reference to a parameter or variable, indices not yet evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VarRef {
+    /// `P<n>` or indirect `P[expr]`, with optional array indices `P1[2]`, `P1[i][j]`.
+    P { number: Index, indices: Vec<Expr> },
+    /// `V.P.name`, `V.L.name`, `V.S.name`, `V.E.name`, optional array indices. Name upper-case.
+    V { scope: VScope, name: String, indices: Vec<Expr> },
+    /// `@P<n>`: a cycle parameter, visible inside a cycle called by `L CYCLE [... @Pn=..]`.
+    CycleParam(u32),
+}
+
+/// The number of a P parameter: written out, or computed (`P[P1+5]`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Index {
+    Const(u32),
+    Expr(Box<Expr>),
+}
+
+/// Scope of a `V.` variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum VScope {
+    /// `V.P.` program-global, cleared at program start.
+    Program,
+    /// `V.L.` local to its program level and its callees.
+    Local,
+    /// `V.S.` self-retaining: survives reset.
+    SelfRetaining,
+    /// `V.E.` external: set from outside through the channel API / ADS.
+    External,
+}
+
+/// An expression tree. Grouping `[ ]` leaves no node of its own.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    Num(f64),
+    Var(Box<VarRef>),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    Func(Func, Vec<Expr>),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UnOp {
+    Neg,
+    /// Logical `NOT`.
+    Not,
+    /// Bitwise `INV`.
+    Inv,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+    Mod,
+    Eq,
+    Ne,
+    Lt,
+    Gt,
+    Le,
+    Ge,
+    And,
+    Or,
+    Xor,
+    BitAnd,
+    BitOr,
+    BitXor,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Func {
+    Abs,
+    Sqr,
+    Sqrt,
+    Exp,
+    Ln,
+    Log,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Int,
+    Fract,
+    Round,
+    Floor,
+    Ceil,
+}
+
+/// A `$` statement.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Control {
+    If(Expr),
+    /// `$IF <cond> $GOTO <target>`: the one statement that may follow another in a block.
+    IfGoto(Expr, GotoTarget),
+    ElseIf(Expr),
+    Else,
+    EndIf,
+    Switch(Expr),
+    Case(Expr),
+    Default,
+    Break,
+    EndSwitch,
+    /// `$FOR P1 = start, end, step` (step optional, default 1).
+    For { var: VarRef, start: Expr, end: Expr, step: Option<Expr> },
+    EndFor,
+    While(Expr),
+    EndWhile,
+    Do,
+    EndDo(Expr),
+    Repeat,
+    Until(Expr),
+    Continue,
+    Goto(GotoTarget),
+}
+
+/// Where a `$GOTO` jumps: `N40` or `[LABEL]` (name upper-case).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum GotoTarget {
+    Number(u32),
+    Name(String),
+}
+
+/// A `#` command.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    Flush(FlushKind),
+    /// `#CACHE LOAD [FILE=name]`.
+    CacheLoad { file: String },
+    /// `#CACHE CLEAR [FILE=name]`.
+    CacheClear { file: String },
+    /// `#CACHE CLEAR ALL`.
+    CacheClearAll,
+    CommentBegin,
+    CommentEnd,
+    /// `#SPLINE ON`, `#SPLINE OFF`, `#SPLINE TYPE AKIMA|BSPLINE`.
+    Spline(SplineCommand),
+    /// `#HSC ON [...]` / `#HSC OFF`; the bracket text is kept verbatim.
+    Hsc { on: bool, options: String },
+    /// `#CONTOUR MODE [...]`; the bracket text kept verbatim.
+    ContourMode { options: String },
+    /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
+    Var,
+    EndVar,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlushKind {
+    /// `#FLUSH`: release all held blocks, stop at the end of the last.
+    Stop,
+    /// `#FLUSH CONTINUE`: release all, no stop if the next block comes in time.
+    Continue,
+    /// `#FLUSH WAIT`: decoding waits until interpolation has emptied the channel.
+    Wait,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SplineCommand {
+    On,
+    Off,
+    TypeAkima,
+    TypeBspline,
+}
+
+/// A subroutine or cycle call.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Call {
+    /// `L file.nc`: global subroutine, found through the program search paths.
+    Global { file: String },
+    /// `LL name`: local subroutine defined by `%L name` in the same file.
+    Local { name: String },
+    /// `L CYCLE [NAME=file.cyc @P1=0 @P2=0]`.
+    Cycle { name: String, params: Vec<(u32, Expr)> },
+}
+
+/// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VarDecl {
+    pub scope: VScope,
+    /// Upper-case name.
+    pub name: String,
+    /// Array dimensions as declared (`[10]` → `[10]`); empty for a scalar.
+    pub dims: Vec<u32>,
+    pub init: Option<Expr>,
+}
