@@ -9,3 +9,7 @@ pub mod diag;
 pub mod dnc;
 pub mod lang;
 pub mod params;
+pub mod feeder;
+pub mod report;
+pub mod runtime;
+pub mod source;

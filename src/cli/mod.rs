@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+pub mod bench;
 pub mod check;
 pub mod receive;
 
@@ -34,6 +35,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Measure the runtime's cycle in real time against a bare spin_sleep loop.
+    Bench(bench::BenchArgs),
     /// Check NC programs and parameter lists; errors as file:line:col.
     Check(check::CheckArgs),
     /// Split received NC data into programs by start/end markers.
@@ -43,6 +46,7 @@ pub enum Command {
 impl Cli {
     pub fn execute(self) -> ExitCode {
         match self.command {
+            Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
             None => {

@@ -1,0 +1,226 @@
+//! `ncchannel bench`: the runtime in real time under a streaming load, against a bare
+//! spin_sleep loop measured in the same run, so lateness is compared on the same machine at
+//! the same moment.
+//!
+//! First version: the load is synthetic ([`StreamingLoad`]: the built-in feeder writing
+//! generated NC lines into a stream buffer and a reader taking segments out and counting
+//! lines). It is swapped for real channels once they land.
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use crossbeam_channel::Sender;
+
+use crate::feeder::{Feeder, FeederError};
+use crate::report::event::{EventBuffer, EventKind, EventLog};
+use crate::report::stats::Histogram;
+use crate::runtime::{bare_loop, Clock, Cycle, Flow, Runtime, Tick};
+use crate::source::stream::{StreamBuffer, StreamWriteError, MAX_PROGRAM_STREAM_SIZE};
+
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Cycle time in microseconds.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(10..=1_000_000))]
+    pub period_us: u64,
+    /// Seconds to run the runtime (the bare loop runs as long again, half before, half after).
+    #[arg(long, default_value_t = 5.0)]
+    pub seconds: f64,
+}
+
+/// A stream write from another thread, answered in the tick that serves it.
+#[derive(Debug)]
+pub struct WriteRequest {
+    pub packet: Vec<u8>,
+    pub reply: Sender<Result<(), StreamWriteError>>,
+}
+
+/// A channel-shaped synthetic load: a feeder writes into a [`StreamBuffer`], a reader takes
+/// the buffered data out as one segment every `take_every` ticks and counts its lines.
+/// Write and segment events go to the event buffer, as a channel's would.
+pub struct StreamingLoad {
+    feeder: Feeder,
+    stream: StreamBuffer,
+    segment: Vec<u8>,
+    take_every: u64,
+    looping: bool,
+    lines: u64,
+    events: EventBuffer,
+    log: EventLog,
+}
+
+impl StreamingLoad {
+    /// `looping`: start the text over when it has all been read, instead of stopping.
+    pub fn new(
+        text: Vec<u8>,
+        packet_max: usize,
+        take_every: u64,
+        looping: bool,
+        log: EventLog,
+    ) -> Result<Self, FeederError> {
+        Ok(StreamingLoad {
+            feeder: Feeder::new(text, packet_max, 1, false)?,
+            stream: StreamBuffer::new(),
+            segment: Vec::with_capacity(MAX_PROGRAM_STREAM_SIZE),
+            take_every: take_every.max(1),
+            looping,
+            lines: 0,
+            events: log.buffer(),
+            log,
+        })
+    }
+
+    /// Lines read out of the stream so far.
+    pub fn lines(&self) -> u64 {
+        self.lines
+    }
+
+    pub fn stream(&self) -> &StreamBuffer {
+        &self.stream
+    }
+
+    /// Write out the event log and join its writer.
+    pub fn finish(self) -> std::io::Result<u64> {
+        self.log.finish()
+    }
+
+    fn write(&mut self, packet_len: usize, r: Result<(), StreamWriteError>, tick: &Tick) {
+        if self.events.enabled() {
+            let code = r.err().and_then(|e| e.isg_code());
+            self.events.push(
+                tick,
+                1,
+                EventKind::Write {
+                    bytes: packet_len as u64,
+                    ok: r.is_ok(),
+                    code,
+                },
+            );
+        }
+    }
+}
+
+impl Cycle for StreamingLoad {
+    type Request = WriteRequest;
+
+    fn serve(&mut self, req: WriteRequest, tick: &Tick) {
+        let r = self.stream.write(&req.packet);
+        self.write(req.packet.len(), r, tick);
+        // A writer that stopped waiting for its answer is no concern of the tick.
+        let _ = req.reply.send(r);
+    }
+
+    fn step(&mut self, tick: &Tick) -> Flow {
+        if let Some(packet) = self.feeder.poll(tick.index) {
+            let r = self.stream.write(packet);
+            let len = packet.len();
+            self.feeder.result(r.is_ok());
+            self.write(len, r, tick);
+        }
+        if tick.index % self.take_every == 0 {
+            let n = self.stream.take_segment(&mut self.segment);
+            if n > 0 {
+                self.lines += self.segment.iter().filter(|&&b| b == b'\n').count() as u64;
+                self.events
+                    .push(tick, 1, EventKind::Segment { bytes: n as u64 });
+            }
+        }
+        self.events.flush_to(&mut self.log);
+        if self.feeder.done() && self.stream.is_empty() {
+            if !self.looping {
+                return Flow::Stop;
+            }
+            self.feeder.rewind();
+        }
+        Flow::Continue
+    }
+}
+
+/// `lines` NC lines of a milling-like contour: linear and circular moves with feeds, comments
+/// and the odd M function, LF-terminated.
+pub fn generated_program(lines: usize) -> Vec<u8> {
+    let mut s = String::with_capacity(lines * 32);
+    s.push_str("%bench\nN1 G90 G17 G71 F2000 ; synthetic load\n");
+    for i in 2..lines {
+        let x = (i * 37 % 2000) as f64 / 10.0;
+        let y = (i * 91 % 1500) as f64 / 10.0;
+        let line = match i % 7 {
+            0 => format!("N{i} G02 X{x:.3} Y{y:.3} I5.000 J0\n"),
+            3 => format!("N{i} G01 X{x:.3} Y{y:.3} F{} (feed change)\n", 1000 + i % 500),
+            5 => format!("N{i} M08\n"),
+            _ => format!("N{i} G01 X{x:.3} Y{y:.3} Z-{:.2}\n", (i % 5) as f64 * 0.25),
+        };
+        s.push_str(&line);
+    }
+    s.push_str("M30\n");
+    s.into_bytes()
+}
+
+fn print_hist(name: &str, h: &Histogram) {
+    println!(
+        "{name:<18} p50 {:>8.2}  p99 {:>8.2}  p99.9 {:>8.2}  max {:>9.2}  (n = {})",
+        h.quantile_us(0.5),
+        h.quantile_us(0.99),
+        h.quantile_us(0.999),
+        h.max_us(),
+        h.count()
+    );
+}
+
+pub fn execute(args: BenchArgs) -> ExitCode {
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
+        eprintln!("ncchannel bench: --seconds must be in (0, 3600]");
+        return ExitCode::from(super::exit::USAGE);
+    }
+    let period = Duration::from_micros(args.period_us);
+    let ticks = ((args.seconds * 1e6) / args.period_us as f64).ceil().max(1.0) as u64;
+    let load = match StreamingLoad::new(
+        generated_program(5000),
+        crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE,
+        1,
+        true,
+        EventLog::disabled(),
+    ) {
+        Ok(l) => l,
+        Err(e) => {
+            eprintln!("ncchannel bench: {e}");
+            return ExitCode::from(super::exit::USAGE);
+        }
+    };
+    println!(
+        "bench: period {} µs, {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop",
+        args.period_us
+    );
+    let mut bare = bare_loop(period, ticks / 2);
+    let (mut rt, _tx) = Runtime::new(load, period, Clock::RealTime);
+    let summary = rt.run(Some(ticks));
+    bare.merge(&bare_loop(period, ticks - ticks / 2));
+    let (load, stats) = rt.into_inner();
+
+    println!("all figures in µs");
+    print_hist("tick work", &stats.work);
+    print_hist("tick lateness", &stats.lateness);
+    print_hist("bare loop lateness", &bare);
+    let bare_p99 = bare.quantile_us(0.99);
+    let ratio = if bare_p99 > 0.0 {
+        stats.lateness.quantile_us(0.99) / bare_p99
+    } else {
+        f64::NAN
+    };
+    println!("overruns           {}", stats.overruns);
+    println!("lateness p99 ratio runtime / bare loop: {ratio:.2} (target ≤ 1.2)");
+    println!(
+        "work p99 {:.2} µs (target ≤ 20 µs)",
+        stats.work.quantile_us(0.99)
+    );
+    let c = load.stream().counters();
+    println!(
+        "load: {} lines, {} segments, {} writes ok, {} rejected, {:.1} MB streamed in {:.2} s",
+        load.lines(),
+        c.segments,
+        c.writes_ok,
+        c.writes_rejected(),
+        c.bytes_written as f64 / 1e6,
+        summary.wall.as_secs_f64()
+    );
+    ExitCode::from(super::exit::OK)
+}

@@ -1,0 +1,302 @@
+//! The event log: what happened in a channel, one JSON object a line (JSON Lines).
+//!
+//! The tick only pushes [`Event`] values into an [`EventBuffer`] (no text, no I/O); the
+//! buffer's batch leaves through [`EventLog::emit`] to a writer thread that serialises and
+//! writes in order. With logging off, [`EventBuffer::enabled`] is false and the channel skips
+//! building events at all.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+use std::thread::JoinHandle;
+
+use crossbeam_channel::{Receiver, Sender};
+use serde::Serialize;
+
+use crate::runtime::Tick;
+
+/// One event: when, where, what. Serialises as `{"tick":…,"t":…,"ch":…,"ev":"…",…fields}`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Event {
+    pub tick: u64,
+    /// Channel time in seconds.
+    pub t: f64,
+    /// Channel number, 1-based.
+    pub ch: u32,
+    #[serde(flatten)]
+    pub kind: EventKind,
+}
+
+/// The event vocabulary of DESIGN.md; the variant name in snake_case is the `ev` field.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "ev", rename_all = "snake_case")]
+pub enum EventKind {
+    /// Channel mode and state changed.
+    State { mode: String, state: String },
+    /// A program started; `stream` when it reads from the stream interface.
+    ProgramStart { prog: String, stream: bool },
+    /// A program ended; `end` is how (`M30`, `M2`, `M17`, `M29`, `reset`, `error`).
+    ProgramEnd { prog: String, end: String },
+    /// A block that took effect: program, 1-based line, byte offset of the line in the
+    /// program (stream: since stream start), block counter, block number (`N`), text.
+    Block {
+        prog: String,
+        line: u64,
+        offset: u64,
+        counter: u64,
+        n: Option<u64>,
+        text: String,
+    },
+    /// A stream write: its length, whether accepted, the ISG code raised when not (if any).
+    Write {
+        bytes: u64,
+        ok: bool,
+        code: Option<u32>,
+    },
+    /// The decoder took a segment out of the stream buffer.
+    Segment { bytes: u64 },
+    /// Data dropped: the rest of a segment after a program end, or the buffer at reset.
+    Discard { bytes: u64 },
+    Warning { code: u32, msg: String },
+    Error {
+        code: u32,
+        msg: String,
+        prog: Option<String>,
+        line: Option<u64>,
+    },
+    /// Motion stopped for lack of stream data.
+    Interrupt,
+    /// Motion resumed after an interrupt.
+    Resume,
+    /// A file cache operation (`load`, `refresh`, `clear`, `clear_all`, `hit`).
+    Cache { op: String, file: Option<String> },
+    /// `#FLUSH` of the given kind (`plain`, `continue`, `wait`).
+    Flush { kind: String },
+    /// Block search: the target and whether it was found.
+    Search { target: String, found: bool },
+}
+
+impl Event {
+    pub fn new(tick: &Tick, ch: u32, kind: EventKind) -> Self {
+        Event {
+            tick: tick.index,
+            t: tick.seconds(),
+            ch,
+            kind,
+        }
+    }
+
+    /// The event as one JSON line (without the newline).
+    pub fn to_json(&self) -> String {
+        // Serialising plain strings, numbers and options cannot fail.
+        serde_json::to_string(self).unwrap_or_default()
+    }
+}
+
+/// Where the tick puts its events: a `Vec` reused from tick to tick, or nothing when logging
+/// is off.
+#[derive(Debug, Default)]
+pub struct EventBuffer {
+    enabled: bool,
+    events: Vec<Event>,
+}
+
+impl EventBuffer {
+    pub fn new(enabled: bool) -> Self {
+        EventBuffer {
+            enabled,
+            events: Vec::new(),
+        }
+    }
+
+    /// Whether events are wanted; check before building one with text in it.
+    #[inline]
+    pub fn enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// Add one event (dropped when disabled).
+    #[inline]
+    pub fn push(&mut self, tick: &Tick, ch: u32, kind: EventKind) {
+        if self.enabled {
+            self.events.push(Event::new(tick, ch, kind));
+        }
+    }
+
+    /// Events collected since the last drain.
+    pub fn events(&self) -> &[Event] {
+        &self.events
+    }
+
+    pub fn len(&self) -> usize {
+        self.events.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.events.is_empty()
+    }
+
+    /// Hand the collected events to `log` (batch move, no serialisation here).
+    pub fn flush_to(&mut self, log: &mut EventLog) {
+        log.emit(&mut self.events);
+    }
+}
+
+/// Batches in flight between the tick and the writer thread before the writer's recycled
+/// `Vec`s run out and new ones are allocated.
+const RECYCLE_BATCHES: usize = 16;
+
+/// The sink: a writer thread serialising batches of events as JSON Lines, in the order they
+/// were emitted. Dropping it or calling [`EventLog::finish`] writes everything out and joins.
+pub struct EventLog {
+    inner: Option<Writer>,
+}
+
+struct Writer {
+    batches: Sender<Vec<Event>>,
+    recycled: Receiver<Vec<Event>>,
+    thread: JoinHandle<io::Result<u64>>,
+}
+
+impl EventLog {
+    /// A sink that drops everything; [`EventLog::enabled`] is false.
+    pub fn disabled() -> Self {
+        EventLog { inner: None }
+    }
+
+    /// Write to a file (created or truncated).
+    pub fn to_file(path: &Path) -> io::Result<Self> {
+        let f = File::create(path)?;
+        Ok(Self::to_writer(Box::new(f)))
+    }
+
+    /// Write to standard output.
+    pub fn stdout() -> Self {
+        Self::to_writer(Box::new(io::stdout()))
+    }
+
+    /// `-` is standard output, anything else a file path (the `--events` option).
+    pub fn open(target: &str) -> io::Result<Self> {
+        if target == "-" {
+            Ok(Self::stdout())
+        } else {
+            Self::to_file(Path::new(target))
+        }
+    }
+
+    /// Write to any writer, buffered, on a thread of its own.
+    pub fn to_writer(w: Box<dyn Write + Send>) -> Self {
+        let (tx, rx) = crossbeam_channel::unbounded::<Vec<Event>>();
+        let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
+        let thread = std::thread::Builder::new()
+            .name("ncchannel-events".into())
+            .spawn(move || -> io::Result<u64> {
+                let mut out = BufWriter::new(w);
+                let mut lines = 0u64;
+                for mut batch in rx {
+                    for ev in batch.drain(..) {
+                        serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
+                        out.write_all(b"\n")?;
+                        lines += 1;
+                    }
+                    // Hand the empty Vec back; if the tick has enough spares, let it go.
+                    let _ = recycle_tx.try_send(batch);
+                }
+                out.flush()?;
+                Ok(lines)
+            });
+        match thread {
+            Ok(thread) => EventLog {
+                inner: Some(Writer {
+                    batches: tx,
+                    recycled: recycle_rx,
+                    thread,
+                }),
+            },
+            // Without a thread there is no log; the run itself must not fail for it.
+            Err(_) => EventLog::disabled(),
+        }
+    }
+
+    /// Whether events are written anywhere.
+    pub fn enabled(&self) -> bool {
+        self.inner.is_some()
+    }
+
+    /// An [`EventBuffer`] matching this sink (disabled when the sink is).
+    pub fn buffer(&self) -> EventBuffer {
+        EventBuffer::new(self.enabled())
+    }
+
+    /// Move the events out of `events` to the writer, leaving `events` empty (with a recycled
+    /// allocation when one is free). Cheap enough for the tick: a swap and a channel send.
+    pub fn emit(&mut self, events: &mut Vec<Event>) {
+        if events.is_empty() {
+            return;
+        }
+        match &self.inner {
+            None => events.clear(),
+            Some(w) => {
+                let spare = w.recycled.try_recv().unwrap_or_default();
+                let batch = std::mem::replace(events, spare);
+                // The writer only goes away on an I/O error; then events are lost, and
+                // `finish` reports the error.
+                let _ = w.batches.send(batch);
+            }
+        }
+    }
+
+    /// Write out everything emitted so far, join the writer and return the lines written.
+    pub fn finish(mut self) -> io::Result<u64> {
+        self.shutdown()
+    }
+
+    fn shutdown(&mut self) -> io::Result<u64> {
+        match self.inner.take() {
+            None => Ok(0),
+            Some(w) => {
+                drop(w.batches);
+                match w.thread.join() {
+                    Ok(r) => r,
+                    Err(_) => Err(io::Error::other("event writer thread panicked")),
+                }
+            }
+        }
+    }
+}
+
+impl Drop for EventLog {
+    fn drop(&mut self) {
+        let _ = self.shutdown();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    #[test]
+    fn serialises_flat_with_ev_tag() {
+        let tick = Tick {
+            index: 3,
+            period: Duration::from_millis(1),
+            time: Duration::from_millis(3),
+        };
+        let e = Event::new(
+            &tick,
+            1,
+            EventKind::Write {
+                bytes: 12,
+                ok: false,
+                code: Some(11012),
+            },
+        );
+        assert_eq!(
+            e.to_json(),
+            r#"{"tick":3,"t":0.003,"ch":1,"ev":"write","bytes":12,"ok":false,"code":11012}"#
+        );
+        let e = Event::new(&tick, 2, EventKind::Interrupt);
+        assert_eq!(e.to_json(), r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt"}"#);
+    }
+}

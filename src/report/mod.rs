@@ -1,0 +1,5 @@
+//! What a run tells the outside: cycle statistics, the JSON Lines event log and the report.
+
+pub mod event;
+pub mod stats;
+pub mod summary;

@@ -1,0 +1,279 @@
+//! The fixed-cycle loop: one thread running ticks of a [`Cycle`] at a fixed period, in real
+//! time (absolute deadlines with spin_sleep) or in virtual time (back to back), serving
+//! requests from any thread at the start of each tick, and keeping cycle statistics.
+//!
+//! The runtime knows nothing of NC: it ticks whatever implements [`Cycle`] (the channels, or
+//! the synthetic load of `ncchannel bench`).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::{Receiver, Sender, TryRecvError};
+
+use crate::report::stats::{CycleStats, Histogram};
+
+/// Requests served per tick at most. A flood of requests (say a client hammering the stream
+/// object from many connections) then delays its own answers, never the tick: the rest wait
+/// in the queue for the next tick. 64 per tick is 64 000 requests a second at 1 ms, far above
+/// what ADS clients send to one controller.
+pub const MAX_REQUESTS_PER_TICK: usize = 64;
+
+/// The tick being run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tick {
+    /// Tick number, from 0.
+    pub index: u64,
+    /// The cycle time.
+    pub period: Duration,
+    /// Channel time at this tick: `index × period`, in either clock.
+    pub time: Duration,
+}
+
+impl Tick {
+    /// Channel time in seconds, as the events carry it.
+    pub fn seconds(&self) -> f64 {
+        self.time.as_secs_f64()
+    }
+}
+
+/// Whether the runtime goes on after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flow {
+    Continue,
+    Stop,
+}
+
+/// What the runtime ticks.
+pub trait Cycle {
+    /// A request from another thread (a stream write, a command). It carries its own reply
+    /// sender, so the answer goes back in the tick that serves it.
+    type Request: Send + 'static;
+
+    /// Serve one request at the start of `tick`, before `step`.
+    fn serve(&mut self, req: Self::Request, tick: &Tick);
+
+    /// Do one tick's work.
+    fn step(&mut self, tick: &Tick) -> Flow;
+}
+
+/// How time passes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clock {
+    /// Ticks run back to back; channel time advances one period per tick. Deterministic and
+    /// faster than real time, for soak tests and the demo.
+    Virtual,
+    /// Tick `k` starts at `start + k × period`, waited for with spin_sleep.
+    RealTime,
+}
+
+/// Why [`Runtime::run`] returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunEnd {
+    /// The cycle's `step` answered [`Flow::Stop`].
+    Stopped,
+    /// `max_ticks` ticks ran.
+    MaxTicks,
+    /// A [`StopHandle`] asked it to stop.
+    StopRequested,
+}
+
+/// The result of one [`Runtime::run`].
+#[derive(Debug, Clone)]
+pub struct RunSummary {
+    pub end: RunEnd,
+    /// Ticks run by this call.
+    pub ticks: u64,
+    /// Channel time at the end of the run (all calls): `total ticks × period`.
+    pub time: Duration,
+    /// Wall-clock time this call took.
+    pub wall: Duration,
+    /// Requests served by this call.
+    pub requests: u64,
+}
+
+/// Stops a running [`Runtime`] from another thread, at its next tick boundary.
+#[derive(Debug, Clone)]
+pub struct StopHandle(Arc<AtomicBool>);
+
+impl StopHandle {
+    pub fn stop(&self) {
+        self.0.store(true, Ordering::Release);
+    }
+
+    pub fn is_stopped(&self) -> bool {
+        self.0.load(Ordering::Acquire)
+    }
+}
+
+/// The fixed-cycle loop over one [`Cycle`].
+pub struct Runtime<C: Cycle> {
+    cycle: C,
+    requests: Receiver<C::Request>,
+    period: Duration,
+    clock: Clock,
+    stop: Arc<AtomicBool>,
+    next_index: u64,
+    stats: CycleStats,
+}
+
+impl<C: Cycle> Runtime<C> {
+    /// A runtime over `cycle` and the sender through which any thread may send it requests.
+    /// The queue is unbounded: senders never block, and the per-tick bound
+    /// [`MAX_REQUESTS_PER_TICK`] protects the tick.
+    ///
+    /// # Panics
+    /// When `period` is zero (a configuration mistake caught by the caller's validation).
+    pub fn new(cycle: C, period: Duration, clock: Clock) -> (Self, Sender<C::Request>) {
+        assert!(!period.is_zero(), "runtime period must be positive");
+        let (tx, rx) = crossbeam_channel::unbounded();
+        let rt = Runtime {
+            cycle,
+            requests: rx,
+            period,
+            clock,
+            stop: Arc::new(AtomicBool::new(false)),
+            next_index: 0,
+            stats: CycleStats::default(),
+        };
+        (rt, tx)
+    }
+
+    /// A handle that stops the run from any thread.
+    pub fn stop_handle(&self) -> StopHandle {
+        StopHandle(Arc::clone(&self.stop))
+    }
+
+    pub fn period(&self) -> Duration {
+        self.period
+    }
+
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// Ticks run so far over all calls to `run`.
+    pub fn ticks(&self) -> u64 {
+        self.next_index
+    }
+
+    /// Channel time so far.
+    pub fn time(&self) -> Duration {
+        channel_time(self.period, self.next_index)
+    }
+
+    /// Statistics over all ticks run so far.
+    pub fn stats(&self) -> &CycleStats {
+        &self.stats
+    }
+
+    pub fn cycle(&self) -> &C {
+        &self.cycle
+    }
+
+    pub fn cycle_mut(&mut self) -> &mut C {
+        &mut self.cycle
+    }
+
+    /// The cycle and the statistics, when the run is over.
+    pub fn into_inner(self) -> (C, CycleStats) {
+        (self.cycle, self.stats)
+    }
+
+    /// Run ticks until the cycle stops, `max_ticks` ticks have run in this call, or a
+    /// [`StopHandle`] fires. A stop request is consumed: a later `run` starts afresh. Tick
+    /// numbers and channel time continue across calls.
+    ///
+    /// In real time, deadlines are absolute (`start + k × period` from this call's start), so
+    /// sleeping never drifts; a late tick runs at once and the next deadlines stay where they
+    /// were, so a hiccup is caught up by ticks running back to back, and channel time stays
+    /// `index × period`.
+    pub fn run(&mut self, max_ticks: Option<u64>) -> RunSummary {
+        let wall_start = Instant::now();
+        let first = self.next_index;
+        let mut requests = 0u64;
+        let end = loop {
+            let k = self.next_index - first;
+            if max_ticks.is_some_and(|m| k >= m) {
+                break RunEnd::MaxTicks;
+            }
+            if self.stop.swap(false, Ordering::AcqRel) {
+                break RunEnd::StopRequested;
+            }
+            let tick = Tick {
+                index: self.next_index,
+                period: self.period,
+                time: channel_time(self.period, self.next_index),
+            };
+            let (started, late) = match self.clock {
+                Clock::Virtual => (Instant::now(), None),
+                Clock::RealTime => {
+                    let ideal = wall_start + mul_duration(self.period, k);
+                    spin_sleep::sleep_until(ideal);
+                    let now = Instant::now();
+                    (now, Some(now.saturating_duration_since(ideal)))
+                }
+            };
+            requests += self.serve_pending(&tick);
+            let flow = self.cycle.step(&tick);
+            let work = started.elapsed();
+            self.stats.work.record(work);
+            if let Some(late) = late {
+                self.stats.lateness.record(late);
+                if late + work > self.period {
+                    self.stats.overruns += 1;
+                }
+            }
+            self.next_index += 1;
+            if flow == Flow::Stop {
+                break RunEnd::Stopped;
+            }
+        };
+        RunSummary {
+            end,
+            ticks: self.next_index - first,
+            time: self.time(),
+            wall: wall_start.elapsed(),
+            requests,
+        }
+    }
+
+    /// Serve up to [`MAX_REQUESTS_PER_TICK`] queued requests; returns how many.
+    fn serve_pending(&mut self, tick: &Tick) -> u64 {
+        let mut n = 0;
+        while n < MAX_REQUESTS_PER_TICK {
+            match self.requests.try_recv() {
+                Ok(req) => {
+                    self.cycle.serve(req, tick);
+                    n += 1;
+                }
+                Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
+            }
+        }
+        n as u64
+    }
+}
+
+fn mul_duration(period: Duration, k: u64) -> Duration {
+    // u32 multiplication would overflow after 4 billion ticks (50 days at 1 ms).
+    let ns = period.as_nanos().saturating_mul(u128::from(k));
+    Duration::from_nanos(u64::try_from(ns).unwrap_or(u64::MAX))
+}
+
+fn channel_time(period: Duration, index: u64) -> Duration {
+    mul_duration(period, index)
+}
+
+/// The reference for lateness: a bare loop that only waits for `ticks` absolute deadlines
+/// `period` apart with spin_sleep and records how late each wake-up was. Run it in the same
+/// process as the runtime to compare like with like on a shared machine.
+pub fn bare_loop(period: Duration, ticks: u64) -> Histogram {
+    let mut h = Histogram::new();
+    let start = Instant::now();
+    for k in 0..ticks {
+        let ideal = start + mul_duration(period, k);
+        spin_sleep::sleep_until(ideal);
+        h.record(Instant::now().saturating_duration_since(ideal));
+    }
+    h
+}
