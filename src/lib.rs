@@ -4,12 +4,17 @@
 //! interpolator → events. Each room below owns one machine part; see the
 //! README's architecture section for who may talk to whom.
 
+pub mod channel;
 pub mod cli;
+pub mod decoder;
 pub mod diag;
 pub mod dnc;
-pub mod lang;
-pub mod params;
 pub mod feeder;
+pub mod lang;
+pub mod machine;
+pub mod motion;
+pub mod params;
+pub mod queue;
 pub mod report;
 pub mod runtime;
 pub mod source;

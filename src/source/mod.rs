@@ -1,3 +1,6 @@
-//! Where NC text comes from: the data-streaming interface (more sources join as they land).
+//! Where NC text comes from: the data-streaming interface, the program files found through the
+//! search paths, and the file cache.
 
+pub mod cache;
+pub mod store;
 pub mod stream;

@@ -1,0 +1,650 @@
+//! One NC channel: the mode and state machine of REFERENCE §7 around the parts it owns —
+//! stream interface, program store, file cache, decoder, block queue and motion.
+//!
+//! Everything a client does to a channel (stream writes, commands) and everything the tick
+//! does happens through this type, in the runtime's one thread; errors and warnings carry
+//! their ISG numbers and become events.
+
+use std::sync::Arc;
+
+use thiserror::Error;
+
+use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
+use crate::motion::{AxisLimits, Motion, MotionNote};
+use crate::queue::{BlockQueue, Position, AXIS_LETTERS};
+use crate::report::event::{EventBuffer, EventKind};
+use crate::runtime::Tick;
+use crate::source::cache::{Cache, CacheLimits};
+use crate::source::store::{ProgramStore, SearchDir, StoreStats};
+use crate::source::stream::{StreamBuffer, StreamWriteError};
+
+/// Warning raised when a stream write is rejected because the buffer is full.
+pub const WARN_WRITE_REJECTED: u32 = 11012;
+/// Error raised by stream data without CR LF line ends.
+pub const ERR_NO_LINE_END: u32 = 21476;
+
+/// Channel modes (REFERENCE §7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Standby = 1,
+    Automatic = 2,
+    Mdi = 3,
+    Manual = 4,
+    Reference = 5,
+}
+
+/// Channel states (REFERENCE §7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    Deselected = 1,
+    Selected = 2,
+    Ready = 3,
+    Active = 4,
+    Hold = 5,
+    Error = 6,
+}
+
+impl Mode {
+    pub fn from_i32(v: i32) -> Option<Mode> {
+        Some(match v {
+            1 => Mode::Standby,
+            2 => Mode::Automatic,
+            3 => Mode::Mdi,
+            4 => Mode::Manual,
+            5 => Mode::Reference,
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Standby => "STANDBY",
+            Mode::Automatic => "AUTOMATIC",
+            Mode::Mdi => "MDI",
+            Mode::Manual => "MANUAL",
+            Mode::Reference => "REFERENCE",
+        }
+    }
+}
+
+impl State {
+    pub fn from_i32(v: i32) -> Option<State> {
+        Some(match v {
+            1 => State::Deselected,
+            2 => State::Selected,
+            3 => State::Ready,
+            4 => State::Active,
+            5 => State::Hold,
+            6 => State::Error,
+            _ => return None,
+        })
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            State::Deselected => "DESELECTED",
+            State::Selected => "SELECTED",
+            State::Ready => "READY",
+            State::Active => "ACTIVE",
+            State::Hold => "HOLD",
+            State::Error => "ERROR",
+        }
+    }
+}
+
+/// Why a command was refused.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CommandError {
+    #[error("value {0} is not a mode or state")]
+    InvalidValue(i32),
+    #[error("not possible in mode {mode} / state {state}")]
+    Busy {
+        mode: &'static str,
+        state: &'static str,
+    },
+    #[error("no program selected (command parameter 0x108)")]
+    NoProgram,
+    #[error("program could not be started: {code} {msg}")]
+    StartFailed { code: u32, msg: String },
+    #[error("feed override {0} outside 0..200 %")]
+    BadOverride(f64),
+}
+
+/// Everything a channel is built from (parameter lists and runtime.toml, already checked).
+#[derive(Debug, Clone)]
+pub struct ChannelSettings {
+    /// 1-based channel number.
+    pub number: u32,
+    pub decoder: DecoderSettings,
+    /// Block queue capacity: lookahead window plus decoder buffer, blocks.
+    pub queue_capacity: usize,
+    pub axes: Vec<AxisLimits>,
+    pub search_dirs: Vec<SearchDir>,
+    /// `streaming_prog_file`; `None` = streaming off.
+    pub streaming_prog: Option<String>,
+    pub cache: CacheLimits,
+}
+
+/// How a channel's program run finished, for `ncchannel run`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Finish {
+    Ended,
+    Error,
+}
+
+/// Counters the report shows.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ChannelStats {
+    /// Blocks that took effect (one `block` event each).
+    pub blocks: u64,
+    pub interrupts: u64,
+    pub warnings: u64,
+    pub programs_ended: u64,
+}
+
+pub struct Channel {
+    number: u32,
+    mode: Mode,
+    state: State,
+    stream: StreamBuffer,
+    store: ProgramStore,
+    cache: Cache,
+    queue: BlockQueue,
+    decoder: Decoder,
+    motion: Motion,
+    /// Command parameter: the program `ACTIVE` starts.
+    program: Option<String>,
+    /// Block search target for the next start.
+    search: Option<SearchTarget>,
+    last_error: Option<(u32, String)>,
+    errors: Vec<(u32, String)>,
+    stats: ChannelStats,
+    /// Motion stopped for lack of stream data; a `resume` is owed.
+    interrupted: bool,
+    /// A block has run since the program start (no interrupt before the first).
+    ran_any: bool,
+    finish: Option<Finish>,
+    running_prog: Option<Arc<str>>,
+    notes: Vec<MotionNote>,
+    events: EventBuffer,
+}
+
+impl Channel {
+    pub fn new(s: ChannelSettings, events_enabled: bool) -> Self {
+        Channel {
+            number: s.number,
+            mode: Mode::Automatic,
+            state: State::Ready,
+            stream: StreamBuffer::new(),
+            store: ProgramStore::new(s.search_dirs, s.streaming_prog.as_deref()),
+            cache: Cache::new(s.cache),
+            queue: BlockQueue::new(s.queue_capacity),
+            decoder: Decoder::new(s.decoder),
+            motion: Motion::new(s.axes),
+            program: None,
+            search: None,
+            last_error: None,
+            errors: Vec::new(),
+            stats: ChannelStats::default(),
+            interrupted: false,
+            ran_any: false,
+            finish: None,
+            running_prog: None,
+            notes: Vec::new(),
+            events: EventBuffer::new(events_enabled),
+        }
+    }
+
+    pub fn number(&self) -> u32 {
+        self.number
+    }
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+    pub fn state(&self) -> State {
+        self.state
+    }
+    pub fn stats(&self) -> ChannelStats {
+        self.stats
+    }
+    pub fn store_stats(&self) -> StoreStats {
+        self.store.stats()
+    }
+    pub fn cache(&self) -> &Cache {
+        &self.cache
+    }
+    pub fn stream(&self) -> &StreamBuffer {
+        &self.stream
+    }
+    pub fn decoder(&self) -> &Decoder {
+        &self.decoder
+    }
+    pub fn decoder_mut(&mut self) -> &mut Decoder {
+        &mut self.decoder
+    }
+    pub fn motion(&self) -> &Motion {
+        &self.motion
+    }
+    pub fn errors(&self) -> &[(u32, String)] {
+        &self.errors
+    }
+    pub fn last_error(&self) -> Option<&(u32, String)> {
+        self.last_error.as_ref()
+    }
+    pub fn position(&self) -> Position {
+        self.motion.position()
+    }
+    /// Block counter of the running program (ISG: every decoded line).
+    pub fn block_counter(&self) -> u64 {
+        self.decoder.counter()
+    }
+    /// Stream fill level: (used, free) bytes.
+    pub fn stream_fill(&self) -> (usize, usize) {
+        (self.stream.used(), self.stream.free())
+    }
+    /// How the last program run finished, taken once.
+    pub fn take_finish(&mut self) -> Option<Finish> {
+        self.finish.take()
+    }
+    pub fn events_mut(&mut self) -> &mut EventBuffer {
+        &mut self.events
+    }
+    /// The position of each configured axis, in `AXIS_LETTERS` order.
+    pub fn axis_positions(&self) -> Vec<(char, f64)> {
+        let p = self.motion.position();
+        AXIS_LETTERS
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| self.decoder_axes()[*i])
+            .map(|(i, l)| (*l as char, p[i]))
+            .collect()
+    }
+    fn decoder_axes(&self) -> [bool; crate::queue::MAX_AXES] {
+        self.decoder.axes()
+    }
+
+    fn set_state(&mut self, tick: &Tick, state: State) {
+        if self.state != state {
+            self.state = state;
+            self.push_state(tick);
+        }
+    }
+
+    fn push_state(&mut self, tick: &Tick) {
+        let (mode, state) = (self.mode.name().to_string(), self.state.name().to_string());
+        self.events
+            .push(tick, self.number, EventKind::State { mode, state });
+    }
+
+    fn raise_error(
+        &mut self,
+        tick: &Tick,
+        code: u32,
+        msg: String,
+        prog: Option<String>,
+        line: Option<u64>,
+    ) {
+        self.events.push(
+            tick,
+            self.number,
+            EventKind::Error {
+                code,
+                msg: msg.clone(),
+                prog,
+                line,
+            },
+        );
+        self.errors.push((code, msg.clone()));
+        self.last_error = Some((code, msg));
+        // An error stops decoding and motion; only a reset leaves ERROR.
+        self.motion.reset();
+        self.queue.clear();
+        if self.finish.is_none() && self.running_prog.is_some() {
+            self.finish = Some(Finish::Error);
+        }
+        self.running_prog = None;
+        self.set_state(tick, State::Error);
+    }
+
+    fn warn(&mut self, tick: &Tick, code: u32, msg: String) {
+        self.stats.warnings += 1;
+        self.events
+            .push(tick, self.number, EventKind::Warning { code, msg });
+    }
+
+    /// A client writes NC lines into the stream interface (`mc_program_stream_w`).
+    pub fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
+        let r = self.stream.write(packet);
+        let code = r.as_ref().err().and_then(|e| e.isg_code());
+        self.events.push(
+            tick,
+            self.number,
+            EventKind::Write {
+                bytes: packet.len() as u64,
+                ok: r.is_ok(),
+                code,
+            },
+        );
+        match &r {
+            Err(StreamWriteError::Full { .. }) => {
+                self.warn(
+                    tick,
+                    WARN_WRITE_REJECTED,
+                    "Error writing the object (stream buffer full)".into(),
+                );
+            }
+            Err(e @ StreamWriteError::NoLineEnd { .. }) => {
+                let msg =
+                    format!("Streaming data does not contain a correct line end marker ({e})");
+                if self.decoder.state() == DecoderState::Running {
+                    self.decoder.abort(ERR_NO_LINE_END, msg.clone());
+                    self.drain_decoder_notes(tick);
+                } else {
+                    self.raise_error(tick, ERR_NO_LINE_END, msg, None, None);
+                }
+            }
+            _ => {}
+        }
+        r
+    }
+
+    /// Command to mode (0x104).
+    pub fn command_mode(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
+        let mode = Mode::from_i32(v).ok_or(CommandError::InvalidValue(v))?;
+        if matches!(self.state, State::Active | State::Hold) {
+            return Err(self.busy());
+        }
+        if self.mode != mode {
+            self.mode = mode;
+            self.push_state(tick);
+        }
+        Ok(())
+    }
+
+    fn busy(&self) -> CommandError {
+        CommandError::Busy {
+            mode: self.mode.name(),
+            state: self.state.name(),
+        }
+    }
+
+    /// Command parameter (0x108): the program to start.
+    pub fn set_program(&mut self, name: &str) {
+        let name = name.trim_matches(char::from(0)).trim();
+        self.program = (!name.is_empty()).then(|| name.to_string());
+    }
+
+    pub fn program(&self) -> Option<&str> {
+        self.program.as_deref()
+    }
+
+    /// Block search target for the next start (`--search`).
+    pub fn set_search(&mut self, target: Option<SearchTarget>) {
+        self.search = target;
+    }
+
+    /// Command to state (0x105): ACTIVE starts (or resumes), HOLD holds, READY resets.
+    pub fn command_state(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
+        let state = State::from_i32(v).ok_or(CommandError::InvalidValue(v))?;
+        match state {
+            State::Active => match self.state {
+                State::Hold => {
+                    self.resume(tick);
+                    Ok(())
+                }
+                State::Ready | State::Selected if self.mode == Mode::Automatic => {
+                    let name = self.program.clone().ok_or(CommandError::NoProgram)?;
+                    self.start(tick, &name)
+                }
+                State::Active => Ok(()),
+                _ => Err(self.busy()),
+            },
+            State::Hold => {
+                self.hold(tick);
+                Ok(())
+            }
+            State::Ready => {
+                self.reset(tick);
+                Ok(())
+            }
+            _ => Err(self.busy()),
+        }
+    }
+
+    /// Start a main program in automatic mode.
+    pub fn start(&mut self, tick: &Tick, name: &str) -> Result<(), CommandError> {
+        if !matches!(self.state, State::Ready | State::Selected) {
+            return Err(self.busy());
+        }
+        self.mode = Mode::Automatic;
+        self.program = Some(name.to_string());
+        self.finish = None;
+        self.ran_any = false;
+        self.interrupted = false;
+        self.motion.start();
+        let pos = self.motion.position();
+        let search = self.search.take();
+        if let Err(e) = self.decoder.start(name, &mut self.store, pos, search) {
+            self.running_prog = Some(name.into());
+            self.raise_error(tick, e.code, e.msg.clone(), Some(name.to_string()), None);
+            return Err(CommandError::StartFailed {
+                code: e.code,
+                msg: e.msg,
+            });
+        }
+        self.running_prog = Some(name.into());
+        self.set_state(tick, State::Active);
+        self.drain_decoder_notes(tick);
+        Ok(())
+    }
+
+    /// Feed hold (0x136).
+    pub fn hold(&mut self, tick: &Tick) {
+        if self.state == State::Active {
+            self.motion.set_hold(true);
+            self.set_state(tick, State::Hold);
+        }
+    }
+
+    /// Resume after hold (0x137).
+    pub fn resume(&mut self, tick: &Tick) {
+        if self.state == State::Hold {
+            self.motion.set_hold(false);
+            self.set_state(tick, State::Active);
+        }
+    }
+
+    /// Feed override, percent 0..=200.
+    pub fn set_override(&mut self, pct: f64) -> Result<(), CommandError> {
+        if !(0.0..=200.0).contains(&pct) {
+            return Err(CommandError::BadOverride(pct));
+        }
+        self.motion.set_override(pct);
+        Ok(())
+    }
+
+    /// V.E. variable written from outside.
+    pub fn write_external(&mut self, name: &str, v: f64) -> bool {
+        self.decoder.vars_mut().set_external(name, v).is_ok()
+    }
+
+    pub fn read_external(&self, name: &str) -> Option<f64> {
+        self.decoder.vars().get_external(name)
+    }
+
+    /// NC reset (0x13C): stream buffer emptied and streaming left, program stack, queue,
+    /// cache and errors cleared, motion stopped at once; READY.
+    pub fn reset(&mut self, tick: &Tick) {
+        let dropped = self.stream.clear();
+        if dropped > 0 {
+            self.events.push(
+                tick,
+                self.number,
+                EventKind::Discard {
+                    bytes: dropped as u64,
+                },
+            );
+        }
+        if let Some(prog) = self.running_prog.take() {
+            self.events.push(
+                tick,
+                self.number,
+                EventKind::ProgramEnd {
+                    prog: prog.to_string(),
+                    end: "reset".into(),
+                },
+            );
+        }
+        self.motion.reset();
+        self.queue.clear();
+        self.decoder.reset(self.motion.position());
+        self.cache.reset();
+        self.last_error = None;
+        self.interrupted = false;
+        self.search = None;
+        self.set_state(tick, State::Ready);
+    }
+
+    fn drain_decoder_notes(&mut self, tick: &Tick) {
+        let notes: Vec<Note> = self.decoder.drain_notes().collect();
+        for n in notes {
+            match n {
+                Note::ProgramStart { prog, stream } => self.events.push(
+                    tick,
+                    self.number,
+                    EventKind::ProgramStart {
+                        prog: prog.to_string(),
+                        stream,
+                    },
+                ),
+                Note::Segment { bytes } => self.events.push(
+                    tick,
+                    self.number,
+                    EventKind::Segment {
+                        bytes: bytes as u64,
+                    },
+                ),
+                Note::Discard { bytes } => self.events.push(
+                    tick,
+                    self.number,
+                    EventKind::Discard {
+                        bytes: bytes as u64,
+                    },
+                ),
+                Note::Warning { code, msg } => self.warn(tick, code, msg),
+                Note::Error {
+                    code,
+                    msg,
+                    prog,
+                    line,
+                    col,
+                } => {
+                    let msg = match col {
+                        Some(c) => format!("{msg} (column {c})"),
+                        None => msg,
+                    };
+                    self.raise_error(tick, code, msg, Some(prog.to_string()), Some(line as u64));
+                }
+                Note::Search { target, found } => self.events.push(
+                    tick,
+                    self.number,
+                    EventKind::Search {
+                        target: target.to_string(),
+                        found,
+                    },
+                ),
+                Note::Cache { op, file } => self.events.push(
+                    tick,
+                    self.number,
+                    EventKind::Cache {
+                        op: op.to_string(),
+                        file: (!file.is_empty()).then_some(file),
+                    },
+                ),
+            }
+        }
+    }
+
+    /// One cycle: decode, execute, report.
+    pub fn step(&mut self, tick: &Tick) {
+        if !matches!(self.state, State::Active | State::Hold) {
+            return;
+        }
+        let mut io = DecoderIo {
+            stream: &mut self.stream,
+            store: &mut self.store,
+            cache: &mut self.cache,
+            queue: &mut self.queue,
+            motion_idle: self.motion.idle(),
+            want_text: self.events.enabled(),
+        };
+        self.decoder.step(&mut io);
+        self.drain_decoder_notes(tick);
+        if self.state == State::Error {
+            return;
+        }
+        let dt = tick.period.as_secs_f64();
+        let mut notes = std::mem::take(&mut self.notes);
+        self.motion.step(dt, &mut self.queue, &mut notes);
+        for n in notes.drain(..) {
+            match n {
+                MotionNote::Started(info) => {
+                    if self.interrupted {
+                        self.interrupted = false;
+                        self.events.push(tick, self.number, EventKind::Resume);
+                    }
+                    self.ran_any = true;
+                    self.stats.blocks += 1;
+                    if self.events.enabled() {
+                        self.events.push(
+                            tick,
+                            self.number,
+                            EventKind::Block {
+                                prog: info.prog.to_string(),
+                                line: info.line as u64,
+                                offset: info.offset,
+                                counter: info.counter,
+                                n: info.n.map(u64::from),
+                                text: info.text.map(String::from).unwrap_or_default(),
+                            },
+                        );
+                    }
+                }
+                MotionNote::Flush(k) => {
+                    let kind = match k {
+                        crate::lang::block::FlushKind::Stop => "plain",
+                        crate::lang::block::FlushKind::Continue => "continue",
+                        crate::lang::block::FlushKind::Wait => "wait",
+                    };
+                    self.events
+                        .push(tick, self.number, EventKind::Flush { kind: kind.into() });
+                }
+                MotionNote::End { m, prog } => {
+                    self.events.push(
+                        tick,
+                        self.number,
+                        EventKind::ProgramEnd {
+                            prog: prog.to_string(),
+                            end: format!("M{m}"),
+                        },
+                    );
+                    self.stats.programs_ended += 1;
+                    self.running_prog = None;
+                    self.finish = Some(Finish::Ended);
+                    self.interrupted = false;
+                    self.set_state(tick, State::Ready);
+                }
+            }
+        }
+        self.notes = notes;
+        if self.state == State::Active
+            && self.ran_any
+            && !self.interrupted
+            && self.motion.idle()
+            && self.queue.is_empty()
+            && self.decoder.starved()
+        {
+            self.interrupted = true;
+            self.stats.interrupts += 1;
+            self.events.push(tick, self.number, EventKind::Interrupt);
+        }
+    }
+}

@@ -1,0 +1,69 @@
+//! The bridge between the language's expression evaluator and the channel's variable store.
+
+use crate::lang::block::{Expr, VarRef};
+use crate::lang::eval::{self, VarKey, Vars};
+
+use super::vars::{VarSlot, VarStore};
+use super::DecodeError;
+
+/// Index bound of the store's keys: ISG arrays have at most three dimensions.
+fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
+    fn idx(v: &[u32]) -> Option<([i64; 3], u8)> {
+        if v.len() > 3 {
+            return None;
+        }
+        let mut out = [0i64; 3];
+        for (o, &i) in out.iter_mut().zip(v) {
+            *o = i as i64;
+        }
+        Some((out, v.len() as u8))
+    }
+    Some(match k {
+        VarKey::P { number, indices } => {
+            let (indices, dims) = idx(indices)?;
+            VarSlot::P {
+                number: *number,
+                indices,
+                dims,
+            }
+        }
+        VarKey::V {
+            scope,
+            name,
+            indices,
+        } => {
+            let (indices, dims) = idx(indices)?;
+            VarSlot::V {
+                scope: *scope,
+                name: (*name).into(),
+                indices,
+                dims,
+            }
+        }
+        VarKey::CycleParam(n) => VarSlot::CycleParam(*n),
+    })
+}
+
+impl Vars for VarStore {
+    fn get(&self, key: &VarKey<'_>) -> Option<f64> {
+        VarStore::get(self, &slot(key)?)
+    }
+}
+
+fn err(e: eval::EvalError) -> DecodeError {
+    DecodeError::new(e.code(), e.to_string())
+}
+
+pub fn eval(e: &Expr, vars: &VarStore) -> Result<f64, DecodeError> {
+    eval::eval(e, vars).map_err(err)
+}
+
+pub fn resolve(v: &VarRef, vars: &VarStore) -> Result<VarSlot, DecodeError> {
+    let k = eval::resolve(v, vars).map_err(err)?;
+    slot(&k).ok_or_else(|| {
+        DecodeError::new(
+            super::own_codes::BAD_VALUE,
+            format!("{k}: more than three indices"),
+        )
+    })
+}

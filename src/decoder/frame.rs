@@ -1,0 +1,264 @@
+//! Decoder frames: one program level each (main program, subroutine, cycle, the stream), and
+//! the incremental line readers behind them.
+//!
+//! A file frame holds its whole text in memory; a stream frame reads the channel's current
+//! stream segment and pulls the next segment from the stream buffer only when it has decoded
+//! the last line of the previous one (seed 003 §2.2: one read extracts all data present).
+
+use std::collections::HashSet;
+use std::sync::Arc;
+
+use crate::lang::block::{GotoTarget, Label};
+use crate::source::store::ProgramText;
+use crate::source::stream::StreamBuffer;
+
+use super::flow::{FlowEntry, Skip};
+
+/// What kind of program level a frame is; decides which end blocks are allowed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameKind {
+    Main,
+    /// `L file`.
+    Global,
+    /// `L CYCLE [NAME=..]`.
+    Cycle,
+    /// `LL name`: a `%L name` section of the calling file.
+    Local,
+}
+
+#[derive(Debug, Clone)]
+pub enum Source {
+    File(ProgramText),
+    Stream,
+}
+
+/// Where a line starts, so loops and backward jumps in files can return to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinePos {
+    /// Byte offset of the line's first byte.
+    pub pos: usize,
+    /// Number of lines before it (the line's own number is `line_no + 1`).
+    pub line_no: u32,
+}
+
+/// One program level.
+#[derive(Debug)]
+pub struct Frame {
+    pub kind: FrameKind,
+    pub source: Source,
+    pub prog: Arc<str>,
+    /// File frames: byte offset of the next line.
+    pub pos: usize,
+    /// File frames: lines read so far.
+    pub line_no: u32,
+    /// Open control structures, innermost last.
+    pub flow: Vec<FlowEntry>,
+    /// Set while lines are being skipped (false branch, forward jump, …).
+    pub skip: Option<Skip>,
+    /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
+    pub comment_block: bool,
+    /// Inside `#VAR` … `#ENDVAR`.
+    pub var_block: bool,
+    /// `@P<n>` values of a cycle call.
+    pub cycle_params: Vec<(u32, f64)>,
+    /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
+    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`.
+    pub seen_labels: HashSet<Label>,
+    /// File frames: label → position and structural depth, built on the first jump.
+    pub label_index: Option<Arc<LabelIndex>>,
+}
+
+/// How many stream labels a frame remembers. A stream may run for days; a label passed more
+/// than this many labels ago is treated as unknown (a jump to it waits forward for it).
+pub const MAX_SEEN_LABELS: usize = 65_536;
+
+/// All labels of a file with where they stand and how deeply nested they are.
+#[derive(Debug, Default)]
+pub struct LabelIndex {
+    pub labels: std::collections::HashMap<Label, (LinePos, usize)>,
+    /// `%L NAME` (upper-case) → the line after the head.
+    pub local_subs: std::collections::HashMap<String, LinePos>,
+}
+
+impl LabelIndex {
+    pub fn find(&self, t: &GotoTarget) -> Option<(LinePos, usize)> {
+        let key = match t {
+            GotoTarget::Number(n) => Label::Number(*n),
+            GotoTarget::Name(s) => Label::Name(s.clone()),
+        };
+        self.labels.get(&key).copied()
+    }
+}
+
+impl Frame {
+    pub fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
+        Frame {
+            kind,
+            source,
+            prog,
+            pos: 0,
+            line_no: 0,
+            flow: Vec::new(),
+            skip: None,
+            comment_block: false,
+            var_block: false,
+            cycle_params: Vec::new(),
+            seen_labels: HashSet::new(),
+            label_index: None,
+        }
+    }
+
+    pub fn is_stream(&self) -> bool {
+        matches!(self.source, Source::Stream)
+    }
+
+    pub fn line_pos(&self) -> LinePos {
+        LinePos {
+            pos: self.pos,
+            line_no: self.line_no,
+        }
+    }
+
+    pub fn seek(&mut self, at: LinePos) {
+        self.pos = at.pos;
+        self.line_no = at.line_no;
+    }
+}
+
+/// One line handed to the interpreter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LineMeta {
+    /// 1-based line number in its program (stream: since stream start).
+    pub line: u32,
+    /// Byte offset of the line (stream: since stream start).
+    pub offset: u64,
+}
+
+/// The result of asking a frame for its next line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineRead {
+    Line(LineMeta),
+    /// A stream frame with no complete line available yet: try again next tick.
+    Pending,
+    /// A file frame at its end.
+    Eof,
+}
+
+/// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
+/// offset after the line end, or `None` when no complete line is there.
+fn cut_line(text: &[u8], pos: usize, out: &mut String, at_eof_ok: bool) -> Option<usize> {
+    let rest = text.get(pos..)?;
+    if rest.is_empty() {
+        return None;
+    }
+    let (line, next) = match rest.iter().position(|&b| b == b'\n') {
+        Some(i) => (&rest[..i], pos + i + 1),
+        None if at_eof_ok => (rest, text.len()),
+        None => return None,
+    };
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    out.clear();
+    match std::str::from_utf8(line) {
+        Ok(s) => out.push_str(s),
+        Err(_) => out.push_str(&String::from_utf8_lossy(line)),
+    }
+    Some(next)
+}
+
+/// Next line of a file frame.
+pub fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
+    let Source::File(p) = &frame.source else {
+        return LineRead::Eof;
+    };
+    let start = frame.pos;
+    match cut_line(&p.text, start, out, true) {
+        Some(next) => {
+            frame.pos = next;
+            frame.line_no += 1;
+            LineRead::Line(LineMeta {
+                line: frame.line_no,
+                offset: start as u64,
+            })
+        }
+        None => LineRead::Eof,
+    }
+}
+
+/// The channel's reader of its stream interface: the current segment and where we are in it.
+#[derive(Debug, Default)]
+pub struct StreamReader {
+    seg: Vec<u8>,
+    /// Reused buffer the stream buffer empties into.
+    scratch: Vec<u8>,
+    pos: usize,
+    /// Stream offset of `seg[0]`, bytes since stream start.
+    seg_base: u64,
+    line_no: u32,
+    /// Segments extracted since stream start.
+    pub segments: u64,
+}
+
+/// What reading the stream did besides returning a line, for the event log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StreamNote {
+    Segment { bytes: usize },
+}
+
+impl StreamReader {
+    /// Start a new stream: forget everything read before.
+    pub fn restart(&mut self) {
+        self.seg.clear();
+        self.pos = 0;
+        self.seg_base = 0;
+        self.line_no = 0;
+        self.segments = 0;
+    }
+
+    /// Bytes of the current segment not yet decoded.
+    pub fn remaining(&self) -> usize {
+        self.seg.len() - self.pos
+    }
+
+    /// Next line; pulls a new segment from `buf` only when the current one is used up.
+    pub fn next_line(
+        &mut self,
+        buf: &mut StreamBuffer,
+        out: &mut String,
+        note: &mut Option<StreamNote>,
+    ) -> LineRead {
+        loop {
+            if let Some(next) = cut_line(&self.seg, self.pos, out, false) {
+                let meta = LineMeta {
+                    line: self.line_no + 1,
+                    offset: self.seg_base + self.pos as u64,
+                };
+                self.line_no += 1;
+                self.pos = next;
+                return LineRead::Line(meta);
+            }
+            if buf.used() == 0 {
+                return LineRead::Pending;
+            }
+            // Keep an incomplete tail (cannot happen with CR LF-checked writes, but costs
+            // nothing) and append the whole next segment after it.
+            let consumed = self.pos;
+            self.seg.drain(..consumed);
+            self.seg_base += consumed as u64;
+            self.pos = 0;
+            let bytes = buf.take_segment(&mut self.scratch);
+            self.seg.extend_from_slice(&self.scratch);
+            self.segments += 1;
+            *note = Some(StreamNote::Segment { bytes });
+        }
+    }
+
+    /// Drop the rest of the current segment (program end inside a segment, seed 003 §2.2).
+    /// Data still in the stream buffer stays. Returns the bytes dropped.
+    pub fn discard_rest(&mut self) -> usize {
+        let n = self.remaining();
+        self.seg_base += self.seg.len() as u64;
+        self.seg.clear();
+        self.pos = 0;
+        n
+    }
+}

@@ -1,0 +1,159 @@
+//! Modal state of a channel: what a block leaves behind for the next (G groups, feed, spindle,
+//! coolant, tool, position), re-initialised at program start and collected by block search.
+
+use crate::lang::block::SplineCommand;
+use crate::queue::{Plane, Position, MAX_AXES};
+
+/// Motion G group.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionMode {
+    Rapid,
+    Linear,
+    ArcCw,
+    ArcCcw,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spindle {
+    Off,
+    /// M3.
+    Cw,
+    /// M4.
+    Ccw,
+}
+
+/// Tool radius compensation (G40 / G41 / G42).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RadiusComp {
+    Off,
+    Left,
+    Right,
+}
+
+/// Everything modal the emulator tracks. Block search compares these between a full run and a
+/// search run, so every field is plain data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modal {
+    pub motion: MotionMode,
+    pub plane: Plane,
+    /// G90 (true) / G91 (false).
+    pub absolute: bool,
+    /// Modal path feed, mm/min; 0 = none programmed yet.
+    pub feed_mm_per_min: f64,
+    pub spindle: Spindle,
+    /// Programmed spindle speed, rpm.
+    pub spindle_rpm: f64,
+    /// M7.
+    pub coolant_mist: bool,
+    /// M8.
+    pub coolant_flood: bool,
+    pub tool: u32,
+    /// D word: tool data set for radius compensation.
+    pub tool_offset: u32,
+    /// Active zero offset: 0 = none (G53 state), 1..=6 = G54..G59.
+    pub zero_offset: usize,
+    pub radius_comp: RadiusComp,
+    /// G261 contouring on (G260 off).
+    pub contouring: bool,
+    /// G151 / `#SPLINE ON`.
+    pub spline: bool,
+    pub spline_type: SplineCommand,
+    /// `#HSC ON`.
+    pub hsc: bool,
+    /// Programmed end position of the last block in machine coordinates (mm / degrees).
+    pub pos: Position,
+}
+
+impl Modal {
+    /// The channel defaults a program start restores; the position is the machine's.
+    pub fn defaults(pos: Position) -> Self {
+        Modal {
+            motion: MotionMode::Linear,
+            plane: Plane::Xy,
+            absolute: true,
+            feed_mm_per_min: 0.0,
+            spindle: Spindle::Off,
+            spindle_rpm: 0.0,
+            coolant_mist: false,
+            coolant_flood: false,
+            tool: 0,
+            tool_offset: 0,
+            zero_offset: 0,
+            radius_comp: RadiusComp::Off,
+            contouring: false,
+            spline: false,
+            spline_type: SplineCommand::TypeAkima,
+            hsc: false,
+            pos,
+        }
+    }
+
+    /// A cross-block function that forbids `#FLUSH` (21909) is active.
+    pub fn cross_block_active(&self) -> bool {
+        self.radius_comp != RadiusComp::Off || self.contouring || self.spline || self.hsc
+    }
+}
+
+/// The outcome of a block's G words beyond the modal groups.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BlockGs {
+    /// G4 in this block: the X word is the dwell time in seconds.
+    pub dwell: bool,
+    /// G53 in this block: coordinates are machine coordinates for this block only.
+    pub machine_coords: bool,
+    /// G61: contouring at this block's end only.
+    pub contour_this_block: bool,
+}
+
+/// Apply one G code. `Err(())` for a G code the channel does not know (20131).
+pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> Result<(), ()> {
+    match g {
+        0 => m.motion = MotionMode::Rapid,
+        1 => m.motion = MotionMode::Linear,
+        2 => m.motion = MotionMode::ArcCw,
+        3 => m.motion = MotionMode::ArcCcw,
+        4 => b.dwell = true,
+        17 => m.plane = Plane::Xy,
+        18 => m.plane = Plane::Zx,
+        19 => m.plane = Plane::Yz,
+        40 => m.radius_comp = RadiusComp::Off,
+        41 => m.radius_comp = RadiusComp::Left,
+        42 => m.radius_comp = RadiusComp::Right,
+        53 => {
+            b.machine_coords = true;
+            m.zero_offset = 0;
+        }
+        54..=59 => m.zero_offset = (g - 53) as usize,
+        61 => b.contour_this_block = true,
+        90 => m.absolute = true,
+        91 => m.absolute = false,
+        // Ramp time weighting: accepted, no effect on the emulated motion.
+        132..=134 => {}
+        150 => m.spline = false,
+        151 => m.spline = true,
+        260 => m.contouring = false,
+        261 => m.contouring = true,
+        _ => return Err(()),
+    }
+    Ok(())
+}
+
+/// Apply an M function's modal effect (spindle, coolant). Program ends are handled by the
+/// decoder; other M functions are PLC outputs with no modal state.
+pub fn apply_m(m: &mut Modal, code: u32) {
+    match code {
+        3 => m.spindle = Spindle::Cw,
+        4 => m.spindle = Spindle::Ccw,
+        5 => m.spindle = Spindle::Off,
+        7 => m.coolant_mist = true,
+        8 => m.coolant_flood = true,
+        9 => {
+            m.coolant_mist = false;
+            m.coolant_flood = false;
+        }
+        _ => {}
+    }
+}
+
+/// Zero-offset table: G54..G59 → offset per axis (mm / degrees).
+pub type ZeroOffsets = [[f64; MAX_AXES]; 6];

@@ -1,0 +1,233 @@
+//! The emulated controller as the runtime ticks it: its channels, the built-in stream feeders,
+//! and the requests other threads (ADS connections, tests) send it.
+//!
+//! One tick: serve requests → feeders write → each channel decodes, executes, reports →
+//! events leave for the log. Nothing here blocks or does I/O.
+
+use crossbeam_channel::Sender;
+
+use crate::channel::{Channel, CommandError, Finish, Mode, State};
+use crate::feeder::Feeder;
+use crate::report::event::EventLog;
+use crate::runtime::{Cycle, Flow, Tick};
+use crate::source::stream::StreamWriteError;
+
+/// What a client asks of a channel.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Op {
+    /// Write NC lines into the stream interface.
+    WriteStream(Vec<u8>),
+    CommandMode(i32),
+    CommandState(i32),
+    /// Command parameter: the program name ACTIVE starts.
+    SetProgram(String),
+    Hold,
+    Resume,
+    Reset,
+    /// Feed override, percent.
+    SetOverride(f64),
+    WriteExternal(String, f64),
+    ReadExternal(String),
+    Status,
+}
+
+/// A snapshot of what a client may read of a channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Status {
+    pub mode: Mode,
+    pub state: State,
+    pub block_counter: u64,
+    /// Stream fill: bytes used, bytes free.
+    pub stream_used: usize,
+    pub stream_free: usize,
+    /// Configured axes with their positions (mm / degrees).
+    pub positions: Vec<(char, f64)>,
+    pub last_error: Option<(u32, String)>,
+    pub override_pct: f64,
+    pub blocks: u64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reply {
+    Done,
+    Stream(Result<(), StreamWriteError>),
+    Command(Result<(), CommandError>),
+    Value(Option<f64>),
+    Status(Box<Status>),
+    /// No channel with that number.
+    NoChannel,
+}
+
+/// A request with its own way back: answered in the tick that serves it.
+#[derive(Debug)]
+pub struct Request {
+    /// 1-based channel number.
+    pub channel: u32,
+    pub op: Op,
+    pub reply: Sender<Reply>,
+}
+
+/// A built-in client streaming a file into one channel.
+pub struct Attached {
+    pub channel: u32,
+    pub feeder: Feeder,
+}
+
+/// When `run` is over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopWhen {
+    /// Never by itself (`serve`).
+    Never,
+    /// When every channel that ran a program has finished it (`run`, `soak`).
+    ProgramsFinished,
+}
+
+pub struct Machine {
+    channels: Vec<Channel>,
+    feeders: Vec<Attached>,
+    log: EventLog,
+    stop_when: StopWhen,
+    /// Per channel: how its last program finished.
+    finishes: Vec<Option<Finish>>,
+}
+
+impl Machine {
+    pub fn new(channels: Vec<Channel>, log: EventLog, stop_when: StopWhen) -> Self {
+        let n = channels.len();
+        Machine {
+            channels,
+            feeders: Vec::new(),
+            log,
+            stop_when,
+            finishes: vec![None; n],
+        }
+    }
+
+    pub fn attach_feeder(&mut self, channel: u32, feeder: Feeder) {
+        self.feeders.push(Attached { channel, feeder });
+    }
+
+    pub fn feeders(&self) -> &[Attached] {
+        &self.feeders
+    }
+
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    pub fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
+        self.channels.get_mut((number as usize).checked_sub(1)?)
+    }
+
+    pub fn finishes(&self) -> &[Option<Finish>] {
+        &self.finishes
+    }
+
+    /// Hand the remaining events to the log and wait for it to write them.
+    pub fn finish_log(&mut self) -> std::io::Result<u64> {
+        for c in &mut self.channels {
+            c.events_mut().flush_to(&mut self.log);
+        }
+        std::mem::replace(&mut self.log, EventLog::disabled()).finish()
+    }
+
+    /// Events from every channel, in channel order within a tick.
+    fn publish(&mut self) {
+        if !self.log.enabled() {
+            return;
+        }
+        for c in &mut self.channels {
+            c.events_mut().flush_to(&mut self.log);
+        }
+    }
+
+    fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
+        let Some(c) = self.channel_mut(channel) else {
+            return Reply::NoChannel;
+        };
+        match op {
+            Op::WriteStream(data) => Reply::Stream(c.write_stream(tick, &data)),
+            Op::CommandMode(v) => Reply::Command(c.command_mode(tick, v)),
+            Op::CommandState(v) => Reply::Command(c.command_state(tick, v)),
+            Op::SetProgram(name) => {
+                c.set_program(&name);
+                Reply::Done
+            }
+            Op::Hold => {
+                c.hold(tick);
+                Reply::Done
+            }
+            Op::Resume => {
+                c.resume(tick);
+                Reply::Done
+            }
+            Op::Reset => {
+                c.reset(tick);
+                Reply::Done
+            }
+            Op::SetOverride(p) => Reply::Command(c.set_override(p)),
+            Op::WriteExternal(name, v) => Reply::Value(c.write_external(&name, v).then_some(v)),
+            Op::ReadExternal(name) => Reply::Value(c.read_external(&name)),
+            Op::Status => Reply::Status(Box::new(status_of(c))),
+        }
+    }
+}
+
+pub fn status_of(c: &Channel) -> Status {
+    let (used, free) = c.stream_fill();
+    Status {
+        mode: c.mode(),
+        state: c.state(),
+        block_counter: c.block_counter(),
+        stream_used: used,
+        stream_free: free,
+        positions: c.axis_positions(),
+        last_error: c.last_error().cloned(),
+        override_pct: c.motion().override_pct(),
+        blocks: c.stats().blocks,
+    }
+}
+
+impl Cycle for Machine {
+    type Request = Request;
+
+    fn serve(&mut self, req: Request, tick: &Tick) {
+        let reply = self.apply(tick, req.channel, req.op);
+        // A client that went away no longer needs its answer.
+        let _ = req.reply.send(reply);
+    }
+
+    fn step(&mut self, tick: &Tick) -> Flow {
+        for a in &mut self.feeders {
+            let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
+                continue;
+            };
+            if let Some(packet) = a.feeder.poll(tick.index) {
+                let ok = c.write_stream(tick, packet).is_ok();
+                a.feeder.result(ok);
+            }
+        }
+        for (i, c) in self.channels.iter_mut().enumerate() {
+            c.step(tick);
+            if let Some(f) = c.take_finish() {
+                self.finishes[i] = Some(f);
+            }
+        }
+        self.publish();
+        match self.stop_when {
+            StopWhen::Never => Flow::Continue,
+            StopWhen::ProgramsFinished => {
+                let running = self
+                    .channels
+                    .iter()
+                    .any(|c| matches!(c.state(), State::Active | State::Hold));
+                let any_finished = self.finishes.iter().any(Option::is_some);
+                if !running && any_finished {
+                    Flow::Stop
+                } else {
+                    Flow::Continue
+                }
+            }
+        }
+    }
+}

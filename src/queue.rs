@@ -1,0 +1,220 @@
+//! The channel's block queue: decoded blocks on their way to motion, bounded for back-pressure.
+//!
+//! The decoder pushes only while the queue has room, so a channel that cannot move faster
+//! stops pulling stream segments, the 4094-byte stream buffer fills, and a writer sees 11012 —
+//! back-pressure by construction, as on the real channel.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use crate::lang::block::FlushKind;
+
+/// Axes the emulator knows, in this order. Configured axes are a subset.
+pub const AXIS_LETTERS: [u8; MAX_AXES] = *b"XYZABC";
+pub const MAX_AXES: usize = 6;
+
+/// Axis positions: mm for linear axes X Y Z, degrees for rotary axes A B C.
+pub type Position = [f64; MAX_AXES];
+
+/// Where a block came from, carried to the `block` event emitted when it takes effect.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockInfo {
+    pub prog: Arc<str>,
+    /// 1-based line number in its program (in a stream: since stream start).
+    pub line: u32,
+    /// Byte offset of the line in its program (in a stream: since stream start).
+    pub offset: u64,
+    /// ISG block counter: every decoded line counts, comments and each loop pass included.
+    pub counter: u64,
+    pub n: Option<u32>,
+    /// The line's text, only when the event log wants it.
+    pub text: Option<Box<str>>,
+    pub stream: bool,
+}
+
+/// The working plane of arcs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plane {
+    /// G17: X Y, tool axis Z.
+    Xy,
+    /// G18: Z X, tool axis Y.
+    Zx,
+    /// G19: Y Z, tool axis X.
+    Yz,
+}
+
+impl Plane {
+    /// Indices of the plane's first axis, second axis and normal (tool) axis.
+    pub fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Plane::Xy => (0, 1, 2),
+            Plane::Zx => (2, 0, 1),
+            Plane::Yz => (1, 2, 0),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MoveKind {
+    /// G0: each axis at most its rapid rate.
+    Rapid,
+    /// G1 at the programmed feed.
+    Line,
+    /// G2 (cw) / G3 (ccw) in `plane` around `center` (plane coordinates, mm), optionally
+    /// a helix along the plane's normal axis. `radius_mm` from the start point.
+    Arc {
+        plane: Plane,
+        center: [f64; 2],
+        radius_mm: f64,
+        cw: bool,
+        /// Swept angle, radians, always > 0 (a full circle is 2π).
+        sweep_rad: f64,
+    },
+}
+
+/// One motion block: start and end positions and how to get there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Move {
+    pub kind: MoveKind,
+    pub start: Position,
+    pub end: Position,
+    /// Programmed path feed, mm/min (ignored for rapid moves).
+    pub feed_mm_per_min: f64,
+}
+
+impl Move {
+    /// Path length in mm (axes' Euclidean length; arcs: helix length).
+    pub fn length_mm(&self) -> f64 {
+        match self.kind {
+            MoveKind::Rapid | MoveKind::Line => {
+                let mut s = 0.0;
+                for i in 0..MAX_AXES {
+                    let d = self.end[i] - self.start[i];
+                    s += d * d;
+                }
+                s.sqrt()
+            }
+            MoveKind::Arc {
+                plane,
+                radius_mm,
+                sweep_rad,
+                ..
+            } => {
+                let (_, _, n) = plane.axes();
+                let arc = radius_mm * sweep_rad;
+                let h = self.end[n] - self.start[n];
+                let mut other = 0.0;
+                for i in 3..MAX_AXES {
+                    let d = self.end[i] - self.start[i];
+                    other += d * d;
+                }
+                (arc * arc + h * h + other).sqrt()
+            }
+        }
+    }
+
+    /// Position at fraction `u` (0..=1) of the path.
+    pub fn point_at(&self, u: f64) -> Position {
+        let u = u.clamp(0.0, 1.0);
+        let mut p = [0.0; MAX_AXES];
+        for i in 0..MAX_AXES {
+            p[i] = self.start[i] + (self.end[i] - self.start[i]) * u;
+        }
+        if let MoveKind::Arc {
+            plane,
+            center,
+            radius_mm,
+            cw,
+            sweep_rad,
+        } = self.kind
+        {
+            if u >= 1.0 {
+                return self.end;
+            }
+            let (a, b, _) = plane.axes();
+            let a0 = (self.start[b] - center[1]).atan2(self.start[a] - center[0]);
+            let ang = if cw {
+                a0 - sweep_rad * u
+            } else {
+                a0 + sweep_rad * u
+            };
+            p[a] = center[0] + radius_mm * ang.cos();
+            p[b] = center[1] + radius_mm * ang.sin();
+        }
+        p
+    }
+}
+
+/// What a decoded block does once it reaches execution.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Takes effect without motion: assignments, M/S/T functions, modal changes.
+    None,
+    Move(Move),
+    /// G4: wait, seconds.
+    Dwell {
+        seconds: f64,
+    },
+    /// `#FLUSH …`: release the held blocks (planner rules, Stage 5).
+    Flush(FlushKind),
+    /// M30/M2 of the main program: the program ends when everything before it has run.
+    End {
+        m: u32,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct QueuedBlock {
+    pub info: BlockInfo,
+    pub action: Action,
+    /// A second part of a block already reported (the program end after a block's move, the
+    /// positioning move of a block search): no `block` event of its own.
+    pub silent: bool,
+}
+
+/// Bounded FIFO between decoder and motion.
+#[derive(Debug)]
+pub struct BlockQueue {
+    items: VecDeque<QueuedBlock>,
+    capacity: usize,
+}
+
+impl BlockQueue {
+    pub fn new(capacity: usize) -> Self {
+        let capacity = capacity.max(1);
+        BlockQueue {
+            items: VecDeque::with_capacity(capacity),
+            capacity,
+        }
+    }
+    pub fn has_room(&self) -> bool {
+        self.items.len() < self.capacity
+    }
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+    /// The decoder checks `has_room` before it reads a line; one line may queue up to three
+    /// entries (dwell or move, program end, search positioning), so the capacity is soft by
+    /// that much and no block is ever refused.
+    pub fn push(&mut self, b: QueuedBlock) {
+        self.items.push_back(b);
+    }
+    pub fn front(&self) -> Option<&QueuedBlock> {
+        self.items.front()
+    }
+    pub fn pop_front(&mut self) -> Option<QueuedBlock> {
+        self.items.pop_front()
+    }
+    pub fn iter(&self) -> impl Iterator<Item = &QueuedBlock> {
+        self.items.iter()
+    }
+    pub fn clear(&mut self) {
+        self.items.clear();
+    }
+}

@@ -1,0 +1,170 @@
+//! The channel's file cache (`#CACHE`, TF5200 File Caching): global subroutines and cycles
+//! held in memory so that calling them no longer touches the file system.
+
+use thiserror::Error;
+
+use super::store::{ProgramKind, ProgramStore, ProgramText, StoreError};
+
+/// Cache limits from the lists (P-STUP-00050..52 / P-CHAN-00500..504).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CacheLimits {
+    /// `FCT_USE_CACHED_FILES` set.
+    pub enabled: bool,
+    /// `max_cache_number`: files.
+    pub max_files: usize,
+    /// `max_cache_size`: bytes per file.
+    pub max_file_bytes: u64,
+}
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CacheError {
+    #[error("#CACHE needs file caching: set configuration.channel[i].decoder.function FCT_USE_CACHED_FILES in the start-up list (or configuration.decoder.function in the channel list)")]
+    NotEnabled,
+    #[error("cache full: {max} files cached, '{name}' cannot be loaded")]
+    Full { name: String, max: usize },
+    #[error("file for cache not found: '{0}'")]
+    NotFound(String),
+    #[error("'{name}' is {bytes} bytes, larger than max_cache_size {max}")]
+    TooLarge { name: String, bytes: u64, max: u64 },
+    #[error("'{name}' could not be read for the cache: {reason}")]
+    Unreadable { name: String, reason: String },
+}
+
+impl CacheError {
+    /// ISG error number (REFERENCE §2, §5); 90160 is ours (no ISG number known).
+    pub fn code(&self) -> u32 {
+        match self {
+            CacheError::NotEnabled => 90160,
+            CacheError::Full { .. } => 21562,
+            CacheError::NotFound(_) => 21563,
+            CacheError::TooLarge { .. } => 21564,
+            CacheError::Unreadable { .. } => 21563,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct CacheEntry {
+    /// Lower-case name: cache names are case-insensitive.
+    key: String,
+    program: ProgramText,
+}
+
+/// One channel's cache. A refresh replaces an entry's text as a whole; a frame already
+/// running from the old text holds its own reference and finishes with it.
+#[derive(Debug, Clone)]
+pub struct Cache {
+    limits: CacheLimits,
+    entries: Vec<CacheEntry>,
+    /// Calls served from the cache.
+    pub hits: u64,
+}
+
+impl Cache {
+    pub fn new(limits: CacheLimits) -> Self {
+        Cache {
+            limits,
+            entries: Vec::new(),
+            hits: 0,
+        }
+    }
+
+    pub fn limits(&self) -> CacheLimits {
+        self.limits
+    }
+
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached.
+    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<(), CacheError> {
+        if !self.limits.enabled {
+            return Err(CacheError::NotEnabled);
+        }
+        let key = name.to_ascii_lowercase();
+        let existing = self.entries.iter().position(|e| e.key == key);
+        if existing.is_none() && self.entries.len() >= self.limits.max_files {
+            return Err(CacheError::Full {
+                name: name.to_string(),
+                max: self.limits.max_files,
+            });
+        }
+        // Check the size before reading: a huge file is refused without being read.
+        let path = store
+            .find(name, ProgramKind::Subroutine)
+            .map_err(|_| CacheError::NotFound(name.to_string()))?;
+        let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        if bytes > self.limits.max_file_bytes {
+            return Err(CacheError::TooLarge {
+                name: name.to_string(),
+                bytes,
+                max: self.limits.max_file_bytes,
+            });
+        }
+        let program = store
+            .read_file(name, ProgramKind::Subroutine)
+            .map_err(|e| match e {
+                StoreError::SubroutineNotFound(_) | StoreError::MainNotFound(_) => {
+                    CacheError::NotFound(name.to_string())
+                }
+                other => CacheError::Unreadable {
+                    name: name.to_string(),
+                    reason: other.to_string(),
+                },
+            })?;
+        if program.text.len() as u64 > self.limits.max_file_bytes {
+            return Err(CacheError::TooLarge {
+                name: name.to_string(),
+                bytes: program.text.len() as u64,
+                max: self.limits.max_file_bytes,
+            });
+        }
+        match existing {
+            Some(i) => self.entries[i].program = program,
+            None => self.entries.push(CacheEntry { key, program }),
+        }
+        Ok(())
+    }
+
+    /// `#CACHE CLEAR [FILE=name]`: silent when not cached.
+    pub fn clear(&mut self, name: &str) -> Result<(), CacheError> {
+        if !self.limits.enabled {
+            return Err(CacheError::NotEnabled);
+        }
+        self.entries.retain(|e| !e.key.eq_ignore_ascii_case(name));
+        Ok(())
+    }
+
+    /// `#CACHE CLEAR ALL`.
+    pub fn clear_all(&mut self) -> Result<(), CacheError> {
+        if !self.limits.enabled {
+            return Err(CacheError::NotEnabled);
+        }
+        self.entries.clear();
+        Ok(())
+    }
+
+    /// Channel reset: the cache empties (seed 002, RESET).
+    pub fn reset(&mut self) {
+        self.entries.clear();
+    }
+
+    /// A call looks here before the file system.
+    pub fn get(&mut self, name: &str) -> Option<ProgramText> {
+        let e = self
+            .entries
+            .iter()
+            .find(|e| e.key.eq_ignore_ascii_case(name))?;
+        self.hits += 1;
+        Some(e.program.clone())
+    }
+
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.entries.iter().map(|e| &*e.program.name)
+    }
+}

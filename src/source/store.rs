@@ -1,0 +1,369 @@
+//! Program store: finds NC programs through the channel's search paths and reads them into memory.
+//!
+//! The real channel reads a program from the file system when it is opened as main program or
+//! called as a subroutine; that read is what the file cache (#CACHE) saves, so every open and
+//! every byte read is counted here. The name in `streaming_prog_file` is not a file at all: it
+//! opens the channel's stream interface instead, transparently (seed 003 §2.2).
+
+use std::fs;
+use std::io::Read;
+use std::path::{Component, Path, PathBuf};
+use std::sync::Arc;
+
+use thiserror::Error;
+
+/// Largest program the store reads into memory. A bound, so a mistaken path to a huge file
+/// cannot exhaust memory; real NC programs that large are streamed instead.
+pub const MAX_PROGRAM_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Type bit of a search path: main programs.
+pub const PATH_MAIN: u8 = 0x01;
+/// Type bit of a search path: subroutines and cycles.
+pub const PATH_SUB: u8 = 0x02;
+
+/// One program search path (start-up list `pfad[i].prg[j]`, channel list `path[i].dir`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchDir {
+    pub dir: PathBuf,
+    /// `PATH_MAIN` | `PATH_SUB`.
+    pub kinds: u8,
+    /// 0 is searched first.
+    pub priority: u32,
+}
+
+/// What a program is opened as; decides the search-path type bit and the error number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProgramKind {
+    Main,
+    Subroutine,
+}
+
+/// A program text in memory. Shared, because a cache entry and a running frame may hold the
+/// same text: a cache refresh replaces the store's text, the running frame keeps the old one.
+#[derive(Debug, Clone)]
+pub struct ProgramText {
+    /// The name as the program called it.
+    pub name: Arc<str>,
+    /// Where it was found.
+    pub path: PathBuf,
+    pub text: Arc<[u8]>,
+}
+
+/// The result of opening a program name.
+#[derive(Debug, Clone)]
+pub enum Opened {
+    File(ProgramText),
+    /// The virtual streaming program: read from the stream interface.
+    Stream {
+        name: Arc<str>,
+    },
+}
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum StoreError {
+    #[error("main program '{0}' not found")]
+    MainNotFound(String),
+    #[error("global subroutine '{0}' not found")]
+    SubroutineNotFound(String),
+    #[error("program '{name}' is {bytes} bytes, more than the {limit}-byte limit")]
+    TooLarge {
+        name: String,
+        bytes: u64,
+        limit: u64,
+    },
+    #[error("program '{name}' could not be read: {reason}")]
+    Unreadable { name: String, reason: String },
+    #[error("program name '{0}' is not allowed (absolute or leaving the search path)")]
+    BadName(String),
+}
+
+impl StoreError {
+    /// The ISG error number (REFERENCE §5).
+    pub fn code(&self) -> u32 {
+        match self {
+            StoreError::MainNotFound(_) => 20368,
+            StoreError::SubroutineNotFound(_) => 20369,
+            // No ISG number known for these: our own range (README, "Error numbers").
+            StoreError::TooLarge { .. } => 90110,
+            StoreError::Unreadable { .. } => 90111,
+            StoreError::BadName(_) => 90112,
+        }
+    }
+}
+
+/// Counters the report shows and the file cache beats.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StoreStats {
+    /// File-system opens that found and read a program.
+    pub opens: u64,
+    /// Bytes read from the file system.
+    pub bytes_read: u64,
+}
+
+/// The channel's view of its programs.
+#[derive(Debug, Clone)]
+pub struct ProgramStore {
+    dirs: Vec<SearchDir>,
+    /// `streaming_prog_file`, lower-case; `None` = streaming off.
+    streaming_prog: Option<String>,
+    stats: StoreStats,
+}
+
+impl ProgramStore {
+    pub fn new(mut dirs: Vec<SearchDir>, streaming_prog: Option<&str>) -> Self {
+        dirs.sort_by_key(|d| d.priority);
+        ProgramStore {
+            dirs,
+            streaming_prog: streaming_prog
+                .filter(|s| !s.is_empty())
+                .map(|s| s.to_ascii_lowercase()),
+            stats: StoreStats::default(),
+        }
+    }
+
+    pub fn stats(&self) -> StoreStats {
+        self.stats
+    }
+
+    pub fn search_dirs(&self) -> &[SearchDir] {
+        &self.dirs
+    }
+
+    /// Whether `name` is the virtual streaming program (case-insensitive, as program names are).
+    pub fn is_streaming_program(&self, name: &str) -> bool {
+        self.streaming_prog
+            .as_deref()
+            .is_some_and(|s| s.eq_ignore_ascii_case(name))
+    }
+
+    /// Open a program by name: the stream if it is `streaming_prog_file`, else the first file
+    /// found through the search paths of that kind, by priority, names case-insensitive.
+    pub fn open(&mut self, name: &str, kind: ProgramKind) -> Result<Opened, StoreError> {
+        if self.is_streaming_program(name) {
+            return Ok(Opened::Stream { name: name.into() });
+        }
+        self.read_file(name, kind).map(Opened::File)
+    }
+
+    /// Find and read a program file (never the stream), counting the file-system access.
+    pub fn read_file(&mut self, name: &str, kind: ProgramKind) -> Result<ProgramText, StoreError> {
+        let path = self.find(name, kind)?;
+        let text = read_bounded(&path, name)?;
+        self.stats.opens += 1;
+        self.stats.bytes_read += text.len() as u64;
+        Ok(ProgramText {
+            name: name.into(),
+            path,
+            text: text.into(),
+        })
+    }
+
+    /// Locate a program file without reading it.
+    pub fn find(&self, name: &str, kind: ProgramKind) -> Result<PathBuf, StoreError> {
+        let rel = checked_relative(name)?;
+        let bit = match kind {
+            ProgramKind::Main => PATH_MAIN,
+            ProgramKind::Subroutine => PATH_SUB,
+        };
+        for d in self.dirs.iter().filter(|d| d.kinds & bit != 0) {
+            if let Some(p) = find_case_insensitive(&d.dir, &rel) {
+                return Ok(p);
+            }
+        }
+        Err(match kind {
+            ProgramKind::Main => StoreError::MainNotFound(name.to_string()),
+            ProgramKind::Subroutine => StoreError::SubroutineNotFound(name.to_string()),
+        })
+    }
+}
+
+/// A program name may name a file below a search path, never outside it.
+fn checked_relative(name: &str) -> Result<PathBuf, StoreError> {
+    let p = Path::new(name);
+    if name.is_empty() || name.contains('\0') {
+        return Err(StoreError::BadName(name.to_string()));
+    }
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            Component::Normal(s) => out.push(s),
+            Component::CurDir => {}
+            _ => return Err(StoreError::BadName(name.to_string())),
+        }
+    }
+    if out.as_os_str().is_empty() {
+        return Err(StoreError::BadName(name.to_string()));
+    }
+    Ok(out)
+}
+
+/// Exact path first (the common case costs one stat), then a case-insensitive match of each
+/// component, as the real kernel treats program names.
+fn find_case_insensitive(dir: &Path, rel: &Path) -> Option<PathBuf> {
+    let exact = dir.join(rel);
+    if exact.is_file() {
+        return Some(exact);
+    }
+    let mut cur = dir.to_path_buf();
+    let comps: Vec<_> = rel.components().collect();
+    for (i, c) in comps.iter().enumerate() {
+        let want = c.as_os_str().to_string_lossy().to_lowercase();
+        let last = i + 1 == comps.len();
+        let entries = fs::read_dir(&cur).ok()?;
+        let mut found = None;
+        for e in entries.flatten() {
+            if e.file_name().to_string_lossy().to_lowercase() == want {
+                let is_file = e
+                    .file_type()
+                    .map(|t| t.is_file() || t.is_symlink())
+                    .unwrap_or(false);
+                let is_dir = e.path().is_dir();
+                if (last && is_file && e.path().is_file()) || (!last && is_dir) {
+                    found = Some(e.path());
+                    break;
+                }
+            }
+        }
+        cur = found?;
+    }
+    Some(cur)
+}
+
+fn read_bounded(path: &Path, name: &str) -> Result<Vec<u8>, StoreError> {
+    let unreadable = |e: std::io::Error| StoreError::Unreadable {
+        name: name.to_string(),
+        reason: e.to_string(),
+    };
+    let f = fs::File::open(path).map_err(unreadable)?;
+    let len = f.metadata().map_err(unreadable)?.len();
+    if len > MAX_PROGRAM_BYTES {
+        return Err(StoreError::TooLarge {
+            name: name.to_string(),
+            bytes: len,
+            limit: MAX_PROGRAM_BYTES,
+        });
+    }
+    let mut buf = Vec::with_capacity(len as usize);
+    // take(): the file may grow between stat and read; the bound holds anyway.
+    f.take(MAX_PROGRAM_BYTES + 1)
+        .read_to_end(&mut buf)
+        .map_err(unreadable)?;
+    if buf.len() as u64 > MAX_PROGRAM_BYTES {
+        return Err(StoreError::TooLarge {
+            name: name.to_string(),
+            bytes: buf.len() as u64,
+            limit: MAX_PROGRAM_BYTES,
+        });
+    }
+    Ok(buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn store(dir: &Path) -> ProgramStore {
+        ProgramStore::new(
+            vec![SearchDir {
+                dir: dir.to_path_buf(),
+                kinds: PATH_MAIN | PATH_SUB,
+                priority: 0,
+            }],
+            Some("streaming.nc"),
+        )
+    }
+
+    #[test]
+    fn finds_names_case_insensitively_and_counts_opens() {
+        let d = tempfile::tempdir().unwrap();
+        fs::write(d.path().join("Laser_On.cyc"), "M17\r\n").unwrap();
+        let mut s = store(d.path());
+        match s.open("LASER_ON.CYC", ProgramKind::Subroutine).unwrap() {
+            Opened::File(p) => assert_eq!(&*p.text, b"M17\r\n"),
+            Opened::Stream { .. } => panic!("not a stream"),
+        }
+        assert_eq!(
+            s.stats(),
+            StoreStats {
+                opens: 1,
+                bytes_read: 5
+            }
+        );
+    }
+
+    #[test]
+    fn streaming_program_is_virtual() {
+        let d = tempfile::tempdir().unwrap();
+        let mut s = store(d.path());
+        assert!(matches!(
+            s.open("Streaming.NC", ProgramKind::Main).unwrap(),
+            Opened::Stream { .. }
+        ));
+        assert_eq!(s.stats().opens, 0);
+    }
+
+    #[test]
+    fn not_found_numbers_and_type_bits() {
+        let d = tempfile::tempdir().unwrap();
+        fs::write(d.path().join("sub.nc"), "M17\r\n").unwrap();
+        let mut s = ProgramStore::new(
+            vec![SearchDir {
+                dir: d.path().to_path_buf(),
+                kinds: PATH_SUB,
+                priority: 0,
+            }],
+            None,
+        );
+        assert_eq!(s.open("x.nc", ProgramKind::Main).unwrap_err().code(), 20368);
+        assert_eq!(
+            s.open("x.nc", ProgramKind::Subroutine).unwrap_err().code(),
+            20369
+        );
+        // sub.nc exists, but only in a subroutine path.
+        assert_eq!(
+            s.open("sub.nc", ProgramKind::Main).unwrap_err().code(),
+            20368
+        );
+        assert!(s.open("sub.nc", ProgramKind::Subroutine).is_ok());
+    }
+
+    #[test]
+    fn priority_orders_the_search() {
+        let a = tempfile::tempdir().unwrap();
+        let b = tempfile::tempdir().unwrap();
+        fs::write(a.path().join("p.nc"), "A\r\n").unwrap();
+        fs::write(b.path().join("p.nc"), "B\r\n").unwrap();
+        let mut s = ProgramStore::new(
+            vec![
+                SearchDir {
+                    dir: a.path().into(),
+                    kinds: 3,
+                    priority: 1,
+                },
+                SearchDir {
+                    dir: b.path().into(),
+                    kinds: 3,
+                    priority: 0,
+                },
+            ],
+            None,
+        );
+        match s.open("p.nc", ProgramKind::Main).unwrap() {
+            Opened::File(p) => assert_eq!(&*p.text, b"B\r\n"),
+            Opened::Stream { .. } => panic!(),
+        }
+    }
+
+    #[test]
+    fn names_cannot_escape_the_search_path() {
+        let d = tempfile::tempdir().unwrap();
+        let mut s = store(d.path());
+        for bad in ["../etc/passwd", "/etc/passwd", "", "a\0b"] {
+            assert_eq!(
+                s.open(bad, ProgramKind::Main).unwrap_err().code(),
+                90112,
+                "{bad:?}"
+            );
+        }
+    }
+}
