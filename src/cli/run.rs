@@ -1,0 +1,229 @@
+//! `ncchannel run` and the no-argument demo: one program on one channel, optionally fed
+//! through the stream interface by the built-in feeder, in virtual or real time.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use crate::decoder::SearchTarget;
+use crate::feeder::Feeder;
+use crate::machine::{Machine, StopWhen};
+use crate::report::event::EventLog;
+use crate::report::summary::{CycleReport, ErrorReport, Outcome, Report, StreamReport};
+use crate::runtime::{Clock, RunEnd, Runtime, Tick};
+use crate::channel::Finish;
+
+use super::exit;
+
+/// Largest file the built-in feeder reads: a soak file, not an accident.
+const MAX_STREAM_FILE_BYTES: u64 = 1 << 30;
+
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Program to start (default: the channel's streaming program when --stream is given).
+    pub program: Option<String>,
+    /// Start-up list.
+    #[arg(long, default_value = "params/startup.lis")]
+    pub params: PathBuf,
+    /// Channel number, 1-based.
+    #[arg(long, default_value_t = 1)]
+    pub channel: u32,
+    /// Feed this file through the stream interface.
+    #[arg(long)]
+    pub stream: Option<PathBuf>,
+    /// Largest packet the feeder writes, bytes (at most 992).
+    #[arg(long, default_value_t = 992)]
+    pub packet: usize,
+    /// One write attempt every this many ticks.
+    #[arg(long, default_value_t = 1)]
+    pub every: u64,
+    /// Send the stream file's bytes as they are (no line handling), for error tests.
+    #[arg(long)]
+    pub raw: bool,
+    /// Run at the cycle period in wall-clock time instead of virtual time.
+    #[arg(long)]
+    pub realtime: bool,
+    /// Stop after this many ticks (exit code 3).
+    #[arg(long)]
+    pub max_ticks: Option<u64>,
+    /// Block search target: n:<N>, count:<K> or offset:<BYTES>.
+    #[arg(long)]
+    pub search: Option<SearchTarget>,
+    /// Event log (JSON Lines): a file, or - for standard output.
+    #[arg(long)]
+    pub events: Option<String>,
+    /// Write the report JSON here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+}
+
+impl RunArgs {
+    /// The demo of `cargo run --release`: nc/demo.nc streamed into the streaming program.
+    pub fn demo() -> Self {
+        RunArgs {
+            program: None,
+            params: PathBuf::from("params/startup.lis"),
+            channel: 1,
+            stream: Some(PathBuf::from("nc/demo.nc")),
+            packet: 992,
+            every: 1,
+            raw: false,
+            realtime: false,
+            max_ticks: None,
+            search: None,
+            events: None,
+            report: None,
+        }
+    }
+}
+
+/// A relative default path that is not where we are run from is looked up in the crate's
+/// folder, so `cargo run` works from any directory of the checkout.
+fn locate(p: &Path) -> PathBuf {
+    if p.is_relative() && !p.exists() {
+        let alt = Path::new(env!("CARGO_MANIFEST_DIR")).join(p);
+        if alt.exists() {
+            return alt;
+        }
+    }
+    p.to_path_buf()
+}
+
+fn usage(msg: impl std::fmt::Display) -> ExitCode {
+    eprintln!("ncchannel run: {msg}");
+    ExitCode::from(exit::USAGE)
+}
+
+pub fn execute(args: RunArgs) -> ExitCode {
+    let params = locate(&args.params);
+    let config = match crate::params::load(&params) {
+        Ok(c) => c,
+        Err(e) => {
+            for d in e.diagnostics() {
+                eprintln!("{}", d.render());
+            }
+            return usage(format!("parameter lists in {} refused", params.display()));
+        }
+    };
+    for w in &config.warnings {
+        eprintln!("{}", w.render());
+    }
+    let channels = match crate::setup::channels(&config, args.events.is_some()) {
+        Ok(c) => c,
+        Err(e) => return usage(e),
+    };
+    let nch = channels.len();
+    let Some(ch_config) = config.channels.get((args.channel as usize).wrapping_sub(1)) else {
+        return usage(format!("channel {} does not exist (the start-up list has {nch})", args.channel));
+    };
+    let program = match (&args.program, &args.stream) {
+        (Some(p), _) => p.clone(),
+        (None, Some(_)) => match &ch_config.streaming_prog_file {
+            Some(s) => s.clone(),
+            None => return usage(format!("--stream needs streaming_prog_file in {}", ch_config.list_path.display())),
+        },
+        (None, None) => return usage("name a PROGRAM or give --stream FILE"),
+    };
+    let feeder = match &args.stream {
+        None => None,
+        Some(f) => {
+            let f = locate(f);
+            let text = match read_bounded(&f) {
+                Ok(t) => t,
+                Err(e) => return usage(format!("{}: {e}", f.display())),
+            };
+            match Feeder::new(text, args.packet, args.every, args.raw) {
+                Ok(fd) => Some(fd),
+                Err(e) => return usage(format!("{}: {e}", f.display())),
+            }
+        }
+    };
+    let log = match &args.events {
+        None => EventLog::disabled(),
+        Some(t) => match EventLog::open(t) {
+            Ok(l) => l,
+            Err(e) => return usage(format!("--events {t}: {e}")),
+        },
+    };
+    let period = Duration::from_micros(config.runtime.cycle_period_us);
+    let mut machine = Machine::new(channels, log, StopWhen::ProgramsFinished);
+    if let Some(f) = feeder {
+        machine.attach_feeder(args.channel, f);
+    }
+    let tick0 = Tick {
+        index: 0,
+        period,
+        time: Duration::ZERO,
+    };
+    let mut start_failed = false;
+    if let Some(c) = machine.channel_mut(args.channel) {
+        c.set_search(args.search);
+        if let Err(e) = c.start(&tick0, &program) {
+            eprintln!("ncchannel run: {e}");
+            start_failed = true;
+        }
+    }
+    let clock = if args.realtime { Clock::RealTime } else { Clock::Virtual };
+    let (mut rt, _requests) = Runtime::new(machine, period, clock);
+    let summary = if start_failed {
+        None
+    } else {
+        Some(rt.run(args.max_ticks))
+    };
+    let ticks = rt.ticks();
+    let time_s = rt.time().as_secs_f64();
+    let (mut machine, stats) = rt.into_inner();
+    let finish = machine.finishes().get(args.channel as usize - 1).copied().flatten();
+    let outcome = match (summary.map(|s| s.end), finish) {
+        (_, Some(Finish::Ended)) => Outcome::Ended,
+        (_, Some(Finish::Error)) => Outcome::Error,
+        (Some(RunEnd::MaxTicks), _) => Outcome::MaxTicks,
+        _ => Outcome::Error,
+    };
+    let c = &machine.channels()[args.channel as usize - 1];
+    let report = Report {
+        outcome,
+        ticks,
+        time_s,
+        wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
+        blocks: c.stats().blocks,
+        position: c.axis_positions().into_iter().map(|(a, v)| (a.to_string(), v)).collect::<BTreeMap<_, _>>(),
+        stream: StreamReport::from(c.stream().counters()),
+        interrupts: c.stats().interrupts,
+        errors: c.errors().iter().map(|(code, msg)| ErrorReport { code: *code, msg: msg.clone() }).collect(),
+        cycle: CycleReport::new(period, &stats),
+    };
+    if let Err(e) = machine.finish_log() {
+        eprintln!("ncchannel run: event log: {e}");
+    }
+    if let Some(p) = &args.report {
+        if let Err(e) = report.write_file(p) {
+            eprintln!("ncchannel run: --report {}: {e}", p.display());
+        }
+    }
+    // The summary goes to stderr when the events go to stdout, so a pipe gets pure JSON Lines.
+    let to_stderr = args.events.as_deref() == Some("-");
+    let r = if to_stderr {
+        report.print_human(&mut std::io::stderr())
+    } else {
+        report.print_human(&mut std::io::stdout())
+    };
+    let _ = r;
+    ExitCode::from(match outcome {
+        Outcome::Ended => exit::OK,
+        Outcome::Error => exit::CHANNEL_ERROR,
+        Outcome::MaxTicks => exit::MAX_TICKS,
+    })
+}
+
+fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let f = std::fs::File::open(p)?;
+    let mut buf = Vec::new();
+    f.take(MAX_STREAM_FILE_BYTES + 1).read_to_end(&mut buf)?;
+    if buf.len() as u64 > MAX_STREAM_FILE_BYTES {
+        return Err(std::io::Error::other(format!("larger than {MAX_STREAM_FILE_BYTES} bytes")));
+    }
+    Ok(buf)
+}

@@ -1,0 +1,92 @@
+//! From checked parameter lists to channels: the one place that turns `params::Config` into
+//! the settings each machine part takes.
+
+use thiserror::Error;
+
+use crate::channel::{Channel, ChannelSettings};
+use crate::decoder::DecoderSettings;
+use crate::motion::AxisLimits;
+use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
+use crate::queue::{AXIS_LETTERS, MAX_AXES};
+use crate::source::cache::CacheLimits;
+use crate::source::store::{SearchDir, PATH_MAIN, PATH_SUB};
+
+#[derive(Debug, Error)]
+pub enum SetupError {
+    #[error("axis '{0}' in runtime.toml: ncchannel knows the axes X Y Z A B C")]
+    UnknownAxis(String),
+    #[error("channel {0} does not exist (the start-up list has {1})")]
+    NoSuchChannel(u32, usize),
+}
+
+/// Axis limits of the configured axes, by `AXIS_LETTERS` index.
+pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
+    config
+        .runtime
+        .axes
+        .iter()
+        .map(|a| {
+            let letter = a.name.trim().to_ascii_uppercase();
+            let index = AXIS_LETTERS
+                .iter()
+                .position(|&l| letter.len() == 1 && letter.as_bytes()[0] == l)
+                .ok_or_else(|| SetupError::UnknownAxis(a.name.clone()))?;
+            Ok(AxisLimits {
+                index,
+                max_velocity_mm_per_min: a.max_velocity_mm_per_min,
+                max_accel_mm_per_s2: a.max_accel_mm_per_s2,
+                rapid_mm_per_min: a.rapid_mm_per_min,
+                min_mm: a.soft_limit_min_mm,
+                max_mm: a.soft_limit_max_mm,
+            })
+        })
+        .collect()
+}
+
+/// Settings of one channel (0-based index in the start-up list).
+pub fn channel_settings(config: &Config, ch: &ChannelConfig) -> Result<ChannelSettings, SetupError> {
+    let axes = axes(config)?;
+    let mut enabled = [false; MAX_AXES];
+    for a in &axes {
+        enabled[a.index] = true;
+    }
+    let rt = &config.runtime;
+    let decoder = DecoderSettings {
+        blocks_per_tick: rt.decoder.blocks_per_tick.max(1) as usize,
+        max_depth: rt.decoder.max_subroutine_depth as usize,
+        axes: enabled,
+        ..DecoderSettings::default()
+    };
+    let search_dirs = ch
+        .search_paths
+        .iter()
+        .map(|p| SearchDir {
+            dir: p.dir.clone(),
+            kinds: (if p.kinds & MAIN_PROGRAMS != 0 { PATH_MAIN } else { 0 }) | (if p.kinds & SUBROUTINES != 0 { PATH_SUB } else { 0 }),
+            priority: u32::from(p.priority),
+        })
+        .collect();
+    let c = &ch.decoder.cache;
+    Ok(ChannelSettings {
+        number: ch.index as u32 + 1,
+        decoder,
+        queue_capacity: (rt.planner.lookahead_blocks + rt.decoder.buffer_blocks).max(1) as usize,
+        axes,
+        search_dirs,
+        streaming_prog: ch.streaming_prog_file.clone(),
+        cache: CacheLimits {
+            enabled: c.enabled,
+            max_files: c.max_files as usize,
+            max_file_bytes: u64::from(c.max_file_bytes),
+        },
+    })
+}
+
+/// Every channel of the configuration.
+pub fn channels(config: &Config, events: bool) -> Result<Vec<Channel>, SetupError> {
+    config
+        .channels
+        .iter()
+        .map(|ch| Ok(Channel::new(channel_settings(config, ch)?, events)))
+        .collect()
+}
