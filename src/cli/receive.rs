@@ -38,10 +38,10 @@ pub struct ReceiveArgs {
     #[arg(long, value_name = "ADDR:PORT")]
     pub listen: Option<String>,
     /// With --listen: stop after this many transfers.
-    #[arg(long, value_name = "N", requires = "listen")]
+    #[arg(long, value_name = "N")]
     pub max_transfers: Option<usize>,
     /// With --listen: end a connection silent for this many seconds (a broken transfer).
-    #[arg(long, value_name = "SECONDS", requires = "listen")]
+    #[arg(long, value_name = "SECONDS")]
     pub idle_timeout: Option<f64>,
     /// Replace existing program files (default: keep them and drop the received program).
     #[arg(long)]
@@ -97,6 +97,11 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     } else {
         Anchor::Anywhere
     };
+    if args.listen.is_none() && (args.max_transfers.is_some() || args.idle_timeout.is_some()) {
+        return Err(Failure::Usage(
+            "--max-transfers and --idle-timeout need --listen".to_string(),
+        ));
+    }
     let markers = Markers::new(&args.start, &args.end, anchor)?;
     let template = NameTemplate::parse(&args.name_template)?;
     let idle = match args.idle_timeout {
