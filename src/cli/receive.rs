@@ -1,15 +1,252 @@
-//! `ncchannel receive`: split a transfer into programs by start/end markers.
+//! `ncchannel receive`: split a transfer into programs by start/end markers and file them in
+//! the program directory.
+//!
+//! Standard output carries the receive log (one line per program filed or dropped) and the
+//! summary; operator messages (no start marker, cut-off transfer, kept files, refused names)
+//! go to standard error. Exit 0 when at least one program was filed and none was cut off,
+//! 1 when no program was filed or a transfer broke inside a program, 2 for bad usage.
 
-use std::path::PathBuf;
+use std::fs::File;
+use std::io::{self, Write};
+use std::net::{SocketAddr, TcpListener};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Duration;
+
+use crate::dnc::{
+    self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram,
+    Splitter, TransferEnd, TransferReport, WriterConfig,
+};
+
+use super::exit;
 
 #[derive(Debug, clap::Args)]
 pub struct ReceiveArgs {
-    /// Input file, or `-` for standard input.
+    /// Input file, or `-` for standard input (the default without --listen).
+    #[arg(conflicts_with = "listen")]
     pub input: Option<PathBuf>,
+    /// Program start marker (up to 3). Matched anywhere in a line, case-sensitive.
+    #[arg(long = "start", value_name = "S")]
+    pub start: Vec<String>,
+    /// Program end marker (up to 3). Matched anywhere in a line, case-sensitive.
+    #[arg(long = "end", value_name = "S")]
+    pub end: Vec<String>,
+    /// Program directory (default: the channel's first program path).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Take transfers on a TCP port, one connection per transfer. `PORT` alone binds loopback.
+    #[arg(long, value_name = "ADDR:PORT")]
+    pub listen: Option<String>,
+    /// With --listen: stop after this many transfers.
+    #[arg(long, value_name = "N")]
+    pub max_transfers: Option<usize>,
+    /// With --listen: end a connection silent for this many seconds (a broken transfer).
+    #[arg(long, value_name = "SECONDS")]
+    pub idle_timeout: Option<f64>,
+    /// Replace existing program files (default: keep them and drop the received program).
+    #[arg(long)]
+    pub overwrite: bool,
+    /// Keep a program cut off by the end of the transfer as `<name>.partial`.
+    #[arg(long)]
+    pub keep_partial: bool,
+    /// Markers count only at the very beginning of a line.
+    #[arg(long)]
+    pub at_line_start: bool,
+    /// Names for programs whose data names none; `{n}` or `{n:W}` is the number.
+    #[arg(long, value_name = "TEMPLATE", default_value = "received_{n}.nc")]
+    pub name_template: String,
+}
+
+/// Where programs go without `--out`: the channel's first program path.
+// The lead wires this to the parameter lists' search paths; until then the demo folder.
+pub fn default_out_dir() -> PathBuf {
+    PathBuf::from("nc")
 }
 
 pub fn execute(args: ReceiveArgs) -> ExitCode {
-    let _ = args;
-    ExitCode::from(super::exit::USAGE)
+    match run(args) {
+        Ok(code) => ExitCode::from(code),
+        Err(Failure::Usage(msg)) => {
+            eprintln!("ncchannel receive: {msg}");
+            ExitCode::from(exit::USAGE)
+        }
+        Err(Failure::Io(msg)) => {
+            eprintln!("ncchannel receive: {msg}");
+            ExitCode::from(exit::CHANNEL_ERROR)
+        }
+    }
+}
+
+enum Failure {
+    Usage(String),
+    Io(String),
+}
+
+impl From<dnc::DncError> for Failure {
+    fn from(e: dnc::DncError) -> Self {
+        match e {
+            dnc::DncError::Io { .. } => Failure::Io(e.to_string()),
+            _ => Failure::Usage(e.to_string()),
+        }
+    }
+}
+
+fn run(args: ReceiveArgs) -> Result<u8, Failure> {
+    let anchor = if args.at_line_start {
+        Anchor::LineStart
+    } else {
+        Anchor::Anywhere
+    };
+    if args.listen.is_none() && (args.max_transfers.is_some() || args.idle_timeout.is_some()) {
+        return Err(Failure::Usage(
+            "--max-transfers and --idle-timeout need --listen".to_string(),
+        ));
+    }
+    let markers = Markers::new(&args.start, &args.end, anchor)?;
+    let template = NameTemplate::parse(&args.name_template)?;
+    let idle = match args.idle_timeout {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
+        Some(s) => return Err(Failure::Usage(format!("--idle-timeout {s}: not a positive time"))),
+    };
+    let out = args.out.clone().unwrap_or_else(default_out_dir);
+    let mut cfg = WriterConfig::new(&out);
+    cfg.overwrite = args.overwrite;
+    cfg.keep_partial = args.keep_partial;
+    cfg.template = template;
+    let mut writer = ProgramWriter::new(cfg).with_log(log_line);
+    let mut splitter = Splitter::new(markers);
+
+    let mut total = Totals::default();
+    if let Some(addr) = &args.listen {
+        let addr = parse_listen(addr).map_err(Failure::Usage)?;
+        let listener =
+            TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
+        let local = listener
+            .local_addr()
+            .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
+        eprintln!("listening on {local}");
+        dnc::receive_connections(
+            &listener,
+            args.max_transfers,
+            idle,
+            &mut splitter,
+            &mut writer,
+            |r| total.add(r),
+        )?;
+    } else {
+        let report = match args.input.as_deref() {
+            None => dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?,
+            Some(p) if p == Path::new("-") => {
+                dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?
+            }
+            Some(p) => {
+                let f = File::open(p).map_err(|e| Failure::Io(format!("{}: {e}", p.display())))?;
+                dnc::receive(f, &mut splitter, &mut writer)?
+            }
+        };
+        total.add(&report);
+    }
+    total.print(&out);
+    Ok(if total.filed > 0 && total.cut_off == 0 {
+        exit::OK
+    } else {
+        exit::CHANNEL_ERROR
+    })
+}
+
+/// `PORT` → loopback, `ADDR:PORT` as given.
+fn parse_listen(s: &str) -> Result<SocketAddr, String> {
+    if let Ok(port) = s.parse::<u16>() {
+        return Ok(SocketAddr::from(([127, 0, 0, 1], port)));
+    }
+    s.parse::<SocketAddr>()
+        .map_err(|_| format!("--listen {s}: expected ADDR:PORT or PORT"))
+}
+
+/// The receive log: one line per program, on standard output as it is filed.
+fn log_line(p: &ReceivedProgram) {
+    let what = match p.disposition {
+        Disposition::Written => "received",
+        Disposition::Replaced => "replaced",
+        Disposition::KeptExisting => "kept existing",
+        Disposition::CutOffDropped => "cut off, dropped",
+        Disposition::CutOffKept => "cut off, kept",
+    };
+    let mut out = io::stdout().lock();
+    let _ = writeln!(
+        out,
+        "{what} {} ({} bytes, lines {}-{})",
+        p.path.display(),
+        p.bytes,
+        p.first_line,
+        p.last_line
+    );
+    let _ = out.flush();
+    for name in &p.rejected_names {
+        eprintln!(
+            "ncchannel receive: name `{name}` in lines {}-{} is not a plain file name; numbered instead",
+            p.first_line, p.last_line
+        );
+    }
+    match p.disposition {
+        Disposition::KeptExisting => eprintln!(
+            "ncchannel receive: {} exists and was kept; the received program was dropped (use --overwrite)",
+            p.path.display()
+        ),
+        Disposition::CutOffDropped => eprintln!(
+            "ncchannel receive: the transfer ended inside the program from line {}; it was dropped (--keep-partial keeps it)",
+            p.first_line
+        ),
+        _ => {}
+    }
+}
+
+#[derive(Default)]
+struct Totals {
+    transfers: usize,
+    filed: usize,
+    kept: usize,
+    cut_off: usize,
+    bytes: u64,
+}
+
+impl Totals {
+    fn add(&mut self, r: &TransferReport) {
+        self.transfers += 1;
+        self.filed += r.filed();
+        self.kept += r
+            .programs
+            .iter()
+            .filter(|p| p.disposition == Disposition::KeptExisting)
+            .count();
+        self.cut_off += r.split.cut_off;
+        self.bytes += r.split.bytes_in;
+        let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
+        if r.split.no_start_marker() {
+            eprintln!(
+                "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
+                r.split.bytes_in
+            );
+        }
+        match &r.end {
+            TransferEnd::Complete => {}
+            TransferEnd::IdleTimeout => {
+                eprintln!("ncchannel receive: transfer{from} timed out")
+            }
+            TransferEnd::Broken(e) => eprintln!("ncchannel receive: transfer{from} broke: {e}"),
+        }
+    }
+
+    fn print(&self, out: &Path) {
+        println!(
+            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off",
+            self.filed,
+            out.display(),
+            self.transfers,
+            self.bytes,
+            self.kept,
+            self.cut_off
+        );
+    }
 }

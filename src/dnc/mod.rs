@@ -1,1 +1,22 @@
-//! Receiving NC data split into programs by start/end markers (SINUMERIK style).
+//! Receiving NC data split into programs by start/end markers (SINUMERIK Manage MyPrograms
+//! style): the splitter state machine, the name lines, and the atomic program writer.
+//!
+//! Data flows `Read` → [`Splitter`] (pure, any chunk sizes) → [`ProgramSink`] →
+//! [`ProgramWriter`] (temp file, fsync, rename). [`transfer`] ties them to a file, standard
+//! input or a TCP port.
+
+pub mod control_line;
+pub mod error;
+pub mod markers;
+pub mod splitter;
+pub mod transfer;
+pub mod writer;
+
+pub use control_line::{NameInfo, SinumerikName};
+pub use error::DncError;
+pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
+pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
+pub use transfer::{receive, receive_connections, TransferEnd, TransferReport};
+pub use writer::{
+    Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig,
+};

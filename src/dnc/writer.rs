@@ -1,0 +1,400 @@
+//! Filing received programs: each program streams into a temporary file in the program
+//! directory, is flushed to disk, and only then renamed to its final name, so a crash or a
+//! broken transfer never leaves part of a program under a name the channel would run.
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use super::error::DncError;
+use super::splitter::{ProgramEnd, ProgramSink, ProgramStart};
+
+/// Numbered file names for programs whose data names none: `received_{n}.nc` gives
+/// `received_001.nc`, `received_002.nc`, …; `{n:W}` sets the digits (default 3).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NameTemplate {
+    prefix: String,
+    suffix: String,
+    width: usize,
+}
+
+impl Default for NameTemplate {
+    fn default() -> Self {
+        NameTemplate {
+            prefix: "received_".into(),
+            suffix: ".nc".into(),
+            width: 3,
+        }
+    }
+}
+
+impl NameTemplate {
+    pub fn parse(template: &str) -> Result<Self, DncError> {
+        let bad = |reason| DncError::BadTemplate {
+            template: template.to_string(),
+            reason,
+        };
+        let open = template.find("{n").ok_or_else(|| bad("no `{n}` placeholder"))?;
+        let close = template[open..]
+            .find('}')
+            .map(|i| open + i)
+            .ok_or_else(|| bad("unclosed `{n`"))?;
+        let spec = &template[open + 2..close];
+        let width = match spec.strip_prefix(':') {
+            None if spec.is_empty() => 3,
+            Some(w) => w
+                .parse::<usize>()
+                .ok()
+                .filter(|w| (1..=9).contains(w))
+                .ok_or_else(|| bad("the width in `{n:W}` must be 1 to 9"))?,
+            None => return Err(bad("write `{n}` or `{n:W}`")),
+        };
+        let t = NameTemplate {
+            prefix: template[..open].to_string(),
+            suffix: template[close + 1..].to_string(),
+            width,
+        };
+        if t.prefix.contains('{') || t.suffix.contains('{') {
+            return Err(bad("only one `{n}` placeholder"));
+        }
+        if super::control_line::safe_name(t.render(1).as_bytes()).is_none() {
+            return Err(bad(
+                "the name must be one plain file name (letters, digits, `_`, `-`, `.`)",
+            ));
+        }
+        Ok(t)
+    }
+
+    pub fn render(&self, n: u32) -> String {
+        format!("{}{:0w$}{}", self.prefix, n, self.suffix, w = self.width)
+    }
+}
+
+/// How the program files are placed.
+#[derive(Debug, Clone)]
+pub struct WriterConfig {
+    /// The program directory; created when missing.
+    pub out_dir: PathBuf,
+    /// Replace an existing file of the same name (otherwise the existing file is kept and the
+    /// received program dropped).
+    pub overwrite: bool,
+    /// Keep a cut-off program as `<final name>.partial` instead of dropping it.
+    pub keep_partial: bool,
+    pub template: NameTemplate,
+}
+
+impl WriterConfig {
+    pub fn new(out_dir: impl Into<PathBuf>) -> Self {
+        WriterConfig {
+            out_dir: out_dir.into(),
+            overwrite: false,
+            keep_partial: false,
+            template: NameTemplate::default(),
+        }
+    }
+}
+
+/// What became of one received program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Disposition {
+    /// Written under a new name.
+    Written,
+    /// Written over an existing file (`--overwrite`).
+    Replaced,
+    /// A file of that name existed; it was kept and the received program dropped.
+    KeptExisting,
+    /// The transfer stopped inside the program; nothing was kept.
+    CutOffDropped,
+    /// The transfer stopped inside the program; kept as `<name>.partial`.
+    CutOffKept,
+}
+
+/// One line of the receive log.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReceivedProgram {
+    /// Where the program is (or would have been) filed.
+    pub path: PathBuf,
+    pub bytes: u64,
+    /// Lines of the transfer the program came from (1-based).
+    pub first_line: u64,
+    pub last_line: u64,
+    pub disposition: Disposition,
+    /// Names from the data refused as unsafe.
+    pub rejected_names: Vec<String>,
+}
+
+impl ReceivedProgram {
+    /// Is the program now on disk under its final name?
+    pub fn is_filed(&self) -> bool {
+        matches!(
+            self.disposition,
+            Disposition::Written | Disposition::Replaced
+        )
+    }
+}
+
+/// How many taken numbered names are skipped at most when looking for a free one.
+const MAX_NUMBER_PROBES: u32 = 100_000;
+
+struct TempProgram {
+    path: PathBuf,
+    file: BufWriter<File>,
+}
+
+/// Files the programs the splitter delivers; see the module doc for the guarantees.
+pub struct ProgramWriter {
+    cfg: WriterConfig,
+    current: Option<TempProgram>,
+    next_number: u32,
+    temp_seq: u64,
+    records: Vec<ReceivedProgram>,
+    log: Option<Box<dyn FnMut(&ReceivedProgram)>>,
+}
+
+impl ProgramWriter {
+    pub fn new(cfg: WriterConfig) -> Self {
+        ProgramWriter {
+            cfg,
+            current: None,
+            next_number: 1,
+            temp_seq: 0,
+            records: Vec::new(),
+            log: None,
+        }
+    }
+
+    /// Called for every program as soon as it is filed (or dropped).
+    pub fn with_log(mut self, log: impl FnMut(&ReceivedProgram) + 'static) -> Self {
+        self.log = Some(Box::new(log));
+        self
+    }
+
+    pub fn config(&self) -> &WriterConfig {
+        &self.cfg
+    }
+
+    /// The records since the last call.
+    pub fn take_records(&mut self) -> Vec<ReceivedProgram> {
+        std::mem::take(&mut self.records)
+    }
+
+    /// Drop a program still being written (the transfer was abandoned).
+    pub fn discard_current(&mut self) {
+        if let Some(t) = self.current.take() {
+            drop(t.file);
+            let _ = fs::remove_file(&t.path);
+        }
+    }
+
+    fn record(&mut self, r: ReceivedProgram) {
+        if let Some(log) = self.log.as_mut() {
+            log(&r);
+        }
+        self.records.push(r);
+    }
+
+    /// The next numbered name not yet on disk (or simply the next number with `overwrite`).
+    /// Bounded: after [`MAX_NUMBER_PROBES`] taken names the next one is used anyway (and the
+    /// existing file kept).
+    fn numbered(&mut self) -> String {
+        let mut probes = 0;
+        loop {
+            let name = self.cfg.template.render(self.next_number);
+            self.next_number = self.next_number.saturating_add(1);
+            probes += 1;
+            if self.cfg.overwrite
+                || probes >= MAX_NUMBER_PROBES
+                || !self.cfg.out_dir.join(&name).exists()
+            {
+                return name;
+            }
+        }
+    }
+
+    fn file(&mut self, end: ProgramEnd) -> Result<(), DncError> {
+        let Some(mut tmp) = self.current.take() else {
+            return Ok(());
+        };
+        let done = tmp
+            .file
+            .flush()
+            .and_then(|_| tmp.file.get_ref().sync_all());
+        if let Err(e) = done {
+            drop(tmp.file);
+            let _ = fs::remove_file(&tmp.path);
+            return Err(DncError::io(&tmp.path, e));
+        }
+        drop(tmp.file);
+
+        let (dir, name) = match end.name.file_name() {
+            Some(n) => n,
+            None => (None, self.numbered()),
+        };
+        let parent = match &dir {
+            Some(d) => self.cfg.out_dir.join(d),
+            None => self.cfg.out_dir.clone(),
+        };
+        let mut target = parent.join(&name);
+        let mut record = ReceivedProgram {
+            path: target.clone(),
+            bytes: end.bytes,
+            first_line: end.first_line,
+            last_line: end.last_line,
+            disposition: Disposition::Written,
+            rejected_names: end.name.rejected.clone(),
+        };
+        if !end.complete {
+            if !self.cfg.keep_partial {
+                let _ = fs::remove_file(&tmp.path);
+                record.disposition = Disposition::CutOffDropped;
+                self.record(record);
+                return Ok(());
+            }
+            target = parent.join(format!("{name}.partial"));
+            record.path = target.clone();
+        }
+        if let Err(e) = fs::create_dir_all(&parent) {
+            let _ = fs::remove_file(&tmp.path);
+            return Err(DncError::io(&parent, e));
+        }
+        let placed = place(&tmp.path, &target, self.cfg.overwrite);
+        match placed {
+            Ok(p) => {
+                record.disposition = match (p, end.complete) {
+                    (Placed::Kept, _) => Disposition::KeptExisting,
+                    (_, false) => Disposition::CutOffKept,
+                    (Placed::New, true) => Disposition::Written,
+                    (Placed::Replaced, true) => Disposition::Replaced,
+                };
+                if p != Placed::Kept {
+                    sync_dir(&parent).map_err(|e| DncError::io(&parent, e))?;
+                }
+                self.record(record);
+                Ok(())
+            }
+            Err(e) => {
+                let _ = fs::remove_file(&tmp.path);
+                Err(DncError::io(&target, e))
+            }
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Placed {
+    New,
+    Replaced,
+    Kept,
+}
+
+/// Move the finished temporary file to its name in one atomic step. Without `overwrite` a hard
+/// link creates the name only if it does not exist yet (no window between test and rename).
+fn place(tmp: &Path, target: &Path, overwrite: bool) -> io::Result<Placed> {
+    if overwrite {
+        let existed = target.exists();
+        fs::rename(tmp, target)?;
+        return Ok(if existed {
+            Placed::Replaced
+        } else {
+            Placed::New
+        });
+    }
+    match fs::hard_link(tmp, target) {
+        Ok(()) => {
+            fs::remove_file(tmp)?;
+            Ok(Placed::New)
+        }
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
+            fs::remove_file(tmp)?;
+            Ok(Placed::Kept)
+        }
+        Err(_) => {
+            // A file system without hard links: test, then rename.
+            if target.exists() {
+                fs::remove_file(tmp)?;
+                Ok(Placed::Kept)
+            } else {
+                fs::rename(tmp, target)?;
+                Ok(Placed::New)
+            }
+        }
+    }
+}
+
+/// Make the rename itself durable.
+fn sync_dir(dir: &Path) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        File::open(dir)?.sync_all()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        Ok(())
+    }
+}
+
+impl ProgramSink for ProgramWriter {
+    type Error = DncError;
+
+    fn start(&mut self, _start: &ProgramStart) -> Result<(), DncError> {
+        self.discard_current();
+        let dir = &self.cfg.out_dir;
+        fs::create_dir_all(dir).map_err(|e| DncError::io(dir, e))?;
+        self.temp_seq += 1;
+        let path = dir.join(format!(
+            ".ncchannel-receive-{}-{}.tmp",
+            std::process::id(),
+            self.temp_seq
+        ));
+        let file = OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+            .map_err(|e| DncError::io(&path, e))?;
+        self.current = Some(TempProgram {
+            path,
+            file: BufWriter::with_capacity(64 * 1024, file),
+        });
+        Ok(())
+    }
+
+    fn data(&mut self, bytes: &[u8]) -> Result<(), DncError> {
+        if let Some(t) = self.current.as_mut() {
+            if let Err(e) = t.file.write_all(bytes) {
+                let path = t.path.clone();
+                self.discard_current();
+                return Err(DncError::io(path, e));
+            }
+        }
+        Ok(())
+    }
+
+    fn end(&mut self, end: ProgramEnd) -> Result<(), DncError> {
+        self.file(end)
+    }
+}
+
+impl Drop for ProgramWriter {
+    fn drop(&mut self) {
+        self.discard_current();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn template_numbers_and_checks() {
+        let t = NameTemplate::default();
+        assert_eq!(t.render(1), "received_001.nc");
+        let t = NameTemplate::parse("prog{n:4}.mpf").unwrap();
+        assert_eq!(t.render(12), "prog0012.mpf");
+        assert!(NameTemplate::parse("plain.nc").is_err());
+        assert!(NameTemplate::parse("../x{n}.nc").is_err());
+        assert!(NameTemplate::parse("a/{n}.nc").is_err());
+        assert!(NameTemplate::parse("{n:0}.nc").is_err());
+        assert!(NameTemplate::parse("{n}{n}.nc").is_err());
+    }
+}
