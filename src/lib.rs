@@ -4,6 +4,7 @@
 //! interpolator → events. Each room below owns one machine part; see the
 //! README's architecture section for who may talk to whom.
 
+pub mod ads;
 pub mod cli;
 pub mod diag;
 pub mod dnc;
