@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 pub mod check;
 pub mod receive;
+pub mod stream;
 
 /// Exit codes of the command-line contract (DESIGN.md).
 pub mod exit {
@@ -38,6 +39,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
+    /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
+    Stream(stream::StreamArgs),
 }
 
 impl Cli {
@@ -45,6 +48,7 @@ impl Cli {
         match self.command {
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
+            Some(Command::Stream(args)) => stream::execute(args),
             None => {
                 eprintln!("ncchannel: no subcommand (the demo needs `run`, not built yet)");
                 ExitCode::from(exit::USAGE)
