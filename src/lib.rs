@@ -4,6 +4,7 @@
 //! interpolator → events. Each room below owns one machine part; see the
 //! README's architecture section for who may talk to whom.
 
+pub mod ads;
 pub mod channel;
 pub mod cli;
 pub mod decoder;
@@ -17,4 +18,5 @@ pub mod params;
 pub mod queue;
 pub mod report;
 pub mod runtime;
+pub mod setup;
 pub mod source;

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod check;
 pub mod receive;
+pub mod stream;
 
 /// Exit codes of the command-line contract (DESIGN.md).
 pub mod exit {
@@ -41,6 +42,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
+    /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
+    Stream(stream::StreamArgs),
 }
 
 impl Cli {
@@ -49,6 +52,7 @@ impl Cli {
             Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
+            Some(Command::Stream(args)) => stream::execute(args),
             None => {
                 eprintln!("ncchannel: no subcommand (the demo needs `run`, not built yet)");
                 ExitCode::from(exit::USAGE)

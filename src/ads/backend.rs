@@ -1,0 +1,130 @@
+//! The seam between the ADS object table and whatever holds the channels.
+//!
+//! The object table never touches channel state: it decodes (group, offset, bytes), calls one
+//! method here, and encodes the answer. The runtime implements this trait by sending a request
+//! into its fixed-cycle loop and waiting for the reply (at most one tick); `MemoryBackend`
+//! implements it with an in-memory stand-in channel. Calls come from the server's connection
+//! threads and may block briefly.
+//!
+//! Channel numbers are 1-based everywhere in this trait (`1..=channel_count()`), as in the
+//! index group `0x20100 + ch`; the object table never passes 0 or a number above the count.
+
+use super::result::AdsResult;
+
+/// Channel modes (REFERENCE §7).
+pub mod mode {
+    pub const STANDBY: i32 = 1;
+    pub const AUTOMATIC: i32 = 2;
+    pub const MDI: i32 = 3;
+    pub const MANUAL: i32 = 4;
+    pub const REFERENCE: i32 = 5;
+}
+
+/// Channel states (REFERENCE §7).
+pub mod state {
+    pub const DESELECTED: i32 = 1;
+    pub const SELECTED: i32 = 2;
+    pub const READY: i32 = 3;
+    pub const ACTIVE: i32 = 4;
+    pub const HOLD: i32 = 5;
+    pub const ERROR: i32 = 6;
+}
+
+/// How one stream write (offset 0x90) went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StreamWriteOutcome {
+    /// The packet is in the stream buffer. ADS result 0.
+    Accepted,
+    /// The buffer cannot take it now; the channel raised warning 11012. ADS result 0x708.
+    Full,
+    /// Empty, or larger than 992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE). ADS result 0x705.
+    BadSize,
+    /// A line lacks CR LF; the channel raised error 21476 and aborted streaming. ADS 0x706.
+    NoLineEnd,
+    /// Refused for another reason (e.g. the channel is gone).
+    Refused(DeviceError),
+}
+
+impl StreamWriteOutcome {
+    pub fn result(self) -> AdsResult {
+        match self {
+            StreamWriteOutcome::Accepted => AdsResult::OK,
+            StreamWriteOutcome::Full => AdsResult::BUSY,
+            StreamWriteOutcome::BadSize => AdsResult::INVALID_SIZE,
+            StreamWriteOutcome::NoLineEnd => AdsResult::INVALID_DATA,
+            StreamWriteOutcome::Refused(e) => e.result(),
+        }
+    }
+}
+
+/// Why a channel request failed; each maps to one ADS result code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum DeviceError {
+    /// The channel cannot do that in its current mode/state (0x707).
+    #[error("device not ready")]
+    NotReady,
+    /// Try again shortly (0x708).
+    #[error("device busy")]
+    Busy,
+    /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
+    #[error("invalid parameter value")]
+    InvalidValue,
+    /// A named thing does not exist, e.g. an unknown V.E. variable (0x70C).
+    #[error("not found")]
+    NotFound,
+}
+
+impl DeviceError {
+    pub fn result(self) -> AdsResult {
+        match self {
+            DeviceError::NotReady => AdsResult::NOT_READY,
+            DeviceError::Busy => AdsResult::BUSY,
+            DeviceError::InvalidValue => AdsResult::INVALID_DATA,
+            DeviceError::NotFound => AdsResult::NOT_FOUND,
+        }
+    }
+}
+
+/// Fill level of a channel's stream buffer, in bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StreamFill {
+    pub used_bytes: u32,
+    pub free_bytes: u32,
+}
+
+/// What the ADS object table needs from the channels. Implemented by the runtime (and by
+/// `MemoryBackend` for tests). `ch` is 1-based.
+pub trait CncBackend: Send + Sync + 'static {
+    /// Number of channels; index groups exist for `1..=channel_count()`.
+    fn channel_count(&self) -> u16;
+    /// Offer one packet (one or more whole CR LF lines) to the stream buffer.
+    fn stream_write(&self, ch: u16, data: &[u8]) -> StreamWriteOutcome;
+    /// Current (mode, state), REFERENCE §7 numbers.
+    fn mode_state(&self, ch: u16) -> Result<(i32, i32), DeviceError>;
+    /// Command a mode (`mode::*`).
+    fn command_mode(&self, ch: u16, mode: i32) -> Result<(), DeviceError>;
+    /// Command a state (`state::*`; ACTIVE starts the selected program).
+    fn command_state(&self, ch: u16, state: i32) -> Result<(), DeviceError>;
+    /// Select the program the next ACTIVE starts.
+    fn command_program(&self, ch: u16, name: &str) -> Result<(), DeviceError>;
+    /// Feed hold (automatic stop).
+    fn hold(&self, ch: u16) -> Result<(), DeviceError>;
+    /// Resume after hold.
+    fn resume(&self, ch: u16) -> Result<(), DeviceError>;
+    /// Channel reset: back to READY, streaming off, stream buffer deleted.
+    fn reset(&self, ch: u16) -> Result<(), DeviceError>;
+    /// The last error message (e.g. "21476 Streaming data does not contain …"), "" if none.
+    fn last_error(&self, ch: u16) -> Result<String, DeviceError>;
+    /// Stream buffer fill level.
+    fn stream_fill(&self, ch: u16) -> Result<StreamFill, DeviceError>;
+    /// Blocks that took effect since the channel started (the ISG block counter).
+    fn block_counter(&self, ch: u16) -> Result<u64, DeviceError>;
+    /// Actual axis positions in mm, in the channel's axis order.
+    fn positions(&self, ch: u16) -> Result<Vec<f64>, DeviceError>;
+    /// Feed override in percent, 0..=200.
+    fn set_override(&self, ch: u16, percent: f64) -> Result<(), DeviceError>;
+    /// Read an external variable `V.E.<name>` (name given without the `V.E.` prefix).
+    fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError>;
+    /// Write an external variable `V.E.<name>`.
+    fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError>;
+}

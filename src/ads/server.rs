@@ -1,0 +1,618 @@
+//! The ADS/TCP server: accepts connections, frames requests, answers them through the object
+//! table, and pushes DeviceNotification frames.
+//!
+//! One thread per connection (at most `max_connections`, default 64; more are closed at once
+//! with a log line), plus one notification thread per connection that has notification
+//! handles. Channel calls may block for up to a runtime tick; that only holds up the
+//! connection that asked. Compatibility rules are REFERENCE §8; each is marked `rule n` below.
+
+use std::collections::HashMap;
+use std::io::{self, Read, Write};
+use std::net::{IpAddr, Ipv4Addr, Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+use super::backend::CncBackend;
+use super::frame::{
+    self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame, AMS_ERR_MACHINE_NOT_FOUND,
+    AMS_ERR_PORT_NOT_FOUND, FLAGS_REQUEST,
+};
+use super::objects::{self, PORT_CNC_COM};
+use super::payload::{self, response, NotificationRequest, Request};
+use super::result::AdsResult;
+
+/// Default bind address: loopback only, the standard ADS/TCP port.
+pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), 48898);
+/// Default bound on simultaneous connections.
+pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
+/// Default bound on notification handles per connection.
+pub const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
+/// Notification cycle times are clamped to this range.
+pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
+pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
+
+/// One entry of the route allow-list: a client NetId or a peer IP address.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RouteEntry {
+    NetId(AmsNetId),
+    Ip(IpAddr),
+}
+
+impl FromStr for RouteEntry {
+    type Err = String;
+
+    /// `a.b.c.d.e.f` is a NetId; anything `IpAddr` parses is an address.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if let Ok(id) = s.parse::<AmsNetId>() {
+            return Ok(RouteEntry::NetId(id));
+        }
+        s.parse::<IpAddr>()
+            .map(RouteEntry::Ip)
+            .map_err(|_| format!("route {s:?} is neither an AMS NetId nor an IP address"))
+    }
+}
+
+/// Server settings (the runtime config's `[ads]` table maps onto this).
+#[derive(Debug, Clone)]
+pub struct ServerConfig {
+    /// Where to listen. Default 127.0.0.1:48898.
+    pub bind: SocketAddr,
+    /// A non-loopback `bind` is refused unless this is set (and then logs a warning): the
+    /// server moves machine axes on request and has no authentication.
+    pub allow_non_loopback: bool,
+    /// This device's NetId. `Some`: frames addressed to another NetId get AMS error 7.
+    /// `None`: any target NetId is accepted (a single-device emulator).
+    pub net_id: Option<AmsNetId>,
+    /// Upper bound of the AMS/TCP length field; longer frames close the connection.
+    pub max_frame_bytes: usize,
+    /// Simultaneous connections; more are closed at once.
+    pub max_connections: usize,
+    /// Notification handles per connection; more are answered 0x710.
+    pub max_notifications: usize,
+    /// Route allow-list; empty = allow all. A client is served when its peer IP or the
+    /// source NetId of its frame is listed; others are dropped silently (after a log line),
+    /// as a router without a route drops them.
+    pub allow: Vec<RouteEntry>,
+}
+
+impl Default for ServerConfig {
+    fn default() -> Self {
+        ServerConfig {
+            bind: DEFAULT_BIND,
+            allow_non_loopback: false,
+            net_id: None,
+            max_frame_bytes: frame::DEFAULT_MAX_FRAME_BYTES,
+            max_connections: DEFAULT_MAX_CONNECTIONS,
+            max_notifications: DEFAULT_MAX_NOTIFICATIONS,
+            allow: Vec::new(),
+        }
+    }
+}
+
+/// A running server; `shutdown()` (or drop) stops it and closes every connection.
+pub struct ServerHandle {
+    local_addr: SocketAddr,
+    shared: Arc<Shared>,
+    accept: Option<JoinHandle<()>>,
+}
+
+impl ServerHandle {
+    /// The address actually bound (useful with port 0).
+    pub fn local_addr(&self) -> SocketAddr {
+        self.local_addr
+    }
+
+    /// Number of connections currently served.
+    pub fn connections(&self) -> usize {
+        self.shared.active.load(Ordering::SeqCst)
+    }
+
+    /// Stop accepting, close all connections, and wait for the accept thread.
+    pub fn shutdown(mut self) {
+        self.stop();
+    }
+
+    fn stop(&mut self) {
+        if self.shared.stopping.swap(true, Ordering::SeqCst) {
+            return;
+        }
+        // Wake the blocking accept() with a connection of our own.
+        let wake = match self.local_addr.ip() {
+            ip if ip.is_unspecified() => {
+                SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), self.local_addr.port())
+            }
+            _ => self.local_addr,
+        };
+        let _ = TcpStream::connect_timeout(&wake, Duration::from_millis(500));
+        for s in lock(&self.shared.sockets).values() {
+            let _ = s.shutdown(Shutdown::Both);
+        }
+        if let Some(h) = self.accept.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+impl Drop for ServerHandle {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
+
+/// State shared by the accept thread and the connections.
+struct Shared {
+    config: ServerConfig,
+    backend: Arc<dyn CncBackend>,
+    stopping: AtomicBool,
+    active: AtomicUsize,
+    /// Clones of every open socket, to close them on shutdown.
+    sockets: Mutex<HashMap<u64, TcpStream>>,
+    /// Next AMS port handed out by the router "port connect" command.
+    next_router_port: AtomicU16,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+fn log(msg: impl std::fmt::Display) {
+    eprintln!("ncchannel ads: {msg}");
+}
+
+/// Bind and start serving `backend`.
+pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<ServerHandle> {
+    if !config.bind.ip().is_loopback() {
+        if !config.allow_non_loopback {
+            return Err(io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                format!(
+                    "refusing to bind ADS to non-loopback address {} without the explicit opt-in",
+                    config.bind
+                ),
+            ));
+        }
+        log(format_args!(
+            "warning: listening on non-loopback {}: any host that reaches it can command the channel",
+            config.bind
+        ));
+    }
+    let listener = TcpListener::bind(config.bind)?;
+    let local_addr = listener.local_addr()?;
+    let shared = Arc::new(Shared {
+        config,
+        backend,
+        stopping: AtomicBool::new(false),
+        active: AtomicUsize::new(0),
+        sockets: Mutex::new(HashMap::new()),
+        next_router_port: AtomicU16::new(32768),
+    });
+    let accept_shared = Arc::clone(&shared);
+    let accept = std::thread::Builder::new()
+        .name("ads-accept".into())
+        .spawn(move || accept_loop(listener, accept_shared))?;
+    Ok(ServerHandle {
+        local_addr,
+        shared,
+        accept: Some(accept),
+    })
+}
+
+fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
+    let mut next_id: u64 = 0;
+    for stream in listener.incoming() {
+        if shared.stopping.load(Ordering::SeqCst) {
+            return;
+        }
+        let stream = match stream {
+            Ok(s) => s,
+            Err(e) => {
+                log(format_args!("accept failed: {e}"));
+                std::thread::sleep(Duration::from_millis(10));
+                continue;
+            }
+        };
+        let peer = match stream.peer_addr() {
+            Ok(p) => p,
+            Err(_) => continue,
+        };
+        let cfg = &shared.config;
+        let ip_listed = cfg.allow.contains(&RouteEntry::Ip(peer.ip()));
+        let any_netid_routes = cfg.allow.iter().any(|r| matches!(r, RouteEntry::NetId(_)));
+        if !cfg.allow.is_empty() && !ip_listed && !any_netid_routes {
+            log(format_args!("no route for {peer}: connection closed"));
+            let _ = stream.shutdown(Shutdown::Both);
+            continue;
+        }
+        if shared.active.load(Ordering::SeqCst) >= cfg.max_connections {
+            log(format_args!(
+                "{peer}: connection limit {} reached: connection closed",
+                cfg.max_connections
+            ));
+            let _ = stream.shutdown(Shutdown::Both);
+            continue;
+        }
+        next_id += 1;
+        let id = next_id;
+        if let Ok(clone) = stream.try_clone() {
+            lock(&shared.sockets).insert(id, clone);
+        }
+        shared.active.fetch_add(1, Ordering::SeqCst);
+        let conn_shared = Arc::clone(&shared);
+        let spawned = std::thread::Builder::new()
+            .name(format!("ads-conn-{id}"))
+            .spawn(move || {
+                let unrouted_ok = ip_listed || conn_shared.config.allow.is_empty();
+                if let Err(e) = serve_connection(stream, peer, unrouted_ok, &conn_shared) {
+                    log(format_args!("{peer}: {e}"));
+                }
+                lock(&conn_shared.sockets).remove(&id);
+                conn_shared.active.fetch_sub(1, Ordering::SeqCst);
+            });
+        if spawned.is_err() {
+            lock(&shared.sockets).remove(&id);
+            shared.active.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
+
+/// The writing half of a connection, shared by the request loop and the notifier.
+type Writer = Arc<Mutex<TcpStream>>;
+
+fn send(writer: &Writer, bytes: &[u8]) -> io::Result<()> {
+    lock(writer).write_all(bytes)
+}
+
+/// One notification handle.
+struct Notification {
+    /// Where samples go (the requester) and where they come from (the device it addressed).
+    client: AmsAddr,
+    device: AmsAddr,
+    req: NotificationRequest,
+    cycle: Duration,
+    on_change: bool,
+    next_due: Instant,
+    last: Option<Vec<u8>>,
+}
+
+/// Per-connection notification table, polled by the notifier thread.
+struct Notifications {
+    table: Mutex<HashMap<u32, Notification>>,
+    next_handle: AtomicU32,
+    closed: AtomicBool,
+    notifier: Mutex<Option<JoinHandle<()>>>,
+}
+
+/// Why a connection ended with a log line.
+#[derive(Debug, thiserror::Error)]
+enum ConnError {
+    #[error("{0}: connection closed")]
+    Frame(#[from] frame::FrameError),
+    #[error("{0}")]
+    Io(#[from] io::Error),
+}
+
+fn serve_connection(
+    stream: TcpStream,
+    peer: SocketAddr,
+    ip_routed: bool,
+    shared: &Arc<Shared>,
+) -> Result<(), ConnError> {
+    stream.set_nodelay(true)?;
+    stream.set_write_timeout(Some(Duration::from_secs(5)))?;
+    let writer: Writer = Arc::new(Mutex::new(stream.try_clone()?));
+    let notifs = Arc::new(Notifications {
+        table: Mutex::new(HashMap::new()),
+        next_handle: AtomicU32::new(1),
+        closed: AtomicBool::new(false),
+        notifier: Mutex::new(None),
+    });
+    let result = request_loop(stream, peer, ip_routed, shared, &writer, &notifs);
+    notifs.closed.store(true, Ordering::SeqCst);
+    let notifier = lock(&notifs.notifier).take();
+    if let Some(h) = notifier {
+        let _ = h.join();
+    }
+    let _ = lock(&writer).shutdown(Shutdown::Both);
+    result
+}
+
+fn request_loop(
+    mut stream: TcpStream,
+    peer: SocketAddr,
+    ip_routed: bool,
+    shared: &Arc<Shared>,
+    writer: &Writer,
+    notifs: &Arc<Notifications>,
+) -> Result<(), ConnError> {
+    let max = shared.config.max_frame_bytes;
+    let mut buf: Vec<u8> = Vec::with_capacity(8192);
+    let mut chunk = [0u8; 8192];
+    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
+    loop {
+        // Cut every complete frame out of the buffer (rule 1) before reading more; the
+        // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
+        // stays below max_frame_bytes + 6 + one chunk.
+        let mut used = 0;
+        while let Some((frame, n)) = frame::decode(&buf[used..], max)? {
+            used += n;
+            match frame {
+                Frame::Ams { header, data } => {
+                    let routed = ip_routed
+                        || shared
+                            .config
+                            .allow
+                            .contains(&RouteEntry::NetId(header.source.net_id));
+                    if !routed {
+                        if !logged_unrouted.contains(&header.source.net_id) {
+                            log(format_args!(
+                                "{peer}: no route for source NetId {}: frames dropped",
+                                header.source.net_id
+                            ));
+                            logged_unrouted.push(header.source.net_id);
+                        }
+                        continue;
+                    }
+                    if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
+                        send(writer, &reply)?;
+                    }
+                }
+                Frame::Router { command, body } => {
+                    if let Some(reply) = handle_router(command, &body, peer, shared) {
+                        send(writer, &reply)?;
+                    }
+                }
+            }
+        }
+        buf.drain(..used);
+        let n = match stream.read(&mut chunk) {
+            Ok(0) => return Ok(()),
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            Err(e) if shared.stopping.load(Ordering::SeqCst) => {
+                let _ = e;
+                return Ok(());
+            }
+            Err(e) => return Err(e.into()),
+        };
+        buf.extend_from_slice(&chunk[..n]);
+    }
+}
+
+/// AMS router commands. 0x1000 "port connect" (sent by clients that expect a local router,
+/// e.g. the `ads` crate's `Source::Request`) gets a NetId made from the peer's IPv4 address
+/// plus `.1.1` and a fresh port; everything else is ignored.
+fn handle_router(command: u16, _body: &[u8], peer: SocketAddr, shared: &Shared) -> Option<Vec<u8>> {
+    if command != 0x1000 {
+        log(format_args!(
+            "{peer}: AMS router command 0x{command:04X} ignored"
+        ));
+        return None;
+    }
+    let ip = match peer.ip() {
+        IpAddr::V4(v4) => v4.octets(),
+        IpAddr::V6(_) => [127, 0, 0, 1],
+    };
+    let port = shared.next_router_port.fetch_add(1, Ordering::SeqCst);
+    let mut out = vec![0x00, 0x10, 8, 0, 0, 0];
+    out.extend_from_slice(&ip);
+    out.extend_from_slice(&[1, 1]);
+    out.extend_from_slice(&port.to_le_bytes());
+    Some(out)
+}
+
+fn device_name() -> String {
+    format!("ncchannel {}", env!("CARGO_PKG_VERSION"))
+}
+
+fn version_numbers() -> (u8, u8, u16) {
+    let mut parts = env!("CARGO_PKG_VERSION")
+        .split(['.', '-'])
+        .map(|p| p.parse::<u16>().unwrap_or(0));
+    let major = parts.next().unwrap_or(0).min(255) as u8;
+    let minor = parts.next().unwrap_or(0).min(255) as u8;
+    let build = parts.next().unwrap_or(0);
+    (major, minor, build)
+}
+
+/// Answer one request frame; `None` when no answer is due (responses from the client, or
+/// DeviceNotification frames sent to us).
+fn handle_request(
+    header: &AmsHeader,
+    data: &[u8],
+    shared: &Arc<Shared>,
+    writer: &Writer,
+    notifs: &Arc<Notifications>,
+) -> Option<Vec<u8>> {
+    if header.state_flags & 0x0001 != 0 {
+        return None; // a response; we never asked anything
+    }
+    if let Some(id) = shared.config.net_id {
+        if header.target.net_id != id {
+            return Some(frame::encode(
+                &header.response(AMS_ERR_MACHINE_NOT_FOUND),
+                &[],
+            ));
+        }
+    }
+    if header.target.port != PORT_CNC_COM {
+        // rule 5: router-level error in the header, empty payload.
+        return Some(frame::encode(&header.response(AMS_ERR_PORT_NOT_FOUND), &[]));
+    }
+    let backend = shared.backend.as_ref();
+    let command = header.command.to_u16();
+    let payload = match payload::decode_request(command, data) {
+        None => {
+            if header.command == CommandId::DeviceNotification {
+                return None;
+            }
+            response::result_only(AdsResult::SERVICE_NOT_SUPPORTED)
+        }
+        Some(Err(e)) => error_payload(header.command, e.result()),
+        Some(Ok(req)) => match req {
+            Request::ReadDeviceInfo => {
+                let (major, minor, build) = version_numbers();
+                response::device_info(major, minor, build, &device_name())
+            }
+            Request::ReadState => response::state(5, 0),
+            Request::WriteControl { ads_state, .. } => response::result_only(if ads_state == 5 {
+                AdsResult::OK
+            } else {
+                AdsResult::SERVICE_NOT_SUPPORTED
+            }),
+            Request::Read {
+                group,
+                offset,
+                length,
+            } => match objects::read(backend, group, offset, length) {
+                Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
+                Err(r) => response::with_data(r, &[]),
+            },
+            Request::Write {
+                group,
+                offset,
+                data,
+            } => response::result_only(match objects::write(backend, group, offset, &data) {
+                Ok(()) => AdsResult::OK,
+                Err(r) => r,
+            }),
+            Request::ReadWrite {
+                group,
+                offset,
+                read_length,
+                data,
+            } => match objects::read_write(backend, group, offset, read_length, &data) {
+                Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
+                Err(r) => response::with_data(r, &[]),
+            },
+            Request::AddNotification(req) => {
+                let (result, handle) = add_notification(header, req, shared, writer, notifs);
+                response::handle(result, handle)
+            }
+            Request::DelNotification { handle } => {
+                let removed = lock(&notifs.table).remove(&handle).is_some();
+                response::result_only(if removed {
+                    AdsResult::OK
+                } else {
+                    AdsResult::INVALID_HANDLE
+                })
+            }
+        },
+    };
+    Some(frame::encode(&header.response(0), &payload))
+}
+
+/// The error response shaped as the command's response (result alone, or result + zero).
+fn error_payload(command: CommandId, result: AdsResult) -> Vec<u8> {
+    match command {
+        CommandId::Read | CommandId::ReadWrite => response::with_data(result, &[]),
+        CommandId::AddDeviceNotification => response::handle(result, 0),
+        _ => response::result_only(result),
+    }
+}
+
+fn add_notification(
+    header: &AmsHeader,
+    req: NotificationRequest,
+    shared: &Arc<Shared>,
+    writer: &Writer,
+    notifs: &Arc<Notifications>,
+) -> (AdsResult, u32) {
+    // The object must be readable with the requested length now.
+    if let Err(r) = objects::read(shared.backend.as_ref(), req.group, req.offset, req.length) {
+        return (r, 0);
+    }
+    let on_change = match req.mode {
+        1 | 3 | 5 => false,
+        2 | 4 | 6 => true,
+        _ => return (AdsResult::INVALID_DATA, 0),
+    };
+    let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
+        .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
+    let mut table = lock(&notifs.table);
+    if table.len() >= shared.config.max_notifications {
+        return (AdsResult::NO_MORE_HANDLES, 0);
+    }
+    let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);
+    table.insert(
+        handle,
+        Notification {
+            client: header.source,
+            device: header.target,
+            req,
+            cycle,
+            on_change,
+            // The first sample goes out right after the response.
+            next_due: Instant::now() + Duration::from_millis(1),
+            last: None,
+        },
+    );
+    drop(table);
+    let mut notifier = lock(&notifs.notifier);
+    if notifier.is_none() {
+        let (s, w, n) = (Arc::clone(shared), Arc::clone(writer), Arc::clone(notifs));
+        *notifier = std::thread::Builder::new()
+            .name("ads-notify".into())
+            .spawn(move || notify_loop(&s, &w, &n))
+            .ok();
+    }
+    (AdsResult::OK, handle)
+}
+
+fn filetime_now() -> u64 {
+    const UNIX_TO_1601_100NS: u64 = 116_444_736_000_000_000;
+    let since = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .unwrap_or_default();
+    UNIX_TO_1601_100NS + (since.as_nanos() / 100) as u64
+}
+
+/// Poll due handles and send a DeviceNotification for each sample that is due (cyclic) or
+/// changed (on change). Flags 0x0004: a notification is a request the client does not answer.
+fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
+    while !notifs.closed.load(Ordering::SeqCst) && !shared.stopping.load(Ordering::SeqCst) {
+        let now = Instant::now();
+        let mut frames = Vec::new();
+        let mut next = now + Duration::from_millis(20);
+        {
+            let mut table = lock(&notifs.table);
+            for (&handle, n) in table.iter_mut() {
+                if n.next_due <= now {
+                    n.next_due = now + n.cycle;
+                    let read = objects::read(
+                        shared.backend.as_ref(),
+                        n.req.group,
+                        n.req.offset,
+                        n.req.length,
+                    );
+                    if let Ok(bytes) = read {
+                        if !n.on_change || n.last.as_deref() != Some(bytes.as_slice()) {
+                            let header = AmsHeader {
+                                target: n.client,
+                                source: n.device,
+                                command: CommandId::DeviceNotification,
+                                state_flags: FLAGS_REQUEST,
+                                error: 0,
+                                invoke_id: 0,
+                            };
+                            let payload =
+                                response::notification(filetime_now(), &[(handle, &bytes)]);
+                            frames.push(frame::encode(&header, &payload));
+                            n.last = Some(bytes);
+                        }
+                    }
+                }
+                next = next.min(n.next_due);
+            }
+        }
+        for f in frames {
+            if send(writer, &f).is_err() {
+                return;
+            }
+        }
+        let wait = next.saturating_duration_since(Instant::now());
+        std::thread::sleep(wait.max(Duration::from_micros(500)));
+    }
+}

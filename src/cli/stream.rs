@@ -1,0 +1,128 @@
+//! `ncchannel stream`: feed an NC file into a channel's stream interface over ADS.
+
+use std::io::Write;
+use std::net::{SocketAddr, ToSocketAddrs};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress, MAX_PACKET_BYTES};
+use crate::ads::frame::{AmsAddr, AmsNetId};
+use crate::ads::objects::PORT_CNC_COM;
+
+#[derive(Debug, clap::Args)]
+pub struct StreamArgs {
+    /// NC file to stream (whole lines; LF is sent as CR LF).
+    pub file: PathBuf,
+    /// ADS/TCP address of the device.
+    #[arg(long, default_value = "127.0.0.1:48898")]
+    pub target: String,
+    /// Target AMS NetId.
+    #[arg(long, default_value = "127.0.0.1.1.1")]
+    pub net_id: AmsNetId,
+    /// Our AMS NetId (default: local IPv4 address + .1.1).
+    #[arg(long)]
+    pub source_net_id: Option<AmsNetId>,
+    /// Channel number, 1-based (index group 0x20100 + N).
+    #[arg(long, default_value_t = 1)]
+    pub channel: u16,
+    /// Largest packet in bytes (whole lines), 1..=992.
+    #[arg(long, default_value_t = MAX_PACKET_BYTES)]
+    pub packet: usize,
+    /// Start the streaming program first (AUTOMATIC, program name, ACTIVE).
+    #[arg(long)]
+    pub start: bool,
+    /// The channel's streaming program name (`streaming_prog_file`), used with --start.
+    #[arg(long, default_value = "streaming.nc")]
+    pub program: String,
+    /// Give up after this many seconds without progress.
+    #[arg(long, default_value_t = 30)]
+    pub stall_secs: u64,
+}
+
+fn print_progress(p: &StreamProgress) {
+    let mut err = std::io::stderr().lock();
+    let _ = write!(
+        err,
+        "\rstream: {}/{} bytes, {} packets, {:.0} B/s, {} rejected (busy)   ",
+        p.bytes_sent,
+        p.bytes_total,
+        p.packets_sent,
+        p.bytes_per_second(),
+        p.rejections
+    );
+    let _ = err.flush();
+}
+
+pub fn execute(args: StreamArgs) -> ExitCode {
+    use super::exit;
+    if args.packet == 0 || args.packet > MAX_PACKET_BYTES {
+        eprintln!(
+            "ncchannel stream: --packet {} out of range 1..=992",
+            args.packet
+        );
+        return ExitCode::from(exit::USAGE);
+    }
+    if args.channel == 0 {
+        eprintln!("ncchannel stream: --channel is 1-based");
+        return ExitCode::from(exit::USAGE);
+    }
+    let addr: SocketAddr = match args.target.to_socket_addrs().map(|mut a| a.next()) {
+        Ok(Some(a)) => a,
+        _ => {
+            eprintln!(
+                "ncchannel stream: --target {:?} is not ADDR:PORT",
+                args.target
+            );
+            return ExitCode::from(exit::USAGE);
+        }
+    };
+    let text = match std::fs::read(&args.file) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("ncchannel stream: {}: {e}", args.file.display());
+            return ExitCode::from(exit::USAGE);
+        }
+    };
+    let target = AmsAddr {
+        net_id: args.net_id,
+        port: PORT_CNC_COM,
+    };
+    let source = args.source_net_id.map(|net_id| AmsAddr {
+        net_id,
+        port: 32905,
+    });
+    let mut client = match AdsClient::connect(addr, target, source, Duration::from_secs(5)) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("ncchannel stream: connecting to {addr}: {e}");
+            return ExitCode::from(exit::CHANNEL_ERROR);
+        }
+    };
+    let opts = StreamOptions {
+        channel: args.channel,
+        packet_bytes: args.packet,
+        start_program: args.start.then(|| args.program.clone()),
+        stall_timeout: Duration::from_secs(args.stall_secs),
+        ..StreamOptions::default()
+    };
+    match client::stream_text(&mut client, &text, &opts, &mut print_progress) {
+        Ok(p) => {
+            eprintln!();
+            eprintln!(
+                "stream: done: {} bytes in {} packets, {:.3} s, {:.0} B/s, {} writes rejected busy (warning 11012)",
+                p.bytes_sent,
+                p.packets_sent,
+                p.elapsed.as_secs_f64(),
+                p.bytes_per_second(),
+                p.rejections
+            );
+            ExitCode::from(exit::OK)
+        }
+        Err(e) => {
+            eprintln!();
+            eprintln!("ncchannel stream: {}: {e}", args.file.display());
+            ExitCode::from(exit::CHANNEL_ERROR)
+        }
+    }
+}
