@@ -630,3 +630,18 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn channels_sharing_a_list_report_its_warnings_once() {
+    let t = tempfile::tempdir().unwrap();
+    let startup = write(
+        t.path(),
+        "startup.lis",
+        "kanal_anzahl 2\nsda_mds[0] ch.lis\nsda_mds[1] ch.lis\n",
+    );
+    write(t.path(), "ch.lis", "streaming_prog_file s.nc\nfoo 1\n");
+    let cfg = params::load(&startup).unwrap();
+    assert_eq!(cfg.channels.len(), 2);
+    assert_eq!(cfg.channels[1].streaming_prog_file.as_deref(), Some("s.nc"));
+    assert_eq!(cfg.warnings.len(), 1, "{:#?}", cfg.warnings);
+}

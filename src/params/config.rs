@@ -1,6 +1,7 @@
 //! The one entry point: read the start-up list, each channel's list and runtime.toml, combine
 //! them into a [`Config`], or refuse with every problem found.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::channel::{interpret_channel, ChannelList};
@@ -136,15 +137,23 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
 fn channels(startup: &StartupList, diags: &mut Vec<Diagnostic>) -> Option<Vec<ChannelConfig>> {
     let count = startup.channel_count?;
     let mut out = Vec::new();
+    // Channels may share one list; read and report it once.
+    let mut seen: HashMap<PathBuf, ChannelList> = HashMap::new();
     for i in 0..count {
         // A missing sda_mds[i] was reported by interpret_startup.
         let Some(r) = startup.channel_lists.get(&i) else {
             continue;
         };
+        if let Some(chan) = seen.get(&r.path) {
+            out.push(combine(startup, i, chan.clone(), diags));
+            continue;
+        }
         let chan = match read_list(&r.path) {
             Ok((list, errs)) => {
                 diags.extend(errs);
-                interpret_channel(list, diags)
+                let chan = interpret_channel(list, diags);
+                seen.insert(r.path.clone(), chan.clone());
+                chan
             }
             Err(e) => {
                 diags.push(startup.list.error_at(
