@@ -1,0 +1,615 @@
+//! `runtime.toml`: what the emulator needs that controller lists do not hold (cycle period,
+//! axis limits, decoder and planner budgets, simulated file-system latency, ADS endpoint).
+//! Every key has a default; an unknown key is an error naming it.
+
+use std::fmt;
+use std::net::{IpAddr, SocketAddr};
+use std::path::Path;
+use std::str::FromStr;
+
+use serde::Deserialize;
+
+use crate::diag::Diagnostic;
+
+/// Largest runtime.toml we read; the real one is a few KiB.
+pub const MAX_RUNTIME_BYTES: u64 = 1024 * 1024;
+/// Most axes one channel drives.
+pub const MAX_AXES: usize = 32;
+
+/// The emulator's own settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RuntimeConfig {
+    /// Period of the fixed-cycle loop in µs (default 1000 = 1 ms, the usual CNC cycle).
+    pub cycle_period_us: u64,
+    /// Simulated latency of every program file open in µs (default 0), so soak tests can
+    /// show what the file cache saves.
+    pub fs_latency_us: u64,
+    /// Additional simulated read latency per KiB in µs (default 0).
+    pub fs_latency_us_per_kib: u64,
+    /// The channel's axes (default X, Y, Z with the limits of [`AxisConfig`]'s defaults).
+    pub axes: Vec<AxisConfig>,
+    pub decoder: DecoderRuntime,
+    pub planner: PlannerConfig,
+    pub ads: AdsConfig,
+}
+
+impl Default for RuntimeConfig {
+    fn default() -> Self {
+        RuntimeConfig {
+            cycle_period_us: 1000,
+            fs_latency_us: 0,
+            fs_latency_us_per_kib: 0,
+            axes: ["X", "Y", "Z"]
+                .iter()
+                .map(|n| AxisConfig::named(n))
+                .collect(),
+            decoder: DecoderRuntime::default(),
+            planner: PlannerConfig::default(),
+            ads: AdsConfig::default(),
+        }
+    }
+}
+
+/// One axis's name and limits.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisConfig {
+    /// Axis name as programmed (`X`, `Y`, `Z`, `A`, `X2` …). Required.
+    pub name: String,
+    /// Largest programmed feed in mm/min (default 30000).
+    #[serde(default = "default_velocity")]
+    pub max_velocity_mm_per_min: f64,
+    /// Largest acceleration in mm/s² (default 2000).
+    #[serde(default = "default_acceleration")]
+    pub max_acceleration_mm_per_s2: f64,
+    /// Largest jerk in mm/s³; absent = no jerk limit (default absent).
+    #[serde(default)]
+    pub max_jerk_mm_per_s3: Option<f64>,
+    /// Rapid traverse (G0) rate in mm/min (default 30000); not above max velocity.
+    #[serde(default = "default_velocity")]
+    pub rapid_mm_per_min: f64,
+    /// Lower software limit in mm (default -1000).
+    #[serde(default = "default_soft_min")]
+    pub soft_limit_min_mm: f64,
+    /// Upper software limit in mm (default 1000).
+    #[serde(default = "default_soft_max")]
+    pub soft_limit_max_mm: f64,
+}
+
+fn default_velocity() -> f64 {
+    30000.0
+}
+fn default_acceleration() -> f64 {
+    2000.0
+}
+fn default_soft_min() -> f64 {
+    -1000.0
+}
+fn default_soft_max() -> f64 {
+    1000.0
+}
+
+impl AxisConfig {
+    /// An axis with the default limits.
+    pub fn named(name: &str) -> Self {
+        AxisConfig {
+            name: name.to_string(),
+            max_velocity_mm_per_min: default_velocity(),
+            max_acceleration_mm_per_s2: default_acceleration(),
+            max_jerk_mm_per_s3: None,
+            rapid_mm_per_min: default_velocity(),
+            soft_limit_min_mm: default_soft_min(),
+            soft_limit_max_mm: default_soft_max(),
+        }
+    }
+}
+
+/// Decoder budgets.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DecoderRuntime {
+    /// Most NC blocks decoded in one tick (default 64), so a long program cannot stall a cycle.
+    pub blocks_per_tick: u32,
+    /// Decoded blocks held between decoder and planner (default 8).
+    pub buffer_blocks: u32,
+    /// Deepest subroutine nesting (default 20).
+    pub max_subroutine_depth: u32,
+}
+
+impl Default for DecoderRuntime {
+    fn default() -> Self {
+        DecoderRuntime {
+            blocks_per_tick: 64,
+            buffer_blocks: 8,
+            max_subroutine_depth: 20,
+        }
+    }
+}
+
+/// Motion planner settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlannerConfig {
+    /// Motion blocks the planner looks ahead over (default 32).
+    pub lookahead_blocks: u32,
+}
+
+impl Default for PlannerConfig {
+    fn default() -> Self {
+        PlannerConfig {
+            lookahead_blocks: 32,
+        }
+    }
+}
+
+/// The ADS server endpoint.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AdsConfig {
+    /// TCP address to listen on (default 127.0.0.1:48898, the ADS port, local only).
+    pub bind: SocketAddrText,
+    /// Our AMS NetId (default 127.0.0.1.1.1).
+    pub net_id: AmsNetId,
+    /// Largest AMS/TCP frame accepted, in bytes (default 65536).
+    pub max_frame_bytes: u32,
+    /// Clients allowed to connect: AMS NetIds or IP addresses (default empty = everyone).
+    pub allowed_clients: Vec<RouteEntry>,
+}
+
+impl Default for AdsConfig {
+    fn default() -> Self {
+        AdsConfig {
+            bind: SocketAddrText(SocketAddr::from(([127, 0, 0, 1], 48898))),
+            net_id: AmsNetId([127, 0, 0, 1, 1, 1]),
+            max_frame_bytes: 65536,
+            allowed_clients: Vec::new(),
+        }
+    }
+}
+
+/// A socket address read from a string, with an error message that says what is expected.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "String")]
+pub struct SocketAddrText(pub SocketAddr);
+
+impl TryFrom<String> for SocketAddrText {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+            .map(SocketAddrText)
+            .map_err(|_| format!("`{s}` is not an address:port such as 127.0.0.1:48898"))
+    }
+}
+
+/// An AMS NetId: six numbers 0…255, written `a.b.c.d.e.f`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
+#[serde(try_from = "String")]
+pub struct AmsNetId(pub [u8; 6]);
+
+impl FromStr for AmsNetId {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not an AMS NetId (six numbers 0-255 separated by dots)");
+        let mut out = [0u8; 6];
+        let mut parts = s.split('.');
+        for b in out.iter_mut() {
+            let p = parts.next().ok_or_else(bad)?;
+            if p.is_empty() || !p.bytes().all(|c| c.is_ascii_digit()) {
+                return Err(bad());
+            }
+            *b = p.parse().map_err(|_| bad())?;
+        }
+        if parts.next().is_some() {
+            return Err(bad());
+        }
+        Ok(AmsNetId(out))
+    }
+}
+
+impl TryFrom<String> for AmsNetId {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+    }
+}
+
+impl fmt::Display for AmsNetId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [a, b, c, d, e, g] = self.0;
+        write!(f, "{a}.{b}.{c}.{d}.{e}.{g}")
+    }
+}
+
+/// One allowed client: by AMS NetId (six parts) or IP address.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "String")]
+pub enum RouteEntry {
+    NetId(AmsNetId),
+    Ip(IpAddr),
+}
+
+impl TryFrom<String> for RouteEntry {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        if let Ok(ip) = s.parse::<IpAddr>() {
+            return Ok(RouteEntry::Ip(ip));
+        }
+        s.parse::<AmsNetId>()
+            .map(RouteEntry::NetId)
+            .map_err(|_| format!("`{s}` is neither an AMS NetId (a.b.c.d.e.f) nor an IP address"))
+    }
+}
+
+/// Parse and check runtime.toml text. Errors name the key (`ads.net_id`, `axes[1].name`).
+pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {
+    let cfg: RuntimeConfig = toml::from_str(text).map_err(|e| vec![toml_error(file, text, &e)])?;
+    let errs = validate(&cfg, file, text);
+    if errs.is_empty() {
+        Ok(cfg)
+    } else {
+        Err(errs)
+    }
+}
+
+/// Read runtime.toml with the size bound, then parse and check it.
+pub fn read_runtime(file: &Path) -> Result<RuntimeConfig, Vec<Diagnostic>> {
+    let err = |m: String| vec![Diagnostic::error(file, 1, 1, None, m)];
+    let meta =
+        std::fs::metadata(file).map_err(|e| err(format!("cannot read runtime.toml: {e}")))?;
+    if meta.len() > MAX_RUNTIME_BYTES {
+        return Err(err(format!(
+            "runtime.toml is {} bytes, more than the limit of {MAX_RUNTIME_BYTES} bytes",
+            meta.len()
+        )));
+    }
+    let text =
+        std::fs::read_to_string(file).map_err(|e| err(format!("cannot read runtime.toml: {e}")))?;
+    parse_runtime(file, &text)
+}
+
+/// A toml error as a diagnostic at its span, prefixed with the dotted key it concerns.
+fn toml_error(file: &Path, text: &str, e: &toml::de::Error) -> Diagnostic {
+    let msg = e.message().trim().to_string();
+    let Some(span) = e.span() else {
+        return Diagnostic::error(file, 1, 1, None, msg);
+    };
+    let (line, col) = line_col(text, span.start);
+    let line_text = text.lines().nth(line - 1).unwrap_or("");
+    let key = key_at(text, line);
+    let message = match key {
+        Some(k) if !msg.contains(&format!("`{k}`")) => format!("{k}: {msg}"),
+        _ => msg,
+    };
+    Diagnostic::error(file, line, col, None, message).with_source(line_text)
+}
+
+/// 1-based line and character column of byte offset `off`.
+fn line_col(text: &str, off: usize) -> (usize, usize) {
+    let off = off.min(text.len());
+    let before = text.get(..off).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before.get(line_start..).map_or(0, |s| s.chars().count()) + 1;
+    (line, col)
+}
+
+/// The table header in force on every line: `headers[line_table[i]]` for 0-based line `i`,
+/// e.g. `("axes", Some(1))` inside the second `[[axes]]`. One pass, so lookups stay linear.
+struct Tables {
+    headers: Vec<(String, Option<usize>)>,
+    line_table: Vec<usize>,
+    header_line: Vec<usize>,
+}
+
+impl Tables {
+    fn new(text: &str) -> Self {
+        let mut t = Tables {
+            headers: vec![(String::new(), None)],
+            line_table: Vec::new(),
+            header_line: vec![0],
+        };
+        let mut counts: std::collections::HashMap<String, usize> = Default::default();
+        for (i, l) in text.lines().enumerate() {
+            let s = l.trim();
+            let header = if let Some(name) = s.strip_prefix("[[").and_then(|r| r.split("]]").next())
+            {
+                let name = name.trim().to_string();
+                let n = counts.entry(name.clone()).or_insert(0);
+                let h = (name, Some(*n));
+                *n += 1;
+                Some(h)
+            } else {
+                s.strip_prefix('[')
+                    .and_then(|r| r.split(']').next())
+                    .map(|name| (name.trim().to_string(), None))
+            };
+            if let Some(h) = header {
+                t.headers.push(h);
+                t.header_line.push(i + 1);
+            }
+            t.line_table.push(t.headers.len() - 1);
+        }
+        t
+    }
+
+    /// Table of 1-based `line`.
+    fn at(&self, line: usize) -> (&str, Option<usize>) {
+        let id = line
+            .checked_sub(1)
+            .and_then(|i| self.line_table.get(i))
+            .copied()
+            .unwrap_or(0);
+        let (name, index) = &self.headers[id];
+        (name.as_str(), *index)
+    }
+}
+
+/// The dotted key on `line` (1-based), with its table: `ads.net_id`, `axes[1].name`.
+fn key_at(text: &str, line: usize) -> Option<String> {
+    let l = text.lines().nth(line.checked_sub(1)?)?;
+    let (key, _) = l.split_once('=')?;
+    let key = key.trim().trim_matches('"');
+    if key.is_empty() || key.starts_with('[') {
+        return None;
+    }
+    let tables = Tables::new(text);
+    let (table, index) = tables.at(line);
+    Some(join_key(table, index, key))
+}
+
+fn join_key(table: &str, index: Option<usize>, key: &str) -> String {
+    match (table.is_empty(), index) {
+        (true, _) => key.to_string(),
+        (false, Some(i)) => format!("{table}[{i}].{key}"),
+        (false, None) => format!("{table}.{key}"),
+    }
+}
+
+/// Where `key` of `table` (entry `index` of an array of tables) is written. A key left at its
+/// default points at its table's header, or at 1:1 when the table is not written either.
+fn locate(
+    text: &str,
+    tables: &Tables,
+    table: &str,
+    index: Option<usize>,
+    key: &str,
+) -> (usize, usize, String) {
+    for (i, l) in text.lines().enumerate() {
+        let Some((k, _)) = l.split_once('=') else {
+            continue;
+        };
+        if k.trim().trim_matches('"') == key && tables.at(i + 1) == (table, index) {
+            let col = l.chars().take_while(|c| c.is_whitespace()).count() + 1;
+            return (i + 1, col, l.to_string());
+        }
+    }
+    if !table.is_empty() {
+        for (id, (name, idx)) in tables.headers.iter().enumerate() {
+            if name == table && *idx == index {
+                let line = tables.header_line[id];
+                let src = text.lines().nth(line - 1).unwrap_or("").to_string();
+                return (line, 1, src);
+            }
+        }
+    }
+    (1, 1, String::new())
+}
+
+fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
+    let mut errs = Vec::new();
+    let tables = Tables::new(text);
+    let mut fail = |table: &str, index: Option<usize>, key: &str, why: String| {
+        let (line, col, src) = locate(text, &tables, table, index, key);
+        let mut d = Diagnostic::error(
+            file,
+            line,
+            col,
+            None,
+            format!("{}: {why}", join_key(table, index, key)),
+        );
+        if !src.is_empty() {
+            d = d.with_source(&src);
+        }
+        errs.push(d);
+    };
+
+    if cfg.cycle_period_us == 0 || cfg.cycle_period_us > 1_000_000 {
+        fail(
+            "",
+            None,
+            "cycle_period_us",
+            format!("{} µs is not in 1 ... 1000000", cfg.cycle_period_us),
+        );
+    }
+    for (key, v) in [
+        ("fs_latency_us", cfg.fs_latency_us),
+        ("fs_latency_us_per_kib", cfg.fs_latency_us_per_kib),
+    ] {
+        if v > 10_000_000 {
+            fail("", None, key, format!("{v} µs is more than 10 s"));
+        }
+    }
+
+    if cfg.axes.is_empty() || cfg.axes.len() > MAX_AXES {
+        fail(
+            "",
+            None,
+            "axes",
+            format!("{} axes; 1 ... {MAX_AXES} are needed", cfg.axes.len()),
+        );
+    }
+    for (i, a) in cfg.axes.iter().enumerate().take(MAX_AXES) {
+        let at = Some(i);
+        let name_ok = a.name.len() <= 8
+            && a.name.starts_with(|c: char| c.is_ascii_alphabetic())
+            && a.name.chars().all(|c| c.is_ascii_alphanumeric());
+        if !name_ok {
+            fail(
+                "axes",
+                at,
+                "name",
+                format!(
+                    "`{}` is not an axis name (a letter, then letters or digits, at most 8)",
+                    a.name
+                ),
+            );
+        }
+        if cfg.axes[..i]
+            .iter()
+            .any(|b| b.name.eq_ignore_ascii_case(&a.name))
+        {
+            fail(
+                "axes",
+                at,
+                "name",
+                format!("axis `{}` is defined twice", a.name),
+            );
+        }
+        let positive = [
+            ("max_velocity_mm_per_min", Some(a.max_velocity_mm_per_min)),
+            (
+                "max_acceleration_mm_per_s2",
+                Some(a.max_acceleration_mm_per_s2),
+            ),
+            ("max_jerk_mm_per_s3", a.max_jerk_mm_per_s3),
+            ("rapid_mm_per_min", Some(a.rapid_mm_per_min)),
+        ];
+        for (key, v) in positive {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    fail("axes", at, key, format!("{v} must be a positive number"));
+                }
+            }
+        }
+        if a.max_velocity_mm_per_min > 0.0 && a.rapid_mm_per_min > a.max_velocity_mm_per_min {
+            fail(
+                "axes",
+                at,
+                "rapid_mm_per_min",
+                format!(
+                    "{} mm/min is above max_velocity_mm_per_min {}",
+                    a.rapid_mm_per_min, a.max_velocity_mm_per_min
+                ),
+            );
+        }
+        if !(a.soft_limit_min_mm.is_finite() && a.soft_limit_max_mm.is_finite())
+            || a.soft_limit_min_mm >= a.soft_limit_max_mm
+        {
+            fail(
+                "axes",
+                at,
+                "soft_limit_max_mm",
+                format!(
+                    "soft limits {} ... {} mm: min must be below max",
+                    a.soft_limit_min_mm, a.soft_limit_max_mm
+                ),
+            );
+        }
+    }
+
+    for (key, v, max) in [
+        ("blocks_per_tick", cfg.decoder.blocks_per_tick, 1_000_000),
+        ("buffer_blocks", cfg.decoder.buffer_blocks, 1_000_000),
+        (
+            "max_subroutine_depth",
+            cfg.decoder.max_subroutine_depth,
+            1000,
+        ),
+    ] {
+        if v == 0 || v > max {
+            fail("decoder", None, key, format!("{v} is not in 1 ... {max}"));
+        }
+    }
+    let la = cfg.planner.lookahead_blocks;
+    if la == 0 || la > 100_000 {
+        fail(
+            "planner",
+            None,
+            "lookahead_blocks",
+            format!("{la} is not in 1 ... 100000"),
+        );
+    }
+    let fb = cfg.ads.max_frame_bytes;
+    // An AMS/TCP header (6) plus an AMS header (32) must fit; 16 MiB bounds one allocation.
+    if !(64..=16 * 1024 * 1024).contains(&fb) {
+        fail(
+            "ads",
+            None,
+            "max_frame_bytes",
+            format!("{fb} is not in 64 ... 16777216"),
+        );
+    }
+    errs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn net_id_parses_and_prints() {
+        let id: AmsNetId = "192.168.0.10.1.1".parse().unwrap();
+        assert_eq!(id.0, [192, 168, 0, 10, 1, 1]);
+        assert_eq!(id.to_string(), "192.168.0.10.1.1");
+        assert!("1.2.3.4.5".parse::<AmsNetId>().is_err());
+        assert!("1.2.3.4.5.6.7".parse::<AmsNetId>().is_err());
+        assert!("1.2.3.4.5.256".parse::<AmsNetId>().is_err());
+        assert!("1.2.3.4.5.+6".parse::<AmsNetId>().is_err());
+    }
+
+    #[test]
+    fn empty_text_is_the_defaults() {
+        let cfg = parse_runtime(Path::new("r.toml"), "").unwrap();
+        assert_eq!(cfg, RuntimeConfig::default());
+        assert_eq!(cfg.axes.len(), 3);
+    }
+
+    #[test]
+    fn error_names_key_in_array_table() {
+        let text =
+            "[[axes]]\nname = \"X\"\n\n[[axes]]\nname = \"Y\"\nmax_velocity_mm_per_min = -5.0\n";
+        let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
+        assert_eq!(errs.len(), 1, "{errs:?}");
+        assert!(
+            errs[0]
+                .message
+                .starts_with("axes[1].max_velocity_mm_per_min:"),
+            "{}",
+            errs[0].message
+        );
+        assert_eq!((errs[0].line, errs[0].col), (6, 1));
+    }
+
+    #[test]
+    fn type_error_names_key() {
+        let errs = parse_runtime(Path::new("r.toml"), "[ads]\nmax_frame_bytes = -1\n").unwrap_err();
+        assert!(
+            errs[0].message.starts_with("ads.max_frame_bytes:"),
+            "{}",
+            errs[0].message
+        );
+        assert_eq!(errs[0].line, 2);
+        let errs = parse_runtime(Path::new("r.toml"), "[ads]\nnet_id = \"1.2.3\"\n").unwrap_err();
+        assert!(
+            errs[0].message.contains("ads.net_id"),
+            "{}",
+            errs[0].message
+        );
+        assert!(errs[0].message.contains("AMS NetId"), "{}", errs[0].message);
+    }
+
+    #[test]
+    fn routes_take_net_ids_and_ips() {
+        let cfg = parse_runtime(
+            Path::new("r.toml"),
+            "[ads]\nallowed_clients = [\"10.0.0.5\", \"10.0.0.5.1.1\", \"::1\"]\n",
+        )
+        .unwrap();
+        assert_eq!(cfg.ads.allowed_clients.len(), 3);
+        assert!(matches!(cfg.ads.allowed_clients[1], RouteEntry::NetId(_)));
+        assert!(
+            parse_runtime(Path::new("r.toml"), "[ads]\nallowed_clients = [\"foo\"]\n").is_err()
+        );
+    }
+}

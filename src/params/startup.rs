@@ -1,0 +1,255 @@
+//! The start-up list (`startup.lis`, `hochlauf.lis` in German installations): channel count,
+//! each channel's list, program search paths and decoder settings per channel.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::PathBuf;
+
+use super::decoder::{DecoderField, DecoderParams};
+use super::list::{Entry, ParamList};
+use super::search_path::{list_folder, resolve, PathCollector, PathField, SearchPath};
+use super::value::{string_value, uint_value};
+use crate::diag::Diagnostic;
+
+/// Channels one kernel runs (ISG: `pfad[i]` with i = 0 ... 11, "maximum number of channels: 12").
+pub const MAX_CHANNELS: u32 = 12;
+/// Longest list path we accept.
+const MAX_PATH_CHARS: usize = 256;
+
+/// Where a channel's list is and which line named it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelListRef {
+    /// Absolute as written, or joined to the start-up list's folder.
+    pub path: PathBuf,
+    /// The `sda_mds[i]` line, so a missing file is reported there.
+    pub entry: Entry,
+}
+
+/// The start-up list, checked.
+#[derive(Debug, Clone)]
+pub struct StartupList {
+    pub list: ParamList,
+    /// `kanal_anzahl`; `None` when missing or bad (an error was reported).
+    pub channel_count: Option<u32>,
+    pub channel_lists: BTreeMap<u32, ChannelListRef>,
+    /// `pfad[i].*` per channel, sorted by priority.
+    pub search_paths: BTreeMap<u32, Vec<SearchPath>>,
+    /// `configuration.channel[i].decoder.*` per channel.
+    pub decoder: BTreeMap<u32, DecoderParams>,
+}
+
+/// Does this list look like a start-up list? (It names `kanal_anzahl` or `sda_mds[…]`.)
+pub fn is_startup_list(list: &ParamList) -> bool {
+    list.entries.iter().any(|e| {
+        matches!(
+            e.name.segments.as_slice(),
+            [s] if (s.ident == "kanal_anzahl" && s.index.is_none())
+                || (s.ident == "sda_mds" && s.index.is_some())
+        )
+    })
+}
+
+/// A name as `(ident, index)` pairs, for slice patterns.
+pub(crate) fn shape(e: &Entry) -> Vec<(&str, Option<u32>)> {
+    e.name
+        .segments
+        .iter()
+        .map(|s| (s.ident.as_str(), s.index))
+        .collect()
+}
+
+/// Warn about a name seen before: the later line wins, as in the kernel's list reader.
+pub(crate) fn warn_duplicates(list: &ParamList, diags: &mut Vec<Diagnostic>) {
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for e in &list.entries {
+        if let Some(first) = seen.insert(e.name.text.as_str(), e.name_pos.line) {
+            diags.push(list.warning_at(
+                e,
+                e.name_pos,
+                format!(
+                    "{} is set again (first on line {first}); this later value is used",
+                    e.name.text
+                ),
+            ));
+        }
+    }
+}
+
+pub(crate) fn warn_unknown(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) {
+    diags.push(list.warning_at(
+        e,
+        e.name_pos,
+        format!(
+            "unknown parameter {}: kept, but the emulator does not use it",
+            e.name.text
+        ),
+    ));
+}
+
+/// Check the start-up list's entries. Problems go to `diags`; the result holds what was good.
+pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> StartupList {
+    warn_duplicates(&list, diags);
+    let base = list_folder(&list.file);
+
+    let channel_count = match list.get("kanal_anzahl") {
+        None => {
+            diags.push(Diagnostic::error(
+                &list.file,
+                1,
+                1,
+                None,
+                "kanal_anzahl (number of channels) is missing from the start-up list",
+            ));
+            None
+        }
+        Some(e) => match uint_value(&list, e, u64::from(MAX_CHANNELS)) {
+            Ok(0) => {
+                diags.push(list.error_at(
+                    e,
+                    e.value_pos,
+                    "kanal_anzahl: at least one channel is needed",
+                ));
+                None
+            }
+            Ok(n) => Some(n as u32),
+            Err(d) => {
+                diags.push(d);
+                None
+            }
+        },
+    };
+    // Without a valid count, indices are still checked against the kernel's maximum.
+    let bound = channel_count.unwrap_or(MAX_CHANNELS);
+
+    let mut channel_lists = BTreeMap::new();
+    let mut decoder: BTreeMap<u32, DecoderParams> = BTreeMap::new();
+    let mut collectors: BTreeMap<u32, PathCollector> = BTreeMap::new();
+
+    for e in &list.entries {
+        let s = shape(e);
+        let channel = match s.as_slice() {
+            [("sda_mds", Some(i))]
+            | [("pfad", Some(i)), (_, Some(_))]
+            | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
+            _ => None,
+        };
+        if let Some(i) = channel {
+            if i >= bound {
+                let why = match channel_count {
+                    Some(n) => format!("not below kanal_anzahl {n}"),
+                    None => format!("not below the maximum of {MAX_CHANNELS} channels"),
+                };
+                // Only indices of names we know; an unknown name is a warning below.
+                if is_known_startup_name(&s) {
+                    diags.push(list.error_at(
+                        e,
+                        e.name_pos,
+                        format!("{}: channel index {i} is {why}", e.name.text),
+                    ));
+                    continue;
+                }
+            }
+        }
+        match s.as_slice() {
+            [("kanal_anzahl", None)] => {}
+            [("sda_mds", Some(i))] => match string_value(&list, e, MAX_PATH_CHARS) {
+                Ok(p) if p.is_empty() => diags.push(list.error_at(
+                    e,
+                    e.value_pos,
+                    format!("{}: empty channel list path", e.name.text),
+                )),
+                Ok(p) => {
+                    channel_lists.insert(
+                        *i,
+                        ChannelListRef {
+                            path: resolve(&base, &p),
+                            entry: e.clone(),
+                        },
+                    );
+                }
+                Err(d) => diags.push(d),
+            },
+            [("pfad", Some(i)), (field, Some(j))] => {
+                let field = match *field {
+                    "prg" => Some(PathField::Dir),
+                    "typ" => Some(PathField::Kinds),
+                    "prioritaet" => Some(PathField::Priority),
+                    "log_nr" => None,
+                    _ => {
+                        warn_unknown(&list, e, diags);
+                        continue;
+                    }
+                };
+                match field {
+                    Some(f) => collectors
+                        .entry(*i)
+                        .or_default()
+                        .add(&list, e, *j, f, diags),
+                    // Logical path number: the kernel's, meaningless here; checked, not used.
+                    None => {
+                        if let Err(d) = uint_value(&list, e, u64::from(u16::MAX)) {
+                            diags.push(d);
+                        }
+                    }
+                }
+            }
+            [("configuration", None), ("channel", Some(i)), ("decoder", None), (field, None)] => {
+                let field = match *field {
+                    "function" => DecoderField::Function,
+                    "max_cache_number" => DecoderField::MaxCacheNumber,
+                    "max_cache_size" => DecoderField::MaxCacheSize,
+                    _ => {
+                        warn_unknown(&list, e, diags);
+                        continue;
+                    }
+                };
+                decoder.entry(*i).or_default().set(&list, e, field, diags);
+            }
+            _ => warn_unknown(&list, e, diags),
+        }
+    }
+
+    let search_paths = collectors
+        .into_iter()
+        .map(|(i, c)| (i, c.finish(&list, &base, diags)))
+        .collect();
+
+    if let (Some(n), Some(count_entry)) = (channel_count, list.get("kanal_anzahl")) {
+        for i in 0..n {
+            if !channel_lists.contains_key(&i) {
+                diags.push(list.error_at(
+                    count_entry,
+                    count_entry.value_pos,
+                    format!(
+                        "kanal_anzahl {n}: channel {} has no channel list (sda_mds[{i}] is missing)",
+                        i + 1
+                    ),
+                ));
+            }
+        }
+    }
+
+    StartupList {
+        list,
+        channel_count,
+        channel_lists,
+        search_paths,
+        decoder,
+    }
+}
+
+fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
+    matches!(
+        s,
+        [("sda_mds", Some(_))]
+            | [
+                ("pfad", Some(_)),
+                ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))
+            ]
+            | [
+                ("configuration", None),
+                ("channel", Some(_)),
+                ("decoder", None),
+                ("function" | "max_cache_number" | "max_cache_size", None)
+            ]
+    )
+}
