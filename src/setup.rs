@@ -34,7 +34,7 @@ pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
             Ok(AxisLimits {
                 index,
                 max_velocity_mm_per_min: a.max_velocity_mm_per_min,
-                max_accel_mm_per_s2: a.max_accel_mm_per_s2,
+                max_accel_mm_per_s2: a.max_acceleration_mm_per_s2,
                 rapid_mm_per_min: a.rapid_mm_per_min,
                 min_mm: a.soft_limit_min_mm,
                 max_mm: a.soft_limit_max_mm,
@@ -44,7 +44,10 @@ pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
 }
 
 /// Settings of one channel (0-based index in the start-up list).
-pub fn channel_settings(config: &Config, ch: &ChannelConfig) -> Result<ChannelSettings, SetupError> {
+pub fn channel_settings(
+    config: &Config,
+    ch: &ChannelConfig,
+) -> Result<ChannelSettings, SetupError> {
     let axes = axes(config)?;
     let mut enabled = [false; MAX_AXES];
     for a in &axes {
@@ -62,7 +65,15 @@ pub fn channel_settings(config: &Config, ch: &ChannelConfig) -> Result<ChannelSe
         .iter()
         .map(|p| SearchDir {
             dir: p.dir.clone(),
-            kinds: (if p.kinds & MAIN_PROGRAMS != 0 { PATH_MAIN } else { 0 }) | (if p.kinds & SUBROUTINES != 0 { PATH_SUB } else { 0 }),
+            kinds: (if p.kinds & MAIN_PROGRAMS != 0 {
+                PATH_MAIN
+            } else {
+                0
+            }) | (if p.kinds & SUBROUTINES != 0 {
+                PATH_SUB
+            } else {
+                0
+            }),
             priority: u32::from(p.priority),
         })
         .collect();

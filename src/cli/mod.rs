@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod check;
 pub mod receive;
+pub mod run;
 pub mod stream;
 
 /// Exit codes of the command-line contract (DESIGN.md).
@@ -40,6 +41,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Check NC programs and parameter lists; errors as file:line:col.
     Check(check::CheckArgs),
+    /// Run one program on a channel, optionally streamed by the built-in feeder.
+    Run(run::RunArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
     /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
@@ -52,11 +55,9 @@ impl Cli {
             Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
+            Some(Command::Run(args)) => run::execute(args),
             Some(Command::Stream(args)) => stream::execute(args),
-            None => {
-                eprintln!("ncchannel: no subcommand (the demo needs `run`, not built yet)");
-                ExitCode::from(exit::USAGE)
-            }
+            None => run::execute(run::RunArgs::demo()),
         }
     }
 }

@@ -6,13 +6,13 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
+use crate::channel::Finish;
 use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::report::summary::{CycleReport, ErrorReport, Outcome, Report, StreamReport};
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
-use crate::channel::Finish;
 
 use super::exit;
 
@@ -115,13 +115,21 @@ pub fn execute(args: RunArgs) -> ExitCode {
     };
     let nch = channels.len();
     let Some(ch_config) = config.channels.get((args.channel as usize).wrapping_sub(1)) else {
-        return usage(format!("channel {} does not exist (the start-up list has {nch})", args.channel));
+        return usage(format!(
+            "channel {} does not exist (the start-up list has {nch})",
+            args.channel
+        ));
     };
     let program = match (&args.program, &args.stream) {
         (Some(p), _) => p.clone(),
         (None, Some(_)) => match &ch_config.streaming_prog_file {
             Some(s) => s.clone(),
-            None => return usage(format!("--stream needs streaming_prog_file in {}", ch_config.list_path.display())),
+            None => {
+                return usage(format!(
+                    "--stream needs streaming_prog_file in {}",
+                    ch_config.list_path.display()
+                ))
+            }
         },
         (None, None) => return usage("name a PROGRAM or give --stream FILE"),
     };
@@ -164,7 +172,11 @@ pub fn execute(args: RunArgs) -> ExitCode {
             start_failed = true;
         }
     }
-    let clock = if args.realtime { Clock::RealTime } else { Clock::Virtual };
+    let clock = if args.realtime {
+        Clock::RealTime
+    } else {
+        Clock::Virtual
+    };
     let (mut rt, _requests) = Runtime::new(machine, period, clock);
     let summary = if start_failed {
         None
@@ -174,8 +186,12 @@ pub fn execute(args: RunArgs) -> ExitCode {
     let ticks = rt.ticks();
     let time_s = rt.time().as_secs_f64();
     let (mut machine, stats) = rt.into_inner();
-    let finish = machine.finishes().get(args.channel as usize - 1).copied().flatten();
-    let outcome = match (summary.map(|s| s.end), finish) {
+    let finish = machine
+        .finishes()
+        .get(args.channel as usize - 1)
+        .copied()
+        .flatten();
+    let outcome = match (summary.as_ref().map(|s| s.end), finish) {
         (_, Some(Finish::Ended)) => Outcome::Ended,
         (_, Some(Finish::Error)) => Outcome::Error,
         (Some(RunEnd::MaxTicks), _) => Outcome::MaxTicks,
@@ -186,12 +202,23 @@ pub fn execute(args: RunArgs) -> ExitCode {
         outcome,
         ticks,
         time_s,
-        wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
+        wall_s: summary.as_ref().map_or(0.0, |s| s.wall.as_secs_f64()),
         blocks: c.stats().blocks,
-        position: c.axis_positions().into_iter().map(|(a, v)| (a.to_string(), v)).collect::<BTreeMap<_, _>>(),
+        position: c
+            .axis_positions()
+            .into_iter()
+            .map(|(a, v)| (a.to_string(), v))
+            .collect::<BTreeMap<_, _>>(),
         stream: StreamReport::from(c.stream().counters()),
         interrupts: c.stats().interrupts,
-        errors: c.errors().iter().map(|(code, msg)| ErrorReport { code: *code, msg: msg.clone() }).collect(),
+        errors: c
+            .errors()
+            .iter()
+            .map(|(code, msg)| ErrorReport {
+                code: *code,
+                msg: msg.clone(),
+            })
+            .collect(),
         cycle: CycleReport::new(period, &stats),
     };
     if let Err(e) = machine.finish_log() {
@@ -223,7 +250,9 @@ fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
     let mut buf = Vec::new();
     f.take(MAX_STREAM_FILE_BYTES + 1).read_to_end(&mut buf)?;
     if buf.len() as u64 > MAX_STREAM_FILE_BYTES {
-        return Err(std::io::Error::other(format!("larger than {MAX_STREAM_FILE_BYTES} bytes")));
+        return Err(std::io::Error::other(format!(
+            "larger than {MAX_STREAM_FILE_BYTES} bytes"
+        )));
     }
     Ok(buf)
 }
