@@ -14,8 +14,8 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use crate::dnc::{
-    self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram,
-    Splitter, TransferEnd, TransferReport, WriterConfig,
+    self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
+    TransferEnd, TransferReport, WriterConfig,
 };
 
 use super::exit;
@@ -107,7 +107,11 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     let idle = match args.idle_timeout {
         None => None,
         Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => return Err(Failure::Usage(format!("--idle-timeout {s}: not a positive time"))),
+        Some(s) => {
+            return Err(Failure::Usage(format!(
+                "--idle-timeout {s}: not a positive time"
+            )))
+        }
     };
     let out = args.out.clone().unwrap_or_else(default_out_dir);
     let mut cfg = WriterConfig::new(&out);
