@@ -41,7 +41,10 @@ struct Trickle<'a> {
 impl Read for Trickle<'_> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         if self.data.is_empty() && self.fail_at_end {
-            return Err(io::Error::new(io::ErrorKind::ConnectionReset, "line dropped"));
+            return Err(io::Error::new(
+                io::ErrorKind::ConnectionReset,
+                "line dropped",
+            ));
         }
         let k = self.n.min(buf.len()).min(self.data.len());
         buf[..k].copy_from_slice(&self.data[..k]);
@@ -65,7 +68,11 @@ fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
             if p.is_dir() {
                 walk(base, &p, out);
             } else {
-                let rel = p.strip_prefix(base).unwrap().to_string_lossy().replace('\\', "/");
+                let rel = p
+                    .strip_prefix(base)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/");
                 out.insert(rel, std::fs::read(&p).unwrap());
             }
         }
@@ -116,7 +123,10 @@ fn archive_lands_in_workpiece_directories() {
         t["SHAFT.wpd/SHAFT.mpf"],
         b"%_N_SHAFT_MPF\r\n;$PATH=/_N_WKS_DIR/_N_SHAFT_WPD\r\nN10 G0 X0 Z0\r\nN20 L CONTOUR\r\nN30 M30\r\n"
     );
-    assert!(r.programs.iter().all(|p| p.disposition == Disposition::Written));
+    assert!(r
+        .programs
+        .iter()
+        .all(|p| p.disposition == Disposition::Written));
     assert_eq!(r.programs[0].path, out.join("SHAFT.wpd").join("SHAFT.mpf"));
 }
 
@@ -172,7 +182,10 @@ fn an_existing_program_is_kept_unless_overwrite() {
     assert_eq!(std::fs::read(dir.path().join("P1.nc")).unwrap(), b"old");
     let r = receive_into(dir.path(), &m, b"%P1\nM30\n", 3, |c| c.overwrite = true);
     assert_eq!(r.programs[0].disposition, Disposition::Replaced);
-    assert_eq!(std::fs::read(dir.path().join("P1.nc")).unwrap(), b"%P1\nM30\n");
+    assert_eq!(
+        std::fs::read(dir.path().join("P1.nc")).unwrap(),
+        b"%P1\nM30\n"
+    );
 }
 
 #[test]
@@ -184,7 +197,11 @@ fn a_cut_off_transfer_leaves_no_file_under_the_final_name() {
     assert_eq!(r.split.cut_off, 1);
     assert_eq!(r.programs[1].disposition, Disposition::CutOffDropped);
     let t = tree(dir.path());
-    assert_eq!(t.keys().collect::<Vec<_>>(), ["DONE.mpf"], "no partial, no temp file");
+    assert_eq!(
+        t.keys().collect::<Vec<_>>(),
+        ["DONE.mpf"],
+        "no partial, no temp file"
+    );
 
     // With keep_partial the piece is kept, but never under the final name.
     let dir = tempfile::tempdir().unwrap();
@@ -221,7 +238,13 @@ fn names_from_the_data_never_leave_the_program_directory() {
     let root = tempfile::tempdir().unwrap();
     let out = root.path().join("out");
     let data = "%_N_.._.._EVIL_MPF\nM30\n%_N_X_MPF\n;$PATH=/_N_WKS_DIR/_N_.._WPD\nM30\n%../evil\nM30\n%/tmp/abs\nM30\n";
-    let r = receive_into(&out, &markers(&["%"], &["M30"]), data.as_bytes(), 64, |_| {});
+    let r = receive_into(
+        &out,
+        &markers(&["%"], &["M30"]),
+        data.as_bytes(),
+        64,
+        |_| {},
+    );
     assert_eq!(r.filed(), 4);
     assert_eq!(
         tree(root.path()).keys().collect::<Vec<_>>(),
@@ -258,7 +281,13 @@ fn cli_files_an_archive_from_a_file() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{stdout}");
-    assert_eq!(stdout.lines().filter(|l| l.starts_with("received ")).count(), 3);
+    assert_eq!(
+        stdout
+            .lines()
+            .filter(|l| l.starts_with("received "))
+            .count(),
+        3
+    );
     assert!(stdout.contains("3 program(s) filed"), "{stdout}");
     assert_eq!(tree(&out).len(), 3);
 }
@@ -297,7 +326,9 @@ fn cli_bad_usage_exits_2() {
     let input = dir.path().join("in.txt");
     std::fs::write(&input, "x\n").unwrap();
     for args in [
-        &["--start", "a", "--start", "b", "--start", "c", "--start", "d"][..],
+        &[
+            "--start", "a", "--start", "b", "--start", "c", "--start", "d",
+        ][..],
         &["--end", "1", "--end", "2", "--end", "3", "--end", "4"][..],
         &["--end", ""][..],
         &["--name-template", "../x{n}.nc"][..],
@@ -316,7 +347,14 @@ fn cli_bad_usage_exits_2() {
 }
 
 /// Start `receive --listen` on an ephemeral loopback port; returns the child and the port.
-fn listen(out: &Path, extra: &[&str]) -> (std::process::Child, u16, BufReader<std::process::ChildStderr>) {
+fn listen(
+    out: &Path,
+    extra: &[&str],
+) -> (
+    std::process::Child,
+    u16,
+    BufReader<std::process::ChildStderr>,
+) {
     let mut child = bin()
         .args(["receive", "--listen", "127.0.0.1:0", "--out"])
         .arg(out)
@@ -365,7 +403,10 @@ fn cli_listen_takes_transfers_one_after_another() {
 fn wait_for(what: &str, mut f: impl FnMut() -> bool) {
     let t0 = Instant::now();
     while !f() {
-        assert!(t0.elapsed() < Duration::from_secs(10), "timed out waiting for {what}");
+        assert!(
+            t0.elapsed() < Duration::from_secs(10),
+            "timed out waiting for {what}"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
 }
@@ -386,7 +427,8 @@ fn a_program_appears_under_its_name_only_when_complete_even_if_the_receiver_dies
     let out = dir.path().join("prog");
     let (mut child, port, _err) = listen(&out, &["--start", "%", "--end", "M30"]);
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
-    s.write_all(b"%_N_DONE_MPF\nM30\n%_N_BIG_MPF\nN1 G1 X1\n").unwrap();
+    s.write_all(b"%_N_DONE_MPF\nM30\n%_N_BIG_MPF\nN1 G1 X1\n")
+        .unwrap();
     s.flush().unwrap();
     wait_for("DONE.mpf", || out.join("DONE.mpf").exists());
     wait_for("the temporary file of BIG", || !temp_files(&out).is_empty());
@@ -395,7 +437,10 @@ fn a_program_appears_under_its_name_only_when_complete_even_if_the_receiver_dies
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(!out.join("BIG.mpf").exists());
-    assert_eq!(std::fs::read(out.join("DONE.mpf")).unwrap(), b"%_N_DONE_MPF\nM30\n");
+    assert_eq!(
+        std::fs::read(out.join("DONE.mpf")).unwrap(),
+        b"%_N_DONE_MPF\nM30\n"
+    );
 }
 
 #[test]
@@ -432,4 +477,40 @@ fn library_listener_files_after_the_end_line_and_drops_a_cut_off_connection() {
     assert_eq!(reports[1].split.cut_off, 1);
     assert!(reports[1].peer.is_some());
     assert_eq!(tree(&out).keys().collect::<Vec<_>>(), ["P1.nc"]);
+}
+
+#[test]
+fn a_silent_connection_times_out_as_a_broken_transfer() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_path_buf();
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let out2 = out.clone();
+    let server = std::thread::spawn(move || {
+        let mut w = ProgramWriter::new(WriterConfig::new(&out2));
+        let mut s = Splitter::new(markers(&[], &["M30"]));
+        let mut reports = Vec::new();
+        dnc::receive_connections(
+            &listener,
+            Some(1),
+            Some(Duration::from_millis(200)),
+            &mut s,
+            &mut w,
+            |r| reports.push(r.clone()),
+        )
+        .unwrap();
+        reports
+    });
+    let mut c = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    // One whole program, then the sender stalls inside the next one.
+    c.write_all(b"%_N_A_MPF\nM30\n%_N_B_MPF\nN1\n").unwrap();
+    let reports = server.join().unwrap();
+    drop(c);
+    assert_eq!(reports[0].end, TransferEnd::IdleTimeout);
+    assert_eq!(reports[0].filed(), 1);
+    assert_eq!(
+        reports[0].programs[1].disposition,
+        Disposition::CutOffDropped
+    );
+    assert_eq!(tree(&out).keys().collect::<Vec<_>>(), ["A.mpf"]);
 }

@@ -29,7 +29,10 @@ impl ProgramSink for Collect {
         Ok(())
     }
     fn data(&mut self, b: &[u8]) -> Result<(), Self::Error> {
-        self.cur.as_mut().expect("data outside a program").extend_from_slice(b);
+        self.cur
+            .as_mut()
+            .expect("data outside a program")
+            .extend_from_slice(b);
         Ok(())
     }
     fn end(&mut self, e: ProgramEnd) -> Result<(), Self::Error> {
@@ -87,7 +90,10 @@ fn start_only_ignores_data_before_the_first_start_and_runs_to_the_next_start() {
     let m = markers(&["%"], &[]);
     let (p, s) = split(&m, "header\nN1 X1\n%P1\nN10 G0\nN20 M30\n%P2\nN10 G1\n");
     assert_eq!(texts(&p), ["%P1\nN10 G0\nN20 M30\n", "%P2\nN10 G1\n"]);
-    assert!(p.iter().all(|p| p.complete), "start-only: the last one runs to the data end");
+    assert!(
+        p.iter().all(|p| p.complete),
+        "start-only: the last one runs to the data end"
+    );
     assert_eq!(p[0].lines, (3, 5));
     assert_eq!(p[1].name, Some((None, "P2.nc".into())));
     assert_eq!(s.bytes_ignored, "header\nN1 X1\n".len() as u64);
@@ -107,7 +113,10 @@ fn start_only_without_a_start_discards_everything() {
 fn end_only_saves_up_to_each_end_and_the_last_block_without_one() {
     let m = markers(&[], &["M30", "M02"]);
     let (p, _) = split(&m, "N1 G0\nN2 M30\nN1 G1\nN2 M02\nN1 G2\nN2 X5\n");
-    assert_eq!(texts(&p), ["N1 G0\nN2 M30\n", "N1 G1\nN2 M02\n", "N1 G2\nN2 X5\n"]);
+    assert_eq!(
+        texts(&p),
+        ["N1 G0\nN2 M30\n", "N1 G1\nN2 M02\n", "N1 G2\nN2 X5\n"]
+    );
     assert!(p.iter().all(|p| p.complete));
     // No end marker at all: the whole data is one file.
     let (p, _) = split(&m, "A\nB\nC");
@@ -121,7 +130,8 @@ fn end_only_saves_up_to_each_end_and_the_last_block_without_one() {
 #[test]
 fn start_and_end_keeps_regions_and_ignores_what_lies_between() {
     let m = markers(&["%"], &["M30"]);
-    let input = "noise\n%P1\nN10 G0\n%NOT_A_START\nN20 M30\nbetween\nM30 outside\n%P2\nN10 M30\ntail\n";
+    let input =
+        "noise\n%P1\nN10 G0\n%NOT_A_START\nN20 M30\nbetween\nM30 outside\n%P2\nN10 M30\ntail\n";
     let (p, s) = split(&m, input);
     assert_eq!(
         texts(&p),
@@ -147,11 +157,11 @@ fn start_and_end_alternate_even_with_the_same_string() {
 #[test]
 fn any_of_three_start_and_three_end_strings() {
     let m = markers(&["BEGIN", "%", "START"], &["M30", "M02", "M17"]);
-    let (p, _) = split(
-        &m,
-        "START a\nM17\nx\nBEGIN b\nM02\ny\n%c\nN5 M30\n",
+    let (p, _) = split(&m, "START a\nM17\nx\nBEGIN b\nM02\ny\n%c\nN5 M30\n");
+    assert_eq!(
+        texts(&p),
+        ["START a\nM17\n", "BEGIN b\nM02\n", "%c\nN5 M30\n"]
     );
-    assert_eq!(texts(&p), ["START a\nM17\n", "BEGIN b\nM02\n", "%c\nN5 M30\n"]);
 }
 
 #[test]
@@ -198,7 +208,10 @@ fn line_ends_are_kept_byte_exact() {
     let input = "%A\r\nN1 G0\r\nN2\nN3 M30\r\nx\r\n%B\nM30";
     let (p, _) = split(&m, input);
     assert_eq!(texts(&p), ["%A\r\nN1 G0\r\nN2\nN3 M30\r\n", "%B\nM30"]);
-    assert!(p[1].complete, "an end line without a line end still ends the region");
+    assert!(
+        p[1].complete,
+        "an end line without a line end still ends the region"
+    );
 }
 
 /// An archive as a SINUMERIK control sends it: each file opens with `%_N_<NAME>_<TYPE>` and a
@@ -282,7 +295,16 @@ fn a_line_longer_than_the_window_streams_through_and_hides_late_markers() {
     input.extend_from_slice(b"N1 M30\n");
     input.extend_from_slice(b"skipped\n");
     let whole = split_chunked(&m, &input, 0);
-    for chunk in [1, 2, 7, 1000, 4096, LINE_WINDOW - 1, LINE_WINDOW, LINE_WINDOW + 1] {
+    for chunk in [
+        1,
+        2,
+        7,
+        1000,
+        4096,
+        LINE_WINDOW - 1,
+        LINE_WINDOW,
+        LINE_WINDOW + 1,
+    ] {
         assert_eq!(split_chunked(&m, &input, chunk), whole, "chunk {chunk}");
     }
     let (p, _) = whole;

@@ -209,7 +209,10 @@ mod tests {
 
     #[test]
     fn isg_program_start_names_the_file() {
-        assert_eq!(info(&["%demo\n"]).file_name(), Some((None, "demo.nc".into())));
+        assert_eq!(
+            info(&["%demo\n"]).file_name(),
+            Some((None, "demo.nc".into()))
+        );
         assert_eq!(
             info(&["% part.nc (comment)\n"]).file_name(),
             Some((None, "part.nc".into()))

@@ -251,8 +251,8 @@ mod tests {
     #[test]
     fn chunk_scan_agrees_with_per_line_search() {
         let none: [&str; 0] = [];
-        let m = Markers::new(none, ["M30", "M2\r", "%"], Anchor::Anywhere).unwrap();
-        let buf = b"N1 G0\nN2 M30\nM2\r\nx\n%%\nM3\nM30";
+        let m = Markers::new(none, ["M30", "M2 ", "%"], Anchor::Anywhere).unwrap();
+        let buf = b"N1 G0\nN2 M30\nM2 \r\nx\n%%\nM3\nM30";
         let mut scan = ChunkScan::new();
         let mut pos = 0;
         while pos < buf.len() {

@@ -17,6 +17,4 @@ pub use error::DncError;
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
 pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
 pub use transfer::{receive, receive_connections, TransferEnd, TransferReport};
-pub use writer::{
-    Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig,
-};
+pub use writer::{Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig};

@@ -317,8 +317,7 @@ impl Splitter {
             }
             let he = le.min(pos + LINE_WINDOW);
             let (ws, we) = self.wants();
-            let sh = ws
-                && start_scan.hit(&self.markers.start, self.markers.anchor, buf, pos, he);
+            let sh = ws && start_scan.hit(&self.markers.start, self.markers.anchor, buf, pos, he);
             let eh = we && end_scan.hit(&self.markers.end, self.markers.anchor, buf, pos, he);
             let a = self.step(&buf[pos..he], sh, eh);
             if a.end_before || a.start_before || !a.include {
@@ -419,7 +418,11 @@ impl Splitter {
         r
     }
 
-    fn end_program<S: ProgramSink>(&mut self, complete: bool, sink: &mut S) -> Result<(), S::Error> {
+    fn end_program<S: ProgramSink>(
+        &mut self,
+        complete: bool,
+        sink: &mut S,
+    ) -> Result<(), S::Error> {
         let Some(o) = self.open.take() else {
             return Ok(());
         };

@@ -34,7 +34,9 @@ impl NameTemplate {
             template: template.to_string(),
             reason,
         };
-        let open = template.find("{n").ok_or_else(|| bad("no `{n}` placeholder"))?;
+        let open = template
+            .find("{n")
+            .ok_or_else(|| bad("no `{n}` placeholder"))?;
         let close = template[open..]
             .find('}')
             .map(|i| open + i)
@@ -133,6 +135,9 @@ impl ReceivedProgram {
     }
 }
 
+/// Called with every record as it is made.
+type LogFn = Box<dyn FnMut(&ReceivedProgram)>;
+
 /// How many taken numbered names are skipped at most when looking for a free one.
 const MAX_NUMBER_PROBES: u32 = 100_000;
 
@@ -148,7 +153,7 @@ pub struct ProgramWriter {
     next_number: u32,
     temp_seq: u64,
     records: Vec<ReceivedProgram>,
-    log: Option<Box<dyn FnMut(&ReceivedProgram)>>,
+    log: Option<LogFn>,
 }
 
 impl ProgramWriter {
@@ -215,10 +220,7 @@ impl ProgramWriter {
         let Some(mut tmp) = self.current.take() else {
             return Ok(());
         };
-        let done = tmp
-            .file
-            .flush()
-            .and_then(|_| tmp.file.get_ref().sync_all());
+        let done = tmp.file.flush().and_then(|_| tmp.file.get_ref().sync_all());
         if let Err(e) = done {
             drop(tmp.file);
             let _ = fs::remove_file(&tmp.path);
