@@ -7,9 +7,9 @@
 pub mod cli;
 pub mod diag;
 pub mod dnc;
+pub mod feeder;
 pub mod lang;
 pub mod params;
-pub mod feeder;
 pub mod report;
 pub mod runtime;
 pub mod source;
