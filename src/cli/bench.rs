@@ -116,7 +116,7 @@ impl Cycle for StreamingLoad {
             self.feeder.result(r.is_ok());
             self.write(len, r, tick);
         }
-        if tick.index % self.take_every == 0 {
+        if tick.index.is_multiple_of(self.take_every) {
             let n = self.stream.take_segment(&mut self.segment);
             if n > 0 {
                 self.lines += self.segment.iter().filter(|&&b| b == b'\n').count() as u64;
@@ -145,7 +145,10 @@ pub fn generated_program(lines: usize) -> Vec<u8> {
         let y = (i * 91 % 1500) as f64 / 10.0;
         let line = match i % 7 {
             0 => format!("N{i} G02 X{x:.3} Y{y:.3} I5.000 J0\n"),
-            3 => format!("N{i} G01 X{x:.3} Y{y:.3} F{} (feed change)\n", 1000 + i % 500),
+            3 => format!(
+                "N{i} G01 X{x:.3} Y{y:.3} F{} (feed change)\n",
+                1000 + i % 500
+            ),
             5 => format!("N{i} M08\n"),
             _ => format!("N{i} G01 X{x:.3} Y{y:.3} Z-{:.2}\n", (i % 5) as f64 * 0.25),
         };
@@ -172,7 +175,9 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         return ExitCode::from(super::exit::USAGE);
     }
     let period = Duration::from_micros(args.period_us);
-    let ticks = ((args.seconds * 1e6) / args.period_us as f64).ceil().max(1.0) as u64;
+    let ticks = ((args.seconds * 1e6) / args.period_us as f64)
+        .ceil()
+        .max(1.0) as u64;
     let load = match StreamingLoad::new(
         generated_program(5000),
         crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE,

@@ -32,11 +32,20 @@ pub struct Event {
 #[serde(tag = "ev", rename_all = "snake_case")]
 pub enum EventKind {
     /// Channel mode and state changed.
-    State { mode: String, state: String },
+    State {
+        mode: String,
+        state: String,
+    },
     /// A program started; `stream` when it reads from the stream interface.
-    ProgramStart { prog: String, stream: bool },
+    ProgramStart {
+        prog: String,
+        stream: bool,
+    },
     /// A program ended; `end` is how (`M30`, `M2`, `M17`, `M29`, `reset`, `error`).
-    ProgramEnd { prog: String, end: String },
+    ProgramEnd {
+        prog: String,
+        end: String,
+    },
     /// A block that took effect: program, 1-based line, byte offset of the line in the
     /// program (stream: since stream start), block counter, block number (`N`), text.
     Block {
@@ -54,10 +63,17 @@ pub enum EventKind {
         code: Option<u32>,
     },
     /// The decoder took a segment out of the stream buffer.
-    Segment { bytes: u64 },
+    Segment {
+        bytes: u64,
+    },
     /// Data dropped: the rest of a segment after a program end, or the buffer at reset.
-    Discard { bytes: u64 },
-    Warning { code: u32, msg: String },
+    Discard {
+        bytes: u64,
+    },
+    Warning {
+        code: u32,
+        msg: String,
+    },
     Error {
         code: u32,
         msg: String,
@@ -69,11 +85,19 @@ pub enum EventKind {
     /// Motion resumed after an interrupt.
     Resume,
     /// A file cache operation (`load`, `refresh`, `clear`, `clear_all`, `hit`).
-    Cache { op: String, file: Option<String> },
+    Cache {
+        op: String,
+        file: Option<String>,
+    },
     /// `#FLUSH` of the given kind (`plain`, `continue`, `wait`).
-    Flush { kind: String },
+    Flush {
+        kind: String,
+    },
     /// Block search: the target and whether it was found.
-    Search { target: String, found: bool },
+    Search {
+        target: String,
+        found: bool,
+    },
 }
 
 impl Event {
@@ -297,6 +321,9 @@ mod tests {
             r#"{"tick":3,"t":0.003,"ch":1,"ev":"write","bytes":12,"ok":false,"code":11012}"#
         );
         let e = Event::new(&tick, 2, EventKind::Interrupt);
-        assert_eq!(e.to_json(), r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt"}"#);
+        assert_eq!(
+            e.to_json(),
+            r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt"}"#
+        );
     }
 }

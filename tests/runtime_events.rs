@@ -1,0 +1,280 @@
+//! The event log and the report as files users parse: one JSON object a line with the field
+//! names of DESIGN.md, nothing lost at shutdown, identical logs from identical virtual runs.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use ncchannel::cli::bench::{generated_program, StreamingLoad};
+use ncchannel::report::event::{Event, EventKind, EventLog};
+use ncchannel::report::stats::CycleStats;
+use ncchannel::report::summary::{CycleReport, ErrorReport, Outcome, Report, StreamReport};
+use ncchannel::runtime::{Clock, RunEnd, Runtime, Tick};
+use serde_json::Value;
+
+fn keys(line: &str) -> Vec<String> {
+    // Field names as a sorted set; the order of the leading four is checked on the text.
+    let v: Value = serde_json::from_str(line).unwrap();
+    let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+    k.sort();
+    k
+}
+
+fn sorted(names: &[&str]) -> Vec<String> {
+    let mut k: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    k.sort();
+    k
+}
+
+#[test]
+fn every_event_kind_has_the_documented_fields() {
+    let tick = Tick {
+        index: 1500,
+        period: Duration::from_millis(1),
+        time: Duration::from_millis(1500),
+    };
+    let s = |x: &str| x.to_string();
+    let cases: Vec<(EventKind, &str, Vec<&str>)> = vec![
+        (
+            EventKind::State {
+                mode: s("automatic"),
+                state: s("active"),
+            },
+            "state",
+            vec!["mode", "state"],
+        ),
+        (
+            EventKind::ProgramStart {
+                prog: s("streaming.nc"),
+                stream: true,
+            },
+            "program_start",
+            vec!["prog", "stream"],
+        ),
+        (
+            EventKind::ProgramEnd {
+                prog: s("streaming.nc"),
+                end: s("M30"),
+            },
+            "program_end",
+            vec!["prog", "end"],
+        ),
+        (
+            EventKind::Block {
+                prog: s("streaming.nc"),
+                line: 3,
+                offset: 40,
+                counter: 3,
+                n: Some(30),
+                text: s("N30 X10"),
+            },
+            "block",
+            vec!["prog", "line", "offset", "counter", "n", "text"],
+        ),
+        (
+            EventKind::Write {
+                bytes: 992,
+                ok: true,
+                code: None,
+            },
+            "write",
+            vec!["bytes", "ok", "code"],
+        ),
+        (EventKind::Segment { bytes: 10 }, "segment", vec!["bytes"]),
+        (EventKind::Discard { bytes: 10 }, "discard", vec!["bytes"]),
+        (
+            EventKind::Warning {
+                code: 11012,
+                msg: s("Error writing the object"),
+            },
+            "warning",
+            vec!["code", "msg"],
+        ),
+        (
+            EventKind::Error {
+                code: 21476,
+                msg: s("no line end"),
+                prog: Some(s("streaming.nc")),
+                line: Some(7),
+            },
+            "error",
+            vec!["code", "msg", "prog", "line"],
+        ),
+        (EventKind::Interrupt, "interrupt", vec![]),
+        (EventKind::Resume, "resume", vec![]),
+        (
+            EventKind::Cache {
+                op: s("load"),
+                file: Some(s("sub.nc")),
+            },
+            "cache",
+            vec!["op", "file"],
+        ),
+        (
+            EventKind::Flush {
+                kind: s("continue"),
+            },
+            "flush",
+            vec!["kind"],
+        ),
+        (
+            EventKind::Search {
+                target: s("n:30"),
+                found: true,
+            },
+            "search",
+            vec!["target", "found"],
+        ),
+    ];
+    for (kind, ev, fields) in cases {
+        let line = Event::new(&tick, 2, kind).to_json();
+        assert!(!line.contains('\n'));
+        assert!(
+            line.starts_with(&format!(r#"{{"tick":1500,"t":1.5,"ch":2,"ev":"{ev}""#)),
+            "{line}"
+        );
+        let mut want = vec!["tick", "t", "ch", "ev"];
+        want.extend(fields);
+        assert_eq!(keys(&line), sorted(&want), "{line}");
+    }
+}
+
+/// Run the synthetic streaming load in virtual time with the events going to `path`.
+fn logged_run(path: &std::path::Path) -> (u64, u64) {
+    let log = EventLog::to_file(path).unwrap();
+    // Reading every 5th tick while writing full packets each tick fills the buffer: 11012s.
+    let load = StreamingLoad::new(generated_program(600), 992, 5, false, log).unwrap();
+    let (mut rt, _tx) = Runtime::new(load, Duration::from_millis(1), Clock::Virtual);
+    let s = rt.run(Some(100_000));
+    assert_eq!(s.end, RunEnd::Stopped);
+    let (load, _) = rt.into_inner();
+    let c = *load.stream().counters();
+    let expected_events = c.writes_ok + c.writes_full + c.segments;
+    let lines = load.finish().unwrap();
+    assert_eq!(lines, expected_events);
+    (lines, c.writes_full)
+}
+
+#[test]
+fn identical_virtual_runs_give_identical_event_logs_and_lose_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.jsonl"), dir.path().join("b.jsonl"));
+    let (lines, rejected) = logged_run(&a);
+    logged_run(&b);
+    let ta = std::fs::read_to_string(&a).unwrap();
+    let tb = std::fs::read_to_string(&b).unwrap();
+    assert_eq!(ta, tb);
+    assert!(rejected > 0, "the run should have provoked 11012");
+    assert_eq!(ta.lines().count() as u64, lines);
+    let mut last_tick = 0;
+    let mut seen_reject = false;
+    for line in ta.lines() {
+        let v: Value = serde_json::from_str(line).unwrap();
+        let tick = v["tick"].as_u64().unwrap();
+        assert!(tick >= last_tick, "events in tick order");
+        last_tick = tick;
+        assert_eq!(v["t"].as_f64().unwrap(), tick as f64 / 1000.0);
+        assert_eq!(v["ch"], 1);
+        if v["ev"] == "write" && v["ok"] == false {
+            assert_eq!(v["code"], 11012);
+            seen_reject = true;
+        }
+    }
+    assert!(seen_reject);
+}
+
+#[test]
+fn a_disabled_log_takes_events_and_writes_nothing() {
+    let mut log = EventLog::disabled();
+    assert!(!log.enabled());
+    let mut buf = log.buffer();
+    assert!(!buf.enabled());
+    let tick = Tick {
+        index: 0,
+        period: Duration::from_millis(1),
+        time: Duration::ZERO,
+    };
+    buf.push(&tick, 1, EventKind::Interrupt);
+    assert!(buf.is_empty());
+    buf.flush_to(&mut log);
+    assert_eq!(log.finish().unwrap(), 0);
+}
+
+#[test]
+fn report_json_has_the_documented_shape() {
+    let mut stats = CycleStats::default();
+    for us in [100u64, 120, 130, 900] {
+        stats.work.record_ns(us * 1000 / 100);
+        stats.lateness.record_ns(us * 10);
+    }
+    let r = Report {
+        outcome: Outcome::MaxTicks,
+        ticks: 4,
+        time_s: 0.004,
+        wall_s: 0.0001,
+        blocks: 2,
+        position: BTreeMap::from([("X".to_string(), 10.0), ("Y".to_string(), -2.5)]),
+        stream: StreamReport {
+            writes_ok: 3,
+            writes_rejected: 1,
+            bytes: 120,
+        },
+        interrupts: 1,
+        errors: vec![ErrorReport {
+            code: 21476,
+            msg: "Streaming data does not contain a correct line end marker".into(),
+        }],
+        cycle: CycleReport::new(Duration::from_millis(1), &stats),
+    };
+    let v: Value = serde_json::from_str(&r.to_json_pretty()).unwrap();
+    assert_eq!(v["outcome"], "max_ticks");
+    assert_eq!(
+        keys(&v.to_string()),
+        sorted(&[
+            "outcome",
+            "ticks",
+            "time_s",
+            "wall_s",
+            "blocks",
+            "position",
+            "stream",
+            "interrupts",
+            "errors",
+            "cycle"
+        ])
+    );
+    assert_eq!(v["position"]["Y"], -2.5);
+    assert_eq!(
+        keys(&v["stream"].to_string()),
+        sorted(&["writes_ok", "writes_rejected", "bytes"])
+    );
+    assert_eq!(v["errors"][0]["code"], 21476);
+    assert_eq!(
+        keys(&v["cycle"].to_string()),
+        sorted(&[
+            "period_us",
+            "work_us_p50",
+            "work_us_p99",
+            "work_us_max",
+            "late_us_p99",
+            "overruns"
+        ])
+    );
+    assert_eq!(v["cycle"]["period_us"], 1000.0);
+    assert_eq!(v["cycle"]["work_us_max"], 9.0);
+    let back: Report = serde_json::from_value(v).unwrap();
+    assert_eq!(back, r);
+
+    let mut human = Vec::new();
+    r.print_human(&mut human).unwrap();
+    let human = String::from_utf8(human).unwrap();
+    for want in [
+        "stopped at --max-ticks",
+        "blocks:     2",
+        "0.004 s channel time",
+        "interrupts: 1",
+        "3 writes accepted, 1 rejected",
+        "error 21476",
+    ] {
+        assert!(human.contains(want), "{want:?} missing in\n{human}");
+    }
+}
