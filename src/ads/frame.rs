@@ -27,8 +27,16 @@ pub const AMS_ERR_PORT_NOT_FOUND: u32 = 6;
 pub const AMS_ERR_MACHINE_NOT_FOUND: u32 = 7;
 
 /// A six-byte AMS network id, written `a.b.c.d.e.f`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub struct AmsNetId(pub [u8; 6]);
+
+impl TryFrom<String> for AmsNetId {
+    type Error = NetIdParseError;
+    fn try_from(s: String) -> Result<Self, Self::Error> {
+        s.parse()
+    }
+}
 
 impl AmsNetId {
     /// The local NetId clients use when they talk to "this machine".

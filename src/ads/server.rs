@@ -35,10 +35,18 @@ pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
 pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
 
 /// One entry of the route allow-list: a client NetId or a peer IP address.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum RouteEntry {
     NetId(AmsNetId),
     Ip(IpAddr),
+}
+
+impl TryFrom<String> for RouteEntry {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+    }
 }
 
 impl FromStr for RouteEntry {

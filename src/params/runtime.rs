@@ -2,10 +2,8 @@
 //! axis limits, decoder and planner budgets, simulated file-system latency, ADS endpoint).
 //! Every key has a default; an unknown key is an error naming it.
 
-use std::fmt;
-use std::net::{IpAddr, SocketAddr};
+use std::net::SocketAddr;
 use std::path::Path;
-use std::str::FromStr;
 
 use serde::Deserialize;
 
@@ -182,64 +180,9 @@ impl TryFrom<String> for SocketAddrText {
     }
 }
 
-/// An AMS NetId: six numbers 0…255, written `a.b.c.d.e.f`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize)]
-#[serde(try_from = "String")]
-pub struct AmsNetId(pub [u8; 6]);
-
-impl FromStr for AmsNetId {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let bad = || format!("`{s}` is not an AMS NetId (six numbers 0-255 separated by dots)");
-        let mut out = [0u8; 6];
-        let mut parts = s.split('.');
-        for b in out.iter_mut() {
-            let p = parts.next().ok_or_else(bad)?;
-            if p.is_empty() || !p.bytes().all(|c| c.is_ascii_digit()) {
-                return Err(bad());
-            }
-            *b = p.parse().map_err(|_| bad())?;
-        }
-        if parts.next().is_some() {
-            return Err(bad());
-        }
-        Ok(AmsNetId(out))
-    }
-}
-
-impl TryFrom<String> for AmsNetId {
-    type Error = String;
-    fn try_from(s: String) -> Result<Self, String> {
-        s.parse()
-    }
-}
-
-impl fmt::Display for AmsNetId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let [a, b, c, d, e, g] = self.0;
-        write!(f, "{a}.{b}.{c}.{d}.{e}.{g}")
-    }
-}
-
-/// One allowed client: by AMS NetId (six parts) or IP address.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(try_from = "String")]
-pub enum RouteEntry {
-    NetId(AmsNetId),
-    Ip(IpAddr),
-}
-
-impl TryFrom<String> for RouteEntry {
-    type Error = String;
-    fn try_from(s: String) -> Result<Self, String> {
-        if let Ok(ip) = s.parse::<IpAddr>() {
-            return Ok(RouteEntry::Ip(ip));
-        }
-        s.parse::<AmsNetId>()
-            .map(RouteEntry::NetId)
-            .map_err(|_| format!("`{s}` is neither an AMS NetId (a.b.c.d.e.f) nor an IP address"))
-    }
-}
+/// NetIds and route entries are the ADS room's types: one parser, one meaning.
+pub use crate::ads::frame::AmsNetId;
+pub use crate::ads::server::RouteEntry;
 
 /// Parse and check runtime.toml text. Errors name the key (`ads.net_id`, `axes[1].name`).
 pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {
