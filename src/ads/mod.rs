@@ -6,6 +6,7 @@
 //! implements it, and [`memory::MemoryBackend`] is an in-memory stand-in for tests.
 
 pub mod backend;
+pub mod channel_backend;
 pub mod client;
 pub mod frame;
 pub mod memory;

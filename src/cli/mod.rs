@@ -10,6 +10,7 @@ pub mod bench;
 pub mod check;
 pub mod receive;
 pub mod run;
+pub mod serve;
 pub mod stream;
 
 /// Exit codes of the command-line contract (DESIGN.md).
@@ -43,6 +44,8 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Run one program on a channel, optionally streamed by the built-in feeder.
     Run(run::RunArgs),
+    /// Serve the channels over ADS/TCP in real time.
+    Serve(serve::ServeArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
     /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
@@ -56,6 +59,7 @@ impl Cli {
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
             Some(Command::Run(args)) => run::execute(args),
+            Some(Command::Serve(args)) => serve::execute(args),
             Some(Command::Stream(args)) => stream::execute(args),
             None => run::execute(run::RunArgs::demo()),
         }

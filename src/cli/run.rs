@@ -80,7 +80,7 @@ impl RunArgs {
 
 /// A relative default path that is not where we are run from is looked up in the crate's
 /// folder, so `cargo run` works from any directory of the checkout.
-fn locate(p: &Path) -> PathBuf {
+pub(crate) fn locate(p: &Path) -> PathBuf {
     if p.is_relative() && !p.exists() {
         let alt = Path::new(env!("CARGO_MANIFEST_DIR")).join(p);
         if alt.exists() {
