@@ -1,0 +1,184 @@
+//! A channel rig for integration tests: parameter lists and programs in a temporary folder,
+//! a machine run in virtual time, the event log captured as JSON values.
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use ncchannel::channel::Finish;
+use ncchannel::feeder::Feeder;
+use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::report::event::EventLog;
+use ncchannel::runtime::{Clock, Runtime, Tick};
+use serde_json::Value;
+
+pub struct Rig {
+    pub dir: tempfile::TempDir,
+}
+
+#[derive(Clone, Default)]
+struct Shared(Arc<Mutex<Vec<u8>>>);
+
+impl Write for Shared {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().unwrap().extend_from_slice(b);
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+pub struct RunResult {
+    pub log: String,
+    pub events: Vec<Value>,
+    pub finish: Option<Finish>,
+    pub machine: Machine,
+    pub ticks: u64,
+}
+
+impl RunResult {
+    pub fn of(&self, ev: &str) -> Vec<&Value> {
+        self.events.iter().filter(|e| e["ev"] == ev).collect()
+    }
+    /// Texts of the `block` events, in order.
+    pub fn block_texts(&self) -> Vec<String> {
+        self.of("block")
+            .iter()
+            .map(|e| e["text"].as_str().unwrap().to_string())
+            .collect()
+    }
+    pub fn error_codes(&self) -> Vec<u64> {
+        self.of("error")
+            .iter()
+            .map(|e| e["code"].as_u64().unwrap())
+            .collect()
+    }
+}
+
+impl Rig {
+    /// One channel, streaming program `streaming.nc`, programs in `nc/`, caching on (2 × 200 B).
+    pub fn new() -> Rig {
+        Self::with_runtime("")
+    }
+
+    pub fn with_runtime(runtime_toml: &str) -> Rig {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("params")).unwrap();
+        std::fs::create_dir_all(dir.path().join("nc")).unwrap();
+        std::fs::write(
+            dir.path().join("params/startup.lis"),
+            "kanal_anzahl 1\nsda_mds[0] channel1.lis\npfad[0].prg[0] ../nc\npfad[0].typ[0] 0x03\npfad[0].prioritaet[0] 0\n\
+             configuration.channel[0].decoder.function FCT_USE_CACHED_FILES\n\
+             configuration.channel[0].decoder.max_cache_number 2\n\
+             configuration.channel[0].decoder.max_cache_size 200\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("params/channel1.lis"),
+            "streaming_prog_file streaming.nc\n",
+        )
+        .unwrap();
+        if !runtime_toml.is_empty() {
+            std::fs::write(dir.path().join("params/runtime.toml"), runtime_toml).unwrap();
+        }
+        Rig { dir }
+    }
+
+    pub fn startup(&self) -> PathBuf {
+        self.dir.path().join("params/startup.lis")
+    }
+
+    pub fn nc(&self) -> PathBuf {
+        self.dir.path().join("nc")
+    }
+
+    pub fn program(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.nc().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    pub fn machine(&self) -> (Machine, Duration, Shared2) {
+        let config = ncchannel::params::load(&self.startup()).unwrap();
+        let channels = ncchannel::setup::channels(&config, true).unwrap();
+        let shared = Shared::default();
+        let log = EventLog::to_writer(Box::new(shared.clone()));
+        let period = Duration::from_micros(config.runtime.cycle_period_us);
+        (
+            Machine::new(channels, log, StopWhen::ProgramsFinished),
+            period,
+            Shared2(shared),
+        )
+    }
+
+    /// Start `program` on channel 1, feed `stream` (if any) with the built-in feeder, run in
+    /// virtual time until the program finishes or `max_ticks`.
+    pub fn run(&self, program: &str, stream: Option<Feeder>, max_ticks: u64) -> RunResult {
+        self.run_with(program, stream, max_ticks, |_| {})
+    }
+
+    pub fn run_with(
+        &self,
+        program: &str,
+        stream: Option<Feeder>,
+        max_ticks: u64,
+        prepare: impl FnOnce(&mut Machine),
+    ) -> RunResult {
+        let (mut machine, period, shared) = self.machine();
+        if let Some(f) = stream {
+            machine.attach_feeder(1, f);
+        }
+        prepare(&mut machine);
+        let t0 = tick0(period);
+        let _ = machine.channel_mut(1).unwrap().start(&t0, program);
+        let (mut rt, _tx) = Runtime::new(machine, period, Clock::Virtual);
+        rt.run(Some(max_ticks));
+        let ticks = rt.ticks();
+        let (mut machine, _) = rt.into_inner();
+        machine.finish_log().unwrap();
+        let finish = machine.finishes()[0];
+        let log = String::from_utf8(shared.0 .0.lock().unwrap().clone()).unwrap();
+        let events = log
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        RunResult {
+            log,
+            events,
+            finish,
+            machine,
+            ticks,
+        }
+    }
+}
+
+pub struct Shared2(Shared);
+
+impl Shared2 {
+    pub fn text(&self) -> String {
+        String::from_utf8(self.0 .0.lock().unwrap().clone()).unwrap()
+    }
+}
+
+pub fn tick0(period: Duration) -> Tick {
+    Tick {
+        index: 0,
+        period,
+        time: Duration::ZERO,
+    }
+}
+
+pub fn feeder(text: &str, packet: usize, every: u64) -> Feeder {
+    Feeder::new(text.as_bytes().to_vec(), packet, every, false).unwrap()
+}
+
+pub fn crlf(text: &str) -> Vec<u8> {
+    text.replace('\n', "\r\n").into_bytes()
+}
+
+pub fn path_str(p: &Path) -> String {
+    p.display().to_string()
+}
