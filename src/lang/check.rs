@@ -197,8 +197,7 @@ fn col_of(line: &str, needle: &str) -> usize {
         .map_or(1, |b| line[..b].chars().count() + 1)
 }
 
-/// Check a whole program text. Diagnostics come in line order, except that open blocks and
-/// missing jump targets are reported when their program level ends.
+/// Check a whole program text. Diagnostics come sorted by line and column.
 pub fn check_program(text: &str) -> Vec<ProgramDiag> {
     let mut diags = Vec::new();
     let mut level = Level::default();
@@ -292,5 +291,6 @@ pub fn check_program(text: &str) -> Vec<ProgramDiag> {
             "#VAR not closed by #ENDVAR before the program ends",
         ));
     }
+    diags.sort_by_key(|d| (d.line, d.col));
     diags
 }
