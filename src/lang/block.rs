@@ -48,6 +48,9 @@ pub enum Item {
     Word(Word),
     /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`.
     Assign { target: VarRef, value: Expr, col: u32 },
+    /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent).
+    /// Seed 003 writes `G134 50`; both forms parse to this item. `col` is the G's column.
+    GValue { g: u32, value: Value, col: u32 },
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.

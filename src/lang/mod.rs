@@ -1,1 +1,23 @@
-//! The NC language: one NC line → `Block`, expressions and their evaluation.
+//! The NC language: one NC line → `Block`, expressions and their evaluation, and a static
+//! checker for whole programs.
+//!
+//! Everything here is pure: no I/O, no state between lines. The decoder keeps the
+//! `#COMMENT` and `#VAR` block state itself and asks [`is_comment_end`] /
+//! [`parse_var_declaration`] for lines inside them.
+
+pub mod block;
+pub mod check;
+pub mod codes;
+mod display;
+pub mod error;
+pub mod eval;
+pub mod expr;
+mod number;
+pub mod parse;
+
+pub use block::*;
+pub use check::{check_program, ProgramDiag};
+pub use error::SyntaxError;
+pub use eval::{case_matches, eval, is_true, resolve, EvalError, VarKey, Vars};
+pub use expr::parse_expr;
+pub use parse::{is_blank_line, is_comment_end, parse_block, parse_var_declaration};

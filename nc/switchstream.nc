@@ -1,0 +1,20 @@
+%switchstream
+(seed 003 §2.3.3 "Jump list in the forward direction"; a blank line separates the packets)
+N010 G00 X0 Y0 Z0
+N020 P1=10
+N030
+N040 $SWITCH P1
+N050 $CASE 1
+N060 X10
+N070 $BREAK
+
+N080 $CASE 5
+N090 X50
+N100 $BREAK
+N110 $CASE 9
+N120 X90
+N130 $BREAK
+N140 $CASE 10
+N150 X100
+N160 $ENDSWITCH
+M30

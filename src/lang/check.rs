@@ -1,0 +1,296 @@
+//! Static check of a whole NC program file: every line parsed, plus the structure a single
+//! line cannot show — control blocks opened and closed, labels unique, `$GOTO` targets found.
+//!
+//! Program levels: each `%name` / `%L name` head starts a new level; labels are searched and
+//! control blocks must close within their level (REFERENCE §4). The check reads files the
+//! way the decoder runs them (both jump directions allowed); streaming's extra limits
+//! (no loops, forward jumps only) are the decoder's business.
+
+use std::collections::{HashMap, HashSet};
+
+use super::block::{Body, Command, Control, GotoTarget, Label};
+use super::codes::{StrayKind, LABEL_NOT_FOUND, LABEL_TWICE, OPEN_CONTROL_BLOCK, SYNTAX};
+use super::parse::{is_blank_line, is_comment_end, parse_block, parse_var_declaration};
+
+/// One finding in a program: 1-based line and character column, ISG error number, message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ProgramDiag {
+    pub line: usize,
+    pub col: usize,
+    pub code: u32,
+    pub message: String,
+}
+
+impl ProgramDiag {
+    fn new(line: usize, col: usize, code: u32, message: impl Into<String>) -> Self {
+        ProgramDiag {
+            line,
+            col,
+            code,
+            message: message.into(),
+        }
+    }
+}
+
+/// An open control block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum OpenKind {
+    If { else_seen: bool },
+    Switch,
+    For,
+    While,
+    Do,
+    Repeat,
+}
+
+impl OpenKind {
+    fn is_loop(self) -> bool {
+        matches!(
+            self,
+            OpenKind::For | OpenKind::While | OpenKind::Do | OpenKind::Repeat
+        )
+    }
+
+    fn keyword(self) -> &'static str {
+        match self {
+            OpenKind::If { .. } => "$IF",
+            OpenKind::Switch => "$SWITCH",
+            OpenKind::For => "$FOR",
+            OpenKind::While => "$WHILE",
+            OpenKind::Do => "$DO",
+            OpenKind::Repeat => "$REPEAT",
+        }
+    }
+
+    fn closer(self) -> &'static str {
+        match self {
+            OpenKind::If { .. } => "$ENDIF",
+            OpenKind::Switch => "$ENDSWITCH",
+            OpenKind::For => "$ENDFOR",
+            OpenKind::While => "$ENDWHILE",
+            OpenKind::Do => "$ENDDO",
+            OpenKind::Repeat => "$UNTIL",
+        }
+    }
+}
+
+/// One program level's labels, jumps and open blocks.
+#[derive(Default)]
+struct Level {
+    labels: HashMap<Label, usize>,
+    block_numbers: HashSet<u32>,
+    gotos: Vec<(GotoTarget, usize, usize)>,
+    open: Vec<(OpenKind, usize, usize)>,
+}
+
+impl Level {
+    fn finish(self, diags: &mut Vec<ProgramDiag>) {
+        for (kind, line, col) in self.open {
+            diags.push(ProgramDiag::new(
+                line,
+                col,
+                OPEN_CONTROL_BLOCK,
+                format!(
+                    "{} not closed by {} before the program ends",
+                    kind.keyword(),
+                    kind.closer()
+                ),
+            ));
+        }
+        for (target, line, col) in self.gotos {
+            let label = match &target {
+                GotoTarget::Number(n) => Label::Number(*n),
+                GotoTarget::Name(s) => Label::Name(s.clone()),
+            };
+            if self.labels.contains_key(&label) {
+                continue;
+            }
+            let hint = match target {
+                GotoTarget::Number(n) if self.block_numbers.contains(&n) => {
+                    format!(" (block N{n} exists but is no label: write `N{n}:`)")
+                }
+                _ => String::new(),
+            };
+            diags.push(ProgramDiag::new(
+                line,
+                col,
+                LABEL_NOT_FOUND,
+                format!("jump target {target} not found in this program level{hint}"),
+            ));
+        }
+    }
+
+    fn stray(&self, kind: StrayKind, line: usize, col: usize, diags: &mut Vec<ProgramDiag>) {
+        diags.push(ProgramDiag::new(
+            line,
+            col,
+            kind.code(),
+            format!("unexpected {} without its opening statement", kind.keyword()),
+        ));
+    }
+
+    fn control(&mut self, c: &Control, line: usize, col: usize, diags: &mut Vec<ProgramDiag>) {
+        let top = self.open.last().map(|o| o.0);
+        let pop_if = |me: &mut Self, want: fn(OpenKind) -> bool, kind, diags: &mut Vec<_>| {
+            if top.is_some_and(want) {
+                me.open.pop();
+            } else {
+                me.stray(kind, line, col, diags);
+            }
+        };
+        match c {
+            Control::If(_) => self.open.push((OpenKind::If { else_seen: false }, line, col)),
+            Control::IfGoto(_, t) | Control::Goto(t) => self.gotos.push((t.clone(), line, col)),
+            Control::ElseIf(_) => {
+                if top != Some(OpenKind::If { else_seen: false }) {
+                    self.stray(StrayKind::ElseIf, line, col, diags);
+                }
+            }
+            Control::Else => match self.open.last_mut() {
+                Some((OpenKind::If { else_seen }, _, _)) if !*else_seen => *else_seen = true,
+                _ => self.stray(StrayKind::Else, line, col, diags),
+            },
+            Control::EndIf => pop_if(self, |k| matches!(k, OpenKind::If { .. }), StrayKind::EndIf, diags),
+            Control::Switch(_) => self.open.push((OpenKind::Switch, line, col)),
+            Control::Case(_) => {
+                if top != Some(OpenKind::Switch) {
+                    self.stray(StrayKind::Case, line, col, diags);
+                }
+            }
+            Control::Default => {
+                if top != Some(OpenKind::Switch) {
+                    self.stray(StrayKind::Default, line, col, diags);
+                }
+            }
+            Control::Break => {
+                if !self
+                    .open
+                    .iter()
+                    .any(|o| o.0 == OpenKind::Switch || o.0.is_loop())
+                {
+                    self.stray(StrayKind::Break, line, col, diags);
+                }
+            }
+            Control::Continue => {
+                if !self.open.iter().any(|o| o.0.is_loop()) {
+                    self.stray(StrayKind::Continue, line, col, diags);
+                }
+            }
+            Control::EndSwitch => pop_if(self, |k| k == OpenKind::Switch, StrayKind::EndSwitch, diags),
+            Control::For { .. } => self.open.push((OpenKind::For, line, col)),
+            Control::EndFor => pop_if(self, |k| k == OpenKind::For, StrayKind::EndFor, diags),
+            Control::While(_) => self.open.push((OpenKind::While, line, col)),
+            Control::EndWhile => pop_if(self, |k| k == OpenKind::While, StrayKind::EndWhile, diags),
+            Control::Do => self.open.push((OpenKind::Do, line, col)),
+            Control::EndDo(_) => pop_if(self, |k| k == OpenKind::Do, StrayKind::EndDo, diags),
+            Control::Repeat => self.open.push((OpenKind::Repeat, line, col)),
+            Control::Until(_) => pop_if(self, |k| k == OpenKind::Repeat, StrayKind::Until, diags),
+        }
+    }
+}
+
+/// 1-based character column of the first `needle` in `line` (case-insensitive ASCII), or 1.
+fn col_of(line: &str, needle: &str) -> usize {
+    let upper = line.to_ascii_uppercase();
+    upper
+        .find(needle)
+        .map_or(1, |b| line[..b].chars().count() + 1)
+}
+
+/// Check a whole program text. Diagnostics come sorted by line and column.
+pub fn check_program(text: &str) -> Vec<ProgramDiag> {
+    let mut diags = Vec::new();
+    let mut level = Level::default();
+    let mut comment_from: Option<usize> = None;
+    let mut var_from: Option<(usize, usize)> = None;
+    for (idx, raw) in text.lines().enumerate() {
+        let line = idx + 1;
+        if comment_from.is_some() {
+            if is_comment_end(raw) {
+                comment_from = None;
+            }
+            continue;
+        }
+        if var_from.is_some() {
+            if is_blank_line(raw) {
+                continue;
+            }
+            if let Ok(b) = parse_block(raw) {
+                if b.body == Body::Command(Command::EndVar) {
+                    var_from = None;
+                    continue;
+                }
+            }
+            if let Err(e) = parse_var_declaration(raw) {
+                diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message));
+            }
+            continue;
+        }
+        let block = match parse_block(raw) {
+            Ok(b) => b,
+            Err(e) => {
+                diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message));
+                continue;
+            }
+        };
+        if let Some(n) = block.n {
+            level.block_numbers.insert(n);
+        }
+        if let Some(label) = &block.label {
+            let col = match label {
+                Label::Number(_) => col_of(raw, "N"),
+                Label::Name(_) => col_of(raw, "["),
+            };
+            if let Some(first) = level.labels.get(label) {
+                diags.push(ProgramDiag::new(
+                    line,
+                    col,
+                    LABEL_TWICE,
+                    format!("label {label} already defined in line {first}"),
+                ));
+            } else {
+                level.labels.insert(label.clone(), line);
+            }
+        }
+        match &block.body {
+            Body::Command(Command::CommentBegin) => comment_from = Some(line),
+            Body::Command(Command::Var) => var_from = Some((line, col_of(raw, "#"))),
+            Body::Command(Command::EndVar) => diags.push(ProgramDiag::new(
+                line,
+                col_of(raw, "#"),
+                SYNTAX,
+                "#ENDVAR without #VAR",
+            )),
+            Body::ProgramHead { .. } => {
+                std::mem::take(&mut level).finish(&mut diags);
+            }
+            Body::Control(c) => {
+                let col = match c {
+                    Control::IfGoto(..) => col_of(raw, "$GOTO"),
+                    _ => col_of(raw, "$"),
+                };
+                level.control(c, line, col, &mut diags);
+            }
+            _ => {}
+        }
+    }
+    level.finish(&mut diags);
+    if let Some(line) = comment_from {
+        diags.push(ProgramDiag::new(
+            line,
+            1,
+            OPEN_CONTROL_BLOCK,
+            "#COMMENT BEGIN not closed by #COMMENT END before the program ends",
+        ));
+    }
+    if let Some((line, col)) = var_from {
+        diags.push(ProgramDiag::new(
+            line,
+            col,
+            OPEN_CONTROL_BLOCK,
+            "#VAR not closed by #ENDVAR before the program ends",
+        ));
+    }
+    diags.sort_by_key(|d| (d.line, d.col));
+    diags
+}

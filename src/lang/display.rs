@@ -1,0 +1,359 @@
+//! Canonical NC text for a parsed block: what the parser reads back to an equal `Block`.
+//!
+//! Canonical means: single blanks between items, keywords and names upper-case, every binary
+//! operation bracketed (`[[P1 + 2] * 3]`), numbers in their shortest round-trip form without
+//! exponent (`0.1`, `-6.789`, `3000`), `G134 50` printed as `G134=50`, `/1` as `/`.
+//! Non-finite numbers (which the parser never produces) print as Rust does and do not parse.
+
+use std::fmt::{self, Display, Formatter, Write};
+
+use super::block::{
+    BinOp, Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Index, Item, Label,
+    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, Word,
+};
+
+impl Display for Block {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        let mut sep = "";
+        match self.skip_level {
+            Some(1) => {
+                f.write_char('/')?;
+                sep = " ";
+            }
+            Some(k) => {
+                write!(f, "/{k}")?;
+                sep = " ";
+            }
+            None => {}
+        }
+        match (&self.label, self.n) {
+            (Some(Label::Number(k)), _) => {
+                write!(f, "{sep}N{k}:")?;
+                sep = " ";
+            }
+            (_, Some(n)) => {
+                write!(f, "{sep}N{n}")?;
+                sep = " ";
+            }
+            _ => {}
+        }
+        if let Some(Label::Name(name)) = &self.label {
+            write!(f, "{sep}[{name}]")?;
+            sep = " ";
+        }
+        match &self.body {
+            Body::Items(items) => {
+                for item in items {
+                    write!(f, "{sep}{item}")?;
+                    sep = " ";
+                }
+                Ok(())
+            }
+            Body::Control(c) => write!(f, "{sep}{c}"),
+            Body::Command(c) => write!(f, "{sep}{c}"),
+            Body::Call(c) => write!(f, "{sep}{c}"),
+            Body::ProgramHead { name, local } => {
+                if *local {
+                    write!(f, "{sep}%L {name}")
+                } else {
+                    write!(f, "{sep}%{name}")
+                }
+            }
+        }
+    }
+}
+
+impl Display for Label {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Label::Number(n) => write!(f, "N{n}:"),
+            Label::Name(s) => write!(f, "[{s}]"),
+        }
+    }
+}
+
+impl Display for Item {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Item::Word(w) => w.fmt(f),
+            Item::Assign { target, value, .. } => write!(f, "{target}={value}"),
+            Item::GValue { g, value, .. } => match value {
+                Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
+                Value::Expr(e) => write!(f, "G{g}={e}"),
+            },
+        }
+    }
+}
+
+impl Display for Word {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        f.write_char(char::from(self.letter))?;
+        self.value.fmt(f)
+    }
+}
+
+/// A word's value directly after its letter: `-6.789` or `[P1 * 2]`.
+impl Display for Value {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Num(v) => Num(*v).fmt(f),
+            Value::Expr(e) => Bracketed(e).fmt(f),
+        }
+    }
+}
+
+/// A number in shortest round-trip form, never with an exponent (`E` is an address letter).
+struct Num(f64);
+
+impl Display for Num {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+/// An expression that must be inside `[ ]` (word values, indices): binary operations carry
+/// their own brackets, everything else gets one pair.
+struct Bracketed<'e>(&'e Expr);
+
+impl Display for Bracketed<'_> {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            Expr::Binary(..) => self.0.fmt(f),
+            e => write!(f, "[{e}]"),
+        }
+    }
+}
+
+impl Display for Expr {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Expr::Num(v) => Num(*v).fmt(f),
+            Expr::Var(v) => v.fmt(f),
+            Expr::Unary(op, e) => {
+                match op {
+                    UnOp::Neg => f.write_char('-')?,
+                    UnOp::Not => f.write_str("NOT ")?,
+                    UnOp::Inv => f.write_str("INV ")?,
+                }
+                match (op, e.as_ref()) {
+                    // `-2` would read back as the literal -2, not as negation of 2.
+                    (UnOp::Neg, Expr::Num(v)) if !v.is_sign_negative() => write!(f, "[{e}]"),
+                    _ => e.fmt(f),
+                }
+            }
+            Expr::Binary(op, a, b) => {
+                f.write_char('[')?;
+                match (op, a.as_ref()) {
+                    // `**` binds tighter than unary minus: `-2 ** 2` is `-[2 ** 2]`.
+                    (BinOp::Pow, Expr::Unary(..)) => write!(f, "[{a}]")?,
+                    (BinOp::Pow, Expr::Num(v)) if v.is_sign_negative() => write!(f, "[{a}]")?,
+                    _ => a.fmt(f)?,
+                }
+                write!(f, " {} {b}]", op.symbol())
+            }
+            Expr::Func(func, args) => {
+                f.write_str(func.name())?;
+                f.write_char('[')?;
+                for (k, a) in args.iter().enumerate() {
+                    if k > 0 {
+                        f.write_str(", ")?;
+                    }
+                    a.fmt(f)?;
+                }
+                f.write_char(']')
+            }
+        }
+    }
+}
+
+impl BinOp {
+    /// The operator as canonical NC text.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Pow => "**",
+            BinOp::Mod => "MOD",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::Lt => "<",
+            BinOp::Gt => ">",
+            BinOp::Le => "<=",
+            BinOp::Ge => ">=",
+            BinOp::And => "&&",
+            BinOp::Or => "||",
+            BinOp::Xor => "XOR",
+            BinOp::BitAnd => "&",
+            BinOp::BitOr => "|",
+            BinOp::BitXor => "^",
+        }
+    }
+}
+
+impl Display for VarRef {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        let indices = match self {
+            VarRef::P { number, indices } => {
+                match number {
+                    Index::Const(n) => write!(f, "P{n}")?,
+                    Index::Expr(e) => write!(f, "P{}", Bracketed(e))?,
+                }
+                indices
+            }
+            VarRef::V {
+                scope,
+                name,
+                indices,
+            } => {
+                write!(f, "V.{}.{name}", scope.letter())?;
+                indices
+            }
+            VarRef::CycleParam(n) => return write!(f, "@P{n}"),
+        };
+        for e in indices {
+            Bracketed(e).fmt(f)?;
+        }
+        Ok(())
+    }
+}
+
+impl VScope {
+    /// The scope letter after `V.`.
+    pub fn letter(self) -> char {
+        match self {
+            VScope::Program => 'P',
+            VScope::Local => 'L',
+            VScope::SelfRetaining => 'S',
+            VScope::External => 'E',
+        }
+    }
+}
+
+impl Display for GotoTarget {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            GotoTarget::Number(n) => write!(f, "N{n}"),
+            GotoTarget::Name(s) => write!(f, "[{s}]"),
+        }
+    }
+}
+
+impl Display for Control {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Control::If(e) => write!(f, "$IF {e}"),
+            Control::IfGoto(e, t) => write!(f, "$IF {e} $GOTO {t}"),
+            Control::ElseIf(e) => write!(f, "$ELSEIF {e}"),
+            Control::Else => f.write_str("$ELSE"),
+            Control::EndIf => f.write_str("$ENDIF"),
+            Control::Switch(e) => write!(f, "$SWITCH {e}"),
+            Control::Case(e) => write!(f, "$CASE {e}"),
+            Control::Default => f.write_str("$DEFAULT"),
+            Control::Break => f.write_str("$BREAK"),
+            Control::EndSwitch => f.write_str("$ENDSWITCH"),
+            Control::For {
+                var,
+                start,
+                end,
+                step,
+            } => {
+                write!(f, "$FOR {var}={start}, {end}")?;
+                match step {
+                    Some(s) => write!(f, ", {s}"),
+                    None => Ok(()),
+                }
+            }
+            Control::EndFor => f.write_str("$ENDFOR"),
+            Control::While(e) => write!(f, "$WHILE {e}"),
+            Control::EndWhile => f.write_str("$ENDWHILE"),
+            Control::Do => f.write_str("$DO"),
+            Control::EndDo(e) => write!(f, "$ENDDO {e}"),
+            Control::Repeat => f.write_str("$REPEAT"),
+            Control::Until(e) => write!(f, "$UNTIL {e}"),
+            Control::Continue => f.write_str("$CONTINUE"),
+            Control::Goto(t) => write!(f, "$GOTO {t}"),
+        }
+    }
+}
+
+/// A file name as written; quoted when it holds a character that would end it.
+struct FileName<'s>(&'s str);
+
+impl Display for FileName<'_> {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        let s = self.0;
+        if s.is_empty() || s.starts_with('"') || s.contains([' ', '\t', ']', '(', ';']) {
+            write!(f, "\"{s}\"")
+        } else {
+            f.write_str(s)
+        }
+    }
+}
+
+impl Display for Command {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Command::Flush(FlushKind::Stop) => f.write_str("#FLUSH"),
+            Command::Flush(FlushKind::Continue) => f.write_str("#FLUSH CONTINUE"),
+            Command::Flush(FlushKind::Wait) => f.write_str("#FLUSH WAIT"),
+            Command::CacheLoad { file } => write!(f, "#CACHE LOAD [FILE={}]", FileName(file)),
+            Command::CacheClear { file } => write!(f, "#CACHE CLEAR [FILE={}]", FileName(file)),
+            Command::CacheClearAll => f.write_str("#CACHE CLEAR ALL"),
+            Command::CommentBegin => f.write_str("#COMMENT BEGIN"),
+            Command::CommentEnd => f.write_str("#COMMENT END"),
+            Command::Spline(SplineCommand::On) => f.write_str("#SPLINE ON"),
+            Command::Spline(SplineCommand::Off) => f.write_str("#SPLINE OFF"),
+            Command::Spline(SplineCommand::TypeAkima) => f.write_str("#SPLINE TYPE AKIMA"),
+            Command::Spline(SplineCommand::TypeBspline) => f.write_str("#SPLINE TYPE BSPLINE"),
+            Command::Hsc { on, options } => {
+                f.write_str(if *on { "#HSC ON" } else { "#HSC OFF" })?;
+                options_fmt(f, options)
+            }
+            Command::ContourMode { options } => {
+                f.write_str("#CONTOUR MODE")?;
+                options_fmt(f, options)
+            }
+            Command::Var => f.write_str("#VAR"),
+            Command::EndVar => f.write_str("#ENDVAR"),
+        }
+    }
+}
+
+fn options_fmt(f: &mut Formatter<'_>, options: &str) -> fmt::Result {
+    if options.is_empty() {
+        Ok(())
+    } else {
+        write!(f, " [{options}]")
+    }
+}
+
+impl Display for Call {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            Call::Global { file } => write!(f, "L {}", FileName(file)),
+            Call::Local { name } => write!(f, "LL {}", FileName(name)),
+            Call::Cycle { name, params } => {
+                write!(f, "L CYCLE [NAME={}", FileName(name))?;
+                for (p, e) in params {
+                    write!(f, " @P{p}={e}")?;
+                }
+                f.write_char(']')
+            }
+        }
+    }
+}
+
+impl Display for VarDecl {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        write!(f, "V.{}.{}", self.scope.letter(), self.name)?;
+        for d in &self.dims {
+            write!(f, "[{d}]")?;
+        }
+        match &self.init {
+            Some(e) => write!(f, "={e}"),
+            None => Ok(()),
+        }
+    }
+}

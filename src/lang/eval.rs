@@ -1,0 +1,303 @@
+//! Evaluating expressions against the decoder's parameters and variables.
+//!
+//! The evaluator resolves indices itself (indirect `P[P1+5]`, array `P1[2]`) and hands the
+//! decoder a [`VarKey`] whose indices are plain numbers, so the decoder's storage never sees
+//! an expression. Trigonometry works in degrees, as ISG does: `SIN[30]` is 0.5, `ATAN2[1, 1]`
+//! is 45. Logical operators take any value with |v| ≥ 0.5 as true and give 1 or 0; bitwise
+//! operators work on the values rounded to 64-bit integers (`INV 0` is -1).
+//!
+//! ISG's own numbers for evaluation errors are not in our sources, so they come from our
+//! documented range 90001–90099 (README "NC language").
+
+use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
+
+/// A variable with every index evaluated: what the decoder stores values under.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum VarKey<'e> {
+    /// `P<number>` with array indices (empty for a scalar).
+    P { number: u32, indices: Vec<u32> },
+    /// `V.<scope>.<name>` with array indices; the name is upper-case, borrowed from the tree.
+    V {
+        scope: VScope,
+        name: &'e str,
+        indices: Vec<u32>,
+    },
+    /// `@P<n>`, a cycle parameter.
+    CycleParam(u32),
+}
+
+impl std::fmt::Display for VarKey<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let indices = match self {
+            VarKey::P { number, indices } => {
+                write!(f, "P{number}")?;
+                indices
+            }
+            VarKey::V {
+                scope,
+                name,
+                indices,
+            } => {
+                write!(f, "V.{}.{name}", scope.letter())?;
+                indices
+            }
+            VarKey::CycleParam(n) => return write!(f, "@P{n}"),
+        };
+        for i in indices {
+            write!(f, "[{i}]")?;
+        }
+        Ok(())
+    }
+}
+
+/// The decoder's view of parameter and variable values.
+pub trait Vars {
+    /// The value stored under `key`, or `None` if it is not defined (or the index is outside
+    /// the declared array).
+    fn get(&self, key: &VarKey<'_>) -> Option<f64>;
+}
+
+/// Why an expression has no value. `code()` gives the number reported to the operator.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    #[error("division by zero")]
+    DivisionByZero,
+    #[error("square root of a negative number ({0})")]
+    SqrtNegative(f64),
+    #[error("{func} argument {value} outside -1..1")]
+    OutOfDomain { func: &'static str, value: f64 },
+    #[error("logarithm of a non-positive number ({0})")]
+    LogNonPositive(f64),
+    #[error("undefined variable {0}")]
+    Undefined(String),
+    #[error("invalid index {0}: indices and parameter numbers are whole numbers from 0")]
+    BadIndex(f64),
+    #[error("result is not a finite number")]
+    NotFinite,
+}
+
+impl EvalError {
+    /// Our numbers (ISG's are unknown to us): 90001 division by zero, 90002 square root of a
+    /// negative number, 90003 ASIN/ACOS outside -1..1, 90004 LN/LOG of a non-positive number,
+    /// 90005 undefined variable, 90006 invalid index, 90007 result not finite.
+    pub fn code(&self) -> u32 {
+        match self {
+            EvalError::DivisionByZero => 90001,
+            EvalError::SqrtNegative(_) => 90002,
+            EvalError::OutOfDomain { .. } => 90003,
+            EvalError::LogNonPositive(_) => 90004,
+            EvalError::Undefined(_) => 90005,
+            EvalError::BadIndex(_) => 90006,
+            EvalError::NotFinite => 90007,
+        }
+    }
+}
+
+/// A condition is true when |v| ≥ 0.5 (REFERENCE §4).
+pub fn is_true(v: f64) -> bool {
+    v.abs() >= 0.5
+}
+
+/// `$CASE` matches when the values differ by less than 0.001 (REFERENCE §4).
+pub fn case_matches(a: f64, b: f64) -> bool {
+    (a - b).abs() < 0.001
+}
+
+/// Evaluate `expr` with values from `vars`.
+pub fn eval(expr: &Expr, vars: &dyn Vars) -> Result<f64, EvalError> {
+    let v = match expr {
+        Expr::Num(v) => *v,
+        Expr::Var(r) => {
+            let key = resolve(r, vars)?;
+            return vars
+                .get(&key)
+                .ok_or_else(|| EvalError::Undefined(key.to_string()));
+        }
+        Expr::Unary(op, e) => {
+            let x = eval(e, vars)?;
+            match op {
+                UnOp::Neg => -x,
+                UnOp::Not => bool_num(!is_true(x)),
+                UnOp::Inv => !to_int(x)? as f64,
+            }
+        }
+        Expr::Binary(op, a, b) => binary(*op, eval(a, vars)?, eval(b, vars)?)?,
+        Expr::Func(func, args) => {
+            let x = match args.first() {
+                Some(a) => eval(a, vars)?,
+                None => return Err(EvalError::NotFinite),
+            };
+            match func {
+                Func::Atan2 => {
+                    let x2 = match args.get(1) {
+                        Some(a) => eval(a, vars)?,
+                        None => return Err(EvalError::NotFinite),
+                    };
+                    x.atan2(x2).to_degrees()
+                }
+                f => function(*f, x)?,
+            }
+        }
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(EvalError::NotFinite)
+    }
+}
+
+/// Evaluate the indices of `var`, so the decoder can assign to (or look up) the result.
+pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalError> {
+    Ok(match var {
+        VarRef::P { number, indices } => VarKey::P {
+            number: match number {
+                Index::Const(n) => *n,
+                Index::Expr(e) => index(eval(e, vars)?)?,
+            },
+            indices: indices_of(indices, vars)?,
+        },
+        VarRef::V {
+            scope,
+            name,
+            indices,
+        } => VarKey::V {
+            scope: *scope,
+            name,
+            indices: indices_of(indices, vars)?,
+        },
+        VarRef::CycleParam(n) => VarKey::CycleParam(*n),
+    })
+}
+
+fn indices_of(indices: &[Expr], vars: &dyn Vars) -> Result<Vec<u32>, EvalError> {
+    indices.iter().map(|e| index(eval(e, vars)?)).collect()
+}
+
+/// An index or computed parameter number: a whole number ≥ 0 (within 1e-6, so that
+/// `P[3*0.1*10]` still means P3).
+fn index(v: f64) -> Result<u32, EvalError> {
+    let r = v.round();
+    if (v - r).abs() > 1e-6 || r < 0.0 || r > f64::from(u32::MAX) {
+        return Err(EvalError::BadIndex(v));
+    }
+    Ok(r as u32)
+}
+
+fn bool_num(b: bool) -> f64 {
+    if b {
+        1.0
+    } else {
+        0.0
+    }
+}
+
+/// A value as a 64-bit integer for bitwise operators (rounded to nearest).
+fn to_int(v: f64) -> Result<i64, EvalError> {
+    let r = v.round();
+    if r.abs() >= 9.2e18 {
+        return Err(EvalError::NotFinite);
+    }
+    Ok(r as i64)
+}
+
+fn binary(op: BinOp, a: f64, b: f64) -> Result<f64, EvalError> {
+    Ok(match op {
+        BinOp::Add => a + b,
+        BinOp::Sub => a - b,
+        BinOp::Mul => a * b,
+        BinOp::Div => {
+            if b == 0.0 {
+                return Err(EvalError::DivisionByZero);
+            }
+            a / b
+        }
+        BinOp::Mod => {
+            if b == 0.0 {
+                return Err(EvalError::DivisionByZero);
+            }
+            a % b
+        }
+        BinOp::Pow => a.powf(b),
+        BinOp::Eq => bool_num(a == b),
+        BinOp::Ne => bool_num(a != b),
+        BinOp::Lt => bool_num(a < b),
+        BinOp::Gt => bool_num(a > b),
+        BinOp::Le => bool_num(a <= b),
+        BinOp::Ge => bool_num(a >= b),
+        BinOp::And => bool_num(is_true(a) && is_true(b)),
+        BinOp::Or => bool_num(is_true(a) || is_true(b)),
+        BinOp::Xor => bool_num(is_true(a) != is_true(b)),
+        BinOp::BitAnd => (to_int(a)? & to_int(b)?) as f64,
+        BinOp::BitOr => (to_int(a)? | to_int(b)?) as f64,
+        BinOp::BitXor => (to_int(a)? ^ to_int(b)?) as f64,
+    })
+}
+
+/// Sine and cosine of an angle in degrees, exact at multiples of 90° so that `COS[90]` is 0
+/// and not 6e-17 (CNC programs compare and multiply these).
+fn sin_cos_deg(deg: f64) -> (f64, f64) {
+    let r = deg % 360.0;
+    if r % 90.0 == 0.0 {
+        let quarter = ((r / 90.0) as i64).rem_euclid(4);
+        return match quarter {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        };
+    }
+    r.to_radians().sin_cos()
+}
+
+fn function(func: Func, x: f64) -> Result<f64, EvalError> {
+    Ok(match func {
+        Func::Abs => x.abs(),
+        Func::Sqr => x * x,
+        Func::Sqrt => {
+            if x < 0.0 {
+                return Err(EvalError::SqrtNegative(x));
+            }
+            x.sqrt()
+        }
+        Func::Exp => x.exp(),
+        Func::Ln | Func::Log => {
+            if x <= 0.0 {
+                return Err(EvalError::LogNonPositive(x));
+            }
+            if func == Func::Ln {
+                x.ln()
+            } else {
+                x.log10()
+            }
+        }
+        Func::Sin => sin_cos_deg(x).0,
+        Func::Cos => sin_cos_deg(x).1,
+        Func::Tan => {
+            let (s, c) = sin_cos_deg(x);
+            if c == 0.0 {
+                return Err(EvalError::NotFinite);
+            }
+            s / c
+        }
+        Func::Asin | Func::Acos => {
+            if !(-1.0..=1.0).contains(&x) {
+                return Err(EvalError::OutOfDomain {
+                    func: func.name(),
+                    value: x,
+                });
+            }
+            if func == Func::Asin {
+                x.asin().to_degrees()
+            } else {
+                x.acos().to_degrees()
+            }
+        }
+        Func::Atan => x.atan().to_degrees(),
+        Func::Atan2 => x.atan2(1.0).to_degrees(),
+        Func::Int => x.trunc(),
+        Func::Fract => x.fract(),
+        Func::Round => x.round(),
+        Func::Floor => x.floor(),
+        Func::Ceil => x.ceil(),
+    })
+}

@@ -1,0 +1,557 @@
+//! Expressions and variable references: `[P1*2+3]`, `SIN[30]`, `P[P1+5]`, `V.L.X[2]`, `@P1`.
+//!
+//! Precedence, lowest first (all binary operators left-associative except `**`):
+//!
+//! | level | operators |
+//! |---|---|
+//! | 1 | `\|\|` (also `OR`) |
+//! | 2 | `XOR` (logical) |
+//! | 3 | `&&` (also `AND`) |
+//! | 4 | `\|` bitwise or |
+//! | 5 | `^` bitwise xor |
+//! | 6 | `&` bitwise and |
+//! | 7 | `== != <> < > <= >=` |
+//! | 8 | `+ -` |
+//! | 9 | `* / MOD` |
+//! | 10 | unary `- + NOT INV` |
+//! | 11 | `**` (right-associative: `2**3**2` = `2**9`; `-2**2` = `-4`) |
+//!
+//! A `-` written directly before a literal folds into it (`-6.789` is one number) unless a
+//! `**` follows. Grouping `[ ]` leaves no node. Keywords are case-insensitive and must not be
+//! followed by a letter, digit or `_`.
+
+use std::borrow::Cow;
+use std::cell::Cell;
+
+use nom::bytes::complete::{tag, tag_no_case, take_while, take_while1};
+use nom::character::complete::{char as ch, digit1};
+use nom::error::{ErrorKind, ParseError};
+use nom::IResult;
+
+use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
+use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX};
+use super::error::SyntaxError;
+use super::number::scan_unsigned;
+
+/// The parser's internal error: where, which ISG number, what.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PErr<'a> {
+    pub input: &'a str,
+    pub code: u32,
+    pub msg: Cow<'static, str>,
+}
+
+impl<'a> ParseError<&'a str> for PErr<'a> {
+    fn from_error_kind(input: &'a str, _kind: ErrorKind) -> Self {
+        PErr {
+            input,
+            code: SYNTAX,
+            msg: Cow::Borrowed("NC command or axis name expected"),
+        }
+    }
+
+    fn append(_input: &'a str, _kind: ErrorKind, other: Self) -> Self {
+        other
+    }
+}
+
+pub(crate) type PResult<'a, O> = IResult<&'a str, O, PErr<'a>>;
+
+/// A committed error: no alternative is tried after it.
+pub(crate) fn fail<'a, O>(input: &'a str, code: u32, msg: impl Into<Cow<'static, str>>) -> PResult<'a, O> {
+    Err(nom::Err::Failure(PErr {
+        input,
+        code,
+        msg: msg.into(),
+    }))
+}
+
+/// The committed error itself, for functions that do not return a parse result.
+pub(crate) fn perr<'a>(input: &'a str, code: u32, msg: impl Into<Cow<'static, str>>) -> nom::Err<PErr<'a>> {
+    nom::Err::Failure(PErr {
+        input,
+        code,
+        msg: msg.into(),
+    })
+}
+
+/// Skip blanks and tabs.
+#[inline]
+pub(crate) fn ws(i: &str) -> &str {
+    i.trim_start_matches([' ', '\t'])
+}
+
+#[inline]
+fn is_ident_byte(b: u8) -> bool {
+    b.is_ascii_alphanumeric() || b == b'_'
+}
+
+/// `kw` (case-insensitive) as a whole word at the start of `i`.
+pub(crate) fn keyword<'a>(i: &'a str, kw: &'static str) -> Option<&'a str> {
+    let r: PResult<'a, &'a str> = tag_no_case(kw)(i);
+    match r {
+        Ok((rest, _)) if !rest.as_bytes().first().is_some_and(|&b| is_ident_byte(b)) => Some(rest),
+        _ => None,
+    }
+}
+
+/// An unsigned decimal integer that fits a `u32`.
+pub(crate) fn uint(i: &str) -> PResult<'_, u32> {
+    let (rest, digits) = digit1(i)?;
+    match digits.parse::<u32>() {
+        Ok(n) => Ok((rest, n)),
+        Err(_) => fail(i, SYNTAX, "number too large"),
+    }
+}
+
+/// An identifier `[A-Za-z_][A-Za-z0-9_]*`, upper-cased.
+pub(crate) fn name_upper(i: &str) -> PResult<'_, String> {
+    let (rest, first) = take_while1(|c: char| c.is_ascii_alphabetic() || c == '_')(i)?;
+    let (rest, more) = take_while(|c: char| c.is_ascii_alphanumeric() || c == '_')(rest)?;
+    let mut s = String::with_capacity(first.len() + more.len());
+    s.push_str(first);
+    s.push_str(more);
+    s.make_ascii_uppercase();
+    Ok((rest, s))
+}
+
+/// Parse state for one line: the line itself (for columns) and the expression nesting depth.
+pub(crate) struct Ctx<'a> {
+    pub line: &'a str,
+    ascii: bool,
+    depth: Cell<u32>,
+    /// Height of the expression tree parsed last (a literal is 0). Bounded by
+    /// [`MAX_EXPR_HEIGHT`] so that evaluating, printing and dropping a tree cannot overflow
+    /// the stack, however the 4000 characters are arranged.
+    height: Cell<u32>,
+}
+
+/// Leaves one nesting level when dropped.
+pub(crate) struct DepthGuard<'c> {
+    depth: &'c Cell<u32>,
+}
+
+impl Drop for DepthGuard<'_> {
+    fn drop(&mut self) {
+        self.depth.set(self.depth.get() - 1);
+    }
+}
+
+impl<'a> Ctx<'a> {
+    pub fn new(line: &'a str) -> Self {
+        Ctx {
+            line,
+            ascii: line.is_ascii(),
+            depth: Cell::new(0),
+            height: Cell::new(0),
+        }
+    }
+
+    /// Record the height of the node just built; too high is 20200.
+    fn set_height(&self, h: u32, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
+        if h > MAX_EXPR_HEIGHT {
+            return Err(perr(at, SYNTAX, "expression too complex"));
+        }
+        self.height.set(h);
+        Ok(())
+    }
+
+    /// 1-based character column of the position where `rest` starts.
+    pub fn col(&self, rest: &str) -> u32 {
+        let off = self.line.len().saturating_sub(rest.len());
+        let chars = if self.ascii {
+            off
+        } else {
+            self.line.get(..off).map_or(off, |p| p.chars().count())
+        };
+        u32::try_from(chars + 1).unwrap_or(u32::MAX)
+    }
+
+    pub fn to_error(&self, e: nom::Err<PErr<'_>>) -> SyntaxError {
+        match e {
+            nom::Err::Error(p) | nom::Err::Failure(p) => {
+                SyntaxError::new(p.code, self.col(p.input), p.msg.into_owned())
+            }
+            nom::Err::Incomplete(_) => SyntaxError::new(SYNTAX, 1, "incomplete block"),
+        }
+    }
+
+    fn enter(&self, i: &'a str) -> Result<DepthGuard<'_>, nom::Err<PErr<'a>>> {
+        let d = self.depth.get() + 1;
+        if d > MAX_EXPR_NESTING {
+            return Err(nom::Err::Failure(PErr {
+                input: i,
+                code: SYNTAX,
+                msg: Cow::Borrowed("expression nested too deeply"),
+            }));
+        }
+        self.depth.set(d);
+        Ok(DepthGuard { depth: &self.depth })
+    }
+
+    /// A full expression. Trailing blanks are not consumed.
+    pub fn expr(&self, i: &'a str) -> PResult<'a, Expr> {
+        self.level(0, i)
+    }
+
+    /// `[expr]`: the bracketed form words use (`X[P1*2]`).
+    pub fn bracketed(&self, i: &'a str) -> PResult<'a, Expr> {
+        let (i, _) = ch('[')(i)?;
+        let _g = self.enter(i)?;
+        let (j, e) = self.expr(ws(i))?;
+        let j = ws(j);
+        match ch::<&str, PErr<'a>>(']')(j) {
+            Ok((k, _)) => Ok((k, e)),
+            Err(_) => fail(j, SYNTAX, "`]` or operator expected"),
+        }
+    }
+
+    const LEVELS: usize = 9;
+
+    fn level(&self, lvl: usize, i: &'a str) -> PResult<'a, Expr> {
+        if lvl == Self::LEVELS {
+            return self.unary(i);
+        }
+        let (mut i, mut lhs) = self.level(lvl + 1, i)?;
+        let mut h = self.height.get();
+        loop {
+            let j = ws(i);
+            let Some((op, n)) = binary_op(lvl, j) else {
+                self.height.set(h);
+                return Ok((i, lhs));
+            };
+            let (k, rhs) = self.level(lvl + 1, ws(&j[n..]))?;
+            h = h.max(self.height.get()) + 1;
+            self.set_height(h, j)?;
+            lhs = Expr::Binary(op, Box::new(lhs), Box::new(rhs));
+            i = k;
+        }
+    }
+
+    fn unary(&self, i: &'a str) -> PResult<'a, Expr> {
+        let b = i.as_bytes().first().copied();
+        match b {
+            Some(b'-') => {
+                let _g = self.enter(i)?;
+                let after = &i[1..];
+                let literal = after
+                    .as_bytes()
+                    .first()
+                    .is_some_and(|&c| c.is_ascii_digit() || c == b'.');
+                let (rest, e) = if literal {
+                    self.power(after)?
+                } else {
+                    self.unary(ws(after))?
+                };
+                match e {
+                    Expr::Num(v) if literal => Ok((rest, Expr::Num(-v))),
+                    e => {
+                        self.set_height(self.height.get() + 1, i)?;
+                        Ok((rest, Expr::Unary(UnOp::Neg, Box::new(e))))
+                    }
+                }
+            }
+            Some(b'+') => {
+                let _g = self.enter(i)?;
+                self.unary(ws(&i[1..]))
+            }
+            Some(b'N' | b'n' | b'I' | b'i') => {
+                let (op, rest) = if let Some(rest) = keyword(i, "NOT") {
+                    (UnOp::Not, rest)
+                } else if let Some(rest) = keyword(i, "INV") {
+                    (UnOp::Inv, rest)
+                } else {
+                    return self.power(i);
+                };
+                let _g = self.enter(i)?;
+                let (rest, e) = self.unary(ws(rest))?;
+                self.set_height(self.height.get() + 1, i)?;
+                Ok((rest, Expr::Unary(op, Box::new(e))))
+            }
+            _ => self.power(i),
+        }
+    }
+
+    fn power(&self, i: &'a str) -> PResult<'a, Expr> {
+        let (i, base) = self.primary(i)?;
+        let j = ws(i);
+        if let Ok((k, _)) = tag::<&str, &str, PErr<'a>>("**")(j) {
+            let hb = self.height.get();
+            let _g = self.enter(j)?;
+            let (k, exp) = self.unary(ws(k))?;
+            self.set_height(hb.max(self.height.get()) + 1, j)?;
+            return Ok((k, Expr::Binary(BinOp::Pow, Box::new(base), Box::new(exp))));
+        }
+        Ok((i, base))
+    }
+
+    fn primary(&self, i: &'a str) -> PResult<'a, Expr> {
+        let Some(&b) = i.as_bytes().first() else {
+            return fail(i, SYNTAX, "operand expected, found end of block");
+        };
+        match b {
+            b'[' => self.bracketed(i),
+            b'0'..=b'9' | b'.' => match scan_unsigned(i.as_bytes()) {
+                Some((v, n)) => {
+                    self.height.set(0);
+                    Ok((&i[n..], Expr::Num(v)))
+                }
+                None => fail(i, SYNTAX, "number expected"),
+            },
+            b'@' => {
+                let (rest, v) = self.var_ref(i)?;
+                Ok((rest, Expr::Var(Box::new(v))))
+            }
+            b'P' | b'p' if i.as_bytes().get(1).is_some_and(|&c| c.is_ascii_digit() || c == b'[') => {
+                let (rest, v) = self.var_ref(i)?;
+                Ok((rest, Expr::Var(Box::new(v))))
+            }
+            b'V' | b'v' if i.as_bytes().get(1) == Some(&b'.') => {
+                let (rest, v) = self.var_ref(i)?;
+                Ok((rest, Expr::Var(Box::new(v))))
+            }
+            c if c.is_ascii_alphabetic() => self.named(i),
+            _ => fail(i, SYNTAX, "operand expected"),
+        }
+    }
+
+    /// A constant or a function call.
+    fn named(&self, i: &'a str) -> PResult<'a, Expr> {
+        let (rest, name) = name_upper(i)?;
+        self.height.set(0);
+        match name.as_str() {
+            "PI" => return Ok((rest, Expr::Num(std::f64::consts::PI))),
+            "TRUE" => return Ok((rest, Expr::Num(1.0))),
+            "FALSE" => return Ok((rest, Expr::Num(0.0))),
+            _ => {}
+        }
+        let Some(func) = func_by_name(&name) else {
+            return fail(i, SYNTAX, format!("unknown function or operand `{name}`"));
+        };
+        let j = ws(rest);
+        let Ok((j, _)) = ch::<&str, PErr<'a>>('[')(j) else {
+            return fail(j, SYNTAX, format!("`[` expected after {name}"));
+        };
+        let _g = self.enter(j)?;
+        let mut args = Vec::with_capacity(func.arity());
+        let mut h = 0;
+        let mut j = ws(j);
+        loop {
+            let (k, e) = self.expr(j)?;
+            h = h.max(self.height.get());
+            args.push(e);
+            let k = ws(k);
+            match k.as_bytes().first() {
+                Some(b',') => j = ws(&k[1..]),
+                Some(b']') => {
+                    j = &k[1..];
+                    break;
+                }
+                _ => return fail(k, SYNTAX, "`,` or `]` expected in function call"),
+            }
+        }
+        if args.len() != func.arity() {
+            return fail(
+                i,
+                SYNTAX,
+                format!("{name} takes {} argument(s), got {}", func.arity(), args.len()),
+            );
+        }
+        self.set_height(h + 1, i)?;
+        Ok((j, Expr::Func(func, args)))
+    }
+
+    /// `P<n>`, `P[expr]`, each with optional adjacent `[i]` indices; `V.x.name[..]`; `@P<n>`.
+    pub fn var_ref(&self, i: &'a str) -> PResult<'a, VarRef> {
+        let bytes = i.as_bytes();
+        match bytes.first() {
+            Some(b'@') => {
+                let Some(rest) = i.get(1..).filter(|r| r.starts_with(['P', 'p'])) else {
+                    return fail(i, SYNTAX, "`@P<number>` expected");
+                };
+                match uint(&rest[1..]) {
+                    Ok((rest, n)) => {
+                        self.height.set(1);
+                        Ok((rest, VarRef::CycleParam(n)))
+                    }
+                    Err(nom::Err::Error(_)) => fail(&rest[1..], SYNTAX, "cycle parameter number expected"),
+                    Err(e) => Err(e),
+                }
+            }
+            Some(b'P' | b'p') => {
+                let rest = &i[1..];
+                let mut h = 0;
+                let (rest, number) = if rest.starts_with('[') {
+                    let (r, e) = self.bracketed(rest)?;
+                    h = self.height.get();
+                    (r, Index::Expr(Box::new(e)))
+                } else {
+                    match uint(rest) {
+                        Ok((r, n)) => (r, Index::Const(n)),
+                        Err(nom::Err::Error(_)) => return fail(rest, SYNTAX, "parameter number expected"),
+                        Err(e) => return Err(e),
+                    }
+                };
+                let (rest, indices) = self.indices(rest)?;
+                self.set_height(h.max(self.height.get()) + 1, i)?;
+                Ok((rest, VarRef::P { number, indices }))
+            }
+            Some(b'V' | b'v') if bytes.get(1) == Some(&b'.') => {
+                let scope = match bytes.get(2).map(u8::to_ascii_uppercase) {
+                    Some(b'P') => VScope::Program,
+                    Some(b'L') => VScope::Local,
+                    Some(b'S') => VScope::SelfRetaining,
+                    Some(b'E') => VScope::External,
+                    _ => return fail(&i[2..], SYNTAX, "variable scope P, L, S or E expected after `V.`"),
+                };
+                let Some(rest) = i.get(3..).filter(|r| r.starts_with('.')) else {
+                    return fail(i.get(3..).unwrap_or(""), SYNTAX, "`.` expected after the variable scope");
+                };
+                let rest = &rest[1..];
+                let (rest, name) = match name_upper(rest) {
+                    Ok(ok) => ok,
+                    Err(nom::Err::Error(_)) => return fail(rest, SYNTAX, "variable name expected"),
+                    Err(e) => return Err(e),
+                };
+                let (rest, indices) = self.indices(rest)?;
+                self.set_height(self.height.get() + 1, i)?;
+                Ok((rest, VarRef::V { scope, name, indices }))
+            }
+            _ => fail(i, SYNTAX, "parameter or variable expected"),
+        }
+    }
+
+    /// Array indices written directly after a variable: `[i]`, `[i][j]`.
+    fn indices(&self, mut i: &'a str) -> PResult<'a, Vec<Expr>> {
+        let mut v = Vec::new();
+        let mut h = 0;
+        while i.starts_with('[') {
+            let (rest, e) = self.bracketed(i)?;
+            h = h.max(self.height.get());
+            v.push(e);
+            i = rest;
+        }
+        self.height.set(h);
+        Ok((i, v))
+    }
+}
+
+/// The binary operator of precedence level `lvl` at the start of `i`, with its length.
+#[inline]
+fn binary_op(lvl: usize, i: &str) -> Option<(BinOp, usize)> {
+    let b = i.as_bytes();
+    let b0 = *b.first()?;
+    let b1 = b.get(1).copied().unwrap_or(0);
+    match lvl {
+        0 => match (b0, b1) {
+            (b'|', b'|') => Some((BinOp::Or, 2)),
+            (b'O' | b'o', _) => keyword(i, "OR").map(|_| (BinOp::Or, 2)),
+            _ => None,
+        },
+        1 => match b0 {
+            b'X' | b'x' => keyword(i, "XOR").map(|_| (BinOp::Xor, 3)),
+            _ => None,
+        },
+        2 => match (b0, b1) {
+            (b'&', b'&') => Some((BinOp::And, 2)),
+            (b'A' | b'a', _) => keyword(i, "AND").map(|_| (BinOp::And, 3)),
+            _ => None,
+        },
+        3 => (b0 == b'|' && b1 != b'|').then_some((BinOp::BitOr, 1)),
+        4 => (b0 == b'^').then_some((BinOp::BitXor, 1)),
+        5 => (b0 == b'&' && b1 != b'&').then_some((BinOp::BitAnd, 1)),
+        6 => match (b0, b1) {
+            (b'=', b'=') => Some((BinOp::Eq, 2)),
+            (b'!', b'=') | (b'<', b'>') => Some((BinOp::Ne, 2)),
+            (b'<', b'=') => Some((BinOp::Le, 2)),
+            (b'>', b'=') => Some((BinOp::Ge, 2)),
+            (b'<', _) => Some((BinOp::Lt, 1)),
+            (b'>', _) => Some((BinOp::Gt, 1)),
+            _ => None,
+        },
+        7 => match b0 {
+            b'+' => Some((BinOp::Add, 1)),
+            b'-' => Some((BinOp::Sub, 1)),
+            _ => None,
+        },
+        8 => match (b0, b1) {
+            (b'*', b'*') => None,
+            (b'*', _) => Some((BinOp::Mul, 1)),
+            (b'/', _) => Some((BinOp::Div, 1)),
+            (b'M' | b'm', _) => keyword(i, "MOD").map(|_| (BinOp::Mod, 3)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+impl Func {
+    /// Number of arguments: ATAN2 takes two, every other function one.
+    pub fn arity(self) -> usize {
+        match self {
+            Func::Atan2 => 2,
+            _ => 1,
+        }
+    }
+
+    /// The function's name as written in NC text.
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Abs => "ABS",
+            Func::Sqr => "SQR",
+            Func::Sqrt => "SQRT",
+            Func::Exp => "EXP",
+            Func::Ln => "LN",
+            Func::Log => "LOG",
+            Func::Sin => "SIN",
+            Func::Cos => "COS",
+            Func::Tan => "TAN",
+            Func::Asin => "ASIN",
+            Func::Acos => "ACOS",
+            Func::Atan => "ATAN",
+            Func::Atan2 => "ATAN2",
+            Func::Int => "INT",
+            Func::Fract => "FRACT",
+            Func::Round => "ROUND",
+            Func::Floor => "FLOOR",
+            Func::Ceil => "CEIL",
+        }
+    }
+}
+
+/// Every function, for lookup by name.
+pub const FUNCS: [Func; 18] = [
+    Func::Abs,
+    Func::Sqr,
+    Func::Sqrt,
+    Func::Exp,
+    Func::Ln,
+    Func::Log,
+    Func::Sin,
+    Func::Cos,
+    Func::Tan,
+    Func::Asin,
+    Func::Acos,
+    Func::Atan,
+    Func::Atan2,
+    Func::Int,
+    Func::Fract,
+    Func::Round,
+    Func::Floor,
+    Func::Ceil,
+];
+
+fn func_by_name(upper: &str) -> Option<Func> {
+    FUNCS.into_iter().find(|f| f.name() == upper)
+}
+
+/// Parse a whole string as one expression (for tests and tools).
+pub fn parse_expr(text: &str) -> Result<Expr, SyntaxError> {
+    let ctx = Ctx::new(text);
+    let (rest, e) = ctx.expr(ws(text)).map_err(|e| ctx.to_error(e))?;
+    let rest = ws(rest);
+    if !rest.is_empty() {
+        return Err(SyntaxError::new(SYNTAX, ctx.col(rest), "operator or end of expression expected"));
+    }
+    Ok(e)
+}

@@ -1,0 +1,812 @@
+//! One NC line → [`Block`]: block skip, block number, label, then words and assignments or
+//! one `$` statement, `#` command, call or program head (REFERENCE §4).
+//!
+//! The hot path — ordinary words with literal numbers, `N123 G01 X12.345 Y-6.789` — is a
+//! byte-level scan with one allocation per block (its item list); everything rarer (commands,
+//! expressions, variable references) goes through the nom parsers in [`super::expr`].
+
+use nom::bytes::complete::take_while1;
+use nom::character::complete::char as ch;
+
+use super::block::{
+    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand,
+    VScope, Value, VarDecl, VarRef, Word,
+};
+use super::codes::{
+    is_known_g, is_known_m, is_word_letter, CACHE_DOUBLE, CACHE_SYNTAX, G_WITH_VALUE,
+    MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
+};
+use super::error::SyntaxError;
+use super::expr::{fail, keyword, perr, name_upper, uint, ws, Ctx, PErr, PResult};
+use super::number::scan_unsigned;
+
+/// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
+/// line, or more than 4000 characters, is error 20200.
+pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
+    let line = checked_line(line)?;
+    let ctx = Ctx::new(line);
+    block(&ctx, line).map_err(|e| ctx.to_error(e))
+}
+
+/// Is this line `#COMMENT END` (case-insensitive, optionally after a block skip and block
+/// number, optionally followed by a comment)? The decoder asks this for every line inside a
+/// `#COMMENT BEGIN` block without parsing the line: comment text need not be valid NC.
+pub fn is_comment_end(line: &str) -> bool {
+    let line = strip_line_end(line);
+    let ctx = Ctx::new(line);
+    let Ok((i, _)) = prefix(&ctx, ws(line)) else {
+        return false;
+    };
+    let Some(i) = gap(i).strip_prefix('#') else {
+        return false;
+    };
+    let Some(i) = keyword(ws(i), "COMMENT") else {
+        return false;
+    };
+    if !i.starts_with([' ', '\t']) {
+        return false;
+    }
+    let Some(i) = keyword(ws(i), "END") else {
+        return false;
+    };
+    gap(i).is_empty()
+}
+
+/// Is this line empty or a comment only? Lines inside `#VAR` … `#ENDVAR` that are blank carry
+/// no declaration; the decoder skips them before calling [`parse_var_declaration`].
+pub fn is_blank_line(line: &str) -> bool {
+    gap(strip_line_end(line)).is_empty()
+}
+
+/// Parse one declaration between `#VAR` and `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,
+/// `V.S.GRID[3][4] = 0`. `V.E.` variables are not declared in programs (20200).
+pub fn parse_var_declaration(line: &str) -> Result<VarDecl, SyntaxError> {
+    let line = checked_line(line)?;
+    let ctx = Ctx::new(line);
+    var_decl(&ctx, line).map_err(|e| ctx.to_error(e))
+}
+
+/// Strip one trailing CR LF, LF or CR.
+fn strip_line_end(line: &str) -> &str {
+    line.strip_suffix("\r\n")
+        .or_else(|| line.strip_suffix('\n'))
+        .or_else(|| line.strip_suffix('\r'))
+        .unwrap_or(line)
+}
+
+fn checked_line(line: &str) -> Result<&str, SyntaxError> {
+    let line = strip_line_end(line);
+    if line.len() > MAX_BLOCK_CHARS && line.chars().count() > MAX_BLOCK_CHARS {
+        return Err(SyntaxError::new(
+            SYNTAX,
+            MAX_BLOCK_CHARS as u32 + 1,
+            format!("block longer than {MAX_BLOCK_CHARS} characters"),
+        ));
+    }
+    if let Some(pos) = line.find(['\r', '\n']) {
+        let col = line[..pos].chars().count() as u32 + 1;
+        return Err(SyntaxError::new(SYNTAX, col, "line end inside the block"));
+    }
+    Ok(line)
+}
+
+/// Skip blanks and comments: `( … )` nesting, an unclosed `(` to block end, `;` to line end.
+pub(crate) fn gap(mut i: &str) -> &str {
+    loop {
+        i = ws(i);
+        match i.as_bytes().first() {
+            Some(b';') => return "",
+            Some(b'(') => {
+                let mut depth = 0usize;
+                let mut end = i.len();
+                for (k, b) in i.bytes().enumerate() {
+                    match b {
+                        b'(' => depth += 1,
+                        b')' => {
+                            depth -= 1;
+                            if depth == 0 {
+                                end = k + 1;
+                                break;
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+                i = &i[end..];
+            }
+            _ => return i,
+        }
+    }
+}
+
+/// Block skip, block number and label: what may precede every body.
+fn prefix<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
+    let mut skip = None;
+    if let Some(rest) = i.strip_prefix('/') {
+        if rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
+            let (r, level) = uint(rest)?;
+            if !(1..=10).contains(&level) {
+                return fail(rest, SYNTAX, "block skip level must be 1 to 10");
+            }
+            skip = Some(level as u8);
+            i = r;
+        } else {
+            skip = Some(1);
+            i = rest;
+        }
+        i = ws(i);
+    }
+    let mut n = None;
+    let mut label = None;
+    if let Some(&b) = i.as_bytes().first() {
+        if b == b'N' || b == b'n' {
+            let rest = &i[1..];
+            if !rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
+                return fail(rest, SYNTAX, "block number expected after N");
+            }
+            let (r, num) = uint(rest)?;
+            n = Some(num);
+            i = r;
+            if let Some(r) = i.strip_prefix(':') {
+                label = Some(Label::Number(num));
+                i = r;
+            }
+        }
+    }
+    let j = gap(i);
+    if label.is_none() && j.starts_with('[') {
+        let (r, name) = bracket_name(j)?;
+        label = Some(Label::Name(name));
+        i = r;
+    }
+    let _ = ctx;
+    Ok((i, (skip, n, label)))
+}
+
+/// `[NAME]`: a string label or `$GOTO` target, upper-cased.
+fn bracket_name(i: &str) -> PResult<'_, String> {
+    let (r, _) = ch('[')(i)?;
+    let r = ws(r);
+    let (r, name) = match name_upper(r) {
+        Ok(ok) => ok,
+        Err(_) => return fail(r, SYNTAX, "label name expected"),
+    };
+    let r = ws(r);
+    match ch::<&str, PErr<'_>>(']')(r) {
+        Ok((r, _)) => Ok((r, name)),
+        Err(_) => fail(r, SYNTAX, "`]` expected after the label name"),
+    }
+}
+
+fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> {
+    let (i, (skip_level, n, label)) = prefix(ctx, ws(line))?;
+    let i = gap(i);
+    let body = match i.as_bytes().first() {
+        None => Body::Items(Vec::new()),
+        Some(b'#') => {
+            let (r, c) = command(ctx, i)?;
+            end_of_block(r, "nothing may follow a # command in its block")?;
+            Body::Command(c)
+        }
+        Some(b'$') => {
+            let (r, c) = control(ctx, i)?;
+            end_of_block(r, "nothing may follow a $ statement in its block")?;
+            Body::Control(c)
+        }
+        Some(b'%') => {
+            let (r, (name, local)) = program_head(i)?;
+            end_of_block(r, "nothing may follow a program head in its block")?;
+            Body::ProgramHead { name, local }
+        }
+        Some(b'L' | b'l') if starts_call(i) => {
+            let (r, c) = call(ctx, i)?;
+            end_of_block(r, "nothing may follow L, LL or L CYCLE in its block")?;
+            Body::Call(c)
+        }
+        Some(_) => Body::Items(items(ctx, i)?),
+    };
+    Ok(Block {
+        skip_level,
+        n,
+        label,
+        body,
+    })
+}
+
+fn end_of_block<'a>(i: &'a str, msg: &'static str) -> Result<(), nom::Err<PErr<'a>>> {
+    let r = gap(i);
+    if r.is_empty() {
+        Ok(())
+    } else {
+        fail::<()>(r, SYNTAX, msg).map(|_| ())
+    }
+}
+
+/// `L ` or `LL ` followed by a blank: a call, not an (unknown) address letter L.
+fn starts_call(i: &str) -> bool {
+    let b = i.as_bytes();
+    let blank = |k: usize| matches!(b.get(k), Some(b' ' | b'\t'));
+    blank(1) || (matches!(b.get(1), Some(b'L' | b'l')) && blank(2))
+}
+
+// ---------------------------------------------------------------------------------------
+// Ordinary blocks: words and assignments
+// ---------------------------------------------------------------------------------------
+
+fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
+    let mut items = Vec::with_capacity(8);
+    loop {
+        i = gap(i);
+        let bytes = i.as_bytes();
+        let Some(&b) = bytes.first() else {
+            return Ok(items);
+        };
+        let up = b.to_ascii_uppercase();
+        let dot_follows = bytes.get(1) == Some(&b'.');
+        if is_word_letter(up) && !(up == b'V' && dot_follows) {
+            i = word(ctx, i, up, &mut items)?;
+        } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
+            let col = ctx.col(i);
+            let (r, target) = ctx.var_ref(i)?;
+            let r = ws(r);
+            let Some(r) = r.strip_prefix('=') else {
+                return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
+            };
+            let (r, value) = ctx.expr(ws(r))?;
+            items.push(Item::Assign { target, value, col });
+            i = r;
+        } else {
+            let msg = match b {
+                b'#' => "a # command must stand alone in its block",
+                b'$' => "a $ statement must stand alone in its block",
+                b'%' => "a program head must stand alone in its block",
+                b'N' | b'n' => "the block number must come first in the block",
+                b'L' | b'l' => "a call must stand alone in its block",
+                _ => "NC command or axis name expected",
+            };
+            return Err(perr(i, SYNTAX, msg));
+        }
+    }
+}
+
+/// One address word at `i` (letter `up`), pushed onto `items`; returns the rest.
+#[inline]
+fn word<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let col = ctx.col(i);
+    let after = &i[1..];
+    let ab = after.as_bytes();
+    let (rest, value) = match ab.first() {
+        Some(b'[') => {
+            let (r, e) = ctx.bracketed(after)?;
+            (r, Value::Expr(e))
+        }
+        Some(&s @ (b'-' | b'+')) if ab.get(1) == Some(&b'[') => {
+            let (r, e) = ctx.bracketed(&after[1..])?;
+            let e = if s == b'-' {
+                super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
+            } else {
+                e
+            };
+            (r, Value::Expr(e))
+        }
+        Some(&s) => {
+            let (neg, digits) = match s {
+                b'-' => (true, &ab[1..]),
+                b'+' => (false, &ab[1..]),
+                _ => (false, ab),
+            };
+            match scan_unsigned(digits) {
+                Some((v, n)) => {
+                    let used = n + (ab.len() - digits.len());
+                    (&after[used..], Value::Num(if neg { -v } else { v }))
+                }
+                None => return Err(perr(after, SYNTAX, word_value_msg(up))),
+            }
+        }
+        None => return Err(perr(after, SYNTAX, word_value_msg(up))),
+    };
+    match up {
+        b'G' => {
+            let g = integer_code(&value);
+            let Some(g) = g.filter(|&g| is_known_g(g)) else {
+                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{}", show_value(&value))));
+            };
+            if G_WITH_VALUE.contains(&g) {
+                if let Some((r, v)) = g_value(ctx, rest)? {
+                    items.push(Item::GValue { g, value: v, col });
+                    return Ok(r);
+                }
+            }
+        }
+        b'M' => {
+            if !integer_code(&value).is_some_and(is_known_m) {
+                return Err(perr(i, UNKNOWN_M, format!("unknown M function M{}", show_value(&value))));
+            }
+        }
+        _ => {}
+    }
+    items.push(Item::Word(Word {
+        letter: up,
+        value,
+        col,
+    }));
+    Ok(rest)
+}
+
+fn word_value_msg(letter: u8) -> String {
+    format!("number or [expression] expected after {}", letter as char)
+}
+
+fn show_value(v: &Value) -> String {
+    match v {
+        Value::Num(n) => n.to_string(),
+        Value::Expr(e) => format!("[{e}]"),
+    }
+}
+
+/// A G or M number: a non-negative integer literal.
+fn integer_code(v: &Value) -> Option<u32> {
+    match *v {
+        Value::Num(n) if n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX) => Some(n as u32),
+        _ => None,
+    }
+}
+
+/// The value of `G133=<expr>` / `G134=<expr>`, also written `G134 50` (seed 003).
+fn g_value<'a>(ctx: &Ctx<'a>, i: &'a str) -> Result<Option<(&'a str, Value)>, nom::Err<PErr<'a>>> {
+    let j = ws(i);
+    if let Some(r) = j.strip_prefix('=') {
+        let (r, e) = ctx.expr(ws(r))?;
+        return Ok(Some((r, expr_value(e))));
+    }
+    let jb = j.as_bytes();
+    let (neg, k) = match jb.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    if j.len() == i.len() && k == 0 {
+        // No blank before a bare number: `G13450` was already read as one number.
+        return Ok(None);
+    }
+    match scan_unsigned(&jb[k..]) {
+        Some((v, n)) => Ok(Some((&j[k + n..], Value::Num(if neg { -v } else { v })))),
+        None => Ok(None),
+    }
+}
+
+fn expr_value(e: super::block::Expr) -> Value {
+    match e {
+        super::block::Expr::Num(v) => Value::Num(v),
+        e => Value::Expr(e),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// $ statements
+// ---------------------------------------------------------------------------------------
+
+/// The letters of a keyword after `$` or `#`, upper-cased into `buf`.
+fn keyword_after<'a>(i: &'a str, buf: &mut [u8; 16]) -> Option<(&'a str, usize)> {
+    let r: PResult<'a, &'a str> = take_while1(|c: char| c.is_ascii_alphabetic())(i);
+    let (rest, kw) = r.ok()?;
+    if kw.len() > buf.len() {
+        return Some((rest, 0));
+    }
+    for (d, s) in buf.iter_mut().zip(kw.bytes()) {
+        *d = s.to_ascii_uppercase();
+    }
+    Some((rest, kw.len()))
+}
+
+fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
+    let after = &i[1..];
+    let mut buf = [0u8; 16];
+    let Some((rest, len)) = keyword_after(after, &mut buf) else {
+        return fail(i, SYNTAX, "control statement expected after $");
+    };
+    let r = ws(rest);
+    let c = match &buf[..len] {
+        b"IF" => {
+            let (r, cond) = ctx.expr(r)?;
+            let j = ws(r);
+            if let Some(g) = j.strip_prefix('$') {
+                let Some(g) = keyword(g, "GOTO") else {
+                    return fail(j, SYNTAX, "only $GOTO may follow the condition of $IF");
+                };
+                let (r, target) = goto_target(ws(g))?;
+                return Ok((r, Control::IfGoto(cond, target)));
+            }
+            return Ok((r, Control::If(cond)));
+        }
+        b"ELSEIF" => return ctx.expr(r).map(|(r, e)| (r, Control::ElseIf(e))),
+        b"SWITCH" => return ctx.expr(r).map(|(r, e)| (r, Control::Switch(e))),
+        b"CASE" => return ctx.expr(r).map(|(r, e)| (r, Control::Case(e))),
+        b"WHILE" => return ctx.expr(r).map(|(r, e)| (r, Control::While(e))),
+        b"ENDDO" => return ctx.expr(r).map(|(r, e)| (r, Control::EndDo(e))),
+        b"UNTIL" => return ctx.expr(r).map(|(r, e)| (r, Control::Until(e))),
+        b"GOTO" => return goto_target(r).map(|(r, t)| (r, Control::Goto(t))),
+        b"FOR" => return for_head(ctx, r),
+        b"ELSE" => Control::Else,
+        b"ENDIF" => Control::EndIf,
+        b"DEFAULT" => Control::Default,
+        b"BREAK" => Control::Break,
+        b"ENDSWITCH" => Control::EndSwitch,
+        b"ENDFOR" => Control::EndFor,
+        b"ENDWHILE" => Control::EndWhile,
+        b"DO" => Control::Do,
+        b"REPEAT" => Control::Repeat,
+        b"CONTINUE" => Control::Continue,
+        _ => {
+            return fail(
+                i,
+                UNKNOWN_COMMAND,
+                format!("unknown control statement ${}", &after[..after.len() - rest.len()]),
+            )
+        }
+    };
+    Ok((rest, c))
+}
+
+/// `$FOR P1 = start, end[, step]`.
+fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
+    let (r, var) = ctx.var_ref(i)?;
+    let r = ws(r);
+    let Some(r) = r.strip_prefix('=') else {
+        return fail(r, SYNTAX, "`=` expected after the $FOR variable");
+    };
+    let (r, start) = ctx.expr(ws(r))?;
+    let r = ws(r);
+    let Some(r) = r.strip_prefix(',') else {
+        return fail(r, SYNTAX, "`,` and end value expected in $FOR");
+    };
+    let (r, end) = ctx.expr(ws(r))?;
+    let j = ws(r);
+    let (r, step) = match j.strip_prefix(',') {
+        Some(s) => {
+            let (r, e) = ctx.expr(ws(s))?;
+            (r, Some(e))
+        }
+        None => (r, None),
+    };
+    Ok((r, Control::For { var, start, end, step }))
+}
+
+/// `N40` or `[LABEL]`.
+fn goto_target(i: &str) -> PResult<'_, GotoTarget> {
+    match i.as_bytes().first() {
+        Some(b'N' | b'n') if i.as_bytes().get(1).is_some_and(u8::is_ascii_digit) => {
+            let (r, n) = uint(&i[1..])?;
+            Ok((r, GotoTarget::Number(n)))
+        }
+        Some(b'[') => bracket_name(i).map(|(r, s)| (r, GotoTarget::Name(s))),
+        _ => fail(i, SYNTAX, "jump target N<number> or [LABEL] expected"),
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// # commands
+// ---------------------------------------------------------------------------------------
+
+fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
+    let after = &i[1..];
+    let mut buf = [0u8; 16];
+    let Some((rest, len)) = keyword_after(after, &mut buf) else {
+        return fail(i, UNKNOWN_COMMAND, "NC command expected after #");
+    };
+    let r = ws(rest);
+    match &buf[..len] {
+        b"FLUSH" => {
+            if let Some(r) = keyword(r, "CONTINUE") {
+                Ok((r, Command::Flush(FlushKind::Continue)))
+            } else if let Some(r) = keyword(r, "WAIT") {
+                Ok((r, Command::Flush(FlushKind::Wait)))
+            } else if gap(r).is_empty() {
+                Ok((r, Command::Flush(FlushKind::Stop)))
+            } else {
+                fail(r, SYNTAX, "#FLUSH takes CONTINUE or WAIT")
+            }
+        }
+        b"CACHE" => cache(r),
+        b"COMMENT" => {
+            if let Some(r) = keyword(r, "BEGIN") {
+                Ok((r, Command::CommentBegin))
+            } else if let Some(r) = keyword(r, "END") {
+                Ok((r, Command::CommentEnd))
+            } else {
+                fail(r, SYNTAX, "#COMMENT takes BEGIN or END")
+            }
+        }
+        b"SPLINE" => {
+            if let Some(r) = keyword(r, "ON") {
+                Ok((r, Command::Spline(SplineCommand::On)))
+            } else if let Some(r) = keyword(r, "OFF") {
+                Ok((r, Command::Spline(SplineCommand::Off)))
+            } else if let Some(t) = keyword(r, "TYPE") {
+                let t = ws(t);
+                if let Some(r) = keyword(t, "AKIMA") {
+                    Ok((r, Command::Spline(SplineCommand::TypeAkima)))
+                } else if let Some(r) = keyword(t, "BSPLINE") {
+                    Ok((r, Command::Spline(SplineCommand::TypeBspline)))
+                } else {
+                    fail(t, SYNTAX, "#SPLINE TYPE takes AKIMA or BSPLINE")
+                }
+            } else {
+                fail(r, SYNTAX, "#SPLINE takes ON, OFF or TYPE")
+            }
+        }
+        b"HSC" => {
+            let (r, on) = if let Some(r) = keyword(r, "ON") {
+                (r, true)
+            } else if let Some(r) = keyword(r, "OFF") {
+                (r, false)
+            } else {
+                return fail(r, SYNTAX, "#HSC takes ON or OFF");
+            };
+            let (r, options) = verbatim_options(ws(r), r)?;
+            Ok((r, Command::Hsc { on, options }))
+        }
+        b"CONTOUR" => {
+            let Some(m) = keyword(r, "MODE") else {
+                return fail(r, SYNTAX, "#CONTOUR takes MODE");
+            };
+            let (r, options) = verbatim_options(ws(m), m)?;
+            Ok((r, Command::ContourMode { options }))
+        }
+        b"VAR" => Ok((rest, Command::Var)),
+        b"ENDVAR" => Ok((rest, Command::EndVar)),
+        _ => {
+            let _ = ctx;
+            fail(
+                i,
+                UNKNOWN_COMMAND,
+                format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
+            )
+        }
+    }
+}
+
+/// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
+/// return when there is no bracket.
+fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
+    if !i.starts_with('[') {
+        return Ok((none, String::new()));
+    }
+    let mut depth = 0usize;
+    for (k, b) in i.bytes().enumerate() {
+        match b {
+            b'[' => depth += 1,
+            b']' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Ok((&i[k + 1..], i[1..k].trim().to_string()));
+                }
+            }
+            _ => {}
+        }
+    }
+    fail(i, SYNTAX, "`]` missing")
+}
+
+/// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (seed 002;
+/// the seed writes no blank before the bracket). Bad form 21560, a second target 21561.
+fn cache(i: &str) -> PResult<'_, Command> {
+    let (r, load) = if let Some(r) = keyword(i, "LOAD") {
+        (r, true)
+    } else if let Some(r) = keyword(i, "CLEAR") {
+        (r, false)
+    } else {
+        return fail(i, CACHE_SYNTAX, "#CACHE takes LOAD or CLEAR");
+    };
+    let r = ws(r);
+    if !load {
+        if let Some(a) = keyword(r, "ALL") {
+            let j = gap(a);
+            if j.starts_with('[') {
+                return fail(j, CACHE_DOUBLE, "#CACHE CLEAR ALL takes no FILE");
+            }
+            if !j.is_empty() {
+                return fail(j, CACHE_SYNTAX, "unexpected text after #CACHE CLEAR ALL");
+            }
+            return Ok((a, Command::CacheClearAll));
+        }
+    }
+    let Some(mut j) = r.strip_prefix('[') else {
+        return fail(r, CACHE_SYNTAX, "[FILE=<name>] expected");
+    };
+    let mut file: Option<String> = None;
+    loop {
+        j = ws(j);
+        if let Some(rest) = j.strip_prefix(']') {
+            let Some(file) = file else {
+                return fail(j, CACHE_SYNTAX, "FILE=<name> missing");
+            };
+            let k = gap(rest);
+            if k.starts_with('[') {
+                return fail(k, CACHE_DOUBLE, "#CACHE programmed twice in one block");
+            }
+            if !k.is_empty() {
+                return fail(k, CACHE_SYNTAX, "unexpected text after #CACHE");
+            }
+            let cmd = if load {
+                Command::CacheLoad { file }
+            } else {
+                Command::CacheClear { file }
+            };
+            return Ok((rest, cmd));
+        }
+        let Some(f) = keyword(j, "FILE") else {
+            return fail(j, CACHE_SYNTAX, "FILE=<name> expected");
+        };
+        let f = ws(f);
+        let Some(f) = f.strip_prefix('=') else {
+            return fail(f, CACHE_SYNTAX, "`=` expected after FILE");
+        };
+        let (rest, name) = file_name(ws(f), true);
+        if name.is_empty() {
+            return fail(f, CACHE_SYNTAX, "file name expected after FILE=");
+        }
+        if file.is_some() {
+            return fail(j, CACHE_DOUBLE, "FILE programmed twice in #CACHE");
+        }
+        file = Some(name.to_string());
+        j = rest;
+    }
+}
+
+/// A file name: `"quoted"` or a run of characters up to a blank, comment start or, inside
+/// brackets, `]`.
+fn file_name(i: &str, in_bracket: bool) -> (&str, &str) {
+    if let Some(q) = i.strip_prefix('"') {
+        if let Some(end) = q.find('"') {
+            return (&q[end + 1..], &q[..end]);
+        }
+    }
+    let end = i
+        .find(|c: char| c == ' ' || c == '\t' || c == '(' || c == ';' || (in_bracket && c == ']'))
+        .unwrap_or(i.len());
+    (&i[end..], &i[..end])
+}
+
+// ---------------------------------------------------------------------------------------
+// Calls and program heads
+// ---------------------------------------------------------------------------------------
+
+fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
+    let local = matches!(i.as_bytes().get(1), Some(b'L' | b'l'));
+    let r = ws(&i[if local { 2 } else { 1 }..]);
+    if local {
+        let (rest, name) = file_name(r, false);
+        if name.is_empty() {
+            return fail(r, SYNTAX, "subroutine name expected after LL");
+        }
+        return Ok((rest, Call::Local { name: name.to_ascii_uppercase() }));
+    }
+    if let Some(c) = keyword(r, "CYCLE") {
+        let c = ws(c);
+        if c.starts_with('[') {
+            return cycle(ctx, c);
+        }
+        return fail(c, SYNTAX, "[NAME=<file> @P<n>=<value> …] expected after L CYCLE");
+    }
+    let (rest, file) = file_name(r, false);
+    if file.is_empty() {
+        return fail(r, SYNTAX, "subroutine file name expected after L");
+    }
+    Ok((rest, Call::Global { file: file.to_string() }))
+}
+
+/// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
+fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
+    let open = i;
+    let mut j = &i[1..];
+    let mut name: Option<String> = None;
+    let mut params: Vec<(u32, super::block::Expr)> = Vec::new();
+    loop {
+        j = j.trim_start_matches([' ', '\t', ',']);
+        if let Some(rest) = j.strip_prefix(']') {
+            let Some(name) = name else {
+                return fail(open, SYNTAX, "NAME=<file> missing in L CYCLE");
+            };
+            return Ok((rest, Call::Cycle { name, params }));
+        }
+        if let Some(n) = keyword(j, "NAME") {
+            let n = ws(n);
+            let Some(n) = n.strip_prefix('=') else {
+                return fail(n, SYNTAX, "`=` expected after NAME");
+            };
+            let (rest, file) = file_name(ws(n), true);
+            if file.is_empty() {
+                return fail(n, SYNTAX, "cycle file name expected after NAME=");
+            }
+            if name.is_some() {
+                return fail(j, SYNTAX, "NAME programmed twice in L CYCLE");
+            }
+            name = Some(file.to_string());
+            j = rest;
+        } else if j.starts_with('@') {
+            let (r, v) = ctx.var_ref(j)?;
+            let VarRef::CycleParam(p) = v else {
+                return fail(j, SYNTAX, "@P<number> expected");
+            };
+            if params.iter().any(|(q, _)| *q == p) {
+                return fail(j, SYNTAX, format!("@P{p} programmed twice in L CYCLE"));
+            }
+            let r = ws(r);
+            let Some(r) = r.strip_prefix('=') else {
+                return fail(r, SYNTAX, "`=` expected after the cycle parameter");
+            };
+            let (r, e) = ctx.expr(ws(r))?;
+            params.push((p, e));
+            j = r;
+        } else if j.is_empty() {
+            return fail(j, SYNTAX, "`]` missing after L CYCLE [");
+        } else {
+            return fail(j, SYNTAX, "NAME=<file> or @P<n>=<value> expected");
+        }
+    }
+}
+
+/// `%name` or `%L name`.
+fn program_head(i: &str) -> PResult<'_, (String, bool)> {
+    let after = &i[1..];
+    let ab = after.as_bytes();
+    if matches!(ab.first(), Some(b'L' | b'l')) && matches!(ab.get(1), Some(b' ' | b'\t')) {
+        let r = ws(&after[1..]);
+        let (rest, name) = file_name(r, false);
+        if name.is_empty() {
+            return fail(r, SYNTAX, "subroutine name expected after %L");
+        }
+        return Ok((rest, (name.to_ascii_uppercase(), true)));
+    }
+    let (rest, name) = file_name(after, false);
+    Ok((rest, (name.to_string(), false)))
+}
+
+// ---------------------------------------------------------------------------------------
+// #VAR declarations
+// ---------------------------------------------------------------------------------------
+
+fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'a>>> {
+    let i = gap(line);
+    let b = i.as_bytes();
+    if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
+        return Err(perr(i, SYNTAX, "variable declaration V.P., V.L. or V.S. expected"));
+    }
+    let (r, v) = ctx.var_ref(i)?;
+    let VarRef::V { scope, name, indices } = v else {
+        return Err(perr(i, SYNTAX, "variable declaration expected"));
+    };
+    if scope == VScope::External {
+        return Err(perr(i, SYNTAX, "V.E. variables are not declared in programs"));
+    }
+    let mut dims = Vec::with_capacity(indices.len());
+    for e in indices {
+        match e {
+            super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 && n <= 1.0e6 => {
+                dims.push(n as u32)
+            }
+            _ => return Err(perr(i, SYNTAX, "array size must be a whole number from 1 to 1000000")),
+        }
+    }
+    let j = ws(r);
+    let (r, init) = match j.strip_prefix('=') {
+        Some(k) => {
+            let (r, e) = ctx.expr(ws(k))?;
+            (r, Some(e))
+        }
+        None => (r, None),
+    };
+    end_of_block(r, "nothing may follow a declaration")?;
+    Ok(VarDecl {
+        scope,
+        name,
+        dims,
+        init,
+    })
+}

@@ -1,0 +1,201 @@
+//! Property: any block printed canonically parses back to the same block, and its canonical
+//! text is a fixed point.
+
+use ncchannel::lang::codes::{KNOWN_G, WORD_LETTERS};
+use ncchannel::lang::expr::FUNCS;
+use ncchannel::lang::*;
+use proptest::prelude::*;
+
+fn num() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        (-100_000i64..100_000).prop_map(|k| k as f64 / 1000.0),
+        (0u32..5000).prop_map(f64::from),
+        -1.0e9..1.0e9f64,
+    ]
+}
+
+fn ident() -> impl Strategy<Value = String> {
+    "[A-Z_][A-Z0-9_]{0,7}"
+}
+
+fn file() -> impl Strategy<Value = String> {
+    "[A-Za-z0-9_][A-Za-z0-9_.-]{0,11}".prop_filter("CYCLE is the cycle keyword", |s| !s.eq_ignore_ascii_case("cycle"))
+}
+
+fn scope() -> impl Strategy<Value = VScope> {
+    prop_oneof![
+        Just(VScope::Program),
+        Just(VScope::Local),
+        Just(VScope::SelfRetaining),
+        Just(VScope::External)
+    ]
+}
+
+fn var_ref(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
+    let idx = prop::collection::vec(e.clone(), 0..3);
+    prop_oneof![
+        (0u32..10_000, idx.clone()).prop_map(|(n, indices)| VarRef::P { number: Index::Const(n), indices }),
+        (e, idx.clone()).prop_map(|(x, indices)| VarRef::P { number: Index::Expr(Box::new(x)), indices }),
+        (scope(), ident(), idx).prop_map(|(scope, name, indices)| VarRef::V { scope, name, indices }),
+        (0u32..100).prop_map(VarRef::CycleParam),
+    ]
+}
+
+fn expr() -> BoxedStrategy<Expr> {
+    let leaf = prop_oneof![
+        3 => num().prop_map(Expr::Num),
+        1 => var_ref(num().prop_map(Expr::Num).boxed()).prop_map(|v| Expr::Var(Box::new(v))),
+    ];
+    leaf.prop_recursive(4, 40, 3, |inner| {
+        let unop = prop_oneof![Just(UnOp::Neg), Just(UnOp::Not), Just(UnOp::Inv)];
+        let binop = prop::sample::select(vec![
+            BinOp::Add, BinOp::Sub, BinOp::Mul, BinOp::Div, BinOp::Pow, BinOp::Mod, BinOp::Eq,
+            BinOp::Ne, BinOp::Lt, BinOp::Gt, BinOp::Le, BinOp::Ge, BinOp::And, BinOp::Or,
+            BinOp::Xor, BinOp::BitAnd, BinOp::BitOr, BinOp::BitXor,
+        ]);
+        prop_oneof![
+            (unop, inner.clone()).prop_map(|(o, e)| Expr::Unary(o, Box::new(e))),
+            (binop, inner.clone(), inner.clone()).prop_map(|(o, a, b)| Expr::Binary(o, Box::new(a), Box::new(b))),
+            (prop::sample::select(FUNCS.to_vec()), inner.clone(), inner.clone()).prop_map(|(f, a, b)| {
+                let args = if f == Func::Atan2 { vec![a, b] } else { vec![a] };
+                Expr::Func(f, args)
+            }),
+            var_ref(inner).prop_map(|v| Expr::Var(Box::new(v))),
+        ]
+    })
+    .boxed()
+}
+
+fn value() -> impl Strategy<Value = Value> {
+    prop_oneof![3 => num().prop_map(Value::Num), 1 => expr().prop_map(Value::Expr)]
+}
+
+fn item() -> impl Strategy<Value = Item> {
+    let letters: Vec<u8> = WORD_LETTERS.iter().copied().filter(|&l| l != b'G' && l != b'M').collect();
+    prop_oneof![
+        4 => (prop::sample::select(letters), value()).prop_map(|(letter, value)| Item::Word(Word { letter, value, col: 0 })),
+        1 => prop::sample::select(KNOWN_G.to_vec()).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
+        1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
+        1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::Assign { target, value, col: 0 }),
+        1 => (prop::sample::select(vec![133u32, 134]), expr()).prop_map(|(g, e)| Item::GValue {
+            g,
+            value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
+            col: 0,
+        }),
+    ]
+}
+
+fn target() -> impl Strategy<Value = GotoTarget> {
+    prop_oneof![(0u32..100_000).prop_map(GotoTarget::Number), ident().prop_map(GotoTarget::Name)]
+}
+
+fn control() -> impl Strategy<Value = Control> {
+    use Control::*;
+    prop_oneof![
+        expr().prop_map(If),
+        (expr(), target()).prop_map(|(e, t)| IfGoto(e, t)),
+        expr().prop_map(ElseIf),
+        expr().prop_map(Switch),
+        expr().prop_map(Case),
+        expr().prop_map(While),
+        expr().prop_map(EndDo),
+        expr().prop_map(Until),
+        target().prop_map(Goto),
+        (var_ref(expr()), expr(), expr(), prop::option::of(expr())).prop_map(|(var, start, end, step)| For { var, start, end, step }),
+        prop::sample::select(vec![Else, EndIf, Default, Break, EndSwitch, EndFor, EndWhile, Do, Repeat, Continue]),
+    ]
+}
+
+fn options() -> impl Strategy<Value = String> {
+    prop_oneof![Just(String::new()), "[A-Z0-9_.=]([A-Z0-9_ .=,]{0,10}[A-Z0-9_.=])?"]
+}
+
+fn command() -> impl Strategy<Value = Command> {
+    use Command::*;
+    prop_oneof![
+        prop::sample::select(vec![
+            Flush(FlushKind::Stop), Flush(FlushKind::Continue), Flush(FlushKind::Wait), CacheClearAll,
+            CommentBegin, CommentEnd, Spline(SplineCommand::On), Spline(SplineCommand::Off),
+            Spline(SplineCommand::TypeAkima), Spline(SplineCommand::TypeBspline), Var, EndVar,
+        ]),
+        file().prop_map(|file| CacheLoad { file }),
+        file().prop_map(|file| CacheClear { file }),
+        (any::<bool>(), options()).prop_map(|(on, options)| Hsc { on, options }),
+        options().prop_map(|options| ContourMode { options }),
+    ]
+}
+
+fn call() -> impl Strategy<Value = Call> {
+    prop_oneof![
+        file().prop_map(|file| Call::Global { file }),
+        ident().prop_map(|name| Call::Local { name }),
+        (file(), prop::collection::btree_map(0u32..20, expr(), 0..4)).prop_map(|(name, params)| Call::Cycle {
+            name,
+            params: params.into_iter().collect(),
+        }),
+    ]
+}
+
+fn body() -> impl Strategy<Value = Body> {
+    prop_oneof![
+        4 => prop::collection::vec(item(), 0..6).prop_map(Body::Items),
+        2 => control().prop_map(Body::Control),
+        1 => command().prop_map(Body::Command),
+        1 => call().prop_map(Body::Call),
+        1 => "[A-Za-z0-9_.-]{0,10}".prop_map(|name| Body::ProgramHead { name, local: false }),
+        1 => ident().prop_map(|name| Body::ProgramHead { name, local: true }),
+    ]
+}
+
+fn block() -> impl Strategy<Value = Block> {
+    let skip = prop::option::of(1u8..=10);
+    let head = prop_oneof![
+        prop::option::of(0u32..100_000).prop_map(|n| (n, None)),
+        (0u32..100_000).prop_map(|k| (Some(k), Some(Label::Number(k)))),
+        (prop::option::of(0u32..100_000), ident()).prop_map(|(n, s)| (n, Some(Label::Name(s)))),
+    ];
+    (skip, head, body()).prop_map(|(skip_level, (n, label), body)| Block { skip_level, n, label, body })
+}
+
+fn without_cols(mut b: Block) -> Block {
+    if let Body::Items(items) = &mut b.body {
+        for item in items {
+            match item {
+                Item::Word(w) => w.col = 0,
+                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+            }
+        }
+    }
+    b
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn printed_block_parses_back_equal(b in block()) {
+        let text = b.to_string();
+        prop_assume!(text.chars().count() <= 4000);
+        let parsed = parse_block(&text).map_err(|e| TestCaseError::fail(format!("{text:?}: {e}")))?;
+        prop_assert_eq!(without_cols(parsed.clone()), b, "text {:?}", text);
+        prop_assert_eq!(parsed.to_string(), text.clone());
+        let crlf = parse_block(&format!("{text}\r\n")).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        prop_assert_eq!(crlf, parsed);
+    }
+
+    #[test]
+    fn arbitrary_text_never_panics(line in "\\PC{0,200}") {
+        let _ = parse_block(&line);
+        let _ = parse_var_declaration(&line);
+        let _ = is_comment_end(&line);
+    }
+
+    #[test]
+    fn nc_like_text_never_panics(line in "[NGXYZPVL$#%@\\[\\]()=+*/<>!&|^;:. 0-9.-]{0,120}") {
+        if let Ok(b) = parse_block(&line) {
+            // Whatever parses prints to something that parses to the same block.
+            let again = parse_block(&b.to_string()).map_err(|e| TestCaseError::fail(format!("{line:?} -> {b}: {e}")))?;
+            prop_assert_eq!(without_cols(again), without_cols(b));
+        }
+    }
+}
