@@ -116,9 +116,9 @@ impl Move {
     /// Position at fraction `u` (0..=1) of the path.
     pub fn point_at(&self, u: f64) -> Position {
         let u = u.clamp(0.0, 1.0);
-        let mut p = [0.0; MAX_AXES];
-        for i in 0..MAX_AXES {
-            p[i] = self.start[i] + (self.end[i] - self.start[i]) * u;
+        let mut p = self.start;
+        for (pi, (s, e)) in p.iter_mut().zip(self.start.iter().zip(&self.end)) {
+            *pi = s + (e - s) * u;
         }
         if let MoveKind::Arc {
             plane,

@@ -14,19 +14,33 @@ pub enum ArcError {
     NoCenter,
 }
 
-/// Build an arc move. `ijk` are the centre offsets from the start point per axis X Y Z
-/// (I J K); only the two in the working plane count. `r` > 0: the arc of at most 180°,
-/// r < 0: the longer one (ISG/DIN convention).
+/// What a G2/G3 block programs besides its end point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcSpec {
+    pub plane: Plane,
+    /// Centre offsets from the start point per axis X Y Z (I J K); only the two in the
+    /// working plane count.
+    pub ijk: [Option<f64>; 3],
+    /// R > 0: the arc of at most 180°, R < 0: the longer one (ISG/DIN convention).
+    pub radius: Option<f64>,
+    /// G2.
+    pub cw: bool,
+}
+
+/// Build an arc move from `start` to `end`.
 pub fn arc_move(
-    plane: Plane,
+    spec: &ArcSpec,
     start: Position,
     end: Position,
-    ijk: [Option<f64>; 3],
-    r: Option<f64>,
-    cw: bool,
     feed_mm_per_min: f64,
     tolerance_mm: f64,
 ) -> Result<Move, ArcError> {
+    let ArcSpec {
+        plane,
+        ijk,
+        radius: r,
+        cw,
+    } = *spec;
     let (a, b, _) = plane.axes();
     let (sa, sb, ea, eb) = (start[a], start[b], end[a], end[b]);
     let center = if ijk[a].is_some() || ijk[b].is_some() {
@@ -107,6 +121,32 @@ fn center_from_radius(
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// The positional form reads best in these tables of cases.
+    #[allow(clippy::too_many_arguments)]
+    fn arc_move(
+        plane: Plane,
+        start: Position,
+        end: Position,
+        ijk: [Option<f64>; 3],
+        radius: Option<f64>,
+        cw: bool,
+        feed: f64,
+        tol: f64,
+    ) -> Result<Move, ArcError> {
+        super::arc_move(
+            &ArcSpec {
+                plane,
+                ijk,
+                radius,
+                cw,
+            },
+            start,
+            end,
+            feed,
+            tol,
+        )
+    }
 
     fn p(x: f64, y: f64) -> Position {
         [x, y, 0.0, 0.0, 0.0, 0.0]

@@ -630,11 +630,11 @@ impl Decoder {
             return Ok(false);
         }
         match (&skip.until, c) {
-            (SkipUntil::IfBranch, Control::ElseIf(e)) => {
-                if crate::lang::eval::is_true(self.eval(e)?) {
-                    self.top().skip = None;
-                    self.set_if_taken();
-                }
+            (SkipUntil::IfBranch, Control::ElseIf(e))
+                if crate::lang::eval::is_true(self.eval(e)?) =>
+            {
+                self.top().skip = None;
+                self.set_if_taken();
             }
             (SkipUntil::IfBranch, Control::Else) => {
                 self.top().skip = None;
@@ -1056,9 +1056,11 @@ impl Decoder {
                     if let Value::Expr(e) = value {
                         self.eval(e).map_err(|e| e.at(*col))?;
                     }
-                    apply_g(&mut self.modal, *g, &mut gs).map_err(|_| {
-                        DecodeError::new(20131, format!("unknown G function G{g}")).at(*col)
-                    })?;
+                    if !apply_g(&mut self.modal, *g, &mut gs) {
+                        return Err(
+                            DecodeError::new(20131, format!("unknown G function G{g}")).at(*col)
+                        );
+                    }
                 }
                 Item::Word(w) => {
                     let v = match &w.value {
@@ -1071,10 +1073,13 @@ impl Decoder {
                                 DecodeError::new(20131, format!("G{v} is not a G function"))
                                     .at(w.col)
                             })?;
-                            apply_g(&mut self.modal, g, &mut gs).map_err(|_| {
-                                DecodeError::new(20131, format!("unknown G function G{g}"))
-                                    .at(w.col)
-                            })?;
+                            if !apply_g(&mut self.modal, g, &mut gs) {
+                                return Err(DecodeError::new(
+                                    20131,
+                                    format!("unknown G function G{g}"),
+                                )
+                                .at(w.col));
+                            }
                         }
                         b'M' => {
                             let m = whole(v).ok_or_else(|| {
@@ -1118,7 +1123,7 @@ impl Decoder {
                                     )
                                     .at(w.col));
                                 }
-                                if !self.settings.axes[i] && !(gs.dwell && letter == b'X') {
+                                if !(self.settings.axes[i] || gs.dwell && letter == b'X') {
                                     return Err(DecodeError::new(
                                         20200,
                                         format!(
@@ -1185,12 +1190,14 @@ impl Decoder {
                         }
                     } else {
                         arc::arc_move(
-                            self.modal.plane,
+                            &arc::ArcSpec {
+                                plane: self.modal.plane,
+                                ijk,
+                                radius,
+                                cw: m == MotionMode::ArcCw,
+                            },
                             start,
                             end,
-                            ijk,
-                            radius,
-                            m == MotionMode::ArcCw,
                             feed,
                             self.settings.arc_tolerance_mm,
                         )

@@ -105,8 +105,9 @@ pub struct BlockGs {
     pub contour_this_block: bool,
 }
 
-/// Apply one G code. `Err(())` for a G code the channel does not know (20131).
-pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> Result<(), ()> {
+/// Apply one G code. `false` for a G code the channel does not know (20131).
+#[must_use]
+pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
     match g {
         0 => m.motion = MotionMode::Rapid,
         1 => m.motion = MotionMode::Linear,
@@ -133,9 +134,9 @@ pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> Result<(), ()> {
         151 => m.spline = true,
         260 => m.contouring = false,
         261 => m.contouring = true,
-        _ => return Err(()),
+        _ => return false,
     }
-    Ok(())
+    true
 }
 
 /// Apply an M function's modal effect (spindle, coolant). Program ends are handled by the
