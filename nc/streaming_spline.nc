@@ -3,6 +3,7 @@
 #SPLINE TYPE BSPLINE
 G151
 G134 50
+G01 F3000 (added: the excerpt starts mid-program, where a feed was already set)
 N36335 X-1.5586 Y-16.3853 (M122
 N36336 X-1.5666 Y-16.4702 Z2.9971
 N36337 X-1.5749 Y-16.5569 Z2.9881
