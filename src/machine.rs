@@ -103,6 +103,10 @@ impl Machine {
         }
     }
 
+    pub fn set_stop_when(&mut self, w: StopWhen) {
+        self.stop_when = w;
+    }
+
     pub fn attach_feeder(&mut self, channel: u32, feeder: Feeder) {
         self.feeders.push(Attached { channel, feeder });
     }

@@ -182,3 +182,43 @@ pub fn crlf(text: &str) -> Vec<u8> {
 pub fn path_str(p: &Path) -> String {
     p.display().to_string()
 }
+
+/// The channels in real time behind a real ADS server on a loopback port, in this process.
+pub struct Served {
+    pub server: ncchannel::ads::ServerHandle,
+    stop: ncchannel::runtime::StopHandle,
+    thread: std::thread::JoinHandle<Machine>,
+    log: Shared2,
+}
+
+impl Served {
+    pub fn start(rig: &Rig) -> Served {
+        let (machine, period, log) = rig.machine();
+        let mut machine = machine;
+        machine.set_stop_when(StopWhen::Never);
+        let n = machine.channels().len() as u16;
+        let (mut rt, tx) = Runtime::new(machine, period, Clock::RealTime);
+        let stop = rt.stop_handle();
+        let thread = std::thread::spawn(move || {
+            rt.run(None);
+            rt.into_inner().0
+        });
+        let backend = ncchannel::ads::channel_backend::ChannelBackend::new(tx, n);
+        let config = ncchannel::ads::ServerConfig {
+            bind: "127.0.0.1:0".parse().unwrap(),
+            ..Default::default()
+        };
+        let server = ncchannel::ads::spawn(config, Arc::new(backend)).unwrap();
+        Served { server, stop, thread, log }
+    }
+
+    /// Stop the runtime and return the event log as JSON values.
+    pub fn finish(self) -> (Machine, Vec<Value>) {
+        self.server.shutdown();
+        self.stop.stop();
+        let mut m = self.thread.join().unwrap();
+        m.finish_log().unwrap();
+        let events = self.log.text().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        (m, events)
+    }
+}
