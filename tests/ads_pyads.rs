@@ -4,6 +4,7 @@
 //! `NCCHANNEL_PYTHON=/path/to/venv/bin/python cargo test --test ads_pyads -- --ignored`
 
 mod ads_common;
+mod common;
 
 use std::process::Command;
 
@@ -21,4 +22,64 @@ fn pyads_talks_to_the_server() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("skipped"), "{stderr}");
+}
+
+/// A streaming client written with pyads drives the real channels at 1 ms: 5,000 lines,
+/// retries on 0x708, every block executed exactly once and in order.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_pyads -- --ignored"]
+fn pyads_streams_5000_lines_into_real_channels() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
+    lines.extend((2..5000).map(|i| {
+        format!(
+            "N{i} X{:.3} Y{:.3}",
+            (i % 50) as f64 * 0.1,
+            (i % 31) as f64 * 0.1
+        )
+    }));
+    lines.push("M30".into());
+    let file = rig.dir.path().join("prog.nc");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/stream_with_pyads.py"
+    );
+    let out = Command::new(python)
+        .arg(script)
+        .arg(&file)
+        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
+        .output()
+        .expect("python runs");
+    let (_, events) = served.finish();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let counts: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let busy = counts["busy"].as_u64().unwrap();
+    assert!(
+        busy > 0,
+        "the pyads client outran the channel at least once"
+    );
+    let notes = counts["notifications"].as_array().unwrap();
+    assert!(
+        notes.iter().any(|n| n[1] == 4),
+        "a notification reported ACTIVE: {notes:?}"
+    );
+    let blocks: Vec<&str> = events
+        .iter()
+        .filter(|e| e["ev"] == "block")
+        .map(|e| e["text"].as_str().unwrap())
+        .collect();
+    assert_eq!(blocks, lines.iter().map(String::as_str).collect::<Vec<_>>());
+    let warnings = events
+        .iter()
+        .filter(|e| e["ev"] == "warning" && e["code"] == 11012)
+        .count() as u64;
+    assert_eq!(warnings, busy);
 }
