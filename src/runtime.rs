@@ -19,6 +19,10 @@ use crate::report::stats::{CycleStats, Histogram};
 /// what ADS clients send to one controller.
 pub const MAX_REQUESTS_PER_TICK: usize = 64;
 
+/// Real time: no request is started closer than this to a tick's deadline. A request costs a
+/// few microseconds; the margin keeps the tick's start on time.
+pub const SERVE_MARGIN: Duration = Duration::from_micros(100);
+
 /// The tick being run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Tick {
@@ -209,6 +213,7 @@ impl<C: Cycle> Runtime<C> {
                 Clock::Virtual => (Instant::now(), None),
                 Clock::RealTime => {
                     let ideal = wall_start + mul_duration(self.period, k);
+                    requests += self.serve_until(ideal, &tick);
                     spin_sleep::sleep_until(ideal);
                     let now = Instant::now();
                     (now, Some(now.saturating_duration_since(ideal)))
@@ -239,6 +244,32 @@ impl<C: Cycle> Runtime<C> {
     }
 
     /// Serve up to [`MAX_REQUESTS_PER_TICK`] queued requests; returns how many.
+    /// Real time: the wait for the next deadline is spent answering requests as they come,
+    /// so a client's write round trip is microseconds, not up to a period (the real CNC's
+    /// COM objects are written asynchronously to its cycle, too). Requests stop being taken
+    /// `SERVE_MARGIN` before the deadline, so serving never makes a tick late; they are
+    /// served with the coming tick's number and time.
+    fn serve_until(&mut self, deadline: Instant, tick: &Tick) -> u64 {
+        let mut n = 0;
+        loop {
+            let now = Instant::now();
+            let Some(left) = deadline.checked_duration_since(now) else {
+                break;
+            };
+            if left <= SERVE_MARGIN {
+                break;
+            }
+            match self.requests.recv_timeout(left - SERVE_MARGIN) {
+                Ok(req) => {
+                    self.cycle.serve(req, tick);
+                    n += 1;
+                }
+                Err(_) => break,
+            }
+        }
+        n
+    }
+
     fn serve_pending(&mut self, tick: &Tick) -> u64 {
         let mut n = 0;
         while n < MAX_REQUESTS_PER_TICK {

@@ -290,7 +290,7 @@ impl Default for StreamOptions {
         StreamOptions {
             channel: 1,
             packet_bytes: MAX_PACKET_BYTES,
-            retry: Duration::from_millis(1),
+            retry: Duration::from_micros(250),
             start_program: None,
             stall_timeout: Duration::from_secs(30),
             wait_empty: true,
@@ -307,6 +307,9 @@ pub struct StreamProgress {
     /// Writes rejected with 0x708 (each one a warning 11012 in the channel).
     pub rejections: u64,
     pub elapsed: Duration,
+    /// Round trip of a stream write (accepted or busy), µs: median and 99th percentile.
+    pub write_rtt_us_p50: f64,
+    pub write_rtt_us_p99: f64,
 }
 
 impl StreamProgress {
@@ -388,9 +391,15 @@ pub fn stream_text(
     };
     let mut last_report = start;
     let mut last_accept = start;
+    let mut rtt = crate::report::stats::Histogram::new();
     for (i, packet) in packets.iter().enumerate() {
         loop {
-            match client.write(g, offset::STREAM, packet) {
+            let sent = Instant::now();
+            let r = client.write(g, offset::STREAM, packet);
+            rtt.record(sent.elapsed());
+            p.write_rtt_us_p50 = rtt.quantile_us(0.5);
+            p.write_rtt_us_p99 = rtt.quantile_us(0.99);
+            match r {
                 Ok(()) => {
                     last_accept = Instant::now();
                     break;
@@ -400,7 +409,7 @@ pub fn stream_text(
                     if last_accept.elapsed() > opts.stall_timeout {
                         return Err(StreamError::Stalled(opts.stall_timeout));
                     }
-                    std::thread::sleep(opts.retry);
+                    spin_sleep::sleep(opts.retry);
                 }
                 Err(ClientError::Ads(result)) => {
                     if let Ok(Some(msg)) = channel_error(client, opts.channel) {

@@ -110,12 +110,14 @@ pub fn execute(args: StreamArgs) -> ExitCode {
         Ok(p) => {
             eprintln!();
             eprintln!(
-                "stream: done: {} bytes in {} packets, {:.3} s, {:.0} B/s, {} writes rejected busy (warning 11012)",
+                "stream: done: {} bytes in {} packets, {:.3} s, {:.0} B/s, {} writes rejected busy (warning 11012), write round trip p50 {:.0} µs p99 {:.0} µs",
                 p.bytes_sent,
                 p.packets_sent,
                 p.elapsed.as_secs_f64(),
                 p.bytes_per_second(),
-                p.rejections
+                p.rejections,
+                p.write_rtt_us_p50,
+                p.write_rtt_us_p99
             );
             ExitCode::from(exit::OK)
         }
