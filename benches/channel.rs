@@ -27,7 +27,11 @@ impl Setup {
             "kanal_anzahl 1\nsda_mds[0] ch.lis\npfad[0].prg[0] ../nc\npfad[0].typ[0] 0x03\n",
         )
         .unwrap();
-        std::fs::write(dir.path().join("p/ch.lis"), "streaming_prog_file streaming.nc\n").unwrap();
+        std::fs::write(
+            dir.path().join("p/ch.lis"),
+            "streaming_prog_file streaming.nc\n",
+        )
+        .unwrap();
         Setup { dir }
     }
 
@@ -40,13 +44,21 @@ impl Setup {
         if let Some(s) = stream {
             m.attach_feeder(1, Feeder::new(s.to_vec(), 992, 1, false).unwrap());
         }
-        let t0 = Tick { index: 0, period, time: Duration::ZERO };
+        let t0 = Tick {
+            index: 0,
+            period,
+            time: Duration::ZERO,
+        };
         m.channel_mut(1).unwrap().start(&t0, program).unwrap();
         let (mut rt, _tx) = Runtime::new(m, period, Clock::Virtual);
         rt.run(None);
         let (m, stats) = rt.into_inner();
         assert_eq!(m.finishes()[0], Some(Finish::Ended));
-        (stats.work.quantile_us(0.5), stats.work.quantile_us(0.99), m.channels()[0].stats().blocks)
+        (
+            stats.work.quantile_us(0.5),
+            stats.work.quantile_us(0.99),
+            m.channels()[0].stats().blocks,
+        )
     }
 }
 
@@ -66,7 +78,11 @@ fn non_moving() -> Vec<u8> {
 fn short_moves() -> Vec<u8> {
     let mut s = String::from("G01 F6000\r\n");
     for i in 0..BLOCKS {
-        s.push_str(&format!("N{i} X{:.3} Y{:.3}\r\n", (i % 100) as f64 * 0.001, (i % 37) as f64 * 0.001));
+        s.push_str(&format!(
+            "N{i} X{:.3} Y{:.3}\r\n",
+            (i % 100) as f64 * 0.001,
+            (i % 37) as f64 * 0.001
+        ));
     }
     s.push_str("M30\r\n");
     s.into_bytes()
@@ -101,17 +117,23 @@ fn bench(c: &mut Criterion) {
     let nm = non_moving();
     let (p50, p99, blocks) = setup.run("streaming.nc", Some(&nm));
     eprintln!("streamed non-moving: {blocks} blocks; tick work p50 {p50:.2} µs p99 {p99:.2} µs");
-    g.bench_function("streamed_non_moving_1M", |b| b.iter(|| setup.run("streaming.nc", Some(&nm))));
+    g.bench_function("streamed_non_moving_1M", |b| {
+        b.iter(|| setup.run("streaming.nc", Some(&nm)))
+    });
 
     let mv = short_moves();
     let (p50, p99, blocks) = setup.run("streaming.nc", Some(&mv));
     eprintln!("streamed short moves: {blocks} blocks; tick work p50 {p50:.2} µs p99 {p99:.2} µs");
-    g.bench_function("streamed_short_moves_1M", |b| b.iter(|| setup.run("streaming.nc", Some(&mv))));
+    g.bench_function("streamed_short_moves_1M", |b| {
+        b.iter(|| setup.run("streaming.nc", Some(&mv)))
+    });
 
     std::fs::write(setup.dir.path().join("nc/branchy.nc"), branchy()).unwrap();
     let (p50, p99, _) = setup.run("branchy.nc", None);
     eprintln!("file with $IF/$SWITCH every 10 lines: tick work p50 {p50:.2} µs p99 {p99:.2} µs");
-    g.bench_function("file_if_switch_1M_lines", |b| b.iter(|| setup.run("branchy.nc", None)));
+    g.bench_function("file_if_switch_1M_lines", |b| {
+        b.iter(|| setup.run("branchy.nc", None))
+    });
     g.finish();
 }
 

@@ -14,7 +14,12 @@ const CH1: u32 = 0x20101;
 
 fn connect(srv: &ncchannel::ads::ServerHandle) -> Client {
     let source = AmsAddr::new(AmsNetId::new(10, 1, 2, 3, 1, 1), 40100);
-    Client::new(srv.local_addr(), Timeouts::new(Duration::from_secs(5)), Source::Addr(source)).unwrap()
+    Client::new(
+        srv.local_addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Addr(source),
+    )
+    .unwrap()
 }
 
 fn target() -> AmsAddr {
@@ -24,7 +29,10 @@ fn target() -> AmsAddr {
 fn mode_state(dev: &ads::Device) -> (i32, i32) {
     let mut b = [0u8; 8];
     dev.read_exact(CH1, offset::MODE_STATE, &mut b).unwrap();
-    (i32::from_le_bytes(b[0..4].try_into().unwrap()), i32::from_le_bytes(b[4..8].try_into().unwrap()))
+    (
+        i32::from_le_bytes(b[0..4].try_into().unwrap()),
+        i32::from_le_bytes(b[4..8].try_into().unwrap()),
+    )
 }
 
 /// Whole lines, CR LF, packets of at most 992 bytes.
@@ -51,18 +59,34 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
 
     // Notifications on mode/state changes, as an HMI watches the channel.
     let (handle, notes) = {
-        let attr = Attributes::new(8, TransmissionMode::ServerOnChange, Duration::from_millis(1), Duration::from_millis(1));
-        (dev.add_notification(CH1, offset::MODE_STATE, &attr).unwrap(), client.get_notification_channel())
+        let attr = Attributes::new(
+            8,
+            TransmissionMode::ServerOnChange,
+            Duration::from_millis(1),
+            Duration::from_millis(1),
+        );
+        (
+            dev.add_notification(CH1, offset::MODE_STATE, &attr)
+                .unwrap(),
+            client.get_notification_channel(),
+        )
     };
 
     // Start the streaming program: AUTOMATIC, program name, ACTIVE.
     dev.write_value(CH1, offset::COMMAND_MODE, &2i32).unwrap();
-    dev.write(CH1, offset::COMMAND_PROGRAM, b"streaming.nc\0").unwrap();
+    dev.write(CH1, offset::COMMAND_PROGRAM, b"streaming.nc\0")
+        .unwrap();
     dev.write_value(CH1, offset::COMMAND_STATE, &4i32).unwrap();
     assert_eq!(mode_state(&dev), (2, 4));
 
     let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
-    lines.extend((2..5000).map(|i| format!("N{i} X{:.3} Y{:.3}", (i % 50) as f64 * 0.1, (i % 31) as f64 * 0.1)));
+    lines.extend((2..5000).map(|i| {
+        format!(
+            "N{i} X{:.3} Y{:.3}",
+            (i % 50) as f64 * 0.1,
+            (i % 31) as f64 * 0.1
+        )
+    }));
     lines.push("M30".into());
     let mut busy = 0u32;
     let deadline = Instant::now() + Duration::from_secs(120);
@@ -85,16 +109,32 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
         std::thread::sleep(Duration::from_millis(5));
     }
     assert!(busy > 0, "a writer faster than the channel sees 0x708");
-    let seen: Vec<Vec<u8>> = notes.try_iter().map(|n| n.samples().flat_map(|s| s.data.to_vec()).collect()).collect();
-    assert!(seen.iter().any(|d| d.len() >= 8 && d[4] == 4), "a notification reported ACTIVE: {seen:?}");
+    let seen: Vec<Vec<u8>> = notes
+        .try_iter()
+        .map(|n| n.samples().flat_map(|s| s.data.to_vec()).collect())
+        .collect();
+    assert!(
+        seen.iter().any(|d| d.len() >= 8 && d[4] == 4),
+        "a notification reported ACTIVE: {seen:?}"
+    );
     dev.delete_notification(handle).unwrap();
     drop(client);
 
     let (_, events) = served.finish();
-    let blocks: Vec<&str> = events.iter().filter(|e| e["ev"] == "block").map(|e| e["text"].as_str().unwrap()).collect();
+    let blocks: Vec<&str> = events
+        .iter()
+        .filter(|e| e["ev"] == "block")
+        .map(|e| e["text"].as_str().unwrap())
+        .collect();
     assert_eq!(blocks, lines.iter().map(String::as_str).collect::<Vec<_>>());
-    let warnings = events.iter().filter(|e| e["ev"] == "warning" && e["code"] == 11012).count();
-    assert_eq!(warnings as u32, busy, "every 0x708 is one 11012 warning in the channel");
+    let warnings = events
+        .iter()
+        .filter(|e| e["ev"] == "warning" && e["code"] == 11012)
+        .count();
+    assert_eq!(
+        warnings as u32, busy,
+        "every 0x708 is one 11012 warning in the channel"
+    );
 }
 
 #[test]
@@ -103,7 +143,8 @@ fn reset_over_ads_empties_the_stream_and_reads_back_ready() {
     let served = Served::start(&rig);
     let client = connect(&served.server);
     let dev = client.device(target());
-    dev.write(CH1, offset::STREAM, b"N1 G01 X1000 F100\r\n").unwrap();
+    dev.write(CH1, offset::STREAM, b"N1 G01 X1000 F100\r\n")
+        .unwrap();
     let mut fill = [0u8; 8];
     dev.read_exact(CH1, offset::STREAM_FILL, &mut fill).unwrap();
     assert_eq!(u32::from_le_bytes(fill[0..4].try_into().unwrap()), 19);

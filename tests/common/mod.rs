@@ -209,7 +209,12 @@ impl Served {
             ..Default::default()
         };
         let server = ncchannel::ads::spawn(config, Arc::new(backend)).unwrap();
-        Served { server, stop, thread, log }
+        Served {
+            server,
+            stop,
+            thread,
+            log,
+        }
     }
 
     /// Stop the runtime and return the event log as JSON values.
@@ -218,7 +223,12 @@ impl Served {
         self.stop.stop();
         let mut m = self.thread.join().unwrap();
         m.finish_log().unwrap();
-        let events = self.log.text().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+        let events = self
+            .log
+            .text()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
         (m, events)
     }
 }
