@@ -9,22 +9,22 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand,
-    VScope, Value, VarDecl, VarRef, Word,
+    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, VScope,
+    Value, VarDecl, VarRef, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, CACHE_DOUBLE, CACHE_SYNTAX, G_WITH_VALUE,
     MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
 };
 use super::error::SyntaxError;
-use super::expr::{fail, keyword, perr, name_upper, uint, ws, Ctx, PErr, PResult};
+use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
 use super::number::scan_unsigned;
 
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
 /// line, or more than 4000 characters, is error 20200.
 pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
-    let line = checked_line(line)?;
-    let ctx = Ctx::new(line);
+    let (line, ascii) = checked_line(line)?;
+    let ctx = Ctx::with_ascii(line, ascii);
     block(&ctx, line).map_err(|e| ctx.to_error(e))
 }
 
@@ -61,8 +61,8 @@ pub fn is_blank_line(line: &str) -> bool {
 /// Parse one declaration between `#VAR` and `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,
 /// `V.S.GRID[3][4] = 0`. `V.E.` variables are not declared in programs (20200).
 pub fn parse_var_declaration(line: &str) -> Result<VarDecl, SyntaxError> {
-    let line = checked_line(line)?;
-    let ctx = Ctx::new(line);
+    let (line, ascii) = checked_line(line)?;
+    let ctx = Ctx::with_ascii(line, ascii);
     var_decl(&ctx, line).map_err(|e| ctx.to_error(e))
 }
 
@@ -74,8 +74,13 @@ fn strip_line_end(line: &str) -> &str {
         .unwrap_or(line)
 }
 
-fn checked_line(line: &str) -> Result<&str, SyntaxError> {
+/// The line without its line end, and whether it is pure ASCII.
+fn checked_line(line: &str) -> Result<(&str, bool), SyntaxError> {
     let line = strip_line_end(line);
+    // One branch-free pass (it vectorises) answers both questions for the common line.
+    let (or, line_end) = line.bytes().fold((0u8, false), |(o, e), b| {
+        (o | b, e | (b == b'\r') | (b == b'\n'))
+    });
     if line.len() > MAX_BLOCK_CHARS && line.chars().count() > MAX_BLOCK_CHARS {
         return Err(SyntaxError::new(
             SYNTAX,
@@ -83,11 +88,12 @@ fn checked_line(line: &str) -> Result<&str, SyntaxError> {
             format!("block longer than {MAX_BLOCK_CHARS} characters"),
         ));
     }
-    if let Some(pos) = line.find(['\r', '\n']) {
+    if line_end {
+        let pos = line.find(['\r', '\n']).unwrap_or(0);
         let col = line[..pos].chars().count() as u32 + 1;
         return Err(SyntaxError::new(SYNTAX, col, "line end inside the block"));
     }
-    Ok(line)
+    Ok((line, or < 0x80))
 }
 
 /// Skip blanks and comments: `( … )` nesting, an unclosed `(` to block end, `;` to line end.
@@ -120,7 +126,10 @@ pub(crate) fn gap(mut i: &str) -> &str {
 }
 
 /// Block skip, block number and label: what may precede every body.
-fn prefix<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
+fn prefix<'a>(
+    ctx: &Ctx<'a>,
+    mut i: &'a str,
+) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
     let mut skip = None;
     if let Some(rest) = i.strip_prefix('/') {
         if rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
@@ -233,8 +242,22 @@ fn starts_call(i: &str) -> bool {
 // Ordinary blocks: words and assignments
 // ---------------------------------------------------------------------------------------
 
+/// An upper bound on the items in the rest of a block: letters and `@` before the first
+/// comment (capped; a longer block grows its list). Sizing the list once keeps the hot path
+/// at one exact-size allocation per block.
+fn item_capacity(i: &str) -> usize {
+    let mut n = 0usize;
+    for &b in i.as_bytes() {
+        if b == b'(' || b == b';' {
+            break;
+        }
+        n += usize::from((b | 0x20).wrapping_sub(b'a') < 26) + usize::from(b == b'@');
+    }
+    n.min(32)
+}
+
 fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
-    let mut items = Vec::with_capacity(8);
+    let mut items = Vec::with_capacity(item_capacity(i));
     loop {
         i = gap(i);
         let bytes = i.as_bytes();
@@ -253,7 +276,11 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
                 return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
             };
             let (r, value) = ctx.expr(ws(r))?;
-            items.push(Item::Assign { target, value, col });
+            items.push(Item::Assign {
+                target: Box::new(target),
+                value,
+                col,
+            });
             i = r;
         } else {
             let msg = match b {
@@ -314,7 +341,11 @@ fn word<'a>(
         b'G' => {
             let g = integer_code(&value);
             let Some(g) = g.filter(|&g| is_known_g(g)) else {
-                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{}", show_value(&value))));
+                return Err(perr(
+                    i,
+                    UNKNOWN_G,
+                    format!("unknown G function G{}", show_value(&value)),
+                ));
             };
             if G_WITH_VALUE.contains(&g) {
                 if let Some((r, v)) = g_value(ctx, rest)? {
@@ -323,10 +354,12 @@ fn word<'a>(
                 }
             }
         }
-        b'M' => {
-            if !integer_code(&value).is_some_and(is_known_m) {
-                return Err(perr(i, UNKNOWN_M, format!("unknown M function M{}", show_value(&value))));
-            }
+        b'M' if !integer_code(&value).is_some_and(is_known_m) => {
+            return Err(perr(
+                i,
+                UNKNOWN_M,
+                format!("unknown M function M{}", show_value(&value)),
+            ));
         }
         _ => {}
     }
@@ -446,7 +479,10 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
             return fail(
                 i,
                 UNKNOWN_COMMAND,
-                format!("unknown control statement ${}", &after[..after.len() - rest.len()]),
+                format!(
+                    "unknown control statement ${}",
+                    &after[..after.len() - rest.len()]
+                ),
             )
         }
     };
@@ -474,7 +510,15 @@ fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
         }
         None => (r, None),
     };
-    Ok((r, Control::For { var, start, end, step }))
+    Ok((
+        r,
+        Control::For {
+            var: Box::new(var),
+            start: Box::new(start),
+            end: Box::new(end),
+            step: step.map(Box::new),
+        },
+    ))
 }
 
 /// `N40` or `[LABEL]`.
@@ -685,20 +729,34 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
         if name.is_empty() {
             return fail(r, SYNTAX, "subroutine name expected after LL");
         }
-        return Ok((rest, Call::Local { name: name.to_ascii_uppercase() }));
+        return Ok((
+            rest,
+            Call::Local {
+                name: name.to_ascii_uppercase(),
+            },
+        ));
     }
     if let Some(c) = keyword(r, "CYCLE") {
         let c = ws(c);
         if c.starts_with('[') {
             return cycle(ctx, c);
         }
-        return fail(c, SYNTAX, "[NAME=<file> @P<n>=<value> …] expected after L CYCLE");
+        return fail(
+            c,
+            SYNTAX,
+            "[NAME=<file> @P<n>=<value> …] expected after L CYCLE",
+        );
     }
     let (rest, file) = file_name(r, false);
     if file.is_empty() {
         return fail(r, SYNTAX, "subroutine file name expected after L");
     }
-    Ok((rest, Call::Global { file: file.to_string() }))
+    Ok((
+        rest,
+        Call::Global {
+            file: file.to_string(),
+        },
+    ))
 }
 
 /// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
@@ -776,14 +834,27 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
     let i = gap(line);
     let b = i.as_bytes();
     if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
-        return Err(perr(i, SYNTAX, "variable declaration V.P., V.L. or V.S. expected"));
+        return Err(perr(
+            i,
+            SYNTAX,
+            "variable declaration V.P., V.L. or V.S. expected",
+        ));
     }
     let (r, v) = ctx.var_ref(i)?;
-    let VarRef::V { scope, name, indices } = v else {
+    let VarRef::V {
+        scope,
+        name,
+        indices,
+    } = v
+    else {
         return Err(perr(i, SYNTAX, "variable declaration expected"));
     };
     if scope == VScope::External {
-        return Err(perr(i, SYNTAX, "V.E. variables are not declared in programs"));
+        return Err(perr(
+            i,
+            SYNTAX,
+            "V.E. variables are not declared in programs",
+        ));
     }
     let mut dims = Vec::with_capacity(indices.len());
     for e in indices {
@@ -791,7 +862,13 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 && n <= 1.0e6 => {
                 dims.push(n as u32)
             }
-            _ => return Err(perr(i, SYNTAX, "array size must be a whole number from 1 to 1000000")),
+            _ => {
+                return Err(perr(
+                    i,
+                    SYNTAX,
+                    "array size must be a whole number from 1 to 1000000",
+                ))
+            }
         }
     }
     let j = ws(r);
