@@ -33,8 +33,7 @@ pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
 /// `#COMMENT BEGIN` block without parsing the line: comment text need not be valid NC.
 pub fn is_comment_end(line: &str) -> bool {
     let line = strip_line_end(line);
-    let ctx = Ctx::new(line);
-    let Ok((i, _)) = prefix(&ctx, ws(line)) else {
+    let Ok((i, _)) = prefix(ws(line)) else {
         return false;
     };
     let Some(i) = gap(i).strip_prefix('#') else {
@@ -126,10 +125,7 @@ pub(crate) fn gap(mut i: &str) -> &str {
 }
 
 /// Block skip, block number and label: what may precede every body.
-fn prefix<'a>(
-    ctx: &Ctx<'a>,
-    mut i: &'a str,
-) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
+fn prefix<'a>(mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
     let mut skip = None;
     if let Some(rest) = i.strip_prefix('/') {
         if rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
@@ -168,7 +164,6 @@ fn prefix<'a>(
         label = Some(Label::Name(name));
         i = r;
     }
-    let _ = ctx;
     Ok((i, (skip, n, label)))
 }
 
@@ -188,12 +183,12 @@ fn bracket_name(i: &str) -> PResult<'_, String> {
 }
 
 fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> {
-    let (i, (skip_level, n, label)) = prefix(ctx, ws(line))?;
+    let (i, (skip_level, n, label)) = prefix(ws(line))?;
     let i = gap(i);
     let body = match i.as_bytes().first() {
         None => Body::Items(Vec::new()),
         Some(b'#') => {
-            let (r, c) = command(ctx, i)?;
+            let (r, c) = command(i)?;
             end_of_block(r, "nothing may follow a # command in its block")?;
             Body::Command(c)
         }
@@ -537,7 +532,7 @@ fn goto_target(i: &str) -> PResult<'_, GotoTarget> {
 // # commands
 // ---------------------------------------------------------------------------------------
 
-fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
+fn command<'a>(i: &'a str) -> PResult<'a, Command> {
     let after = &i[1..];
     let mut buf = [0u8; 16];
     let Some((rest, len)) = keyword_after(after, &mut buf) else {
@@ -604,14 +599,11 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
         }
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
-        _ => {
-            let _ = ctx;
-            fail(
-                i,
-                UNKNOWN_COMMAND,
-                format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
-            )
-        }
+        _ => fail(
+            i,
+            UNKNOWN_COMMAND,
+            format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
+        ),
     }
 }
 
