@@ -12,7 +12,8 @@ pub struct Block {
     pub skip_level: Option<u8>,
     /// The block number `N<n>` if present.
     pub n: Option<u32>,
-    /// A jump target defined on this line: `N40:` or `[LABEL_1]`.
+    /// A jump target defined on this line: `N40:` or `[LABEL_1]`. The parser sets
+    /// `Label::Number(k)` only together with `n == Some(k)`; printing writes `Nk:` for it.
     pub label: Option<Label>,
     pub body: Body,
 }

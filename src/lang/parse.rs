@@ -292,6 +292,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
 }
 
 /// One address word at `i` (letter `up`), pushed onto `items`; returns the rest.
+///
+/// The literal case is the hot path and builds the item from scalars: moving a whole
+/// `Value` through the stack cost store-forwarding stalls that showed in the profile.
 #[inline]
 fn word<'a>(
     ctx: &Ctx<'a>,
@@ -302,65 +305,73 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
-    let (rest, value) = match ab.first() {
-        Some(b'[') => {
-            let (r, e) = ctx.bracketed(after)?;
-            (r, Value::Expr(e))
+    let (neg, skip) = match ab.first() {
+        Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
+        Some(b'-') if ab.get(1) == Some(&b'[') => {
+            return word_expr(ctx, i, up, col, &after[1..], true, items)
         }
-        Some(&s @ (b'-' | b'+')) if ab.get(1) == Some(&b'[') => {
-            let (r, e) = ctx.bracketed(&after[1..])?;
-            let e = if s == b'-' {
-                super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
-            } else {
-                e
-            };
-            (r, Value::Expr(e))
+        Some(b'+') if ab.get(1) == Some(&b'[') => {
+            return word_expr(ctx, i, up, col, &after[1..], false, items)
         }
-        Some(&s) => {
-            let (neg, digits) = match s {
-                b'-' => (true, &ab[1..]),
-                b'+' => (false, &ab[1..]),
-                _ => (false, ab),
-            };
-            match scan_unsigned(digits) {
-                Some((v, n)) => {
-                    let used = n + (ab.len() - digits.len());
-                    (&after[used..], Value::Num(if neg { -v } else { v }))
-                }
-                None => return Err(perr(after, SYNTAX, word_value_msg(up))),
-            }
-        }
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        Some(_) => (false, 0),
         None => return Err(perr(after, SYNTAX, word_value_msg(up))),
     };
+    let Some((mag, n)) = scan_unsigned(&ab[skip..]) else {
+        return Err(perr(after, SYNTAX, word_value_msg(up)));
+    };
+    let v = if neg { -mag } else { mag };
+    let rest = &after[skip + n..];
     match up {
         b'G' => {
-            let g = integer_code(&value);
-            let Some(g) = g.filter(|&g| is_known_g(g)) else {
-                return Err(perr(
-                    i,
-                    UNKNOWN_G,
-                    format!("unknown G function G{}", show_value(&value)),
-                ));
+            let Some(g) = integer_code(v).filter(|&g| is_known_g(g)) else {
+                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if G_WITH_VALUE.contains(&g) {
-                if let Some((r, v)) = g_value(ctx, rest)? {
-                    items.push(Item::GValue { g, value: v, col });
+                if let Some((r, value)) = g_value(ctx, rest)? {
+                    items.push(Item::GValue { g, value, col });
                     return Ok(r);
                 }
             }
         }
-        b'M' if !integer_code(&value).is_some_and(is_known_m) => {
-            return Err(perr(
-                i,
-                UNKNOWN_M,
-                format!("unknown M function M{}", show_value(&value)),
-            ));
+        b'M' if !integer_code(v).is_some_and(is_known_m) => {
+            return Err(perr(i, UNKNOWN_M, format!("unknown M function M{v}")));
         }
         _ => {}
     }
     items.push(Item::Word(Word {
         letter: up,
-        value,
+        value: Value::Num(v),
+        col,
+    }));
+    Ok(rest)
+}
+
+/// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
+fn word_expr<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    bracket: &'a str,
+    negate: bool,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    match up {
+        b'G' => return Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
+        b'M' => return Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
+        _ => {}
+    }
+    let (rest, e) = ctx.bracketed(bracket)?;
+    let e = if negate {
+        super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
+    } else {
+        e
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
         col,
     }));
     Ok(rest)
@@ -370,19 +381,9 @@ fn word_value_msg(letter: u8) -> String {
     format!("number or [expression] expected after {}", letter as char)
 }
 
-fn show_value(v: &Value) -> String {
-    match v {
-        Value::Num(n) => n.to_string(),
-        Value::Expr(e) => format!("[{e}]"),
-    }
-}
-
-/// A G or M number: a non-negative integer literal.
-fn integer_code(v: &Value) -> Option<u32> {
-    match *v {
-        Value::Num(n) if n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX) => Some(n as u32),
-        _ => None,
-    }
+/// A G or M number: a non-negative whole number.
+fn integer_code(n: f64) -> Option<u32> {
+    (n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX)).then_some(n as u32)
 }
 
 /// The value of `G133=<expr>` / `G134=<expr>`, also written `G134 50` (seed 003).
