@@ -12,7 +12,8 @@ pub struct Block {
     pub skip_level: Option<u8>,
     /// The block number `N<n>` if present.
     pub n: Option<u32>,
-    /// A jump target defined on this line: `N40:` or `[LABEL_1]`.
+    /// A jump target defined on this line: `N40:` or `[LABEL_1]`. The parser sets
+    /// `Label::Number(k)` only together with `n == Some(k)`; printing writes `Nk:` for it.
     pub label: Option<Label>,
     pub body: Body,
 }
@@ -46,11 +47,20 @@ pub enum Body {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Item {
     Word(Word),
-    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`.
-    Assign { target: VarRef, value: Expr, col: u32 },
+    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`. The target is boxed to keep `Item` at 48 bytes:
+    /// plain word blocks are the hot path and their item lists are allocated per block.
+    Assign {
+        target: Box<VarRef>,
+        value: Expr,
+        col: u32,
+    },
     /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent).
     /// Seed 003 writes `G134 50`; both forms parse to this item. `col` is the G's column.
-    GValue { g: u32, value: Value, col: u32 },
+    GValue {
+        g: u32,
+        value: Value,
+        col: u32,
+    },
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.
@@ -76,7 +86,11 @@ pub enum VarRef {
     /// `P<n>` or indirect `P[expr]`, with optional array indices `P1[2]`, `P1[i][j]`.
     P { number: Index, indices: Vec<Expr> },
     /// `V.P.name`, `V.L.name`, `V.S.name`, `V.E.name`, optional array indices. Name upper-case.
-    V { scope: VScope, name: String, indices: Vec<Expr> },
+    V {
+        scope: VScope,
+        name: String,
+        indices: Vec<Expr>,
+    },
     /// `@P<n>`: a cycle parameter, visible inside a cycle called by `L CYCLE [... @Pn=..]`.
     CycleParam(u32),
 }
@@ -178,8 +192,14 @@ pub enum Control {
     Default,
     Break,
     EndSwitch,
-    /// `$FOR P1 = start, end, step` (step optional, default 1).
-    For { var: VarRef, start: Expr, end: Expr, step: Option<Expr> },
+    /// `$FOR P1 = start, end, step` (step optional, default 1). Boxed parts keep `Block`
+    /// small (104 bytes instead of 192); `&Box<Expr>` derefs to `&Expr` where passed.
+    For {
+        var: Box<VarRef>,
+        start: Box<Expr>,
+        end: Box<Expr>,
+        step: Option<Box<Expr>>,
+    },
     EndFor,
     While(Expr),
     EndWhile,
@@ -203,9 +223,13 @@ pub enum GotoTarget {
 pub enum Command {
     Flush(FlushKind),
     /// `#CACHE LOAD [FILE=name]`.
-    CacheLoad { file: String },
+    CacheLoad {
+        file: String,
+    },
     /// `#CACHE CLEAR [FILE=name]`.
-    CacheClear { file: String },
+    CacheClear {
+        file: String,
+    },
     /// `#CACHE CLEAR ALL`.
     CacheClearAll,
     CommentBegin,
@@ -213,9 +237,14 @@ pub enum Command {
     /// `#SPLINE ON`, `#SPLINE OFF`, `#SPLINE TYPE AKIMA|BSPLINE`.
     Spline(SplineCommand),
     /// `#HSC ON [...]` / `#HSC OFF`; the bracket text is kept verbatim.
-    Hsc { on: bool, options: String },
+    Hsc {
+        on: bool,
+        options: String,
+    },
     /// `#CONTOUR MODE [...]`; the bracket text kept verbatim.
-    ContourMode { options: String },
+    ContourMode {
+        options: String,
+    },
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,
@@ -247,7 +276,10 @@ pub enum Call {
     /// `LL name`: local subroutine defined by `%L name` in the same file.
     Local { name: String },
     /// `L CYCLE [NAME=file.cyc @P1=0 @P2=0]`.
-    Cycle { name: String, params: Vec<(u32, Expr)> },
+    Cycle {
+        name: String,
+        params: Vec<(u32, Expr)>,
+    },
 }
 
 /// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`.

@@ -9,22 +9,22 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand,
-    VScope, Value, VarDecl, VarRef, Word,
+    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, VScope,
+    Value, VarDecl, VarRef, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, CACHE_DOUBLE, CACHE_SYNTAX, G_WITH_VALUE,
     MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
 };
 use super::error::SyntaxError;
-use super::expr::{fail, keyword, perr, name_upper, uint, ws, Ctx, PErr, PResult};
+use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
 use super::number::scan_unsigned;
 
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
 /// line, or more than 4000 characters, is error 20200.
 pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
-    let line = checked_line(line)?;
-    let ctx = Ctx::new(line);
+    let (line, ascii) = checked_line(line)?;
+    let ctx = Ctx::with_ascii(line, ascii);
     block(&ctx, line).map_err(|e| ctx.to_error(e))
 }
 
@@ -33,8 +33,7 @@ pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
 /// `#COMMENT BEGIN` block without parsing the line: comment text need not be valid NC.
 pub fn is_comment_end(line: &str) -> bool {
     let line = strip_line_end(line);
-    let ctx = Ctx::new(line);
-    let Ok((i, _)) = prefix(&ctx, ws(line)) else {
+    let Ok((i, _)) = prefix(ws(line)) else {
         return false;
     };
     let Some(i) = gap(i).strip_prefix('#') else {
@@ -61,8 +60,8 @@ pub fn is_blank_line(line: &str) -> bool {
 /// Parse one declaration between `#VAR` and `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,
 /// `V.S.GRID[3][4] = 0`. `V.E.` variables are not declared in programs (20200).
 pub fn parse_var_declaration(line: &str) -> Result<VarDecl, SyntaxError> {
-    let line = checked_line(line)?;
-    let ctx = Ctx::new(line);
+    let (line, ascii) = checked_line(line)?;
+    let ctx = Ctx::with_ascii(line, ascii);
     var_decl(&ctx, line).map_err(|e| ctx.to_error(e))
 }
 
@@ -74,8 +73,13 @@ fn strip_line_end(line: &str) -> &str {
         .unwrap_or(line)
 }
 
-fn checked_line(line: &str) -> Result<&str, SyntaxError> {
+/// The line without its line end, and whether it is pure ASCII.
+fn checked_line(line: &str) -> Result<(&str, bool), SyntaxError> {
     let line = strip_line_end(line);
+    // One branch-free pass (it vectorises) answers both questions for the common line.
+    let (or, line_end) = line.bytes().fold((0u8, false), |(o, e), b| {
+        (o | b, e | (b == b'\r') | (b == b'\n'))
+    });
     if line.len() > MAX_BLOCK_CHARS && line.chars().count() > MAX_BLOCK_CHARS {
         return Err(SyntaxError::new(
             SYNTAX,
@@ -83,11 +87,12 @@ fn checked_line(line: &str) -> Result<&str, SyntaxError> {
             format!("block longer than {MAX_BLOCK_CHARS} characters"),
         ));
     }
-    if let Some(pos) = line.find(['\r', '\n']) {
+    if line_end {
+        let pos = line.find(['\r', '\n']).unwrap_or(0);
         let col = line[..pos].chars().count() as u32 + 1;
         return Err(SyntaxError::new(SYNTAX, col, "line end inside the block"));
     }
-    Ok(line)
+    Ok((line, or < 0x80))
 }
 
 /// Skip blanks and comments: `( … )` nesting, an unclosed `(` to block end, `;` to line end.
@@ -120,7 +125,7 @@ pub(crate) fn gap(mut i: &str) -> &str {
 }
 
 /// Block skip, block number and label: what may precede every body.
-fn prefix<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
+fn prefix<'a>(mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
     let mut skip = None;
     if let Some(rest) = i.strip_prefix('/') {
         if rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
@@ -159,7 +164,6 @@ fn prefix<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> PResult<'a, (Option<u8>, Option<
         label = Some(Label::Name(name));
         i = r;
     }
-    let _ = ctx;
     Ok((i, (skip, n, label)))
 }
 
@@ -179,12 +183,12 @@ fn bracket_name(i: &str) -> PResult<'_, String> {
 }
 
 fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> {
-    let (i, (skip_level, n, label)) = prefix(ctx, ws(line))?;
+    let (i, (skip_level, n, label)) = prefix(ws(line))?;
     let i = gap(i);
     let body = match i.as_bytes().first() {
         None => Body::Items(Vec::new()),
         Some(b'#') => {
-            let (r, c) = command(ctx, i)?;
+            let (r, c) = command(i)?;
             end_of_block(r, "nothing may follow a # command in its block")?;
             Body::Command(c)
         }
@@ -233,8 +237,22 @@ fn starts_call(i: &str) -> bool {
 // Ordinary blocks: words and assignments
 // ---------------------------------------------------------------------------------------
 
+/// An upper bound on the items in the rest of a block: letters and `@` before the first
+/// comment (capped; a longer block grows its list). Sizing the list once keeps the hot path
+/// at one exact-size allocation per block.
+fn item_capacity(i: &str) -> usize {
+    let mut n = 0usize;
+    for &b in i.as_bytes() {
+        if b == b'(' || b == b';' {
+            break;
+        }
+        n += usize::from((b | 0x20).wrapping_sub(b'a') < 26) + usize::from(b == b'@');
+    }
+    n.min(32)
+}
+
 fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
-    let mut items = Vec::with_capacity(8);
+    let mut items = Vec::with_capacity(item_capacity(i));
     loop {
         i = gap(i);
         let bytes = i.as_bytes();
@@ -253,7 +271,11 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
                 return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
             };
             let (r, value) = ctx.expr(ws(r))?;
-            items.push(Item::Assign { target, value, col });
+            items.push(Item::Assign {
+                target: Box::new(target),
+                value,
+                col,
+            });
             i = r;
         } else {
             let msg = match b {
@@ -270,6 +292,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
 }
 
 /// One address word at `i` (letter `up`), pushed onto `items`; returns the rest.
+///
+/// The literal case is the hot path and builds the item from scalars: moving a whole
+/// `Value` through the stack cost store-forwarding stalls that showed in the profile.
 #[inline]
 fn word<'a>(
     ctx: &Ctx<'a>,
@@ -280,59 +305,73 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
-    let (rest, value) = match ab.first() {
-        Some(b'[') => {
-            let (r, e) = ctx.bracketed(after)?;
-            (r, Value::Expr(e))
+    let (neg, skip) = match ab.first() {
+        Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
+        Some(b'-') if ab.get(1) == Some(&b'[') => {
+            return word_expr(ctx, i, up, col, &after[1..], true, items)
         }
-        Some(&s @ (b'-' | b'+')) if ab.get(1) == Some(&b'[') => {
-            let (r, e) = ctx.bracketed(&after[1..])?;
-            let e = if s == b'-' {
-                super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
-            } else {
-                e
-            };
-            (r, Value::Expr(e))
+        Some(b'+') if ab.get(1) == Some(&b'[') => {
+            return word_expr(ctx, i, up, col, &after[1..], false, items)
         }
-        Some(&s) => {
-            let (neg, digits) = match s {
-                b'-' => (true, &ab[1..]),
-                b'+' => (false, &ab[1..]),
-                _ => (false, ab),
-            };
-            match scan_unsigned(digits) {
-                Some((v, n)) => {
-                    let used = n + (ab.len() - digits.len());
-                    (&after[used..], Value::Num(if neg { -v } else { v }))
-                }
-                None => return Err(perr(after, SYNTAX, word_value_msg(up))),
-            }
-        }
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        Some(_) => (false, 0),
         None => return Err(perr(after, SYNTAX, word_value_msg(up))),
     };
+    let Some((mag, n)) = scan_unsigned(&ab[skip..]) else {
+        return Err(perr(after, SYNTAX, word_value_msg(up)));
+    };
+    let v = if neg { -mag } else { mag };
+    let rest = &after[skip + n..];
     match up {
         b'G' => {
-            let g = integer_code(&value);
-            let Some(g) = g.filter(|&g| is_known_g(g)) else {
-                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{}", show_value(&value))));
+            let Some(g) = integer_code(v).filter(|&g| is_known_g(g)) else {
+                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if G_WITH_VALUE.contains(&g) {
-                if let Some((r, v)) = g_value(ctx, rest)? {
-                    items.push(Item::GValue { g, value: v, col });
+                if let Some((r, value)) = g_value(ctx, rest)? {
+                    items.push(Item::GValue { g, value, col });
                     return Ok(r);
                 }
             }
         }
-        b'M' => {
-            if !integer_code(&value).is_some_and(is_known_m) {
-                return Err(perr(i, UNKNOWN_M, format!("unknown M function M{}", show_value(&value))));
-            }
+        b'M' if !integer_code(v).is_some_and(is_known_m) => {
+            return Err(perr(i, UNKNOWN_M, format!("unknown M function M{v}")));
         }
         _ => {}
     }
     items.push(Item::Word(Word {
         letter: up,
-        value,
+        value: Value::Num(v),
+        col,
+    }));
+    Ok(rest)
+}
+
+/// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
+fn word_expr<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    bracket: &'a str,
+    negate: bool,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    match up {
+        b'G' => return Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
+        b'M' => return Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
+        _ => {}
+    }
+    let (rest, e) = ctx.bracketed(bracket)?;
+    let e = if negate {
+        super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
+    } else {
+        e
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
         col,
     }));
     Ok(rest)
@@ -342,19 +381,9 @@ fn word_value_msg(letter: u8) -> String {
     format!("number or [expression] expected after {}", letter as char)
 }
 
-fn show_value(v: &Value) -> String {
-    match v {
-        Value::Num(n) => n.to_string(),
-        Value::Expr(e) => format!("[{e}]"),
-    }
-}
-
-/// A G or M number: a non-negative integer literal.
-fn integer_code(v: &Value) -> Option<u32> {
-    match *v {
-        Value::Num(n) if n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX) => Some(n as u32),
-        _ => None,
-    }
+/// A G or M number: a non-negative whole number.
+fn integer_code(n: f64) -> Option<u32> {
+    (n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX)).then_some(n as u32)
 }
 
 /// The value of `G133=<expr>` / `G134=<expr>`, also written `G134 50` (seed 003).
@@ -446,7 +475,10 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
             return fail(
                 i,
                 UNKNOWN_COMMAND,
-                format!("unknown control statement ${}", &after[..after.len() - rest.len()]),
+                format!(
+                    "unknown control statement ${}",
+                    &after[..after.len() - rest.len()]
+                ),
             )
         }
     };
@@ -474,7 +506,15 @@ fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
         }
         None => (r, None),
     };
-    Ok((r, Control::For { var, start, end, step }))
+    Ok((
+        r,
+        Control::For {
+            var: Box::new(var),
+            start: Box::new(start),
+            end: Box::new(end),
+            step: step.map(Box::new),
+        },
+    ))
 }
 
 /// `N40` or `[LABEL]`.
@@ -493,7 +533,7 @@ fn goto_target(i: &str) -> PResult<'_, GotoTarget> {
 // # commands
 // ---------------------------------------------------------------------------------------
 
-fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
+fn command<'a>(i: &'a str) -> PResult<'a, Command> {
     let after = &i[1..];
     let mut buf = [0u8; 16];
     let Some((rest, len)) = keyword_after(after, &mut buf) else {
@@ -560,14 +600,11 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
         }
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
-        _ => {
-            let _ = ctx;
-            fail(
-                i,
-                UNKNOWN_COMMAND,
-                format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
-            )
-        }
+        _ => fail(
+            i,
+            UNKNOWN_COMMAND,
+            format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
+        ),
     }
 }
 
@@ -685,20 +722,34 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
         if name.is_empty() {
             return fail(r, SYNTAX, "subroutine name expected after LL");
         }
-        return Ok((rest, Call::Local { name: name.to_ascii_uppercase() }));
+        return Ok((
+            rest,
+            Call::Local {
+                name: name.to_ascii_uppercase(),
+            },
+        ));
     }
     if let Some(c) = keyword(r, "CYCLE") {
         let c = ws(c);
         if c.starts_with('[') {
             return cycle(ctx, c);
         }
-        return fail(c, SYNTAX, "[NAME=<file> @P<n>=<value> …] expected after L CYCLE");
+        return fail(
+            c,
+            SYNTAX,
+            "[NAME=<file> @P<n>=<value> …] expected after L CYCLE",
+        );
     }
     let (rest, file) = file_name(r, false);
     if file.is_empty() {
         return fail(r, SYNTAX, "subroutine file name expected after L");
     }
-    Ok((rest, Call::Global { file: file.to_string() }))
+    Ok((
+        rest,
+        Call::Global {
+            file: file.to_string(),
+        },
+    ))
 }
 
 /// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
@@ -776,14 +827,27 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
     let i = gap(line);
     let b = i.as_bytes();
     if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
-        return Err(perr(i, SYNTAX, "variable declaration V.P., V.L. or V.S. expected"));
+        return Err(perr(
+            i,
+            SYNTAX,
+            "variable declaration V.P., V.L. or V.S. expected",
+        ));
     }
     let (r, v) = ctx.var_ref(i)?;
-    let VarRef::V { scope, name, indices } = v else {
+    let VarRef::V {
+        scope,
+        name,
+        indices,
+    } = v
+    else {
         return Err(perr(i, SYNTAX, "variable declaration expected"));
     };
     if scope == VScope::External {
-        return Err(perr(i, SYNTAX, "V.E. variables are not declared in programs"));
+        return Err(perr(
+            i,
+            SYNTAX,
+            "V.E. variables are not declared in programs",
+        ));
     }
     let mut dims = Vec::with_capacity(indices.len());
     for e in indices {
@@ -791,7 +855,13 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 && n <= 1.0e6 => {
                 dims.push(n as u32)
             }
-            _ => return Err(perr(i, SYNTAX, "array size must be a whole number from 1 to 1000000")),
+            _ => {
+                return Err(perr(
+                    i,
+                    SYNTAX,
+                    "array size must be a whole number from 1 to 1000000",
+                ))
+            }
         }
     }
     let j = ws(r);
