@@ -134,10 +134,13 @@ fn read_text(path: &Path) -> Result<String, String> {
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// PLACEHOLDER (lead wires this at merge): parameter lists are checked by
-/// `crate::params::check_list_file`, which lives on another branch. Until then `.lis` and
-/// `.toml` files are accepted unchecked.
+/// Parameter lists (a start-up list with its channel lists and runtime.toml, or a channel
+/// list alone) and runtime.toml files, through the params room's own checks.
 pub fn check_params_file(path: &Path) -> Vec<Diagnostic> {
-    let _ = path;
-    Vec::new()
+    if extension(path) == "toml" {
+        return crate::params::runtime::read_runtime(path)
+            .err()
+            .unwrap_or_default();
+    }
+    crate::params::check_list_file(path)
 }

@@ -478,6 +478,8 @@ impl Decoder {
         if top.var_block {
             match block.body {
                 Body::Command(Command::EndVar) => top.var_block = false,
+                // Blank and comment-only lines declare nothing.
+                Body::Items(ref items) if items.is_empty() => {}
                 _ => {
                     let d = parse_var_declaration(text)
                         .map_err(|e| DecodeError::new(e.code, e.message.clone()).at(e.col))?;

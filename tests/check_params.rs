@@ -1,0 +1,44 @@
+//! `ncchannel check` on parameter lists: the shipped ones pass, a broken one names file, line,
+//! column and parameter, and exits 1.
+
+use std::process::Command;
+
+fn check(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("check")
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+    )
+}
+
+#[test]
+fn shipped_lists_and_programs_pass() {
+    let (code, out) = check(&[
+        "params/startup.lis",
+        "params/channel1.lis",
+        "params/runtime.toml",
+        "nc",
+    ]);
+    assert_eq!(code, 0, "{out}");
+}
+
+#[test]
+fn a_broken_list_gives_file_line_column_and_exit_1() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("startup.lis");
+    std::fs::write(&p, "kanal_anzahl 1\nsda_mds[0] missing.lis\n").unwrap();
+    let (code, out) = check(&[p.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(out.contains("startup.lis:2:12: error"), "{out}");
+    assert!(out.contains("sda_mds[0]"), "{out}");
+    let t = d.path().join("runtime.toml");
+    std::fs::write(&t, "cycle_period_us = 1000\nbogus = 1\n").unwrap();
+    let (code, out) = check(&[t.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(out.contains("bogus"), "{out}");
+}
