@@ -67,7 +67,9 @@ impl RunArgs {
             channel: 1,
             stream: Some(PathBuf::from("nc/demo.nc")),
             packet: 992,
-            every: 1,
+            // A client offering a packet every 250 ms, as a PLC task might: the demo meets
+            // a full buffer a few times instead of on every tick.
+            every: 250,
             raw: false,
             realtime: false,
             max_ticks: None,
