@@ -365,3 +365,18 @@ fn run_short_segments_at_f6000_without_interrupts_when_the_stream_keeps_up() {
     let t = r["time_s"].as_f64().unwrap();
     assert!(t < 2.5, "{t}");
 }
+
+#[test]
+fn check_list_file_recognises_a_zero_offset_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("zero.lis");
+    std::fs::write(
+        &p,
+        "np_grp[0].achse[0].versch 1.5\nnp_grp[0].achse[1].versch 100\n",
+    )
+    .unwrap();
+    let d = ncchannel::params::check_list_file(&p);
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!((d[0].line, d[0].col), (1, 27));
+    assert!(d[0].message.contains("0.1 µm"), "{}", d[0].message);
+}

@@ -149,8 +149,8 @@ pub fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
     if length_mm <= 0.0 {
         return t;
     }
-    for i in 0..MAX_AXES {
-        t[i] = (m.end[i] - m.start[i]) / length_mm;
+    for (i, ti) in t.iter_mut().enumerate() {
+        *ti = (m.end[i] - m.start[i]) / length_mm;
     }
     if let MoveKind::Arc {
         plane,

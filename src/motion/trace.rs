@@ -46,7 +46,7 @@ impl Trace {
 
     /// Offer one tick's sample; kept if it falls on the stride.
     pub fn record(&mut self, s: Sample) {
-        let keep = self.ticks % self.stride == 0;
+        let keep = self.ticks.is_multiple_of(self.stride);
         self.ticks += 1;
         if !keep {
             return;
