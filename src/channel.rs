@@ -10,7 +10,7 @@ use std::sync::Arc;
 use thiserror::Error;
 
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
-use crate::motion::{AxisLimits, Motion, MotionNote};
+use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use crate::queue::{BlockQueue, Position, AXIS_LETTERS};
 use crate::report::event::{EventBuffer, EventKind};
 use crate::runtime::Tick;
@@ -117,6 +117,8 @@ pub struct ChannelSettings {
     /// Block queue capacity: lookahead window plus decoder buffer, blocks.
     pub queue_capacity: usize,
     pub axes: Vec<AxisLimits>,
+    /// Lookahead window (runtime.toml `[planner]`).
+    pub planner: PlannerSettings,
     pub search_dirs: Vec<SearchDir>,
     /// `streaming_prog_file`; `None` = streaming off.
     pub streaming_prog: Option<String>,
@@ -178,7 +180,7 @@ impl Channel {
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
             decoder: Decoder::new(s.decoder),
-            motion: Motion::new(s.axes),
+            motion: Motion::with_planner(s.axes, s.planner),
             program: None,
             search: None,
             last_error: None,
@@ -222,6 +224,10 @@ impl Channel {
     }
     pub fn motion(&self) -> &Motion {
         &self.motion
+    }
+    /// For `--plot`: switch on the motion trace.
+    pub fn motion_mut(&mut self) -> &mut Motion {
+        &mut self.motion
     }
     pub fn errors(&self) -> &[(u32, String)] {
         &self.errors
@@ -638,12 +644,13 @@ impl Channel {
         if self.state == State::Active
             && self.ran_any
             && !self.interrupted
-            && self.motion.idle()
+            && self.motion.waiting_for_data()
             && self.queue.is_empty()
             && self.decoder.starved()
         {
             self.interrupted = true;
             self.stats.interrupts += 1;
+            self.motion.note_interrupt();
             self.events.push(tick, self.number, EventKind::Interrupt);
         }
     }

@@ -5,7 +5,7 @@ use thiserror::Error;
 
 use crate::channel::{Channel, ChannelSettings};
 use crate::decoder::DecoderSettings;
-use crate::motion::AxisLimits;
+use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
 use crate::queue::{AXIS_LETTERS, MAX_AXES};
 use crate::source::cache::CacheLimits;
@@ -58,6 +58,7 @@ pub fn channel_settings(
         blocks_per_tick: rt.decoder.blocks_per_tick.max(1) as usize,
         max_depth: rt.decoder.max_subroutine_depth as usize,
         axes: enabled,
+        zero_offsets: ch.zero_offsets,
         ..DecoderSettings::default()
     };
     let search_dirs = ch
@@ -83,6 +84,9 @@ pub fn channel_settings(
         decoder,
         queue_capacity: (rt.planner.lookahead_blocks + rt.decoder.buffer_blocks).max(1) as usize,
         axes,
+        planner: PlannerSettings {
+            lookahead_blocks: rt.planner.lookahead_blocks.max(1) as usize,
+        },
         search_dirs,
         streaming_prog: ch.streaming_prog_file.clone(),
         cache: CacheLimits {

@@ -18,6 +18,8 @@ use super::exit;
 
 /// Largest file the built-in feeder reads: a soak file, not an accident.
 const MAX_STREAM_FILE_BYTES: u64 = 1 << 30;
+/// Points `--plot` keeps at most (the trace decimates beyond).
+const PLOT_SAMPLES: usize = 20_000;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
@@ -56,6 +58,9 @@ pub struct RunArgs {
     /// Write the report JSON here.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Draw the tool path and path velocity (interrupts marked) into this SVG file.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 impl RunArgs {
@@ -76,6 +81,7 @@ impl RunArgs {
             search: None,
             events: None,
             report: None,
+            plot: None,
         }
     }
 }
@@ -157,6 +163,12 @@ pub fn execute(args: RunArgs) -> ExitCode {
         },
     };
     let period = Duration::from_micros(config.runtime.cycle_period_us);
+    let mut channels = channels;
+    if args.plot.is_some() {
+        if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
+            c.motion_mut().enable_trace(PLOT_SAMPLES);
+        }
+    }
     let mut machine = Machine::new(channels, log, StopWhen::ProgramsFinished);
     if let Some(f) = feeder {
         machine.attach_feeder(args.channel, f);
@@ -223,6 +235,12 @@ pub fn execute(args: RunArgs) -> ExitCode {
             .collect(),
         cycle: CycleReport::new(period, &stats),
     };
+    if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
+        let title = format!("ncchannel run {program}");
+        if let Err(e) = crate::report::plot::write_svg(p, trace, &title) {
+            eprintln!("ncchannel run: --plot {}: {e}", p.display());
+        }
+    }
     if let Err(e) = machine.finish_log() {
         eprintln!("ncchannel run: event log: {e}");
     }

@@ -1,11 +1,27 @@
 //! Motion: executes the queued blocks in channel time and reports where the axes are.
 //!
-//! This is the channel's first time model (Stage 2): every motion block takes its length over
-//! its feed (G0: the slowest axis at its rapid rate), with no acceleration. The lookahead
-//! planner and interpolator of Stage 5 replace its insides; its verbs stay.
+//! Each tick it takes decoded blocks from the block queue into the planner's lookahead window
+//! (where they are held until released: [`planner`]), re-plans the velocity profile when
+//! something was released or the override changed, and lets the [`interpolator`] move along
+//! the released blocks for one tick. Block events come out as [`MotionNote`]s in program order:
+//! a motion block's when its interpolation starts, a non-motion block's when interpolation
+//! reaches it (M functions and assignments do not stop the motion; a dwell, `#FLUSH`,
+//! `#FLUSH WAIT` and the program end do).
+
+pub mod check;
+pub mod interpolator;
+pub mod planner;
+pub mod trace;
+
+use std::sync::Arc;
 
 use crate::lang::block::FlushKind;
-use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, Position, MAX_AXES};
+use crate::queue::{BlockInfo, BlockQueue, MoveKind, Position, MAX_AXES};
+
+use interpolator::{advance, point_at, Profile};
+pub use planner::PlannerSettings;
+use planner::{EntryKind, Planner};
+use trace::{Sample, Trace};
 
 /// Limits of one axis (runtime.toml `[[axes]]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,230 +48,322 @@ pub enum MotionNote {
     /// The main program's end was reached: everything before it has run.
     End {
         m: u32,
-        prog: std::sync::Arc<str>,
+        prog: Arc<str>,
     },
 }
 
-#[derive(Debug, Clone)]
-struct Active {
-    kind: ActiveKind,
-    /// Seconds this block takes at 100 % override.
-    duration_s: f64,
-    /// Seconds of it done.
-    done_s: f64,
-}
-
-#[derive(Debug, Clone)]
-enum ActiveKind {
-    Move(Move),
-    Dwell,
+/// What happens to the front entry after its share of a tick.
+enum Next {
+    /// Done: remove it, go on with the next.
+    Pop,
+    /// Not done: the tick is used up (or the motion waits).
+    Stay,
+    /// The program ended.
+    End,
 }
 
 /// The executor of one channel.
 #[derive(Debug)]
 pub struct Motion {
     axes: Vec<AxisLimits>,
-    active: Option<Active>,
+    planner: Planner,
     pos: Position,
+    /// Path position in the front block, mm.
+    s_mm: f64,
+    /// Path velocity, mm/s.
+    v_mm_per_s: f64,
+    /// The front entry has begun (its `Started` note is out).
+    front_started: bool,
+    /// Seconds of the front dwell done.
+    dwell_done_s: f64,
     /// Feed override, percent (0–200).
     override_pct: f64,
     hold: bool,
     /// The program end was executed; nothing more runs until the next start.
     ended: bool,
-    /// Path velocity of the last tick, mm/s (for plots and checks).
-    velocity_mm_per_s: f64,
+    /// Tick length seen last, s (junction limits depend on it).
+    dt_s: f64,
+    /// Channel time this motion has stepped through, s.
+    time_s: f64,
+    trace: Option<Trace>,
 }
 
 impl Motion {
+    /// Motion with the default planner settings.
     pub fn new(axes: Vec<AxisLimits>) -> Self {
+        Self::with_planner(axes, PlannerSettings::default())
+    }
+
+    pub fn with_planner(axes: Vec<AxisLimits>, settings: PlannerSettings) -> Self {
         Motion {
+            planner: Planner::new(&axes, settings),
             axes,
-            active: None,
             pos: [0.0; MAX_AXES],
+            s_mm: 0.0,
+            v_mm_per_s: 0.0,
+            front_started: false,
+            dwell_done_s: 0.0,
             override_pct: 100.0,
             hold: false,
             ended: false,
-            velocity_mm_per_s: 0.0,
+            dt_s: 0.001,
+            time_s: 0.0,
+            trace: None,
         }
+    }
+
+    pub fn axes(&self) -> &[AxisLimits] {
+        &self.axes
     }
 
     pub fn position(&self) -> Position {
         self.pos
     }
 
+    /// Path velocity at the end of the last tick, mm/s.
     pub fn velocity_mm_per_s(&self) -> f64 {
-        self.velocity_mm_per_s
+        self.v_mm_per_s
     }
 
-    /// Nothing in execution (the queue may still hold blocks).
+    /// Nothing in execution and nothing held (the queue may still hold blocks).
     pub fn idle(&self) -> bool {
-        self.active.is_none()
+        self.planner.is_empty()
+    }
+
+    /// Motion stands still only because no more blocks came: everything released has run, and
+    /// what the window holds (if anything) waits for the window to fill, a flush or the program
+    /// end. Not during a feed hold, not after the program end.
+    pub fn waiting_for_data(&self) -> bool {
+        !self.ended && !self.hold && self.planner.released() == 0 && self.v_mm_per_s == 0.0
+    }
+
+    /// Blocks held in the window (not yet released).
+    pub fn held_blocks(&self) -> usize {
+        self.planner.held()
+    }
+
+    /// Blocks released and not yet done (the one executing included).
+    pub fn released_blocks(&self) -> usize {
+        self.planner.released()
+    }
+
+    pub fn lookahead_blocks(&self) -> usize {
+        self.planner.lookahead()
     }
 
     pub fn set_override(&mut self, pct: f64) {
-        self.override_pct = pct.clamp(0.0, 200.0);
+        let pct = if pct.is_finite() {
+            pct.clamp(0.0, 200.0)
+        } else {
+            100.0
+        };
+        if pct != self.override_pct {
+            self.override_pct = pct;
+            self.planner.mark_dirty();
+        }
     }
 
     pub fn override_pct(&self) -> f64 {
         self.override_pct
     }
 
+    /// Feed hold: brake on the path to a stop; `false` resumes.
     pub fn set_hold(&mut self, hold: bool) {
         self.hold = hold;
+    }
+
+    pub fn hold(&self) -> bool {
+        self.hold
     }
 
     /// A program starts: execution may run again.
     pub fn start(&mut self) {
         self.ended = false;
         self.hold = false;
+        self.clear();
     }
 
     /// Reset: stop at once where we are.
     pub fn reset(&mut self) {
-        self.active = None;
         self.hold = false;
         self.ended = false;
-        self.velocity_mm_per_s = 0.0;
+        self.clear();
     }
 
-    /// Seconds a move takes at 100 % override.
-    fn duration_s(&self, m: &Move) -> f64 {
-        match m.kind {
-            MoveKind::Rapid => {
-                // Each axis at most at its rapid rate: the slowest one decides.
-                let mut t: f64 = 0.0;
-                for a in &self.axes {
-                    let d = (m.end[a.index] - m.start[a.index]).abs();
-                    if a.rapid_mm_per_min > 0.0 {
-                        t = t.max(d / (a.rapid_mm_per_min / 60.0));
-                    }
-                }
-                t
-            }
-            _ => {
-                let feed = self.limited_feed(m);
-                if feed <= 0.0 {
-                    0.0
-                } else {
-                    m.length_mm() / (feed / 60.0)
-                }
-            }
-        }
-    }
-
-    /// The programmed feed, lowered so no axis exceeds its maximum velocity on a line.
-    fn limited_feed(&self, m: &Move) -> f64 {
-        let len = m.length_mm();
-        let mut feed = m.feed_mm_per_min;
-        if len <= 0.0 {
-            return feed;
-        }
-        if let MoveKind::Line = m.kind {
-            for a in &self.axes {
-                let share = (m.end[a.index] - m.start[a.index]).abs() / len;
-                if share > 0.0 {
-                    feed = feed.min(a.max_velocity_mm_per_min / share);
-                }
-            }
-        } else {
-            let vmax = self
-                .axes
-                .iter()
-                .map(|a| a.max_velocity_mm_per_min)
-                .fold(f64::INFINITY, f64::min);
-            feed = feed.min(vmax);
-        }
-        feed
-    }
-
-    /// Advance channel time by `dt_s`: finish what runs, take new blocks from the queue.
-    pub fn step(&mut self, dt_s: f64, queue: &mut BlockQueue, notes: &mut Vec<MotionNote>) {
-        let start_pos = self.pos;
-        if self.hold || self.ended {
-            self.velocity_mm_per_s = 0.0;
-            return;
-        }
-        let rate = self.override_pct / 100.0;
-        // Channel seconds of program progress available this tick.
-        let mut budget = dt_s * rate;
-        let mut path_mm = 0.0;
-        loop {
-            if self.active.is_none() {
-                if rate <= 0.0 {
-                    break;
-                }
-                let Some(b) = queue.pop_front() else {
-                    break;
-                };
-                if !b.silent {
-                    notes.push(MotionNote::Started(b.info.clone()));
-                }
-                match b.action {
-                    Action::None => continue,
-                    Action::Flush(k) => {
-                        notes.push(MotionNote::Flush(k));
-                        continue;
-                    }
-                    Action::End { m } => {
-                        notes.push(MotionNote::End {
-                            m,
-                            prog: b.info.prog,
-                        });
-                        self.ended = true;
-                        break;
-                    }
-                    Action::Dwell { seconds } => {
-                        self.active = Some(Active {
-                            kind: ActiveKind::Dwell,
-                            duration_s: seconds,
-                            done_s: 0.0,
-                        });
-                    }
-                    Action::Move(m) => {
-                        let d = self.duration_s(&m);
-                        self.active = Some(Active {
-                            kind: ActiveKind::Move(m),
-                            duration_s: d,
-                            done_s: 0.0,
-                        });
-                    }
-                }
-            }
-            let Some(a) = self.active.as_mut() else {
-                break;
-            };
-            let left = a.duration_s - a.done_s;
-            if budget <= 0.0 && left > 0.0 {
-                break;
-            }
-            let take = left.min(budget).max(0.0);
-            a.done_s += take;
-            budget -= take;
-            let finished = a.done_s >= a.duration_s - 1e-12;
-            if let ActiveKind::Move(m) = &a.kind {
-                let u = if a.duration_s > 0.0 {
-                    a.done_s / a.duration_s
-                } else {
-                    1.0
-                };
-                let p = if finished { m.end } else { m.point_at(u) };
-                if a.duration_s > 0.0 {
-                    path_mm += m.length_mm() * take / a.duration_s;
-                }
-                self.pos = p;
-            }
-            if finished {
-                self.active = None;
-            } else {
-                break;
-            }
-        }
-        let _ = start_pos;
-        self.velocity_mm_per_s = if dt_s > 0.0 { path_mm / dt_s } else { 0.0 };
+    fn clear(&mut self) {
+        self.planner.clear();
+        self.s_mm = 0.0;
+        self.v_mm_per_s = 0.0;
+        self.front_started = false;
+        self.dwell_done_s = 0.0;
     }
 
     /// Set the machine position (start-up, or after a reset moved nothing).
     pub fn set_position(&mut self, p: Position) {
         self.pos = p;
+    }
+
+    /// Record per-tick samples for a plot, at most `max_samples` (decimated).
+    pub fn enable_trace(&mut self, max_samples: usize) {
+        self.trace = Some(Trace::new(max_samples));
+    }
+
+    pub fn trace(&self) -> Option<&Trace> {
+        self.trace.as_ref()
+    }
+
+    /// The channel reported an interrupt here: mark it in the trace.
+    pub fn note_interrupt(&mut self) {
+        let s = self.sample();
+        if let Some(t) = self.trace.as_mut() {
+            t.mark_interrupt(s);
+        }
+    }
+
+    fn sample(&self) -> Sample {
+        Sample {
+            time_s: self.time_s,
+            pos: self.pos,
+            velocity_mm_per_s: self.v_mm_per_s,
+        }
+    }
+
+    /// Advance channel time by `dt_s`: take blocks into the window, plan, interpolate.
+    pub fn step(&mut self, dt_s: f64, queue: &mut BlockQueue, notes: &mut Vec<MotionNote>) {
+        let dt_s = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
+        if dt_s > 0.0 {
+            self.dt_s = dt_s;
+        }
+        self.time_s += dt_s;
+        if !self.ended {
+            self.planner.take_from(queue);
+            self.planner.plan_if_needed(self.override_pct, self.dt_s);
+            self.execute(dt_s, notes);
+        } else {
+            self.v_mm_per_s = 0.0;
+        }
+        if self.trace.is_some() {
+            let s = self.sample();
+            if let Some(t) = self.trace.as_mut() {
+                t.record(s);
+            }
+        }
+    }
+
+    /// Run released entries for `dt_s` seconds.
+    fn execute(&mut self, dt_s: f64, notes: &mut Vec<MotionNote>) {
+        let cruise_pct = if self.hold { 0.0 } else { self.override_pct };
+        let mut left = dt_s;
+        // Each pass pops an entry or ends the tick, so the window length bounds the loop.
+        let passes = self.planner.len() + 1;
+        for _ in 0..passes {
+            if self.planner.released() == 0 {
+                break;
+            }
+            let Some(front) = self.planner.front_mut() else {
+                break;
+            };
+            if !self.front_started {
+                if matches!(front.kind, EntryKind::Move(_)) && left <= 0.0 {
+                    break;
+                }
+                if let Some(info) = front.info.take() {
+                    notes.push(MotionNote::Started(info));
+                }
+                self.front_started = true;
+                self.s_mm = 0.0;
+                self.dwell_done_s = 0.0;
+                if let (EntryKind::Move(seg), Some(t)) = (&front.kind, self.trace.as_mut()) {
+                    if let MoveKind::Arc { plane, .. } = seg.mv.kind {
+                        t.set_plane(plane);
+                    }
+                }
+            }
+            let next = match &front.kind {
+                EntryKind::Move(seg) => {
+                    let profile = Profile {
+                        length_mm: seg.length_mm,
+                        accel_mm_per_s2: seg.accel_mm_per_s2,
+                        cruise_mm_per_s: seg.cruise_mm_per_s(cruise_pct),
+                        exit_mm_per_s: seg.exit_mm_per_s,
+                    };
+                    let r = advance(&mut self.s_mm, &mut self.v_mm_per_s, &profile, left);
+                    left -= r.used_s;
+                    if r.finished {
+                        // Snap: the block ends exactly at its programmed end point.
+                        self.pos = seg.mv.end;
+                        Next::Pop
+                    } else {
+                        self.pos = point_at(&seg.mv, seg.length_mm, self.s_mm);
+                        Next::Stay
+                    }
+                }
+                EntryKind::Dwell { seconds } => {
+                    self.v_mm_per_s = 0.0;
+                    if self.hold {
+                        Next::Stay
+                    } else {
+                        let take = (seconds - self.dwell_done_s).min(left).max(0.0);
+                        self.dwell_done_s += take;
+                        left -= take;
+                        if self.dwell_done_s >= seconds - 1e-12 {
+                            Next::Pop
+                        } else {
+                            Next::Stay
+                        }
+                    }
+                }
+                EntryKind::Plain => Next::Pop,
+                EntryKind::Flush(k) => {
+                    notes.push(MotionNote::Flush(*k));
+                    Next::Pop
+                }
+                EntryKind::End { m, prog } => {
+                    notes.push(MotionNote::End {
+                        m: *m,
+                        prog: prog.clone(),
+                    });
+                    Next::End
+                }
+            };
+            match next {
+                Next::Pop => self.finish_front(),
+                Next::Stay => break,
+                Next::End => {
+                    self.ended = true;
+                    self.clear();
+                    break;
+                }
+            }
+        }
+        // Standing unless a motion block is under way (the plan brought it to rest already;
+        // this only removes rounding residue).
+        let moving = self.front_started
+            && self
+                .planner
+                .front()
+                .is_some_and(|e| matches!(e.kind, EntryKind::Move(_)));
+        let continues = self.planner.released() > 0
+            && self
+                .planner
+                .entries()
+                .take(self.planner.released())
+                .find(|e| {
+                    !matches!(
+                        e.kind,
+                        EntryKind::Plain | EntryKind::Flush(FlushKind::Continue)
+                    )
+                })
+                .is_some_and(|e| matches!(e.kind, EntryKind::Move(_)));
+        if !moving && !continues {
+            self.v_mm_per_s = 0.0;
+        }
+    }
+
+    fn finish_front(&mut self) {
+        self.planner.pop_front();
+        self.front_started = false;
+        self.s_mm = 0.0;
+        self.dwell_done_s = 0.0;
     }
 }

@@ -11,6 +11,9 @@ use super::list::{parse_list, read_list, read_list_text, ParamList};
 use super::runtime::{read_runtime, RuntimeConfig};
 use super::search_path::{list_folder, SearchPath};
 use super::startup::{interpret_startup, is_startup_list, StartupList};
+use super::zero_offsets::{
+    interpret_zero_offsets, is_zero_offset_list, read_zero_offsets, ZeroOffsetTable,
+};
 use crate::diag::{Diagnostic, Severity};
 
 /// The file name runtime settings are read from, in the start-up list's folder.
@@ -45,6 +48,10 @@ pub struct ChannelConfig {
     /// `true` when the channel list's `path[j].*` replaced the start-up list's paths.
     pub paths_from_channel_list: bool,
     pub decoder: DecoderSettings,
+    /// The zero-offset list named by the start-up list (`None`: all offsets 0).
+    pub zero_offset_list: Option<PathBuf>,
+    /// G54 … G59 offsets by group and axis, mm.
+    pub zero_offsets: ZeroOffsetTable,
     /// The channel list's entries, unknown ones included.
     pub list: ParamList,
 }
@@ -84,7 +91,7 @@ pub fn load(startup_list: &Path) -> Result<Config, ParamError> {
 
 /// Check a start-up list (with its channel lists and runtime.toml), a channel list, or a
 /// runtime.toml, returning every error and warning. The list kind is decided by content:
-/// a start-up list names `kanal_anzahl` or `sda_mds[…]`.
+/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`.
 pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
     if path
         .extension()
@@ -99,6 +106,8 @@ pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
     let (list, mut diags) = parse_list(path, &text);
     if is_startup_list(&list) {
         build(list, &mut diags);
+    } else if is_zero_offset_list(&list) {
+        interpret_zero_offsets(&list, &mut diags);
     } else {
         // Cache values are not finished here: the start-up list may switch caching on.
         interpret_channel(list, &mut diags);
@@ -171,6 +180,35 @@ fn channels(startup: &StartupList, diags: &mut Vec<Diagnostic>) -> Option<Vec<Ch
         };
         out.push(combine(startup, i, chan, diags));
     }
+    // Zero-offset lists; channels may share one: read and report it once.
+    let mut tables: HashMap<PathBuf, Option<ZeroOffsetTable>> = HashMap::new();
+    for c in &mut out {
+        let Some(r) = startup.zero_offset_list(c.index as u32) else {
+            continue;
+        };
+        let table = tables.entry(r.path.clone()).or_insert_with(|| {
+            match read_zero_offsets(&r.path, diags) {
+                Ok(t) => Some(t),
+                Err(e) => {
+                    diags.push(startup.list.error_at(
+                        &r.entry,
+                        r.entry.value_pos,
+                        format!(
+                            "{}: zero-offset list {} cannot be read: {}",
+                            r.entry.name.text,
+                            r.path.display(),
+                            e.message
+                        ),
+                    ));
+                    None
+                }
+            }
+        });
+        if let Some(t) = table {
+            c.zero_offset_list = Some(r.path.clone());
+            c.zero_offsets = *t;
+        }
+    }
     (out.len() == count as usize).then_some(out)
 }
 
@@ -194,6 +232,8 @@ fn combine(
         search_paths,
         paths_from_channel_list,
         decoder: decoder.finish(diags),
+        zero_offset_list: None,
+        zero_offsets: Default::default(),
         list: chan.list,
     }
 }

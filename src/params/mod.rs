@@ -12,6 +12,7 @@ pub mod runtime;
 pub mod search_path;
 pub mod startup;
 pub mod value;
+pub mod zero_offsets;
 
 pub use config::{check_list_file, load, ChannelConfig, Config, RUNTIME_FILE};
 pub use decoder::{CacheSettings, DecoderSettings, FCT_USE_CACHED_FILES};

@@ -35,6 +35,10 @@ pub struct StartupList {
     pub search_paths: BTreeMap<u32, Vec<SearchPath>>,
     /// `configuration.channel[i].decoder.*` per channel.
     pub decoder: BTreeMap<u32, DecoderParams>,
+    /// `zero_offset_list[i]`: channel i's zero-offset list.
+    pub zero_offset_lists: BTreeMap<u32, ChannelListRef>,
+    /// `zero_offset_list`: the zero-offset list of every channel without its own.
+    pub zero_offset_default: Option<ChannelListRef>,
 }
 
 /// Does this list look like a start-up list? (It names `kanal_anzahl` or `sda_mds[…]`.)
@@ -121,13 +125,15 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
     let bound = channel_count.unwrap_or(MAX_CHANNELS);
 
     let mut channel_lists = BTreeMap::new();
+    let mut zero_offset_lists = BTreeMap::new();
+    let mut zero_offset_default = None;
     let mut decoder: BTreeMap<u32, DecoderParams> = BTreeMap::new();
     let mut collectors: BTreeMap<u32, PathCollector> = BTreeMap::new();
 
     for e in &list.entries {
         let s = shape(e);
         let channel = match s.as_slice() {
-            [("sda_mds", Some(i))]
+            [("sda_mds" | "zero_offset_list", Some(i))]
             | [("pfad", Some(i)), (_, Some(_))]
             | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
             _ => None,
@@ -165,6 +171,26 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
                             entry: e.clone(),
                         },
                     );
+                }
+                Err(d) => diags.push(d),
+            },
+            [("zero_offset_list", index)] => match string_value(&list, e, MAX_PATH_CHARS) {
+                Ok(p) if p.is_empty() => diags.push(list.error_at(
+                    e,
+                    e.value_pos,
+                    format!("{}: empty zero-offset list path", e.name.text),
+                )),
+                Ok(p) => {
+                    let r = ChannelListRef {
+                        path: resolve(&base, &p),
+                        entry: e.clone(),
+                    };
+                    match index {
+                        Some(i) => {
+                            zero_offset_lists.insert(*i, r);
+                        }
+                        None => zero_offset_default = Some(r),
+                    }
                 }
                 Err(d) => diags.push(d),
             },
@@ -234,13 +260,24 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
         channel_lists,
         search_paths,
         decoder,
+        zero_offset_lists,
+        zero_offset_default,
+    }
+}
+
+impl StartupList {
+    /// The zero-offset list of channel `i` (0-based), if the start-up list names one.
+    pub fn zero_offset_list(&self, i: u32) -> Option<&ChannelListRef> {
+        self.zero_offset_lists
+            .get(&i)
+            .or(self.zero_offset_default.as_ref())
     }
 }
 
 fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
     matches!(
         s,
-        [("sda_mds", Some(_))]
+        [("sda_mds" | "zero_offset_list", Some(_))]
             | [
                 ("pfad", Some(_)),
                 ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))

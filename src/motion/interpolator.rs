@@ -1,0 +1,264 @@
+//! Interpolator: advances the path position of one block through a tick along a trapezoidal
+//! velocity profile, and turns a path position into axis positions (lines, G2/G3 arcs in
+//! G17/G18/G19, helices).
+//!
+//! The profile is integrated in closed form (phases of constant acceleration +a, 0, −a), not
+//! by stepping the velocity per tick: a block that ends inside a tick hands the rest of the tick
+//! to the next block, so block end times are exact and a square at F1000 reaches its corners
+//! when the trapezoid says. Time is whatever the caller passes; no clock is read here.
+
+use crate::queue::{Move, MoveKind, Position, MAX_AXES};
+
+/// Below this a remaining length counts as the block end, mm.
+pub const END_EPS_MM: f64 = 1e-9;
+/// Velocities closer than this count as equal, mm/s.
+const V_EPS: f64 = 1e-9;
+/// Phases one block can pass through in one tick: accelerate, cruise, decelerate, plus slack
+/// for rounding; the loop is bounded so no input can make a tick spin.
+const MAX_PHASES: usize = 8;
+
+/// What the profile of one block aims for this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Profile {
+    /// Block path length, mm.
+    pub length_mm: f64,
+    /// Path acceleration and deceleration limit, mm/s² (> 0).
+    pub accel_mm_per_s2: f64,
+    /// Velocity to cruise at (feed × override, or 0 during a feed hold), mm/s.
+    pub cruise_mm_per_s: f64,
+    /// Velocity planned at the block end, mm/s.
+    pub exit_mm_per_s: f64,
+}
+
+/// Where the block stands after [`advance`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Advanced {
+    /// Seconds of the offered time used.
+    pub used_s: f64,
+    /// The block end was reached.
+    pub finished: bool,
+}
+
+/// Advance path position `s_mm` and path velocity `v_mm_per_s` along `p` by at most `dt_s`.
+///
+/// The velocity follows the largest of: accelerate at `a` towards the cruise velocity, cruise,
+/// and brake at `a` so the block ends at the planned exit velocity. When the velocity is
+/// already too high to brake to the exit (the override was lowered after planning), it brakes
+/// at `a` all the way and ends faster; the next block then brakes on.
+pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> Advanced {
+    let a = p.accel_mm_per_s2.max(1e-9);
+    let mut t = 0.0;
+    for _ in 0..MAX_PHASES {
+        let rem = p.length_mm - *s_mm;
+        if rem <= END_EPS_MM {
+            *s_mm = p.length_mm;
+            return Advanced {
+                used_s: t,
+                finished: true,
+            };
+        }
+        let left = dt_s - t;
+        if left <= 0.0 {
+            break;
+        }
+        let v = *v_mm_per_s;
+        // The exit we can still reach, and the braking curve through it at s.
+        let reach2 = v * v - 2.0 * a * rem;
+        let ve = if reach2 > p.exit_mm_per_s * p.exit_mm_per_s {
+            reach2.sqrt()
+        } else {
+            p.exit_mm_per_s.max(0.0)
+        };
+        let brake = (ve * ve + 2.0 * a * rem).sqrt();
+        let vc = p.cruise_mm_per_s.max(0.0);
+        let eps = V_EPS * (1.0 + v.max(vc));
+        // (acceleration, duration of the phase, velocity at its end, reaches block end)
+        let (acc, dur, v_end, to_end) = if v >= brake - eps {
+            (-a, ((v - ve) / a).max(0.0), ve, true)
+        } else if v > vc + eps {
+            let d = (v * v - vc * vc) / (2.0 * a);
+            if d >= rem {
+                let ve2 = reach2.max(0.0).sqrt();
+                (-a, ((v - ve2) / a).max(0.0), ve2, true)
+            } else {
+                (-a, (v - vc) / a, vc, false)
+            }
+        } else if v >= vc - eps {
+            if vc <= V_EPS {
+                // Held (or 0 % override) and standing: time passes, the path does not.
+                *v_mm_per_s = 0.0;
+                return Advanced {
+                    used_s: dt_s,
+                    finished: false,
+                };
+            }
+            let d = if vc > ve {
+                rem - (vc * vc - ve * ve) / (2.0 * a)
+            } else {
+                rem
+            };
+            (0.0, (d.max(0.0)) / vc, vc, vc <= ve)
+        } else {
+            let x_meet = (ve * ve + 2.0 * a * rem - v * v) / (4.0 * a);
+            let x_cruise = (vc * vc - v * v) / (2.0 * a);
+            let x = x_meet.min(x_cruise).max(0.0);
+            let v1 = (v * v + 2.0 * a * x).sqrt();
+            (a, (v1 - v) / a, v1, false)
+        };
+        if dur <= left {
+            t += dur;
+            if to_end {
+                *s_mm = p.length_mm;
+                *v_mm_per_s = v_end.max(0.0);
+                return Advanced {
+                    used_s: t,
+                    finished: true,
+                };
+            }
+            *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
+            *v_mm_per_s = v_end.max(0.0);
+        } else {
+            *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
+            *v_mm_per_s = (v + acc * left).max(0.0);
+            t = dt_s;
+            break;
+        }
+    }
+    let finished = p.length_mm - *s_mm <= END_EPS_MM;
+    if finished {
+        *s_mm = p.length_mm;
+    }
+    Advanced {
+        used_s: t.min(dt_s),
+        finished,
+    }
+}
+
+/// Axis positions at path position `s_mm` of `m` (of length `length_mm`). The block end is
+/// returned exactly at `s_mm >= length_mm`: corners and arc end points are hit, not neared.
+pub fn point_at(m: &Move, length_mm: f64, s_mm: f64) -> Position {
+    if s_mm >= length_mm || length_mm <= 0.0 {
+        return m.end;
+    }
+    m.point_at(s_mm / length_mm)
+}
+
+/// Unit tangent of `m` at its start (`at_end` false) or end, by axis.
+pub fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
+    let mut t = [0.0; MAX_AXES];
+    if length_mm <= 0.0 {
+        return t;
+    }
+    for (i, ti) in t.iter_mut().enumerate() {
+        *ti = (m.end[i] - m.start[i]) / length_mm;
+    }
+    if let MoveKind::Arc {
+        plane,
+        center,
+        radius_mm,
+        cw,
+        sweep_rad,
+    } = m.kind
+    {
+        let (a, b, _) = plane.axes();
+        let a0 = (m.start[b] - center[1]).atan2(m.start[a] - center[0]);
+        let dir = if cw { -1.0 } else { 1.0 };
+        let ang = if at_end { a0 + dir * sweep_rad } else { a0 };
+        // d(point)/d(u) of the circle part, divided by the path length.
+        let k = dir * radius_mm * sweep_rad / length_mm;
+        t[a] = -k * ang.sin();
+        t[b] = k * ang.cos();
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::queue::Plane;
+
+    fn run(p: &Profile, v0: f64, dt: f64) -> (f64, Vec<(f64, f64)>) {
+        let (mut s, mut v, mut t) = (0.0, v0, 0.0);
+        let mut samples = Vec::new();
+        for _ in 0..1_000_000 {
+            let r = advance(&mut s, &mut v, p, dt);
+            t += r.used_s;
+            samples.push((s, v));
+            if r.finished {
+                return (t, samples);
+            }
+        }
+        panic!("never finished");
+    }
+
+    #[test]
+    fn trapezoid_takes_the_textbook_time() {
+        // 10 mm, a = 1000, v = 50: ramps of 0.05 s covering 1.25 mm each, cruise 7.5 mm.
+        let p = Profile {
+            length_mm: 10.0,
+            accel_mm_per_s2: 1000.0,
+            cruise_mm_per_s: 50.0,
+            exit_mm_per_s: 0.0,
+        };
+        let (t, samples) = run(&p, 0.0, 0.001);
+        assert!((t - (0.1 + 7.5 / 50.0)).abs() < 1e-9, "{t}");
+        assert_eq!(samples.last().unwrap(), &(10.0, 0.0));
+        // Velocity changes at most a·dt per tick.
+        let mut prev = 0.0;
+        for (_, v) in samples {
+            assert!((v - prev).abs() <= 1000.0 * 0.001 + 1e-9);
+            prev = v;
+        }
+    }
+
+    #[test]
+    fn triangle_when_the_block_is_short() {
+        let p = Profile {
+            length_mm: 1.0,
+            accel_mm_per_s2: 1000.0,
+            cruise_mm_per_s: 500.0,
+            exit_mm_per_s: 0.0,
+        };
+        let (t, _) = run(&p, 0.0, 0.0005);
+        // Peak sqrt(a·L) = 31.62 mm/s; total 2·sqrt(L/a).
+        assert!((t - 2.0 * (1.0f64 / 1000.0).sqrt()).abs() < 1e-9, "{t}");
+    }
+
+    #[test]
+    fn hold_brakes_to_a_stop_and_stays() {
+        let p = Profile {
+            length_mm: 100.0,
+            accel_mm_per_s2: 1000.0,
+            cruise_mm_per_s: 0.0,
+            exit_mm_per_s: 0.0,
+        };
+        let (mut s, mut v) = (0.0, 50.0);
+        for _ in 0..100 {
+            advance(&mut s, &mut v, &p, 0.001);
+        }
+        assert_eq!(v, 0.0);
+        assert!((s - 50.0 * 50.0 / 2000.0).abs() < 1e-9, "{s}");
+    }
+
+    #[test]
+    fn arc_tangents_are_unit_and_perpendicular_to_the_radius() {
+        let m = Move {
+            kind: MoveKind::Arc {
+                plane: Plane::Xy,
+                center: [0.0, 0.0],
+                radius_mm: 10.0,
+                cw: false,
+                sweep_rad: std::f64::consts::FRAC_PI_2,
+            },
+            start: [10.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            end: [0.0, 10.0, 0.0, 0.0, 0.0, 0.0],
+            feed_mm_per_min: 1000.0,
+        };
+        let l = m.length_mm();
+        let t0 = tangent(&m, l, false);
+        let t1 = tangent(&m, l, true);
+        assert!((t0[0]).abs() < 1e-12 && (t0[1] - 1.0).abs() < 1e-12);
+        assert!((t1[0] + 1.0).abs() < 1e-12 && t1[1].abs() < 1e-12);
+        assert_eq!(point_at(&m, l, l), m.end);
+    }
+}

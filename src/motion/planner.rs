@@ -1,0 +1,457 @@
+//! Planner: the lookahead window of blocks held in the channel (the "memory effect" of seed 003
+//! §2.3.1), the rules that release them for execution (`#FLUSH`, a full window, the program
+//! end), and the velocity plan over the released motion blocks.
+//!
+//! Release rules. Blocks taken from the block queue are *held* until one of these releases every
+//! block in the window: the window holds `lookahead_blocks` motion blocks (it is full); the
+//! program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT` enters it.
+//! `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a stream that
+//! delivers it in time continues without a stop (seed: "if the next motion block is presented in
+//! good time before an NC block end, motion is resumed without stopping").
+//!
+//! Velocity plan. Every released motion block gets a nominal velocity (programmed feed, G0 at
+//! the axes' rapid rates, lowered so no axis exceeds its maximum velocity; arcs also so the
+//! centripetal acceleration stays within the axes' limit), a path acceleration (the axis limits
+//! projected on the path direction) and an entry velocity limit at its junction with the
+//! previous block. A backward pass from the last released block, which always ends at rest,
+//! gives every block the highest exit velocity from which everything after it can still brake
+//! in time: so a feed that starves is safe, and a block released before the deceleration point
+//! lifts the plan without a stop.
+//!
+//! Junction rule. At a corner the direction jumps from t1 to t2 and each axis' velocity jumps
+//! by v·|t2ᵢ − t1ᵢ| within one tick. The planner reserves [`JUNCTION_ACCEL_SHARE`] of every
+//! axis' acceleration for these jumps and plans path acceleration with the rest, so
+//! v ≤ share·aᵢ·dt / |Δtᵢ| keeps the per-tick velocity change of every axis within aᵢ; when
+//! blocks are shorter than one tick's travel several corners fall into one tick, so also
+//! v² ≤ share·aᵢ·L / |Δtᵢ| (L the shorter of the two blocks), the polygon's own centripetal
+//! limit. Non-motion blocks between two moves do not break the junction; a dwell, the program
+//! end, `#FLUSH` and `#FLUSH WAIT` do (the motion stops there).
+
+use std::collections::VecDeque;
+
+use crate::lang::block::FlushKind;
+use crate::queue::{Action, BlockInfo, Move, MoveKind, QueuedBlock, MAX_AXES};
+
+use super::interpolator::tangent;
+use super::AxisLimits;
+
+/// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
+/// profile uses the rest.
+pub const JUNCTION_ACCEL_SHARE: f64 = 0.25;
+/// Share of the profile acceleration an arc may use for its centripetal acceleration; the
+/// tangential ramp gets √(1 − share²) of it, so both together stay within the limit.
+pub const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
+/// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
+/// window when a program is mostly assignments or M functions.
+const NON_MOTION_PER_BLOCK: usize = 4;
+
+/// Planner settings (runtime.toml `[planner]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlannerSettings {
+    /// Motion blocks held and planned over (lookahead window), at least 1.
+    pub lookahead_blocks: usize,
+}
+
+impl Default for PlannerSettings {
+    fn default() -> Self {
+        PlannerSettings {
+            lookahead_blocks: 32,
+        }
+    }
+}
+
+/// A motion block with what the plan needs of it.
+#[derive(Debug, Clone)]
+pub struct Segment {
+    pub mv: Move,
+    pub length_mm: f64,
+    /// Programmed path velocity at 100 % override (G0: the rapid limit), mm/s.
+    pub programmed_mm_per_s: f64,
+    /// Highest path velocity the axes allow on this block, whatever the override, mm/s.
+    pub limit_mm_per_s: f64,
+    /// Path acceleration limit, mm/s².
+    pub accel_mm_per_s2: f64,
+    /// Junction with the previous motion block: `None` = the motion stops before this block.
+    pub junction: Option<Junction>,
+    /// Planned velocity at the block end, mm/s.
+    pub exit_mm_per_s: f64,
+}
+
+/// What limits the velocity at the start of a block coming from the previous one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Junction {
+    /// maxᵢ |Δtᵢ| / (share·aᵢ), s²/mm: velocity ≤ dt / k and ≤ √(L / k).
+    pub k_s2_per_mm: f64,
+    /// The shorter of the two blocks, mm.
+    pub short_mm: f64,
+    /// The previous block's programmed and limit velocity, mm/s.
+    pub prev_programmed_mm_per_s: f64,
+    pub prev_limit_mm_per_s: f64,
+}
+
+impl Junction {
+    /// The junction's geometric velocity limit for tick length `dt_s`, mm/s.
+    pub fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
+        if self.k_s2_per_mm <= 0.0 {
+            return f64::INFINITY;
+        }
+        (dt_s / self.k_s2_per_mm).min((self.short_mm / self.k_s2_per_mm).sqrt())
+    }
+}
+
+impl Segment {
+    /// The velocity this block aims for at `override_pct`, mm/s.
+    pub fn cruise_mm_per_s(&self, override_pct: f64) -> f64 {
+        (self.programmed_mm_per_s * override_pct / 100.0).min(self.limit_mm_per_s)
+    }
+}
+
+/// What a window entry does.
+#[derive(Debug, Clone)]
+pub enum EntryKind {
+    Move(Box<Segment>),
+    Dwell {
+        seconds: f64,
+    },
+    /// Takes effect without motion (assignments, M/S/T functions, modal changes).
+    Plain,
+    Flush(FlushKind),
+    End {
+        m: u32,
+        prog: std::sync::Arc<str>,
+    },
+}
+
+impl EntryKind {
+    /// The motion stops before anything after this entry runs.
+    fn is_barrier(&self) -> bool {
+        matches!(
+            self,
+            EntryKind::Dwell { .. }
+                | EntryKind::End { .. }
+                | EntryKind::Flush(FlushKind::Stop | FlushKind::Wait)
+        )
+    }
+}
+
+/// One block in the window.
+#[derive(Debug, Clone)]
+pub struct Entry {
+    /// Taken when the `block` event is emitted (`None` for silent second parts).
+    pub info: Option<BlockInfo>,
+    pub kind: EntryKind,
+}
+
+/// The lookahead window: a prefix of it is released, the rest held.
+#[derive(Debug)]
+pub struct Planner {
+    axes: [Option<AxisLimits>; MAX_AXES],
+    lookahead: usize,
+    max_entries: usize,
+    window: VecDeque<Entry>,
+    /// Entries at the front that may execute.
+    released: usize,
+    /// Motion blocks in the window.
+    moves: usize,
+    /// `#FLUSH CONTINUE` seen: release the next motion block when it arrives.
+    release_next_move: bool,
+    /// The plan must be recomputed (new releases, override change).
+    dirty: bool,
+}
+
+impl Planner {
+    pub fn new(axes: &[AxisLimits], settings: PlannerSettings) -> Self {
+        let mut by_index: [Option<AxisLimits>; MAX_AXES] = Default::default();
+        for a in axes {
+            if a.index < MAX_AXES {
+                by_index[a.index] = Some(a.clone());
+            }
+        }
+        let lookahead = settings.lookahead_blocks.max(1);
+        let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
+        Planner {
+            axes: by_index,
+            lookahead,
+            max_entries,
+            window: VecDeque::with_capacity(max_entries),
+            released: 0,
+            moves: 0,
+            release_next_move: false,
+            dirty: false,
+        }
+    }
+
+    pub fn lookahead(&self) -> usize {
+        self.lookahead
+    }
+    pub fn len(&self) -> usize {
+        self.window.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.window.is_empty()
+    }
+    /// Entries released for execution and not yet done.
+    pub fn released(&self) -> usize {
+        self.released
+    }
+    /// Entries held back (the memory effect).
+    pub fn held(&self) -> usize {
+        self.window.len() - self.released
+    }
+    pub fn front(&self) -> Option<&Entry> {
+        self.window.front()
+    }
+    pub fn front_mut(&mut self) -> Option<&mut Entry> {
+        self.window.front_mut()
+    }
+    pub fn entries(&self) -> impl Iterator<Item = &Entry> {
+        self.window.iter()
+    }
+    /// The next entry after the front, if released.
+    pub fn released_after_front(&self) -> Option<&Entry> {
+        (self.released > 1).then(|| &self.window[1])
+    }
+
+    fn full(&self) -> bool {
+        self.moves >= self.lookahead || self.window.len() >= self.max_entries
+    }
+
+    /// The plan must be recomputed before the next tick's interpolation.
+    pub fn mark_dirty(&mut self) {
+        self.dirty = true;
+    }
+
+    /// Take blocks from the queue into the window while it has room, applying the release
+    /// rules.
+    pub fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
+        while !self.full() {
+            let Some(b) = queue.pop_front() else { break };
+            self.push(b);
+        }
+        if self.full() {
+            self.release_all();
+        }
+    }
+
+    /// Put one decoded block into the window (held unless a rule releases it).
+    pub fn push(&mut self, b: QueuedBlock) {
+        let QueuedBlock {
+            info,
+            action,
+            silent,
+        } = b;
+        let kind = match action {
+            Action::None => EntryKind::Plain,
+            Action::Dwell { seconds } => EntryKind::Dwell {
+                seconds: if seconds.is_finite() {
+                    seconds.max(0.0)
+                } else {
+                    0.0
+                },
+            },
+            Action::Flush(k) => EntryKind::Flush(k),
+            Action::End { m } => EntryKind::End {
+                m,
+                prog: info.prog.clone(),
+            },
+            Action::Move(mv) => EntryKind::Move(Box::new(self.segment(mv))),
+        };
+        let is_move = matches!(kind, EntryKind::Move(_));
+        let release = match &kind {
+            EntryKind::Flush(_) | EntryKind::End { .. } => true,
+            EntryKind::Move(_) => self.release_next_move,
+            _ => false,
+        };
+        let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
+        self.window.push_back(Entry {
+            info: (!silent).then_some(info),
+            kind,
+        });
+        if is_move {
+            self.moves += 1;
+            if self.release_next_move {
+                self.release_next_move = false;
+            }
+        }
+        if release {
+            self.release_all();
+        }
+        if continue_after {
+            self.release_next_move = true;
+        }
+    }
+
+    /// Release every block in the window.
+    pub fn release_all(&mut self) {
+        if self.released != self.window.len() {
+            self.released = self.window.len();
+            self.dirty = true;
+        }
+    }
+
+    /// Remove the front entry (it has been executed).
+    pub fn pop_front(&mut self) -> Option<Entry> {
+        let e = self.window.pop_front()?;
+        if matches!(e.kind, EntryKind::Move(_)) {
+            self.moves -= 1;
+        }
+        self.released = self.released.saturating_sub(1);
+        Some(e)
+    }
+
+    /// Drop everything (reset, error).
+    pub fn clear(&mut self) {
+        self.window.clear();
+        self.released = 0;
+        self.moves = 0;
+        self.release_next_move = false;
+        self.dirty = false;
+    }
+
+    /// Recompute the exit velocities of the released motion blocks if something changed.
+    pub fn plan_if_needed(&mut self, override_pct: f64, dt_s: f64) {
+        if self.dirty {
+            self.plan(override_pct, dt_s);
+            self.dirty = false;
+        }
+    }
+
+    /// Backward pass over the released blocks: the last one ends at rest; each block's exit is
+    /// the next block's admissible entry velocity.
+    fn plan(&mut self, override_pct: f64, dt_s: f64) {
+        let mut next_entry = 0.0_f64;
+        let mut stop = true;
+        for e in self.window.iter_mut().take(self.released).rev() {
+            match &mut e.kind {
+                EntryKind::Move(seg) => {
+                    seg.exit_mm_per_s = if stop { 0.0 } else { next_entry };
+                    let entry_limit = match seg.junction {
+                        None => 0.0,
+                        Some(j) => {
+                            let prev_cruise = (j.prev_programmed_mm_per_s * override_pct / 100.0)
+                                .min(j.prev_limit_mm_per_s);
+                            j.limit_mm_per_s(dt_s)
+                                .min(prev_cruise)
+                                .min(seg.cruise_mm_per_s(override_pct))
+                        }
+                    };
+                    let reachable = (seg.exit_mm_per_s * seg.exit_mm_per_s
+                        + 2.0 * seg.accel_mm_per_s2 * seg.length_mm)
+                        .sqrt();
+                    next_entry = entry_limit.min(reachable).max(0.0);
+                    stop = false;
+                }
+                k if k.is_barrier() => stop = true,
+                _ => {}
+            }
+        }
+    }
+
+    /// A motion block's nominal velocity, velocity limit, path acceleration and junction.
+    fn segment(&self, mv: Move) -> Segment {
+        let length_mm = mv.length_mm();
+        let t0 = tangent(&mv, length_mm, false);
+        // Largest share of the path velocity each axis takes anywhere on the block.
+        let mut share = [0.0; MAX_AXES];
+        for (i, s) in share.iter_mut().enumerate() {
+            *s = t0[i].abs();
+        }
+        let mut curvature = 0.0;
+        if let MoveKind::Arc {
+            plane,
+            radius_mm,
+            sweep_rad,
+            ..
+        } = mv.kind
+        {
+            let (a, b, _) = plane.axes();
+            if length_mm > 0.0 {
+                // The circle part's share: on a full turn each plane axis takes all of it.
+                let k = radius_mm * sweep_rad / length_mm;
+                share[a] = k;
+                share[b] = k;
+                if radius_mm > 0.0 {
+                    curvature = k * k / radius_mm;
+                }
+            }
+        }
+        let mut limit = f64::INFINITY;
+        let mut accel = f64::INFINITY;
+        let mut rapid = f64::INFINITY;
+        let mut min_accel = f64::INFINITY;
+        for (i, s) in share.iter().enumerate() {
+            if *s <= 1e-12 {
+                continue;
+            }
+            let Some(ax) = &self.axes[i] else { continue };
+            let vmax = ax.max_velocity_mm_per_min.max(1e-6) / 60.0;
+            let amax = ax.max_accel_mm_per_s2.max(1e-6) * (1.0 - JUNCTION_ACCEL_SHARE);
+            limit = limit.min(vmax / s);
+            rapid = rapid.min(ax.rapid_mm_per_min.max(1e-6) / 60.0 / s);
+            accel = accel.min(amax / s);
+            min_accel = min_accel.min(amax);
+        }
+        if curvature > 0.0 && min_accel.is_finite() {
+            // Centripetal v²·κ ≤ share·a; the tangential ramp gets the rest of the vector.
+            limit = limit.min((ARC_CENTRIPETAL_SHARE * min_accel / curvature).sqrt());
+            let tangential = (1.0 - ARC_CENTRIPETAL_SHARE * ARC_CENTRIPETAL_SHARE).sqrt();
+            accel = accel.min(tangential * min_accel);
+        }
+        if !limit.is_finite() {
+            // No configured axis moves (zero length, or an axis without limits): nothing to
+            // limit, the block ends at once or moves at its feed.
+            limit = f64::MAX;
+        }
+        if !accel.is_finite() {
+            accel = f64::MAX;
+        }
+        let programmed = match mv.kind {
+            MoveKind::Rapid => rapid.min(limit),
+            _ => mv.feed_mm_per_min.max(0.0) / 60.0,
+        };
+        let junction = self.junction_to(length_mm, &t0);
+        Segment {
+            mv,
+            length_mm,
+            programmed_mm_per_s: programmed,
+            limit_mm_per_s: limit,
+            accel_mm_per_s2: accel,
+            junction,
+            exit_mm_per_s: 0.0,
+        }
+    }
+
+    /// The junction with the last motion block in the window, unless a barrier lies between.
+    fn junction_to(&self, length_mm: f64, t_next: &[f64; MAX_AXES]) -> Option<Junction> {
+        for e in self.window.iter().rev() {
+            match &e.kind {
+                EntryKind::Move(prev) => {
+                    if length_mm <= 0.0 || prev.length_mm <= 0.0 {
+                        return None;
+                    }
+                    let t_prev = tangent(&prev.mv, prev.length_mm, true);
+                    let mut k: f64 = 0.0;
+                    for i in 0..MAX_AXES {
+                        let d = (t_next[i] - t_prev[i]).abs();
+                        if d <= 1e-12 {
+                            continue;
+                        }
+                        let a = self.axes[i]
+                            .as_ref()
+                            .map_or(f64::INFINITY, |ax| ax.max_accel_mm_per_s2.max(1e-6));
+                        k = k.max(d / (JUNCTION_ACCEL_SHARE * a));
+                    }
+                    return Some(Junction {
+                        k_s2_per_mm: k,
+                        short_mm: length_mm.min(prev.length_mm),
+                        prev_programmed_mm_per_s: prev.programmed_mm_per_s,
+                        prev_limit_mm_per_s: prev.limit_mm_per_s,
+                    });
+                }
+                k if k.is_barrier() => return None,
+                _ => {}
+            }
+        }
+        None
+    }
+}

@@ -1,0 +1,382 @@
+//! Motion through a whole channel and through `ncchannel run`: parameter files on disk, NC text
+//! decoded, streamed programs with slow and fast feeders, `#FLUSH CONTINUE`, interrupts and
+//! resumes, zero offsets from the zero-offset list, `--plot`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use ncchannel::channel::{Channel, State};
+use ncchannel::report::event::{EventKind, EventLog};
+use ncchannel::runtime::Tick;
+
+const PERIOD: Duration = Duration::from_millis(1);
+
+/// A parameter set in a temp folder: params/{startup.lis,channel1.lis,runtime.toml}, nc/.
+struct Setup {
+    dir: tempfile::TempDir,
+}
+
+impl Setup {
+    fn new(extra_startup: &str, runtime: &str) -> Setup {
+        let dir = tempfile::tempdir().unwrap();
+        let params = dir.path().join("params");
+        std::fs::create_dir_all(&params).unwrap();
+        std::fs::create_dir_all(dir.path().join("nc")).unwrap();
+        std::fs::write(
+            params.join("startup.lis"),
+            format!(
+                "kanal_anzahl 1\nsda_mds[0] channel1.lis\npfad[0].prg[0] ../nc\n\
+                 pfad[0].typ[0] 0x03\npfad[0].prioritaet[0] 0\n{extra_startup}"
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            params.join("channel1.lis"),
+            "streaming_prog_file streaming.nc\n",
+        )
+        .unwrap();
+        std::fs::write(params.join("runtime.toml"), runtime).unwrap();
+        Setup { dir }
+    }
+    fn startup(&self) -> PathBuf {
+        self.dir.path().join("params/startup.lis")
+    }
+    fn write(&self, rel: &str, text: &str) -> PathBuf {
+        let p = self.dir.path().join(rel);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+    fn channel(&self) -> Channel {
+        let config = ncchannel::params::load(&self.startup()).unwrap();
+        ncchannel::setup::channels(&config, true).unwrap().remove(0)
+    }
+}
+
+fn tick(k: u64) -> Tick {
+    Tick {
+        index: k,
+        period: PERIOD,
+        time: PERIOD * k as u32,
+    }
+}
+
+/// Run a streamed program: `writes` are (tick, text) written into the stream interface.
+/// Returns the channel and every event kind with its tick.
+fn run_stream(
+    s: &Setup,
+    writes: &[(u64, &str)],
+    max_ticks: u64,
+) -> (Channel, Vec<(u64, EventKind)>, Vec<f64>) {
+    let mut c = s.channel();
+    c.start(&tick(0), "streaming.nc").unwrap();
+    let mut events = Vec::new();
+    let mut velocity = Vec::new();
+    for k in 0..max_ticks {
+        let t = tick(k);
+        for (at, text) in writes {
+            if *at == k {
+                c.write_stream(&t, text.as_bytes()).unwrap();
+            }
+        }
+        c.step(&t);
+        velocity.push(c.motion().velocity_mm_per_s());
+        events.extend(
+            c.events_mut()
+                .events()
+                .iter()
+                .map(|e| (e.tick, e.kind.clone())),
+        );
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.state() != State::Active && c.state() != State::Hold {
+            break;
+        }
+    }
+    (c, events, velocity)
+}
+
+fn count(events: &[(u64, EventKind)], k: &EventKind) -> usize {
+    events.iter().filter(|(_, e)| e == k).count()
+}
+
+fn blocks(events: &[(u64, EventKind)]) -> Vec<(u64, Option<u64>)> {
+    events
+        .iter()
+        .filter_map(|(t, e)| match e {
+            EventKind::Block { n, .. } => Some((*t, *n)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
+    let s = Setup::new("", "");
+    let first = "N10 G1 X10 F1000\r\n#FLUSH CONTINUE\r\n";
+    let next = "N20 X20\r\n#FLUSH CONTINUE\r\n";
+    let end = "N30 M30\r\n";
+    // N10 takes about 0.61 s at F1000. In time: N20 arrives at 0.3 s.
+    let (c, ev, v) = run_stream(&s, &[(1, first), (300, next), (1500, end)], 5000);
+    assert_eq!(
+        count(&ev, &EventKind::Interrupt),
+        1,
+        "only after N20, waiting for M30"
+    );
+    let b = blocks(&ev);
+    let t10 = b.iter().find(|x| x.1 == Some(10)).unwrap().0 as usize;
+    let t20 = b.iter().find(|x| x.1 == Some(20)).unwrap().0 as usize;
+    let min_v = v[t10 + 100..t20 + 100]
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        min_v > 16.0,
+        "slowed to {min_v} mm/s at the N10/N20 junction"
+    );
+    assert_eq!(c.position()[0], 20.0);
+    assert_eq!(c.stats().interrupts, 1);
+
+    // Late: N20 arrives at 1.0 s, after N10 has stopped: an interrupt, then a resume.
+    let (c, ev, _) = run_stream(&s, &[(1, first), (1000, next), (2500, end)], 6000);
+    assert_eq!(count(&ev, &EventKind::Interrupt), 2);
+    assert_eq!(count(&ev, &EventKind::Resume), 2);
+    let first_interrupt = ev.iter().find(|e| e.1 == EventKind::Interrupt).unwrap().0;
+    assert!((600..1000).contains(&first_interrupt), "{first_interrupt}");
+    let resume = ev.iter().find(|e| e.1 == EventKind::Resume).unwrap().0;
+    assert_eq!(resume, 1000, "resumes when N20 starts");
+    assert_eq!(c.position()[0], 20.0);
+    assert!(ev.iter().any(|e| e.1
+        == EventKind::ProgramEnd {
+            prog: "streaming.nc".into(),
+            end: "M30".into()
+        }));
+}
+
+#[test]
+fn without_flush_blocks_wait_in_the_window_and_the_program_end_releases_them() {
+    let s = Setup::new("", "[planner]\nlookahead_blocks = 8\n");
+    let text: String = (1..=3)
+        .map(|i| format!("N{i} G1 X{} F3000\r\n", i * 5))
+        .collect();
+    let (c, ev, _) = run_stream(&s, &[(1, &text), (400, "M30\r\n")], 3000);
+    let b = blocks(&ev);
+    // Held: nothing takes effect until M30 arrives, and no interrupt before the first block.
+    assert!(b.iter().all(|x| x.0 >= 400), "{b:?}");
+    assert_eq!(count(&ev, &EventKind::Interrupt), 0);
+    assert_eq!(c.position()[0], 15.0);
+}
+
+#[test]
+fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
+    let s = Setup::new("", "");
+    let mut c = s.channel();
+    s.write("nc/long.nc", "N10 G1 X100 F6000\nN20 M30\n");
+    c.start(&tick(0), "long.nc").unwrap();
+    let mut events = Vec::new();
+    for k in 1..3000u64 {
+        let t = tick(k);
+        if k == 300 {
+            c.hold(&t);
+        }
+        if k == 800 {
+            c.resume(&t);
+        }
+        c.step(&t);
+        if k == 790 {
+            assert_eq!(c.state(), State::Hold);
+            assert_eq!(c.motion().velocity_mm_per_s(), 0.0);
+        }
+        events.extend(c.events_mut().events().iter().map(|e| e.kind.clone()));
+        c.events_mut().flush_to(&mut EventLog::disabled());
+    }
+    assert!(!events.contains(&EventKind::Interrupt));
+    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.position()[0], 100.0);
+}
+
+#[test]
+fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
+    let s = Setup::new("", "");
+    s.write(
+        "nc/arcs.nc",
+        "N10 G17 G90 G1 X10 Y0 F3000\n\
+         N20 G3 X-10 Y0 I-10 J0\n\
+         N30 G2 X10 Y0 R10\n\
+         N40 G18 G3 X0 Z10 K10 Y5\n\
+         N50 G19 G2 Y-5 Z20 R10\n\
+         N60 M30\n",
+    );
+    let mut c = s.channel();
+    c.start(&tick(0), "arcs.nc").unwrap();
+    for k in 1..20_000 {
+        c.step(&tick(k));
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    let p = c.position();
+    assert_eq!((p[0], p[1], p[2]), (0.0, -5.0, 20.0));
+
+    s.write(
+        "nc/bad.nc",
+        "N10 G1 X10 Y0 F3000\nN20 G3 X0 Y10.5 I-10 J0\nM30\n",
+    );
+    let mut c = s.channel();
+    c.start(&tick(0), "bad.nc").unwrap();
+    for k in 1..5000 {
+        c.step(&tick(k));
+    }
+    assert_eq!(c.state(), State::Error);
+    assert_eq!(c.last_error().unwrap().0, 90130);
+}
+
+#[test]
+fn zero_offsets_from_the_list_named_in_the_startup_list() {
+    let s = Setup::new("zero_offset_list zero.lis\n", "");
+    s.write(
+        "params/zero.lis",
+        "# G54: X 10 mm, Y -2.5 mm; G55: Z 1 mm\n\
+         np_grp[0].achse[0].versch 100000\n\
+         np_grp[0].achse[1].versch -25000\n\
+         np_grp[1].achse[2].versch 10000\n",
+    );
+    s.write(
+        "nc/np.nc",
+        "N10 G54 G90 G0 X0 Y0\nN20 #FLUSH WAIT\nN30 G55 G0 X1 Z0\nN40 G53 G0 Y7\nM30\n",
+    );
+    let mut c = s.channel();
+    c.start(&tick(0), "np.nc").unwrap();
+    let mut after_n10 = None;
+    for k in 1..10_000u64 {
+        c.step(&tick(k));
+        let ev: Vec<EventKind> = c
+            .events_mut()
+            .events()
+            .iter()
+            .map(|e| e.kind.clone())
+            .collect();
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if ev.iter().any(|e| matches!(e, EventKind::Flush { .. })) {
+            after_n10 = Some(c.position());
+        }
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    let p = after_n10.unwrap();
+    assert_eq!((p[0], p[1]), (10.0, -2.5));
+    let p = c.position();
+    assert_eq!((p[0], p[1], p[2]), (1.0, 7.0, 1.0));
+
+    // A list that cannot be read is refused at start-up, pointing at the start-up entry.
+    let s = Setup::new("zero_offset_list missing.lis\n", "");
+    let e = ncchannel::params::load(&s.startup()).unwrap_err();
+    let d = &e.errors()[0];
+    assert!(d.message.contains("zero-offset list"), "{}", d.message);
+    assert_eq!(d.line, 6);
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+}
+
+fn run_report(s: &Setup, stream: &Path, extra: &[&str]) -> serde_json::Value {
+    let report = s.dir.path().join("report.json");
+    let out = bin()
+        .arg("run")
+        .arg("--params")
+        .arg(s.startup())
+        .arg("--stream")
+        .arg(stream)
+        .arg("--report")
+        .arg(&report)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+}
+
+#[test]
+fn run_slow_feeder_interrupts_fast_feeder_does_not_and_plot_marks_them() {
+    let s = Setup::new("", "");
+    // 200 blocks of 1 mm at F6000: 10 ms each.
+    let mut text = String::from("G90 G1 F6000\n");
+    for i in 1..=200 {
+        text.push_str(&format!("N{i} X{i}\n"));
+    }
+    text.push_str("M30\n");
+    let prog = s.write("prog.txt", &text);
+
+    let fast = run_report(&s, &prog, &[]);
+    assert_eq!(fast["outcome"], "ended");
+    assert_eq!(fast["interrupts"], 0);
+    assert_eq!(fast["position"]["X"], 200.0);
+
+    // One ~24-byte packet every 30 ticks: a block every 30 ms, slower than motion needs.
+    let plot = s.dir.path().join("p.svg");
+    let slow = run_report(
+        &s,
+        &prog,
+        &[
+            "--packet",
+            "24",
+            "--every",
+            "30",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(slow["outcome"], "ended");
+    let n = slow["interrupts"].as_u64().unwrap();
+    assert!(n >= 2, "{n}");
+    assert_eq!(slow["position"]["X"], 200.0);
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.starts_with("<svg"));
+    assert_eq!(
+        svg.matches("<circle").count() as u64,
+        n,
+        "one mark per interrupt"
+    );
+    assert!(svg.contains(&format!("{n} interrupt(s)")));
+}
+
+#[test]
+fn run_short_segments_at_f6000_without_interrupts_when_the_stream_keeps_up() {
+    let s = Setup::new("", "");
+    // 2000 segments of 0.1 mm at F6000: 1,000 blocks per second at full feed.
+    let mut text = String::from("G90 G1 F6000\n");
+    for i in 1..=2000 {
+        text.push_str(&format!("X{:.1}\n", i as f64 * 0.1));
+    }
+    text.push_str("M30\n");
+    let prog = s.write("seg.txt", &text);
+    let r = run_report(&s, &prog, &[]);
+    assert_eq!(r["outcome"], "ended");
+    assert_eq!(r["interrupts"], 0);
+    assert_eq!(r["position"]["X"], 200.0);
+    // 200 mm at close to 100 mm/s: about 2 s, certainly under 2.5 s.
+    let t = r["time_s"].as_f64().unwrap();
+    assert!(t < 2.5, "{t}");
+}
+
+#[test]
+fn check_list_file_recognises_a_zero_offset_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("zero.lis");
+    std::fs::write(
+        &p,
+        "np_grp[0].achse[0].versch 1.5\nnp_grp[0].achse[1].versch 100\n",
+    )
+    .unwrap();
+    let d = ncchannel::params::check_list_file(&p);
+    assert_eq!(d.len(), 1, "{d:?}");
+    assert_eq!((d[0].line, d[0].col), (1, 27));
+    assert!(d[0].message.contains("0.1 µm"), "{}", d[0].message);
+}
