@@ -208,8 +208,9 @@ fn a_line_without_cr_lf_raises_21476_and_stops_the_channel() {
 #[test]
 fn a_starved_stream_interrupts_and_resumes() {
     let rig = Rig::new();
-    // A form feed ends the packet and pauses the feeder 500 ticks.
-    let text = "N1 G01 X10 F6000\n\x0c 500\nN2 X20\nM30\n";
+    // `#FLUSH CONTINUE` releases the held block; a form feed ends the packet and pauses the
+    // feeder 500 ticks, longer than the move takes.
+    let text = "N1 G01 X10 F6000\n#FLUSH CONTINUE\n\x0c 500\nN2 X20\nM30\n";
     let r = rig.run("streaming.nc", Some(feeder(text, 992, 1)), 100_000);
     assert_eq!(r.finish, Some(Finish::Ended));
     let kinds: Vec<&str> = r
@@ -218,7 +219,7 @@ fn a_starved_stream_interrupts_and_resumes() {
         .filter(|e| ["interrupt", "resume", "block"].contains(&e["ev"].as_str().unwrap()))
         .map(|e| e["ev"].as_str().unwrap())
         .collect();
-    assert_eq!(kinds, ["block", "interrupt", "resume", "block", "block"]);
+    assert_eq!(kinds, ["block", "block", "interrupt", "resume", "block", "block"]);
     assert_eq!(r.machine.channels()[0].stats().interrupts, 1);
 }
 

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use ncchannel::decoder::arc::arc_move;
+use ncchannel::decoder::arc::{ArcError, ArcSpec};
 use ncchannel::lang::block::FlushKind;
 use ncchannel::motion::check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
@@ -12,6 +12,32 @@ use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, Plane, Position, QueuedBlock,
 };
+
+/// The positional form reads best in these tables of cases.
+#[allow(clippy::too_many_arguments)]
+fn arc_move(
+    plane: Plane,
+    start: Position,
+    end: Position,
+    ijk: [Option<f64>; 3],
+    radius: Option<f64>,
+    cw: bool,
+    feed: f64,
+    tol: f64,
+) -> Result<Move, ArcError> {
+    ncchannel::decoder::arc::arc_move(
+        &ArcSpec {
+            plane,
+            ijk,
+            radius,
+            cw,
+        },
+        start,
+        end,
+        feed,
+        tol,
+    )
+}
 
 const DT: f64 = 0.001;
 
