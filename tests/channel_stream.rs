@@ -219,7 +219,10 @@ fn a_starved_stream_interrupts_and_resumes() {
         .filter(|e| ["interrupt", "resume", "block"].contains(&e["ev"].as_str().unwrap()))
         .map(|e| e["ev"].as_str().unwrap())
         .collect();
-    assert_eq!(kinds, ["block", "block", "interrupt", "resume", "block", "block"]);
+    assert_eq!(
+        kinds,
+        ["block", "block", "interrupt", "resume", "block", "block"]
+    );
     assert_eq!(r.machine.channels()[0].stats().interrupts, 1);
 }
 
