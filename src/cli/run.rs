@@ -98,28 +98,38 @@ pub(crate) fn locate(p: &Path) -> PathBuf {
     p.to_path_buf()
 }
 
-fn usage(msg: impl std::fmt::Display) -> ExitCode {
-    eprintln!("ncchannel run: {msg}");
-    ExitCode::from(exit::USAGE)
-}
-
-pub fn execute(args: RunArgs) -> ExitCode {
-    let params = locate(&args.params);
+/// Read and check the parameter lists (diagnostics on stderr) and build the channels: what
+/// every command that runs channels does first.
+pub(crate) fn load_channels(
+    params: &Path,
+    events: bool,
+) -> Result<(crate::params::Config, Vec<crate::channel::Channel>), String> {
+    let params = locate(params);
     let config = match crate::params::load(&params) {
         Ok(c) => c,
         Err(e) => {
             for d in e.diagnostics() {
                 eprintln!("{}", d.render());
             }
-            return usage(format!("parameter lists in {} refused", params.display()));
+            return Err(format!("parameter lists in {} refused", params.display()));
         }
     };
     for w in &config.warnings {
         eprintln!("{}", w.render());
     }
-    let channels = match crate::setup::channels(&config, args.events.is_some()) {
+    let channels = crate::setup::channels(&config, events).map_err(|e| e.to_string())?;
+    Ok((config, channels))
+}
+
+fn usage(msg: impl std::fmt::Display) -> ExitCode {
+    eprintln!("ncchannel run: {msg}");
+    ExitCode::from(exit::USAGE)
+}
+
+pub fn execute(args: RunArgs) -> ExitCode {
+    let (config, channels) = match load_channels(&args.params, args.events.is_some()) {
         Ok(c) => c,
-        Err(e) => return usage(e),
+        Err(msg) => return usage(msg),
     };
     let nch = channels.len();
     let Some(ch_config) = config.channels.get((args.channel as usize).wrapping_sub(1)) else {

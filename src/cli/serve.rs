@@ -45,22 +45,9 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
 }
 
 pub fn execute(args: ServeArgs) -> ExitCode {
-    let params = super::run::locate(&args.params);
-    let config = match crate::params::load(&params) {
+    let (config, channels) = match super::run::load_channels(&args.params, args.events.is_some()) {
         Ok(c) => c,
-        Err(e) => {
-            for d in e.diagnostics() {
-                eprintln!("{}", d.render());
-            }
-            return usage(format!("parameter lists in {} refused", params.display()));
-        }
-    };
-    for w in &config.warnings {
-        eprintln!("{}", w.render());
-    }
-    let channels = match crate::setup::channels(&config, args.events.is_some()) {
-        Ok(c) => c,
-        Err(e) => return usage(e),
+        Err(msg) => return usage(msg),
     };
     let log = match &args.events {
         None => EventLog::disabled(),
