@@ -43,6 +43,25 @@ impl CacheError {
     }
 }
 
+/// What `#CACHE LOAD` did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Loaded {
+    /// The file was not cached before.
+    New,
+    /// It was: its text was replaced by the file's current content.
+    Refreshed,
+}
+
+impl Loaded {
+    /// The `op` of the `cache` event.
+    pub fn op(self) -> &'static str {
+        match self {
+            Loaded::New => "load",
+            Loaded::Refreshed => "refresh",
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 struct CacheEntry {
     /// Lower-case name: cache names are case-insensitive.
@@ -81,8 +100,9 @@ impl Cache {
         self.entries.is_empty()
     }
 
-    /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached.
-    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<(), CacheError> {
+    /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached. The file is read
+    /// through the store, so the load counts as a file-system open and pays its latency.
+    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<Loaded, CacheError> {
         if !self.limits.enabled {
             return Err(CacheError::NotEnabled);
         }
@@ -124,11 +144,16 @@ impl Cache {
                 max: self.limits.max_file_bytes,
             });
         }
-        match existing {
-            Some(i) => self.entries[i].program = program,
-            None => self.entries.push(CacheEntry { key, program }),
-        }
-        Ok(())
+        Ok(match existing {
+            Some(i) => {
+                self.entries[i].program = program;
+                Loaded::Refreshed
+            }
+            None => {
+                self.entries.push(CacheEntry { key, program });
+                Loaded::New
+            }
+        })
     }
 
     /// `#CACHE CLEAR [FILE=name]`: silent when not cached.
