@@ -20,8 +20,12 @@ const SEED_FILES: [&str; 5] = [
 ];
 
 fn repo_nc(name: &str) -> String {
-    std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("nc").join(name))
-        .unwrap()
+    std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("nc")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// `(op, file)` of every `cache` event, in order.
@@ -195,10 +199,7 @@ fn cache_full_is_21562_and_a_refresh_needs_no_room() {
 #[test]
 fn file_not_found_is_21563() {
     let rig = Rig::new();
-    let (code, msg, _) = failing(
-        &rig,
-        "#CACHE LOAD[FILE=nowhere.cyc]\nG1 X10 F1000\nM30\n",
-    );
+    let (code, msg, _) = failing(&rig, "#CACHE LOAD[FILE=nowhere.cyc]\nG1 X10 F1000\nM30\n");
     assert_eq!(code, 21563);
     assert!(msg.contains("nowhere.cyc"), "{msg}");
 }
@@ -213,7 +214,10 @@ fn file_larger_than_max_cache_size_is_21564_and_is_not_read() {
     big.push_str(")\nM17\n");
     rig.program("big.cyc", &big);
     rig.program("fits.cyc", &format!("({})\nM17\n", "y".repeat(193)));
-    assert_eq!(std::fs::metadata(rig.nc().join("fits.cyc")).unwrap().len(), 200);
+    assert_eq!(
+        std::fs::metadata(rig.nc().join("fits.cyc")).unwrap().len(),
+        200
+    );
     let (code, msg, r) = failing(
         &rig,
         "#CACHE LOAD[FILE=fits.cyc]\n#CACHE LOAD[FILE=big.cyc]\nG1 X10 F1000\nM30\n",
@@ -221,7 +225,11 @@ fn file_larger_than_max_cache_size_is_21564_and_is_not_read() {
     assert_eq!(code, 21564);
     assert!(msg.contains("big.cyc") && msg.contains("200"), "{msg}");
     let c = &r.machine.channels()[0];
-    assert_eq!(c.store_stats().opens, 2, "main + fits.cyc; big.cyc is refused unread");
+    assert_eq!(
+        c.store_stats().opens,
+        2,
+        "main + fits.cyc; big.cyc is refused unread"
+    );
     assert_eq!(c.cache().names().collect::<Vec<_>>(), ["fits.cyc"]);
 }
 
@@ -292,13 +300,21 @@ fn the_cache_lasts_across_programs_until_a_reset() {
     assert_eq!(c.cache().len(), 1);
     run_program(c, &mut t, "call.nc");
     assert_eq!(c.state(), State::Ready);
-    assert_eq!(c.store_stats().opens, 3, "load.nc, the load, call.nc: the call is a hit");
+    assert_eq!(
+        c.store_stats().opens,
+        3,
+        "load.nc, the load, call.nc: the call is a hit"
+    );
     assert_eq!(c.cache().hits, 1);
     c.reset(&t);
     assert!(c.cache().is_empty(), "a channel reset clears the cache");
     run_program(c, &mut t, "call.nc");
     assert_eq!(c.state(), State::Ready);
-    assert_eq!(c.store_stats().opens, 5, "call.nc and c.cyc from the file system");
+    assert_eq!(
+        c.store_stats().opens,
+        5,
+        "call.nc and c.cyc from the file system"
+    );
     assert_eq!(c.cache().hits, 1);
 }
 
@@ -451,10 +467,7 @@ fn a_streamed_program_calls_from_the_cache() {
 fn a_stream_called_from_a_file_program_uses_the_cache_the_file_loaded() {
     let rig = Rig::new();
     rig.program("sub.nc", "G1 Y5 F6000\nM17\n");
-    rig.program(
-        "main.nc",
-        "#CACHE LOAD[FILE=sub.nc]\nL streaming.nc\nM30\n",
-    );
+    rig.program("main.nc", "#CACHE LOAD[FILE=sub.nc]\nL streaming.nc\nM30\n");
     let r = rig.run(
         "main.nc",
         Some(feeder("N100 L sub.nc\nN110 G1 X3 F6000\nM17\n", 992, 1)),
@@ -516,7 +529,10 @@ fn fs_latency_below_a_tick_is_accounted_in_fractions_of_ticks() {
     let main_bytes = 5 + 100 * 21 + 4;
     assert_eq!(latency, fs.cost(12) * 100 + fs.cost(main_bytes));
     let ms = latency.as_millis() as u64; // 23
-    assert!((ms..ms + 3).contains(&ticks), "{ticks} ticks for {latency:?}");
+    assert!(
+        (ms..ms + 3).contains(&ticks),
+        "{ticks} ticks for {latency:?}"
+    );
 }
 
 #[test]

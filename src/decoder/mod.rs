@@ -1455,8 +1455,7 @@ impl Decoder {
                 for (n, e) in params {
                     values.push((*n, self.eval(e)?));
                 }
-                let mut frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
-                frame.cycle_params = values.clone();
+                let frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(values);
                 self.frames.push(frame);
@@ -1553,7 +1552,7 @@ fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
         FrameKind::Main,
         Source::File(ProgramText {
             name: Arc::from(""),
-            path: Default::default(),
+            path: Arc::from(std::path::Path::new("")),
             text: Arc::from(text),
         }),
         Arc::from(""),

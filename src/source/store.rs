@@ -50,8 +50,8 @@ pub enum ProgramKind {
 pub struct ProgramText {
     /// The name as the program called it.
     pub name: Arc<str>,
-    /// Where it was found.
-    pub path: PathBuf,
+    /// Where it was found. Shared like the text: a cache hit copies no path.
+    pub path: Arc<Path>,
     pub text: Arc<[u8]>,
 }
 
@@ -216,7 +216,7 @@ impl ProgramStore {
         }
         Ok(ProgramText {
             name: name.into(),
-            path,
+            path: path.into(),
             text: text.into(),
         })
     }
