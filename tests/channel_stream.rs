@@ -155,7 +155,7 @@ fn big_program() -> String {
     let mut i = 0u64;
     while s.len() < 1_000_000 {
         i += 1;
-        if i % 3 == 0 {
+        if i.is_multiple_of(3) {
             s.push_str(&format!("N{i} P{} = [P1 + {i}]\n", 2 + i % 50));
         } else {
             s.push_str(&format!(
