@@ -548,3 +548,24 @@ fn motion_keeps_running_while_a_read_is_pending() {
     let first = r.of("block")[0]["t"].as_f64().unwrap();
     assert!((first - 0.3).abs() < 0.002, "first block at {first} s");
 }
+
+#[test]
+fn the_channel_list_can_switch_caching_on() {
+    let rig = Rig::with_cache(None, "");
+    std::fs::write(
+        rig.dir.path().join("params/channel1.lis"),
+        "streaming_prog_file streaming.nc\nconfiguration.decoder.function FCT_USE_CACHED_FILES\n\
+         configuration.decoder.max_cache_number 1\n",
+    )
+    .unwrap();
+    rig.program("a.cyc", "M17\n");
+    rig.program("b.cyc", "M17\n");
+    rig.program(
+        "main.nc",
+        "#CACHE LOAD[FILE=a.cyc]\nL CYCLE [NAME=a.cyc]\n#CACHE LOAD[FILE=b.cyc]\nM30\n",
+    );
+    let r = rig.run("main.nc", None, 10_000);
+    // One file allowed by the channel list: the second load is 21562.
+    assert_eq!(r.error_codes(), [21562], "{}", r.log);
+    assert_eq!(r.machine.channels()[0].cache().hits, 1);
+}

@@ -329,6 +329,8 @@ impl Decoder {
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
+        // A read charged to an earlier program is not this one's to wait for.
+        store.take_owed();
         self.stream_active = false;
         self.search = search.map(|target| Search {
             target,
