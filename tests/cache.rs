@@ -569,3 +569,32 @@ fn the_channel_list_can_switch_caching_on() {
     assert_eq!(r.error_codes(), [21562], "{}", r.log);
     assert_eq!(r.machine.channels()[0].cache().hits, 1);
 }
+
+#[test]
+fn run_reports_file_system_opens_bytes_and_cache_hits() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = tempfile::tempdir().unwrap();
+    let report = out.path().join("r.json");
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args(["run", "cache_example.nc", "--params"])
+        .arg(root.join("params/startup.lis"))
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    let human = String::from_utf8_lossy(&st.stdout);
+    assert!(human.contains("files:      7 opens"), "{human}");
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let size = |f: &str| std::fs::metadata(root.join("nc").join(f)).unwrap().len();
+    // Main program, the five loads (Laser_off.cyc twice) and the uncached Laser_on.cyc call.
+    let bytes = size("cache_example.nc")
+        + 2 * size("Laser_on.cyc")
+        + size("Macro.cyc")
+        + 2 * size("Laser_off.cyc")
+        + size("Global.sub");
+    assert_eq!(v["files"]["opens"], 7);
+    assert_eq!(v["files"]["bytes_read"], bytes);
+    assert_eq!(v["files"]["cache_hits"], 3);
+    assert_eq!(v["files"]["latency_s"], 0.0);
+}
