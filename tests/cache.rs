@@ -582,7 +582,11 @@ fn run_reports_file_system_opens_bytes_and_cache_hits() {
         .arg(&report)
         .output()
         .unwrap();
-    assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
     let human = String::from_utf8_lossy(&st.stdout);
     assert!(human.contains("files:      7 opens"), "{human}");
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
