@@ -15,7 +15,7 @@ use crate::queue::{BlockQueue, Position, AXIS_LETTERS};
 use crate::report::event::{EventBuffer, EventKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
-use crate::source::store::{ProgramStore, SearchDir, StoreStats};
+use crate::source::store::{FsLatency, ProgramStore, SearchDir, StoreStats};
 use crate::source::stream::{StreamBuffer, StreamWriteError};
 
 /// Warning raised when a stream write is rejected because the buffer is full.
@@ -123,6 +123,8 @@ pub struct ChannelSettings {
     /// `streaming_prog_file`; `None` = streaming off.
     pub streaming_prog: Option<String>,
     pub cache: CacheLimits,
+    /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
+    pub fs_latency: FsLatency,
 }
 
 /// How a channel's program run finished, for `ncchannel run`.
@@ -176,7 +178,8 @@ impl Channel {
             mode: Mode::Automatic,
             state: State::Ready,
             stream: StreamBuffer::new(),
-            store: ProgramStore::new(s.search_dirs, s.streaming_prog.as_deref()),
+            store: ProgramStore::new(s.search_dirs, s.streaming_prog.as_deref())
+                .with_latency(s.fs_latency),
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
             decoder: Decoder::new(s.decoder),
@@ -503,6 +506,8 @@ impl Channel {
         self.queue.clear();
         self.decoder.reset(self.motion.position());
         self.cache.reset();
+        // A read still pending is abandoned with the program.
+        self.store.take_owed();
         self.last_error = None;
         self.interrupted = false;
         self.search = None;
@@ -581,6 +586,8 @@ impl Channel {
             queue: &mut self.queue,
             motion_idle: self.motion.idle(),
             want_text: self.events.enabled(),
+            now: tick.time,
+            period: tick.period,
         };
         self.decoder.step(&mut io);
         self.drain_decoder_notes(tick);

@@ -9,7 +9,7 @@ use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
 use crate::queue::{AXIS_LETTERS, MAX_AXES};
 use crate::source::cache::CacheLimits;
-use crate::source::store::{SearchDir, PATH_MAIN, PATH_SUB};
+use crate::source::store::{FsLatency, SearchDir, PATH_MAIN, PATH_SUB};
 
 #[derive(Debug, Error)]
 pub enum SetupError {
@@ -94,6 +94,7 @@ pub fn channel_settings(
             max_files: c.max_files as usize,
             max_file_bytes: u64::from(c.max_file_bytes),
         },
+        fs_latency: FsLatency::from_us(rt.fs_latency_us, rt.fs_latency_us_per_kib),
     })
 }
 

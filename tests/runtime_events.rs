@@ -7,7 +7,9 @@ use std::time::Duration;
 use ncchannel::cli::bench::{generated_program, StreamingLoad};
 use ncchannel::report::event::{Event, EventKind, EventLog};
 use ncchannel::report::stats::CycleStats;
-use ncchannel::report::summary::{CycleReport, ErrorReport, Outcome, Report, StreamReport};
+use ncchannel::report::summary::{
+    CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
+};
 use ncchannel::runtime::{Clock, RunEnd, Runtime, Tick};
 use serde_json::Value;
 
@@ -224,6 +226,12 @@ fn report_json_has_the_documented_shape() {
             msg: "Streaming data does not contain a correct line end marker".into(),
         }],
         cycle: CycleReport::new(Duration::from_millis(1), &stats),
+        files: FilesReport {
+            opens: 3,
+            bytes_read: 700,
+            cache_hits: 5,
+            latency_s: 0.0006,
+        },
     };
     let v: Value = serde_json::from_str(&r.to_json_pretty()).unwrap();
     assert_eq!(v["outcome"], "max_ticks");
@@ -239,8 +247,13 @@ fn report_json_has_the_documented_shape() {
             "stream",
             "interrupts",
             "errors",
-            "cycle"
+            "cycle",
+            "files"
         ])
+    );
+    assert_eq!(
+        keys(&v["files"].to_string()),
+        sorted(&["opens", "bytes_read", "cache_hits", "latency_s"])
     );
     assert_eq!(v["position"]["Y"], -2.5);
     assert_eq!(
@@ -274,6 +287,7 @@ fn report_json_has_the_documented_shape() {
         "interrupts: 1",
         "3 writes accepted, 1 rejected",
         "error 21476",
+        "3 opens, 700 bytes read, 5 cache hits",
     ] {
         assert!(human.contains(want), "{want:?} missing in\n{human}");
     }

@@ -11,7 +11,9 @@ use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
-use crate::report::summary::{CycleReport, ErrorReport, Outcome, Report, StreamReport};
+use crate::report::summary::{
+    CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
+};
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
 
 use super::exit;
@@ -244,6 +246,12 @@ pub fn execute(args: RunArgs) -> ExitCode {
             })
             .collect(),
         cycle: CycleReport::new(period, &stats),
+        files: FilesReport {
+            opens: c.store_stats().opens,
+            bytes_read: c.store_stats().bytes_read,
+            cache_hits: c.cache().hits,
+            latency_s: c.store_stats().latency.as_secs_f64(),
+        },
     };
     if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
         let title = format!("ncchannel run {program}");

@@ -59,8 +59,6 @@ pub struct Frame {
     pub comment_block: bool,
     /// Inside `#VAR` … `#ENDVAR`.
     pub var_block: bool,
-    /// `@P<n>` values of a cycle call.
-    pub cycle_params: Vec<(u32, f64)>,
     /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
     /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`.
     pub seen_labels: HashSet<Label>,
@@ -102,7 +100,6 @@ impl Frame {
             skip: None,
             comment_block: false,
             var_block: false,
-            cycle_params: Vec::new(),
             seen_labels: HashSet::new(),
             label_index: None,
         }

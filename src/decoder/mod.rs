@@ -14,6 +14,7 @@ pub mod vars;
 
 use std::fmt;
 use std::sync::Arc;
+use std::time::Duration;
 
 use crate::lang::block::{
     Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, Value,
@@ -200,8 +201,13 @@ pub struct DecoderIo<'a> {
     pub queue: &'a mut BlockQueue,
     /// Motion has nothing left to do (for `#FLUSH WAIT`).
     pub motion_idle: bool,
-    /// Keep each block's text for the event log.
+    /// Keep each block's text for the event log (and report cache hits: events are on).
     pub want_text: bool,
+    /// Channel time at the start of this tick.
+    pub now: Duration,
+    /// Length of this tick: decoding stops for the tick once simulated file-system latency
+    /// has used it up.
+    pub period: Duration,
 }
 
 /// Counters for the report.
@@ -231,6 +237,9 @@ pub struct Decoder {
     wait_idle: bool,
     /// The top frame is a stream that has no complete line: motion may starve.
     starved: bool,
+    /// Channel time when the last simulated file-system read completes (runtime.toml
+    /// `fs_latency_us`). Decoding does nothing before it; motion runs on meanwhile.
+    ready_at: Duration,
     line: String,
     notes: Vec<Note>,
     stats: DecoderStats,
@@ -253,6 +262,7 @@ impl Decoder {
             skip_mask: 0,
             wait_idle: false,
             starved: false,
+            ready_at: Duration::ZERO,
             line: String::new(),
             notes: Vec::new(),
             stats: DecoderStats::default(),
@@ -318,6 +328,9 @@ impl Decoder {
         self.counter = 0;
         self.wait_idle = false;
         self.starved = false;
+        self.ready_at = Duration::ZERO;
+        // A read charged to an earlier program is not this one's to wait for.
+        store.take_owed();
         self.stream_active = false;
         self.search = search.map(|target| Search {
             target,
@@ -362,6 +375,7 @@ impl Decoder {
         self.search = None;
         self.wait_idle = false;
         self.starved = false;
+        self.ready_at = Duration::ZERO;
     }
 
     fn begin_stream(&mut self) {
@@ -370,9 +384,22 @@ impl Decoder {
     }
 
     /// Decode up to the per-tick budget.
+    ///
+    /// Simulated file-system latency never blocks the tick: a file read (main program, call,
+    /// `#CACHE LOAD`) moves `ready_at` on by its cost, counted from when the decoder was free,
+    /// and decoding goes on in this tick only while `ready_at` lies inside it. So reads of
+    /// 200 µs in 1 ms ticks give five per tick, and a 5 ms read pauses decoding for five ticks.
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
         let mut budget = self.settings.blocks_per_tick;
+        let tick_end = io.now + io.period;
         while budget > 0 && self.state == DecoderState::Running {
+            let owed = io.store.take_owed();
+            if !owed.is_zero() {
+                self.ready_at = self.ready_at.max(io.now) + owed;
+            }
+            if self.ready_at >= tick_end {
+                break;
+            }
             if self.wait_idle {
                 if io.queue.is_empty() && io.motion_idle {
                     self.wait_idle = false;
@@ -1353,11 +1380,12 @@ impl Decoder {
                 }
             }
             Command::CacheLoad { file } => {
-                io.cache
+                let loaded = io
+                    .cache
                     .load(file, io.store)
                     .map_err(|e| DecodeError::new(e.code(), e.to_string()))?;
                 self.notes.push(Note::Cache {
-                    op: "load",
+                    op: loaded.op(),
                     file: file.clone(),
                 });
                 self.emit(info, Action::None, false, io);
@@ -1431,8 +1459,7 @@ impl Decoder {
                 for (n, e) in params {
                     values.push((*n, self.eval(e)?));
                 }
-                let mut frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
-                frame.cycle_params = values.clone();
+                let frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(values);
                 self.frames.push(frame);
@@ -1472,6 +1499,13 @@ impl Decoder {
         io: &mut DecoderIo<'_>,
     ) -> Res<Frame> {
         if let Some(p) = io.cache.get(name) {
+            if io.want_text {
+                // Only with events on: the hot call path stays free of the allocation.
+                self.notes.push(Note::Cache {
+                    op: "hit",
+                    file: name.to_string(),
+                });
+            }
             let prog = p.name.clone();
             return Ok(Frame::new(kind, Source::File(p), prog));
         }
@@ -1522,7 +1556,7 @@ fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
         FrameKind::Main,
         Source::File(ProgramText {
             name: Arc::from(""),
-            path: Default::default(),
+            path: Arc::from(std::path::Path::new("")),
             text: Arc::from(text),
         }),
         Arc::from(""),

@@ -41,6 +41,20 @@ impl From<&StreamCounters> for StreamReport {
     }
 }
 
+/// Program file accesses: what the file cache (`#CACHE`) saves.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FilesReport {
+    /// Program files opened and read from the file system (main program, uncached calls,
+    /// `#CACHE LOAD`).
+    pub opens: u64,
+    /// Bytes those opens read.
+    pub bytes_read: u64,
+    /// Calls served from the file cache.
+    pub cache_hits: u64,
+    /// Simulated file-system latency charged (runtime.toml `fs_latency_us…`), seconds.
+    pub latency_s: f64,
+}
+
 /// One channel error or warning raised during the run.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ErrorReport {
@@ -91,6 +105,9 @@ pub struct Report {
     pub interrupts: u64,
     pub errors: Vec<ErrorReport>,
     pub cycle: CycleReport,
+    /// File-system opens, bytes read and cache hits (absent in reports from before Stage 4).
+    #[serde(default)]
+    pub files: FilesReport,
 }
 
 impl Report {
@@ -136,6 +153,11 @@ impl Report {
             w,
             "stream:     {} writes accepted, {} rejected, {} bytes",
             self.stream.writes_ok, self.stream.writes_rejected, self.stream.bytes
+        )?;
+        writeln!(
+            w,
+            "files:      {} opens, {} bytes read, {} cache hits, {:.6} s simulated latency",
+            self.files.opens, self.files.bytes_read, self.files.cache_hits, self.files.latency_s
         )?;
         writeln!(
             w,

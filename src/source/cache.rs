@@ -43,6 +43,25 @@ impl CacheError {
     }
 }
 
+/// What `#CACHE LOAD` did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Loaded {
+    /// The file was not cached before.
+    New,
+    /// It was: its text was replaced by the file's current content.
+    Refreshed,
+}
+
+impl Loaded {
+    /// The `op` of the `cache` event.
+    pub fn op(self) -> &'static str {
+        match self {
+            Loaded::New => "load",
+            Loaded::Refreshed => "refresh",
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 struct CacheEntry {
     /// Lower-case name: cache names are case-insensitive.
@@ -81,8 +100,9 @@ impl Cache {
         self.entries.is_empty()
     }
 
-    /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached.
-    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<(), CacheError> {
+    /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached. The file is read
+    /// through the store, so the load counts as a file-system open and pays its latency.
+    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<Loaded, CacheError> {
         if !self.limits.enabled {
             return Err(CacheError::NotEnabled);
         }
@@ -124,11 +144,16 @@ impl Cache {
                 max: self.limits.max_file_bytes,
             });
         }
-        match existing {
-            Some(i) => self.entries[i].program = program,
-            None => self.entries.push(CacheEntry { key, program }),
-        }
-        Ok(())
+        Ok(match existing {
+            Some(i) => {
+                self.entries[i].program = program;
+                Loaded::Refreshed
+            }
+            None => {
+                self.entries.push(CacheEntry { key, program });
+                Loaded::New
+            }
+        })
     }
 
     /// `#CACHE CLEAR [FILE=name]`: silent when not cached.
@@ -166,5 +191,86 @@ impl Cache {
 
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.entries.iter().map(|e| &*e.program.name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::source::store::{SearchDir, PATH_MAIN, PATH_SUB};
+    use std::fs;
+
+    fn store(dir: &std::path::Path) -> ProgramStore {
+        ProgramStore::new(
+            vec![SearchDir {
+                dir: dir.to_path_buf(),
+                kinds: PATH_MAIN | PATH_SUB,
+                priority: 0,
+            }],
+            None,
+        )
+    }
+
+    fn limits(max_files: usize, max_file_bytes: u64) -> CacheLimits {
+        CacheLimits {
+            enabled: true,
+            max_files,
+            max_file_bytes,
+        }
+    }
+
+    #[test]
+    fn load_refresh_clear_and_limits() {
+        let d = tempfile::tempdir().unwrap();
+        fs::write(d.path().join("A.cyc"), "M17\n").unwrap();
+        fs::write(d.path().join("b.cyc"), "M17\n").unwrap();
+        fs::write(d.path().join("c.cyc"), "M17\n").unwrap();
+        fs::write(d.path().join("big.cyc"), vec![b'x'; 11]).unwrap();
+        let mut s = store(d.path());
+        let mut c = Cache::new(limits(2, 10));
+        assert_eq!(c.load("a.cyc", &mut s), Ok(Loaded::New));
+        assert_eq!(c.load("A.CYC", &mut s), Ok(Loaded::Refreshed));
+        assert_eq!(c.load("b.cyc", &mut s), Ok(Loaded::New));
+        assert_eq!(c.load("c.cyc", &mut s).unwrap_err().code(), 21562);
+        c.clear("B.cyc").unwrap();
+        assert_eq!(c.load("nope.cyc", &mut s).unwrap_err().code(), 21563);
+        let opens = s.stats().opens;
+        assert_eq!(c.load("big.cyc", &mut s).unwrap_err().code(), 21564);
+        assert_eq!(s.stats().opens, opens, "too large: refused unread");
+        c.clear("not-cached.cyc").unwrap();
+        assert_eq!(c.len(), 1);
+        assert!(c.get("a.CYC").is_some() && c.get("b.cyc").is_none());
+        assert_eq!(c.hits, 1);
+        c.clear_all().unwrap();
+        assert!(c.is_empty());
+    }
+
+    #[test]
+    fn a_refresh_leaves_a_running_copy_alone() {
+        let d = tempfile::tempdir().unwrap();
+        fs::write(d.path().join("s.sub"), "X1\n").unwrap();
+        let mut s = store(d.path());
+        let mut c = Cache::new(limits(1, 100));
+        c.load("s.sub", &mut s).unwrap();
+        let running = c.get("s.sub").unwrap();
+        fs::write(d.path().join("s.sub"), "X2\n").unwrap();
+        c.load("s.sub", &mut s).unwrap();
+        assert_eq!(&*running.text, b"X1\n");
+        assert_eq!(&*c.get("s.sub").unwrap().text, b"X2\n");
+    }
+
+    #[test]
+    fn everything_but_reset_needs_the_function() {
+        let d = tempfile::tempdir().unwrap();
+        let mut s = store(d.path());
+        let mut c = Cache::new(CacheLimits {
+            enabled: false,
+            max_files: 0,
+            max_file_bytes: 0,
+        });
+        assert_eq!(c.load("x", &mut s).unwrap_err().code(), 90160);
+        assert_eq!(c.clear("x").unwrap_err().code(), 90160);
+        assert_eq!(c.clear_all().unwrap_err().code(), 90160);
+        c.reset();
     }
 }

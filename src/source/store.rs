@@ -4,11 +4,17 @@
 //! called as a subroutine; that read is what the file cache (#CACHE) saves, so every open and
 //! every byte read is counted here. The name in `streaming_prog_file` is not a file at all: it
 //! opens the channel's stream interface instead, transparently (seed 003 §2.2).
+//!
+//! A slow drive or network share is modelled by [`FsLatency`]: every file-system read is
+//! charged `per_open + per_kib × KiB` of channel time. The store never sleeps; it only adds the
+//! charge to an account the decoder takes with [`ProgramStore::take_owed`] and turns into "the
+//! read completes at channel time T" (decoding waits, motion keeps running what is queued).
 
 use std::fs;
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 use std::sync::Arc;
+use std::time::Duration;
 
 use thiserror::Error;
 
@@ -44,8 +50,8 @@ pub enum ProgramKind {
 pub struct ProgramText {
     /// The name as the program called it.
     pub name: Arc<str>,
-    /// Where it was found.
-    pub path: PathBuf,
+    /// Where it was found. Shared like the text: a cache hit copies no path.
+    pub path: Arc<Path>,
     pub text: Arc<[u8]>,
 }
 
@@ -98,6 +104,37 @@ pub struct StoreStats {
     pub opens: u64,
     /// Bytes read from the file system.
     pub bytes_read: u64,
+    /// Simulated file-system latency charged for those reads (runtime.toml `fs_latency_us…`).
+    pub latency: Duration,
+}
+
+/// Simulated cost of a file-system read (runtime.toml `fs_latency_us`, `fs_latency_us_per_kib`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FsLatency {
+    /// Charged once per file opened.
+    pub per_open: Duration,
+    /// Charged per KiB read, pro rata (a 512-byte file costs half of it).
+    pub per_kib: Duration,
+}
+
+impl FsLatency {
+    pub fn from_us(per_open_us: u64, per_kib_us: u64) -> Self {
+        FsLatency {
+            per_open: Duration::from_micros(per_open_us),
+            per_kib: Duration::from_micros(per_kib_us),
+        }
+    }
+
+    /// What reading a file of `bytes` costs.
+    pub fn cost(&self, bytes: u64) -> Duration {
+        // In ns: per_kib ≤ 10 s and bytes ≤ MAX_PROGRAM_BYTES keep this far below u128 limits.
+        let per_kib_ns = self.per_kib.as_nanos() * u128::from(bytes) / 1024;
+        self.per_open + Duration::from_nanos(u64::try_from(per_kib_ns).unwrap_or(u64::MAX))
+    }
+
+    pub fn is_zero(&self) -> bool {
+        self.per_open.is_zero() && self.per_kib.is_zero()
+    }
 }
 
 /// The channel's view of its programs.
@@ -107,6 +144,9 @@ pub struct ProgramStore {
     /// `streaming_prog_file`, lower-case; `None` = streaming off.
     streaming_prog: Option<String>,
     stats: StoreStats,
+    latency: FsLatency,
+    /// Latency charged and not yet taken by the decoder.
+    owed: Duration,
 }
 
 impl ProgramStore {
@@ -118,11 +158,29 @@ impl ProgramStore {
                 .filter(|s| !s.is_empty())
                 .map(|s| s.to_ascii_lowercase()),
             stats: StoreStats::default(),
+            latency: FsLatency::default(),
+            owed: Duration::ZERO,
         }
+    }
+
+    /// Charge every file-system read with this simulated latency.
+    pub fn with_latency(mut self, latency: FsLatency) -> Self {
+        self.latency = latency;
+        self
+    }
+
+    pub fn latency(&self) -> FsLatency {
+        self.latency
     }
 
     pub fn stats(&self) -> StoreStats {
         self.stats
+    }
+
+    /// Latency charged since the last call: the caller (the decoder) waits it out in channel
+    /// time. Zero when no file was read or no latency is configured.
+    pub fn take_owed(&mut self) -> Duration {
+        std::mem::take(&mut self.owed)
     }
 
     pub fn search_dirs(&self) -> &[SearchDir] {
@@ -151,9 +209,14 @@ impl ProgramStore {
         let text = read_bounded(&path, name)?;
         self.stats.opens += 1;
         self.stats.bytes_read += text.len() as u64;
+        if !self.latency.is_zero() {
+            let cost = self.latency.cost(text.len() as u64);
+            self.owed += cost;
+            self.stats.latency += cost;
+        }
         Ok(ProgramText {
             name: name.into(),
-            path,
+            path: path.into(),
             text: text.into(),
         })
     }
@@ -286,8 +349,32 @@ mod tests {
             s.stats(),
             StoreStats {
                 opens: 1,
-                bytes_read: 5
+                bytes_read: 5,
+                latency: Duration::ZERO,
             }
+        );
+        assert_eq!(s.take_owed(), Duration::ZERO);
+    }
+
+    #[test]
+    fn every_file_read_is_charged_its_latency_once() {
+        let d = tempfile::tempdir().unwrap();
+        fs::write(d.path().join("big.nc"), vec![b'x'; 2048]).unwrap();
+        let mut s = store(d.path()).with_latency(FsLatency::from_us(200, 100));
+        s.open("big.nc", ProgramKind::Main).unwrap();
+        // 200 µs per open + 2 KiB × 100 µs.
+        assert_eq!(s.take_owed(), Duration::from_micros(400));
+        assert_eq!(s.take_owed(), Duration::ZERO, "taken once");
+        // The stream is no file: no charge.
+        s.open("streaming.nc", ProgramKind::Main).unwrap();
+        assert_eq!(s.take_owed(), Duration::ZERO);
+        // A failed open reads nothing and costs nothing.
+        assert!(s.open("absent.nc", ProgramKind::Main).is_err());
+        assert_eq!(s.take_owed(), Duration::ZERO);
+        assert_eq!(s.stats().latency, Duration::from_micros(400));
+        assert_eq!(
+            FsLatency::from_us(0, 1024).cost(512),
+            Duration::from_micros(512)
         );
     }
 

@@ -65,17 +65,26 @@ impl Rig {
     }
 
     pub fn with_runtime(runtime_toml: &str) -> Rig {
+        Self::with_cache(Some((2, 200)), runtime_toml)
+    }
+
+    /// Like `with_runtime`, with other cache limits: `Some((max_cache_number,
+    /// max_cache_size))`, or `None` for file caching off.
+    pub fn with_cache(cache: Option<(u32, u32)>, runtime_toml: &str) -> Rig {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir_all(dir.path().join("params")).unwrap();
         std::fs::create_dir_all(dir.path().join("nc")).unwrap();
-        std::fs::write(
-            dir.path().join("params/startup.lis"),
-            "kanal_anzahl 1\nsda_mds[0] channel1.lis\npfad[0].prg[0] ../nc\npfad[0].typ[0] 0x03\npfad[0].prioritaet[0] 0\n\
-             configuration.channel[0].decoder.function FCT_USE_CACHED_FILES\n\
-             configuration.channel[0].decoder.max_cache_number 2\n\
-             configuration.channel[0].decoder.max_cache_size 200\n",
-        )
-        .unwrap();
+        let mut startup = String::from(
+            "kanal_anzahl 1\nsda_mds[0] channel1.lis\npfad[0].prg[0] ../nc\npfad[0].typ[0] 0x03\npfad[0].prioritaet[0] 0\n",
+        );
+        if let Some((files, bytes)) = cache {
+            startup.push_str(&format!(
+                "configuration.channel[0].decoder.function FCT_USE_CACHED_FILES\n\
+                 configuration.channel[0].decoder.max_cache_number {files}\n\
+                 configuration.channel[0].decoder.max_cache_size {bytes}\n"
+            ));
+        }
+        std::fs::write(dir.path().join("params/startup.lis"), startup).unwrap();
         std::fs::write(
             dir.path().join("params/channel1.lis"),
             "streaming_prog_file streaming.nc\n",
