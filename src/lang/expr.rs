@@ -232,26 +232,28 @@ impl<'a> Ctx<'a> {
         }
     }
 
-    const LEVELS: usize = 9;
-
-    fn level(&self, lvl: usize, i: &'a str) -> PResult<'a, Expr> {
-        if lvl == Self::LEVELS {
-            return self.unary(i);
-        }
-        let (mut i, mut lhs) = self.level(lvl + 1, i)?;
+    /// Precedence climbing: an operand, then every binary operator of level `min` or tighter,
+    /// each with its right operand parsed one level tighter (left associative). One operator
+    /// lookup per operator position, instead of one per level per operand.
+    fn level(&self, min: usize, i: &'a str) -> PResult<'a, Expr> {
+        let (mut i, mut lhs) = self.unary(i)?;
         let mut h = self.height.get();
         loop {
             let j = ws(i);
-            let Some((op, n)) = binary_op(lvl, j) else {
-                self.height.set(h);
-                return Ok((i, lhs));
+            let Some((op, n, lvl)) = any_binary_op(j) else {
+                break;
             };
+            if lvl < min {
+                break;
+            }
             let (k, rhs) = self.level(lvl + 1, ws(&j[n..]))?;
             h = h.max(self.height.get()) + 1;
             self.set_height(h, j)?;
             lhs = Expr::Binary(op, Box::new(lhs), Box::new(rhs));
             i = k;
         }
+        self.height.set(h);
+        Ok((i, lhs))
     }
 
     fn unary(&self, i: &'a str) -> PResult<'a, Expr> {
@@ -493,6 +495,40 @@ impl<'a> Ctx<'a> {
 
 /// The binary operator of precedence level `lvl` at the start of `i`, with its length.
 #[inline]
+/// The binary operator at the start of `i`, its length and its level (0 binds loosest). The
+/// operators of different levels never share a prefix, so at most one level matches.
+fn any_binary_op(i: &str) -> Option<(BinOp, usize, usize)> {
+    let b0 = *i.as_bytes().first()?;
+    // Most positions hold no operator at all: rule them out with one byte.
+    if !matches!(
+        b0,
+        b'|' | b'&'
+            | b'^'
+            | b'='
+            | b'!'
+            | b'<'
+            | b'>'
+            | b'+'
+            | b'-'
+            | b'*'
+            | b'/'
+            | b'O'
+            | b'o'
+            | b'X'
+            | b'x'
+            | b'A'
+            | b'a'
+            | b'M'
+            | b'm'
+    ) {
+        return None;
+    }
+    (0..LEVELS).find_map(|lvl| binary_op(lvl, i).map(|(op, n)| (op, n, lvl)))
+}
+
+/// Number of binary precedence levels.
+const LEVELS: usize = 9;
+
 fn binary_op(lvl: usize, i: &str) -> Option<(BinOp, usize)> {
     let b = i.as_bytes();
     let b0 = *b.first()?;
