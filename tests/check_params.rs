@@ -42,3 +42,19 @@ fn a_broken_list_gives_file_line_column_and_exit_1() {
     assert_eq!(code, 1);
     assert!(out.contains("bogus"), "{out}");
 }
+
+#[test]
+fn the_shipped_folders_pass_as_the_issue_names_them() {
+    // `check nc/* params/*.lis` as a shell expands it: nc/README.md is skipped, not an error.
+    let mut args: Vec<String> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/nc"))
+        .unwrap()
+        .map(|e| format!("nc/{}", e.unwrap().file_name().to_string_lossy()))
+        .collect();
+    args.extend([
+        "params/startup.lis".to_string(),
+        "params/channel1.lis".to_string(),
+    ]);
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, out) = check(&refs);
+    assert_eq!(code, 0, "{out}");
+}

@@ -19,7 +19,7 @@ pub struct CheckArgs {
 }
 
 /// Extensions picked up when walking a directory. Files named explicitly are checked
-/// whatever their extension (anything not `.lis`/`.toml` as an NC program).
+/// whatever their extension (anything not `.lis`/`.toml` as an NC program), but Markdown.
 const NC_EXTENSIONS: &[&str] = &["nc", "cyc", "sub", "spf", "mpf"];
 const PARAM_EXTENSIONS: &[&str] = &["lis", "toml"];
 
@@ -93,6 +93,16 @@ fn collect(path: &Path, explicit: bool, files: &mut Vec<PathBuf>, diags: &mut Ve
         return;
     }
     let ext = extension(path);
+    // Markdown is documentation, never NC text: `check nc/*` must not trip on nc/README.md.
+    if ext == "md" {
+        if explicit {
+            eprintln!(
+                "ncchannel check: {}: skipped (documentation)",
+                path.display()
+            );
+        }
+        return;
+    }
     if explicit || NC_EXTENSIONS.contains(&ext.as_str()) || PARAM_EXTENSIONS.contains(&ext.as_str())
     {
         files.push(path.to_path_buf());
