@@ -514,3 +514,35 @@ fn a_silent_connection_times_out_as_a_broken_transfer() {
     );
     assert_eq!(tree(&out).keys().collect::<Vec<_>>(), ["A.mpf"]);
 }
+
+#[test]
+fn without_out_programs_land_in_the_channels_first_program_path() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(d.path().join("params")).unwrap();
+    std::fs::create_dir_all(d.path().join("progs")).unwrap();
+    std::fs::write(
+        d.path().join("params/startup.lis"),
+        "kanal_anzahl 1\nsda_mds[0] ch.lis\npfad[0].prg[0] ../progs\npfad[0].typ[0] 0x01\n",
+    )
+    .unwrap();
+    std::fs::write(d.path().join("params/ch.lis"), "streaming_prog_file s.nc\n").unwrap();
+    let input = d.path().join("in.txt");
+    std::fs::write(&input, "%_N_PART1_MPF\nG1 X1 F100\nM30\n").unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args([
+            "receive",
+            input.to_str().unwrap(),
+            "--end",
+            "M30",
+            "--params",
+        ])
+        .arg(d.path().join("params/startup.lis"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(d.path().join("progs/PART1.mpf").is_file());
+}

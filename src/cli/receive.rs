@@ -55,12 +55,33 @@ pub struct ReceiveArgs {
     /// Names for programs whose data names none; `{n}` or `{n:W}` is the number.
     #[arg(long, value_name = "TEMPLATE", default_value = "received_{n}.nc")]
     pub name_template: String,
+    /// Start-up list whose channel decides the default program directory.
+    #[arg(long, default_value = "params/startup.lis")]
+    pub params: PathBuf,
+    /// Channel (1-based) whose first program path is the default program directory.
+    #[arg(long, default_value_t = 1)]
+    pub channel: u32,
 }
 
-/// Where programs go without `--out`: the channel's first program path.
-// The lead wires this to the parameter lists' search paths; until then the demo folder.
-pub fn default_out_dir() -> PathBuf {
-    PathBuf::from("nc")
+/// Where programs go without `--out`: the channel's first main-program search path, from the
+/// parameter lists, so received programs are ready to run.
+pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
+    let params = super::run::locate(params);
+    let config = crate::params::load(&params).map_err(|e| {
+        for d in e.diagnostics() {
+            eprintln!("{}", d.render());
+        }
+        format!(
+            "no --out, and the parameter lists in {} are refused",
+            params.display()
+        )
+    })?;
+    let ch = config
+        .channels
+        .get((channel as usize).wrapping_sub(1))
+        .ok_or_else(|| format!("no --out, and channel {channel} does not exist"))?;
+    let dir = ch.main_program_paths().next().map(Path::to_path_buf);
+    dir.ok_or_else(|| format!("no --out, and channel {channel} has no main-program path"))
 }
 
 pub fn execute(args: ReceiveArgs) -> ExitCode {
@@ -113,7 +134,10 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
             )))
         }
     };
-    let out = args.out.clone().unwrap_or_else(default_out_dir);
+    let out = match args.out.clone() {
+        Some(o) => o,
+        None => default_out_dir(&args.params, args.channel).map_err(Failure::Usage)?,
+    };
     let mut cfg = WriterConfig::new(&out);
     cfg.overwrite = args.overwrite;
     cfg.keep_partial = args.keep_partial;
