@@ -269,12 +269,14 @@ pub fn execute(args: RunArgs) -> ExitCode {
     }
     // The summary goes to stderr when the events go to stdout, so a pipe gets pure JSON Lines.
     let to_stderr = args.events.as_deref() == Some("-");
-    let r = if to_stderr {
+    let printed = if to_stderr {
         report.print_human(&mut std::io::stderr())
     } else {
         report.print_human(&mut std::io::stdout())
     };
-    let _ = r;
+    if let Err(e) = printed {
+        eprintln!("ncchannel run: summary: {e}");
+    }
     ExitCode::from(match outcome {
         Outcome::Ended => exit::OK,
         Outcome::Error => exit::CHANNEL_ERROR,

@@ -739,7 +739,7 @@ impl Decoder {
     }
 
     fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
-        use crate::lang::eval::{case_matches, is_true};
+        use crate::lang::eval::is_true;
         let here = LinePos {
             pos: meta.offset as usize,
             line_no: meta.line - 1,
@@ -774,9 +774,7 @@ impl Decoder {
             }
             // Executing into a later case: fall through (no `$BREAK` before it).
             Control::Case(_) | Control::Default => match self.top().flow.last() {
-                Some(FlowEntry::Switch { .. }) => {
-                    let _ = case_matches;
-                }
+                Some(FlowEntry::Switch { .. }) => {}
                 _ => return Err(self.stray(c)),
             },
             Control::EndSwitch => match self.top().flow.last() {
