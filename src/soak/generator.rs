@@ -34,6 +34,9 @@ pub struct ProgramSpec {
     pub box_mm: f64,
     pub subroutines: Vec<String>,
     pub cache_files: Vec<String>,
+    /// Cache entries the program may hold at once (the channel's max_cache_number): a
+    /// `#CACHE LOAD` beyond it would be error 21562, so the generator clears one first.
+    pub cache_slots: u32,
 }
 
 impl Default for ProgramSpec {
@@ -50,6 +53,7 @@ impl Default for ProgramSpec {
             box_mm: 200.0,
             subroutines: Vec::new(),
             cache_files: Vec::new(),
+            cache_slots: 2,
         }
     }
 }
@@ -82,18 +86,21 @@ impl ProgramSpec {
         if self.calls > 0 && self.subroutines.is_empty() {
             return Err("[program] calls > 0 needs subroutines = [\"name\", …]".into());
         }
+        if self.cache_ops > 0 && self.cache_slots == 0 {
+            return Err("[program] cache_ops > 0 needs cache_slots >= 1".into());
+        }
         if self.cache_ops > 0 && self.cache_files.is_empty() {
             return Err("[program] cache_ops > 0 needs cache_files = [\"name\", …]".into());
         }
         for name in self.subroutines.iter().chain(&self.cache_files) {
             let ok = !name.is_empty()
-                && name.len() <= 48
+                && name.len() <= 32
                 && name
                     .bytes()
                     .all(|b| b.is_ascii_alphanumeric() || b"._-".contains(&b));
             if !ok {
                 return Err(format!(
-                    "[program] file name '{name}': 1 to 48 characters of letters, digits, . _ -"
+                    "[program] file name '{name}': 1 to 32 characters of letters, digits, . _ -"
                 ));
             }
         }
@@ -117,6 +124,8 @@ pub struct Generator {
     /// Bit k: P<k> was assigned this epoch (a reset forgets parameters; reading an unset one
     /// is error 90005).
     params_set: u16,
+    /// Indices into `cache_files` loaded this epoch (a reset clears the cache).
+    cached: Vec<usize>,
 }
 
 impl Generator {
@@ -130,6 +139,7 @@ impl Generator {
             y_mm: 0.0,
             position_unknown: true,
             params_set: 0,
+            cached: Vec::new(),
         }
     }
 
@@ -138,6 +148,7 @@ impl Generator {
         self.next_n = 1;
         self.position_unknown = true;
         self.params_set = 0;
+        self.cached.clear();
     }
 
     fn feed(&mut self) -> u32 {
@@ -197,12 +208,38 @@ impl Generator {
                 }
                 4 => {
                     let i = self.rng.range(0, self.spec.subroutines.len() as u64 - 1) as usize;
-                    let _ = write!(s, "N{n} L {}", self.spec.subroutines[i]);
+                    let name = &self.spec.subroutines[i];
+                    if name.ends_with(".cyc") {
+                        // A cycle takes its parameters @P1, @P2 (0.05 ... 0.5 mm).
+                        let a = self.rng.range(50, 500) as f64 / 1000.0;
+                        let b = self.rng.range(50, 500) as f64 / 1000.0;
+                        let _ = write!(s, "N{n} L CYCLE [NAME={name} @P1={a:.3} @P2={b:.3}]");
+                    } else {
+                        let _ = write!(s, "N{n} L {name}");
+                    }
                     self.position_unknown = true;
                 }
                 _ => {
-                    let i = self.rng.range(0, self.spec.cache_files.len() as u64 - 1) as usize;
-                    let op = if self.rng.chance(0.6) { "LOAD" } else { "CLEAR" };
+                    let mut i = self.rng.range(0, self.spec.cache_files.len() as u64 - 1) as usize;
+                    let loaded = self.cached.iter().position(|&c| c == i);
+                    let full = self.cached.len() >= self.spec.cache_slots as usize;
+                    // Load (or refresh) what fits; when full, clear an entry first.
+                    let op = match loaded {
+                        Some(k) if self.rng.chance(0.5) => {
+                            self.cached.swap_remove(k);
+                            "CLEAR"
+                        }
+                        Some(_) => "LOAD",
+                        None if !full => {
+                            self.cached.push(i);
+                            "LOAD"
+                        }
+                        None => {
+                            let k = self.rng.range(0, self.cached.len() as u64 - 1) as usize;
+                            i = self.cached.swap_remove(k);
+                            "CLEAR"
+                        }
+                    };
                     let _ = write!(s, "N{n} #CACHE {op}[FILE={}]", self.spec.cache_files[i]);
                 }
             }
