@@ -6,6 +6,7 @@ pub mod driver;
 pub mod feed;
 pub mod generator;
 pub mod invariants;
+pub mod plot;
 pub mod report;
 pub mod rng;
 pub mod scenario;
