@@ -234,7 +234,10 @@ pub fn streaming_channels(
         slots.push(Slot::new(channel, program, feeder, &axes, r.fork(3)));
     }
     let period = Duration::from_micros(config.runtime.cycle_period_us.max(1));
-    Ok((SoakCycle::new(slots, Faults::default(), Vec::new(), None), period))
+    Ok((
+        SoakCycle::new(slots, Faults::default(), Vec::new(), None),
+        period,
+    ))
 }
 
 pub fn execute(args: BenchArgs) -> ExitCode {

@@ -259,9 +259,9 @@ impl Cycle for SoakCycle {
                 for (code, msg) in &errors[slot.errors_seen..] {
                     *slot.counters.errors.entry(*code).or_default() += 1;
                     if !self.expected_errors.contains(code) {
-                        self.tallies.errors.violate(|| {
-                            format!("channel {number}, tick {t}: error {code}: {msg}")
-                        });
+                        self.tallies
+                            .errors
+                            .violate(|| format!("channel {number}, tick {t}: error {code}: {msg}"));
                     }
                 }
                 slot.errors_seen = errors.len();

@@ -45,14 +45,19 @@ impl FeederSpec {
         }
         let [i0, i1] = self.interval_ticks;
         if !(1 <= i0 && i0 <= i1 && i1 <= 1_000_000) {
-            return Err("[feeder] interval_ticks must be [low, high] with 1 <= low <= high <= 1000000".into());
+            return Err(
+                "[feeder] interval_ticks must be [low, high] with 1 <= low <= high <= 1000000"
+                    .into(),
+            );
         }
         if !(0.0..=1.0).contains(&self.pause_chance) {
             return Err("[feeder] pause_chance must be in [0, 1]".into());
         }
         let [q0, q1] = self.pause_ticks;
         if q0 > q1 || q1 > 10_000_000 {
-            return Err("[feeder] pause_ticks must be [low, high] with low <= high <= 10000000".into());
+            return Err(
+                "[feeder] pause_ticks must be [low, high] with low <= high <= 10000000".into(),
+            );
         }
         Ok(())
     }
@@ -74,7 +79,10 @@ pub struct Owed {
 pub enum Source {
     Generated(Generator),
     /// A file's lines (each CR LF ended, ≤ 96 bytes), streamed from the top each epoch.
-    File { lines: Vec<Vec<u8>>, next: usize },
+    File {
+        lines: Vec<Vec<u8>>,
+        next: usize,
+    },
 }
 
 impl Source {

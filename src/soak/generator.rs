@@ -77,10 +77,11 @@ impl ProgramSpec {
         }
         let [f0, f1] = self.feed_mm_per_min;
         if !(f0.is_finite() && f1.is_finite() && f0 > 0.0 && f0 <= f1 && f1 <= 1e6) {
-            return Err("[program] feed_mm_per_min must be [low, high] with 0 < low <= high".into());
+            return Err(
+                "[program] feed_mm_per_min must be [low, high] with 0 < low <= high".into(),
+            );
         }
-        if !(self.box_mm.is_finite() && self.box_mm >= 4.0 * self.step_mm && self.box_mm <= 1e5)
-        {
+        if !(self.box_mm.is_finite() && self.box_mm >= 4.0 * self.step_mm && self.box_mm <= 1e5) {
             return Err("[program] box_mm must be at least 4 × step_mm".into());
         }
         if self.calls > 0 && self.subroutines.is_empty() {

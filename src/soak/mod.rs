@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 
 use crate::runtime::{Clock, RunEnd, Runtime};
-use driver::{SoakCycle, Slot};
+use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
 use invariants::{resident_kib, Tally};
@@ -51,7 +51,11 @@ pub struct Options {
 }
 
 /// Build the cycle of a scenario: its channels, clients and fault schedules.
-pub fn build(scenario: &Scenario, seed: u64, target_blocks: Option<u64>) -> Result<(SoakCycle, Duration), SoakError> {
+pub fn build(
+    scenario: &Scenario,
+    seed: u64,
+    target_blocks: Option<u64>,
+) -> Result<(SoakCycle, Duration), SoakError> {
     let params = scenario.params_path();
     let config = crate::params::load(&params).map_err(|e| SoakError::Params {
         path: params.display().to_string(),
@@ -105,12 +109,16 @@ pub fn build(scenario: &Scenario, seed: u64, target_blocks: Option<u64>) -> Resu
                     .map_err(|e| SoakError::Setup(format!("{}: {e}", path.display())))?
             }
             None => Source::Generated(Generator::new(
-                spec.program_mix.clone().unwrap_or_else(|| scenario.program.clone()),
+                spec.program_mix
+                    .clone()
+                    .unwrap_or_else(|| scenario.program.clone()),
                 ch_rng.fork(1),
             )),
         };
         let feeder = SoakFeeder::new(
-            spec.feeder.clone().unwrap_or_else(|| scenario.feeder.clone()),
+            spec.feeder
+                .clone()
+                .unwrap_or_else(|| scenario.feeder.clone()),
             ch_rng.fork(2),
             source,
         );
@@ -123,7 +131,10 @@ pub fn build(scenario: &Scenario, seed: u64, target_blocks: Option<u64>) -> Resu
         scenario.invariants.expected_errors.clone(),
         target_blocks,
     );
-    Ok((cycle, Duration::from_micros(config.runtime.cycle_period_us.max(1))))
+    Ok((
+        cycle,
+        Duration::from_micros(config.runtime.cycle_period_us.max(1)),
+    ))
 }
 
 fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
@@ -140,11 +151,18 @@ fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
 
 /// Run a scenario to its end and report.
 pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
-    let length = opts.length.clone().unwrap_or_else(|| scenario.length.clone());
+    let length = opts
+        .length
+        .clone()
+        .unwrap_or_else(|| scenario.length.clone());
     let seed = opts.seed.unwrap_or(scenario.seed);
     let (cycle, period) = build(scenario, seed, length.blocks)?;
     let realtime = opts.realtime || scenario.clock == ClockSpec::Realtime;
-    let clock = if realtime { Clock::RealTime } else { Clock::Virtual };
+    let clock = if realtime {
+        Clock::RealTime
+    } else {
+        Clock::Virtual
+    };
     let (mut rt, _tx) = Runtime::new(cycle, period, clock);
 
     let period_s = period.as_secs_f64();
@@ -227,18 +245,23 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     let slack = scenario.invariants.memory_slack_kib;
     if let Some(g) = growth {
         if g > slack as i64 {
-            memory.violate(|| format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)"));
+            memory.violate(|| {
+                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
+            });
         }
     }
     let order_note = format!("{} blocks checked", cycle.total_blocks);
     let invariants = vec![
-        cycle
-            .tallies
-            .order
-            .verdict("every streamed block executed exactly once, in order, between resets", Some(order_note)),
+        cycle.tallies.order.verdict(
+            "every streamed block executed exactly once, in order, between resets",
+            Some(order_note),
+        ),
         cycle.tallies.errors.verdict(
             "no channel error but the expected ones",
-            Some(format!("expected: {:?}", scenario.invariants.expected_errors)),
+            Some(format!(
+                "expected: {:?}",
+                scenario.invariants.expected_errors
+            )),
         ),
         cycle
             .tallies
@@ -308,7 +331,10 @@ pub fn shipped_scenarios() -> Vec<PathBuf> {
         .flatten()
         .flatten()
         .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml") && p.file_name().is_some_and(|n| n != "runtime.toml"))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "toml")
+                && p.file_name().is_some_and(|n| n != "runtime.toml")
+        })
         .collect();
     v.sort();
     v

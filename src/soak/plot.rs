@@ -92,7 +92,10 @@ pub fn lateness_svg(runtime: &Histogram, bare: &Histogram, period: Duration) -> 
             r#"<path d="{d}" stroke="{color}" stroke-width="1.5" fill="none"/>"#
         );
     }
-    for (h, color, name, dy) in [(runtime, "red", "runtime", 0.0), (bare, "blue", "bare", 14.0)] {
+    for (h, color, name, dy) in [
+        (runtime, "red", "runtime", 0.0),
+        (bare, "blue", "bare", 14.0),
+    ] {
         let p99 = h.quantile_us(0.99).max(0.1);
         let x = x_of(p99.log10().clamp(lo_exp, hi_exp));
         let _ = writeln!(

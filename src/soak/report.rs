@@ -106,11 +106,19 @@ impl SoakReport {
     }
 
     pub fn print_human(&self, w: &mut dyn Write) -> io::Result<()> {
-        writeln!(w, "soak {} (seed {}, {} time)", self.scenario, self.seed, self.clock)?;
+        writeln!(
+            w,
+            "soak {} (seed {}, {} time)",
+            self.scenario, self.seed, self.clock
+        )?;
         writeln!(
             w,
             "run:       {} blocks in {} ticks, {:.3} s channel time, {:.2} s wall ({:.0} blocks/s)",
-            self.blocks, self.ticks, self.sim_seconds, self.wall_seconds, self.blocks_per_wall_second
+            self.blocks,
+            self.ticks,
+            self.sim_seconds,
+            self.wall_seconds,
+            self.blocks_per_wall_second
         )?;
         for c in &self.channels {
             let errors: Vec<String> = c.errors.iter().map(|(k, v)| format!("{k}×{v}")).collect();
@@ -131,7 +139,9 @@ impl SoakReport {
             "memory:    resident {} after warm-up, {} at the end ({} KiB growth)",
             kib(self.memory.warmup_kib),
             kib(self.memory.end_kib),
-            self.memory.growth_kib.map_or("n/a".into(), |g| g.to_string())
+            self.memory
+                .growth_kib
+                .map_or("n/a".into(), |g| g.to_string())
         )?;
         let c = &self.cycle;
         writeln!(

@@ -92,7 +92,10 @@ mod tests {
         for _ in 0..1000 {
             seen[(a.range(3, 9) - 3) as usize] = true;
         }
-        assert!(seen.iter().all(|&s| s), "every value of a small range comes up");
+        assert!(
+            seen.iter().all(|&s| s),
+            "every value of a small range comes up"
+        );
         assert_eq!(a.weighted(&[0, 0]), None);
         assert_eq!(a.weighted(&[0, 5, 0]), Some(1));
     }

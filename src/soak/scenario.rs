@@ -40,7 +40,7 @@ pub struct Length {
 }
 
 /// Faults injected at random ticks (scenario `[faults]`); every range is `[low, high]`.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Faults {
     /// NC reset after this many executed blocks of the channel (then the program restarts).
@@ -59,6 +59,22 @@ pub struct Faults {
     pub reject_every_ticks: Option<[u64; 2]>,
     #[serde(default = "default_reject")]
     pub reject_ticks: [u64; 2],
+}
+
+impl Default for Faults {
+    /// No faults.
+    fn default() -> Self {
+        Faults {
+            reset_every_blocks: None,
+            reset_every_ticks: None,
+            hold_every_ticks: None,
+            hold_ticks: default_hold(),
+            override_every_ticks: None,
+            override_pct: default_override(),
+            reject_every_ticks: None,
+            reject_ticks: default_reject(),
+        }
+    }
 }
 
 fn default_hold() -> [u64; 2] {
@@ -199,7 +215,10 @@ impl Scenario {
         {
             return Err("[length] needs blocks, ticks, sim_seconds or wall_seconds".into());
         }
-        for (name, v) in [("sim_seconds", l.sim_seconds), ("wall_seconds", l.wall_seconds)] {
+        for (name, v) in [
+            ("sim_seconds", l.sim_seconds),
+            ("wall_seconds", l.wall_seconds),
+        ] {
             if v.is_some_and(|s| !(s.is_finite() && s > 0.0 && s <= 1e7)) {
                 return Err(format!("[length] {name} must be in (0, 1e7]"));
             }
@@ -217,7 +236,9 @@ impl Scenario {
             ("reject_ticks", Some(f.reject_ticks)),
         ] {
             if !range_ok(r) {
-                return Err(format!("[faults] {name} must be [low, high] with 1 <= low <= high"));
+                return Err(format!(
+                    "[faults] {name} must be [low, high] with 1 <= low <= high"
+                ));
             }
         }
         let [o0, o1] = f.override_pct;
