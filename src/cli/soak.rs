@@ -53,7 +53,7 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         Err(e) => return usage(e.to_string()),
     };
     let length = (args.blocks.is_some() || args.ticks.is_some() || args.wall_seconds.is_some())
-        .then(|| Length {
+        .then_some(Length {
             blocks: args.blocks,
             ticks: args.ticks,
             sim_seconds: None,

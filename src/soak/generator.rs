@@ -268,14 +268,12 @@ impl Generator {
         let r = ((self.rng.range_f64(0.2, 0.5) * self.spec.step_mm) * 1000.0).round() / 1000.0;
         let r = r.max(0.001);
         let limit = self.spec.box_mm - 2.0 * self.spec.step_mm;
-        let dir = if self.x_mm + 2.0 * r > limit {
+        let room_right = self.x_mm + 2.0 * r <= limit;
+        let room_left = self.x_mm - 2.0 * r >= -limit;
+        let dir = if !room_right || (room_left && self.rng.chance(0.5)) {
             -1.0
-        } else if self.x_mm - 2.0 * r < -limit {
-            1.0
-        } else if self.rng.chance(0.5) {
-            1.0
         } else {
-            -1.0
+            1.0
         };
         let g = if self.rng.chance(0.5) { 2 } else { 3 };
         self.x_mm = ((self.x_mm + dir * 2.0 * r) * 1000.0).round() / 1000.0;
