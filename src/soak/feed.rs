@@ -89,6 +89,9 @@ impl Source {
     /// Cut a file into CR LF lines for streaming; a line longer than a packet's minimum is an
     /// error (the feeder never splits a line).
     pub fn file(text: &[u8]) -> Result<Source, String> {
+        if text.is_empty() {
+            return Err("the file is empty".into());
+        }
         let mut lines = Vec::new();
         for (i, raw) in text.split(|&b| b == b'\n').enumerate() {
             let l = raw.strip_suffix(b"\r").unwrap_or(raw);
@@ -268,5 +271,73 @@ impl SoakFeeder {
     pub fn exhausted(&self) -> bool {
         matches!(&self.source, Source::File { lines, next } if *next >= lines.len())
             && self.packet.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::soak::generator::ProgramSpec;
+
+    fn feeder(spec: FeederSpec) -> SoakFeeder {
+        let g = Generator::new(ProgramSpec::default(), SplitMix64::new(5));
+        SoakFeeder::new(spec, SplitMix64::new(6), Source::Generated(g))
+    }
+
+    #[test]
+    fn accepted_packets_are_owed_line_by_line_at_their_stream_offsets() {
+        let mut f = feeder(FeederSpec::default());
+        let mut stream = Vec::new();
+        for t in 0..5 {
+            let p = f.poll(t).unwrap().to_vec();
+            assert!(p.len() <= MAX_PROGRAM_STREAM_INPUT_SIZE && p.ends_with(b"\r\n"));
+            stream.extend_from_slice(&p);
+            f.result(t, true);
+        }
+        let owed: Vec<Owed> = f.owed_mut().iter().copied().collect();
+        assert_eq!(owed.len() as u64, f.counters().lines);
+        for (i, o) in owed.iter().enumerate() {
+            let line = &stream[o.offset as usize..];
+            let want = format!("N{} ", i + 1);
+            assert!(line.starts_with(want.as_bytes()), "line {i}");
+            assert_eq!(o.n, Some(i as u32 + 1));
+        }
+        f.new_epoch(10);
+        assert!(f.owed_mut().is_empty());
+        assert!(f.poll(10).unwrap().starts_with(b"N1 G90"));
+    }
+
+    #[test]
+    fn a_rejected_packet_is_offered_again_unchanged_and_not_owed() {
+        let mut f = feeder(FeederSpec {
+            interval_ticks: [3, 3],
+            ..FeederSpec::default()
+        });
+        let first = f.poll(0).unwrap().to_vec();
+        f.result(0, false);
+        assert!(f.poll(1).is_none(), "next attempt 3 ticks later");
+        assert_eq!(f.poll(3).unwrap(), first.as_slice());
+        assert!(f.owed_mut().is_empty());
+        f.skip(6);
+        assert_eq!(f.counters().writes_skipped, 1);
+        assert!(f.poll(7).is_none());
+    }
+
+    #[test]
+    fn files_are_cut_into_crlf_lines_and_long_lines_refused() {
+        let Source::File { lines, .. } = Source::file(b"N1 X1\r\nN2 X2\n(c)\n").unwrap() else {
+            panic!()
+        };
+        assert_eq!(
+            lines,
+            [
+                b"N1 X1\r\n".to_vec(),
+                b"N2 X2\r\n".to_vec(),
+                b"(c)\r\n".to_vec()
+            ]
+        );
+        let long = vec![b'X'; 200];
+        assert!(Source::file(&long).is_err());
+        assert!(Source::file(b"").is_err());
     }
 }
