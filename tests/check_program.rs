@@ -7,10 +7,7 @@ use std::process::Command as Process;
 use ncchannel::lang::*;
 
 fn codes(text: &str) -> Vec<(usize, usize, u32)> {
-    check_program(text)
-        .into_iter()
-        .map(|d| (d.line, d.col, d.code))
-        .collect()
+    check_program(text).into_iter().map(|d| (d.line, d.col, d.code)).collect()
 }
 
 fn nc_files() -> Vec<std::path::PathBuf> {
@@ -51,10 +48,7 @@ fn streaming_program_is_virtual() {
     let demo = std::fs::read_to_string(dir.join("demo.nc")).unwrap();
     let blocks: Vec<Block> = demo.lines().map(|l| parse_block(l).unwrap()).collect();
     let has = |f: &dyn Fn(&Body) -> bool| blocks.iter().any(|b| f(&b.body));
-    assert!(has(&|b| matches!(
-        b,
-        Body::Command(Command::Flush(FlushKind::Continue))
-    )));
+    assert!(has(&|b| matches!(b, Body::Command(Command::Flush(FlushKind::Continue)))));
     assert!(has(&|b| matches!(b, Body::Control(Control::If(_)))));
     // Streamable: no loops, no backward jumps.
     assert!(!has(&|b| matches!(
@@ -69,11 +63,7 @@ fn streaming_program_is_virtual() {
         })
         .flatten()
         .filter_map(|i| match i {
-            Item::Word(Word {
-                letter: b'G',
-                value: Value::Num(v),
-                ..
-            }) => Some(*v),
+            Item::Word(Word { letter: b'G', value: Value::Num(v), .. }) => Some(*v),
             _ => None,
         })
         .collect();
@@ -107,10 +97,7 @@ fn stray_control_statements_have_their_own_numbers() {
     // Mismatched closers are stray too, and the opener stays open.
     assert_eq!(codes("$IF P1\n$ENDFOR\n$ENDIF\n"), vec![(2, 1, 20218)]);
     assert_eq!(codes("$IF P1\n$ELSE\n$ELSE\n$ENDIF\n"), vec![(3, 1, 20211)]);
-    assert_eq!(
-        codes("$IF P1\n$ELSE\n$ELSEIF P2\n$ENDIF\n"),
-        vec![(3, 1, 20212)]
-    );
+    assert_eq!(codes("$IF P1\n$ELSE\n$ELSEIF P2\n$ENDIF\n"), vec![(3, 1, 20212)]);
 }
 
 #[test]
@@ -157,15 +144,9 @@ M30
 
 #[test]
 fn open_blocks_at_program_end() {
-    assert_eq!(
-        codes("N10 $IF P1\nN20 $WHILE 1\nM30\n"),
-        vec![(1, 5, 20375), (2, 5, 20375)]
-    );
+    assert_eq!(codes("N10 $IF P1\nN20 $WHILE 1\nM30\n"), vec![(1, 5, 20375), (2, 5, 20375)]);
     // Each program level closes its own blocks.
-    assert_eq!(
-        codes("%L SUB\n$SWITCH P1\nM17\n%main\n$ENDSWITCH\nM30\n"),
-        vec![(2, 1, 20375), (5, 1, 20217)]
-    );
+    assert_eq!(codes("%L SUB\n$SWITCH P1\nM17\n%main\n$ENDSWITCH\nM30\n"), vec![(2, 1, 20375), (5, 1, 20217)]);
     assert_eq!(codes("#VAR\nV.L.X = 1\n"), vec![(1, 1, 20375)]);
     assert_eq!(codes("G1 X1\n#COMMENT BEGIN\nM30\n"), vec![(2, 1, 20375)]);
 }
@@ -175,37 +156,22 @@ fn labels_and_jumps() {
     assert_eq!(codes("N40: X1\nN50 X2\nN40: X3\n"), vec![(3, 1, 20836)]);
     assert_eq!(codes("[A] X1\n[a] X3\n"), vec![(2, 1, 20836)]);
     assert_eq!(codes("$GOTO N40\nN30 X1\nM30\n"), vec![(1, 1, 20840)]);
-    assert_eq!(
-        codes("N10 $IF P1 == 1 $GOTO [LATER]\nM30\n"),
-        vec![(1, 17, 20840)]
-    );
+    assert_eq!(codes("N10 $IF P1 == 1 $GOTO [LATER]\nM30\n"), vec![(1, 17, 20840)]);
     // A plain block number is no label; the message says so.
     let d = check_program("$GOTO N40\nN40 X1\n");
     assert_eq!(d[0].code, 20840);
     assert!(d[0].message.contains("N40:"), "{}", d[0].message);
     // Backward and forward jumps both resolve in a file.
-    assert_eq!(
-        codes("N10: X1\n$GOTO N10\n$GOTO [FWD]\n[FWD] M30\n"),
-        vec![]
-    );
+    assert_eq!(codes("N10: X1\n$GOTO N10\n$GOTO [FWD]\n[FWD] M30\n"), vec![]);
     // Labels are per program level.
-    assert_eq!(
-        codes("%L SUB\n[A] M17\n%main\n$GOTO [A]\nM30\n"),
-        vec![(4, 1, 20840)]
-    );
+    assert_eq!(codes("%L SUB\n[A] M17\n%main\n$GOTO [A]\nM30\n"), vec![(4, 1, 20840)]);
 }
 
 #[test]
 fn syntax_errors_inside_var_and_program() {
-    assert_eq!(
-        codes("#VAR\nV.L.A = \nV.E.B\n#ENDVAR\n"),
-        vec![(2, 9, 20200), (3, 1, 20200)]
-    );
+    assert_eq!(codes("#VAR\nV.L.A = \nV.E.B\n#ENDVAR\n"), vec![(2, 9, 20200), (3, 1, 20200)]);
     assert_eq!(codes("#ENDVAR\n"), vec![(1, 1, 20200)]);
-    assert_eq!(
-        codes("G1 X1\nG1 M200\n#CACHE LOAD\n"),
-        vec![(2, 4, 20157), (3, 12, 21560)]
-    );
+    assert_eq!(codes("G1 X1\nG1 M200\n#CACHE LOAD\n"), vec![(2, 4, 20157), (3, 12, 21560)]);
 }
 
 fn run_check(args: &[&Path]) -> (i32, String) {
@@ -237,10 +203,7 @@ fn cli_check_broken_file_reports_position_and_caret() {
     std::fs::write(&bad, "N10 G1 X10\r\nN20 G999 X1\r\nM30\r\n").unwrap();
     let (code, out) = run_check(&[&bad]);
     assert_eq!(code, 1, "{out}");
-    let want = format!(
-        "{}:2:5: error 20131: unknown G function G999\n  N20 G999 X1\n      ^",
-        bad.display()
-    );
+    let want = format!("{}:2:5: error 20131: unknown G function G999\n  N20 G999 X1\n      ^", bad.display());
     assert!(out.contains(&want), "{out}");
 
     let missing = dir.path().join("missing.nc");

@@ -152,42 +152,17 @@ fn variables_and_indices_resolve() {
     assert_eq!(ev_with("P1 * 3", &vars), 6.0);
     assert_eq!(ev_with("P[P1 + 5]", &vars), 70.0, "indirect P[P1+5] is P7");
     assert_eq!(ev_with("P3[P1]", &vars), 32.0);
-    assert_eq!(
-        ev_with("P[3*0.1*10][2]", &vars),
-        32.0,
-        "near-integers index"
-    );
+    assert_eq!(ev_with("P[3*0.1*10][2]", &vars), 32.0, "near-integers index");
     assert_eq!(ev_with("v.l.count + 1", &vars), 6.0);
     assert_eq!(ev_with("V.P.GRID[P1 - 1][P1]", &vars), 12.0);
     assert_eq!(ev_with("@P1 * 4", &vars), 1.0);
 
     let target = parse_block("P[P1+5][P1]=1").unwrap();
-    let Body::Items(items) = &target.body else {
-        panic!()
-    };
-    let Item::Assign { target, .. } = &items[0] else {
-        panic!()
-    };
-    assert_eq!(
-        resolve(target, &vars),
-        Ok(VarKey::P {
-            number: 7,
-            indices: vec![2]
-        })
-    );
-    let v = VarRef::V {
-        scope: VScope::Local,
-        name: "X".into(),
-        indices: vec![],
-    };
-    assert_eq!(
-        resolve(&v, &vars),
-        Ok(VarKey::V {
-            scope: VScope::Local,
-            name: "X",
-            indices: vec![]
-        })
-    );
+    let Body::Items(items) = &target.body else { panic!() };
+    let Item::Assign { target, .. } = &items[0] else { panic!() };
+    assert_eq!(resolve(target, &vars), Ok(VarKey::P { number: 7, indices: vec![2] }));
+    let v = VarRef::V { scope: VScope::Local, name: "X".into(), indices: vec![] };
+    assert_eq!(resolve(&v, &vars), Ok(VarKey::V { scope: VScope::Local, name: "X", indices: vec![] }));
 }
 
 #[test]

@@ -32,27 +32,17 @@ fn canon(line: &str) -> String {
     let b = p(line);
     let s = b.to_string();
     let again = p(&s);
-    assert_eq!(
-        without_cols(again.clone()),
-        without_cols(b),
-        "canonical {s:?} of {line:?} reparses differently"
-    );
+    assert_eq!(without_cols(again.clone()), without_cols(b), "canonical {s:?} of {line:?} reparses differently");
     assert_eq!(again.to_string(), s);
     s
 }
 
 fn words(b: &Block) -> Vec<(char, f64)> {
-    let Body::Items(items) = &b.body else {
-        panic!("not items: {b:?}")
-    };
+    let Body::Items(items) = &b.body else { panic!("not items: {b:?}") };
     items
         .iter()
         .map(|i| match i {
-            Item::Word(Word {
-                letter,
-                value: Value::Num(v),
-                ..
-            }) => (*letter as char, *v),
+            Item::Word(Word { letter, value: Value::Num(v), .. }) => (*letter as char, *v),
             other => panic!("not a literal word: {other:?}"),
         })
         .collect()
@@ -65,17 +55,9 @@ fn plain_motion_block() {
     assert_eq!(b.skip_level, None);
     assert_eq!(
         words(&b),
-        vec![
-            ('G', 1.0),
-            ('X', 12.345),
-            ('Y', -6.789),
-            ('Z', 0.5),
-            ('F', 3000.0)
-        ]
+        vec![('G', 1.0), ('X', 12.345), ('Y', -6.789), ('Z', 0.5), ('F', 3000.0)]
     );
-    let Body::Items(items) = &b.body else {
-        unreachable!()
-    };
+    let Body::Items(items) = &b.body else { unreachable!() };
     let cols: Vec<u32> = items
         .iter()
         .map(|i| match i {
@@ -91,10 +73,7 @@ fn plain_motion_block() {
 fn words_without_blanks_and_lower_case() {
     let b = p("n10g1x10y-2.5f1000");
     assert_eq!(b.n, Some(10));
-    assert_eq!(
-        words(&b),
-        vec![('G', 1.0), ('X', 10.0), ('Y', -2.5), ('F', 1000.0)]
-    );
+    assert_eq!(words(&b), vec![('G', 1.0), ('X', 10.0), ('Y', -2.5), ('F', 1000.0)]);
 }
 
 #[test]
@@ -122,27 +101,12 @@ fn labels() {
 
 #[test]
 fn empty_and_comment_lines() {
-    for line in [
-        "",
-        "   ",
-        "(comment)",
-        "; only",
-        "( nested ( deeper ) still ) ",
-        "(unclosed to the end X10",
-        "N030",
-        "N22 ( ===== )",
-    ] {
+    for line in ["", "   ", "(comment)", "; only", "( nested ( deeper ) still ) ", "(unclosed to the end X10", "N030", "N22 ( ===== )"] {
         let b = p(line);
         assert_eq!(b.body, Body::Items(vec![]), "{line:?}");
     }
-    assert_eq!(
-        words(&p("N10 G00 X0 (Move to start) Y1 ; rest X99")),
-        vec![('G', 0.0), ('X', 0.0), ('Y', 1.0)]
-    );
-    assert_eq!(
-        words(&p("N36348 X-1.657 Y-17.4202 (Z2.4442")),
-        vec![('X', -1.657), ('Y', -17.4202)]
-    );
+    assert_eq!(words(&p("N10 G00 X0 (Move to start) Y1 ; rest X99")), vec![('G', 0.0), ('X', 0.0), ('Y', 1.0)]);
+    assert_eq!(words(&p("N36348 X-1.657 Y-17.4202 (Z2.4442")), vec![('X', -1.657), ('Y', -17.4202)]);
     // A comment cannot sit between an address letter and its value.
     assert_eq!(err("G1 X(a(b)c)5"), (20200, 5));
 }
@@ -150,38 +114,16 @@ fn empty_and_comment_lines() {
 #[test]
 fn word_values_as_expressions() {
     let b = p("X[P1*2] Y-[P2] F[SIN[30]*1000]");
-    let Body::Items(items) = &b.body else {
-        unreachable!()
-    };
-    assert!(matches!(
-        &items[0],
-        Item::Word(Word {
-            letter: b'X',
-            value: Value::Expr(Expr::Binary(BinOp::Mul, _, _)),
-            col: 1
-        })
-    ));
-    assert!(matches!(
-        &items[1],
-        Item::Word(Word {
-            letter: b'Y',
-            value: Value::Expr(Expr::Unary(UnOp::Neg, _)),
-            ..
-        })
-    ));
+    let Body::Items(items) = &b.body else { unreachable!() };
+    assert!(matches!(&items[0], Item::Word(Word { letter: b'X', value: Value::Expr(Expr::Binary(BinOp::Mul, _, _)), col: 1 })));
+    assert!(matches!(&items[1], Item::Word(Word { letter: b'Y', value: Value::Expr(Expr::Unary(UnOp::Neg, _)), .. })));
     assert_eq!(b.to_string(), "X[P1 * 2] Y[-P2] F[SIN[30] * 1000]");
 }
 
 #[test]
 fn every_word_letter() {
     for l in "GMHFSTDXYZABCIJKREUVW".chars() {
-        let v = if l == 'G' {
-            "1"
-        } else if l == 'M' {
-            "3"
-        } else {
-            "2.5"
-        };
+        let v = if l == 'G' { "1" } else if l == 'M' { "3" } else { "2.5" };
         let line = format!("{l}{v}");
         let b = p(&line);
         assert_eq!(words(&b).len(), 1, "{line}");
@@ -194,10 +136,7 @@ fn every_word_letter() {
 
 #[test]
 fn known_and_unknown_g_and_m() {
-    for g in [
-        0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 59, 61, 90, 91, 132, 133, 134, 150, 151,
-        260, 261,
-    ] {
+    for g in [0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 59, 61, 90, 91, 132, 133, 134, 150, 151, 260, 261] {
         p(&format!("G{g}"));
     }
     assert_eq!(err("N10 G999 X1"), (20131, 5));
@@ -214,14 +153,7 @@ fn known_and_unknown_g_and_m() {
 #[test]
 fn ramp_time_weighting_value() {
     let b = p("G134 50");
-    assert_eq!(
-        b.body,
-        Body::Items(vec![Item::GValue {
-            g: 134,
-            value: Value::Num(50.0),
-            col: 1
-        }])
-    );
+    assert_eq!(b.body, Body::Items(vec![Item::GValue { g: 134, value: Value::Num(50.0), col: 1 }]));
     assert_eq!(p("G134=50").body, b.body);
     assert_eq!(canon("G133 = [P1*2] X1"), "G133=[P1 * 2] X1");
     // Without a value G134 stays a plain word.
@@ -231,33 +163,12 @@ fn ramp_time_weighting_value() {
 #[test]
 fn assignments() {
     let b = p("P1=10 P5=[P1*2+3] P1[2]=4 P[P1+5]=3 V.L.X=1 v.p.arr[1][P2]=2 @P1=7");
-    let Body::Items(items) = &b.body else {
-        unreachable!()
-    };
+    let Body::Items(items) = &b.body else { unreachable!() };
     assert_eq!(items.len(), 7);
-    assert!(
-        matches!(&items[0], Item::Assign { target: VarRef::P { number: Index::Const(1), indices }, value: Expr::Num(v), col: 1 } if indices.is_empty() && *v == 10.0)
-    );
-    assert!(matches!(
-        &items[3],
-        Item::Assign {
-            target: VarRef::P {
-                number: Index::Expr(_),
-                ..
-            },
-            ..
-        }
-    ));
-    assert!(
-        matches!(&items[5], Item::Assign { target: VarRef::V { scope: VScope::Program, name, indices }, .. } if name == "ARR" && indices.len() == 2)
-    );
-    assert!(matches!(
-        &items[6],
-        Item::Assign {
-            target: VarRef::CycleParam(1),
-            ..
-        }
-    ));
+    assert!(matches!(&items[0], Item::Assign { target: VarRef::P { number: Index::Const(1), indices }, value: Expr::Num(v), col: 1 } if indices.is_empty() && *v == 10.0));
+    assert!(matches!(&items[3], Item::Assign { target: VarRef::P { number: Index::Expr(_), .. }, .. }));
+    assert!(matches!(&items[5], Item::Assign { target: VarRef::V { scope: VScope::Program, name, indices }, .. } if name == "ARR" && indices.len() == 2));
+    assert!(matches!(&items[6], Item::Assign { target: VarRef::CycleParam(1), .. }));
     assert_eq!(
         b.to_string(),
         "P1=10 P5=[[P1 * 2] + 3] P1[2]=4 P[[P1 + 5]]=3 V.L.X=1 V.P.ARR[1][P2]=2 @P1=7"
@@ -291,10 +202,7 @@ fn control_statements() {
         ("$CONTINUE", Continue),
         ("$GOTO N40", Goto(GotoTarget::Number(40))),
         ("$GOTO [label_1]", Goto(GotoTarget::Name("LABEL_1".into()))),
-        (
-            "$IF P1 == 1 $GOTO [END]",
-            IfGoto(parse_expr("P1==1").unwrap(), GotoTarget::Name("END".into())),
-        ),
+        ("$IF P1 == 1 $GOTO [END]", IfGoto(parse_expr("P1==1").unwrap(), GotoTarget::Name("END".into()))),
     ];
     for (line, want) in cases {
         let b = p(&format!("N5 {line} ; comment"));
@@ -304,10 +212,7 @@ fn control_statements() {
     let b = p("$FOR P1 = 0, 10, 2");
     assert!(matches!(b.body, Body::Control(For { step: Some(_), .. })));
     assert_eq!(b.to_string(), "$FOR P1=0, 10, 2");
-    assert!(matches!(
-        p("$FOR V.L.I=1,P2").body,
-        Body::Control(For { step: None, .. })
-    ));
+    assert!(matches!(p("$FOR V.L.I=1,P2").body, Body::Control(For { step: None, .. })));
     assert_eq!(err("$FOOBAR"), (20209, 1));
     assert_eq!(err("N10 $IF P1 G1"), (20200, 12));
     assert_eq!(err("N10 $ENDIF X1"), (20200, 12));
@@ -322,18 +227,8 @@ fn hash_commands() {
         ("#FLUSH", Flush(FlushKind::Stop)),
         ("#FLUSH CONTINUE", Flush(FlushKind::Continue)),
         ("#flush wait", Flush(FlushKind::Wait)),
-        (
-            "#CACHE LOAD[FILE=Laser_on.cyc]",
-            CacheLoad {
-                file: "Laser_on.cyc".into(),
-            },
-        ),
-        (
-            "#CACHE CLEAR [ FILE = Macro.cyc ]",
-            CacheClear {
-                file: "Macro.cyc".into(),
-            },
-        ),
+        ("#CACHE LOAD[FILE=Laser_on.cyc]", CacheLoad { file: "Laser_on.cyc".into() }),
+        ("#CACHE CLEAR [ FILE = Macro.cyc ]", CacheClear { file: "Macro.cyc".into() }),
         ("#CACHE CLEAR ALL", CacheClearAll),
         ("#COMMENT BEGIN", CommentBegin),
         ("#COMMENT END", CommentEnd),
@@ -341,26 +236,9 @@ fn hash_commands() {
         ("#SPLINE OFF", Spline(SplineCommand::Off)),
         ("#SPLINE TYPE AKIMA", Spline(SplineCommand::TypeAkima)),
         ("#SPLINE TYPE BSPLINE", Spline(SplineCommand::TypeBspline)),
-        (
-            "#HSC ON [OPMODE 2]",
-            Hsc {
-                on: true,
-                options: "OPMODE 2".into(),
-            },
-        ),
-        (
-            "#HSC OFF",
-            Hsc {
-                on: false,
-                options: String::new(),
-            },
-        ),
-        (
-            "#CONTOUR MODE [DEV PATH_DEV 0.1 [P1]]",
-            ContourMode {
-                options: "DEV PATH_DEV 0.1 [P1]".into(),
-            },
-        ),
+        ("#HSC ON [OPMODE 2]", Hsc { on: true, options: "OPMODE 2".into() }),
+        ("#HSC OFF", Hsc { on: false, options: String::new() }),
+        ("#CONTOUR MODE [DEV PATH_DEV 0.1 [P1]]", ContourMode { options: "DEV PATH_DEV 0.1 [P1]".into() }),
         ("#VAR", Var),
         ("#ENDVAR", EndVar),
     ];
@@ -392,43 +270,16 @@ fn cache_errors() {
 
 #[test]
 fn calls_and_heads() {
-    assert_eq!(
-        p("N40 L streaming.nc").body,
-        Body::Call(Call::Global {
-            file: "streaming.nc".into()
-        })
-    );
-    assert_eq!(
-        p("LL Sub_1").body,
-        Body::Call(Call::Local {
-            name: "SUB_1".into()
-        })
-    );
+    assert_eq!(p("N40 L streaming.nc").body, Body::Call(Call::Global { file: "streaming.nc".into() }));
+    assert_eq!(p("LL Sub_1").body, Body::Call(Call::Local { name: "SUB_1".into() }));
     let b = p("N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5*2]]");
-    let Body::Call(Call::Cycle { name, params }) = &b.body else {
-        panic!("{b:?}")
-    };
+    let Body::Call(Call::Cycle { name, params }) = &b.body else { panic!("{b:?}") };
     assert_eq!(name, "Laser_on.cyc");
     assert_eq!(params.len(), 2);
     assert_eq!(params[0], (1, Expr::Num(0.0)));
-    assert_eq!(
-        b.to_string(),
-        "N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5 * 2]]"
-    );
-    assert_eq!(
-        p("%streaming-spline").body,
-        Body::ProgramHead {
-            name: "streaming-spline".into(),
-            local: false
-        }
-    );
-    assert_eq!(
-        p("%L sub1").body,
-        Body::ProgramHead {
-            name: "SUB1".into(),
-            local: true
-        }
-    );
+    assert_eq!(b.to_string(), "N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5 * 2]]");
+    assert_eq!(p("%streaming-spline").body, Body::ProgramHead { name: "streaming-spline".into(), local: false });
+    assert_eq!(p("%L sub1").body, Body::ProgramHead { name: "SUB1".into(), local: true });
     canon("%L SUB1");
     canon("%main (head)");
     assert_eq!(err("L streaming.nc X10"), (20200, 16));
@@ -474,25 +325,9 @@ fn comment_end_detection() {
 #[test]
 fn var_declarations() {
     let d = parse_var_declaration("V.L.COUNT = 5\r\n").unwrap();
-    assert_eq!(
-        d,
-        VarDecl {
-            scope: VScope::Local,
-            name: "COUNT".into(),
-            dims: vec![],
-            init: Some(Expr::Num(5.0))
-        }
-    );
+    assert_eq!(d, VarDecl { scope: VScope::Local, name: "COUNT".into(), dims: vec![], init: Some(Expr::Num(5.0)) });
     let d = parse_var_declaration("  v.p.table[10][3] ; grid").unwrap();
-    assert_eq!(
-        (
-            d.scope,
-            d.name.as_str(),
-            d.dims.as_slice(),
-            d.init.is_none()
-        ),
-        (VScope::Program, "TABLE", &[10u32, 3][..], true)
-    );
+    assert_eq!((d.scope, d.name.as_str(), d.dims.as_slice(), d.init.is_none()), (VScope::Program, "TABLE", &[10u32, 3][..], true));
     assert_eq!(d.to_string(), "V.P.TABLE[10][3]");
     assert_eq!(parse_var_declaration("V.E.X = 1").unwrap_err().code, 20200);
     assert_eq!(parse_var_declaration("V.L.A[0]").unwrap_err().code, 20200);
@@ -512,17 +347,11 @@ fn deep_nesting_is_an_error_not_a_crash() {
     assert_eq!(parse_block(&too_long).unwrap_err().code, 20200);
     let chain = format!("P1={}1", "1+".repeat(250));
     let b = p(&chain);
-    let Body::Items(items) = &b.body else {
-        unreachable!()
-    };
-    let Item::Assign { value, .. } = &items[0] else {
-        unreachable!()
-    };
+    let Body::Items(items) = &b.body else { unreachable!() };
+    let Item::Assign { value, .. } = &items[0] else { unreachable!() };
     struct NoVars;
     impl Vars for NoVars {
-        fn get(&self, _: &VarKey<'_>) -> Option<f64> {
-            None
-        }
+        fn get(&self, _: &VarKey<'_>) -> Option<f64> { None }
     }
     assert_eq!(eval(value, &NoVars), Ok(251.0));
     assert!(b.to_string().len() > 1000);

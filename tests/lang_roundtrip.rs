@@ -19,9 +19,7 @@ fn ident() -> impl Strategy<Value = String> {
 }
 
 fn file() -> impl Strategy<Value = String> {
-    "[A-Za-z0-9_][A-Za-z0-9_.-]{0,11}".prop_filter("CYCLE is the cycle keyword", |s| {
-        !s.eq_ignore_ascii_case("cycle")
-    })
+    "[A-Za-z0-9_][A-Za-z0-9_.-]{0,11}".prop_filter("CYCLE is the cycle keyword", |s| !s.eq_ignore_ascii_case("cycle"))
 }
 
 fn scope() -> impl Strategy<Value = VScope> {
@@ -36,19 +34,9 @@ fn scope() -> impl Strategy<Value = VScope> {
 fn var_ref(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
     let idx = prop::collection::vec(e.clone(), 0..3);
     prop_oneof![
-        (0u32..10_000, idx.clone()).prop_map(|(n, indices)| VarRef::P {
-            number: Index::Const(n),
-            indices
-        }),
-        (e, idx.clone()).prop_map(|(x, indices)| VarRef::P {
-            number: Index::Expr(Box::new(x)),
-            indices
-        }),
-        (scope(), ident(), idx).prop_map(|(scope, name, indices)| VarRef::V {
-            scope,
-            name,
-            indices
-        }),
+        (0u32..10_000, idx.clone()).prop_map(|(n, indices)| VarRef::P { number: Index::Const(n), indices }),
+        (e, idx.clone()).prop_map(|(x, indices)| VarRef::P { number: Index::Expr(Box::new(x)), indices }),
+        (scope(), ident(), idx).prop_map(|(scope, name, indices)| VarRef::V { scope, name, indices }),
         (0u32..100).prop_map(VarRef::CycleParam),
     ]
 }
@@ -61,45 +49,17 @@ fn expr() -> BoxedStrategy<Expr> {
     leaf.prop_recursive(4, 40, 3, |inner| {
         let unop = prop_oneof![Just(UnOp::Neg), Just(UnOp::Not), Just(UnOp::Inv)];
         let binop = prop::sample::select(vec![
-            BinOp::Add,
-            BinOp::Sub,
-            BinOp::Mul,
-            BinOp::Div,
-            BinOp::Pow,
-            BinOp::Mod,
-            BinOp::Eq,
-            BinOp::Ne,
-            BinOp::Lt,
-            BinOp::Gt,
-            BinOp::Le,
-            BinOp::Ge,
-            BinOp::And,
-            BinOp::Or,
-            BinOp::Xor,
-            BinOp::BitAnd,
-            BinOp::BitOr,
-            BinOp::BitXor,
+            BinOp::Add, BinOp::Sub, BinOp::Mul, BinOp::Div, BinOp::Pow, BinOp::Mod, BinOp::Eq,
+            BinOp::Ne, BinOp::Lt, BinOp::Gt, BinOp::Le, BinOp::Ge, BinOp::And, BinOp::Or,
+            BinOp::Xor, BinOp::BitAnd, BinOp::BitOr, BinOp::BitXor,
         ]);
         prop_oneof![
             (unop, inner.clone()).prop_map(|(o, e)| Expr::Unary(o, Box::new(e))),
-            (binop, inner.clone(), inner.clone()).prop_map(|(o, a, b)| Expr::Binary(
-                o,
-                Box::new(a),
-                Box::new(b)
-            )),
-            (
-                prop::sample::select(FUNCS.to_vec()),
-                inner.clone(),
-                inner.clone()
-            )
-                .prop_map(|(f, a, b)| {
-                    let args = if f == Func::Atan2 {
-                        vec![a, b]
-                    } else {
-                        vec![a]
-                    };
-                    Expr::Func(f, args)
-                }),
+            (binop, inner.clone(), inner.clone()).prop_map(|(o, a, b)| Expr::Binary(o, Box::new(a), Box::new(b))),
+            (prop::sample::select(FUNCS.to_vec()), inner.clone(), inner.clone()).prop_map(|(f, a, b)| {
+                let args = if f == Func::Atan2 { vec![a, b] } else { vec![a] };
+                Expr::Func(f, args)
+            }),
             var_ref(inner).prop_map(|v| Expr::Var(Box::new(v))),
         ]
     })
@@ -111,11 +71,7 @@ fn value() -> impl Strategy<Value = Value> {
 }
 
 fn item() -> impl Strategy<Value = Item> {
-    let letters: Vec<u8> = WORD_LETTERS
-        .iter()
-        .copied()
-        .filter(|&l| l != b'G' && l != b'M')
-        .collect();
+    let letters: Vec<u8> = WORD_LETTERS.iter().copied().filter(|&l| l != b'G' && l != b'M').collect();
     prop_oneof![
         4 => (prop::sample::select(letters), value()).prop_map(|(letter, value)| Item::Word(Word { letter, value, col: 0 })),
         1 => prop::sample::select(KNOWN_G.to_vec()).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
@@ -130,10 +86,7 @@ fn item() -> impl Strategy<Value = Item> {
 }
 
 fn target() -> impl Strategy<Value = GotoTarget> {
-    prop_oneof![
-        (0u32..100_000).prop_map(GotoTarget::Number),
-        ident().prop_map(GotoTarget::Name)
-    ]
+    prop_oneof![(0u32..100_000).prop_map(GotoTarget::Number), ident().prop_map(GotoTarget::Name)]
 }
 
 fn control() -> impl Strategy<Value = Control> {
@@ -148,43 +101,22 @@ fn control() -> impl Strategy<Value = Control> {
         expr().prop_map(EndDo),
         expr().prop_map(Until),
         target().prop_map(Goto),
-        (var_ref(expr()), expr(), expr(), prop::option::of(expr())).prop_map(
-            |(var, start, end, step)| For {
-                var,
-                start,
-                end,
-                step
-            }
-        ),
-        prop::sample::select(vec![
-            Else, EndIf, Default, Break, EndSwitch, EndFor, EndWhile, Do, Repeat, Continue
-        ]),
+        (var_ref(expr()), expr(), expr(), prop::option::of(expr())).prop_map(|(var, start, end, step)| For { var, start, end, step }),
+        prop::sample::select(vec![Else, EndIf, Default, Break, EndSwitch, EndFor, EndWhile, Do, Repeat, Continue]),
     ]
 }
 
 fn options() -> impl Strategy<Value = String> {
-    prop_oneof![
-        Just(String::new()),
-        "[A-Z0-9_.=]([A-Z0-9_ .=,]{0,10}[A-Z0-9_.=])?"
-    ]
+    prop_oneof![Just(String::new()), "[A-Z0-9_.=]([A-Z0-9_ .=,]{0,10}[A-Z0-9_.=])?"]
 }
 
 fn command() -> impl Strategy<Value = Command> {
     use Command::*;
     prop_oneof![
         prop::sample::select(vec![
-            Flush(FlushKind::Stop),
-            Flush(FlushKind::Continue),
-            Flush(FlushKind::Wait),
-            CacheClearAll,
-            CommentBegin,
-            CommentEnd,
-            Spline(SplineCommand::On),
-            Spline(SplineCommand::Off),
-            Spline(SplineCommand::TypeAkima),
-            Spline(SplineCommand::TypeBspline),
-            Var,
-            EndVar,
+            Flush(FlushKind::Stop), Flush(FlushKind::Continue), Flush(FlushKind::Wait), CacheClearAll,
+            CommentBegin, CommentEnd, Spline(SplineCommand::On), Spline(SplineCommand::Off),
+            Spline(SplineCommand::TypeAkima), Spline(SplineCommand::TypeBspline), Var, EndVar,
         ]),
         file().prop_map(|file| CacheLoad { file }),
         file().prop_map(|file| CacheClear { file }),
@@ -197,11 +129,9 @@ fn call() -> impl Strategy<Value = Call> {
     prop_oneof![
         file().prop_map(|file| Call::Global { file }),
         ident().prop_map(|name| Call::Local { name }),
-        (file(), prop::collection::btree_map(0u32..20, expr(), 0..4)).prop_map(|(name, params)| {
-            Call::Cycle {
-                name,
-                params: params.into_iter().collect(),
-            }
+        (file(), prop::collection::btree_map(0u32..20, expr(), 0..4)).prop_map(|(name, params)| Call::Cycle {
+            name,
+            params: params.into_iter().collect(),
         }),
     ]
 }
@@ -224,12 +154,7 @@ fn block() -> impl Strategy<Value = Block> {
         (0u32..100_000).prop_map(|k| (Some(k), Some(Label::Number(k)))),
         (prop::option::of(0u32..100_000), ident()).prop_map(|(n, s)| (n, Some(Label::Name(s)))),
     ];
-    (skip, head, body()).prop_map(|(skip_level, (n, label), body)| Block {
-        skip_level,
-        n,
-        label,
-        body,
-    })
+    (skip, head, body()).prop_map(|(skip_level, (n, label), body)| Block { skip_level, n, label, body })
 }
 
 fn without_cols(mut b: Block) -> Block {

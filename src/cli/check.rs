@@ -68,23 +68,13 @@ fn collect(path: &Path, explicit: bool, files: &mut Vec<PathBuf>, diags: &mut Ve
         let entries = match std::fs::read_dir(path) {
             Ok(rd) => rd,
             Err(e) => {
-                diags.push(Diagnostic::error(
-                    path,
-                    0,
-                    0,
-                    None,
-                    format!("cannot read directory: {e}"),
-                ));
+                diags.push(Diagnostic::error(path, 0, 0, None, format!("cannot read directory: {e}")));
                 return;
             }
         };
         let mut children: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                !p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with('.'))
-            })
+            .filter(|p| !p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with('.')))
             .collect();
         children.sort();
         for child in children {
@@ -93,8 +83,7 @@ fn collect(path: &Path, explicit: bool, files: &mut Vec<PathBuf>, diags: &mut Ve
         return;
     }
     let ext = extension(path);
-    if explicit || NC_EXTENSIONS.contains(&ext.as_str()) || PARAM_EXTENSIONS.contains(&ext.as_str())
-    {
+    if explicit || NC_EXTENSIONS.contains(&ext.as_str()) || PARAM_EXTENSIONS.contains(&ext.as_str()) {
         files.push(path.to_path_buf());
     }
 }

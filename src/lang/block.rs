@@ -47,18 +47,10 @@ pub enum Body {
 pub enum Item {
     Word(Word),
     /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`.
-    Assign {
-        target: VarRef,
-        value: Expr,
-        col: u32,
-    },
+    Assign { target: VarRef, value: Expr, col: u32 },
     /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent).
     /// Seed 003 writes `G134 50`; both forms parse to this item. `col` is the G's column.
-    GValue {
-        g: u32,
-        value: Value,
-        col: u32,
-    },
+    GValue { g: u32, value: Value, col: u32 },
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.
@@ -84,11 +76,7 @@ pub enum VarRef {
     /// `P<n>` or indirect `P[expr]`, with optional array indices `P1[2]`, `P1[i][j]`.
     P { number: Index, indices: Vec<Expr> },
     /// `V.P.name`, `V.L.name`, `V.S.name`, `V.E.name`, optional array indices. Name upper-case.
-    V {
-        scope: VScope,
-        name: String,
-        indices: Vec<Expr>,
-    },
+    V { scope: VScope, name: String, indices: Vec<Expr> },
     /// `@P<n>`: a cycle parameter, visible inside a cycle called by `L CYCLE [... @Pn=..]`.
     CycleParam(u32),
 }
@@ -191,12 +179,7 @@ pub enum Control {
     Break,
     EndSwitch,
     /// `$FOR P1 = start, end, step` (step optional, default 1).
-    For {
-        var: VarRef,
-        start: Expr,
-        end: Expr,
-        step: Option<Expr>,
-    },
+    For { var: VarRef, start: Expr, end: Expr, step: Option<Expr> },
     EndFor,
     While(Expr),
     EndWhile,
@@ -220,13 +203,9 @@ pub enum GotoTarget {
 pub enum Command {
     Flush(FlushKind),
     /// `#CACHE LOAD [FILE=name]`.
-    CacheLoad {
-        file: String,
-    },
+    CacheLoad { file: String },
     /// `#CACHE CLEAR [FILE=name]`.
-    CacheClear {
-        file: String,
-    },
+    CacheClear { file: String },
     /// `#CACHE CLEAR ALL`.
     CacheClearAll,
     CommentBegin,
@@ -234,14 +213,9 @@ pub enum Command {
     /// `#SPLINE ON`, `#SPLINE OFF`, `#SPLINE TYPE AKIMA|BSPLINE`.
     Spline(SplineCommand),
     /// `#HSC ON [...]` / `#HSC OFF`; the bracket text is kept verbatim.
-    Hsc {
-        on: bool,
-        options: String,
-    },
+    Hsc { on: bool, options: String },
     /// `#CONTOUR MODE [...]`; the bracket text kept verbatim.
-    ContourMode {
-        options: String,
-    },
+    ContourMode { options: String },
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,
@@ -273,10 +247,7 @@ pub enum Call {
     /// `LL name`: local subroutine defined by `%L name` in the same file.
     Local { name: String },
     /// `L CYCLE [NAME=file.cyc @P1=0 @P2=0]`.
-    Cycle {
-        name: String,
-        params: Vec<(u32, Expr)>,
-    },
+    Cycle { name: String, params: Vec<(u32, Expr)> },
 }
 
 /// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`.

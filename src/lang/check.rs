@@ -125,10 +125,7 @@ impl Level {
             line,
             col,
             kind.code(),
-            format!(
-                "unexpected {} without its opening statement",
-                kind.keyword()
-            ),
+            format!("unexpected {} without its opening statement", kind.keyword()),
         ));
     }
 
@@ -142,9 +139,7 @@ impl Level {
             }
         };
         match c {
-            Control::If(_) => self
-                .open
-                .push((OpenKind::If { else_seen: false }, line, col)),
+            Control::If(_) => self.open.push((OpenKind::If { else_seen: false }, line, col)),
             Control::IfGoto(_, t) | Control::Goto(t) => self.gotos.push((t.clone(), line, col)),
             Control::ElseIf(_) => {
                 if top != Some(OpenKind::If { else_seen: false }) {
@@ -155,12 +150,7 @@ impl Level {
                 Some((OpenKind::If { else_seen }, _, _)) if !*else_seen => *else_seen = true,
                 _ => self.stray(StrayKind::Else, line, col, diags),
             },
-            Control::EndIf => pop_if(
-                self,
-                |k| matches!(k, OpenKind::If { .. }),
-                StrayKind::EndIf,
-                diags,
-            ),
+            Control::EndIf => pop_if(self, |k| matches!(k, OpenKind::If { .. }), StrayKind::EndIf, diags),
             Control::Switch(_) => self.open.push((OpenKind::Switch, line, col)),
             Control::Case(_) => {
                 if top != Some(OpenKind::Switch) {
@@ -186,9 +176,7 @@ impl Level {
                     self.stray(StrayKind::Continue, line, col, diags);
                 }
             }
-            Control::EndSwitch => {
-                pop_if(self, |k| k == OpenKind::Switch, StrayKind::EndSwitch, diags)
-            }
+            Control::EndSwitch => pop_if(self, |k| k == OpenKind::Switch, StrayKind::EndSwitch, diags),
             Control::For { .. } => self.open.push((OpenKind::For, line, col)),
             Control::EndFor => pop_if(self, |k| k == OpenKind::For, StrayKind::EndFor, diags),
             Control::While(_) => self.open.push((OpenKind::While, line, col)),

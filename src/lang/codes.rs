@@ -64,8 +64,8 @@ pub fn is_word_letter(b: u8) -> bool {
 /// absolute/incremental G90/G91, ramp time weighting G132–G134, spline off/on G150/G151,
 /// contouring off/on G260/G261. Everything else is 20131.
 pub const KNOWN_G: &[u32] = &[
-    0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 90, 91, 132, 133, 134,
-    150, 151, 260, 261,
+    0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 90, 91, 132, 133,
+    134, 150, 151, 260, 261,
 ];
 
 /// G functions that take a value: `G133=<expr>`, `G134=<expr>` (ISG manual "Weighting the
@@ -148,12 +148,7 @@ mod tests {
     #[test]
     fn word_letter_mask_matches_the_list() {
         for b in b'A'..=b'Z' {
-            assert_eq!(
-                is_word_letter(b),
-                WORD_LETTERS.contains(&b),
-                "{}",
-                b as char
-            );
+            assert_eq!(is_word_letter(b), WORD_LETTERS.contains(&b), "{}", b as char);
         }
         assert!(!is_word_letter(b'g'));
         assert!(!is_word_letter(b'['));

@@ -58,11 +58,7 @@ impl<'a> ParseError<&'a str> for PErr<'a> {
 pub(crate) type PResult<'a, O> = IResult<&'a str, O, PErr<'a>>;
 
 /// A committed error: no alternative is tried after it.
-pub(crate) fn fail<'a, O>(
-    input: &'a str,
-    code: u32,
-    msg: impl Into<Cow<'static, str>>,
-) -> PResult<'a, O> {
+pub(crate) fn fail<'a, O>(input: &'a str, code: u32, msg: impl Into<Cow<'static, str>>) -> PResult<'a, O> {
     Err(nom::Err::Failure(PErr {
         input,
         code,
@@ -71,11 +67,7 @@ pub(crate) fn fail<'a, O>(
 }
 
 /// The committed error itself, for functions that do not return a parse result.
-pub(crate) fn perr<'a>(
-    input: &'a str,
-    code: u32,
-    msg: impl Into<Cow<'static, str>>,
-) -> nom::Err<PErr<'a>> {
+pub(crate) fn perr<'a>(input: &'a str, code: u32, msg: impl Into<Cow<'static, str>>) -> nom::Err<PErr<'a>> {
     nom::Err::Failure(PErr {
         input,
         code,
@@ -310,11 +302,7 @@ impl<'a> Ctx<'a> {
                 let (rest, v) = self.var_ref(i)?;
                 Ok((rest, Expr::Var(Box::new(v))))
             }
-            b'P' | b'p'
-                if i.as_bytes()
-                    .get(1)
-                    .is_some_and(|&c| c.is_ascii_digit() || c == b'[') =>
-            {
+            b'P' | b'p' if i.as_bytes().get(1).is_some_and(|&c| c.is_ascii_digit() || c == b'[') => {
                 let (rest, v) = self.var_ref(i)?;
                 Ok((rest, Expr::Var(Box::new(v))))
             }
@@ -366,11 +354,7 @@ impl<'a> Ctx<'a> {
             return fail(
                 i,
                 SYNTAX,
-                format!(
-                    "{name} takes {} argument(s), got {}",
-                    func.arity(),
-                    args.len()
-                ),
+                format!("{name} takes {} argument(s), got {}", func.arity(), args.len()),
             );
         }
         self.set_height(h + 1, i)?;
@@ -390,9 +374,7 @@ impl<'a> Ctx<'a> {
                         self.height.set(1);
                         Ok((rest, VarRef::CycleParam(n)))
                     }
-                    Err(nom::Err::Error(_)) => {
-                        fail(&rest[1..], SYNTAX, "cycle parameter number expected")
-                    }
+                    Err(nom::Err::Error(_)) => fail(&rest[1..], SYNTAX, "cycle parameter number expected"),
                     Err(e) => Err(e),
                 }
             }
@@ -406,9 +388,7 @@ impl<'a> Ctx<'a> {
                 } else {
                     match uint(rest) {
                         Ok((r, n)) => (r, Index::Const(n)),
-                        Err(nom::Err::Error(_)) => {
-                            return fail(rest, SYNTAX, "parameter number expected")
-                        }
+                        Err(nom::Err::Error(_)) => return fail(rest, SYNTAX, "parameter number expected"),
                         Err(e) => return Err(e),
                     }
                 };
@@ -422,20 +402,10 @@ impl<'a> Ctx<'a> {
                     Some(b'L') => VScope::Local,
                     Some(b'S') => VScope::SelfRetaining,
                     Some(b'E') => VScope::External,
-                    _ => {
-                        return fail(
-                            &i[2..],
-                            SYNTAX,
-                            "variable scope P, L, S or E expected after `V.`",
-                        )
-                    }
+                    _ => return fail(&i[2..], SYNTAX, "variable scope P, L, S or E expected after `V.`"),
                 };
                 let Some(rest) = i.get(3..).filter(|r| r.starts_with('.')) else {
-                    return fail(
-                        i.get(3..).unwrap_or(""),
-                        SYNTAX,
-                        "`.` expected after the variable scope",
-                    );
+                    return fail(i.get(3..).unwrap_or(""), SYNTAX, "`.` expected after the variable scope");
                 };
                 let rest = &rest[1..];
                 let (rest, name) = match name_upper(rest) {
@@ -445,14 +415,7 @@ impl<'a> Ctx<'a> {
                 };
                 let (rest, indices) = self.indices(rest)?;
                 self.set_height(self.height.get() + 1, i)?;
-                Ok((
-                    rest,
-                    VarRef::V {
-                        scope,
-                        name,
-                        indices,
-                    },
-                ))
+                Ok((rest, VarRef::V { scope, name, indices }))
             }
             _ => fail(i, SYNTAX, "parameter or variable expected"),
         }
@@ -588,11 +551,7 @@ pub fn parse_expr(text: &str) -> Result<Expr, SyntaxError> {
     let (rest, e) = ctx.expr(ws(text)).map_err(|e| ctx.to_error(e))?;
     let rest = ws(rest);
     if !rest.is_empty() {
-        return Err(SyntaxError::new(
-            SYNTAX,
-            ctx.col(rest),
-            "operator or end of expression expected",
-        ));
+        return Err(SyntaxError::new(SYNTAX, ctx.col(rest), "operator or end of expression expected"));
     }
     Ok(e)
 }

@@ -9,15 +9,15 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, VScope,
-    Value, VarDecl, VarRef, Word,
+    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand,
+    VScope, Value, VarDecl, VarRef, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, CACHE_DOUBLE, CACHE_SYNTAX, G_WITH_VALUE,
     MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
 };
 use super::error::SyntaxError;
-use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
+use super::expr::{fail, keyword, perr, name_upper, uint, ws, Ctx, PErr, PResult};
 use super::number::scan_unsigned;
 
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
@@ -120,10 +120,7 @@ pub(crate) fn gap(mut i: &str) -> &str {
 }
 
 /// Block skip, block number and label: what may precede every body.
-fn prefix<'a>(
-    ctx: &Ctx<'a>,
-    mut i: &'a str,
-) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
+fn prefix<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<Label>)> {
     let mut skip = None;
     if let Some(rest) = i.strip_prefix('/') {
         if rest.as_bytes().first().is_some_and(u8::is_ascii_digit) {
@@ -317,11 +314,7 @@ fn word<'a>(
         b'G' => {
             let g = integer_code(&value);
             let Some(g) = g.filter(|&g| is_known_g(g)) else {
-                return Err(perr(
-                    i,
-                    UNKNOWN_G,
-                    format!("unknown G function G{}", show_value(&value)),
-                ));
+                return Err(perr(i, UNKNOWN_G, format!("unknown G function G{}", show_value(&value))));
             };
             if G_WITH_VALUE.contains(&g) {
                 if let Some((r, v)) = g_value(ctx, rest)? {
@@ -332,11 +325,7 @@ fn word<'a>(
         }
         b'M' => {
             if !integer_code(&value).is_some_and(is_known_m) {
-                return Err(perr(
-                    i,
-                    UNKNOWN_M,
-                    format!("unknown M function M{}", show_value(&value)),
-                ));
+                return Err(perr(i, UNKNOWN_M, format!("unknown M function M{}", show_value(&value))));
             }
         }
         _ => {}
@@ -457,10 +446,7 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
             return fail(
                 i,
                 UNKNOWN_COMMAND,
-                format!(
-                    "unknown control statement ${}",
-                    &after[..after.len() - rest.len()]
-                ),
+                format!("unknown control statement ${}", &after[..after.len() - rest.len()]),
             )
         }
     };
@@ -488,15 +474,7 @@ fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
         }
         None => (r, None),
     };
-    Ok((
-        r,
-        Control::For {
-            var,
-            start,
-            end,
-            step,
-        },
-    ))
+    Ok((r, Control::For { var, start, end, step }))
 }
 
 /// `N40` or `[LABEL]`.
@@ -707,34 +685,20 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
         if name.is_empty() {
             return fail(r, SYNTAX, "subroutine name expected after LL");
         }
-        return Ok((
-            rest,
-            Call::Local {
-                name: name.to_ascii_uppercase(),
-            },
-        ));
+        return Ok((rest, Call::Local { name: name.to_ascii_uppercase() }));
     }
     if let Some(c) = keyword(r, "CYCLE") {
         let c = ws(c);
         if c.starts_with('[') {
             return cycle(ctx, c);
         }
-        return fail(
-            c,
-            SYNTAX,
-            "[NAME=<file> @P<n>=<value> …] expected after L CYCLE",
-        );
+        return fail(c, SYNTAX, "[NAME=<file> @P<n>=<value> …] expected after L CYCLE");
     }
     let (rest, file) = file_name(r, false);
     if file.is_empty() {
         return fail(r, SYNTAX, "subroutine file name expected after L");
     }
-    Ok((
-        rest,
-        Call::Global {
-            file: file.to_string(),
-        },
-    ))
+    Ok((rest, Call::Global { file: file.to_string() }))
 }
 
 /// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
@@ -812,27 +776,14 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
     let i = gap(line);
     let b = i.as_bytes();
     if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
-        return Err(perr(
-            i,
-            SYNTAX,
-            "variable declaration V.P., V.L. or V.S. expected",
-        ));
+        return Err(perr(i, SYNTAX, "variable declaration V.P., V.L. or V.S. expected"));
     }
     let (r, v) = ctx.var_ref(i)?;
-    let VarRef::V {
-        scope,
-        name,
-        indices,
-    } = v
-    else {
+    let VarRef::V { scope, name, indices } = v else {
         return Err(perr(i, SYNTAX, "variable declaration expected"));
     };
     if scope == VScope::External {
-        return Err(perr(
-            i,
-            SYNTAX,
-            "V.E. variables are not declared in programs",
-        ));
+        return Err(perr(i, SYNTAX, "V.E. variables are not declared in programs"));
     }
     let mut dims = Vec::with_capacity(indices.len());
     for e in indices {
@@ -840,13 +791,7 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 && n <= 1.0e6 => {
                 dims.push(n as u32)
             }
-            _ => {
-                return Err(perr(
-                    i,
-                    SYNTAX,
-                    "array size must be a whole number from 1 to 1000000",
-                ))
-            }
+            _ => return Err(perr(i, SYNTAX, "array size must be a whole number from 1 to 1000000")),
         }
     }
     let j = ws(r);
