@@ -134,6 +134,15 @@ pub enum Finish {
     Error,
 }
 
+/// A stream block that took effect, as the soak checker sees it: cheap enough to record for
+/// every block of a 10-million-block run, where the event log would cost far more.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExecutedBlock {
+    /// Byte offset of the line since stream start.
+    pub offset: u64,
+    pub n: Option<u32>,
+}
+
 /// Counters the report shows.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ChannelStats {
@@ -169,6 +178,10 @@ pub struct Channel {
     running_prog: Option<Arc<str>>,
     notes: Vec<MotionNote>,
     events: EventBuffer,
+    /// Record executed stream blocks in `executed` (soak checks); off by default.
+    observe: bool,
+    /// Executed stream blocks since the last [`Channel::drain_executed`].
+    executed: Vec<ExecutedBlock>,
 }
 
 impl Channel {
@@ -195,6 +208,8 @@ impl Channel {
             running_prog: None,
             notes: Vec::new(),
             events: EventBuffer::new(events_enabled),
+            observe: false,
+            executed: Vec::new(),
         }
     }
 
@@ -255,6 +270,18 @@ impl Channel {
     }
     pub fn events_mut(&mut self) -> &mut EventBuffer {
         &mut self.events
+    }
+    /// Record every executed stream block for [`Channel::drain_executed`]. Whoever turns this
+    /// on drains every tick: the record grows by the blocks of one tick only.
+    pub fn observe_stream_blocks(&mut self, on: bool) {
+        self.observe = on;
+        if !on {
+            self.executed.clear();
+        }
+    }
+    /// The stream blocks executed since the last call, in execution order.
+    pub fn drain_executed(&mut self) -> std::vec::Drain<'_, ExecutedBlock> {
+        self.executed.drain(..)
     }
     /// The position of each configured axis, in `AXIS_LETTERS` order.
     pub fn axis_positions(&self) -> Vec<(char, f64)> {
@@ -606,6 +633,12 @@ impl Channel {
                     }
                     self.ran_any = true;
                     self.stats.blocks += 1;
+                    if self.observe && info.stream {
+                        self.executed.push(ExecutedBlock {
+                            offset: info.offset,
+                            n: info.n,
+                        });
+                    }
                     if self.events.enabled() {
                         self.events.push(
                             tick,

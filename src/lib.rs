@@ -19,4 +19,5 @@ pub mod queue;
 pub mod report;
 pub mod runtime;
 pub mod setup;
+pub mod soak;
 pub mod source;

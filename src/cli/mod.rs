@@ -11,6 +11,7 @@ pub mod check;
 pub mod receive;
 pub mod run;
 pub mod serve;
+pub mod soak;
 pub mod stream;
 
 /// Exit codes of the command-line contract (DESIGN.md).
@@ -48,6 +49,8 @@ pub enum Command {
     Serve(serve::ServeArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
+    /// Soak test: run a scenario (params/soak/*.toml) and check its invariants.
+    Soak(soak::SoakArgs),
     /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
     Stream(stream::StreamArgs),
 }
@@ -60,6 +63,7 @@ impl Cli {
             Some(Command::Receive(args)) => receive::execute(args),
             Some(Command::Run(args)) => run::execute(args),
             Some(Command::Serve(args)) => serve::execute(args),
+            Some(Command::Soak(args)) => soak::execute(args),
             Some(Command::Stream(args)) => stream::execute(args),
             None => run::execute(run::RunArgs::demo()),
         }

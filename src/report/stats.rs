@@ -158,6 +158,16 @@ impl Histogram {
     pub fn max_us(&self) -> f64 {
         self.max_ns as f64 / 1000.0
     }
+
+    /// The non-empty buckets as (largest value in the bucket in ns, count), ascending: what a
+    /// plot of the distribution needs.
+    pub fn buckets(&self) -> impl Iterator<Item = (u64, u64)> + '_ {
+        self.counts
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c > 0)
+            .map(|(i, &c)| (bucket_high(i), c))
+    }
 }
 
 /// Per-tick statistics of a run: how long the tick's work took, how late it started against

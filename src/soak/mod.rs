@@ -1,0 +1,341 @@
+//! Soak tests: a scenario file drives every channel of a start-up list for millions of blocks
+//! with a randomised client and injected faults, checking invariants as it goes; see
+//! `ncchannel soak` and the README section "Soak and bench".
+
+pub mod driver;
+pub mod feed;
+pub mod generator;
+pub mod invariants;
+pub mod plot;
+pub mod report;
+pub mod rng;
+pub mod scenario;
+
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use thiserror::Error;
+
+use crate::runtime::{Clock, RunEnd, Runtime};
+use driver::{Slot, SoakCycle};
+use feed::{SoakFeeder, Source};
+use generator::Generator;
+use invariants::{resident_kib, Tally};
+use report::{ChannelReport, CycleFigures, MemoryReport, SoakReport};
+use rng::SplitMix64;
+use scenario::{ClockSpec, Length, Scenario};
+
+/// Largest file a scenario streams.
+const MAX_STREAM_FILE_BYTES: u64 = 16 << 20;
+
+#[derive(Debug, Error)]
+pub enum SoakError {
+    #[error(transparent)]
+    Scenario(#[from] scenario::ScenarioError),
+    #[error("parameter lists {path}: {msg}")]
+    Params { path: String, msg: String },
+    #[error("{0}")]
+    Setup(String),
+}
+
+/// Command-line choices that override the scenario.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    pub realtime: bool,
+    /// Print a progress line on stderr (only when it is a terminal).
+    pub progress: bool,
+    /// Replace the scenario's `[length]` (the CI's short runs).
+    pub length: Option<Length>,
+    pub seed: Option<u64>,
+}
+
+/// Build the cycle of a scenario: its channels, clients and fault schedules.
+pub fn build(
+    scenario: &Scenario,
+    seed: u64,
+    target_blocks: Option<u64>,
+) -> Result<(SoakCycle, Duration), SoakError> {
+    let params = scenario.params_path();
+    let config = crate::params::load(&params).map_err(|e| SoakError::Params {
+        path: params.display().to_string(),
+        msg: e
+            .diagnostics()
+            .iter()
+            .map(|d| d.render())
+            .collect::<Vec<_>>()
+            .join("\n"),
+    })?;
+    let axes = crate::setup::axes(&config).map_err(|e| SoakError::Setup(e.to_string()))?;
+    let specs: Vec<scenario::ChannelSpec> = if scenario.channels.is_empty() {
+        (1..=config.channels.len() as u32)
+            .map(|number| scenario::ChannelSpec {
+                number,
+                ..Default::default()
+            })
+            .collect()
+    } else {
+        scenario.channels.clone()
+    };
+    let mut rng = SplitMix64::new(seed);
+    let mut slots = Vec::new();
+    for spec in &specs {
+        let Some(cc) = config.channels.get(spec.number as usize - 1) else {
+            return Err(SoakError::Setup(format!(
+                "[[channel]] number {}: the start-up list has {} channels",
+                spec.number,
+                config.channels.len()
+            )));
+        };
+        let settings = crate::setup::channel_settings(&config, cc)
+            .map_err(|e| SoakError::Setup(e.to_string()))?;
+        let program = match (&spec.program, &cc.streaming_prog_file) {
+            (Some(p), _) | (None, Some(p)) => p.clone(),
+            (None, None) => {
+                return Err(SoakError::Setup(format!(
+                    "channel {}: no program named and streaming is off in {}",
+                    spec.number,
+                    cc.list_path.display()
+                )))
+            }
+        };
+        let mut ch_rng = rng.fork(u64::from(spec.number));
+        let source = match &spec.file {
+            Some(f) => {
+                let path = scenario.dir.join(f);
+                let text = read_bounded(&path)
+                    .map_err(|e| SoakError::Setup(format!("{}: {e}", path.display())))?;
+                Source::file(&text)
+                    .map_err(|e| SoakError::Setup(format!("{}: {e}", path.display())))?
+            }
+            None => Source::Generated(Generator::new(
+                spec.program_mix
+                    .clone()
+                    .unwrap_or_else(|| scenario.program.clone()),
+                ch_rng.fork(1),
+            )),
+        };
+        let feeder = SoakFeeder::new(
+            spec.feeder
+                .clone()
+                .unwrap_or_else(|| scenario.feeder.clone()),
+            ch_rng.fork(2),
+            source,
+        );
+        let channel = crate::channel::Channel::new(settings, false);
+        slots.push(Slot::new(channel, program, feeder, &axes, ch_rng.fork(3)));
+    }
+    let cycle = SoakCycle::new(
+        slots,
+        scenario.faults.clone(),
+        scenario.invariants.expected_errors.clone(),
+        target_blocks,
+    );
+    Ok((
+        cycle,
+        Duration::from_micros(config.runtime.cycle_period_us.max(1)),
+    ))
+}
+
+fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut buf = Vec::new();
+    std::fs::File::open(p)?
+        .take(MAX_STREAM_FILE_BYTES + 1)
+        .read_to_end(&mut buf)?;
+    if buf.len() as u64 > MAX_STREAM_FILE_BYTES {
+        return Err(std::io::Error::other("larger than 16 MiB"));
+    }
+    Ok(buf)
+}
+
+/// Run a scenario to its end and report.
+pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
+    let length = opts
+        .length
+        .clone()
+        .unwrap_or_else(|| scenario.length.clone());
+    let seed = opts.seed.unwrap_or(scenario.seed);
+    let (cycle, period) = build(scenario, seed, length.blocks)?;
+    let realtime = opts.realtime || scenario.clock == ClockSpec::Realtime;
+    let clock = if realtime {
+        Clock::RealTime
+    } else {
+        Clock::Virtual
+    };
+    let (mut rt, _tx) = Runtime::new(cycle, period, clock);
+
+    let period_s = period.as_secs_f64();
+    let tick_limit = [
+        length.ticks,
+        length.sim_seconds.map(|s| (s / period_s).ceil() as u64),
+    ]
+    .into_iter()
+    .flatten()
+    .min();
+    let wall_limit = length.wall_seconds.map(Duration::from_secs_f64);
+    let chunk = if realtime {
+        ((0.05 / period_s) as u64).max(1)
+    } else {
+        2048
+    };
+    let progress = opts.progress && std::io::stderr().is_terminal();
+    let fraction = |rt: &Runtime<SoakCycle>, wall: Duration| -> f64 {
+        let mut f: f64 = 0.0;
+        if let Some(b) = length.blocks {
+            f = f.max(rt.cycle().total_blocks as f64 / b.max(1) as f64);
+        }
+        if let Some(t) = tick_limit {
+            f = f.max(rt.ticks() as f64 / t.max(1) as f64);
+        }
+        if let Some(w) = wall_limit {
+            f = f.max(wall.as_secs_f64() / w.as_secs_f64());
+        }
+        f.min(1.0)
+    };
+
+    let start = Instant::now();
+    let mut last_progress = start;
+    let mut warmup_kib = None;
+    loop {
+        let n = tick_limit.map_or(chunk, |t| chunk.min(t.saturating_sub(rt.ticks())));
+        if n == 0 {
+            break;
+        }
+        let s = rt.run(Some(n));
+        let wall = start.elapsed();
+        let f = fraction(&rt, wall);
+        if warmup_kib.is_none() && f >= scenario.invariants.warmup {
+            warmup_kib = resident_kib();
+        }
+        if s.end == RunEnd::Stopped || wall_limit.is_some_and(|w| wall >= w) {
+            break;
+        }
+        if progress && last_progress.elapsed() >= Duration::from_millis(500) {
+            last_progress = Instant::now();
+            let blocks = rt.cycle().total_blocks;
+            let width = 30;
+            let done = (f * width as f64) as usize;
+            eprint!(
+                "\r[{}{}] {:5.1}%  {} blocks  {:.0} blocks/s  ",
+                "#".repeat(done),
+                ".".repeat(width - done),
+                f * 100.0,
+                blocks,
+                blocks as f64 / wall.as_secs_f64().max(1e-9)
+            );
+            let _ = std::io::stderr().flush();
+        }
+    }
+    if progress {
+        eprint!("\r{:70}\r", "");
+    }
+    let wall = start.elapsed();
+    let end_kib = resident_kib();
+    let warmup_kib = warmup_kib.or(end_kib);
+    let ticks = rt.ticks();
+    let sim = rt.time().as_secs_f64();
+    let (cycle, stats) = rt.into_inner();
+
+    let growth = match (warmup_kib, end_kib) {
+        (Some(a), Some(b)) => Some(b as i64 - a as i64),
+        _ => None,
+    };
+    let mut memory = Tally::default();
+    let slack = scenario.invariants.memory_slack_kib;
+    if let Some(g) = growth {
+        if g > slack as i64 {
+            memory.violate(|| {
+                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
+            });
+        }
+    }
+    let order_note = format!("{} blocks checked", cycle.total_blocks);
+    let invariants = vec![
+        cycle.tallies.order.verdict(
+            "every streamed block executed exactly once, in order, between resets",
+            Some(order_note),
+        ),
+        cycle.tallies.errors.verdict(
+            "no channel error but the expected ones",
+            Some(format!(
+                "expected: {:?}",
+                scenario.invariants.expected_errors
+            )),
+        ),
+        cycle
+            .tallies
+            .limits
+            .verdict("positions within the axis soft limits", None),
+        memory.verdict(
+            "memory steady",
+            growth.map(|g| format!("growth {g} KiB ≤ {slack} KiB")),
+        ),
+    ];
+    let channels = cycle
+        .slots
+        .iter()
+        .map(|s| {
+            let f = s.feeder.counters();
+            let st = s.channel.stats();
+            ChannelReport {
+                number: s.channel.number(),
+                program: s.program.clone(),
+                blocks: s.counters.blocks,
+                resets: s.counters.resets,
+                error_resets: s.counters.error_resets,
+                restarts: s.counters.restarts,
+                holds: s.counters.holds,
+                overrides: s.counters.overrides,
+                forced_rejections: s.counters.forced_rejections,
+                writes_ok: f.writes_ok,
+                writes_rejected: f.writes_rejected,
+                writes_skipped: f.writes_skipped,
+                bytes: f.bytes,
+                lines_written: f.lines,
+                pauses: f.pauses,
+                interrupts: st.interrupts,
+                warnings: st.warnings,
+                errors: s.counters.errors.clone(),
+                checksum: format!("{:016x}", s.counters.checksum.0),
+            }
+        })
+        .collect();
+    let blocks = cycle.total_blocks;
+    Ok(SoakReport {
+        scenario: scenario.path.display().to_string(),
+        seed,
+        clock: if realtime { "real" } else { "virtual" }.into(),
+        ticks,
+        sim_seconds: sim,
+        wall_seconds: wall.as_secs_f64(),
+        blocks,
+        blocks_per_wall_second: blocks as f64 / wall.as_secs_f64().max(1e-9),
+        all_held: invariants.iter().all(|v| v.held),
+        invariants,
+        channels,
+        memory: MemoryReport {
+            warmup_kib,
+            end_kib,
+            growth_kib: growth,
+        },
+        cycle: CycleFigures::new(period.as_secs_f64() * 1e6, &stats),
+    })
+}
+
+/// The scenarios shipped in `params/soak/`, for the CI and the tests.
+pub fn shipped_scenarios() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "toml")
+                && p.file_name().is_some_and(|n| n != "runtime.toml")
+        })
+        .collect();
+    v.sort();
+    v
+}
