@@ -542,7 +542,10 @@ fn motion_keeps_running_while_a_read_is_pending() {
     // releases the move at once (else the planner holds it for the window or program end).
     let rig = Rig::with_cache(Some((2, 200)), "fs_latency_us = 300000\n");
     rig.program("c.cyc", "P1=1\nM17\n");
-    rig.program("main.nc", "G1 X10 F600\n#FLUSH CONTINUE\nL CYCLE [NAME=c.cyc]\nM30\n");
+    rig.program(
+        "main.nc",
+        "G1 X10 F600\n#FLUSH CONTINUE\nL CYCLE [NAME=c.cyc]\nM30\n",
+    );
     let r = rig.run("main.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
     assert!((1300..1400).contains(&r.ticks), "{} ticks", r.ticks);
