@@ -18,6 +18,9 @@ use crate::source::cache::{Cache, CacheLimits};
 use crate::source::store::{FsLatency, ProgramStore, SearchDir, StoreStats};
 use crate::source::stream::{StreamBuffer, StreamWriteError};
 
+/// Errors kept for the report (`ChannelStats::errors` counts all of them).
+pub const MAX_LISTED_ERRORS: usize = 256;
+
 /// Warning raised when a stream write is rejected because the buffer is full.
 pub const WARN_WRITE_REJECTED: u32 = 11012;
 /// Error raised by stream data without CR LF line ends.
@@ -150,6 +153,8 @@ pub struct ChannelStats {
     pub blocks: u64,
     pub interrupts: u64,
     pub warnings: u64,
+    /// Every error raised (the first `MAX_LISTED_ERRORS` are kept with their text).
+    pub errors: u64,
     pub programs_ended: u64,
 }
 
@@ -247,6 +252,7 @@ impl Channel {
     pub fn motion_mut(&mut self) -> &mut Motion {
         &mut self.motion
     }
+    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
     pub fn errors(&self) -> &[(u32, String)] {
         &self.errors
     }
@@ -328,7 +334,12 @@ impl Channel {
                 line,
             },
         );
-        self.errors.push((code, msg.clone()));
+        self.stats.errors += 1;
+        // The report lists the first errors of a run; a soak raising the same expected
+        // error for days must not grow memory, so the list is bounded and the rest counted.
+        if self.errors.len() < MAX_LISTED_ERRORS {
+            self.errors.push((code, msg.clone()));
+        }
         self.last_error = Some((code, msg));
         // An error stops decoding and motion; only a reset leaves ERROR.
         self.motion.reset();

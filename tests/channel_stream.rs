@@ -281,3 +281,18 @@ fn unknown_main_program_is_20368_and_unknown_subroutine_20369() {
     let r = rig.run("m.nc", None, 100);
     assert_eq!(r.error_codes(), [20369]);
 }
+
+#[test]
+fn the_error_list_is_bounded_and_counts_the_rest() {
+    let rig = Rig::new();
+    let (mut machine, period, _log) = rig.machine();
+    let t = tick0(period);
+    let c = machine.channel_mut(1).unwrap();
+    for _ in 0..1000 {
+        let _ = c.write_stream(&t, b"N1 X1\n");
+        c.reset(&t);
+    }
+    assert_eq!(c.stats().errors, 1000);
+    assert_eq!(c.errors().len(), ncchannel::channel::MAX_LISTED_ERRORS);
+    assert!(c.errors().iter().all(|(code, _)| *code == 21476));
+}
