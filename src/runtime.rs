@@ -21,7 +21,7 @@ pub const MAX_REQUESTS_PER_TICK: usize = 64;
 
 /// Real time: no request is started closer than this to a tick's deadline. A request costs a
 /// few microseconds; the margin keeps the tick's start on time.
-pub const SERVE_MARGIN: Duration = Duration::from_micros(100);
+pub const SERVE_MARGIN: Duration = Duration::from_micros(250);
 
 /// The tick being run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
