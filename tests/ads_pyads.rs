@@ -31,21 +31,7 @@ fn pyads_talks_to_the_server() {
 fn pyads_streams_5000_lines_into_real_channels() {
     let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
     let rig = common::Rig::new();
-    let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
-    // Mostly parameter blocks with a short move every 25 lines: the channel is running and
-    // moving, yet 5,000 lines take seconds, not minutes, of real time.
-    lines.extend((2..5000).map(|i| {
-        if i % 25 == 0 {
-            format!(
-                "N{i} X{:.3} Y{:.3}",
-                (i % 50) as f64 * 0.02,
-                (i % 31) as f64 * 0.02
-            )
-        } else {
-            format!("N{i} P{}={i}", 1 + i % 20)
-        }
-    }));
-    lines.push("M30".into());
+    let lines = common::streamed_5000_lines();
     let file = rig.dir.path().join("prog.nc");
     std::fs::write(&file, lines.join("\n") + "\n").unwrap();
     let served = common::Served::start(&rig);

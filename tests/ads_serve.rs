@@ -79,21 +79,7 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
     dev.write_value(CH1, offset::COMMAND_STATE, &4i32).unwrap();
     assert_eq!(mode_state(&dev), (2, 4));
 
-    let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
-    // Mostly parameter blocks with a short move every 25 lines: the channel is running and
-    // moving, yet 5,000 lines take seconds, not minutes, of real time.
-    lines.extend((2..5000).map(|i| {
-        if i % 25 == 0 {
-            format!(
-                "N{i} X{:.3} Y{:.3}",
-                (i % 50) as f64 * 0.02,
-                (i % 31) as f64 * 0.02
-            )
-        } else {
-            format!("N{i} P{}={i}", 1 + i % 20)
-        }
-    }));
-    lines.push("M30".into());
+    let lines = common::streamed_5000_lines();
     let mut busy = 0u32;
     let deadline = Instant::now() + Duration::from_secs(120);
     for p in packets(&lines) {

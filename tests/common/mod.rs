@@ -241,3 +241,23 @@ impl Served {
         (m, events)
     }
 }
+
+/// The 5,000-line program the ADS end-to-end tests stream: mostly parameter blocks with a
+/// short move every 25 lines, so the channel runs and moves, yet 5,000 lines take seconds,
+/// not minutes, of real time. Ends with M30.
+pub fn streamed_5000_lines() -> Vec<String> {
+    let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
+    lines.extend((2..5000).map(|i| {
+        if i % 25 == 0 {
+            format!(
+                "N{i} X{:.3} Y{:.3}",
+                (i % 50) as f64 * 0.02,
+                (i % 31) as f64 * 0.02
+            )
+        } else {
+            format!("N{i} P{}={i}", 1 + i % 20)
+        }
+    }));
+    lines.push("M30".into());
+    lines
+}
