@@ -63,12 +63,7 @@ fn pyads_streams_5000_lines_into_real_channels() {
         notes.iter().any(|n| n[1] == 4),
         "a notification reported ACTIVE: {notes:?}"
     );
-    let blocks: Vec<&str> = events
-        .iter()
-        .filter(|e| e["ev"] == "block")
-        .map(|e| e["text"].as_str().unwrap())
-        .collect();
-    assert_eq!(blocks, lines.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(common::block_texts(&events), lines);
     let warnings = events
         .iter()
         .filter(|e| e["ev"] == "warning" && e["code"] == 11012)

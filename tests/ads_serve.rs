@@ -113,12 +113,7 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
     drop(client);
 
     let (_, events) = served.finish();
-    let blocks: Vec<&str> = events
-        .iter()
-        .filter(|e| e["ev"] == "block")
-        .map(|e| e["text"].as_str().unwrap())
-        .collect();
-    assert_eq!(blocks, lines.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(common::block_texts(&events), lines);
     let warnings = events
         .iter()
         .filter(|e| e["ev"] == "warning" && e["code"] == 11012)

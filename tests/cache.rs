@@ -4,7 +4,7 @@ mod common;
 
 use std::time::Duration;
 
-use common::{feeder, tick0, Rig};
+use common::{channel_events, feeder, tick0, Rig};
 use ncchannel::channel::{Channel, Finish, State};
 use ncchannel::runtime::Tick;
 use ncchannel::source::store::FsLatency;
@@ -53,14 +53,6 @@ fn blocks(events: &[Value]) -> Vec<(String, String)> {
                 e["text"].as_str().unwrap().to_string(),
             )
         })
-        .collect()
-}
-
-fn channel_events(c: &mut Channel) -> Vec<Value> {
-    c.events_mut()
-        .events()
-        .iter()
-        .map(|e| serde_json::to_value(e).unwrap())
         .collect()
 }
 

@@ -86,13 +86,8 @@ fn packets_written_before_the_read_merge_into_one_segment() {
     assert_eq!(c.stream_fill().0, 9 + 18);
     c.start(&t, "streaming.nc").unwrap();
     c.step(&t);
-    let ev: Vec<_> = c
-        .events_mut()
-        .events()
-        .iter()
-        .map(|e| serde_json::to_value(e).unwrap())
-        .collect();
-    let segs: Vec<_> = ev.iter().filter(|e| e["ev"] == "segment").collect();
+    let ev = common::channel_events(c);
+    let segs = common::of(&ev, "segment");
     assert_eq!(segs.len(), 1);
     assert_eq!(segs[0]["bytes"], 27);
 }
@@ -113,20 +108,11 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
         c.step(&t);
     }
     assert_eq!(c.state(), State::Ready);
-    let ev: Vec<_> = c
-        .events_mut()
-        .events()
-        .iter()
-        .map(|e| serde_json::to_value(e).unwrap())
-        .collect();
-    let discard: Vec<_> = ev.iter().filter(|e| e["ev"] == "discard").collect();
+    let ev = common::channel_events(c);
+    let discard = common::of(&ev, "discard");
     assert_eq!(discard.len(), 1);
     assert_eq!(discard[0]["bytes"], 9, "'N2 P2=2\\r\\n' dropped");
-    let texts: Vec<_> = ev
-        .iter()
-        .filter(|e| e["ev"] == "block")
-        .map(|e| e["text"].as_str().unwrap())
-        .collect();
+    let texts = common::block_texts(&ev);
     assert_eq!(texts, ["N1 P1=1", "M30"]);
     assert_eq!(c.stream_fill().0, 9);
     // The next start runs it.
@@ -135,17 +121,8 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     for _ in 0..5 {
         c.step(&t);
     }
-    let ev: Vec<_> = c
-        .events_mut()
-        .events()
-        .iter()
-        .map(|e| serde_json::to_value(e).unwrap())
-        .collect();
-    let texts: Vec<_> = ev
-        .iter()
-        .filter(|e| e["ev"] == "block")
-        .map(|e| e["text"].as_str().unwrap())
-        .collect();
+    let ev = common::channel_events(c);
+    let texts = common::block_texts(&ev);
     assert_eq!(&texts[2..], ["N9 P9=9", "M30"]);
 }
 

@@ -39,16 +39,35 @@ pub struct RunResult {
     pub ticks: u64,
 }
 
+/// Events of one kind (`ev`), in order.
+pub fn of<'a>(events: &'a [Value], ev: &str) -> Vec<&'a Value> {
+    events.iter().filter(|e| e["ev"] == ev).collect()
+}
+
+/// Texts of the `block` events, in order.
+pub fn block_texts(events: &[Value]) -> Vec<String> {
+    of(events, "block")
+        .iter()
+        .map(|e| e["text"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// The events a channel driven by hand has collected, as JSON values.
+pub fn channel_events(c: &mut ncchannel::channel::Channel) -> Vec<Value> {
+    c.events_mut()
+        .events()
+        .iter()
+        .map(|e| serde_json::to_value(e).unwrap())
+        .collect()
+}
+
 impl RunResult {
     pub fn of(&self, ev: &str) -> Vec<&Value> {
-        self.events.iter().filter(|e| e["ev"] == ev).collect()
+        of(&self.events, ev)
     }
     /// Texts of the `block` events, in order.
     pub fn block_texts(&self) -> Vec<String> {
-        self.of("block")
-            .iter()
-            .map(|e| e["text"].as_str().unwrap().to_string())
-            .collect()
+        block_texts(&self.events)
     }
     pub fn error_codes(&self) -> Vec<u64> {
         self.of("error")
