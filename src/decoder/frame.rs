@@ -143,7 +143,12 @@ pub enum LineRead {
 
 /// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
 /// offset after the line end, or `None` when no complete line is there.
-fn cut_line(text: &[u8], pos: usize, out: &mut String, at_eof_ok: bool) -> Option<usize> {
+pub(super) fn cut_line(
+    text: &[u8],
+    pos: usize,
+    out: &mut String,
+    at_eof_ok: bool,
+) -> Option<usize> {
     let rest = text.get(pos..)?;
     if rest.is_empty() {
         return None;
@@ -236,14 +241,20 @@ impl StreamReader {
             if buf.used() == 0 {
                 return LineRead::Pending;
             }
-            // Keep an incomplete tail (cannot happen with CR LF-checked writes, but costs
-            // nothing) and append the whole next segment after it.
             let consumed = self.pos;
-            self.seg.drain(..consumed);
             self.seg_base += consumed as u64;
             self.pos = 0;
-            let bytes = buf.take_segment(&mut self.scratch);
-            self.seg.extend_from_slice(&self.scratch);
+            let bytes = if consumed == self.seg.len() {
+                // The usual case: the segment is used up; the next one replaces it in place.
+                buf.take_segment(&mut self.seg)
+            } else {
+                // An incomplete tail (impossible with CR LF-checked writes) stays, and the
+                // next segment is appended after it.
+                self.seg.drain(..consumed);
+                let n = buf.take_segment(&mut self.scratch);
+                self.seg.extend_from_slice(&self.scratch);
+                n
+            };
             self.segments += 1;
             *note = Some(StreamNote::Segment { bytes });
         }

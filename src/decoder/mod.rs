@@ -24,7 +24,7 @@ use crate::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
 };
 use crate::source::cache::Cache;
-use crate::source::store::{Opened, ProgramKind, ProgramStore, ProgramText};
+use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::source::stream::StreamBuffer;
 
 use flow::{closes_loop, is_loop_statement, nesting, FlowEntry, Nesting, Skip, SkipUntil};
@@ -1550,23 +1550,13 @@ fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
     let mut depth = 0usize;
     let mut comment = false;
     let mut line = String::new();
-    let mut scratch = Frame::new(
-        FrameKind::Main,
-        Source::File(ProgramText {
-            name: Arc::from(""),
-            path: Arc::from(std::path::Path::new("")),
-            text: Arc::from(text),
-        }),
-        Arc::from(""),
-    );
     loop {
         let at = LinePos { pos, line_no };
-        scratch.seek(at);
-        let LineRead::Line(meta) = read_file_line(&mut scratch, &mut line) else {
+        let Some(next) = frame::cut_line(text, pos, &mut line, true) else {
             break;
         };
-        pos = scratch.pos;
-        line_no = scratch.line_no;
+        pos = next;
+        line_no += 1;
         if comment {
             if is_comment_end(&line) {
                 comment = false;
@@ -1580,7 +1570,7 @@ fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
             if index.labels.insert(l.clone(), (at, depth)).is_some() {
                 return Err(DecodeError::new(
                     20836,
-                    format!("label {} defined twice (line {})", label_text(l), meta.line),
+                    format!("label {} defined twice (line {})", label_text(l), line_no),
                 ));
             }
         }
