@@ -182,6 +182,8 @@ pub struct Channel {
     finish: Option<Finish>,
     running_prog: Option<Arc<str>>,
     notes: Vec<MotionNote>,
+    /// Reused buffer for the decoder's notes of a tick.
+    decoder_notes: Vec<Note>,
     events: EventBuffer,
     /// Record executed stream blocks in `executed` (soak checks); off by default.
     observe: bool,
@@ -212,6 +214,7 @@ impl Channel {
             finish: None,
             running_prog: None,
             notes: Vec::new(),
+            decoder_notes: Vec::new(),
             events: EventBuffer::new(events_enabled),
             observe: false,
             executed: Vec::new(),
@@ -292,15 +295,13 @@ impl Channel {
     /// The position of each configured axis, in `AXIS_LETTERS` order.
     pub fn axis_positions(&self) -> Vec<(char, f64)> {
         let p = self.motion.position();
+        let configured = self.decoder.axes();
         AXIS_LETTERS
             .iter()
             .enumerate()
-            .filter(|(i, _)| self.decoder_axes()[*i])
+            .filter(|(i, _)| configured[*i])
             .map(|(i, l)| (*l as char, p[i]))
             .collect()
-    }
-    fn decoder_axes(&self) -> [bool; crate::queue::MAX_AXES] {
-        self.decoder.axes()
     }
 
     fn set_state(&mut self, tick: &Tick, state: State) {
@@ -553,8 +554,9 @@ impl Channel {
     }
 
     fn drain_decoder_notes(&mut self, tick: &Tick) {
-        let notes: Vec<Note> = self.decoder.drain_notes().collect();
-        for n in notes {
+        let mut notes = std::mem::take(&mut self.decoder_notes);
+        self.decoder.take_notes(&mut notes);
+        for n in notes.drain(..) {
             match n {
                 Note::ProgramStart { prog, stream } => self.events.push(
                     tick,
@@ -610,6 +612,7 @@ impl Channel {
                 ),
             }
         }
+        self.decoder_notes = notes;
     }
 
     /// One cycle: decode, execute, report.

@@ -309,8 +309,10 @@ impl Decoder {
         self.frames.len()
     }
     /// Notes since the last call, oldest first.
-    pub fn drain_notes(&mut self) -> std::vec::Drain<'_, Note> {
-        self.notes.drain(..)
+    pub fn take_notes(&mut self, into: &mut Vec<Note>) {
+        // A swap: both vectors keep their allocations from tick to tick.
+        into.clear();
+        std::mem::swap(&mut self.notes, into);
     }
 
     /// Start a main program (automatic mode). Channel defaults are restored here — for a
