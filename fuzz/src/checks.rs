@@ -1,0 +1,293 @@
+//! What each fuzz target asserts about one input. The bodies are plain functions over bytes so
+//! that `tests/fuzz_regressions.rs` runs the same assertions over the kept inputs in
+//! `cargo test`, with no libFuzzer and no nightly toolchain.
+//!
+//! Every check panics on a finding (that is how libFuzzer sees it); a malformed input that is
+//! refused with an error is not a finding.
+
+use std::path::Path;
+
+use arbitrary::{Arbitrary, Unstructured};
+
+use ncchannel::ads::frame::{self, Frame, DEFAULT_MAX_FRAME_BYTES};
+use ncchannel::ads::payload;
+use ncchannel::dnc::markers::{Anchor, Markers};
+use ncchannel::dnc::splitter::{ProgramEnd, ProgramSink, ProgramStart, Splitter};
+use ncchannel::lang::{self, VarKey, Vars};
+use ncchannel::source::stream::{StreamBuffer, MAX_PROGRAM_STREAM_SIZE};
+
+/// Longest NC line the fuzzers hand to the parser: ISG lines are at most 4000 characters, and
+/// a longer one only slows the fuzzer without reaching new code.
+const MAX_LINE_BYTES: usize = 8 * 1024;
+
+fn text(data: &[u8]) -> Option<&str> {
+    std::str::from_utf8(data).ok()
+}
+
+/// The NC line parser never panics, whatever the line (and neither do the two helpers the
+/// decoder calls inside `#COMMENT` and `#VAR` blocks).
+pub fn nc_line(data: &[u8]) {
+    let Some(line) = text(data) else { return };
+    if line.len() > MAX_LINE_BYTES {
+        return;
+    }
+    let _ = lang::parse_block(line);
+    let _ = lang::parse_var_declaration(line);
+    let _ = lang::is_comment_end(line);
+    let _ = lang::is_blank_line(line);
+}
+
+/// A block that parses prints as canonical text that parses back to the same block: what the
+/// decoder logs and block search replays must mean what the programmer wrote.
+pub fn nc_roundtrip(data: &[u8]) {
+    let Some(line) = text(data) else { return };
+    if line.len() > MAX_LINE_BYTES {
+        return;
+    }
+    let Ok(block) = lang::parse_block(line) else {
+        return;
+    };
+    let canonical = block.to_string();
+    let again = match lang::parse_block(&canonical) {
+        Ok(b) => b,
+        Err(e) => panic!("{line:?} printed as {canonical:?}, which does not parse: {e}"),
+    };
+    assert_eq!(
+        again.to_string(),
+        canonical,
+        "{line:?}: the canonical text is not a fixed point"
+    );
+}
+
+/// Every variable has the same value: the evaluator's arithmetic, indices and functions are
+/// what is under test, not the decoder's storage.
+struct AnyVars(f64);
+
+impl Vars for AnyVars {
+    fn get(&self, _key: &VarKey<'_>) -> Option<f64> {
+        Some(self.0)
+    }
+}
+
+/// Expression parsing and evaluation never panic: a result or an error with a number.
+pub fn expr_eval(data: &[u8]) {
+    let Some((&seed, rest)) = data.split_first() else {
+        return;
+    };
+    let Some(src) = text(rest) else { return };
+    if src.len() > MAX_LINE_BYTES {
+        return;
+    }
+    let Ok(expr) = lang::parse_expr(src) else {
+        return;
+    };
+    let value = f64::from(seed) - 128.0;
+    if let Err(e) = lang::eval(&expr, &AnyVars(value)) {
+        let _ = e.code();
+    }
+}
+
+/// The static program checker never panics, and every finding points into the program.
+pub fn program_check(data: &[u8]) {
+    let Some(program) = text(data) else { return };
+    let lines = program.lines().count().max(1);
+    for d in lang::check_program(program) {
+        assert!(
+            d.line >= 1 && d.line <= lines + 1,
+            "diagnostic on line {} of a {lines}-line program: {d:?}",
+            d.line
+        );
+    }
+}
+
+/// The ISG parameter-list parser never panics and reports every problem with a position.
+pub fn param_list(data: &[u8]) {
+    let Some(src) = text(data) else { return };
+    let (_list, _diags) = ncchannel::params::list::parse_list(Path::new("fuzz.lis"), src);
+}
+
+/// The AMS/TCP codec cuts any byte stream into frames or a clear error, never reads past what
+/// it was given, and the ADS payload decoders take any frame body.
+pub fn ams_codec(data: &[u8]) {
+    let mut rest = data;
+    loop {
+        match frame::decode(rest, DEFAULT_MAX_FRAME_BYTES) {
+            Ok(Some((f, used))) => {
+                assert!(
+                    used > 0 && used <= rest.len(),
+                    "consumed {used} of {}",
+                    rest.len()
+                );
+                if let Frame::Ams { header, data } = f {
+                    let _ = payload::decode_request(header.command.to_u16(), &data);
+                    let _ = payload::decode_data_response(&data);
+                    let _ = payload::decode_result(&data);
+                    let _ = payload::decode_notification(&data);
+                    let encoded = frame::encode(&header, &data);
+                    match frame::decode(&encoded, DEFAULT_MAX_FRAME_BYTES) {
+                        Ok(Some((Frame::Ams { data: d2, .. }, n))) => {
+                            assert_eq!(n, encoded.len());
+                            assert_eq!(d2, data);
+                        }
+                        other => panic!("a decoded frame does not re-encode: {other:?}"),
+                    }
+                }
+                rest = &rest[used..];
+            }
+            Ok(None) | Err(_) => return,
+        }
+    }
+}
+
+/// One program as the splitter delivered it.
+#[derive(Debug, PartialEq)]
+struct Program {
+    bytes: Vec<u8>,
+    complete: bool,
+    /// (workpiece folder, file name) from the program's name lines.
+    file_name: Option<(Option<String>, String)>,
+}
+
+/// Collects the programs of one transfer.
+#[derive(Default)]
+struct Collect {
+    programs: Vec<Program>,
+    open: Option<Vec<u8>>,
+}
+
+impl ProgramSink for Collect {
+    type Error = std::convert::Infallible;
+    fn start(&mut self, _start: &ProgramStart) -> Result<(), Self::Error> {
+        assert!(self.open.is_none(), "a program starts inside another");
+        self.open = Some(Vec::new());
+        Ok(())
+    }
+    fn data(&mut self, bytes: &[u8]) -> Result<(), Self::Error> {
+        match &mut self.open {
+            Some(p) => p.extend_from_slice(bytes),
+            None => panic!("data outside a program"),
+        }
+        Ok(())
+    }
+    fn end(&mut self, end: ProgramEnd) -> Result<(), Self::Error> {
+        let Some(p) = self.open.take() else {
+            panic!("end outside a program")
+        };
+        assert_eq!(p.len() as u64, end.bytes, "byte count of a program");
+        self.programs.push(Program {
+            bytes: p,
+            complete: end.complete,
+            file_name: end.name.file_name(),
+        });
+        Ok(())
+    }
+}
+
+#[derive(Debug, Arbitrary)]
+struct SplitCase {
+    start: Vec<String>,
+    end: Vec<String>,
+    at_line_start: bool,
+    /// Chunk lengths, used in turn (0 is read as 1).
+    chunks: Vec<u8>,
+    transfer: Vec<u8>,
+}
+
+/// The DNC splitter gives the same programs, names and byte counts whatever the chunking of
+/// the transfer (compared with the whole transfer in one chunk).
+pub fn dnc_split(data: &[u8]) {
+    let Ok(case) = SplitCase::arbitrary_take_rest(Unstructured::new(data)) else {
+        return;
+    };
+    let anchor = if case.at_line_start {
+        Anchor::LineStart
+    } else {
+        Anchor::Anywhere
+    };
+    let start: Vec<&String> = case.start.iter().take(3).collect();
+    let end: Vec<&String> = case.end.iter().take(3).collect();
+    let Ok(markers) = Markers::new(start, end, anchor) else {
+        return;
+    };
+    let mut whole = Collect::default();
+    let mut splitter = Splitter::new(markers.clone());
+    let Ok(()) = splitter.feed(&case.transfer, &mut whole);
+    let Ok(whole_summary) = splitter.finish(&mut whole);
+
+    let mut chunked = Collect::default();
+    let mut splitter = Splitter::new(markers);
+    let mut rest = &case.transfer[..];
+    let mut sizes = case.chunks.iter().cycle();
+    while !rest.is_empty() {
+        let n = sizes.next().map_or(rest.len(), |&s| usize::from(s.max(1)));
+        let (chunk, tail) = rest.split_at(n.min(rest.len()));
+        let Ok(()) = splitter.feed(chunk, &mut chunked);
+        rest = tail;
+    }
+    let Ok(chunked_summary) = splitter.finish(&mut chunked);
+    assert_eq!(
+        whole.programs, chunked.programs,
+        "programs differ by chunking"
+    );
+    assert_eq!(
+        whole_summary, chunked_summary,
+        "summaries differ by chunking"
+    );
+}
+
+#[derive(Debug, Arbitrary)]
+enum StreamOp {
+    /// A packet: `lines` whole lines of `width` bytes each (CR LF included), or raw bytes.
+    Lines {
+        lines: u8,
+        width: u8,
+    },
+    Raw(Vec<u8>),
+    Take,
+    Reset,
+}
+
+/// The 4094-byte stream buffer: whole-or-nothing writes, fill level always consistent, and
+/// exactly the accepted bytes read back, in order, once (none after a reset).
+pub fn stream_buffer(data: &[u8]) {
+    let Ok(ops) = Vec::<StreamOp>::arbitrary_take_rest(Unstructured::new(data)) else {
+        return;
+    };
+    let mut buffer = StreamBuffer::new();
+    let mut owed: Vec<u8> = Vec::new();
+    let mut segment = Vec::with_capacity(MAX_PROGRAM_STREAM_SIZE);
+    for op in ops.into_iter().take(10_000) {
+        match op {
+            StreamOp::Lines { lines, width } => {
+                let width = usize::from(width.max(3));
+                let mut packet = Vec::new();
+                for _ in 0..lines {
+                    packet.extend(std::iter::repeat_n(b'N', width - 2));
+                    packet.extend_from_slice(b"\r\n");
+                }
+                write(&mut buffer, &mut owed, &packet);
+            }
+            StreamOp::Raw(bytes) => write(&mut buffer, &mut owed, &bytes),
+            StreamOp::Take => {
+                let n = buffer.take_segment(&mut segment);
+                assert_eq!(n, segment.len());
+                assert_eq!(segment, owed, "read back differs from what was accepted");
+                owed.clear();
+            }
+            StreamOp::Reset => {
+                assert_eq!(buffer.clear(), owed.len());
+                owed.clear();
+            }
+        }
+        assert_eq!(buffer.used(), owed.len());
+        assert_eq!(buffer.used() + buffer.free(), MAX_PROGRAM_STREAM_SIZE);
+    }
+}
+
+fn write(buffer: &mut StreamBuffer, owed: &mut Vec<u8>, packet: &[u8]) {
+    let before = buffer.used();
+    match buffer.write(packet) {
+        Ok(()) => owed.extend_from_slice(packet),
+        Err(_) => assert_eq!(buffer.used(), before, "a refused write changed the buffer"),
+    }
+}
