@@ -278,6 +278,22 @@ fn sinumerik_archive_control_lines_name_and_split_programs() {
 }
 
 #[test]
+fn a_refused_sinumerik_name_is_never_merged_into_the_next_program() {
+    // An umlaut, a blank and an over-long name are refused; each program still ends where the
+    // next `%_N_` line begins and falls back to a numbered name.
+    let long = "A".repeat(101);
+    for bad in ["WELLE_\u{c4}", "WEL LE", long.as_str()] {
+        let input = format!("%_N_{bad}_MPF\r\nN10 G1 X1\r\nM30\r\n%_N_PART2_MPF\r\nN10 G1 X2\r\nM30\r\n");
+        for m in [markers(&[], &[]), markers(&["%_N_"], &[])] {
+            let (p, _) = split(&m, &input);
+            assert_eq!(names(&p), ["-", "PART2.mpf"], "{bad:?}");
+            assert_eq!(texts(&p)[1], "%_N_PART2_MPF\r\nN10 G1 X2\r\nM30\r\n");
+            assert_eq!(texts(&p).concat(), input, "nothing lost, nothing added");
+        }
+    }
+}
+
+#[test]
 fn unnamed_programs_have_no_name() {
     let (p, _) = split(&markers(&[], &["M30"]), "N1\nM30\n%\nN2\nM30\n");
     assert_eq!(names(&p), ["-", "-"]);

@@ -37,6 +37,8 @@ pub struct NameInfo {
     /// Names refused as unsafe (excerpts, lossy UTF-8), for the operator message.
     pub rejected: Vec<String>,
     path_seen: bool,
+    /// A `%_N_` line was seen, accepted or refused: the next one starts another program.
+    sinumerik_seen: bool,
 }
 
 /// Does this line begin a SINUMERIK program (`%_N_…`)? Such a line inside an already named
@@ -56,7 +58,8 @@ impl NameInfo {
     pub fn note(&mut self, head: &[u8]) {
         let line = trim_line(head);
         if let Some(rest) = line.strip_prefix(b"%_N_") {
-            if self.sinumerik.is_none() {
+            if !self.sinumerik_seen {
+                self.sinumerik_seen = true;
                 match parse_sinumerik(rest) {
                     Some(n) => self.sinumerik = Some(n),
                     None => self.reject(rest),
@@ -92,6 +95,13 @@ impl NameInfo {
                 }
             }
         }
+    }
+
+    /// Did this program have a `%_N_` line, even one whose name was refused? Then a further
+    /// `%_N_` line begins the next program: a refused name must never merge its program into
+    /// the next one's file.
+    pub fn has_sinumerik_line(&self) -> bool {
+        self.sinumerik_seen
     }
 
     /// The file name inside the program directory, with the workpiece directory when the

@@ -231,7 +231,7 @@ impl Splitter {
         let split = || {
             self.open
                 .as_ref()
-                .is_some_and(|o| o.name.sinumerik.is_some())
+                .is_some_and(|o| o.name.has_sinumerik_line())
                 && control_line::is_sinumerik_start(head)
         };
         let open = self.open.is_some();
