@@ -283,7 +283,8 @@ fn a_refused_sinumerik_name_is_never_merged_into_the_next_program() {
     // next `%_N_` line begins and falls back to a numbered name.
     let long = "A".repeat(101);
     for bad in ["WELLE_\u{c4}", "WEL LE", long.as_str()] {
-        let input = format!("%_N_{bad}_MPF\r\nN10 G1 X1\r\nM30\r\n%_N_PART2_MPF\r\nN10 G1 X2\r\nM30\r\n");
+        let input =
+            format!("%_N_{bad}_MPF\r\nN10 G1 X1\r\nM30\r\n%_N_PART2_MPF\r\nN10 G1 X2\r\nM30\r\n");
         for m in [markers(&[], &[]), markers(&["%_N_"], &[])] {
             let (p, _) = split(&m, &input);
             assert_eq!(names(&p), ["-", "PART2.mpf"], "{bad:?}");

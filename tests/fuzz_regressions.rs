@@ -22,6 +22,7 @@ const TARGETS: &[Target] = &[
     ("ams_codec", checks::ams_codec),
     ("dnc_split", checks::dnc_split),
     ("stream_buffer", checks::stream_buffer),
+    ("channel_program", checks::channel_program),
 ];
 
 fn root() -> PathBuf {
@@ -61,6 +62,7 @@ fn shipped_programs_pass_the_nc_targets() {
         let data = fs::read(&file).unwrap();
         checks::program_check(&data);
         checks::dnc_split(&data);
+        checks::channel_program(&data);
         for line in data.split(|&b| b == b'\n') {
             let line = line.strip_suffix(b"\r").unwrap_or(line);
             checks::nc_line(line);

@@ -291,3 +291,89 @@ fn write(buffer: &mut StreamBuffer, owed: &mut Vec<u8>, packet: &[u8]) {
         Err(_) => assert_eq!(buffer.used(), before, "a refused write changed the buffer"),
     }
 }
+
+/// Longest a tick may take on any NC text. The real kernel's cycle is 1 ms; this bound is
+/// generous (sanitizers, debug builds, a loaded machine) but far below what an unbounded
+/// declaration or loop costs.
+const MAX_TICK: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// Ticks one fuzzed program may run: enough to decode and move through a few kilobytes.
+const MAX_TICKS: u64 = 20_000;
+
+/// The shipped start-up list, found from whichever crate compiled this file.
+fn shipped_config() -> Option<&'static ncchannel::params::config::Config> {
+    static CONFIG: std::sync::OnceLock<Option<ncchannel::params::config::Config>> =
+        std::sync::OnceLock::new();
+    CONFIG
+        .get_or_init(|| {
+            let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+            let list = here
+                .ancestors()
+                .map(|d| d.join("params/startup.lis"))
+                .find(|p| p.is_file())?;
+            ncchannel::params::config::load(&list).ok()
+        })
+        .as_ref()
+}
+
+/// A whole channel in virtual time runs a fuzzed program streamed in whole-line packets:
+/// no panic, and no tick over [`MAX_TICK`], whatever the NC text.
+pub fn channel_program(data: &[u8]) {
+    use ncchannel::runtime::Tick;
+    let Some(config) = shipped_config() else {
+        panic!("params/startup.lis not found or refused")
+    };
+    let Ok(mut channels) = ncchannel::setup::channels(config, false) else {
+        panic!("the shipped parameter lists give no channel")
+    };
+    let Some(channel) = channels.first_mut() else {
+        return;
+    };
+    let Some(program) = config.channels[0].streaming_prog_file.clone() else {
+        return;
+    };
+    let period = std::time::Duration::from_micros(config.runtime.cycle_period_us);
+    let tick = |index: u64| Tick {
+        index,
+        period,
+        time: period * u32::try_from(index).unwrap_or(u32::MAX),
+    };
+    // Whole lines with CR LF, cut into packets of at most 992 bytes; longer lines are left out
+    // (the stream interface refuses them whole, which the stream_buffer target covers).
+    let mut packets: Vec<Vec<u8>> = Vec::new();
+    let mut packet = Vec::new();
+    for line in data.split(|&b| b == b'\n') {
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        if line.len() + 2 > ncchannel::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE {
+            continue;
+        }
+        if packet.len() + line.len() + 2 > ncchannel::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE
+        {
+            packets.push(std::mem::take(&mut packet));
+        }
+        packet.extend_from_slice(line);
+        packet.extend_from_slice(b"\r\n");
+    }
+    packets.push(packet);
+    packets.push(b"M30\r\n".to_vec());
+
+    if channel.start(&tick(0), &program).is_err() {
+        return;
+    }
+    let mut next = packets.iter().peekable();
+    for k in 1..MAX_TICKS {
+        let t = tick(k);
+        if let Some(p) = next.peek() {
+            if channel.write_stream(&t, p).is_ok() {
+                next.next();
+            }
+        }
+        let began = std::time::Instant::now();
+        channel.step(&t);
+        let took = began.elapsed();
+        assert!(took <= MAX_TICK, "tick {k} took {took:?}");
+        if channel.take_finish().is_some() {
+            return;
+        }
+    }
+}
