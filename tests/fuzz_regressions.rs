@@ -23,6 +23,7 @@ const TARGETS: &[Target] = &[
     ("dnc_split", checks::dnc_split),
     ("stream_buffer", checks::stream_buffer),
     ("channel_program", checks::channel_program),
+    ("param_folder", checks::param_folder),
 ];
 
 fn root() -> PathBuf {

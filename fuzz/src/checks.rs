@@ -377,3 +377,43 @@ pub fn channel_program(data: &[u8]) {
         }
     }
 }
+
+#[derive(Debug, Arbitrary)]
+struct ParamFolder {
+    startup: String,
+    channel_list: String,
+    runtime_toml: String,
+    /// Seed the generated start-up list from the shipped one (the mutator then edits it).
+    from_shipped: bool,
+}
+
+/// `params::load` over a generated folder (start-up list, channel list, runtime.toml): a
+/// configuration or diagnostics, never a panic; and a configuration it accepts builds channels
+/// without a panic (what `check` accepts, `run` can start).
+pub fn param_folder(data: &[u8]) {
+    let Ok(case) = ParamFolder::arbitrary_take_rest(Unstructured::new(data)) else {
+        return;
+    };
+    let Ok(dir) = tempfile::tempdir() else { return };
+    let startup = if case.from_shipped {
+        format!(
+            "kanal_anzahl 1\nsda_mds[0] channel1.lis\n{}\n",
+            case.startup
+        )
+    } else {
+        case.startup
+    };
+    let files = [
+        ("startup.lis", startup),
+        ("channel1.lis", case.channel_list),
+        ("runtime.toml", case.runtime_toml),
+    ];
+    for (name, text) in &files {
+        if std::fs::write(dir.path().join(name), text).is_err() {
+            return;
+        }
+    }
+    if let Ok(config) = ncchannel::params::config::load(&dir.path().join("startup.lis")) {
+        let _ = ncchannel::setup::channels(&config, false);
+    }
+}
