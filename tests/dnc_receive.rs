@@ -131,6 +131,42 @@ fn archive_lands_in_workpiece_directories() {
 }
 
 #[test]
+fn a_name_taken_by_a_file_or_folder_drops_only_that_program() {
+    // `%X.wpd` files a program named `X.wpd`; a later program in workpiece `X` would need a
+    // folder of that name. That program is not filed; the others of the transfer are.
+    let data = "%X.wpd\r\nN1 G1 X1\r\nM30\r\n\
+                %_N_PART_MPF\r\n;$PATH=/_N_WKS_DIR/_N_X_WPD\r\nN1 G1 X2\r\nM30\r\n\
+                %_N_NEXT_MPF\r\nN1 G1 X3\r\nM30\r\n";
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("prog");
+    std::fs::create_dir_all(out.join("NEXT.mpf")).unwrap();
+    let r = receive_into(&out, &markers(&["%"], &["M30"]), data.as_bytes(), 7, |_| {});
+    assert_eq!(r.end, TransferEnd::Complete);
+    let d: Vec<Disposition> = r.programs.iter().map(|p| p.disposition).collect();
+    assert_eq!(
+        d,
+        [
+            Disposition::Written,
+            Disposition::NameUnusable,
+            Disposition::NameUnusable
+        ]
+    );
+    assert!(r.programs[1]
+        .reason
+        .as_deref()
+        .unwrap()
+        .contains("not a folder"));
+    assert!(r.programs[2]
+        .reason
+        .as_deref()
+        .unwrap()
+        .contains("is a folder"));
+    let t = tree(&out);
+    assert_eq!(t.keys().collect::<Vec<_>>(), ["X.wpd"]);
+    assert!(temp_files(&out).is_empty(), "no temporary file left behind");
+}
+
+#[test]
 fn every_chunk_size_from_1_to_64_gives_identical_files() {
     let mut data = ARCHIVE.as_bytes().to_vec();
     data.extend_from_slice(b"%\nN1 G0\nN2 M30\n%\nN1 G1\nN2 M30\n");

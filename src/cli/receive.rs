@@ -200,6 +200,7 @@ fn log_line(p: &ReceivedProgram) {
         Disposition::KeptExisting => "kept existing",
         Disposition::CutOffDropped => "cut off, dropped",
         Disposition::CutOffKept => "cut off, kept",
+        Disposition::NameUnusable => "not filed",
     };
     let mut out = io::stdout().lock();
     let _ = writeln!(
@@ -225,6 +226,12 @@ fn log_line(p: &ReceivedProgram) {
         Disposition::CutOffDropped => eprintln!(
             "ncchannel receive: the transfer ended inside the program from line {}; it was dropped (--keep-partial keeps it)",
             p.first_line
+        ),
+        Disposition::NameUnusable => eprintln!(
+            "ncchannel receive: the program from line {} cannot be filed as {}: {}; it was dropped",
+            p.first_line,
+            p.path.display(),
+            p.reason.as_deref().unwrap_or("name unusable")
         ),
         _ => {}
     }

@@ -1,10 +1,16 @@
 //! Filing received programs: each program streams into a temporary file in the program
 //! directory, is flushed to disk, and only then renamed to its final name, so a crash or a
 //! broken transfer never leaves part of a program under a name the channel would run.
+//!
+//! The temporary file is the `tempfile` crate's `NamedTempFile`: it is removed when dropped
+//! (a broken transfer, a writer error, the receiver stopping), and `persist_noclobber` gives
+//! the final name only if nothing has it yet, atomically (no window between test and rename).
 
-use std::fs::{self, File, OpenOptions};
+use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
 
 use super::error::DncError;
 use super::splitter::{ProgramEnd, ProgramSink, ProgramStart};
@@ -109,6 +115,9 @@ pub enum Disposition {
     CutOffDropped,
     /// The transfer stopped inside the program; kept as `<name>.partial`.
     CutOffKept,
+    /// The program could not be filed under its name (the name is taken by a directory, or a
+    /// workpiece folder's name by a file); it was dropped and the transfer went on.
+    NameUnusable,
 }
 
 /// One line of the receive log.
@@ -123,6 +132,8 @@ pub struct ReceivedProgram {
     pub disposition: Disposition,
     /// Names from the data refused as unsafe.
     pub rejected_names: Vec<String>,
+    /// Why the program was not filed, for [`Disposition::NameUnusable`].
+    pub reason: Option<String>,
 }
 
 impl ReceivedProgram {
@@ -141,17 +152,14 @@ type LogFn = Box<dyn FnMut(&ReceivedProgram)>;
 /// How many taken numbered names are skipped at most when looking for a free one.
 const MAX_NUMBER_PROBES: u32 = 100_000;
 
-struct TempProgram {
-    path: PathBuf,
-    file: BufWriter<File>,
-}
+/// The program being received: its temporary file, removed on drop unless persisted.
+type TempProgram = BufWriter<NamedTempFile>;
 
 /// Files the programs the splitter delivers; see the module doc for the guarantees.
 pub struct ProgramWriter {
     cfg: WriterConfig,
     current: Option<TempProgram>,
     next_number: u32,
-    temp_seq: u64,
     records: Vec<ReceivedProgram>,
     log: Option<LogFn>,
 }
@@ -162,7 +170,6 @@ impl ProgramWriter {
             cfg,
             current: None,
             next_number: 1,
-            temp_seq: 0,
             records: Vec::new(),
             log: None,
         }
@@ -183,12 +190,10 @@ impl ProgramWriter {
         std::mem::take(&mut self.records)
     }
 
-    /// Drop a program still being written (the transfer was abandoned).
+    /// Drop a program still being written (the transfer was abandoned); dropping the
+    /// temporary file removes it.
     pub fn discard_current(&mut self) {
-        if let Some(t) = self.current.take() {
-            drop(t.file);
-            let _ = fs::remove_file(&t.path);
-        }
+        self.current = None;
     }
 
     fn record(&mut self, r: ReceivedProgram) {
@@ -217,17 +222,10 @@ impl ProgramWriter {
     }
 
     fn file(&mut self, end: ProgramEnd) -> Result<(), DncError> {
-        let Some(mut tmp) = self.current.take() else {
+        let Some(tmp) = self.current.take() else {
             return Ok(());
         };
-        let done = tmp.file.flush().and_then(|_| tmp.file.get_ref().sync_all());
-        if let Err(e) = done {
-            drop(tmp.file);
-            let _ = fs::remove_file(&tmp.path);
-            return Err(DncError::io(&tmp.path, e));
-        }
-        drop(tmp.file);
-
+        let tmp = finish_temp(tmp)?;
         let (dir, name) = match end.name.file_name() {
             Some(n) => n,
             None => (None, self.numbered()),
@@ -244,10 +242,10 @@ impl ProgramWriter {
             last_line: end.last_line,
             disposition: Disposition::Written,
             rejected_names: end.name.rejected.clone(),
+            reason: None,
         };
         if !end.complete {
             if !self.cfg.keep_partial {
-                let _ = fs::remove_file(&tmp.path);
                 record.disposition = Disposition::CutOffDropped;
                 self.record(record);
                 return Ok(());
@@ -255,31 +253,45 @@ impl ProgramWriter {
             target = parent.join(format!("{name}.partial"));
             record.path = target.clone();
         }
-        if let Err(e) = fs::create_dir_all(&parent) {
-            let _ = fs::remove_file(&tmp.path);
-            return Err(DncError::io(&parent, e));
+        if parent.exists() && !parent.is_dir() {
+            record.disposition = Disposition::NameUnusable;
+            record.reason = Some(format!("{} is a file, not a folder", parent.display()));
+            self.record(record);
+            return Ok(());
         }
-        let placed = place(&tmp.path, &target, self.cfg.overwrite);
-        match placed {
-            Ok(p) => {
-                record.disposition = match (p, end.complete) {
-                    (Placed::Kept, _) => Disposition::KeptExisting,
-                    (_, false) => Disposition::CutOffKept,
-                    (Placed::New, true) => Disposition::Written,
-                    (Placed::Replaced, true) => Disposition::Replaced,
-                };
-                if p != Placed::Kept {
-                    sync_dir(&parent).map_err(|e| DncError::io(&parent, e))?;
-                }
-                self.record(record);
-                Ok(())
-            }
-            Err(e) => {
-                let _ = fs::remove_file(&tmp.path);
-                Err(DncError::io(&target, e))
-            }
+        fs::create_dir_all(&parent).map_err(|e| DncError::io(&parent, e))?;
+        if target.is_dir() {
+            record.disposition = Disposition::NameUnusable;
+            record.reason = Some(format!("{} is a folder", target.display()));
+            self.record(record);
+            return Ok(());
         }
+        let placed =
+            place(tmp, &target, self.cfg.overwrite).map_err(|e| DncError::io(&target, e))?;
+        record.disposition = match (placed, end.complete) {
+            (Placed::Kept, _) => Disposition::KeptExisting,
+            (_, false) => Disposition::CutOffKept,
+            (Placed::New, true) => Disposition::Written,
+            (Placed::Replaced, true) => Disposition::Replaced,
+        };
+        if placed != Placed::Kept {
+            sync_dir(&parent).map_err(|e| DncError::io(&parent, e))?;
+        }
+        self.record(record);
+        Ok(())
     }
+}
+
+/// Flush a finished program's temporary file to disk.
+fn finish_temp(tmp: TempProgram) -> Result<NamedTempFile, DncError> {
+    let path = tmp.get_ref().path().to_path_buf();
+    let tmp = tmp
+        .into_inner()
+        .map_err(|e| DncError::io(&path, e.into_error()))?;
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| DncError::io(tmp.path(), e))?;
+    Ok(tmp)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -289,37 +301,23 @@ enum Placed {
     Kept,
 }
 
-/// Move the finished temporary file to its name in one atomic step. Without `overwrite` a hard
-/// link creates the name only if it does not exist yet (no window between test and rename).
-fn place(tmp: &Path, target: &Path, overwrite: bool) -> io::Result<Placed> {
+/// Give the finished temporary file its name in one atomic step. Without `overwrite` the name
+/// is created only if it does not exist yet; otherwise the existing file is kept and the
+/// temporary file removed.
+fn place(tmp: NamedTempFile, target: &Path, overwrite: bool) -> io::Result<Placed> {
     if overwrite {
         let existed = target.exists();
-        fs::rename(tmp, target)?;
+        tmp.persist(target).map_err(|e| e.error)?;
         return Ok(if existed {
             Placed::Replaced
         } else {
             Placed::New
         });
     }
-    match fs::hard_link(tmp, target) {
-        Ok(()) => {
-            fs::remove_file(tmp)?;
-            Ok(Placed::New)
-        }
-        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {
-            fs::remove_file(tmp)?;
-            Ok(Placed::Kept)
-        }
-        Err(_) => {
-            // A file system without hard links: test, then rename.
-            if target.exists() {
-                fs::remove_file(tmp)?;
-                Ok(Placed::Kept)
-            } else {
-                fs::rename(tmp, target)?;
-                Ok(Placed::New)
-            }
-        }
+    match tmp.persist_noclobber(target) {
+        Ok(_) => Ok(Placed::New),
+        Err(e) if e.error.kind() == io::ErrorKind::AlreadyExists => Ok(Placed::Kept),
+        Err(e) => Err(e.error),
     }
 }
 
@@ -343,28 +341,19 @@ impl ProgramSink for ProgramWriter {
         self.discard_current();
         let dir = &self.cfg.out_dir;
         fs::create_dir_all(dir).map_err(|e| DncError::io(dir, e))?;
-        self.temp_seq += 1;
-        let path = dir.join(format!(
-            ".ncchannel-receive-{}-{}.tmp",
-            std::process::id(),
-            self.temp_seq
-        ));
-        let file = OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&path)
-            .map_err(|e| DncError::io(&path, e))?;
-        self.current = Some(TempProgram {
-            path,
-            file: BufWriter::with_capacity(64 * 1024, file),
-        });
+        let file = tempfile::Builder::new()
+            .prefix(".ncchannel-receive-")
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .map_err(|e| DncError::io(dir, e))?;
+        self.current = Some(BufWriter::with_capacity(64 * 1024, file));
         Ok(())
     }
 
     fn data(&mut self, bytes: &[u8]) -> Result<(), DncError> {
         if let Some(t) = self.current.as_mut() {
-            if let Err(e) = t.file.write_all(bytes) {
-                let path = t.path.clone();
+            if let Err(e) = t.write_all(bytes) {
+                let path = t.get_ref().path().to_path_buf();
                 self.discard_current();
                 return Err(DncError::io(path, e));
             }
