@@ -33,7 +33,10 @@ fn node_ads_client_streams_5000_lines_and_watches_the_block_count() {
     );
     let seen: serde_json::Value =
         serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
-    assert!(seen["busy"].as_u64().unwrap() > 0, "the client was refused at least once");
+    assert!(
+        seen["busy"].as_u64().unwrap() > 0,
+        "the client was refused at least once"
+    );
     assert_eq!(seen["final_count"], 5000);
     assert_eq!(common::block_texts(&events), lines);
 }

@@ -32,7 +32,8 @@ pub const GROUP_DESCRIPTION: u32 = 0x130100;
 pub const GROUP_DESCRIPTION_INDEX: u32 = 0x30100;
 /// Channel-axis and TwinSharp platform-axis offsets: `AXIS_STRIDE · axis + element`.
 pub const AXIS_STRIDE: u32 = 0x10000;
-/// Offsets of ncchannel's own channel objects (`ncc_*`), a range the kernel does not use.
+/// Offsets of ncchannel's own channel objects (`ncc_*`): the ISG object dump's channel objects
+/// end at 0x3118 and channel axes start at 0x10000 (docs/ads.md).
 pub const VENDOR_OFFSETS: std::ops::RangeInclusive<u32> = 0x8000..=0x8FFF;
 
 /// Longest program name accepted by `mcm_command_parameter_w` (its STRING(300) buffer).
