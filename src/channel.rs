@@ -9,9 +9,10 @@ use std::sync::Arc;
 
 use thiserror::Error;
 
+use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
 use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use crate::queue::{Action, BlockQueue, Position, QueuedBlock, AXIS_LETTERS};
+use crate::queue::{Action, BlockQueue, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES};
 use crate::report::event::{EventBuffer, EventKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
@@ -252,10 +253,13 @@ pub struct Channel {
     single_credit: bool,
     /// Flushes put into the gate whose notes are not program events.
     single_flushes: usize,
+    /// G54…G59 offsets (mm), for positions in the programming coordinate system.
+    zero_offsets: ZeroOffsets,
 }
 
 impl Channel {
     pub fn new(s: ChannelSettings, events_enabled: bool) -> Self {
+        let zero_offsets = s.decoder.zero_offsets;
         Channel {
             number: s.number,
             mode: Mode::Automatic,
@@ -286,6 +290,7 @@ impl Channel {
             single_gate: BlockQueue::new(2),
             single_credit: false,
             single_flushes: 0,
+            zero_offsets,
         }
     }
 
@@ -369,6 +374,28 @@ impl Channel {
             .enumerate()
             .filter(|(i, _)| configured[*i])
             .map(|(i, l)| (*l as char, p[i]))
+            .collect()
+    }
+
+    /// Positions in the programming coordinate system: machine positions minus the zero
+    /// offset (G54…G59) the decoder has active, which runs ahead of execution by the
+    /// lookahead when a program switches offsets.
+    pub fn pcs_positions(&self) -> Vec<(char, f64)> {
+        let offset = self
+            .decoder
+            .modal()
+            .zero_offset
+            .checked_sub(1)
+            .and_then(|i| self.zero_offsets.get(i))
+            .copied()
+            .unwrap_or([0.0; MAX_AXES]);
+        let p = self.motion.position();
+        let configured = self.decoder.axes();
+        AXIS_LETTERS
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| configured[*i])
+            .map(|(i, l)| (*l as char, p[i] - offset[i]))
             .collect()
     }
 

@@ -115,6 +115,8 @@ pub struct Status {
     pub ipo_blocks: usize,
     /// Errors raised since the channel was built.
     pub errors_total: u64,
+    /// Positions in the programming coordinate system (mm / degrees), as `positions`.
+    pub pcs_positions: Vec<(char, f64)>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -321,6 +323,7 @@ pub fn status_of(c: &Channel) -> Status {
         searching: c.decoder().searching(),
         ipo_blocks: c.ipo_blocks(),
         errors_total: c.stats().errors,
+        pcs_positions: c.pcs_positions(),
     }
 }
 

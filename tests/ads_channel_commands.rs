@@ -155,3 +155,40 @@ fn block_search_by_number_through_the_com_objects() {
     assert_eq!(search[0]["found"], true);
     assert_eq!(block_ns(&events).first(), Some(&50));
 }
+
+#[test]
+fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
+    let rig = common::Rig::new();
+    let startup = std::fs::read_to_string(rig.startup()).unwrap();
+    std::fs::write(rig.startup(), startup + "zero_offset_list zero.lis\n").unwrap();
+    // G54 shifts X by 10 mm (list unit 0.1 µm).
+    std::fs::write(
+        rig.dir.path().join("params/zero.lis"),
+        "np_grp[0].achse[0].versch 100000\n",
+    )
+    .unwrap();
+    rig.program("g54.nc", "N10 G54 G01 X5 F6000\nN20 X6\nN30 M30\n");
+    let served = common::Served::start(&rig);
+    let c = client(&served);
+    let com = com_device(&c);
+    com.write(0x01, &[1]);
+    com.start("g54.nc");
+    com.wait_state(5);
+    assert_eq!(com.u32(0x0E), 10);
+    let mut b = [0u8; 4];
+    com.0.read_exact(0x120200, 0x10000 + 0x02, &mut b).unwrap();
+    assert_eq!(i32::from_le_bytes(b), 150_000, "ACS X = 15 mm");
+    com.0.read_exact(0x120201, 0x03, &mut b).unwrap();
+    assert_eq!(i32::from_le_bytes(b), 150_000);
+    com.0.read_exact(CH, 0x10006, &mut b).unwrap();
+    assert_eq!(i32::from_le_bytes(b), 50_000, "PCS X = 5 mm");
+    let mut hr = [0u8; 8];
+    com.0.read_exact(0x120201, 0x30, &mut hr).unwrap();
+    assert_eq!(f64::from_le_bytes(hr), 150_000.0);
+    assert_eq!(com.string(0x10002, 16), "X", "mc_axis_1_name_r");
+    com.write(0x01, &[0]);
+    com.write(0x137, &[1]);
+    com.wait_state(3);
+    drop(c);
+    served.finish();
+}

@@ -120,6 +120,7 @@ enum Field {
     AxisChannel,
     AxisPosition,
     AxisPositionHr,
+    AxisPositionPcs,
 }
 
 /// One object of the table.
@@ -233,6 +234,8 @@ static TABLE: &[Def] = &[
     d(CH, 0x8003, "ncc_positions_mm_r", LrealArray, 0, R, "mm per axis", SRC_NCC, F::NccPositions),
     d(CA, 0x01, "mc_axis_{k}_logical_no_r", Word, 2, R, "", SRC_TS, F::AxisLogicalNo),
     d(CA, 0x02, "mc_axis_{k}_name_r", String, 16, R, "", SRC_TS, F::AxisName),
+    d(CA, 0x06, "mc_ax_{k}_active_position_pcs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPositionPcs),
+    d(CA, 0x07, "mc_ax_{k}_curr_position_pcs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPositionPcs),
     d(CA, 0x09, "mc_axis_{k}_state_r", Word, 2, R, "1 ready, 3 active, 5 hold, 7 error", SRC_TS, F::AxisState),
     d(PA, 0x02, "ac_{k}_active_position_acs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPosition),
     d(PA, 0x03, "ac_{k}_current_position_acs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPosition),
@@ -605,6 +608,13 @@ fn read_axis(
         Field::AxisChannel => ch.to_le_bytes().to_vec(),
         Field::AxisPosition => tenth_um_i32(mm).to_le_bytes().to_vec(),
         Field::AxisPositionHr => tenth_um(mm).to_le_bytes().to_vec(),
+        Field::AxisPositionPcs => {
+            let (_, pcs) = *v
+                .pcs_positions
+                .get(index)
+                .ok_or(AdsResult::INVALID_OFFSET)?;
+            tenth_um_i32(pcs).to_le_bytes().to_vec()
+        }
         _ => return Err(AdsResult::ACCESS_DENIED),
     };
     fixed(bytes, length)

@@ -374,6 +374,7 @@ impl MemChannel {
             searching: false,
             ipo_blocks: 0,
             errors_total: self.errors_total,
+            pcs_positions: ['X', 'Y', 'Z'].into_iter().zip(self.positions_mm).collect(),
         }
     }
 }
