@@ -367,13 +367,18 @@ impl Channel {
     }
     /// The position of each configured axis, in `AXIS_LETTERS` order.
     pub fn axis_positions(&self) -> Vec<(char, f64)> {
+        self.positions_less(&[0.0; MAX_AXES])
+    }
+
+    /// The configured axes' positions minus `offset`, in `AXIS_LETTERS` order.
+    fn positions_less(&self, offset: &Position) -> Vec<(char, f64)> {
         let p = self.motion.position();
         let configured = self.decoder.axes();
         AXIS_LETTERS
             .iter()
             .enumerate()
             .filter(|(i, _)| configured[*i])
-            .map(|(i, l)| (*l as char, p[i]))
+            .map(|(i, l)| (*l as char, p[i] - offset[i]))
             .collect()
     }
 
@@ -389,14 +394,7 @@ impl Channel {
             .and_then(|i| self.zero_offsets.get(i))
             .copied()
             .unwrap_or([0.0; MAX_AXES]);
-        let p = self.motion.position();
-        let configured = self.decoder.axes();
-        AXIS_LETTERS
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| configured[*i])
-            .map(|(i, l)| (*l as char, p[i] - offset[i]))
-            .collect()
+        self.positions_less(&offset)
     }
 
     fn set_state(&mut self, tick: &Tick, state: State) {

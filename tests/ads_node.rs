@@ -7,8 +7,6 @@
 
 mod common;
 
-use std::process::Command;
-
 #[test]
 #[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
 fn node_ads_client_streams_5000_lines_and_watches_the_block_count() {
@@ -19,20 +17,7 @@ fn node_ads_client_streams_5000_lines_and_watches_the_block_count() {
     std::fs::write(&file, lines.join("\n") + "\n").unwrap();
     let served = common::Served::start(&rig);
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/ads_client_test.js");
-    let out = Command::new(node)
-        .arg(script)
-        .arg(&file)
-        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
-        .output()
-        .expect("node runs");
-    let (_, events) = served.finish();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let seen: serde_json::Value =
-        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    let (seen, events) = common::run_client(served, &node, script, &[&file]);
     assert!(
         seen["busy"].as_u64().unwrap() > 0,
         "the client was refused at least once"

@@ -85,19 +85,7 @@ fn pyads_drives_the_hli_unit_and_reads_geo() {
         env!("CARGO_MANIFEST_DIR"),
         "/tests/python/hli_with_pyads.py"
     );
-    let out = Command::new(python)
-        .arg(script)
-        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
-        .output()
-        .expect("python runs");
-    let (_, events) = served.finish();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let seen: serde_json::Value =
-        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    let (seen, events) = common::run_client(served, &python, script, &[]);
     assert_eq!(seen["errors"][0], 21476);
     let codes: Vec<_> = common::of(&events, "error")
         .iter()

@@ -55,6 +55,27 @@ def transition(to_mode, to_state, parameter=b""):
     return list(b)
 
 
+def command(plc, to_mode, to_state, parameter=b""):
+    """The command unit as TwinSharp drives it: command_w, then command_semaphor_rw TRUE."""
+    plc.write_by_name(MS + ".command_w", transition(to_mode, to_state, parameter), TRANSITION)
+    plc.write_by_name(MS + ".command_semaphor_rw", True, pyads.PLCTYPE_BOOL)
+
+
+def watch(plc, lock, name, plc_type, cycle_ms):
+    """An on-change notification by symbol name (as TwinSharp's AddDeviceNotificationEx):
+    the list its values arrive in, and the handles to delete it with."""
+    values = []
+
+    def on_change(notification, _name):
+        _h, _ts, value = plc.parse_notification(notification, plc_type)
+        with lock:
+            values.append(value)
+
+    size = ctypes.sizeof(plc_type)
+    attr = pyads.NotificationAttrib(size, trans_mode=pyads.ADSTRANS_SERVERONCHA, cycle_time=cycle_ms)
+    return values, plc.add_device_notification(name, attr, on_change)
+
+
 def main():
     pyads.open_port()
     pyads.set_local_address("10.1.2.3.1.1")
@@ -72,21 +93,12 @@ def main():
     # Without a type pyads asks for the symbol info (0xF009) first.
     check(plc.read_by_name(MS + ".state_r.state") == 3, "READY before the start")
 
-    states = []
     lock = threading.Lock()
-
-    def on_state(notification, _name):
-        _h, _ts, value = plc.parse_notification(notification, pyads.PLCTYPE_UDINT)
-        with lock:
-            states.append(value)
-
-    attr = pyads.NotificationAttrib(4, trans_mode=pyads.ADSTRANS_SERVERONCHA, cycle_time=1)
-    state_handles = plc.add_device_notification(MS + ".state_r.state", attr, on_state)
+    states, state_handles = watch(plc, lock, MS + ".state_r.state", pyads.PLCTYPE_UDINT, 1)
     wait_for("the first state sample", lambda: len(states) > 0)
 
     # The command unit: command_w, then command_semaphor_rw TRUE; the CNC takes it.
-    plc.write_by_name(MS + ".command_w", transition(2, 4, b"streaming.nc"), TRANSITION)
-    plc.write_by_name(MS + ".command_semaphor_rw", True, pyads.PLCTYPE_BOOL)
+    command(plc, 2, 4, b"streaming.nc")
     check(plc.read_by_name(MS + ".command_semaphor_rw", pyads.PLCTYPE_BOOL) is False,
           "the CNC cleared command_semaphor_rw")
     state_r = plc.read_by_name(MS + ".state_r", pyads.PLCTYPE_UDINT * 2)
@@ -149,15 +161,7 @@ def main():
           "state_r followed READY → ACTIVE → READY: %r" % seen["states"])
 
     # Errors: one record posted with the semaphore TRUE, the next only after it is cleared.
-    sem_values = []
-
-    def on_sem(notification, _name):
-        _h, _ts, value = plc.parse_notification(notification, pyads.PLCTYPE_BOOL)
-        with lock:
-            sem_values.append(value)
-
-    sem_attr = pyads.NotificationAttrib(1, trans_mode=pyads.ADSTRANS_SERVERONCHA, cycle_time=50)
-    sem_handles = plc.add_device_notification(ERR + ".semaphor_rw", sem_attr, on_sem)
+    sem_values, sem_handles = watch(plc, lock, ERR + ".semaphor_rw", pyads.PLCTYPE_BOOL, 50)
     try:
         com.write(CH, 0x90, list(b"N10 X1\n"), ctypes.c_uint8 * 7)
         check(False, "a line without CR LF is refused")
@@ -191,8 +195,7 @@ def main():
     seen["errors"] = [21476, second_id]
 
     # Reset through the HLI: to_state 15 ("Resetting").
-    plc.write_by_name(MS + ".command_w", transition(0, 15), TRANSITION)
-    plc.write_by_name(MS + ".command_semaphor_rw", True, pyads.PLCTYPE_BOOL)
+    command(plc, 0, 15)
     check(list(plc.read_by_name(MS + ".state_r", pyads.PLCTYPE_UDINT * 2))[1] == 3, "reset → READY")
 
     for c in (plc, com, geo):
