@@ -668,6 +668,26 @@ impl Channel {
         self.hmi.search.target()
     }
 
+    /// Remember the block that took effect. The program name is shared (`Arc`) and only
+    /// replaced when it changes: this runs for every block, at tens per tick.
+    fn note_active(&mut self, info: &crate::queue::BlockInfo) {
+        match &mut self.active {
+            Some(a) if Arc::ptr_eq(&a.prog, &info.prog) => {
+                a.offset = info.offset;
+                a.counter = info.counter;
+                a.n = info.n;
+            }
+            _ => {
+                self.active = Some(ActiveBlock {
+                    prog: info.prog.clone(),
+                    offset: info.offset,
+                    counter: info.counter,
+                    n: info.n,
+                })
+            }
+        }
+    }
+
     /// Single block: let the next decoded block (with its silent second parts) into motion,
     /// once per start, followed by a flush so the planner releases it at once instead of
     /// holding it for its lookahead window.
@@ -836,12 +856,7 @@ impl Channel {
                     }
                     self.ran_any = true;
                     self.stats.blocks += 1;
-                    self.active = Some(ActiveBlock {
-                        prog: info.prog.clone(),
-                        offset: info.offset,
-                        counter: info.counter,
-                        n: info.n,
-                    });
+                    self.note_active(&info);
                     if self.observe && info.stream {
                         self.executed.push(ExecutedBlock {
                             offset: info.offset,
