@@ -281,3 +281,68 @@ pub fn read_write(
     };
     Ok([group.to_le_bytes(), offset.to_le_bytes()].concat())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use std::sync::Arc;
+
+    fn query(b: &dyn CncBackend, group: u32, ch: i32, axis: i32) -> (u32, u32) {
+        let data = [ch.to_le_bytes(), axis.to_le_bytes()].concat();
+        let r = read_write(b, group, 0, 8, &data).unwrap();
+        (
+            u32::from_le_bytes([r[0], r[1], r[2], r[3]]),
+            u32::from_le_bytes([r[4], r[5], r[6], r[7]]),
+        )
+    }
+
+    #[test]
+    fn address_query_names_existing_instances_only() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        assert_eq!(query(b.as_ref(), 0x121900, 1, 0), (0x121301, 0));
+        assert_eq!(query(b.as_ref(), 0x123900, 1, 0), (0x123301, 0));
+        assert_eq!(
+            query(b.as_ref(), 0x21900, 1, 0),
+            (0x121301, 0),
+            "index-based"
+        );
+        assert_eq!(query(b.as_ref(), 0x121900, 2, 0), (0, 0));
+        assert_eq!(query(b.as_ref(), 0x121900, 0, 1), (0, 0));
+        assert_eq!(
+            read_write(b.as_ref(), 0x121900, 0, 8, &[0; 4]),
+            Err(AdsResult::INVALID_SIZE)
+        );
+    }
+
+    #[test]
+    fn hld_shows_mode_state_and_the_hli_unit() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(Arc::clone(&b) as Arc<dyn CncBackend>);
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x1F, 4).unwrap(),
+            [3, 0, 0, 0]
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x20, 4).unwrap(),
+            [1, 0, 0, 0]
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x2F, 300).unwrap().len(),
+            300
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x70, 8).unwrap(),
+            1.0f64.to_le_bytes()
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x15, 4),
+            Err(AdsResult::INVALID_SIZE)
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x02, 8),
+            Err(AdsResult::INVALID_OFFSET),
+            "moved path is not modelled"
+        );
+    }
+}

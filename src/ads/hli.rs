@@ -795,6 +795,7 @@ fn put(field: &mut [u8], text: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ads::backend::CncBackend;
     use crate::ads::memory::{DrainRate, MemoryBackend};
 
     #[test]
@@ -815,6 +816,71 @@ mod tests {
             Err(SYMBOL_NOT_FOUND)
         );
         assert_eq!(hli.write(GROUP_RELEASE_HANDLE, 0, &h.to_le_bytes()), Ok(()));
+    }
+
+    fn handle_of(hli: &Hli, name: &str) -> u32 {
+        let h = hli
+            .read_write(GROUP_HANDLE_BY_NAME, 0, 4, name.as_bytes())
+            .unwrap();
+        u32::from_le_bytes([h[0], h[1], h[2], h[3]])
+    }
+
+    #[test]
+    fn command_unit_is_taken_when_the_semaphore_is_set_and_cleared() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+        let mut cmd = vec![0u8; MODE_TRANSITION_BYTES];
+        cmd[8..12].copy_from_slice(&2u32.to_le_bytes());
+        cmd[12..16].copy_from_slice(&4u32.to_le_bytes());
+        cmd[24..36].copy_from_slice(b"streaming.nc");
+        let command = handle_of(&hli, &format!("{ms}.command_w"));
+        hli.write(GROUP_VALUE_BY_HANDLE, command, &cmd).unwrap();
+        // Written but not handed over: nothing happens.
+        assert_eq!(b.mode_state(1), Ok((1, 3)));
+        let sem = handle_of(&hli, &format!("{ms}.command_semaphor_rw"));
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1]).unwrap();
+        assert_eq!(b.mode_state(1), Ok((2, 4)));
+        assert_eq!(b.program(1), "streaming.nc");
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [0]);
+        let state = handle_of(&hli, &format!("{ms}.state_r.state"));
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, state, 4).unwrap(),
+            [4, 0, 0, 0]
+        );
+        // A read-only live symbol refuses writes; a too long write is refused.
+        assert_eq!(
+            hli.write(GROUP_VALUE_BY_HANDLE, state, &[0; 4]),
+            Err(AdsResult::ACCESS_DENIED)
+        );
+        assert_eq!(
+            hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1, 0]),
+            Err(AdsResult::INVALID_SIZE)
+        );
+    }
+
+    #[test]
+    fn errors_are_posted_one_at_a_time() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        let sem = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.semaphor_rw");
+        let rec = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.satz_r");
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "no error yet"
+        );
+        let _ = b.stream_write(1, b"N10 X1\n");
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        let r = hli.read(GROUP_VALUE_BY_HANDLE, rec, 942).unwrap();
+        assert_eq!(r.len(), ERROR_RECORD_BYTES);
+        assert_eq!(&r[0..4], &21476u32.to_le_bytes());
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "posted once"
+        );
     }
 
     #[test]
