@@ -15,6 +15,7 @@
 
 use super::backend::{CncBackend, DeviceError, HmiOp, Status};
 use super::description::{self, Access, AdsType, ObjectInfo};
+use super::hli::{Hli, HmiRequest};
 use super::result::AdsResult;
 use crate::channel::{Mode, State};
 
@@ -662,9 +663,11 @@ fn i32_arg(data: &[u8]) -> Result<i32, AdsResult> {
     i32::try_from(int_arg(data)?).map_err(|_| AdsResult::INVALID_DATA)
 }
 
-/// ADS Write on port 553.
+/// ADS Write on port 553. Mode and state commands go to the PLC instead when its HLI unit
+/// operates them ([`Hli::redirect`]).
 pub fn write(
     backend: &dyn CncBackend,
+    hli: &Hli,
     group: u32,
     offset: u32,
     data: &[u8],
@@ -729,8 +732,20 @@ pub fn write(
             let n = uint_arg(data)?;
             search(&|s| s.block_number = n)
         }
-        Field::McmToMode => unit(backend.command_mode(ch, i32_arg(data)?)),
-        Field::McmToState => unit(backend.command_state(ch, i32_arg(data)?)),
+        Field::McmToMode => {
+            let m = i32_arg(data)?;
+            match hli.redirect(ch, HmiRequest::ToMode(m)) {
+                Some(r) => r,
+                None => unit(backend.command_mode(ch, m)),
+            }
+        }
+        Field::McmToState => {
+            let s = i32_arg(data)?;
+            match hli.redirect(ch, HmiRequest::ToState(s)) {
+                Some(r) => r,
+                None => unit(backend.command_state(ch, s)),
+            }
+        }
         Field::McmFromMode | Field::McmFromState => {
             // "Optional; 0 = no significance" (HLI docs): ncchannel checks nothing here.
             let v = i32_arg(data)?;
@@ -745,7 +760,10 @@ pub fn write(
             if name.is_empty() {
                 return Err(AdsResult::INVALID_SIZE);
             }
-            unit(backend.command_program(ch, name))
+            match hli.redirect(ch, HmiRequest::Parameter(name)) {
+                Some(r) => r,
+                None => unit(backend.command_program(ch, name)),
+            }
         }
         Field::Hold | Field::Resume | Field::Reset => {
             if data.len() > 4 {

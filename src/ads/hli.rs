@@ -120,6 +120,23 @@ struct Image {
     channels: Vec<ChannelAreas>,
     /// Per channel: errors handed to the PLC so far.
     posted: Mutex<Vec<u64>>,
+    /// Per channel: the HMI's to-mode and parameter waiting for its to-state (redirection).
+    pending: Mutex<Vec<PendingRequest>>,
+}
+
+/// What an HMI wrote of a mode transition before the to-state that completes it.
+#[derive(Debug, Clone, Default)]
+struct PendingRequest {
+    to_mode: Option<u32>,
+    parameter: Vec<u8>,
+}
+
+/// An HMI (COM) mode-and-state command, for redirection to the PLC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HmiRequest<'a> {
+    ToMode(i32),
+    ToState(i32),
+    Parameter(&'a str),
 }
 
 struct Builder {
@@ -440,6 +457,7 @@ impl Image {
                 memory: Mutex::new(Vec::new()),
                 channels: Vec::new(),
                 posted: Mutex::new(vec![0; axes_per_channel.len()]),
+                pending: Mutex::new(vec![PendingRequest::default(); axes_per_channel.len()]),
             },
         };
         b.constant(
@@ -653,6 +671,56 @@ impl Hli {
         Ok(())
     }
 
+    /// infosys 174725259: with `enable_w` TRUE "the PLC operates this command": an HMI's mode
+    /// and state commands (COM `mcm_command_*_w`) are not executed but handed to the PLC in
+    /// `request_r` with `request_semaphor_rw` TRUE; the PLC decides and commands through
+    /// `command_w`. `None` when the PLC does not operate the unit (the channel executes the
+    /// command itself). A to-state while the PLC has not taken the last request is 0x708.
+    pub fn redirect(&self, ch: u16, req: HmiRequest<'_>) -> Option<Result<(), AdsResult>> {
+        // Without a PLC client the image may not exist yet: then nobody set enable_w.
+        let img = self.image.get()?;
+        let areas = img.areas(ch).ok()?;
+        if img.memory()[areas.enable][0] == 0 {
+            return None;
+        }
+        let i = usize::from(ch) - 1;
+        let mut pending = img.pending.lock().unwrap_or_else(|p| p.into_inner());
+        let p = &mut pending[i];
+        match req {
+            HmiRequest::ToMode(m) => p.to_mode = u32::try_from(m).ok(),
+            HmiRequest::Parameter(text) => {
+                p.parameter = text.as_bytes()[..text.len().min(PARAMETER_BYTES - 1)].to_vec()
+            }
+            HmiRequest::ToState(s) => {
+                // `pending` stays locked: redirections of a channel are one at a time.
+                if img.memory()[areas.request_semaphore][0] != 0 {
+                    return Some(Err(AdsResult::BUSY));
+                }
+                let (mode, state) = match self.backend.mode_state(ch) {
+                    Ok(ms) => ms,
+                    Err(e) => return Some(Err(e.result())),
+                };
+                let mut mem = img.memory();
+                let r = &mut mem[areas.request];
+                r.fill(0);
+                let words = [
+                    mode as u32,
+                    state as u32,
+                    p.to_mode.unwrap_or(mode as u32),
+                    s as u32,
+                    u32::from(ch),
+                ];
+                for (k, w) in words.iter().enumerate() {
+                    r[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+                }
+                r[PARAMETER_AT..PARAMETER_AT + p.parameter.len()].copy_from_slice(&p.parameter);
+                mem[areas.request_semaphore][0] = 1;
+                *p = PendingRequest::default();
+            }
+        }
+        Some(Ok(()))
+    }
+
     /// Bytes `[at, at + size)` of a channel's mode-and-state unit (for the GEO mirror).
     pub fn unit_bytes(
         &self,
@@ -857,6 +925,38 @@ mod tests {
             hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1, 0]),
             Err(AdsResult::INVALID_SIZE)
         );
+    }
+
+    #[test]
+    fn with_enable_w_hmi_commands_become_requests_for_the_plc() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), None, "no PLC yet");
+        let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+        let enable = handle_of(&hli, &format!("{ms}.enable_w"));
+        hli.write(GROUP_VALUE_BY_HANDLE, enable, &[1]).unwrap();
+        assert_eq!(hli.redirect(1, HmiRequest::ToMode(2)), Some(Ok(())));
+        assert_eq!(hli.redirect(1, HmiRequest::Parameter("a.nc")), Some(Ok(())));
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), Some(Ok(())));
+        assert_eq!(b.mode_state(1), Ok((1, 3)), "not executed");
+        let req = handle_of(&hli, &format!("{ms}.request_r"));
+        let r = hli.read(GROUP_VALUE_BY_HANDLE, req, 327).unwrap();
+        let word =
+            |k: usize| u32::from_le_bytes([r[4 * k], r[4 * k + 1], r[4 * k + 2], r[4 * k + 3]]);
+        assert_eq!(
+            (word(0), word(1), word(2), word(3), word(4)),
+            (1, 3, 2, 4, 1)
+        );
+        assert_eq!(&r[24..29], b"a.nc\0");
+        let sem = handle_of(&hli, &format!("{ms}.request_semaphor_rw"));
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        assert_eq!(
+            hli.redirect(1, HmiRequest::ToState(5)),
+            Some(Err(AdsResult::BUSY)),
+            "the PLC has not taken the last request"
+        );
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(3)), Some(Ok(())));
     }
 
     #[test]

@@ -105,7 +105,7 @@ impl Devices {
     /// ADS Write.
     pub fn write(&self, port: u16, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
         match port {
-            com::PORT => com::write(self.backend.as_ref(), group, offset, data),
+            com::PORT => com::write(self.backend.as_ref(), &self.hli, group, offset, data),
             geo::PORT => Err(AdsResult::ACCESS_DENIED),
             sda::PORT => self.sda.write(group, offset, data),
             hli::PORT => self.hli.write(group, offset, data),

@@ -160,6 +160,25 @@ def main():
     check(seen["states"][:2] == [3, 4] and seen["states"][-1] == 3,
           "state_r followed READY → ACTIVE → READY: %r" % seen["states"])
 
+    # While enable_w is TRUE the PLC operates the unit: an HMI's start over COM is not executed
+    # but handed to the PLC in request_r with request_semaphor_rw TRUE.
+    com.write(CH, 0x108, list(b"other.nc\0"), ctypes.c_uint8 * 9)
+    com.write(CH, 0x105, 4, pyads.PLCTYPE_DINT)
+    check(plc.read_by_name(MS + ".request_semaphor_rw", pyads.PLCTYPE_BOOL) is True, "request posted")
+    req = bytes(plc.read_by_name(MS + ".request_r", TRANSITION))
+    check(struct.unpack_from("<5I", req, 0) == (2, 3, 2, 4, 1), "request_r %r" % (struct.unpack_from("<5I", req, 0),))
+    check(req[24:33] == b"other.nc\0", "request_r.parameter")
+    check(geo.read(0x123301, 0x27, pyads.PLCTYPE_UDINT) == 4, "GEO mirrors request_r.to_state")
+    check(plc.read_by_name(MS + ".state_r.state", pyads.PLCTYPE_UDINT) == 3, "not executed")
+    try:
+        com.write(CH, 0x105, 4, pyads.PLCTYPE_DINT)
+        check(False, "a second request before the PLC took the first")
+    except pyads.ADSError as e:
+        check(e.err_code == ADSERR_BUSY, "0x708 until the PLC takes the request")
+    plc.write_by_name(MS + ".request_semaphor_rw", False, pyads.PLCTYPE_BOOL)
+    # The PLC hands the unit back to the CNC.
+    plc.write_by_name(MS + ".enable_w", False, pyads.PLCTYPE_BOOL)
+
     # Errors: one record posted with the semaphore TRUE, the next only after it is cleared.
     sem_values, sem_handles = watch(plc, lock, ERR + ".semaphor_rw", pyads.PLCTYPE_BOOL, 50)
     try:
