@@ -18,6 +18,9 @@ use super::hli::{Hli, Unit};
 use super::result::AdsResult;
 
 pub const PORT: u16 = 551;
+/// Position controller, platform instance (ISG sample client `cnc_demo_samples.c` waits
+/// ticks on its tick counter).
+pub const GROUP_POS_CTRL: u32 = 0x120300;
 /// Interpolator instance of channel ch: `GROUP_IPO + ch`.
 pub const GROUP_IPO: u32 = 0x121300;
 /// HLD instance of channel ch: `GROUP_HLD + ch`.
@@ -32,6 +35,7 @@ const SRC_DUMP: &str = "ISG object dump";
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Class {
+    PosCtrl,
     Ipo,
     Hld,
 }
@@ -39,6 +43,9 @@ enum Class {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Field {
     Elements,
+    CycleTime,
+    PlatformAxes,
+    TickCounter,
     AxisCount,
     IpoBufLevel,
     PathVelocity,
@@ -92,11 +99,15 @@ const fn d(
 }
 
 use AdsType::*;
-use Class::{Hld, Ipo};
+use Class::{Hld, Ipo, PosCtrl};
 use Field as F;
 
 #[rustfmt::skip]
 static TABLE: &[Def] = &[
+    d(PosCtrl, 0x00, "POS-CTRL: elements", Dword, 4, "element types served", SRC_DUMP, F::Elements),
+    d(PosCtrl, 0x01, "cycle time", Lreal, 8, "s", SRC_DUMP, F::CycleTime),
+    d(PosCtrl, 0x02, "number of axes", Word, 2, "", SRC_DUMP, F::PlatformAxes),
+    d(PosCtrl, 0x07, "tick counter", Dword, 4, "CNC ticks", SRC_DUMP, F::TickCounter),
     d(Ipo, 0x00, "IPO: elements", Dword, 4, "element types served", SRC, F::Elements),
     d(Ipo, 0x01, "number of axes", Word, 2, "", SRC, F::AxisCount),
     d(Ipo, 0x05, "ipo_buf_level", Dword, 4, "blocks", SRC, F::IpoBufLevel),
@@ -133,6 +144,7 @@ static TABLE: &[Def] = &[
 
 fn class_group(c: Class) -> u32 {
     match c {
+        Class::PosCtrl => GROUP_POS_CTRL,
         Class::Ipo => GROUP_IPO,
         Class::Hld => GROUP_HLD,
     }
@@ -144,7 +156,12 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
         .iter()
         .map(|d| ObjectInfo {
             port: PORT,
-            group: class_group(d.class) + u32::from(ch),
+            group: class_group(d.class)
+                + if d.class == Class::PosCtrl {
+                    0
+                } else {
+                    u32::from(ch)
+                },
             offset: d.element,
             name: d.name.into(),
             ty: d.ty,
@@ -180,7 +197,9 @@ pub fn read(
     length: u32,
 ) -> Result<Vec<u8>, AdsResult> {
     let group = logical(group);
-    let (class, ch) = if (GROUP_IPO + 1..GROUP_IPO + 0x100).contains(&group) {
+    let (class, ch) = if group == GROUP_POS_CTRL {
+        (Class::PosCtrl, 1)
+    } else if (GROUP_IPO + 1..GROUP_IPO + 0x100).contains(&group) {
         (Class::Ipo, group - GROUP_IPO)
     } else if (GROUP_HLD + 1..GROUP_HLD + 0x100).contains(&group) {
         (Class::Hld, group - GROUP_HLD)
@@ -202,6 +221,17 @@ pub fn read(
         return fixed(bytes, length);
     }
     let v = backend.view(ch).map_err(DeviceError::result)?;
+    if def.field == Field::PlatformAxes {
+        let mut n = 0usize;
+        for c in 1..=backend.channel_count() {
+            n += backend
+                .view(c)
+                .map_err(DeviceError::result)?
+                .positions
+                .len();
+        }
+        return fixed((n as u16).to_le_bytes().to_vec(), length);
+    }
     fixed(value(&v, hli, ch, class, def.field)?, length)
 }
 
@@ -215,6 +245,8 @@ fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<V
             n.to_le_bytes().to_vec()
         }
         Field::AxisCount => (v.positions.len() as u16).to_le_bytes().to_vec(),
+        Field::CycleTime => v.period.as_secs_f64().to_le_bytes().to_vec(),
+        Field::TickCounter => (v.tick as u32).to_le_bytes().to_vec(),
         Field::IpoBufLevel => (v.ipo_blocks as u32).to_le_bytes().to_vec(),
         Field::PathVelocity => (v.velocity_mm_per_s * 1000.0).to_le_bytes().to_vec(),
         Field::ProgrammedVelocity => feed_um_s.to_le_bytes().to_vec(),
@@ -240,7 +272,7 @@ fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<V
         Field::State => (v.state as u32).to_le_bytes().to_vec(),
         Field::Mode => (v.mode as u32).to_le_bytes().to_vec(),
         Field::PlcPresent => hli.plc_present(ch)?,
-        Field::Unit(..) => return Err(AdsResult::ACCESS_DENIED),
+        Field::Unit(..) | Field::PlatformAxes => return Err(AdsResult::ACCESS_DENIED),
     })
 }
 
@@ -331,6 +363,12 @@ mod tests {
             read(b.as_ref(), &hli, 0x123301, 0x2F, 300).unwrap().len(),
             300
         );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x20300, 0x01, 8).unwrap(),
+            0.001f64.to_le_bytes(),
+            "position controller: cycle time in s"
+        );
+        assert_eq!(read(b.as_ref(), &hli, 0x120300, 0x02, 2).unwrap(), [3, 0]);
         assert_eq!(
             read(b.as_ref(), &hli, 0x121301, 0x70, 8).unwrap(),
             1.0f64.to_le_bytes()
