@@ -9,9 +9,10 @@ use std::sync::Arc;
 
 use thiserror::Error;
 
+use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
 use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use crate::queue::{BlockQueue, Position, AXIS_LETTERS};
+use crate::queue::{Action, BlockQueue, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES};
 use crate::report::event::{EventBuffer, EventKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
@@ -158,6 +159,61 @@ pub struct ChannelStats {
     pub programs_ended: u64,
 }
 
+/// What an HMI commands besides mode and state: the COM task's `mc_command_*` objects
+/// (ISG kernel object list, `SamWieHTWG/web-api` `examples/example1-hello-cnc/cnc_objects.csv`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct HmiCommands {
+    /// `mc_command_single_block_w`: one block per start.
+    pub single_block: bool,
+    /// `mc_command_block_ignore_w`: skip levels 1–10 as the kernel's mask (level n = bit n−1).
+    pub skip_levels: u32,
+    /// `mc_command_execution_mode_w`: bit 0 = block search at the next start.
+    pub execution_mode: i32,
+    pub search: SearchCommand,
+}
+
+/// Block-search parameters (`mc_cmd_bs_*_w`, TwinSharp `BlockSearch.cs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SearchCommand {
+    /// `mc_cmd_bs_type_w`: 1 file offset, 3 block counter, 4 block number.
+    pub kind: u16,
+    /// Byte offset in the main program (`mc_command_file_offset_w` / `…pos_start_offset_w`).
+    pub file_offset: i32,
+    /// `mc_cmd_bs_intern_block_count_w`.
+    pub block_count: u32,
+    /// `mc_cmd_bs_block_number_w`: the N number.
+    pub block_number: u32,
+}
+
+/// Execution mode bit: block search at the next program start.
+pub const EXECUTION_MODE_BLOCK_SEARCH: i32 = 0x1;
+
+impl SearchCommand {
+    /// The decoder's search target this command names, if any.
+    pub fn target(&self) -> Option<SearchTarget> {
+        match self.kind {
+            1 => u64::try_from(self.file_offset)
+                .ok()
+                .map(SearchTarget::Offset),
+            3 => Some(SearchTarget::Counter(u64::from(self.block_count))),
+            4 => Some(SearchTarget::BlockNumber(self.block_number)),
+            _ => None,
+        }
+    }
+}
+
+/// The block that took effect last: what `mc_active_*` objects show.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ActiveBlock {
+    /// Program (file) the block is in.
+    pub prog: Arc<str>,
+    /// Byte offset of the line in that program (in a stream: since stream start).
+    pub offset: u64,
+    /// ISG block counter of the block.
+    pub counter: u64,
+    pub n: Option<u32>,
+}
+
 pub struct Channel {
     number: u32,
     mode: Mode,
@@ -189,10 +245,21 @@ pub struct Channel {
     observe: bool,
     /// Executed stream blocks since the last [`Channel::drain_executed`].
     executed: Vec<ExecutedBlock>,
+    hmi: HmiCommands,
+    active: Option<ActiveBlock>,
+    /// Single block: the one block motion may take (then a flush that releases it).
+    single_gate: BlockQueue,
+    /// Single block: a start allows one more block.
+    single_credit: bool,
+    /// Flushes put into the gate whose notes are not program events.
+    single_flushes: usize,
+    /// G54…G59 offsets (mm), for positions in the programming coordinate system.
+    zero_offsets: ZeroOffsets,
 }
 
 impl Channel {
     pub fn new(s: ChannelSettings, events_enabled: bool) -> Self {
+        let zero_offsets = s.decoder.zero_offsets;
         Channel {
             number: s.number,
             mode: Mode::Automatic,
@@ -218,6 +285,12 @@ impl Channel {
             events: EventBuffer::new(events_enabled),
             observe: false,
             executed: Vec::new(),
+            hmi: HmiCommands::default(),
+            active: None,
+            single_gate: BlockQueue::new(2),
+            single_credit: false,
+            single_flushes: 0,
+            zero_offsets,
         }
     }
 
@@ -294,14 +367,34 @@ impl Channel {
     }
     /// The position of each configured axis, in `AXIS_LETTERS` order.
     pub fn axis_positions(&self) -> Vec<(char, f64)> {
+        self.positions_less(&[0.0; MAX_AXES])
+    }
+
+    /// The configured axes' positions minus `offset`, in `AXIS_LETTERS` order.
+    fn positions_less(&self, offset: &Position) -> Vec<(char, f64)> {
         let p = self.motion.position();
         let configured = self.decoder.axes();
         AXIS_LETTERS
             .iter()
             .enumerate()
             .filter(|(i, _)| configured[*i])
-            .map(|(i, l)| (*l as char, p[i]))
+            .map(|(i, l)| (*l as char, p[i] - offset[i]))
             .collect()
+    }
+
+    /// Positions in the programming coordinate system: machine positions minus the zero
+    /// offset (G54…G59) the decoder has active, which runs ahead of execution by the
+    /// lookahead when a program switches offsets.
+    pub fn pcs_positions(&self) -> Vec<(char, f64)> {
+        let offset = self
+            .decoder
+            .modal()
+            .zero_offset
+            .checked_sub(1)
+            .and_then(|i| self.zero_offsets.get(i))
+            .copied()
+            .unwrap_or([0.0; MAX_AXES]);
+        self.positions_less(&offset)
     }
 
     fn set_state(&mut self, tick: &Tick, state: State) {
@@ -345,6 +438,8 @@ impl Channel {
         // An error stops decoding and motion; only a reset leaves ERROR.
         self.motion.reset();
         self.queue.clear();
+        self.single_gate.clear();
+        self.single_flushes = 0;
         if self.finish.is_none() && self.running_prog.is_some() {
             self.finish = Some(Finish::Error);
         }
@@ -469,7 +564,11 @@ impl Channel {
         self.interrupted = false;
         self.motion.start();
         let pos = self.motion.position();
-        let search = self.search.take();
+        let search = self.search.take().or_else(|| self.take_commanded_search());
+        self.active = None;
+        self.single_credit = true;
+        self.single_flushes = 0;
+        self.single_gate.clear();
         if let Err(e) = self.decoder.start(name, &mut self.store, pos, search) {
             self.running_prog = Some(name.into());
             self.raise_error(tick, e.code, e.msg.clone(), Some(name.to_string()), None);
@@ -495,6 +594,7 @@ impl Channel {
     /// Resume after hold (0x137).
     pub fn resume(&mut self, tick: &Tick) {
         if self.state == State::Hold {
+            self.single_credit = true;
             self.motion.set_hold(false);
             self.set_state(tick, State::Active);
         }
@@ -516,6 +616,105 @@ impl Channel {
 
     pub fn read_external(&self, name: &str) -> Option<f64> {
         self.decoder.vars().get_external(name)
+    }
+
+    /// HMI commands as last written (the `mc_command_*_r` objects read them back).
+    pub fn hmi(&self) -> HmiCommands {
+        self.hmi
+    }
+    /// The block that took effect last since the program start.
+    pub fn active_block(&self) -> Option<&ActiveBlock> {
+        self.active.as_ref()
+    }
+    /// The main program running (ACTIVE or HOLD), if any.
+    pub fn running_program(&self) -> Option<&str> {
+        self.running_prog.as_deref()
+    }
+    /// Blocks handed to the interpolator and not yet done (`mc_ipo_buf_level`).
+    pub fn ipo_blocks(&self) -> usize {
+        self.motion.released_blocks() + self.motion.held_blocks() + self.single_gate.len()
+    }
+    /// `mc_command_single_block_w`: stop after each block until the next start.
+    pub fn set_single_block(&mut self, on: bool) {
+        self.hmi.single_block = on;
+    }
+    /// `mc_command_block_ignore_w`: skip levels 1–10 as a mask (level n = bit n−1); the
+    /// decoder skips `/n` blocks of a set level from the next line it reads.
+    pub fn set_skip_levels(&mut self, mask: u32) {
+        let mask = mask & 0x3FF;
+        self.hmi.skip_levels = mask;
+        self.decoder.set_skip_mask((mask << 1) as u16);
+    }
+    /// `mc_command_execution_mode_w`: 0 standard, 1 block search at the next start; other
+    /// modes (contour visualisation, syntax check, machine lock …) are not modelled.
+    pub fn set_execution_mode(&mut self, mode: i32) -> Result<(), CommandError> {
+        if mode & !EXECUTION_MODE_BLOCK_SEARCH != 0 {
+            return Err(CommandError::InvalidValue(mode));
+        }
+        self.hmi.execution_mode = mode;
+        Ok(())
+    }
+    /// Block-search parameters for the next start in block-search execution mode.
+    pub fn set_search_command(&mut self, search: SearchCommand) {
+        self.hmi.search = search;
+    }
+
+    /// The commanded block search, taken once by a start in block-search execution mode.
+    fn take_commanded_search(&mut self) -> Option<SearchTarget> {
+        if self.hmi.execution_mode & EXECUTION_MODE_BLOCK_SEARCH == 0 {
+            return None;
+        }
+        self.hmi.execution_mode &= !EXECUTION_MODE_BLOCK_SEARCH;
+        self.hmi.search.target()
+    }
+
+    /// Remember the block that took effect. The program name is shared (`Arc`) and only
+    /// replaced when it changes: this runs for every block, at tens per tick.
+    fn note_active(&mut self, info: &crate::queue::BlockInfo) {
+        match &mut self.active {
+            Some(a) if Arc::ptr_eq(&a.prog, &info.prog) => {
+                a.offset = info.offset;
+                a.counter = info.counter;
+                a.n = info.n;
+            }
+            _ => {
+                self.active = Some(ActiveBlock {
+                    prog: info.prog.clone(),
+                    offset: info.offset,
+                    counter: info.counter,
+                    n: info.n,
+                })
+            }
+        }
+    }
+
+    /// Single block: let the next decoded block (with its silent second parts) into motion,
+    /// once per start, followed by a flush so the planner releases it at once instead of
+    /// holding it for its lookahead window.
+    fn feed_single_block(&mut self) {
+        if !self.single_credit || !self.motion.idle() || !self.single_gate.is_empty() {
+            return;
+        }
+        let Some(first) = self.queue.pop_front() else {
+            return;
+        };
+        let mut last = first.clone();
+        self.single_gate.push(first);
+        while self.queue.front().is_some_and(|b| b.silent) {
+            if let Some(b) = self.queue.pop_front() {
+                last = b.clone();
+                self.single_gate.push(b);
+            }
+        }
+        if !matches!(last.action, Action::Flush(_) | Action::End { .. }) {
+            self.single_gate.push(QueuedBlock {
+                info: last.info,
+                action: Action::Flush(crate::lang::block::FlushKind::Stop),
+                silent: true,
+            });
+            self.single_flushes += 1;
+        }
+        self.single_credit = false;
     }
 
     /// NC reset (0x13C): stream buffer emptied and streaming left, program stack, queue,
@@ -543,6 +742,9 @@ impl Channel {
         }
         self.motion.reset();
         self.queue.clear();
+        self.single_gate.clear();
+        self.single_flushes = 0;
+        self.active = None;
         self.decoder.reset(self.motion.position());
         self.cache.reset();
         // A read still pending is abandoned with the program.
@@ -637,7 +839,14 @@ impl Channel {
         }
         let dt = tick.period.as_secs_f64();
         let mut notes = std::mem::take(&mut self.notes);
-        self.motion.step(dt, &mut self.queue, &mut notes);
+        if self.hmi.single_block || !self.single_gate.is_empty() {
+            if self.hmi.single_block {
+                self.feed_single_block();
+            }
+            self.motion.step(dt, &mut self.single_gate, &mut notes);
+        } else {
+            self.motion.step(dt, &mut self.queue, &mut notes);
+        }
         for n in notes.drain(..) {
             match n {
                 MotionNote::Started(info) => {
@@ -647,6 +856,7 @@ impl Channel {
                     }
                     self.ran_any = true;
                     self.stats.blocks += 1;
+                    self.note_active(&info);
                     if self.observe && info.stream {
                         self.executed.push(ExecutedBlock {
                             offset: info.offset,
@@ -667,6 +877,12 @@ impl Channel {
                             },
                         );
                     }
+                }
+                MotionNote::Flush(crate::lang::block::FlushKind::Stop)
+                    if self.single_flushes > 0 =>
+                {
+                    // The flush feed_single_block added: no program event.
+                    self.single_flushes -= 1;
                 }
                 MotionNote::Flush(k) => {
                     let kind = match k {
@@ -695,6 +911,16 @@ impl Channel {
             }
         }
         self.notes = notes;
+        if self.hmi.single_block
+            && self.state == State::Active
+            && !self.single_credit
+            && self.motion.idle()
+            && self.single_gate.is_empty()
+        {
+            // Single block: the block is done; wait for the next start.
+            self.motion.set_hold(true);
+            self.set_state(tick, State::Hold);
+        }
         if self.state == State::Active
             && self.ran_any
             && !self.interrupted

@@ -4,9 +4,13 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+use std::time::{Duration, Instant};
+
 use crossbeam_channel::Sender;
 
-use crate::channel::{Channel, CommandError, Finish, Mode, State};
+use crate::channel::{
+    ActiveBlock, Channel, CommandError, Finish, HmiCommands, Mode, SearchCommand, State,
+};
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
 use crate::runtime::{Cycle, Flow, Tick};
@@ -29,6 +33,54 @@ pub enum Op {
     WriteExternal(String, f64),
     ReadExternal(String),
     Status,
+    /// An HMI command object (`mc_command_*_w`) of the COM task.
+    Hmi(HmiOp),
+    /// The error with this index (0 = the first the channel raised) and the total count.
+    ErrorRecord(u64),
+}
+
+/// The HMI command objects a client writes (see [`crate::channel::HmiCommands`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HmiOp {
+    SingleBlock(bool),
+    SkipLevels(u32),
+    ExecutionMode(i32),
+    Search(SearchCommand),
+    /// Forget the cycle-time statistics (`cnc_time_reset`).
+    ResetCycleTimes,
+}
+
+/// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
+/// kernel's `cnc_time_*` runtime statistics show their tasks' times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CycleTimes {
+    pub min: Duration,
+    pub max: Duration,
+    pub last: Duration,
+    pub total: Duration,
+    pub ticks: u64,
+}
+
+impl CycleTimes {
+    fn record(&mut self, work: Duration) {
+        self.min = if self.ticks == 0 {
+            work
+        } else {
+            self.min.min(work)
+        };
+        self.max = self.max.max(work);
+        self.last = work;
+        self.total = self.total.saturating_add(work);
+        self.ticks += 1;
+    }
+    /// Mean work time, zero before the first tick.
+    pub fn mean(&self) -> Duration {
+        match u32::try_from(self.ticks) {
+            Ok(0) => Duration::ZERO,
+            Ok(n) => self.total / n,
+            Err(_) => Duration::from_secs_f64(self.total.as_secs_f64() / self.ticks as f64),
+        }
+    }
 }
 
 /// A snapshot of what a client may read of a channel.
@@ -45,6 +97,26 @@ pub struct Status {
     pub last_error: Option<(u32, String)>,
     pub override_pct: f64,
     pub blocks: u64,
+    /// Tick that served the request, and the cycle time.
+    pub tick: u64,
+    pub period: Duration,
+    pub cycle_times: CycleTimes,
+    /// The main program running, if any.
+    pub program: Option<String>,
+    pub active_block: Option<ActiveBlock>,
+    /// Modal programmed feed as decoded, mm/min (0 = none yet).
+    pub feed_mm_per_min: f64,
+    /// Path velocity, mm/s.
+    pub velocity_mm_per_s: f64,
+    pub hmi: HmiCommands,
+    /// A block search is running (the decoder skips towards its target).
+    pub searching: bool,
+    /// Blocks handed to the interpolator and not yet done.
+    pub ipo_blocks: usize,
+    /// Errors raised since the channel was built.
+    pub errors_total: u64,
+    /// Positions in the programming coordinate system (mm / degrees), as `positions`.
+    pub pcs_positions: Vec<(char, f64)>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -54,6 +126,11 @@ pub enum Reply {
     Command(Result<(), CommandError>),
     Value(Option<f64>),
     Status(Box<Status>),
+    /// The error asked for (if still kept) and how many the channel raised.
+    ErrorRecord {
+        total: u64,
+        record: Option<(u32, String)>,
+    },
     /// No channel with that number.
     NoChannel,
 }
@@ -89,6 +166,7 @@ pub struct Machine {
     stop_when: StopWhen,
     /// Per channel: how its last program finished.
     finishes: Vec<Option<Finish>>,
+    cycle_times: CycleTimes,
 }
 
 impl Machine {
@@ -100,6 +178,7 @@ impl Machine {
             log,
             stop_when,
             finishes: vec![None; n],
+            cycle_times: CycleTimes::default(),
         }
     }
 
@@ -146,6 +225,11 @@ impl Machine {
     }
 
     fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
+        if op == Op::Hmi(HmiOp::ResetCycleTimes) {
+            self.cycle_times = CycleTimes::default();
+            return Reply::Done;
+        }
+        let times = self.cycle_times;
         let Some(c) = self.channel_mut(channel) else {
             return Reply::NoChannel;
         };
@@ -172,9 +256,48 @@ impl Machine {
             Op::SetOverride(p) => Reply::Command(c.set_override(p)),
             Op::WriteExternal(name, v) => Reply::Value(c.write_external(&name, v).then_some(v)),
             Op::ReadExternal(name) => Reply::Value(c.read_external(&name)),
-            Op::Status => Reply::Status(Box::new(status_of(c))),
+            Op::Status => {
+                let mut s = status_of(c);
+                s.tick = tick.index;
+                s.period = tick.period;
+                s.cycle_times = times;
+                Reply::Status(Box::new(s))
+            }
+            Op::Hmi(h) => Reply::Command(match h {
+                HmiOp::SingleBlock(on) => {
+                    c.set_single_block(on);
+                    Ok(())
+                }
+                HmiOp::SkipLevels(mask) => {
+                    c.set_skip_levels(mask);
+                    Ok(())
+                }
+                HmiOp::ExecutionMode(m) => c.set_execution_mode(m),
+                HmiOp::Search(s) => {
+                    c.set_search_command(s);
+                    Ok(())
+                }
+                HmiOp::ResetCycleTimes => Ok(()),
+            }),
+            Op::ErrorRecord(i) => Reply::ErrorRecord {
+                total: c.stats().errors,
+                record: error_record(c, i),
+            },
         }
     }
+}
+
+/// The `index`-th error of the channel (0 = first): kept in the channel's error list, or the
+/// last error when it is the newest one.
+fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
+    let i = usize::try_from(index).ok()?;
+    if let Some(e) = c.errors().get(i) {
+        return Some(e.clone());
+    }
+    if index + 1 == c.stats().errors {
+        return c.last_error().cloned();
+    }
+    None
 }
 
 pub fn status_of(c: &Channel) -> Status {
@@ -189,6 +312,18 @@ pub fn status_of(c: &Channel) -> Status {
         last_error: c.last_error().cloned(),
         override_pct: c.motion().override_pct(),
         blocks: c.stats().blocks,
+        tick: 0,
+        period: Duration::ZERO,
+        cycle_times: CycleTimes::default(),
+        program: c.running_program().map(String::from),
+        active_block: c.active_block().cloned(),
+        feed_mm_per_min: c.decoder().modal().feed_mm_per_min,
+        velocity_mm_per_s: c.motion().velocity_mm_per_s(),
+        hmi: c.hmi(),
+        searching: c.decoder().searching(),
+        ipo_blocks: c.ipo_blocks(),
+        errors_total: c.stats().errors,
+        pcs_positions: c.pcs_positions(),
     }
 }
 
@@ -202,6 +337,7 @@ impl Cycle for Machine {
     }
 
     fn step(&mut self, tick: &Tick) -> Flow {
+        let work_start = Instant::now();
         for a in &mut self.feeders {
             let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
                 continue;
@@ -218,6 +354,7 @@ impl Cycle for Machine {
             }
         }
         self.publish();
+        self.cycle_times.record(work_start.elapsed());
         match self.stop_when {
             StopWhen::Never => Flow::Continue,
             StopWhen::ProgramsFinished => {

@@ -66,21 +66,31 @@ fn stream_writes_until_busy_then_0x708() {
     let n = dev.read(CH1, offset::ERROR_MESSAGE, &mut text).unwrap();
     assert!(String::from_utf8_lossy(&text[..n]).starts_with("21476"));
     // Wrong port: the crate reports the AMS header error.
-    let plc = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 851));
-    assert_eq!(ads_code(plc.get_info().unwrap_err()), 6);
+    let none = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 800));
+    assert_eq!(ads_code(none.get_info().unwrap_err()), 6);
 }
 
+/// V.E. variables in the SDA task (port 552) as TwinSharp `ZeroOffsets.cs` reaches variables:
+/// a handle by name (0x46), then plain Read/Write at the handle.
 #[test]
-fn ve_variables_through_write_read() {
-    let (srv, _b) = server();
+fn ve_variables_through_an_sda_handle() {
+    let (srv, b) = server();
+    use ncchannel::ads::CncBackend;
+    b.write_ve(1, "DEPTH", 0.0).unwrap();
     let client = connect(&srv, 40003);
-    let dev = client.device(target());
-    dev.write(CH1, offset::VE_VARIABLE, b"V.E.depth=-2.25")
+    let sda = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 552));
+    let mut h = [0u8; 4];
+    sda.write_read_exact(0x122301, 0x46, b"V.E.depth", &mut h)
         .unwrap();
+    let h = u32::from_le_bytes(h);
+    sda.write(0x122301, h, &(-2.25f64).to_le_bytes()).unwrap();
     let mut out = [0u8; 8];
-    dev.write_read_exact(CH1, offset::VE_VARIABLE, b"depth", &mut out)
-        .unwrap();
+    sda.read_exact(0x122301, h, &mut out).unwrap();
     assert_eq!(f64::from_le_bytes(out), -2.25);
+    let err = sda
+        .write_read_exact(0x122301, 0x46, b"V.E.nothing", &mut [0u8; 4])
+        .unwrap_err();
+    assert_eq!(ads_code(err), 0x70C);
 }
 
 #[test]

@@ -70,3 +70,29 @@ fn pyads_streams_5000_lines_into_real_channels() {
         .count() as u64;
     assert_eq!(warnings, busy);
 }
+
+/// The PLC's HLI (port 851) with pyads `read_by_name`/`write_by_name`/notifications by name
+/// against the real channels: the mode-and-state unit starts the streaming program, a stream
+/// runs, `state_r` follows; override at COM 0x09 halves the interpolator's path velocity
+/// (GEO 551); NC errors reach `mc_error.satz_r` with their ISG numbers, one at a time.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_pyads -- --ignored"]
+fn pyads_drives_the_hli_unit_and_reads_geo() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/hli_with_pyads.py"
+    );
+    let (seen, events) = common::run_client(served, &python, script, &[]);
+    assert_eq!(seen["errors"][0], 21476);
+    let codes: Vec<_> = common::of(&events, "error")
+        .iter()
+        .map(|e| e["code"].clone())
+        .collect();
+    assert_eq!(
+        codes,
+        [seen["errors"][0].clone(), seen["errors"][1].clone()]
+    );
+}

@@ -269,7 +269,7 @@ fn unknown_command_is_0x701_and_unknown_port_is_header_error_6() {
     assert_eq!(d, 0x701u32.to_le_bytes());
 
     let plc = AmsAddr {
-        port: 851,
+        port: 800,
         ..device()
     };
     raw.send(&request_bytes(
@@ -424,15 +424,15 @@ fn groups_offsets_and_sizes_are_checked() {
         "hold while not active"
     );
     assert_eq!(
-        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &150f64.to_le_bytes()),
+        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &1500u16.to_le_bytes()),
         0
     );
     assert_eq!(
-        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &250f64.to_le_bytes()),
+        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &2500u16.to_le_bytes()),
         0x706
     );
     assert_eq!(
-        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &[1, 2]),
+        result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &[1, 2, 3]),
         0x705
     );
     assert_eq!(
@@ -477,25 +477,40 @@ fn program_start_hold_resume_and_ve_variables() {
         4
     );
 
-    assert_eq!(
-        result_of_write(&mut raw, CH1, offset::VE_VARIABLE, b"V.E.speed = 12.5"),
-        0
+    // V.E. variables live in the SDA task (port 552, decoder group 0x1223<ch>).
+    let sda = AmsAddr {
+        port: 552,
+        ..device()
+    };
+    let mut sda_call = |command, invoke, data: &[u8]| {
+        raw.send(&request_bytes(
+            command,
+            sda,
+            client_addr(40000),
+            invoke,
+            data,
+        ));
+        raw.frame().1
+    };
+    let write_by_name = [b"V.E.speed\0".as_slice(), &12.5f64.to_le_bytes()].concat();
+    let d = sda_call(WRITE, 1, &write_req(0x122301, 0x4A, &write_by_name));
+    assert_eq!(u32_at(&d, 0), 0);
+    let d = sda_call(
+        READ_WRITE,
+        2,
+        &request::read_write(0x122301, 0x48, 8, b"V.E.SPEED\0"),
     );
-    let rw = request::read_write(CH1, offset::VE_VARIABLE, 8, b"V.E.SPEED\0");
-    let (_, d) = raw.call(READ_WRITE, 2, &rw);
     assert_eq!(u32_at(&d, 0), 0);
     assert_eq!(f64::from_le_bytes(d[8..16].try_into().unwrap()), 12.5);
-    let (_, d) = raw.call(
+    let d = sda_call(
         READ_WRITE,
         3,
-        &request::read_write(CH1, offset::VE_VARIABLE, 8, b"nope"),
+        &request::read_write(0x122301, 0x48, 8, b"V.E.nope"),
     );
     assert_eq!(u32_at(&d, 0), 0x70C);
     assert_eq!(d.len(), 8);
-    assert_eq!(
-        result_of_write(&mut raw, CH1, offset::VE_VARIABLE, b"speed=abc"),
-        0x706
-    );
+    let d = sda_call(WRITE, 4, &write_req(0x122301, 0x4A, b"V.E.speed\0abc"));
+    assert_eq!(u32_at(&d, 0), 0x705);
 
     // Streamed lines are consumed while ACTIVE: block counter and positions move.
     assert_eq!(

@@ -11,6 +11,8 @@
 
 use super::result::AdsResult;
 
+pub use crate::machine::{HmiOp, Status};
+
 /// Channel modes (REFERENCE §7).
 pub mod mode {
     pub const STANDBY: i32 = 1;
@@ -127,4 +129,18 @@ pub trait CncBackend: Send + Sync + 'static {
     fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError>;
     /// Write an external variable `V.E.<name>`.
     fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError>;
+    /// Everything the COM, GEO and HLI objects show of a channel, in one snapshot.
+    fn view(&self, ch: u16) -> Result<Status, DeviceError>;
+    /// An HMI command object (`mc_command_*_w`).
+    fn hmi(&self, ch: u16, op: HmiOp) -> Result<(), DeviceError>;
+    /// The `index`-th error the channel raised (0 = first), if still kept.
+    fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError>;
+}
+
+/// One entry of a channel's error history and how many errors it raised in all.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ErrorRecord {
+    pub total: u64,
+    /// ISG error number and text; `None` when that error is no longer kept.
+    pub error: Option<(u32, String)>,
 }

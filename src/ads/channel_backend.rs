@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use crossbeam_channel::Sender;
 
-use super::backend::{CncBackend, DeviceError, StreamFill, StreamWriteOutcome};
+use super::backend::{CncBackend, DeviceError, ErrorRecord, HmiOp, StreamFill, StreamWriteOutcome};
 use crate::channel::CommandError;
 use crate::machine::{Op, Reply, Request, Status};
 use crate::source::stream::StreamWriteError;
@@ -159,6 +159,24 @@ impl CncBackend for ChannelBackend {
         match self.call(ch, Op::WriteExternal(name.to_string(), value))? {
             Reply::Value(Some(_)) => Ok(()),
             _ => Err(DeviceError::InvalidValue),
+        }
+    }
+
+    fn view(&self, ch: u16) -> Result<Status, DeviceError> {
+        self.status(ch)
+    }
+
+    fn hmi(&self, ch: u16, op: HmiOp) -> Result<(), DeviceError> {
+        self.command(ch, Op::Hmi(op))
+    }
+
+    fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+        match self.call(ch, Op::ErrorRecord(index))? {
+            Reply::ErrorRecord { total, record } => Ok(ErrorRecord {
+                total,
+                error: record,
+            }),
+            _ => Err(DeviceError::NotReady),
         }
     }
 }

@@ -11,7 +11,11 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Mutex, MutexGuard, Weak};
 use std::time::Duration;
 
-use super::backend::{mode, state, CncBackend, DeviceError, StreamFill, StreamWriteOutcome};
+use super::backend::{
+    mode, state, CncBackend, DeviceError, ErrorRecord, HmiOp, Status, StreamFill,
+    StreamWriteOutcome,
+};
+use crate::channel::{HmiCommands, Mode, State};
 
 /// MAX_PROGRAM_STREAM_SIZE: bytes the stream buffer holds.
 pub const STREAM_BUFFER_BYTES: usize = 4094;
@@ -51,6 +55,9 @@ struct MemChannel {
     override_percent: f64,
     ve: HashMap<String, f64>,
     warnings_11012: u64,
+    hmi: HmiCommands,
+    /// Errors raised (each 21476 counts one).
+    errors_total: u64,
     /// Every line consumed, in order, for tests to compare with what was sent.
     consumed: Vec<u8>,
 }
@@ -68,6 +75,8 @@ impl MemChannel {
             override_percent: 100.0,
             ve: HashMap::new(),
             warnings_11012: 0,
+            hmi: HmiCommands::default(),
+            errors_total: 0,
             consumed: Vec::new(),
         }
     }
@@ -199,6 +208,7 @@ impl CncBackend for MemoryBackend {
         }
         if !lines_end_with_crlf(data) {
             c.last_error = MSG_21476.to_string();
+            c.errors_total += 1;
             c.state = state::ERROR;
             c.buffer.clear();
             return StreamWriteOutcome::NoLineEnd;
@@ -311,6 +321,61 @@ impl CncBackend for MemoryBackend {
     fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError> {
         self.ch(ch)?.ve.insert(name.to_ascii_uppercase(), value);
         Ok(())
+    }
+
+    fn view(&self, ch: u16) -> Result<Status, DeviceError> {
+        Ok(self.ch(ch)?.view())
+    }
+
+    fn hmi(&self, ch: u16, op: HmiOp) -> Result<(), DeviceError> {
+        let mut c = self.ch(ch)?;
+        match op {
+            HmiOp::SingleBlock(on) => c.hmi.single_block = on,
+            HmiOp::SkipLevels(mask) => c.hmi.skip_levels = mask & 0x3FF,
+            HmiOp::ExecutionMode(m) if m & !1 == 0 => c.hmi.execution_mode = m,
+            HmiOp::ExecutionMode(_) => return Err(DeviceError::InvalidValue),
+            HmiOp::Search(s) => c.hmi.search = s,
+            HmiOp::ResetCycleTimes => {}
+        }
+        Ok(())
+    }
+
+    fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+        let c = self.ch(ch)?;
+        let newest = index + 1 == c.errors_total;
+        Ok(ErrorRecord {
+            total: c.errors_total,
+            error: newest.then(|| (21476, MSG_21476.to_string())),
+        })
+    }
+}
+
+impl MemChannel {
+    /// The snapshot the object table reads; what the stand-in does not model stays at rest.
+    fn view(&self) -> Status {
+        Status {
+            mode: Mode::from_i32(self.mode).unwrap_or(Mode::Standby),
+            state: State::from_i32(self.state).unwrap_or(State::Ready),
+            block_counter: self.block_counter,
+            stream_used: self.buffer.len(),
+            stream_free: STREAM_BUFFER_BYTES - self.buffer.len(),
+            positions: ['X', 'Y', 'Z'].into_iter().zip(self.positions_mm).collect(),
+            last_error: (!self.last_error.is_empty()).then(|| (21476, MSG_21476.to_string())),
+            override_pct: self.override_percent,
+            blocks: self.block_counter,
+            tick: 0,
+            period: Duration::from_millis(1),
+            cycle_times: Default::default(),
+            program: (self.state == state::ACTIVE).then(|| self.program.clone()),
+            active_block: None,
+            feed_mm_per_min: 0.0,
+            velocity_mm_per_s: 0.0,
+            hmi: self.hmi,
+            searching: false,
+            ipo_blocks: 0,
+            errors_total: self.errors_total,
+            pcs_positions: ['X', 'Y', 'Z'].into_iter().zip(self.positions_mm).collect(),
+        }
     }
 }
 

@@ -20,7 +20,7 @@ use super::frame::{
     self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame, AMS_ERR_MACHINE_NOT_FOUND,
     AMS_ERR_PORT_NOT_FOUND, FLAGS_REQUEST,
 };
-use super::objects::{self, PORT_CNC_COM};
+use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
 
@@ -153,7 +153,8 @@ impl Drop for ServerHandle {
 /// State shared by the accept thread and the connections.
 struct Shared {
     config: ServerConfig,
-    backend: Arc<dyn CncBackend>,
+    /// The tasks behind the AMS ports (one TCP port for all, as a TwinCAT router).
+    devices: Devices,
     stopping: AtomicBool,
     active: AtomicUsize,
     /// Clones of every open socket, to close them on shutdown.
@@ -191,7 +192,7 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
     let local_addr = listener.local_addr()?;
     let shared = Arc::new(Shared {
         config,
-        backend,
+        devices: Devices::new(backend),
         stopping: AtomicBool::new(false),
         active: AtomicUsize::new(0),
         sockets: Mutex::new(HashMap::new()),
@@ -445,11 +446,11 @@ fn handle_request(
             ));
         }
     }
-    if header.target.port != PORT_CNC_COM {
+    if !Devices::serves(header.target.port) {
         // rule 5: router-level error in the header, empty payload.
         return Some(frame::encode(&header.response(AMS_ERR_PORT_NOT_FOUND), &[]));
     }
-    let backend = shared.backend.as_ref();
+    let (devices, port) = (&shared.devices, header.target.port);
     let command = header.command.to_u16();
     let payload = match payload::decode_request(command, data) {
         None => {
@@ -474,7 +475,7 @@ fn handle_request(
                 group,
                 offset,
                 length,
-            } => match objects::read(backend, group, offset, length) {
+            } => match devices.read(port, group, offset, length) {
                 Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
                 Err(r) => response::with_data(r, &[]),
             },
@@ -482,7 +483,7 @@ fn handle_request(
                 group,
                 offset,
                 data,
-            } => response::result_only(match objects::write(backend, group, offset, &data) {
+            } => response::result_only(match devices.write(port, group, offset, &data) {
                 Ok(()) => AdsResult::OK,
                 Err(r) => r,
             }),
@@ -491,7 +492,7 @@ fn handle_request(
                 offset,
                 read_length,
                 data,
-            } => match objects::read_write(backend, group, offset, read_length, &data) {
+            } => match devices.read_write(port, group, offset, read_length, &data) {
                 Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
                 Err(r) => response::with_data(r, &[]),
             },
@@ -529,7 +530,8 @@ fn add_notification(
     notifs: &Arc<Notifications>,
 ) -> (AdsResult, u32) {
     // The object must be readable with the requested length now.
-    if let Err(r) = objects::read(shared.backend.as_ref(), req.group, req.offset, req.length) {
+    let port = header.target.port;
+    if let Err(r) = shared.devices.read(port, req.group, req.offset, req.length) {
         return (r, 0);
     }
     let on_change = match req.mode {
@@ -589,12 +591,10 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
             for (&handle, n) in table.iter_mut() {
                 if n.next_due <= now {
                     n.next_due = now + n.cycle;
-                    let read = objects::read(
-                        shared.backend.as_ref(),
-                        n.req.group,
-                        n.req.offset,
-                        n.req.length,
-                    );
+                    let read =
+                        shared
+                            .devices
+                            .read(n.device.port, n.req.group, n.req.offset, n.req.length);
                     if let Ok(bytes) = read {
                         if !n.on_change || n.last.as_deref() != Some(bytes.as_slice()) {
                             let header = AmsHeader {

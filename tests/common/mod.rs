@@ -280,3 +280,28 @@ pub fn streamed_5000_lines() -> Vec<String> {
     lines.push("M30".into());
     lines
 }
+
+/// Run an outside client, `program script args…`, against `served` (its address in
+/// `NCCHANNEL_ADS_ADDR`); it must succeed and print one JSON line. Returns that line and the
+/// run's events.
+pub fn run_client(
+    served: Served,
+    program: &str,
+    script: &str,
+    args: &[&Path],
+) -> (Value, Vec<Value>) {
+    let out = std::process::Command::new(program)
+        .arg(script)
+        .args(args)
+        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
+        .output()
+        .unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    let (_, events) = served.finish();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let seen = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    (seen, events)
+}

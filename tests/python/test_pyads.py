@@ -12,6 +12,7 @@ the test starts (e.g. `ncchannel serve` without --start, or the in-memory backen
 
 import ctypes
 import os
+import struct
 import threading
 import time
 import unittest
@@ -28,7 +29,10 @@ OFF_COMMAND_MODE = 0x104
 OFF_RESET = 0x13C
 OFF_ERROR_MESSAGE = 0x26
 OFF_STREAM_FILL = 0x8001
-OFF_VE = 0x8005
+PORT_SDA = 552
+GROUP_SDA = 0x122301  # decoder class of channel 1
+OFF_SDA_WRITE_BY_NAME = 0x4A
+OFF_SDA_READ_BY_NAME = 0x48
 DINT2 = ctypes.c_int32 * 2
 UDINT2 = ctypes.c_uint32 * 2
 
@@ -103,11 +107,19 @@ class PyadsAgainstNcchannel(unittest.TestCase):
         self.assertEqual(ctx.exception.err_code, 0x702)
 
     def test_ve_variable_write_then_read_write(self):
-        self.plc.write(GROUP, OFF_VE, "V.E.pyads_test=4.75", pyads.PLCTYPE_STRING)
-        value = self.plc.read_write(
-            GROUP, OFF_VE, pyads.PLCTYPE_LREAL, "pyads_test", pyads.PLCTYPE_STRING
-        )
-        self.assertEqual(value, 4.75)
+        """V.E. variables in the SDA task: write by name (name, NUL, LREAL), read by name."""
+        sda = pyads.Connection(NETID, PORT_SDA, ADDR)
+        sda.open()
+        try:
+            data = b"V.E.pyads_test\0" + struct.pack("<d", 4.75)
+            write_bytes(sda, GROUP_SDA, OFF_SDA_WRITE_BY_NAME, data)
+            value = sda.read_write(
+                GROUP_SDA, OFF_SDA_READ_BY_NAME, pyads.PLCTYPE_LREAL, "V.E.pyads_test",
+                pyads.PLCTYPE_STRING
+            )
+            self.assertEqual(value, 4.75)
+        finally:
+            sda.close()
 
     def test_notification_on_mode_change(self):
         seen = []

@@ -1,0 +1,386 @@
+//! The GEO task (AMS port 551): the interpolator and HLD class instances of each channel and
+//! the class address query.
+//!
+//! Class groups (Beckhoff infosys `tf5200_ads_access_to_cnc/312767243.html`, `…/312768779.html`):
+//! interpolator `0x121300 + ch`, HLD `0x123300 + ch`; the address query is a ReadWrite at the
+//! class group plus 0x600 with `{i32 channel, i32 axis}` → `{u32 group, u32 offset}`, `(0, 0)`
+//! when the instance does not exist. Elements, types and units from the ISG object dump
+//! (`SamWieHTWG/web-api` `examples/example1-hello-cnc/cnc_objects.csv`, groups `0x21301`,
+//! `0x23301`); TwinSharp `Interpolator.cs` reads exactly these interpolator offsets and
+//! `OperationModeManager.cs` publishes HLD 0x1F (state) and 0x20 (mode).
+//!
+//! The HLD's mode-and-state unit (0x21–0x2F) mirrors the PLC's HLI unit
+//! (`gpCh[i]^.channel_mc_control.mode_and_state`, see [`super::hli`]): one store, two views.
+
+use super::backend::{CncBackend, DeviceError, Status};
+use super::description::{Access, AdsType, ObjectInfo};
+use super::hli::{Hli, Unit};
+use super::result::AdsResult;
+
+pub const PORT: u16 = 551;
+/// Position controller, platform instance (ISG sample client `cnc_demo_samples.c` waits
+/// ticks on its tick counter).
+pub const GROUP_POS_CTRL: u32 = 0x120300;
+/// Interpolator instance of channel ch: `GROUP_IPO + ch`.
+pub const GROUP_IPO: u32 = 0x121300;
+/// HLD instance of channel ch: `GROUP_HLD + ch`.
+pub const GROUP_HLD: u32 = 0x123300;
+/// Attribute add-on of the address query.
+const ADDRESS_QUERY: u32 = 0x600;
+/// Logical-addressing bit of index groups (infosys "logical vs index-based", 312762635).
+const LOGICAL: u32 = 0x100000;
+
+const SRC: &str = "ISG object dump; TwinSharp";
+const SRC_DUMP: &str = "ISG object dump";
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Class {
+    PosCtrl,
+    Ipo,
+    Hld,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Field {
+    Elements,
+    CycleTime,
+    PlatformAxes,
+    TickCounter,
+    AxisCount,
+    IpoBufLevel,
+    PathVelocity,
+    ProgrammedVelocity,
+    BlockNumber,
+    BlockCount,
+    InputBlockCount,
+    OverrideFactor,
+    PlcPresent,
+    OverrideEnable,
+    OverrideCommand,
+    OverrideRequest,
+    OverrideState,
+    State,
+    Mode,
+    Unit(Unit, u32),
+}
+
+struct Def {
+    class: Class,
+    element: u32,
+    name: &'static str,
+    ty: AdsType,
+    size: u32,
+    unit: &'static str,
+    source: &'static str,
+    field: Field,
+}
+
+#[allow(clippy::too_many_arguments)]
+const fn d(
+    class: Class,
+    element: u32,
+    name: &'static str,
+    ty: AdsType,
+    size: u32,
+    unit: &'static str,
+    source: &'static str,
+    field: Field,
+) -> Def {
+    Def {
+        class,
+        element,
+        name,
+        ty,
+        size,
+        unit,
+        source,
+        field,
+    }
+}
+
+use AdsType::*;
+use Class::{Hld, Ipo, PosCtrl};
+use Field as F;
+
+#[rustfmt::skip]
+static TABLE: &[Def] = &[
+    d(PosCtrl, 0x00, "POS-CTRL: elements", Dword, 4, "element types served", SRC_DUMP, F::Elements),
+    d(PosCtrl, 0x01, "cycle time", Lreal, 8, "s", SRC_DUMP, F::CycleTime),
+    d(PosCtrl, 0x02, "number of axes", Word, 2, "", SRC_DUMP, F::PlatformAxes),
+    d(PosCtrl, 0x07, "tick counter", Dword, 4, "CNC ticks", SRC_DUMP, F::TickCounter),
+    d(Ipo, 0x00, "IPO: elements", Dword, 4, "element types served", SRC, F::Elements),
+    d(Ipo, 0x01, "number of axes", Word, 2, "", SRC, F::AxisCount),
+    d(Ipo, 0x05, "ipo_buf_level", Dword, 4, "blocks", SRC, F::IpoBufLevel),
+    d(Ipo, 0x15, "Actual velocity on path", Lreal, 8, "µm/s", SRC, F::PathVelocity),
+    d(Ipo, 0x16, "Programmed velocity on path", Lreal, 8, "µm/s", SRC, F::ProgrammedVelocity),
+    d(Ipo, 0x21, "actual_block_nr", Dint, 4, "N number", SRC, F::BlockNumber),
+    d(Ipo, 0x2E, "actual_block_count", Dint, 4, "block counter", SRC_DUMP, F::BlockCount),
+    d(Ipo, 0x2F, "latest_input_block_clount", Dint, 4, "block counter", SRC_DUMP, F::InputBlockCount),
+    d(Ipo, 0x70, "override feed factor", Lreal, 8, "1 = 100 %", SRC_DUMP, F::OverrideFactor),
+    d(Hld, 0x00, "HLD : elements", Dword, 4, "element types served", SRC_DUMP, F::Elements),
+    d(Hld, 0x0E, "head.plc_present_w", Bool, 1, "", SRC_DUMP, F::PlcPresent),
+    d(Hld, 0x1B, "override_feedrate.enable_w", Bool, 1, "", SRC_DUMP, F::OverrideEnable),
+    d(Hld, 0x1C, "override_feedrate.command_w", Word, 2, "0.1 %", SRC_DUMP, F::OverrideCommand),
+    d(Hld, 0x1D, "override_feedrate.request_r", Word, 2, "0.1 %", SRC_DUMP, F::OverrideRequest),
+    d(Hld, 0x1E, "override_feedrate.state_r", Word, 2, "0.1 %", SRC_DUMP, F::OverrideState),
+    d(Hld, 0x1F, "mcm_mode_state", Dword, 4, "state", SRC, F::State),
+    d(Hld, 0x20, "active_mcm_mode", Dword, 4, "mode", SRC, F::Mode),
+    d(Hld, 0x21, "mode_and_state.enable_w", Bool, 1, "", SRC_DUMP, F::Unit(Unit::Enable, 0)),
+    d(Hld, 0x22, "mode_and_state.request_semaphor_rw", Bool, 1, "", SRC_DUMP, F::Unit(Unit::RequestSemaphore, 0)),
+    d(Hld, 0x23, "mode_and_state.command_semaphor_rw", Bool, 1, "", SRC_DUMP, F::Unit(Unit::CommandSemaphore, 0)),
+    d(Hld, 0x24, "mode_and_state.request_r.from_mode", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Request, 0)),
+    d(Hld, 0x25, "mode_and_state.request_r.from_state", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Request, 4)),
+    d(Hld, 0x26, "mode_and_state.request_r.to_mode", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Request, 8)),
+    d(Hld, 0x27, "mode_and_state.request_r.to_state", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Request, 12)),
+    d(Hld, 0x28, "mode_and_state.request_r.channel_number", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Request, 16)),
+    d(Hld, 0x29, "mode_and_state.request_r.parameter", String, 300, "", SRC_DUMP, F::Unit(Unit::Request, 24)),
+    d(Hld, 0x2A, "mode_and_state.command_w.from_mode", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Command, 0)),
+    d(Hld, 0x2B, "mode_and_state.command_w.from_state", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Command, 4)),
+    d(Hld, 0x2C, "mode_and_state.command_w.to_mode", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Command, 8)),
+    d(Hld, 0x2D, "mode_and_state.command_w.to_state", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Command, 12)),
+    d(Hld, 0x2E, "mode_and_state.command_w.channel_number", Dword, 4, "", SRC_DUMP, F::Unit(Unit::Command, 16)),
+    d(Hld, 0x2F, "mode_and_state.command_w.parameter", String, 300, "", SRC_DUMP, F::Unit(Unit::Command, 24)),
+];
+
+fn class_group(c: Class) -> u32 {
+    match c {
+        Class::PosCtrl => GROUP_POS_CTRL,
+        Class::Ipo => GROUP_IPO,
+        Class::Hld => GROUP_HLD,
+    }
+}
+
+/// Objects of channel `ch`'s interpolator and HLD, for the object map.
+pub fn objects(ch: u16) -> Vec<ObjectInfo> {
+    TABLE
+        .iter()
+        .map(|d| ObjectInfo {
+            port: PORT,
+            group: class_group(d.class)
+                + if d.class == Class::PosCtrl {
+                    0
+                } else {
+                    u32::from(ch)
+                },
+            offset: d.element,
+            name: d.name.into(),
+            ty: d.ty,
+            size: d.size,
+            access: Access::Read,
+            unit: d.unit,
+            source: d.source,
+        })
+        .collect()
+}
+
+fn logical(group: u32) -> u32 {
+    if group < LOGICAL {
+        group | LOGICAL
+    } else {
+        group
+    }
+}
+
+fn fixed(bytes: Vec<u8>, length: u32) -> Result<Vec<u8>, AdsResult> {
+    if (length as usize) < bytes.len() {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    Ok(bytes)
+}
+
+/// ADS Read on port 551.
+pub fn read(
+    backend: &dyn CncBackend,
+    hli: &Hli,
+    group: u32,
+    offset: u32,
+    length: u32,
+) -> Result<Vec<u8>, AdsResult> {
+    let group = logical(group);
+    let (class, ch) = if group == GROUP_POS_CTRL {
+        (Class::PosCtrl, 1)
+    } else if (GROUP_IPO + 1..GROUP_IPO + 0x100).contains(&group) {
+        (Class::Ipo, group - GROUP_IPO)
+    } else if (GROUP_HLD + 1..GROUP_HLD + 0x100).contains(&group) {
+        (Class::Hld, group - GROUP_HLD)
+    } else if group == GROUP_IPO + ADDRESS_QUERY || group == GROUP_HLD + ADDRESS_QUERY {
+        return Err(AdsResult::ACCESS_DENIED);
+    } else {
+        return Err(AdsResult::INVALID_GROUP);
+    };
+    if ch > u32::from(backend.channel_count()) {
+        return Err(AdsResult::INVALID_GROUP);
+    }
+    let ch = ch as u16;
+    let def = TABLE
+        .iter()
+        .find(|d| d.class == class && d.element == offset)
+        .ok_or(AdsResult::INVALID_OFFSET)?;
+    if let Field::Unit(unit, at) = def.field {
+        let bytes = hli.unit_bytes(ch, unit, at as usize, def.size as usize)?;
+        return fixed(bytes, length);
+    }
+    let v = backend.view(ch).map_err(DeviceError::result)?;
+    if def.field == Field::PlatformAxes {
+        let mut n = 0usize;
+        for c in 1..=backend.channel_count() {
+            n += backend
+                .view(c)
+                .map_err(DeviceError::result)?
+                .positions
+                .len();
+        }
+        return fixed((n as u16).to_le_bytes().to_vec(), length);
+    }
+    fixed(value(&v, hli, ch, class, def.field)?, length)
+}
+
+fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
+    let feed_um_s = v.feed_mm_per_min * 1000.0 / 60.0;
+    let active = v.active_block.as_ref();
+    let tenths = (v.override_pct * 10.0).round().clamp(0.0, 2000.0) as u16;
+    Ok(match field {
+        Field::Elements => {
+            let n = TABLE.iter().filter(|d| d.class == class).count() as u32 - 1;
+            n.to_le_bytes().to_vec()
+        }
+        Field::AxisCount => (v.positions.len() as u16).to_le_bytes().to_vec(),
+        Field::CycleTime => v.period.as_secs_f64().to_le_bytes().to_vec(),
+        Field::TickCounter => (v.tick as u32).to_le_bytes().to_vec(),
+        Field::IpoBufLevel => (v.ipo_blocks as u32).to_le_bytes().to_vec(),
+        Field::PathVelocity => (v.velocity_mm_per_s * 1000.0).to_le_bytes().to_vec(),
+        Field::ProgrammedVelocity => feed_um_s.to_le_bytes().to_vec(),
+        Field::BlockNumber => active
+            .and_then(|a| a.n)
+            .map_or(0, |n| i32::try_from(n).unwrap_or(i32::MAX))
+            .to_le_bytes()
+            .to_vec(),
+        Field::BlockCount => active
+            .map_or(0, |a| i32::try_from(a.counter).unwrap_or(i32::MAX))
+            .to_le_bytes()
+            .to_vec(),
+        Field::InputBlockCount => i32::try_from(v.block_counter)
+            .unwrap_or(i32::MAX)
+            .to_le_bytes()
+            .to_vec(),
+        Field::OverrideFactor => (v.override_pct / 100.0).to_le_bytes().to_vec(),
+        // ncchannel has no PLC override unit: the HMI's override request is taken directly.
+        Field::OverrideEnable => vec![0],
+        Field::OverrideCommand | Field::OverrideRequest | Field::OverrideState => {
+            tenths.to_le_bytes().to_vec()
+        }
+        Field::State => (v.state as u32).to_le_bytes().to_vec(),
+        Field::Mode => (v.mode as u32).to_le_bytes().to_vec(),
+        Field::PlcPresent => hli.plc_present(ch)?,
+        Field::Unit(..) | Field::PlatformAxes => return Err(AdsResult::ACCESS_DENIED),
+    })
+}
+
+/// ADS ReadWrite on port 551: the address queries of the interpolator and HLD classes.
+pub fn read_write(
+    backend: &dyn CncBackend,
+    group: u32,
+    offset: u32,
+    read_length: u32,
+    data: &[u8],
+) -> Result<Vec<u8>, AdsResult> {
+    let group = logical(group);
+    let base = match group.checked_sub(ADDRESS_QUERY) {
+        Some(g) if g == GROUP_IPO || g == GROUP_HLD => g,
+        _ if (GROUP_IPO..GROUP_IPO + 0x100).contains(&group)
+            || (GROUP_HLD..GROUP_HLD + 0x100).contains(&group) =>
+        {
+            return Err(AdsResult::ACCESS_DENIED)
+        }
+        _ => return Err(AdsResult::INVALID_GROUP),
+    };
+    if offset != 0 {
+        return Err(AdsResult::INVALID_OFFSET);
+    }
+    if read_length < 8 {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    let [a, b, c, e, f, g, h, i] = *data else {
+        return Err(AdsResult::INVALID_SIZE);
+    };
+    let ch = i32::from_le_bytes([a, b, c, e]);
+    let axis = i32::from_le_bytes([f, g, h, i]);
+    let exists = axis == 0 && ch >= 1 && ch <= i32::from(backend.channel_count());
+    let (group, offset) = if exists {
+        (base + ch as u32, 0u32)
+    } else {
+        (0, 0)
+    };
+    Ok([group.to_le_bytes(), offset.to_le_bytes()].concat())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use std::sync::Arc;
+
+    fn query(b: &dyn CncBackend, group: u32, ch: i32, axis: i32) -> (u32, u32) {
+        let data = [ch.to_le_bytes(), axis.to_le_bytes()].concat();
+        let r = read_write(b, group, 0, 8, &data).unwrap();
+        (
+            u32::from_le_bytes([r[0], r[1], r[2], r[3]]),
+            u32::from_le_bytes([r[4], r[5], r[6], r[7]]),
+        )
+    }
+
+    #[test]
+    fn address_query_names_existing_instances_only() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        assert_eq!(query(b.as_ref(), 0x121900, 1, 0), (0x121301, 0));
+        assert_eq!(query(b.as_ref(), 0x123900, 1, 0), (0x123301, 0));
+        assert_eq!(
+            query(b.as_ref(), 0x21900, 1, 0),
+            (0x121301, 0),
+            "index-based"
+        );
+        assert_eq!(query(b.as_ref(), 0x121900, 2, 0), (0, 0));
+        assert_eq!(query(b.as_ref(), 0x121900, 0, 1), (0, 0));
+        assert_eq!(
+            read_write(b.as_ref(), 0x121900, 0, 8, &[0; 4]),
+            Err(AdsResult::INVALID_SIZE)
+        );
+    }
+
+    #[test]
+    fn hld_shows_mode_state_and_the_hli_unit() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(Arc::clone(&b) as Arc<dyn CncBackend>);
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x1F, 4).unwrap(),
+            [3, 0, 0, 0]
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x20, 4).unwrap(),
+            [1, 0, 0, 0]
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x123301, 0x2F, 300).unwrap().len(),
+            300
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x20300, 0x01, 8).unwrap(),
+            0.001f64.to_le_bytes(),
+            "position controller: cycle time in s"
+        );
+        assert_eq!(read(b.as_ref(), &hli, 0x120300, 0x02, 2).unwrap(), [3, 0]);
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x70, 8).unwrap(),
+            1.0f64.to_le_bytes()
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x15, 4),
+            Err(AdsResult::INVALID_SIZE)
+        );
+        assert_eq!(
+            read(b.as_ref(), &hli, 0x121301, 0x02, 8),
+            Err(AdsResult::INVALID_OFFSET),
+            "moved path is not modelled"
+        );
+    }
+}

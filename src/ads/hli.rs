@@ -1,0 +1,993 @@
+//! The PLC's HLI on AMS port 851: the `HLI_Global_Variables` symbols a TwinCAT 3 CNC PLC
+//! exposes, served by the standard ADS symbol services, with the CNC side of the control units
+//! played by the channel.
+//!
+//! Symbols and layouts as TwinSharp uses them (`kimblad/TwinSharp` `TwinSharp/CNC/*.cs`,
+//! `Structs.cs` `Pack = 1`): every handle TwinSharp's constructors create resolves. Control
+//! unit semantics (Beckhoff infosys `tf5200_hli_interface/174725259.html`, `174858763.html`):
+//! the PLC writes `command_w`, then sets `command_semaphor_rw` TRUE; the CNC takes the data
+//! and sets the semaphore FALSE. Here that happens when the write of TRUE arrives: the
+//! command goes to the channel (mode, program name, state; one request each) and the
+//! semaphore reads FALSE afterwards. Errors (`mc_error`, infosys `174914699.html`): one record
+//! is posted with `semaphor_rw` TRUE; the next only after the client wrote it FALSE.
+//!
+//! Symbols without behaviour in ncchannel (backward motion, manual mode keys, technology
+//! units, external axis commands …) are plain memory: they resolve, read back what was
+//! written and act on nothing (listed as inert in docs/ads.md).
+//!
+//! Services (ADS index groups of the TwinCAT PLC runtime): 0xF003 handle by name
+//! (ReadWrite), 0xF004 value by name (ReadWrite), 0xF005 value by handle (Read/Write, offset =
+//! handle), 0xF006 release handle (Write), 0xF009 symbol info by name (ReadWrite).
+//! Handles are stable per symbol (symbol index + 1), so releasing is bookkeeping-free and a
+//! client that never releases cannot exhaust anything.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
+
+use super::backend::{CncBackend, DeviceError};
+use super::description::{Access, AdsType, ObjectInfo};
+use super::result::AdsResult;
+
+pub const PORT: u16 = 851;
+pub const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
+pub const GROUP_VALUE_BY_NAME: u32 = 0xF004;
+pub const GROUP_VALUE_BY_HANDLE: u32 = 0xF005;
+pub const GROUP_RELEASE_HANDLE: u32 = 0xF006;
+pub const GROUP_INFO_BY_NAME: u32 = 0xF009;
+/// ADS error "symbol not found".
+pub const SYMBOL_NOT_FOUND: AdsResult = AdsResult(0x710);
+/// Longest symbol name accepted.
+const MAX_NAME_BYTES: usize = 255;
+
+/// `HLI_PROC_TRANS_TO_MODE_STATE` (TwinSharp `Structs.cs`): 5 × UDINT, DINT fill, char[299]
+/// parameter, DINT fill = 327 bytes.
+pub const MODE_TRANSITION_BYTES: usize = 327;
+const PARAMETER_AT: usize = 24;
+const PARAMETER_BYTES: usize = 299;
+/// `HLI_ERROR_SATZ` (TwinSharp `Structs.cs`): 104-byte head + 838-byte body.
+pub const ERROR_RECORD_BYTES: usize = 942;
+/// `TECHNO_UNIT_CH` bytes and `techno_unit_std_sync` entries (`[0..19]`).
+const TECHNO_UNIT_BYTES: usize = 47;
+const TECHNO_UNITS: usize = 20;
+/// TwinSharp `Constants.cs`: keys `[0..10]`; the kernel dump lists handwheels `[0..5]`.
+const KEYS: usize = 11;
+const HANDWHEELS: usize = 6;
+/// Error body type "LEER" (empty): ncchannel's error text travels in `mc_error_message_r`.
+const BODY_EMPTY: u32 = 9;
+
+/// ADS data type ids of symbol info (ADST_*).
+const ADST_INT16: u32 = 2;
+const ADST_INT32: u32 = 3;
+const ADST_UINT16: u32 = 18;
+const ADST_UINT32: u32 = 19;
+const ADST_STRING: u32 = 30;
+const ADST_BIT: u32 = 33;
+const ADST_BIGTYPE: u32 = 65;
+
+/// The parts of a channel's mode-and-state control unit (the GEO task mirrors them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    Enable,
+    RequestSemaphore,
+    CommandSemaphore,
+    Request,
+    Command,
+}
+
+/// What a root area does besides holding bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Plain,
+    /// `state_r`: the channel's mode and state, read live.
+    ModeState(u16),
+    /// `command_semaphor_rw`: TRUE hands `command_w` to the channel.
+    CommandSemaphore(u16),
+    /// `mc_error.satz_r` / `semaphor_rw`: posts the next error when the semaphore is FALSE.
+    ErrorRecord(u16),
+    ErrorSemaphore(u16),
+}
+
+/// One symbol: a window `[at, at + size)` of a root area.
+#[derive(Debug, Clone)]
+struct Symbol {
+    name: String,
+    root: usize,
+    at: usize,
+    size: usize,
+    ty: &'static str,
+    adst: u32,
+}
+
+/// Per channel: where its control-unit areas are.
+#[derive(Debug, Clone, Copy, Default)]
+struct ChannelAreas {
+    enable: usize,
+    request: usize,
+    request_semaphore: usize,
+    command: usize,
+    command_semaphore: usize,
+    plc_present: usize,
+    error_record: usize,
+    error_semaphore: usize,
+}
+
+/// The symbol table and its memory, built once the channels are known.
+struct Image {
+    symbols: Vec<Symbol>,
+    by_name: HashMap<String, usize>,
+    roles: Vec<Role>,
+    memory: Mutex<Vec<Vec<u8>>>,
+    channels: Vec<ChannelAreas>,
+    /// Per channel: errors handed to the PLC so far.
+    posted: Mutex<Vec<u64>>,
+    /// Per channel: the HMI's to-mode and parameter waiting for its to-state (redirection).
+    pending: Mutex<Vec<PendingRequest>>,
+}
+
+/// What an HMI wrote of a mode transition before the to-state that completes it.
+#[derive(Debug, Clone, Default)]
+struct PendingRequest {
+    to_mode: Option<u32>,
+    parameter: Vec<u8>,
+}
+
+/// An HMI (COM) mode-and-state command, for redirection to the PLC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HmiRequest<'a> {
+    ToMode(i32),
+    ToState(i32),
+    Parameter(&'a str),
+}
+
+struct Builder {
+    img: Image,
+}
+
+impl Builder {
+    fn root(
+        &mut self,
+        name: String,
+        size: usize,
+        ty: &'static str,
+        adst: u32,
+        role: Role,
+    ) -> usize {
+        let root = self.img.roles.len();
+        self.img.roles.push(role);
+        if let Ok(mut m) = self.img.memory.lock() {
+            m.push(vec![0; size]);
+        }
+        self.sub(name, root, 0, size, ty, adst);
+        root
+    }
+
+    fn sub(
+        &mut self,
+        name: String,
+        root: usize,
+        at: usize,
+        size: usize,
+        ty: &'static str,
+        adst: u32,
+    ) {
+        self.img
+            .by_name
+            .insert(name.to_ascii_lowercase(), self.img.symbols.len());
+        self.img.symbols.push(Symbol {
+            name,
+            root,
+            at,
+            size,
+            ty,
+            adst,
+        });
+    }
+
+    fn bool(&mut self, name: String) -> usize {
+        self.root(name, 1, "BOOL", ADST_BIT, Role::Plain)
+    }
+
+    /// A `command_w` / `enable_w` / `command_semaphor_rw` unit of plain memory.
+    fn unit(&mut self, prefix: &str, command_size: usize, command_ty: &'static str) {
+        self.bool(format!("{prefix}.enable_w"));
+        self.root(
+            format!("{prefix}.command_w"),
+            command_size,
+            command_ty,
+            ADST_BIGTYPE,
+            Role::Plain,
+        );
+        self.bool(format!("{prefix}.command_semaphor_rw"));
+    }
+
+    fn transition(&mut self, name: String, role: Role) -> usize {
+        let r = self.root(
+            name.clone(),
+            MODE_TRANSITION_BYTES,
+            "HLI_PROC_TRANS_TO_MODE_STATE",
+            ADST_BIGTYPE,
+            role,
+        );
+        for (i, f) in [
+            "from_mode",
+            "from_state",
+            "to_mode",
+            "to_state",
+            "channel_number",
+        ]
+        .iter()
+        .enumerate()
+        {
+            self.sub(format!("{name}.{f}"), r, 4 * i, 4, "UDINT", ADST_UINT32);
+        }
+        self.sub(
+            format!("{name}.parameter"),
+            r,
+            PARAMETER_AT,
+            PARAMETER_BYTES,
+            "STRING(298)",
+            ADST_STRING,
+        );
+        r
+    }
+
+    fn channel(&mut self, i: usize, ch: u16, axes: usize) -> ChannelAreas {
+        let p = format!("HLI_Global_Variables.gpCh[{i}]^");
+        let ms = format!("{p}.channel_mc_control.mode_and_state");
+        let state = self.root(
+            format!("{ms}.state_r"),
+            8,
+            "HLI_IMCM_MODE_STATE",
+            ADST_BIGTYPE,
+            Role::ModeState(ch),
+        );
+        self.sub(
+            format!("{ms}.state_r.mode"),
+            state,
+            0,
+            4,
+            "UDINT",
+            ADST_UINT32,
+        );
+        self.sub(
+            format!("{ms}.state_r.state"),
+            state,
+            4,
+            4,
+            "UDINT",
+            ADST_UINT32,
+        );
+        let areas = ChannelAreas {
+            request: self.transition(format!("{ms}.request_r"), Role::Plain),
+            enable: self.bool(format!("{ms}.enable_w")),
+            command: self.transition(format!("{ms}.command_w"), Role::Plain),
+            request_semaphore: self.bool(format!("{ms}.request_semaphor_rw")),
+            command_semaphore: self.root(
+                format!("{ms}.command_semaphor_rw"),
+                1,
+                "BOOL",
+                ADST_BIT,
+                Role::CommandSemaphore(ch),
+            ),
+            plc_present: self.bool(format!("{p}.head.plc_present_w")),
+            error_record: self.root(
+                format!("{p}.mc_error.satz_r"),
+                ERROR_RECORD_BYTES,
+                "HLI_ERROR_SATZ",
+                ADST_BIGTYPE,
+                Role::ErrorRecord(ch),
+            ),
+            error_semaphore: self.root(
+                format!("{p}.mc_error.semaphor_rw"),
+                1,
+                "BOOL",
+                ADST_BIT,
+                Role::ErrorSemaphore(ch),
+            ),
+        };
+        self.sub(
+            format!("{p}.mc_error.satz_r.kopf.error_id"),
+            areas.error_record,
+            0,
+            4,
+            "UDINT",
+            ADST_UINT32,
+        );
+        // Technology units (M/H/S/T handshakes): ncchannel raises none; plain memory.
+        let tu = self.root(
+            format!("{p}.techno_unit_std_sync"),
+            TECHNO_UNITS * TECHNO_UNIT_BYTES,
+            "ARRAY [0..19] OF TECHNO_UNIT_CH",
+            ADST_BIGTYPE,
+            Role::Plain,
+        );
+        for k in 0..TECHNO_UNITS {
+            self.sub(
+                format!("{p}.techno_unit_std_sync[{k}]"),
+                tu,
+                k * TECHNO_UNIT_BYTES,
+                TECHNO_UNIT_BYTES,
+                "TECHNO_UNIT_CH",
+                ADST_BIGTYPE,
+            );
+            self.sub(
+                format!("{p}.techno_unit_std_sync[{k}].please_rw"),
+                tu,
+                k * TECHNO_UNIT_BYTES,
+                1,
+                "BOOL",
+                ADST_BIT,
+            );
+            self.sub(
+                format!("{p}.techno_unit_std_sync[{k}].done_w"),
+                tu,
+                k * TECHNO_UNIT_BYTES + 1,
+                1,
+                "BOOL",
+                ADST_BIT,
+            );
+        }
+        self.root(
+            format!("{p}.used_units_std_sync_r"),
+            2,
+            "UINT",
+            ADST_UINT16,
+            Role::Plain,
+        );
+        // Path control units (TwinSharp BackwardsOnPath.cs, DeleteDistanceToGo.cs).
+        let bahn = format!("{p}.bahn_mc_control");
+        for unit in [
+            "backward_motion",
+            "simulate_motion",
+            "backward_storage_off",
+            "ext_command_speed_valid",
+            "delete_distance_to_go",
+        ] {
+            for f in ["command_w", "enable_w", "state_r"] {
+                self.bool(format!("{bahn}.{unit}.{f}"));
+            }
+        }
+        self.root(
+            format!("{bahn}.ext_command_speed.command_w"),
+            4,
+            "UDINT",
+            ADST_UINT32,
+            Role::Plain,
+        );
+        self.bool(format!("{bahn}.ext_command_speed.enable_w"));
+        self.root(
+            format!("{bahn}.ext_command_speed.state_r"),
+            4,
+            "UDINT",
+            ADST_UINT32,
+            Role::Plain,
+        );
+        // Manual mode units (TwinSharp ManualOperation.cs, Structs.cs sizes).
+        let hb = format!("{p}.hb_mc_control");
+        self.unit(&format!("{hb}.activation"), 12, "HLI_HB_ACTIVATION");
+        self.unit(&format!("{hb}.tip_parameter"), 8, "HLI_HB_TIP_PARAMETER");
+        self.unit(&format!("{hb}.jog_parameter"), 16, "HLI_HB_JOG_PARAMETER");
+        self.unit(&format!("{hb}.hr_parameter"), 8, "HLI_HB_HR_PARAMETER");
+        self.unit(&format!("{hb}.rapid_key"), 8, "HLI_HB_RAPID_KEY");
+        for k in 0..KEYS {
+            self.unit(&format!("{hb}.key[{k}]"), 16, "HLI_HB_KEY");
+        }
+        for k in 0..HANDWHEELS {
+            self.bool(format!("{hb}.handwheel_incs[{k}].enable_w"));
+            self.root(
+                format!("{hb}.handwheel_incs[{k}].command_w"),
+                2,
+                "INT",
+                ADST_INT16,
+                Role::Plain,
+            );
+        }
+        for k in 0..axes {
+            let d = format!("{p}.bahn_state.coord_r[{k}].hb_display_r");
+            let r = self.root(d.clone(), 10, "HLI_HB_DISPLAY", ADST_BIGTYPE, Role::Plain);
+            self.sub(format!("{d}.state"), r, 0, 2, "UINT", ADST_UINT16);
+            self.sub(format!("{d}.operation_mode"), r, 2, 2, "UINT", ADST_UINT16);
+            self.sub(format!("{d}.control_element"), r, 4, 2, "UINT", ADST_UINT16);
+            self.sub(format!("{d}.tipp_geschw"), r, 6, 4, "DINT", ADST_INT32);
+        }
+        areas
+    }
+
+    fn axis(&mut self, a: usize) {
+        let p = format!("HLI_Global_Variables.gpAx[{a}]^");
+        self.bool(format!("{p}.head.plc_present_w"));
+        let add = format!("{p}.lr_mc_control.add_cmd_values");
+        let r = self.root(
+            format!("{add}.command_w"),
+            32,
+            "HLI_ADD_CMD_VALUE",
+            ADST_BIGTYPE,
+            Role::Plain,
+        );
+        self.sub(
+            format!("{add}.command_w.m_add_pos_value"),
+            r,
+            0,
+            4,
+            "DINT",
+            ADST_INT32,
+        );
+        self.sub(
+            format!("{add}.command_w.m_add_speed_value"),
+            r,
+            4,
+            4,
+            "DINT",
+            ADST_INT32,
+        );
+        self.bool(format!("{add}.enable_w"));
+        let dyn_low = format!("{p}.ipo_mc_control.dyn_pos_limit_low");
+        self.bool(format!("{dyn_low}.enable_w"));
+        self.root(
+            format!("{dyn_low}.command_w"),
+            4,
+            "DINT",
+            ADST_INT32,
+            Role::Plain,
+        );
+        self.root(
+            format!("{dyn_low}.state_r"),
+            4,
+            "DINT",
+            ADST_INT32,
+            Role::Plain,
+        );
+    }
+
+    fn constant(&mut self, name: &str, value: i32) {
+        let r = self.root(name.into(), 4, "DINT", ADST_INT32, Role::Plain);
+        if let Ok(mut m) = self.img.memory.lock() {
+            m[r].copy_from_slice(&value.to_le_bytes());
+        }
+    }
+}
+
+impl Image {
+    fn build(axes_per_channel: &[usize]) -> Image {
+        let mut b = Builder {
+            img: Image {
+                symbols: Vec::new(),
+                by_name: HashMap::new(),
+                roles: Vec::new(),
+                memory: Mutex::new(Vec::new()),
+                channels: Vec::new(),
+                posted: Mutex::new(vec![0; axes_per_channel.len()]),
+                pending: Mutex::new(vec![PendingRequest::default(); axes_per_channel.len()]),
+            },
+        };
+        b.constant(
+            "HLI_Global_Constants.HLI_TU_CH_STD_SYNC_MAXIDX",
+            TECHNO_UNITS as i32 - 1,
+        );
+        // TECHNO_UNIT_CH's process data is byte[39] (TwinSharp Structs.cs): index 0..38.
+        b.constant("HLI_Global_Constants.HLI_TECH_UNIT_CH_MAXIDX", 38);
+        for (i, &axes) in axes_per_channel.iter().enumerate() {
+            let areas = b.channel(i, (i + 1) as u16, axes);
+            b.img.channels.push(areas);
+        }
+        for a in 0..axes_per_channel.iter().sum::<usize>() {
+            b.axis(a);
+        }
+        b.img
+    }
+
+    fn memory(&self) -> MutexGuard<'_, Vec<Vec<u8>>> {
+        self.memory.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn areas(&self, ch: u16) -> Result<ChannelAreas, AdsResult> {
+        usize::from(ch)
+            .checked_sub(1)
+            .and_then(|i| self.channels.get(i))
+            .copied()
+            .ok_or(AdsResult::INVALID_GROUP)
+    }
+}
+
+/// The HLI of one server: built on first use from the channels the backend has.
+pub struct Hli {
+    backend: Arc<dyn CncBackend>,
+    image: OnceLock<Image>,
+}
+
+impl Hli {
+    pub fn new(backend: Arc<dyn CncBackend>) -> Self {
+        Hli {
+            backend,
+            image: OnceLock::new(),
+        }
+    }
+
+    fn image(&self) -> Result<&Image, AdsResult> {
+        if let Some(img) = self.image.get() {
+            return Ok(img);
+        }
+        let mut axes = Vec::new();
+        for ch in 1..=self.backend.channel_count() {
+            axes.push(
+                self.backend
+                    .view(ch)
+                    .map_err(DeviceError::result)?
+                    .positions
+                    .len(),
+            );
+        }
+        Ok(self.image.get_or_init(|| Image::build(&axes)))
+    }
+
+    /// Every symbol, for the object map (`group` 0xF005 and `offset` = its handle).
+    pub fn objects(&self) -> Result<Vec<ObjectInfo>, AdsResult> {
+        let img = self.image()?;
+        Ok(img
+            .symbols
+            .iter()
+            .enumerate()
+            .map(|(i, s)| ObjectInfo {
+                port: PORT,
+                group: GROUP_VALUE_BY_HANDLE,
+                offset: i as u32 + 1,
+                name: s.name.clone(),
+                ty: AdsType::Named(s.ty),
+                size: s.size as u32,
+                access: Access::ReadWrite,
+                unit: "",
+                source: role_source(img.roles[s.root]),
+            })
+            .collect())
+    }
+
+    fn symbol_by_name(&self, data: &[u8]) -> Result<usize, AdsResult> {
+        let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+        if end > MAX_NAME_BYTES {
+            return Err(AdsResult::INVALID_SIZE);
+        }
+        let name = std::str::from_utf8(&data[..end]).map_err(|_| AdsResult::INVALID_DATA)?;
+        let img = self.image()?;
+        img.by_name
+            .get(&name.trim().to_ascii_lowercase())
+            .copied()
+            .ok_or(SYMBOL_NOT_FOUND)
+    }
+
+    fn symbol_by_handle(&self, handle: u32) -> Result<usize, AdsResult> {
+        let img = self.image()?;
+        let i = (handle as usize).checked_sub(1).ok_or(SYMBOL_NOT_FOUND)?;
+        if i < img.symbols.len() {
+            Ok(i)
+        } else {
+            Err(SYMBOL_NOT_FOUND)
+        }
+    }
+
+    /// Read a symbol: its bytes, or the first `length` of them (TwinSharp reads
+    /// `[MAXIDX]` elements of an array).
+    fn read_symbol(&self, i: usize, length: u32) -> Result<Vec<u8>, AdsResult> {
+        let img = self.image()?;
+        let s = &img.symbols[i];
+        match img.roles[s.root] {
+            Role::ModeState(ch) => {
+                let (m, st) = self.backend.mode_state(ch).map_err(DeviceError::result)?;
+                let mut mem = img.memory();
+                mem[s.root][0..4].copy_from_slice(&(m as u32).to_le_bytes());
+                mem[s.root][4..8].copy_from_slice(&(st as u32).to_le_bytes());
+            }
+            Role::ErrorRecord(ch) | Role::ErrorSemaphore(ch) => self.post_error(img, ch)?,
+            _ => {}
+        }
+        let mem = img.memory();
+        let n = s.size.min(length as usize);
+        Ok(mem[s.root][s.at..s.at + n].to_vec())
+    }
+
+    fn write_symbol(&self, i: usize, data: &[u8]) -> Result<(), AdsResult> {
+        let img = self.image()?;
+        let s = &img.symbols[i];
+        if data.is_empty() || data.len() > s.size {
+            return Err(AdsResult::INVALID_SIZE);
+        }
+        let role = img.roles[s.root];
+        if matches!(role, Role::ModeState(_) | Role::ErrorRecord(_)) {
+            return Err(AdsResult::ACCESS_DENIED);
+        }
+        img.memory()[s.root][s.at..s.at + data.len()].copy_from_slice(data);
+        if let (Role::CommandSemaphore(ch), [1, ..]) = (role, data) {
+            self.take_command(img, ch);
+        }
+        Ok(())
+    }
+
+    /// The CNC side of the mode-and-state unit: take `command_w` (to mode, parameter, to
+    /// state; 0 = no change) and clear the semaphore. A transition the channel refuses
+    /// leaves mode and state as they are (`state_r` shows it).
+    fn take_command(&self, img: &Image, ch: u16) {
+        let Ok(areas) = img.areas(ch) else { return };
+        let cmd = img.memory()[areas.command].clone();
+        let word = |at: usize| u32::from_le_bytes([cmd[at], cmd[at + 1], cmd[at + 2], cmd[at + 3]]);
+        let (to_mode, to_state) = (word(8), word(12));
+        let param = &cmd[PARAMETER_AT..PARAMETER_AT + PARAMETER_BYTES];
+        let end = param.iter().position(|&b| b == 0).unwrap_or(param.len());
+        let program = String::from_utf8_lossy(&param[..end]).trim().to_string();
+        let b = &self.backend;
+        let r = (|| {
+            let (mode, _) = b.mode_state(ch)?;
+            if to_mode != 0 && to_mode as i32 != mode {
+                b.command_mode(ch, to_mode as i32)?;
+            }
+            if !program.is_empty() {
+                b.command_program(ch, &program)?;
+            }
+            match to_state {
+                0 => Ok(()),
+                // "Resetting" as a target state (diagnosis 270061).
+                15 => b.reset(ch),
+                s => b.command_state(ch, s as i32),
+            }
+        })();
+        if let Err(e) = r {
+            eprintln!(
+                "ncchannel ads: HLI channel {ch}: mode/state command {to_mode}/{to_state} refused: {e}"
+            );
+        }
+        img.memory()[areas.command_semaphore][0] = 0;
+    }
+
+    /// Post the channel's next error into `mc_error.satz_r` when the semaphore is FALSE.
+    fn post_error(&self, img: &Image, ch: u16) -> Result<(), AdsResult> {
+        let areas = img.areas(ch)?;
+        if img.memory()[areas.error_semaphore][0] != 0 {
+            return Ok(());
+        }
+        let i = usize::from(ch) - 1;
+        let next = img.posted.lock().unwrap_or_else(|p| p.into_inner())[i];
+        let mut rec = self
+            .backend
+            .error_record(ch, next)
+            .map_err(DeviceError::result)?;
+        if next >= rec.total {
+            return Ok(());
+        }
+        let mut index = next;
+        if rec.error.is_none() {
+            // No longer kept: skip to the newest.
+            index = rec.total - 1;
+            rec = self
+                .backend
+                .error_record(ch, index)
+                .map_err(DeviceError::result)?;
+        }
+        let tick = self.backend.view(ch).map_err(DeviceError::result)?.tick;
+        let code = rec.error.as_ref().map_or(0, |(c, _)| *c);
+        let record = error_record(code, ch, tick);
+        let mut mem = img.memory();
+        mem[areas.error_record].copy_from_slice(&record);
+        mem[areas.error_semaphore][0] = 1;
+        drop(mem);
+        img.posted.lock().unwrap_or_else(|p| p.into_inner())[i] = index + 1;
+        Ok(())
+    }
+
+    /// infosys 174725259: with `enable_w` TRUE "the PLC operates this command": an HMI's mode
+    /// and state commands (COM `mcm_command_*_w`) are not executed but handed to the PLC in
+    /// `request_r` with `request_semaphor_rw` TRUE; the PLC decides and commands through
+    /// `command_w`. `None` when the PLC does not operate the unit (the channel executes the
+    /// command itself). A to-state while the PLC has not taken the last request is 0x708.
+    pub fn redirect(&self, ch: u16, req: HmiRequest<'_>) -> Option<Result<(), AdsResult>> {
+        // Without a PLC client the image may not exist yet: then nobody set enable_w.
+        let img = self.image.get()?;
+        let areas = img.areas(ch).ok()?;
+        if img.memory()[areas.enable][0] == 0 {
+            return None;
+        }
+        let i = usize::from(ch) - 1;
+        let mut pending = img.pending.lock().unwrap_or_else(|p| p.into_inner());
+        let p = &mut pending[i];
+        match req {
+            HmiRequest::ToMode(m) => p.to_mode = u32::try_from(m).ok(),
+            HmiRequest::Parameter(text) => {
+                p.parameter = text.as_bytes()[..text.len().min(PARAMETER_BYTES - 1)].to_vec()
+            }
+            HmiRequest::ToState(s) => {
+                // `pending` stays locked: redirections of a channel are one at a time.
+                if img.memory()[areas.request_semaphore][0] != 0 {
+                    return Some(Err(AdsResult::BUSY));
+                }
+                let (mode, state) = match self.backend.mode_state(ch) {
+                    Ok(ms) => ms,
+                    Err(e) => return Some(Err(e.result())),
+                };
+                let mut mem = img.memory();
+                let r = &mut mem[areas.request];
+                r.fill(0);
+                let words = [
+                    mode as u32,
+                    state as u32,
+                    p.to_mode.unwrap_or(mode as u32),
+                    s as u32,
+                    u32::from(ch),
+                ];
+                for (k, w) in words.iter().enumerate() {
+                    r[4 * k..4 * k + 4].copy_from_slice(&w.to_le_bytes());
+                }
+                r[PARAMETER_AT..PARAMETER_AT + p.parameter.len()].copy_from_slice(&p.parameter);
+                mem[areas.request_semaphore][0] = 1;
+                *p = PendingRequest::default();
+            }
+        }
+        Some(Ok(()))
+    }
+
+    /// Bytes `[at, at + size)` of a channel's mode-and-state unit (for the GEO mirror).
+    pub fn unit_bytes(
+        &self,
+        ch: u16,
+        unit: Unit,
+        at: usize,
+        size: usize,
+    ) -> Result<Vec<u8>, AdsResult> {
+        let img = self.image()?;
+        let a = img.areas(ch)?;
+        let root = match unit {
+            Unit::Enable => a.enable,
+            Unit::RequestSemaphore => a.request_semaphore,
+            Unit::CommandSemaphore => a.command_semaphore,
+            Unit::Request => a.request,
+            Unit::Command => a.command,
+        };
+        let mem = img.memory();
+        let area = &mem[root];
+        let mut out = area[at.min(area.len())..(at + size).min(area.len())].to_vec();
+        out.resize(size, 0);
+        Ok(out)
+    }
+
+    /// `gpCh[ch-1]^.head.plc_present_w` as one byte.
+    pub fn plc_present(&self, ch: u16) -> Result<Vec<u8>, AdsResult> {
+        let img = self.image()?;
+        let a = img.areas(ch)?;
+        Ok(img.memory()[a.plc_present].clone())
+    }
+
+    /// ADS Read on port 851.
+    pub fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+        match group {
+            GROUP_VALUE_BY_HANDLE => self.read_symbol(self.symbol_by_handle(offset)?, length),
+            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME
+            | GROUP_RELEASE_HANDLE => Err(AdsResult::ACCESS_DENIED),
+            _ => Err(AdsResult::INVALID_GROUP),
+        }
+    }
+
+    /// ADS Write on port 851.
+    pub fn write(&self, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
+        match group {
+            GROUP_VALUE_BY_HANDLE => self.write_symbol(self.symbol_by_handle(offset)?, data),
+            GROUP_RELEASE_HANDLE => {
+                let [a, b, c, d] = *data else {
+                    return Err(AdsResult::INVALID_SIZE);
+                };
+                self.symbol_by_handle(u32::from_le_bytes([a, b, c, d]))
+                    .map(|_| ())
+            }
+            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME => {
+                Err(AdsResult::ACCESS_DENIED)
+            }
+            _ => Err(AdsResult::INVALID_GROUP),
+        }
+    }
+
+    /// ADS ReadWrite on port 851.
+    pub fn read_write(
+        &self,
+        group: u32,
+        _offset: u32,
+        read_length: u32,
+        data: &[u8],
+    ) -> Result<Vec<u8>, AdsResult> {
+        match group {
+            GROUP_HANDLE_BY_NAME => {
+                if read_length < 4 {
+                    return Err(AdsResult::INVALID_SIZE);
+                }
+                let i = self.symbol_by_name(data)?;
+                Ok((i as u32 + 1).to_le_bytes().to_vec())
+            }
+            GROUP_VALUE_BY_NAME => self.read_symbol(self.symbol_by_name(data)?, read_length),
+            GROUP_INFO_BY_NAME => {
+                let i = self.symbol_by_name(data)?;
+                let entry = symbol_entry(&self.image()?.symbols[i], i as u32 + 1);
+                if (read_length as usize) < entry.len() {
+                    return Err(AdsResult::INVALID_SIZE);
+                }
+                Ok(entry)
+            }
+            GROUP_VALUE_BY_HANDLE | GROUP_RELEASE_HANDLE => Err(AdsResult::ACCESS_DENIED),
+            _ => Err(AdsResult::INVALID_GROUP),
+        }
+    }
+}
+
+fn role_source(role: Role) -> &'static str {
+    match role {
+        Role::Plain => "TwinSharp; inert",
+        _ => "TwinSharp; HLI docs",
+    }
+}
+
+/// `AdsSymbolEntry`: entry length, group, offset, size, data type, flags, name/type/comment
+/// lengths, then the three NUL-terminated texts. The address is value-by-handle.
+fn symbol_entry(s: &Symbol, handle: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(30 + s.name.len() + s.ty.len() + 3);
+    out.extend_from_slice(&[0; 4]);
+    out.extend_from_slice(&GROUP_VALUE_BY_HANDLE.to_le_bytes());
+    out.extend_from_slice(&handle.to_le_bytes());
+    out.extend_from_slice(&(s.size as u32).to_le_bytes());
+    out.extend_from_slice(&s.adst.to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&(s.name.len() as u16).to_le_bytes());
+    out.extend_from_slice(&(s.ty.len() as u16).to_le_bytes());
+    out.extend_from_slice(&0u16.to_le_bytes());
+    out.extend_from_slice(s.name.as_bytes());
+    out.push(0);
+    out.extend_from_slice(s.ty.as_bytes());
+    out.push(0);
+    out.push(0);
+    let n = out.len() as u32;
+    out[0..4].copy_from_slice(&n.to_le_bytes());
+    out
+}
+
+/// `HLI_ERROR_SATZ` for error `code` of channel `ch` (TwinSharp `Structs.cs`,
+/// `HLI_ERROR_SATZ_KOPF`, Pack = 1): error_id @0, modul_name @8, cnc_channel @56, time
+/// stamp cycle counter @68, version_name @72, body type @100; the body stays empty.
+pub fn error_record(code: u32, ch: u16, tick: u64) -> [u8; ERROR_RECORD_BYTES] {
+    let mut r = [0u8; ERROR_RECORD_BYTES];
+    r[0..4].copy_from_slice(&code.to_le_bytes());
+    put(&mut r[8..24], "ncchannel");
+    r[56..58].copy_from_slice(&ch.to_le_bytes());
+    r[68..72].copy_from_slice(&(tick as u32).to_le_bytes());
+    put(&mut r[72..88], env!("CARGO_PKG_VERSION"));
+    r[100..104].copy_from_slice(&BODY_EMPTY.to_le_bytes());
+    r
+}
+
+fn put(field: &mut [u8], text: &str) {
+    let n = text.len().min(field.len() - 1);
+    field[..n].copy_from_slice(&text.as_bytes()[..n]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ads::backend::CncBackend;
+    use crate::ads::memory::{DrainRate, MemoryBackend};
+
+    #[test]
+    fn names_resolve_case_insensitively_to_stable_handles() {
+        let hli = Hli::new(MemoryBackend::new(1, DrainRate::default()));
+        let name = b"HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r\0";
+        let h = hli.read_write(GROUP_HANDLE_BY_NAME, 0, 4, name).unwrap();
+        let lower = name.to_ascii_lowercase();
+        assert_eq!(
+            hli.read_write(GROUP_HANDLE_BY_NAME, 0, 4, &lower).unwrap(),
+            h
+        );
+        let h = u32::from_le_bytes([h[0], h[1], h[2], h[3]]);
+        let v = hli.read(GROUP_VALUE_BY_HANDLE, h, 8).unwrap();
+        assert_eq!(v, [1, 0, 0, 0, 3, 0, 0, 0], "STANDBY / READY");
+        assert_eq!(
+            hli.read_write(GROUP_HANDLE_BY_NAME, 0, 4, b"HLI_Global_Variables.nope"),
+            Err(SYMBOL_NOT_FOUND)
+        );
+        assert_eq!(hli.write(GROUP_RELEASE_HANDLE, 0, &h.to_le_bytes()), Ok(()));
+    }
+
+    fn handle_of(hli: &Hli, name: &str) -> u32 {
+        let h = hli
+            .read_write(GROUP_HANDLE_BY_NAME, 0, 4, name.as_bytes())
+            .unwrap();
+        u32::from_le_bytes([h[0], h[1], h[2], h[3]])
+    }
+
+    #[test]
+    fn command_unit_is_taken_when_the_semaphore_is_set_and_cleared() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+        let mut cmd = vec![0u8; MODE_TRANSITION_BYTES];
+        cmd[8..12].copy_from_slice(&2u32.to_le_bytes());
+        cmd[12..16].copy_from_slice(&4u32.to_le_bytes());
+        cmd[24..36].copy_from_slice(b"streaming.nc");
+        let command = handle_of(&hli, &format!("{ms}.command_w"));
+        hli.write(GROUP_VALUE_BY_HANDLE, command, &cmd).unwrap();
+        // Written but not handed over: nothing happens.
+        assert_eq!(b.mode_state(1), Ok((1, 3)));
+        let sem = handle_of(&hli, &format!("{ms}.command_semaphor_rw"));
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1]).unwrap();
+        assert_eq!(b.mode_state(1), Ok((2, 4)));
+        assert_eq!(b.program(1), "streaming.nc");
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [0]);
+        let state = handle_of(&hli, &format!("{ms}.state_r.state"));
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, state, 4).unwrap(),
+            [4, 0, 0, 0]
+        );
+        // A read-only live symbol refuses writes; a too long write is refused.
+        assert_eq!(
+            hli.write(GROUP_VALUE_BY_HANDLE, state, &[0; 4]),
+            Err(AdsResult::ACCESS_DENIED)
+        );
+        assert_eq!(
+            hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1, 0]),
+            Err(AdsResult::INVALID_SIZE)
+        );
+    }
+
+    #[test]
+    fn with_enable_w_hmi_commands_become_requests_for_the_plc() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), None, "no PLC yet");
+        let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+        let enable = handle_of(&hli, &format!("{ms}.enable_w"));
+        hli.write(GROUP_VALUE_BY_HANDLE, enable, &[1]).unwrap();
+        assert_eq!(hli.redirect(1, HmiRequest::ToMode(2)), Some(Ok(())));
+        assert_eq!(hli.redirect(1, HmiRequest::Parameter("a.nc")), Some(Ok(())));
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), Some(Ok(())));
+        assert_eq!(b.mode_state(1), Ok((1, 3)), "not executed");
+        let req = handle_of(&hli, &format!("{ms}.request_r"));
+        let r = hli.read(GROUP_VALUE_BY_HANDLE, req, 327).unwrap();
+        let word =
+            |k: usize| u32::from_le_bytes([r[4 * k], r[4 * k + 1], r[4 * k + 2], r[4 * k + 3]]);
+        assert_eq!(
+            (word(0), word(1), word(2), word(3), word(4)),
+            (1, 3, 2, 4, 1)
+        );
+        assert_eq!(&r[24..29], b"a.nc\0");
+        let sem = handle_of(&hli, &format!("{ms}.request_semaphor_rw"));
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        assert_eq!(
+            hli.redirect(1, HmiRequest::ToState(5)),
+            Some(Err(AdsResult::BUSY)),
+            "the PLC has not taken the last request"
+        );
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(hli.redirect(1, HmiRequest::ToState(3)), Some(Ok(())));
+    }
+
+    #[test]
+    fn errors_are_posted_one_at_a_time() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        let hli = Hli::new(b.clone());
+        let sem = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.semaphor_rw");
+        let rec = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.satz_r");
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "no error yet"
+        );
+        let _ = b.stream_write(1, b"N10 X1\n");
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        let r = hli.read(GROUP_VALUE_BY_HANDLE, rec, 942).unwrap();
+        assert_eq!(r.len(), ERROR_RECORD_BYTES);
+        assert_eq!(&r[0..4], &21476u32.to_le_bytes());
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "posted once"
+        );
+    }
+
+    #[test]
+    fn record_is_942_bytes_with_the_error_id_first() {
+        let r = error_record(21476, 1, 5);
+        assert_eq!(r.len(), 942);
+        assert_eq!(&r[0..4], &21476u32.to_le_bytes());
+        assert_eq!(&r[100..104], &9u32.to_le_bytes());
+    }
+}

@@ -1,0 +1,300 @@
+//! The SDA task (AMS port 552): NC variable access in the decoder class `0x122300 + ch`.
+//!
+//! Offsets as documented (ISG kernel docs "Channel-specific interface", 312791435, and "read
+//! by handle", 312799627): 0x46 handle by name (ReadWrite: name → u32 handle), 0x47 read by
+//! handle (ReadWrite: `{u32 handle, u32 ndims, u32 index…}` → value), 0x48 read by name
+//! (ReadWrite: name → value), 0x49 write by handle (Write: `{u32 handle, u32 ndims, u32
+//! index…, value}`), 0x4A write by name (Write: name, NUL, value). TwinSharp `ZeroOffsets.cs`
+//! also reads and writes a variable with the handle as index offset: `Read/Write(0x1223<ch>,
+//! handle)`; that form is served too.
+//!
+//! ncchannel models the external variables `V.E.<name>` (LREAL, 8 bytes); other variable
+//! kinds (`V.G.*`, `V.A.*`, `V.P.*` …) are not modelled and answer "not found" (0x70C).
+//! Handles are `0x2000_0000 + n` for the n-th distinct name asked for (at most
+//! [`MAX_HANDLES`]); the same name always gets the same handle.
+
+use std::sync::{Arc, Mutex};
+
+use super::backend::{CncBackend, DeviceError};
+use super::description::{Access, AdsType, ObjectInfo};
+use super::result::AdsResult;
+
+pub const PORT: u16 = 552;
+/// Decoder class instance of channel ch: `GROUP_DECODER + ch`.
+pub const GROUP_DECODER: u32 = 0x122300;
+pub const HANDLE_BY_NAME: u32 = 0x46;
+pub const READ_BY_HANDLE: u32 = 0x47;
+pub const READ_BY_NAME: u32 = 0x48;
+pub const WRITE_BY_HANDLE: u32 = 0x49;
+pub const WRITE_BY_NAME: u32 = 0x4A;
+/// First handle; handles look like the documented `0x20012341`.
+const HANDLE_BASE: u32 = 0x2000_0000;
+/// Distinct variable names a server hands out handles for.
+pub const MAX_HANDLES: usize = 4096;
+const MAX_NAME_BYTES: usize = 255;
+/// ADS "insufficient memory": the handle table is full.
+const NO_MEMORY: AdsResult = AdsResult(0x70A);
+const LOGICAL: u32 = 0x100000;
+/// Bytes of a value: ncchannel's V.E. variables are LREAL.
+const VALUE_BYTES: usize = 8;
+
+/// The objects of channel `ch`'s decoder class, for the object map.
+pub fn objects(ch: u16) -> Vec<ObjectInfo> {
+    let group = GROUP_DECODER + u32::from(ch);
+    let o = |offset, name: &str, access, size| ObjectInfo {
+        port: PORT,
+        group,
+        offset,
+        name: name.into(),
+        ty: AdsType::Named("V.E.* → LREAL"),
+        size,
+        access,
+        unit: "",
+        source: "ISG docs 312791435; TwinSharp ZeroOffsets.cs",
+    };
+    vec![
+        o(
+            HANDLE_BY_NAME,
+            "variable handle by name (ReadWrite)",
+            Access::ReadWrite,
+            4,
+        ),
+        o(
+            READ_BY_HANDLE,
+            "read variable by handle (ReadWrite)",
+            Access::ReadWrite,
+            8,
+        ),
+        o(
+            READ_BY_NAME,
+            "read variable by name (ReadWrite)",
+            Access::ReadWrite,
+            8,
+        ),
+        o(
+            WRITE_BY_HANDLE,
+            "write variable by handle",
+            Access::Write,
+            8,
+        ),
+        o(WRITE_BY_NAME, "write variable by name", Access::Write, 8),
+        o(
+            HANDLE_BASE,
+            "variable value at its handle (0x2000_0000 + n)",
+            Access::ReadWrite,
+            8,
+        ),
+    ]
+}
+
+/// The SDA task of one server: its variable handles.
+pub struct Sda {
+    backend: Arc<dyn CncBackend>,
+    /// Handle n ↔ `names[n]` (upper case, without `V.E.`).
+    names: Mutex<Vec<String>>,
+}
+
+/// `V.E.name` (any case) → `NAME`; other variable kinds → not found.
+fn ve_name(data: &[u8]) -> Result<String, AdsResult> {
+    let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+    if end == 0 || end > MAX_NAME_BYTES {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    let text = std::str::from_utf8(&data[..end])
+        .map_err(|_| AdsResult::INVALID_DATA)?
+        .trim();
+    match text.get(..4) {
+        Some(p) if p.eq_ignore_ascii_case("V.E.") && text.len() > 4 => {
+            Ok(text[4..].to_ascii_uppercase())
+        }
+        _ => Err(AdsResult::NOT_FOUND),
+    }
+}
+
+fn value_arg(data: &[u8]) -> Result<f64, AdsResult> {
+    let bytes: [u8; VALUE_BYTES] = data.try_into().map_err(|_| AdsResult::INVALID_SIZE)?;
+    let v = f64::from_le_bytes(bytes);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(AdsResult::INVALID_DATA)
+    }
+}
+
+fn u32_at(data: &[u8], at: usize) -> Result<u32, AdsResult> {
+    data.get(at..at + 4)
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+        .ok_or(AdsResult::INVALID_SIZE)
+}
+
+impl Sda {
+    pub fn new(backend: Arc<dyn CncBackend>) -> Self {
+        Sda {
+            backend,
+            names: Mutex::new(Vec::new()),
+        }
+    }
+
+    fn channel(&self, group: u32) -> Result<u16, AdsResult> {
+        let group = if group < LOGICAL {
+            group | LOGICAL
+        } else {
+            group
+        };
+        let ch = group
+            .checked_sub(GROUP_DECODER)
+            .filter(|&c| (1..=u32::from(self.backend.channel_count())).contains(&c))
+            .ok_or(AdsResult::INVALID_GROUP)?;
+        Ok(ch as u16)
+    }
+
+    fn name_of(&self, handle: u32) -> Result<String, AdsResult> {
+        let i = handle
+            .checked_sub(HANDLE_BASE)
+            .ok_or(AdsResult::INVALID_OFFSET)? as usize;
+        let names = self.names.lock().unwrap_or_else(|p| p.into_inner());
+        names.get(i).cloned().ok_or(AdsResult::NOT_FOUND)
+    }
+
+    fn handle(&self, ch: u16, name: String) -> Result<u32, AdsResult> {
+        // Only a variable that exists gets a handle.
+        self.backend
+            .read_ve(ch, &name)
+            .map_err(DeviceError::result)?;
+        let mut names = self.names.lock().unwrap_or_else(|p| p.into_inner());
+        let i = match names.iter().position(|n| *n == name) {
+            Some(i) => i,
+            None if names.len() < MAX_HANDLES => {
+                names.push(name);
+                names.len() - 1
+            }
+            None => return Err(NO_MEMORY),
+        };
+        Ok(HANDLE_BASE + i as u32)
+    }
+
+    fn value(&self, ch: u16, name: &str, read_length: u32) -> Result<Vec<u8>, AdsResult> {
+        if (read_length as usize) < VALUE_BYTES {
+            return Err(AdsResult::INVALID_SIZE);
+        }
+        let v = self
+            .backend
+            .read_ve(ch, name)
+            .map_err(DeviceError::result)?;
+        Ok(v.to_le_bytes().to_vec())
+    }
+
+    fn store(&self, ch: u16, name: &str, data: &[u8]) -> Result<(), AdsResult> {
+        self.backend
+            .write_ve(ch, name, value_arg(data)?)
+            .map_err(DeviceError::result)
+    }
+
+    /// `{u32 handle, u32 ndims, u32 index × ndims}` → (handle, bytes used). ncchannel's
+    /// V.E. variables are scalars: ndims must be 0.
+    fn handle_head(data: &[u8]) -> Result<(u32, usize), AdsResult> {
+        let handle = u32_at(data, 0)?;
+        let ndims = u32_at(data, 4)?;
+        if ndims != 0 {
+            return Err(AdsResult::INVALID_DATA);
+        }
+        Ok((handle, 8))
+    }
+
+    /// ADS Read on port 552: a variable's value at its handle.
+    pub fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+        let ch = self.channel(group)?;
+        if offset < HANDLE_BASE {
+            return Err(AdsResult::INVALID_OFFSET);
+        }
+        self.value(ch, &self.name_of(offset)?, length)
+    }
+
+    /// ADS Write on port 552.
+    pub fn write(&self, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
+        let ch = self.channel(group)?;
+        match offset {
+            WRITE_BY_HANDLE => {
+                let (handle, used) = Self::handle_head(data)?;
+                self.store(ch, &self.name_of(handle)?, &data[used..])
+            }
+            WRITE_BY_NAME => {
+                let end = data
+                    .iter()
+                    .position(|&b| b == 0)
+                    .ok_or(AdsResult::INVALID_DATA)?;
+                let name = ve_name(&data[..end])?;
+                self.store(ch, &name, &data[end + 1..])
+            }
+            o if o >= HANDLE_BASE => self.store(ch, &self.name_of(o)?, data),
+            HANDLE_BY_NAME | READ_BY_HANDLE | READ_BY_NAME => Err(AdsResult::ACCESS_DENIED),
+            _ => Err(AdsResult::INVALID_OFFSET),
+        }
+    }
+
+    /// ADS ReadWrite on port 552.
+    pub fn read_write(
+        &self,
+        group: u32,
+        offset: u32,
+        read_length: u32,
+        data: &[u8],
+    ) -> Result<Vec<u8>, AdsResult> {
+        let ch = self.channel(group)?;
+        match offset {
+            HANDLE_BY_NAME => {
+                if read_length < 4 {
+                    return Err(AdsResult::INVALID_SIZE);
+                }
+                let h = self.handle(ch, ve_name(data)?)?;
+                Ok(h.to_le_bytes().to_vec())
+            }
+            READ_BY_HANDLE => {
+                let (handle, _) = Self::handle_head(data)?;
+                self.value(ch, &self.name_of(handle)?, read_length)
+            }
+            READ_BY_NAME => self.value(ch, &ve_name(data)?, read_length),
+            WRITE_BY_HANDLE | WRITE_BY_NAME => Err(AdsResult::ACCESS_DENIED),
+            _ => Err(AdsResult::INVALID_OFFSET),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ads::memory::{DrainRate, MemoryBackend};
+
+    #[test]
+    fn handle_then_plain_read_and_write_as_twinsharp_does() {
+        let b = MemoryBackend::new(1, DrainRate::default());
+        b.write_ve(1, "DEPTH", 1.5).unwrap();
+        let sda = Sda::new(b);
+        let h = sda
+            .read_write(0x122301, HANDLE_BY_NAME, 4, b"V.E.depth")
+            .unwrap();
+        let h = u32::from_le_bytes([h[0], h[1], h[2], h[3]]);
+        assert_eq!(h, 0x2000_0000);
+        assert_eq!(sda.read(0x122301, h, 1024).unwrap(), 1.5f64.to_le_bytes());
+        sda.write(0x122301, h, &(-2.0f64).to_le_bytes()).unwrap();
+        let by_name = sda
+            .read_write(0x122301, READ_BY_NAME, 8, b"V.E.DEPTH\0")
+            .unwrap();
+        assert_eq!(by_name, (-2.0f64).to_le_bytes());
+        let mut req = h.to_le_bytes().to_vec();
+        req.extend_from_slice(&0u32.to_le_bytes());
+        assert_eq!(
+            sda.read_write(0x22301, READ_BY_HANDLE, 8, &req).unwrap(),
+            by_name
+        );
+        assert_eq!(
+            sda.read_write(0x122301, HANDLE_BY_NAME, 4, b"V.G.NP[1].V"),
+            Err(AdsResult::NOT_FOUND)
+        );
+        assert_eq!(
+            sda.read_write(0x122301, HANDLE_BY_NAME, 4, b"V.E.missing"),
+            Err(AdsResult::NOT_FOUND)
+        );
+    }
+}
