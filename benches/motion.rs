@@ -35,6 +35,7 @@ impl Bench {
                 index,
                 max_velocity_mm_per_min: 30000.0,
                 max_accel_mm_per_s2: 2000.0,
+                max_jerk_mm_per_s3: None,
                 rapid_mm_per_min: 30000.0,
                 min_mm: -1e9,
                 max_mm: 1e9,
@@ -45,6 +46,7 @@ impl Bench {
                 axes,
                 PlannerSettings {
                     lookahead_blocks: WINDOW,
+                    ..PlannerSettings::default()
                 },
             ),
             queue: BlockQueue::new(WINDOW + 8),

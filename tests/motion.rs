@@ -47,6 +47,7 @@ fn axes(vmax_mm_per_min: f64, accel: f64) -> Vec<AxisLimits> {
             index,
             max_velocity_mm_per_min: vmax_mm_per_min,
             max_accel_mm_per_s2: accel,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: vmax_mm_per_min,
             min_mm: -1000.0,
             max_mm: 1000.0,
@@ -252,6 +253,7 @@ fn blocks_are_held_until_the_window_is_full_then_run_without_stopping() {
         axes(30000.0, 2000.0),
         PlannerSettings {
             lookahead_blocks: 4,
+            ..PlannerSettings::default()
         },
     );
     let mut q = BlockQueue::new(64);
@@ -516,6 +518,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 0,
             max_velocity_mm_per_min: 12000.0,
             max_accel_mm_per_s2: 1500.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 12000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -524,6 +527,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 1,
             max_velocity_mm_per_min: 9000.0,
             max_accel_mm_per_s2: 1000.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 8000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -532,6 +536,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 2,
             max_velocity_mm_per_min: 6000.0,
             max_accel_mm_per_s2: 600.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 6000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -542,6 +547,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
         limits.clone(),
         PlannerSettings {
             lookahead_blocks: 16,
+            ..PlannerSettings::default()
         },
     );
     let mut q = BlockQueue::new(1_000_000);

@@ -50,12 +50,15 @@ const NON_MOTION_PER_BLOCK: usize = 4;
 pub struct PlannerSettings {
     /// Motion blocks held and planned over (lookahead window), at least 1.
     pub lookahead_blocks: usize,
+    /// Corner smoothing window, s (0 = off): see [`super::filter`].
+    pub corner_smoothing_s: f64,
 }
 
 impl Default for PlannerSettings {
     fn default() -> Self {
         PlannerSettings {
             lookahead_blocks: 32,
+            corner_smoothing_s: 0.0,
         }
     }
 }
@@ -84,6 +87,8 @@ pub struct Junction {
     pub k_s2_per_mm: f64,
     /// The shorter of the two blocks, mm.
     pub short_mm: f64,
+    /// The previous block's length, mm.
+    pub prev_length_mm: f64,
     /// The previous block's programmed and limit velocity, mm/s.
     pub prev_programmed_mm_per_s: f64,
     pub prev_limit_mm_per_s: f64,
@@ -96,6 +101,33 @@ impl Junction {
             return f64::INFINITY;
         }
         (dt_s / self.k_s2_per_mm).min((self.short_mm / self.k_s2_per_mm).sqrt())
+    }
+
+    /// The limit when a corner filter of `window_s` spreads the velocity jump (0 = no filter).
+    ///
+    /// Each junction owns the time τ = min(window, time on the previous block, time on the
+    /// next block) at the blocks' cruise velocities; owned times of successive junctions do not
+    /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
+    /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
+    /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
+    pub fn smoothed_limit_mm_per_s(
+        &self,
+        window_s: f64,
+        prev_cruise_mm_per_s: f64,
+        length_mm: f64,
+        cruise_mm_per_s: f64,
+    ) -> f64 {
+        if window_s <= 0.0 {
+            return 0.0;
+        }
+        if self.k_s2_per_mm <= 0.0 {
+            return f64::INFINITY;
+        }
+        let time_on = |l: f64, v: f64| if v > 0.0 { l / v } else { f64::INFINITY };
+        let tau = window_s
+            .min(time_on(self.prev_length_mm, prev_cruise_mm_per_s))
+            .min(time_on(length_mm, cruise_mm_per_s));
+        0.5 * tau / self.k_s2_per_mm
     }
 }
 
@@ -124,7 +156,7 @@ pub enum EntryKind {
 
 impl EntryKind {
     /// The motion stops before anything after this entry runs.
-    fn is_barrier(&self) -> bool {
+    pub fn is_barrier(&self) -> bool {
         matches!(
             self,
             EntryKind::Dwell { .. }
@@ -157,6 +189,8 @@ pub struct Planner {
     release_next_move: bool,
     /// The plan must be recomputed (new releases, override change).
     dirty: bool,
+    /// Corner smoothing window, s (0 = off).
+    corner_s: f64,
 }
 
 impl Planner {
@@ -178,6 +212,11 @@ impl Planner {
             moves: 0,
             release_next_move: false,
             dirty: false,
+            corner_s: if settings.corner_smoothing_s.is_finite() {
+                settings.corner_smoothing_s.max(0.0)
+            } else {
+                0.0
+            },
         }
     }
 
@@ -330,9 +369,16 @@ impl Planner {
                         Some(j) => {
                             let prev_cruise = (j.prev_programmed_mm_per_s * override_pct / 100.0)
                                 .min(j.prev_limit_mm_per_s);
+                            let cruise = seg.cruise_mm_per_s(override_pct);
                             j.limit_mm_per_s(dt_s)
+                                .max(j.smoothed_limit_mm_per_s(
+                                    self.corner_s,
+                                    prev_cruise,
+                                    seg.length_mm,
+                                    cruise,
+                                ))
                                 .min(prev_cruise)
-                                .min(seg.cruise_mm_per_s(override_pct))
+                                .min(cruise)
                         }
                     };
                     let reachable = (seg.exit_mm_per_s * seg.exit_mm_per_s
@@ -444,6 +490,7 @@ impl Planner {
                     return Some(Junction {
                         k_s2_per_mm: k,
                         short_mm: length_mm.min(prev.length_mm),
+                        prev_length_mm: prev.length_mm,
                         prev_programmed_mm_per_s: prev.programmed_mm_per_s,
                         prev_limit_mm_per_s: prev.limit_mm_per_s,
                     });

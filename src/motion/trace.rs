@@ -9,8 +9,12 @@ pub struct Sample {
     /// Channel time since the motion was created, s.
     pub time_s: f64,
     pub pos: Position,
-    /// Path velocity at the end of the tick, mm/s.
+    /// Path velocity over the tick, mm/s.
     pub velocity_mm_per_s: f64,
+    /// Path acceleration (change of the path velocity), mm/s².
+    pub accel_mm_per_s2: f64,
+    /// Path jerk, mm/s³.
+    pub jerk_mm_per_s3: f64,
 }
 
 /// Samples at a stride that doubles whenever the buffer fills; interrupts are kept apart and
@@ -96,6 +100,8 @@ mod tests {
                 time_s: k as f64,
                 pos: [0.0; 6],
                 velocity_mm_per_s: 0.0,
+                accel_mm_per_s2: 0.0,
+                jerk_mm_per_s3: 0.0,
             });
         }
         assert!(t.samples().len() <= 100);

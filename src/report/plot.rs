@@ -186,12 +186,16 @@ mod tests {
                 time_s: k as f64 * 0.001,
                 pos: [k as f64, 2.0 * k as f64, 0.0, 0.0, 0.0, 0.0],
                 velocity_mm_per_s: k as f64,
+                accel_mm_per_s2: 0.0,
+                jerk_mm_per_s3: 0.0,
             });
         }
         t.mark_interrupt(Sample {
             time_s: 0.005,
             pos: [5.0, 10.0, 0.0, 0.0, 0.0, 0.0],
             velocity_mm_per_s: 0.0,
+            accel_mm_per_s2: 0.0,
+            jerk_mm_per_s3: 0.0,
         });
         let svg = render_svg(&t, "a <b> & c");
         assert!(svg.starts_with("<svg"));
