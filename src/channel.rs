@@ -262,6 +262,12 @@ impl Channel {
     pub fn last_error(&self) -> Option<&(u32, String)> {
         self.last_error.as_ref()
     }
+    /// Blocks the lookahead window holds and may not release yet (the memory effect): what
+    /// the axes wait for during an interrupt.
+    pub fn held_blocks(&self) -> usize {
+        self.motion.held_blocks()
+    }
+
     pub fn position(&self) -> Position {
         self.motion.position()
     }
@@ -696,7 +702,7 @@ impl Channel {
         }
         self.notes = notes;
         if self.state == State::Active
-            && self.ran_any
+            && (self.ran_any || self.motion.held_blocks() > 0)
             && !self.interrupted
             && self.motion.waiting_for_data()
             && self.queue.is_empty()
@@ -705,7 +711,9 @@ impl Channel {
             self.interrupted = true;
             self.stats.interrupts += 1;
             self.motion.note_interrupt();
-            self.events.push(tick, self.number, EventKind::Interrupt);
+            let held = self.motion.held_blocks() as u64;
+            self.events
+                .push(tick, self.number, EventKind::Interrupt { held });
         }
     }
 }

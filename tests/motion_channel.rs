@@ -95,8 +95,13 @@ fn run_stream(
     (c, events, velocity)
 }
 
+/// Events of `k`'s kind (fields not compared).
 fn count(events: &[(u64, EventKind)], k: &EventKind) -> usize {
-    events.iter().filter(|(_, e)| e == k).count()
+    let d = std::mem::discriminant(k);
+    events
+        .iter()
+        .filter(|(_, e)| std::mem::discriminant(e) == d)
+        .count()
 }
 
 fn blocks(events: &[(u64, EventKind)]) -> Vec<(u64, Option<u64>)> {
@@ -118,7 +123,7 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
     // N10 takes about 0.61 s at F1000. In time: N20 arrives at 0.3 s.
     let (c, ev, v) = run_stream(&s, &[(1, first), (300, next), (1500, end)], 5000);
     assert_eq!(
-        count(&ev, &EventKind::Interrupt),
+        count(&ev, &EventKind::Interrupt { held: 0 }),
         1,
         "only after N20, waiting for M30"
     );
@@ -138,9 +143,13 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
 
     // Late: N20 arrives at 1.0 s, after N10 has stopped: an interrupt, then a resume.
     let (c, ev, _) = run_stream(&s, &[(1, first), (1000, next), (2500, end)], 6000);
-    assert_eq!(count(&ev, &EventKind::Interrupt), 2);
+    assert_eq!(count(&ev, &EventKind::Interrupt { held: 0 }), 2);
     assert_eq!(count(&ev, &EventKind::Resume), 2);
-    let first_interrupt = ev.iter().find(|e| e.1 == EventKind::Interrupt).unwrap().0;
+    let first_interrupt = ev
+        .iter()
+        .find(|e| e.1 == EventKind::Interrupt { held: 0 })
+        .unwrap()
+        .0;
     assert!((600..1000).contains(&first_interrupt), "{first_interrupt}");
     let resume = ev.iter().find(|e| e.1 == EventKind::Resume).unwrap().0;
     assert_eq!(resume, 1000, "resumes when N20 starts");
@@ -160,9 +169,17 @@ fn without_flush_blocks_wait_in_the_window_and_the_program_end_releases_them() {
         .collect();
     let (c, ev, _) = run_stream(&s, &[(1, &text), (400, "M30\r\n")], 3000);
     let b = blocks(&ev);
-    // Held: nothing takes effect until M30 arrives, and no interrupt before the first block.
+    // Held: nothing takes effect until M30 arrives; the standstill is an interrupt that says
+    // the window holds the three blocks.
     assert!(b.iter().all(|x| x.0 >= 400), "{b:?}");
-    assert_eq!(count(&ev, &EventKind::Interrupt), 0);
+    let held: Vec<u64> = ev
+        .iter()
+        .filter_map(|e| match e.1 {
+            EventKind::Interrupt { held } => Some(held),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(held, vec![3]);
     assert_eq!(c.position()[0], 15.0);
 }
 
@@ -189,7 +206,7 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
         events.extend(c.events_mut().events().iter().map(|e| e.kind.clone()));
         c.events_mut().flush_to(&mut EventLog::disabled());
     }
-    assert!(!events.contains(&EventKind::Interrupt));
+    assert!(!events.contains(&EventKind::Interrupt { held: 0 }));
     assert_eq!(c.state(), State::Ready);
     assert_eq!(c.position()[0], 100.0);
 }
@@ -379,4 +396,43 @@ fn check_list_file_recognises_a_zero_offset_list() {
     assert_eq!(d.len(), 1, "{d:?}");
     assert_eq!((d[0].line, d[0].col), (1, 27));
     assert!(d[0].message.contains("0.1 µm"), "{}", d[0].message);
+}
+
+#[test]
+fn m5_after_the_last_motion_of_a_paused_stream_takes_effect_when_the_motion_ends() {
+    let s = Setup::new("", "[planner]\nlookahead_blocks = 4\n");
+    // Six moves fill the window (4) and are released; M5 and a dwell follow, then the stream
+    // pauses for 3 s before M30.
+    let mut text: String = (1..=6)
+        .map(|i| format!("N{i} G1 X{} F3000\r\n", i * 5))
+        .collect();
+    text.push_str("N7 M5\r\nN8 G4 X0.2\r\n");
+    let (c, ev, v) = run_stream(&s, &[(1, &text), (3000, "N9 M30\r\n")], 6000);
+    let b = blocks(&ev);
+    let t6 = b.iter().find(|x| x.1 == Some(6)).unwrap().0 as usize;
+    let t7 = b.iter().find(|x| x.1 == Some(7)).unwrap().0 as usize;
+    let t8 = b.iter().find(|x| x.1 == Some(8)).unwrap().0 as usize;
+    // M5 when interpolation reaches it: the axes have just stopped at X30, long before M30.
+    assert!(t7 > t6 && t7 < 2000, "M5 at tick {t7}");
+    assert!(
+        v[t7] == 0.0 && v[t7 - 1] > 0.0,
+        "M5 in the tick the motion ends: {:?}",
+        &v[t7 - 3..t7 + 2]
+    );
+    assert!(t8 >= t7 && t8 < 2000, "G4 at tick {t8}");
+    // Waiting for M30 after the dwell is an interrupt with nothing held.
+    let held: Vec<(u64, u64)> = ev
+        .iter()
+        .filter_map(|e| match e.1 {
+            EventKind::Interrupt { held } => Some((e.0, held)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(held.len(), 1, "{held:?}");
+    assert_eq!(held[0].1, 0);
+    assert!(
+        held[0].0 as usize > t8 + 150,
+        "not during the dwell: {held:?}"
+    );
+    assert_eq!(c.position()[0], 30.0);
 }

@@ -299,7 +299,9 @@ impl Planner {
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
-            _ => false,
+            // Nothing held before it: it takes no part in cross-block planning, so it runs
+            // when interpolation reaches it, not when more motion arrives.
+            EntryKind::Plain | EntryKind::Dwell { .. } => self.held() == 0,
         };
         let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
         self.window.push_back(Entry {
