@@ -11,7 +11,9 @@ use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock};
+use ncchannel::queue::{
+    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Position, QueuedBlock,
+};
 
 const DT: f64 = 0.001;
 const WINDOW: usize = 32;
@@ -94,6 +96,7 @@ impl Bench {
                 start: self.at,
                 end: to,
                 feed_mm_per_min: 6000.0,
+                path: PathMode::default(),
             }),
             silent: false,
         });

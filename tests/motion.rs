@@ -10,7 +10,7 @@ use ncchannel::motion::check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, Plane, Position, QueuedBlock,
+    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
 };
 
 /// The positional form reads best in these tables of cases.
@@ -81,6 +81,7 @@ fn line(start: Position, end: Position, feed: f64) -> Action {
         start,
         end,
         feed_mm_per_min: feed,
+        path: PathMode::default(),
     })
 }
 
@@ -567,6 +568,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
                 start: at,
                 end: to,
                 feed_mm_per_min: 0.0,
+                path: PathMode::default(),
             });
             at = to;
             a

@@ -10,7 +10,7 @@ use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, Plane, Position, QueuedBlock,
+    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
 };
 
 const DT: f64 = 0.001;
@@ -62,6 +62,7 @@ fn line(start: Position, end: Position, feed: f64) -> Action {
         start,
         end,
         feed_mm_per_min: feed,
+        path: PathMode::default(),
     })
 }
 
@@ -215,6 +216,7 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
                     start: at,
                     end: to,
                     feed_mm_per_min: 0.0,
+                    path: PathMode::default(),
                 }),
             ));
             at = to;

@@ -12,11 +12,11 @@
 //! deceleration after interpolation"); its price is a lag of T and rounded corners (the path
 //! seen through the window), which docs/motion.md quantifies.
 //!
-//! Rounding. Every tick's output is recomputed from the window (no running sum), relative to
-//! the newest input, so nothing drifts; once the window holds one position only the output is
-//! that position exactly, so programmed end points are reached exactly.
+//! Rounding. The window's sum is kept relative to a nearby origin and recomputed exactly once
+//! per turn of the window, so nothing drifts; once the window holds one position only, the
+//! output is that position exactly, so programmed end points are reached exactly.
 
-use crate::queue::Position;
+use crate::queue::{Position, MAX_AXES};
 
 /// Longest window, ticks (bounds memory and tick work whatever the limits say).
 pub const MAX_WINDOW_TICKS: usize = 4096;
@@ -29,6 +29,10 @@ struct Stage {
     head: usize,
     /// Consecutive pushes equal to the newest input (≥ len: settled).
     same: usize,
+    /// Σ (entry − origin) over the ring; recomputed exactly once per turn of the ring.
+    sum: Position,
+    /// Reference the sum is kept relative to (small terms, small rounding).
+    origin: Position,
     out: Position,
 }
 
@@ -38,6 +42,8 @@ impl Stage {
             ring: vec![p; len.clamp(1, MAX_WINDOW_TICKS)],
             head: 0,
             same: usize::MAX,
+            sum: [0.0; MAX_AXES],
+            origin: p,
             out: p,
         }
     }
@@ -63,20 +69,28 @@ impl Stage {
         } else {
             self.same = 1;
         }
+        let old = self.ring[self.head];
         self.ring[self.head] = p;
         self.head = (self.head + 1) % n;
         if self.settled() {
             self.out = p;
             return p;
         }
+        if self.head == 0 {
+            // Once per turn: the sum afresh, relative to the newest input (no drift).
+            self.origin = p;
+            for i in 0..MAX_AXES {
+                self.sum[i] = self.ring.iter().map(|q| q[i] - p[i]).sum();
+            }
+        } else {
+            for i in 0..MAX_AXES {
+                self.sum[i] += (p[i] - self.origin[i]) - (old[i] - self.origin[i]);
+            }
+        }
         let inv = 1.0 / n as f64;
         let mut out = p;
         for (i, o) in out.iter_mut().enumerate() {
-            let mut sum = 0.0;
-            for q in &self.ring {
-                sum += q[i] - p[i];
-            }
-            *o = p[i] + sum * inv;
+            *o = self.origin[i] + self.sum[i] * inv;
         }
         self.out = out;
         out
@@ -185,7 +199,6 @@ pub fn jerk_window_s(axes: &[super::AxisLimits]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::queue::MAX_AXES;
 
     #[test]
     fn a_step_becomes_a_ramp_and_settles_exactly() {

@@ -260,6 +260,7 @@ mod tests {
             start: [10.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             end: [0.0, 10.0, 0.0, 0.0, 0.0, 0.0],
             feed_mm_per_min: 1000.0,
+            path: Default::default(),
         };
         let l = m.length_mm();
         let t0 = tangent(&m, l, false);

@@ -9,6 +9,7 @@
 //! `#FLUSH WAIT` and the program end do).
 
 pub mod check;
+pub mod contour;
 pub mod filter;
 pub mod interpolator;
 pub mod planner;
@@ -299,6 +300,7 @@ impl Motion {
         self.time_s += dt_s;
         self.filter.configure(self.dt_s);
         if !self.ended {
+            self.planner.front_busy = self.front_started;
             self.planner.take_from(queue);
             self.planner.plan_if_needed(self.override_pct, self.dt_s);
             self.execute(dt_s, notes);

@@ -191,6 +191,8 @@ pub struct Planner {
     dirty: bool,
     /// Corner smoothing window, s (0 = off).
     corner_s: f64,
+    /// The front entry is executing (its geometry is fixed).
+    pub front_busy: bool,
 }
 
 impl Planner {
@@ -212,6 +214,7 @@ impl Planner {
             moves: 0,
             release_next_move: false,
             dirty: false,
+            front_busy: false,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -293,7 +296,12 @@ impl Planner {
                 m,
                 prog: info.prog.clone(),
             },
-            Action::Move(mv) => EntryKind::Move(Box::new(self.segment(mv))),
+            Action::Move(mut mv) => {
+                if let Some(arc) = self.blend_corner(&mut mv) {
+                    self.push_move(None, arc);
+                }
+                EntryKind::Move(Box::new(self.segment(mv)))
+            }
         };
         let is_move = matches!(kind, EntryKind::Move(_));
         let release = match &kind {
@@ -320,6 +328,44 @@ impl Planner {
         if continue_after {
             self.release_next_move = true;
         }
+    }
+
+    /// A silent motion entry (a contour blend) at the back of the window.
+    fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
+        let kind = EntryKind::Move(Box::new(self.segment(mv)));
+        self.window.push_back(Entry { info, kind });
+        self.moves += 1;
+    }
+
+    /// Contouring: if the last motion block in the window ends in a corner it should blend
+    /// (G261 / G61), shorten it and `next` and return the blend arc (see [`super::contour`]).
+    /// The window's front is not changed once it executes.
+    fn blend_corner(&mut self, next: &mut Move) -> Option<Move> {
+        let mut at = None;
+        for (i, e) in self.window.iter().enumerate().rev() {
+            match &e.kind {
+                EntryKind::Move(_) => {
+                    at = Some(i);
+                    break;
+                }
+                k if k.is_barrier() => return None,
+                _ => {}
+            }
+        }
+        let i = at.filter(|&i| i > 0 || !self.front_busy)?;
+        let EntryKind::Move(prev) = &mut self.window[i].kind else {
+            return None;
+        };
+        let dev = prev.mv.path.contour_dev_mm?;
+        let (p1, arc, p2) = super::contour::blend(&prev.mv, next, dev)?;
+        prev.mv.end = p1;
+        prev.length_mm = prev.mv.length_mm();
+        if let Some(j) = prev.junction.as_mut() {
+            j.short_mm = j.short_mm.min(prev.length_mm);
+        }
+        next.start = p2;
+        self.dirty = true;
+        Some(arc)
     }
 
     /// Release every block in the window.
