@@ -511,3 +511,41 @@ fn contoured_square_stays_within_the_deviation_and_does_not_stop_at_corners() {
         .fold(f64::INFINITY, f64::min);
     assert!(slowest < 1.0, "{slowest}");
 }
+
+#[test]
+fn run_trace_writes_a_header_and_one_row_per_stride_ending_at_the_end_point() {
+    let s = Setup::new(
+        "",
+        "[[axes]]\nname = \"X\"\nmax_jerk_mm_per_s3 = 20000.0\n\
+         [[axes]]\nname = \"Y\"\nmax_jerk_mm_per_s3 = 20000.0\n",
+    );
+    let stream = s.write("nc/sq.nc", "G1 X20 F3000\nY20\nM30\n");
+    let csv = s.dir.path().join("trace.csv");
+    let r = run_report(
+        &s,
+        &stream,
+        &["--trace", csv.to_str().unwrap(), "--trace-every", "5"],
+    );
+    let ticks = r["ticks"].as_u64().unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time_s,X_mm,Y_mm,velocity_mm_per_s,acceleration_mm_per_s2,jerk_mm_per_s3")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|f| f.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(
+        rows.len() as u64,
+        ticks.div_ceil(5),
+        "one row every 5 ticks"
+    );
+    assert!(rows
+        .windows(2)
+        .all(|w| (w[1][0] - w[0][0] - 0.005).abs() < 1e-9));
+    let peak_jerk = rows.iter().map(|r| r[5].abs()).fold(0.0, f64::max);
+    assert!(peak_jerk > 1000.0, "jerk is traced ({peak_jerk})");
+    let last = rows.last().unwrap();
+    assert_eq!((last[1], last[2], last[3]), (20.0, 20.0, 0.0));
+}

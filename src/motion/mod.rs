@@ -24,7 +24,7 @@ use filter::{jerk_window_s, AxisFilter};
 use interpolator::{advance, point_at, Profile};
 pub use planner::PlannerSettings;
 use planner::{EntryKind, Planner};
-use trace::{Sample, Trace};
+use trace::{CsvTrace, Sample, Trace};
 
 /// Limits of one axis (runtime.toml `[[axes]]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -101,6 +101,7 @@ pub struct Motion {
     /// Channel time this motion has stepped through, s.
     time_s: f64,
     trace: Option<Trace>,
+    csv: Option<CsvTrace>,
 }
 
 impl Motion {
@@ -134,6 +135,7 @@ impl Motion {
             dt_s: 0.001,
             time_s: 0.0,
             trace: None,
+            csv: None,
         }
     }
 
@@ -269,6 +271,22 @@ impl Motion {
         self.trace = Some(Trace::new(max_samples));
     }
 
+    /// Stream every `every`-th tick's axis positions, path velocity, acceleration and jerk to
+    /// a CSV file (`run --trace`).
+    pub fn enable_csv_trace(&mut self, path: &std::path::Path, every: u64) -> std::io::Result<()> {
+        let axes: Vec<usize> = self.axes.iter().map(|a| a.index).collect();
+        self.csv = Some(CsvTrace::create(path, &axes, every)?);
+        Ok(())
+    }
+
+    /// Close the CSV trace (if any): its first write error, if there was one.
+    pub fn finish_csv_trace(&mut self) -> std::io::Result<()> {
+        match self.csv.take() {
+            Some(c) => c.finish(),
+            None => Ok(()),
+        }
+    }
+
     pub fn trace(&self) -> Option<&Trace> {
         self.trace.as_ref()
     }
@@ -310,10 +328,13 @@ impl Motion {
         if dt_s > 0.0 {
             self.filter_step(dt_s);
         }
-        if self.trace.is_some() {
+        if self.trace.is_some() || self.csv.is_some() {
             let s = self.sample();
             if let Some(t) = self.trace.as_mut() {
                 t.record(s);
+            }
+            if let Some(c) = self.csv.as_mut() {
+                c.record(&s);
             }
         }
     }
