@@ -193,7 +193,18 @@ impl Rng {
     }
 }
 
-/// A random program: rapids, lines (long, short, chains of tiny nearly collinear ones), arcs
+/// Half the lines with G261 (a deviation of 0.01 … 0.5 mm).
+fn contoured(a: Action, rng: &mut Rng) -> Action {
+    match a {
+        Action::Move(mut mv) if rng.next() < 0.5 => {
+            mv.path.contour_dev_mm = Some(rng.range(0.01, 0.5));
+            Action::Move(mv)
+        }
+        a => a,
+    }
+}
+
+/// A random program: rapids, lines (long, short, CAM polylines; half of them contoured), arcs
 /// and helices in all planes, dwells, M30. Returns the end point.
 fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
     let mut at = p(0.0, 0.0, 0.0);
@@ -232,7 +243,7 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
                 at[1] + len * th.sin() * ph.cos(),
                 at[2] + len * ph.sin(),
             );
-            q.push(block(n, line(at, to, feed)));
+            q.push(block(n, contoured(line(at, to, feed), rng)));
             at = to;
         } else if kind < 0.6 {
             // A CAM polyline: 20..200 chords of a circle, radius 5..60 mm.
@@ -244,7 +255,7 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
             for k in 1..=chords {
                 let phi = phi0 + sweep * k as f64 / chords as f64;
                 let to = p(c[0] + r * phi.cos(), c[1] + r * phi.sin(), at[2]);
-                q.push(block(n, line(at, to, feed)));
+                q.push(block(n, contoured(line(at, to, feed), rng)));
                 at = to;
             }
         } else if kind < 0.95 {

@@ -8,9 +8,9 @@
 //! arc's centripetal acceleration v²/r bounds the speed through it like any programmed arc,
 //! and the axis filter (if on) turns the step in curvature into a jerk-limited ramp. The arc
 //! of a corner with direction change θ and deviation δ has radius r = δ·cos(θ/2)/(1 − cos(θ/2))
-//! and cuts d = r·tan(θ/2) off both blocks; d is capped at half the next block and at what
-//! the previous block has left, so blends never overlap (the radius, and with it the deviation,
-//! shrinks instead).
+//! and cuts d = r·tan(θ/2) off both blocks; d is capped at half the next block and half of what
+//! the previous block has left, so blends never overlap and no line shrinks to nothing (the
+//! radius, and with it the deviation, shrinks instead).
 
 use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
 
@@ -67,7 +67,9 @@ pub fn blend(prev: &Move, next: &Move, dev_mm: f64) -> Option<(Position, Move, P
     let half = 0.5 * turn;
     let mut r = dev_mm * half.cos() / (1.0 - half.cos());
     let mut cut = r * half.tan();
-    let max_cut = (0.5 * l2).min(l1 * (1.0 - 1e-9));
+    // Half of each block at most, and half of what an earlier blend left of `prev`: no blend
+    // eats a block (a line of nearly no length has no usable direction).
+    let max_cut = 0.5 * l2.min(l1);
     if cut > max_cut {
         cut = max_cut;
         r = cut / half.tan();
