@@ -549,3 +549,50 @@ fn run_trace_writes_a_header_and_one_row_per_stride_ending_at_the_end_point() {
     let last = rows.last().unwrap();
     assert_eq!((last[1], last[2], last[3]), (20.0, 20.0, 0.0));
 }
+
+/// The seed's streaming-spline example (nc/streaming_spline.nc), with the feed the excerpt
+/// leaves out.
+/// Lines end in CR LF, as the stream interface wants them.
+fn streaming_spline_text() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("nc/streaming_spline.nc"))
+        .unwrap()
+        .lines()
+        .map(|l| format!("{l}\r\n"))
+        .collect()
+}
+
+/// The spline geometry itself is not built yet (docs/motion.md): the points run as a polyline,
+/// and the corner filter keeps the speed through them.
+#[test]
+fn streaming_spline_example_in_packets_with_the_corner_filter_passes_its_points_without_stopping() {
+    let s = Setup::new("", "[planner]\ncorner_smoothing_ms = 50\n");
+    let text = streaming_spline_text();
+    // Packets of two lines, one every 5 ticks: the example arrives while it runs.
+    let lines: Vec<&str> = text.split_inclusive("\r\n").collect();
+    let writes: Vec<(u64, String)> = lines
+        .chunks(2)
+        .enumerate()
+        .map(|(i, c)| (1 + 5 * i as u64, c.concat()))
+        .collect();
+    let refs: Vec<(u64, &str)> = writes.iter().map(|(t, w)| (*t, w.as_str())).collect();
+    let (c, ev, v) = run_stream(&s, &refs, 20_000);
+    assert!(c.errors().is_empty(), "{:?}", c.errors());
+    let b = blocks(&ev);
+    let first = b.iter().find(|x| x.1 == Some(36338)).unwrap().0 as usize;
+    let last = b.iter().find(|x| x.1 == Some(36355)).unwrap().0 as usize;
+    let slowest = v[first..last].iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(
+        slowest > 1.0,
+        "stopped at a programmed point: {slowest} mm/s"
+    );
+    assert!((c.position()[2] - 1.8353).abs() < 1e-9);
+}
+
+#[test]
+fn flush_inside_the_streaming_spline_is_21909() {
+    let s = Setup::new("", "");
+    let text = streaming_spline_text().replace("N36345", "#FLUSH\r\nN36345");
+    let (head, tail) = text.split_at(text.find("N36340").unwrap());
+    let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
+    assert_eq!(c.last_error().map(|e| e.0), Some(21909), "{:?}", c.errors());
+}
