@@ -1,13 +1,16 @@
-//! Planner: the lookahead window of blocks held in the channel (the "memory effect" of seed 003
-//! §2.3.1), the rules that release them for execution (`#FLUSH`, a full window, the program
-//! end), and the velocity plan over the released motion blocks.
+//! Planner: the lookahead window of blocks held in the channel (the "memory effect" of ISG
+//! FCT-C19 Data streaming §2.3.1), the rules that release them for execution (`#FLUSH`, a full
+//! window, the program end), contour blends (G261/G61) and the velocity plan over the released
+//! motion blocks.
 //!
-//! Release rules. Blocks taken from the block queue are *held* until one of these releases every
-//! block in the window: the window holds `lookahead_blocks` motion blocks (it is full); the
-//! program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT` enters it.
-//! `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a stream that
-//! delivers it in time continues without a stop (seed: "if the next motion block is presented in
-//! good time before an NC block end, motion is resumed without stopping").
+//! Release rules. Motion blocks taken from the block queue are *held* until one of these
+//! releases every block in the window: the window holds `lookahead_blocks` motion blocks (it is
+//! full); the program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT`
+//! enters it. `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a
+//! stream that delivers it in time continues without a stop ("if the next motion block is
+//! presented in good time before an NC block end, motion is resumed without stopping"). A
+//! non-motion block or a dwell with nothing held before it is released at once: it takes no
+//! part in cross-block planning.
 //!
 //! Velocity plan. Every released motion block gets a nominal velocity (programmed feed, G0 at
 //! the axes' rapid rates, lowered so no axis exceeds its maximum velocity; arcs also so the

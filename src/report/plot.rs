@@ -36,6 +36,9 @@ pub fn render_svg(trace: &Trace, title: &str) -> String {
 
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
+/// One time panel: caption, axis label, the sampled quantity, colour.
+type Series = (&'static str, &'static str, fn(&Sample) -> f64, RGBColor);
+
 fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, trace: &Trace, title: &str) -> DrawResult {
     root.fill(&WHITE)?;
     let n = trace.interrupts().len();
@@ -46,7 +49,7 @@ fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, trace: &Trace, title: &str) -
     let (left, right) = root.split_horizontally(PATH_PANEL);
     path_panel(&left, trace)?;
     let rows = right.split_evenly((3, 1));
-    let series: [(&str, &str, fn(&Sample) -> f64, RGBColor); 3] = [
+    let series: [Series; 3] = [
         (
             "path velocity",
             "v (mm/s)",
