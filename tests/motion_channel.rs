@@ -561,11 +561,11 @@ fn streaming_spline_text() -> String {
         .collect()
 }
 
-/// The spline geometry itself is not built yet (docs/motion.md): the points run as a polyline,
-/// and the corner filter keeps the speed through them.
+/// The example is a B-spline (`#SPLINE TYPE BSPLINE`, G151): the motion follows the curve
+/// through the streamed points without stopping at them.
 #[test]
-fn streaming_spline_example_in_packets_with_the_corner_filter_passes_its_points_without_stopping() {
-    let s = Setup::new("", "[planner]\ncorner_smoothing_ms = 50\n");
+fn streaming_spline_example_in_packets_passes_its_points_without_stopping() {
+    let s = Setup::new("", "");
     let text = streaming_spline_text();
     // Packets of two lines, one every 5 ticks: the example arrives while it runs.
     let lines: Vec<&str> = text.split_inclusive("\r\n").collect();

@@ -11,6 +11,7 @@ use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
+    SplineKind,
 };
 
 const DT: f64 = 0.001;
@@ -204,8 +205,8 @@ fn contoured(a: Action, rng: &mut Rng) -> Action {
     }
 }
 
-/// A random program: rapids, lines (long, short, CAM polylines; half of them contoured), arcs
-/// and helices in all planes, dwells, M30. Returns the end point.
+/// A random program: rapids, lines (long, short, CAM polylines: a third of them splines, half
+/// of the rest contoured), arcs and helices in all planes, dwells, M30. Returns the end point.
 fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
     let mut at = p(0.0, 0.0, 0.0);
     let planes = [Plane::Xy, Plane::Zx, Plane::Yz];
@@ -252,10 +253,23 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
             let phi0 = rng.range(0.0, 6.3);
             let sweep = rng.range(0.5, 6.0);
             let c = [at[0] - r * phi0.cos(), at[1] - r * phi0.sin()];
+            // A third of the polylines as a spline (G151), of either type.
+            let spline = match rng.next() {
+                x if x < 0.17 => Some(SplineKind::Akima),
+                x if x < 0.34 => Some(SplineKind::BSpline),
+                _ => None,
+            };
             for k in 1..=chords {
                 let phi = phi0 + sweep * k as f64 / chords as f64;
                 let to = p(c[0] + r * phi.cos(), c[1] + r * phi.sin(), at[2]);
-                q.push(block(n, contoured(line(at, to, feed), rng)));
+                let a = match (spline, line(at, to, feed)) {
+                    (Some(kind), Action::Move(mut mv)) => {
+                        mv.path.spline = Some(kind);
+                        Action::Move(mv)
+                    }
+                    (_, a) => contoured(a, rng),
+                };
+                q.push(block(n, a));
                 at = to;
             }
         } else if kind < 0.95 {

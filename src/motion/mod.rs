@@ -13,6 +13,7 @@ pub mod contour;
 pub mod filter;
 pub mod interpolator;
 pub mod planner;
+pub mod spline;
 pub mod trace;
 
 use std::sync::Arc;

@@ -33,9 +33,10 @@
 use std::collections::VecDeque;
 
 use crate::lang::block::FlushKind;
-use crate::queue::{Action, BlockInfo, Move, MoveKind, QueuedBlock, MAX_AXES};
+use crate::queue::{Action, BlockInfo, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES};
 
 use super::interpolator::tangent;
+use super::spline::Spline;
 use super::AxisLimits;
 
 /// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
@@ -175,6 +176,9 @@ pub struct Entry {
     /// Taken when the `block` event is emitted (`None` for silent second parts).
     pub info: Option<BlockInfo>,
     pub kind: EntryKind,
+    /// A motion entry that counts towards the lookahead (a programmed block; not a contour
+    /// blend, not the second and later pieces of a spline segment).
+    pub counted: bool,
 }
 
 /// The lookahead window: a prefix of it is released, the rest held.
@@ -196,6 +200,14 @@ pub struct Planner {
     corner_s: f64,
     /// The front entry is executing (its geometry is fixed).
     pub front_busy: bool,
+    /// The spline being built (G151), if any.
+    spline: Option<Spline>,
+    /// Spline blocks waiting for their curve: (point number, event).
+    spline_infos: VecDeque<(usize, Option<BlockInfo>)>,
+    /// Plain blocks programmed after spline point n, waiting for its curve.
+    spline_waiting: VecDeque<(usize, Option<BlockInfo>)>,
+    /// Reused buffer of finished curve segments.
+    spline_out: Vec<super::spline::Segment>,
 }
 
 impl Planner {
@@ -218,6 +230,10 @@ impl Planner {
             release_next_move: false,
             dirty: false,
             front_busy: false,
+            spline: None,
+            spline_infos: VecDeque::new(),
+            spline_waiting: VecDeque::new(),
+            spline_out: Vec::new(),
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -239,9 +255,9 @@ impl Planner {
     pub fn released(&self) -> usize {
         self.released
     }
-    /// Entries held back (the memory effect).
+    /// Entries held back (the memory effect), blocks waiting for their spline curve included.
     pub fn held(&self) -> usize {
-        self.window.len() - self.released
+        self.window.len() - self.released + self.spline_infos.len() + self.spline_waiting.len()
     }
     pub fn front(&self) -> Option<&Entry> {
         self.window.front()
@@ -285,6 +301,26 @@ impl Planner {
             action,
             silent,
         } = b;
+        let prog = info.prog.clone();
+        let info = (!silent).then_some(info);
+        // Splines: G1 points in spline mode go to the spline; anything else but a plain block
+        // ends it first.
+        if let Action::Move(mv) = &action {
+            if let (Some(kind), MoveKind::Line) = (mv.path.spline, mv.kind) {
+                self.spline_point(info, kind, mv);
+                return;
+            }
+        }
+        if self.spline.is_some() {
+            if matches!(action, Action::None) {
+                if let Some(sp) = self.spline.as_ref() {
+                    let at = sp.received();
+                    self.spline_waiting.push_back((at, info));
+                }
+                return;
+            }
+            self.finish_spline();
+        }
         let kind = match action {
             Action::None => EntryKind::Plain,
             Action::Dwell { seconds } => EntryKind::Dwell {
@@ -297,7 +333,7 @@ impl Planner {
             Action::Flush(k) => EntryKind::Flush(k),
             Action::End { m } => EntryKind::End {
                 m,
-                prog: info.prog.clone(),
+                prog,
             },
             Action::Move(mut mv) => {
                 if let Some(arc) = self.blend_corner(&mut mv) {
@@ -306,7 +342,13 @@ impl Planner {
                 EntryKind::Move(Box::new(self.segment(mv)))
             }
         };
+        self.push_entry(info, kind, true);
+    }
+
+    /// Append one entry and apply the release rules.
+    fn push_entry(&mut self, info: Option<BlockInfo>, kind: EntryKind, counted: bool) {
         let is_move = matches!(kind, EntryKind::Move(_));
+        let counted = counted && is_move;
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
@@ -316,14 +358,15 @@ impl Planner {
         };
         let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
         self.window.push_back(Entry {
-            info: (!silent).then_some(info),
+            info,
             kind,
+            counted,
         });
-        if is_move {
+        if counted {
             self.moves += 1;
-            if self.release_next_move {
-                self.release_next_move = false;
-            }
+        }
+        if is_move && self.release_next_move {
+            self.release_next_move = false;
         }
         if release {
             self.release_all();
@@ -333,11 +376,93 @@ impl Planner {
         }
     }
 
-    /// A silent motion entry (a contour blend) at the back of the window.
+    /// A silent motion entry (a contour blend) at the back of the window; it does not count
+    /// towards the lookahead.
     fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
         let kind = EntryKind::Move(Box::new(self.segment(mv)));
-        self.window.push_back(Entry { info, kind });
-        self.moves += 1;
+        self.window.push_back(Entry {
+            info,
+            kind,
+            counted: false,
+        });
+    }
+
+    /// A G1 point in spline mode: into the spline (a new one if the type changed), and the
+    /// curve it completes into the window.
+    fn spline_point(&mut self, info: Option<BlockInfo>, kind: SplineKind, mv: &Move) {
+        if self.spline.as_ref().is_some_and(|s| s.kind() != kind) {
+            self.finish_spline();
+        }
+        let sp = self
+            .spline
+            .get_or_insert_with(|| Spline::new(kind, mv.start, mv.feed_mm_per_min, mv.path));
+        if mv.end == sp.last() {
+            // No motion: the block takes effect like a plain one, in order.
+            let at = sp.received();
+            self.spline_waiting.push_back((at, info));
+            return;
+        }
+        let at = sp.received() + 1;
+        self.spline_infos.push_back((at, info));
+        let mut out = std::mem::take(&mut self.spline_out);
+        if let Some(sp) = self.spline.as_mut() {
+            sp.push(mv.end, mv.feed_mm_per_min, &mut out);
+        }
+        self.emit_spline(&mut out);
+        self.spline_out = out;
+    }
+
+    /// End the spline: the rest of its curve and everything waiting for it.
+    fn finish_spline(&mut self) {
+        let Some(sp) = self.spline.take() else { return };
+        let mut out = std::mem::take(&mut self.spline_out);
+        sp.finish(&mut out);
+        self.emit_spline(&mut out);
+        // Blocks whose curve never came (nothing moved): in order, as plain entries.
+        let mut rest: Vec<(usize, Option<BlockInfo>)> = self
+            .spline_infos
+            .drain(..)
+            .chain(self.spline_waiting.drain(..))
+            .collect();
+        rest.sort_by_key(|(at, _)| *at);
+        for (_, info) in rest {
+            self.push_entry(info, EntryKind::Plain, false);
+        }
+        self.spline_out = out;
+    }
+
+    /// Curve segments into the window: each segment's first piece carries its block's event,
+    /// and plain blocks programmed after that block follow it.
+    fn emit_spline(&mut self, out: &mut Vec<super::spline::Segment>) {
+        for seg in out.drain(..) {
+            let mut info = None;
+            while self
+                .spline_infos
+                .front()
+                .is_some_and(|(at, _)| *at <= seg.point)
+            {
+                if let Some((_, i)) = self.spline_infos.pop_front() {
+                    if info.is_some() {
+                        self.push_entry(i, EntryKind::Plain, false);
+                    } else {
+                        info = i;
+                    }
+                }
+            }
+            for (k, mv) in seg.pieces.into_iter().enumerate() {
+                let kind = EntryKind::Move(Box::new(self.segment(mv)));
+                self.push_entry(if k == 0 { info.take() } else { None }, kind, k == 0);
+            }
+            while self
+                .spline_waiting
+                .front()
+                .is_some_and(|(at, _)| *at <= seg.point)
+            {
+                if let Some((_, i)) = self.spline_waiting.pop_front() {
+                    self.push_entry(i, EntryKind::Plain, false);
+                }
+            }
+        }
     }
 
     /// Contouring: if the last motion block in the window ends in a corner it should blend
@@ -382,7 +507,7 @@ impl Planner {
     /// Remove the front entry (it has been executed).
     pub fn pop_front(&mut self) -> Option<Entry> {
         let e = self.window.pop_front()?;
-        if matches!(e.kind, EntryKind::Move(_)) {
+        if e.counted {
             self.moves -= 1;
         }
         self.released = self.released.saturating_sub(1);
@@ -392,6 +517,9 @@ impl Planner {
     /// Drop everything (reset, error).
     pub fn clear(&mut self) {
         self.window.clear();
+        self.spline = None;
+        self.spline_infos.clear();
+        self.spline_waiting.clear();
         self.released = 0;
         self.moves = 0;
         self.release_next_move = false;
