@@ -128,6 +128,8 @@ pub struct ChannelSettings {
     pub cache: CacheLimits,
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
     pub fs_latency: FsLatency,
+    /// Tool radii by D number for G41/G42, mm (`tools.lis`).
+    pub tools: Vec<(u32, f64)>,
 }
 
 /// How a channel's program run finished, for `ncchannel run`.
@@ -203,7 +205,11 @@ impl Channel {
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
             decoder: Decoder::new(s.decoder),
-            motion: Motion::with_planner(s.axes, s.planner),
+            motion: {
+                let mut m = Motion::with_planner(s.axes, s.planner);
+                m.set_tool_radii(s.tools);
+                m
+            },
             program: None,
             search: None,
             last_error: None,
@@ -682,6 +688,10 @@ impl Channel {
                     };
                     self.events
                         .push(tick, self.number, EventKind::Flush { kind: kind.into() });
+                }
+                MotionNote::Error { code, msg } => {
+                    self.raise_error(tick, code, msg, None, None);
+                    break;
                 }
                 MotionNote::End { m, prog } => {
                     self.events.push(

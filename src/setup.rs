@@ -97,6 +97,7 @@ pub fn channel_settings(
             max_file_bytes: u64::from(c.max_file_bytes),
         },
         fs_latency: FsLatency::from_us(rt.fs_latency_us, rt.fs_latency_us_per_kib),
+        tools: config.tools.clone(),
     })
 }
 

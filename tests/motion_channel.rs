@@ -596,3 +596,97 @@ fn flush_inside_the_streaming_spline_is_21909() {
     let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
     assert_eq!(c.last_error().map(|e| e.0), Some(21909), "{:?}", c.errors());
 }
+
+/// Distance of (x, y) from the circle of radius `r` around (cx, cy).
+fn distance_to_circle(x: f64, y: f64, cx: f64, cy: f64, r: f64) -> f64 {
+    ((x - cx).hypot(y - cy) - r).abs()
+}
+
+/// Positions of a program run with the tool list D1 = 5 mm, between the first and the last
+/// block whose `N` lies in `from..=to` (the compensated contour without selection and
+/// deselection).
+fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
+    let s = Setup::new("", "");
+    s.write("params/tools.lis", "wz[1].radius 50000\n");
+    s.write("nc/trc.nc", program);
+    let mut c = s.channel();
+    c.start(&tick(0), "trc.nc").unwrap();
+    let (mut inside, mut out) = (false, Vec::new());
+    for k in 1..200_000u64 {
+        c.step(&tick(k));
+        for e in c.events_mut().events() {
+            if let EventKind::Block { n: Some(n), .. } = e.kind {
+                inside = (from..=to).contains(&n);
+            }
+        }
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if inside {
+            out.push(c.position());
+        }
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    out
+}
+
+#[test]
+fn trc_square_and_circle_stay_equidistant_to_the_programmed_path() {
+    let square = [(0.0, 0.0), (50.0, 0.0), (50.0, 50.0), (0.0, 50.0)];
+    for (g, outside) in [("G41", false), ("G42", true)] {
+        // A counter-clockwise square: G41 keeps the tool inside (corners cut at the
+        // intersections), G42 outside (arcs around the corners).
+        let program = format!(
+            "G0 X-20 Y-20\nN1 {g} D1 G1 X0 Y0 F3000\nN2 X50\nN3 Y50\nN4 X0\nN5 Y0\nN6 X10\n\
+             N7 G40 X-20 Y-20\nM30\n"
+        );
+        let pos = trc_run(&program, 3, 5);
+        assert!(pos.len() > 1000);
+        let worst = pos
+            .iter()
+            .map(|p| (distance_to_polygon(p[0], p[1], &square) - 5.0).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-3 * 1.0, "{g}: off by {worst} mm");
+        // Outside the square for G42, inside for G41.
+        let mid = pos[pos.len() / 2];
+        let inside = (0.0..=50.0).contains(&mid[0]) && (0.0..=50.0).contains(&mid[1]);
+        assert_eq!(inside, !outside, "{g}: {mid:?}");
+    }
+    for (g, r) in [("G41", 25.0), ("G42", 35.0)] {
+        // A counter-clockwise full circle of radius 30 around (0, 0), entered from the left.
+        let program = format!(
+            "G0 X-60 Y0\nN1 {g} D1 G1 X-30 Y0 F3000\nN2 G3 X-30 Y0 I30 J0\nN3 G2 X-20 Y-10 R10\n\
+             N4 G40 G1 X-60 Y-40\nM30\n"
+        );
+        let pos = trc_run(&program, 2, 2);
+        assert!(pos.len() > 500);
+        // The arc around the circle's end point (G42: an outer corner towards N3) is
+        // equidistant to that point, not to the circle: left out.
+        let worst = pos
+            .iter()
+            .filter(|p| (p[0] + 30.0).hypot(p[1]) > 5.0 + 1e-6)
+            .map(|p| distance_to_circle(p[0], p[1], 0.0, 0.0, r))
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-3, "{g}: off by {worst} mm");
+    }
+}
+
+#[test]
+fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
+    let s = Setup::new("", "");
+    s.write("params/tools.lis", "wz[1].radius 50000\n");
+    let program = "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F3000\nG3 X6 Y0 I3 J0\nG1 X20\nG40 X30\nM30\n";
+    s.write("nc/bad_trc.nc", program);
+    let mut c = s.channel();
+    c.start(&tick(0), "bad_trc.nc").unwrap();
+    for k in 1..20_000u64 {
+        c.step(&tick(k));
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Error);
+    assert_eq!(c.last_error().map(|e| e.0), Some(90140), "{:?}", c.errors());
+}

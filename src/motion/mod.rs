@@ -15,6 +15,7 @@ pub mod interpolator;
 pub mod planner;
 pub mod spline;
 pub mod trace;
+pub mod trc;
 
 use std::sync::Arc;
 
@@ -51,6 +52,11 @@ pub enum MotionNote {
     /// A block took effect (started executing): its `block` event.
     Started(BlockInfo),
     Flush(FlushKind),
+    /// Planning found an error (tool radius compensation impossible): the channel stops.
+    Error {
+        code: u32,
+        msg: String,
+    },
     /// The main program's end was reached: everything before it has run.
     End {
         m: u32,
@@ -138,6 +144,11 @@ impl Motion {
             trace: None,
             csv: None,
         }
+    }
+
+    /// Tool radii by D number for tool radius compensation, mm (the tool list).
+    pub fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
+        self.planner.set_tool_radii(tools);
     }
 
     pub fn axes(&self) -> &[AxisLimits] {
@@ -321,6 +332,12 @@ impl Motion {
         if !self.ended {
             self.planner.front_busy = self.front_started;
             self.planner.take_from(queue);
+            if let Some(e) = self.planner.take_error() {
+                notes.push(MotionNote::Error {
+                    code: e.code,
+                    msg: e.msg,
+                });
+            }
             self.planner.plan_if_needed(self.override_pct, self.dt_s);
             self.execute(dt_s, notes);
         } else {

@@ -33,10 +33,13 @@
 use std::collections::VecDeque;
 
 use crate::lang::block::FlushKind;
-use crate::queue::{Action, BlockInfo, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES};
+use crate::queue::{
+    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
+};
 
 use super::interpolator::tangent;
 use super::spline::Spline;
+use super::trc::{Comp, TrcError};
 use super::AxisLimits;
 
 /// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
@@ -208,6 +211,18 @@ pub struct Planner {
     spline_waiting: VecDeque<(usize, Option<BlockInfo>)>,
     /// Reused buffer of finished curve segments.
     spline_out: Vec<super::spline::Segment>,
+    /// Tool radius compensation under way (G41/G42), if any.
+    comp: Option<Comp>,
+    /// The event of the block whose element waits in the compensator.
+    comp_info: Option<BlockInfo>,
+    /// Plain blocks programmed after the waiting element.
+    comp_waiting: VecDeque<Option<BlockInfo>>,
+    /// Reused buffer of compensated moves.
+    comp_out: Vec<Move>,
+    /// Tool radii by D number, mm.
+    tool_radii: Vec<(u32, f64)>,
+    /// An error found while planning (compensation impossible), for the channel.
+    error: Option<TrcError>,
 }
 
 impl Planner {
@@ -234,6 +249,12 @@ impl Planner {
             spline_infos: VecDeque::new(),
             spline_waiting: VecDeque::new(),
             spline_out: Vec::new(),
+            comp: None,
+            comp_info: None,
+            comp_waiting: VecDeque::new(),
+            comp_out: Vec::new(),
+            tool_radii: Vec::new(),
+            error: None,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -257,7 +278,11 @@ impl Planner {
     }
     /// Entries held back (the memory effect), blocks waiting for their spline curve included.
     pub fn held(&self) -> usize {
-        self.window.len() - self.released + self.spline_infos.len() + self.spline_waiting.len()
+        self.window.len() - self.released
+            + self.spline_infos.len()
+            + self.spline_waiting.len()
+            + usize::from(self.comp_info.is_some())
+            + self.comp_waiting.len()
     }
     pub fn front(&self) -> Option<&Entry> {
         self.window.front()
@@ -303,6 +328,22 @@ impl Planner {
         } = b;
         let prog = info.prog.clone();
         let info = (!silent).then_some(info);
+        // Tool radius compensation: every move while it is on (and the G40 block) goes
+        // through the compensator; a plain block waits behind the element it follows, a stop
+        // ends the element.
+        if let Action::Move(mv) = &action {
+            if mv.path.comp != CompSide::Off || self.comp.is_some() {
+                self.comp_move(info, *mv);
+                return;
+            }
+        }
+        if self.comp.is_some() {
+            if matches!(action, Action::None) {
+                self.comp_waiting.push_back(info);
+                return;
+            }
+            self.comp_finish();
+        }
         // Splines: G1 points in spline mode go to the spline; anything else but a plain block
         // ends it first.
         if let Action::Move(mv) = &action {
@@ -331,10 +372,7 @@ impl Planner {
                 },
             },
             Action::Flush(k) => EntryKind::Flush(k),
-            Action::End { m } => EntryKind::End {
-                m,
-                prog,
-            },
+            Action::End { m } => EntryKind::End { m, prog },
             Action::Move(mut mv) => {
                 if let Some(arc) = self.blend_corner(&mut mv) {
                     self.push_move(None, arc);
@@ -410,6 +448,115 @@ impl Planner {
         }
         self.emit_spline(&mut out);
         self.spline_out = out;
+    }
+
+    /// A move while compensation is on, or the block that switches it on or off.
+    fn comp_move(&mut self, info: Option<BlockInfo>, mv: Move) {
+        let side = mv.path.comp;
+        let mut out = std::mem::take(&mut self.comp_out);
+        let done = match (self.comp.take(), side) {
+            (None, CompSide::Off) => Ok(()),
+            (None, _) => self.comp_select(info, mv),
+            (Some(c), CompSide::Off) => {
+                let r = c.deselect(mv, &mut out);
+                // The G40 line is this block's; what comes before it is the waiting element's.
+                let last = out.pop();
+                let pending = self.comp_info.take();
+                self.emit_comp(&mut out, pending);
+                if let Some(l) = last {
+                    out.push(l);
+                }
+                self.emit_comp(&mut out, info);
+                r
+            }
+            (Some(mut c), s) if s == c.side() => {
+                let r = c.next(mv, &mut out);
+                let pending = std::mem::replace(&mut self.comp_info, info);
+                self.emit_comp(&mut out, pending);
+                self.comp = Some(c);
+                r
+            }
+            (Some(mut c), _) => {
+                let r = c.finish(&mut out);
+                let pending = self.comp_info.take();
+                self.emit_comp(&mut out, pending);
+                r.and_then(|()| self.comp_select(info, mv))
+            }
+        };
+        if let Err(e) = done {
+            self.comp = None;
+            self.comp_info = None;
+            self.comp_waiting.clear();
+            self.error = Some(e);
+        }
+        out.clear();
+        self.comp_out = out;
+    }
+
+    /// G41/G42 switches on with `mv`, the radius of its D word's tool.
+    fn comp_select(&mut self, info: Option<BlockInfo>, mv: Move) -> Result<(), TrcError> {
+        let d = mv.path.tool_offset;
+        let radius = if d == 0 {
+            0.0
+        } else {
+            self.tool_radii
+                .iter()
+                .find(|(n, _)| *n == d)
+                .map(|(_, r)| *r)
+                .ok_or_else(|| TrcError {
+                    code: super::trc::TRC_IMPOSSIBLE,
+                    msg: format!("tool radius compensation: no tool data for D{d}"),
+                })?
+        };
+        self.comp = Some(Comp::select(mv.path.comp, radius, mv));
+        self.comp_info = info;
+        Ok(())
+    }
+
+    /// A stop while compensation is on: the waiting element ends at its own offset end.
+    fn comp_finish(&mut self) {
+        let Some(mut c) = self.comp.take() else {
+            return;
+        };
+        let mut out = std::mem::take(&mut self.comp_out);
+        let r = c.finish(&mut out);
+        let pending = self.comp_info.take();
+        self.emit_comp(&mut out, pending);
+        self.comp = Some(c);
+        if let Err(e) = r {
+            self.comp = None;
+            self.error = Some(e);
+        }
+        self.comp_out = out;
+    }
+
+    /// Compensated moves of one block into the window (its event on the first), then the
+    /// plain blocks that waited behind it.
+    fn emit_comp(&mut self, out: &mut Vec<Move>, info: Option<BlockInfo>) {
+        let mut info = info;
+        for (k, mv) in out.drain(..).enumerate() {
+            if mv.length_mm() <= 0.0 && info.is_none() {
+                continue;
+            }
+            let kind = EntryKind::Move(Box::new(self.segment(mv)));
+            self.push_entry(info.take(), kind, k == 0);
+        }
+        if let Some(i) = info {
+            self.push_entry(Some(i), EntryKind::Plain, false);
+        }
+        while let Some(i) = self.comp_waiting.pop_front() {
+            self.push_entry(i, EntryKind::Plain, false);
+        }
+    }
+
+    /// The error compensation ran into, once.
+    pub fn take_error(&mut self) -> Option<TrcError> {
+        self.error.take()
+    }
+
+    /// Tool radii by D number, mm (the tool list).
+    pub fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
+        self.tool_radii = tools;
     }
 
     /// End the spline: the rest of its curve and everything waiting for it.
@@ -520,6 +667,9 @@ impl Planner {
         self.spline = None;
         self.spline_infos.clear();
         self.spline_waiting.clear();
+        self.comp = None;
+        self.comp_info = None;
+        self.comp_waiting.clear();
         self.released = 0;
         self.moves = 0;
         self.release_next_move = false;

@@ -31,6 +31,10 @@ pub struct Config {
     pub runtime: RuntimeConfig,
     /// One per channel, in channel order (index 0 = channel 1).
     pub channels: Vec<ChannelConfig>,
+    /// `tools.lis` next to the start-up list, if present.
+    pub tools_file: Option<PathBuf>,
+    /// Tool radii by D number, mm (empty without a tool list).
+    pub tools: super::tools::ToolRadii,
     /// Warnings found on the way (unknown entries, values without effect).
     pub warnings: Vec<Diagnostic>,
 }
@@ -132,6 +136,18 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
         (None, Some(RuntimeConfig::default()))
     };
 
+    let tools_path = list_folder(&startup_path).join(super::tools::TOOLS_FILE);
+    let (tools_file, tools) = if tools_path.exists() {
+        match super::tools::read_tools(&tools_path, diags) {
+            Ok(t) => (Some(tools_path), t),
+            Err(e) => {
+                diags.push(e);
+                (Some(tools_path), Vec::new())
+            }
+        }
+    } else {
+        (None, Vec::new())
+    };
     let channels = channels(&startup, diags);
     Some(Config {
         startup_list: startup_path,
@@ -139,6 +155,8 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
         runtime_file,
         runtime: runtime?,
         channels: channels?,
+        tools_file,
+        tools,
         warnings: Vec::new(),
     })
 }
