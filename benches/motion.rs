@@ -1,9 +1,10 @@
 //! Planning plus interpolation per tick with a 32-block lookahead window on a stream of 0.1 mm
 //! segments at F6000 (1,000 blocks per second: one block arrives, is released and re-planned,
-//! and one finishes every 1 ms tick — the planner's busiest steady state), in four set-ups:
+//! and one finishes every 1 ms tick — the planner's busiest steady state), in seven set-ups:
 //! plain (trapezoid profiles), jerk (jerk limits 20,000 mm/s³ and a 50 ms corner filter, the
-//! axis filter on), contour (G261, every corner blended by an arc within 0.05 mm), and
-//! contour + jerk.
+//! axis filter on), contour (G261, every corner blended by an arc within 0.05 mm), contour +
+//! jerk, trc (G41 with a 5 mm tool: every segment offset and joined), spline_akima (G151,
+//! Akima through the points) and spline_bspline+jerk.
 //!
 //! Criterion reports the mean per tick; `per_tick_percentiles` times 200,000 single ticks with
 //! `Instant` and prints p50 / p99 / max, the figure the budget (p99 ≤ 10 µs) is stated in.
@@ -15,7 +16,8 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, Criterion};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Position, QueuedBlock,
+    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Position, QueuedBlock,
+    SplineKind,
 };
 
 const DT: f64 = 0.001;
@@ -34,18 +36,69 @@ struct Bench {
     info: BlockInfo,
 }
 
-/// One set-up: name, jerk limit, corner filter (s), contour deviation.
-type Setup = (&'static str, Option<f64>, f64, Option<f64>);
+/// One set-up: name, jerk limit, corner filter (s), the blocks' cross-block state.
+type Setup = (&'static str, Option<f64>, f64, PathMode);
 
-const SETUPS: [Setup; 4] = [
-    ("plain", None, 0.0, None),
-    ("jerk", Some(20_000.0), 0.05, None),
-    ("contour", None, 0.0, Some(0.05)),
-    ("contour+jerk", Some(20_000.0), 0.05, Some(0.05)),
+const PLAIN: PathMode = PathMode {
+    contour_dev_mm: None,
+    comp: CompSide::Off,
+    tool_offset: 0,
+    spline: None,
+};
+
+const SETUPS: [Setup; 7] = [
+    ("plain", None, 0.0, PLAIN),
+    ("jerk", Some(20_000.0), 0.05, PLAIN),
+    (
+        "contour",
+        None,
+        0.0,
+        PathMode {
+            contour_dev_mm: Some(0.05),
+            ..PLAIN
+        },
+    ),
+    (
+        "contour+jerk",
+        Some(20_000.0),
+        0.05,
+        PathMode {
+            contour_dev_mm: Some(0.05),
+            ..PLAIN
+        },
+    ),
+    (
+        "trc",
+        None,
+        0.0,
+        PathMode {
+            comp: CompSide::Left,
+            tool_offset: 1,
+            ..PLAIN
+        },
+    ),
+    (
+        "spline_akima",
+        None,
+        0.0,
+        PathMode {
+            spline: Some(SplineKind::Akima),
+            ..PLAIN
+        },
+    ),
+    (
+        "spline_bspline+jerk",
+        Some(20_000.0),
+        0.05,
+        PathMode {
+            spline: Some(SplineKind::BSpline),
+            ..PLAIN
+        },
+    ),
 ];
 
 impl Bench {
-    fn new((_, jerk, corner_s, contour): Setup) -> Self {
+    fn new((_, jerk, corner_s, path): Setup) -> Self {
         let axes = (0..3)
             .map(|index| AxisLimits {
                 index,
@@ -65,10 +118,7 @@ impl Bench {
                     corner_smoothing_s: corner_s,
                 },
             ),
-            path: PathMode {
-                contour_dev_mm: contour,
-                ..PathMode::default()
-            },
+            path,
             queue: BlockQueue::new(WINDOW + 8),
             notes: Vec::new(),
             at: [50.0, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -84,6 +134,8 @@ impl Bench {
                 stream: true,
             },
         };
+        // Tool data set D1: radius 5 mm (the trc set-up).
+        b.motion.set_tool_radii(vec![(1, 5.0)]);
         // Fill the window and run into the steady state.
         for _ in 0..WINDOW + 8 {
             b.push();
