@@ -10,8 +10,8 @@ use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
-    SplineKind,
+    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,
+    QueuedBlock, SplineKind,
 };
 
 const DT: f64 = 0.001;
@@ -85,6 +85,11 @@ fn run_to_end(
         positions.push(m.position());
         if let Some(c) = check.as_deref_mut() {
             c.record(m.position());
+        }
+        if let Some(MotionNote::Error { code, msg }) =
+            notes.iter().find(|n| matches!(n, MotionNote::Error { .. }))
+        {
+            panic!("motion error {code}: {msg}");
         }
         if notes.iter().any(|n| matches!(n, MotionNote::End { .. })) {
             return (k, positions);
@@ -206,7 +211,8 @@ fn contoured(a: Action, rng: &mut Rng) -> Action {
 }
 
 /// A random program: rapids, lines (long, short, CAM polylines: a third of them splines, half
-/// of the rest contoured), arcs and helices in all planes, dwells, M30. Returns the end point.
+/// of the rest contoured), squares with tool radius compensation, arcs and helices in all
+/// planes, dwells, M30. Returns the end point.
 fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
     let mut at = p(0.0, 0.0, 0.0);
     let planes = [Plane::Xy, Plane::Zx, Plane::Yz];
@@ -272,6 +278,44 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
                 q.push(block(n, a));
                 at = to;
             }
+        } else if kind < 0.66 {
+            // A square with tool radius compensation (D1, radius 1 mm), G41 or G42, then G40.
+            let side = if rng.next() < 0.5 {
+                CompSide::Left
+            } else {
+                CompSide::Right
+            };
+            let l = rng.range(5.0, 30.0);
+            let th = rng.range(0.0, 6.3);
+            let (c, s) = (th.cos(), th.sin());
+            let corners = [(0.0, 0.0), (l, 0.0), (l, l), (0.0, l), (0.0, 0.0)];
+            let base = p(at[0] + 3.0, at[1] + 3.0, at[2]);
+            let pts: Vec<Position> = corners
+                .iter()
+                .map(|(x, y)| p(base[0] + c * x - s * y, base[1] + s * x + c * y, base[2]))
+                .collect();
+            let comp = PathMode {
+                comp: side,
+                tool_offset: 1,
+                ..PathMode::default()
+            };
+            let mut from = at;
+            for to in &pts {
+                q.push(block(
+                    n,
+                    Action::Move(Move {
+                        kind: MoveKind::Line,
+                        start: from,
+                        end: *to,
+                        feed_mm_per_min: feed,
+                        path: comp,
+                    }),
+                ));
+                from = *to;
+            }
+            let off = p(from[0] - 3.0, from[1] - 3.0, from[2]);
+            q.push(block(n, line(from, off, feed)));
+            at = off;
         } else if kind < 0.95 {
             let plane = planes[(rng.next() * 3.0) as usize % 3];
             let (ia, ib, inn) = plane.axes();
@@ -329,6 +373,7 @@ fn limits_hold_on_random_programs(jerk: Option<f64>, corner_ms: f64, seed: u64) 
     limits[2].rapid_mm_per_min = 6000.0;
     let mut rng = Rng(seed);
     let mut m = Motion::with_planner(limits.clone(), settings(24, corner_ms));
+    m.set_tool_radii(vec![(1, 1.0)]);
     let mut q = BlockQueue::new(1_000_000);
     let end = random_program(&mut rng, &mut q, 300);
     let mut check = LimitCheck::new(&limits, DT, FILTERED_EPS);

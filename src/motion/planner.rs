@@ -329,39 +329,39 @@ impl Planner {
         let prog = info.prog.clone();
         let info = (!silent).then_some(info);
         // Tool radius compensation: every move while it is on (and the G40 block) goes
-        // through the compensator; a plain block waits behind the element it follows, a stop
-        // ends the element.
-        if let Action::Move(mv) = &action {
-            if mv.path.comp != CompSide::Off || self.comp.is_some() {
-                self.comp_move(info, *mv);
+        // through the compensator; splines: G1 points in spline mode go to the spline. A plain
+        // block waits behind the element or point it follows; anything else ends the spline
+        // first, then (unless it is a compensated move) the waiting compensated element.
+        let comp_move = matches!(&action, Action::Move(mv)
+            if mv.path.comp != CompSide::Off || self.comp.is_some());
+        let spline_move = matches!(&action, Action::Move(mv)
+            if !comp_move && mv.path.spline.is_some() && matches!(mv.kind, MoveKind::Line));
+        if matches!(action, Action::None) {
+            if let Some(sp) = self.spline.as_ref() {
+                let at = sp.received();
+                self.spline_waiting.push_back((at, info));
                 return;
             }
-        }
-        if self.comp.is_some() {
-            if matches!(action, Action::None) {
+            if self.comp.is_some() {
                 self.comp_waiting.push_back(info);
                 return;
             }
-            self.comp_finish();
         }
-        // Splines: G1 points in spline mode go to the spline; anything else but a plain block
-        // ends it first.
+        if !spline_move {
+            self.finish_spline();
+        }
         if let Action::Move(mv) = &action {
-            if let (Some(kind), MoveKind::Line) = (mv.path.spline, mv.kind) {
+            if comp_move {
+                self.comp_move(info, *mv);
+                return;
+            }
+            if let (true, Some(kind)) = (spline_move, mv.path.spline) {
+                self.comp_finish();
                 self.spline_point(info, kind, mv);
                 return;
             }
         }
-        if self.spline.is_some() {
-            if matches!(action, Action::None) {
-                if let Some(sp) = self.spline.as_ref() {
-                    let at = sp.received();
-                    self.spline_waiting.push_back((at, info));
-                }
-                return;
-            }
-            self.finish_spline();
-        }
+        self.comp_finish();
         let kind = match action {
             Action::None => EntryKind::Plain,
             Action::Dwell { seconds } => EntryKind::Dwell {
