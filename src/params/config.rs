@@ -95,7 +95,8 @@ pub fn load(startup_list: &Path) -> Result<Config, ParamError> {
 
 /// Check a start-up list (with its channel lists and runtime.toml), a channel list, or a
 /// runtime.toml, returning every error and warning. The list kind is decided by content:
-/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`.
+/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`, a
+/// tool list `wz[…]`.
 pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
     if path
         .extension()
@@ -112,6 +113,8 @@ pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
         build(list, &mut diags);
     } else if is_zero_offset_list(&list) {
         interpret_zero_offsets(&list, &mut diags);
+    } else if super::tools::is_tool_list(&list) {
+        super::tools::interpret_tools(&list, &mut diags);
     } else {
         // Cache values are not finished here: the start-up list may switch caching on.
         interpret_channel(list, &mut diags);

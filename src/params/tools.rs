@@ -26,6 +26,16 @@ pub const MAX_TOOL: u32 = 10_000;
 /// Radius by D number, mm, sorted by D.
 pub type ToolRadii = Vec<(u32, f64)>;
 
+/// Does this list look like a tool list? (It names `wz[…]`.)
+pub fn is_tool_list(list: &ParamList) -> bool {
+    list.entries.iter().any(|e| {
+        e.name
+            .segments
+            .first()
+            .is_some_and(|s| s.ident == "wz" && s.index.is_some())
+    })
+}
+
 /// Read and check a tool list. `Err` when the file cannot be read; entry problems go to
 /// `diags`.
 pub fn read_tools(path: &Path, diags: &mut Vec<Diagnostic>) -> Result<ToolRadii, Diagnostic> {
@@ -85,6 +95,7 @@ mod tests {
         assert!(errs.is_empty());
         let mut d = Vec::new();
         let t = interpret_tools(&list, &mut d);
+        assert!(is_tool_list(&list));
         assert_eq!(t, vec![(1, 5.0), (2, 2.5)]);
         assert_eq!(d.len(), 2, "{d:?}");
     }
