@@ -470,6 +470,17 @@ fn distance_to_polygon(x: f64, y: f64, corners: &[(f64, f64)]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The lowest path velocity between leaving the start and arriving at the end (50 ticks of
+/// acceleration and braking left out).
+fn slowest_while_moving(vel: &[f64]) -> f64 {
+    let first = vel.iter().position(|v| *v > 0.0).unwrap();
+    let last = vel.iter().rposition(|v| *v > 0.0).unwrap();
+    vel[first + 50..last - 50]
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min)
+}
+
 #[test]
 fn contoured_square_stays_within_the_deviation_and_does_not_stop_at_corners() {
     let s = Setup::new("", "");
@@ -491,24 +502,14 @@ fn contoured_square_stays_within_the_deviation_and_does_not_stop_at_corners() {
     assert!((0.0499..=0.0501).contains(&closest), "{closest} mm");
     assert!(worst > 0.03, "the corners are blended ({worst} mm)");
     // From leaving the start until arriving back: never standing.
-    let first = vel.iter().position(|v| *v > 0.0).unwrap();
-    let last = vel.iter().rposition(|v| *v > 0.0).unwrap();
-    let slowest = vel[first + 50..last - 50]
-        .iter()
-        .cloned()
-        .fold(f64::INFINITY, f64::min);
+    let slowest = slowest_while_moving(&vel);
     assert!(slowest > 5.0, "slowed to {slowest} mm/s");
     assert_eq!(pos.last().map(|p| (p[0], p[1])), Some((0.0, 0.0)));
 
     // Without G261 the same square stops at each corner.
     let sharp = "G1 X50 F3000\nY50\nX0\nY0\nM30\n";
     let (_, vel) = run_file(&s, "sharp.nc", sharp, 20_000);
-    let first = vel.iter().position(|v| *v > 0.0).unwrap();
-    let last = vel.iter().rposition(|v| *v > 0.0).unwrap();
-    let slowest = vel[first + 50..last - 50]
-        .iter()
-        .cloned()
-        .fold(f64::INFINITY, f64::min);
+    let slowest = slowest_while_moving(&vel);
     assert!(slowest < 1.0, "{slowest}");
 }
 

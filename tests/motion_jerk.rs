@@ -5,6 +5,9 @@
 
 use std::sync::Arc;
 
+mod common;
+use common::random_path::{self, Rng};
+
 use ncchannel::decoder::arc::{arc_move, ArcSpec};
 use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
@@ -185,20 +188,6 @@ fn rest_to_rest_time_is_the_trapezoid_plus_the_jerk_window() {
     assert!((t - model).abs() <= 2.0 * DT, "{t} s against {model} s");
 }
 
-/// xorshift: a fixed sequence, so a failure reproduces.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 /// Half the lines with G261 (a deviation of 0.01 … 0.5 mm).
 fn contoured(a: Action, rng: &mut Rng) -> Action {
     match a {
@@ -215,43 +204,19 @@ fn contoured(a: Action, rng: &mut Rng) -> Action {
 /// planes, dwells, M30. Returns the end point.
 fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
     let mut at = p(0.0, 0.0, 0.0);
-    let planes = [Plane::Xy, Plane::Zx, Plane::Yz];
     let mut n = 0u32;
     while n < blocks {
         n += 1;
         let kind = rng.next();
         let feed = rng.range(100.0, 15000.0);
         if kind < 0.1 {
-            let to = p(
-                rng.range(-50.0, 50.0),
-                rng.range(-50.0, 50.0),
-                rng.range(-20.0, 20.0),
-            );
-            q.push(block(
-                n,
-                Action::Move(Move {
-                    kind: MoveKind::Rapid,
-                    start: at,
-                    end: to,
-                    feed_mm_per_min: 0.0,
-                    path: PathMode::default(),
-                }),
-            ));
-            at = to;
+            let mv = random_path::rapid(rng, at);
+            at = mv.end;
+            q.push(block(n, Action::Move(mv)));
         } else if kind < 0.4 {
-            let len = if rng.next() < 0.5 {
-                rng.range(0.05, 0.5)
-            } else {
-                rng.range(1.0, 20.0)
-            };
-            let (th, ph) = (rng.range(0.0, 6.3), rng.range(-0.5, 0.5));
-            let to = p(
-                at[0] + len * th.cos() * ph.cos(),
-                at[1] + len * th.sin() * ph.cos(),
-                at[2] + len * ph.sin(),
-            );
-            q.push(block(n, contoured(line(at, to, feed), rng)));
-            at = to;
+            let mv = random_path::line(rng, at, feed);
+            at = mv.end;
+            q.push(block(n, contoured(Action::Move(mv), rng)));
         } else if kind < 0.6 {
             // A CAM polyline: 20..200 chords of a circle, radius 5..60 mm.
             let chords = (rng.range(20.0, 200.0)) as usize;
@@ -317,36 +282,9 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
             q.push(block(n, line(from, off, feed)));
             at = off;
         } else if kind < 0.95 {
-            let plane = planes[(rng.next() * 3.0) as usize % 3];
-            let (ia, ib, inn) = plane.axes();
-            let r = rng.range(0.5, 15.0);
-            let phi0 = rng.range(0.0, 6.3);
-            let sweep = rng.range(0.1, 6.0);
-            let cw = rng.next() < 0.5;
-            let center = [at[ia] - r * phi0.cos(), at[ib] - r * phi0.sin()];
-            let phi1 = if cw { phi0 - sweep } else { phi0 + sweep };
-            let mut to = at;
-            to[ia] = center[0] + r * phi1.cos();
-            to[ib] = center[1] + r * phi1.sin();
-            to[inn] += rng.range(-2.0, 2.0);
-            let mut ijk = [None; 3];
-            ijk[ia] = Some(center[0] - at[ia]);
-            ijk[ib] = Some(center[1] - at[ib]);
-            let mv = arc_move(
-                &ArcSpec {
-                    plane,
-                    ijk,
-                    radius: None,
-                    cw,
-                },
-                at,
-                to,
-                feed,
-                1e-6,
-            )
-            .unwrap();
+            let mv = random_path::arc(rng, at, feed);
+            at = mv.end;
             q.push(block(n, Action::Move(mv)));
-            at = to;
         } else {
             q.push(block(
                 n,

@@ -119,37 +119,16 @@ impl Comp {
         Ok(())
     }
 
-    /// Left normal (unit, XY) of `m` at its start or end.
+    /// Left normal (unit, XY) of `m` at its start or end; a block without XY motion keeps
+    /// the last element's.
     fn normal(&self, m: &Move, at_end: bool) -> [f64; 2] {
-        match m.kind {
-            MoveKind::Arc {
-                center,
-                radius_mm,
-                cw,
-                ..
-            } if radius_mm > 0.0 => {
-                let p = if at_end { m.end } else { m.start };
-                let r = [
-                    (p[0] - center[0]) / radius_mm,
-                    (p[1] - center[1]) / radius_mm,
-                ];
-                // ccw: tangent = left normal of the radius, so the left normal points inwards.
-                if cw {
-                    r
-                } else {
-                    [-r[0], -r[1]]
-                }
-            }
-            _ => {
-                let (dx, dy) = (m.end[0] - m.start[0], m.end[1] - m.start[1]);
-                let l = dx.hypot(dy);
-                if l <= EPS_MM {
-                    self.last_normal
-                } else {
-                    [-dy / l, dx / l]
-                }
-            }
+        let no_xy = matches!(m.kind, MoveKind::Line | MoveKind::Rapid)
+            && (m.end[0] - m.start[0]).hypot(m.end[1] - m.start[1]) <= EPS_MM;
+        if no_xy {
+            return self.last_normal;
         }
+        let t = tangent2(m, at_end);
+        [-t[1], t[0]]
     }
 
     fn sign(&self) -> f64 {

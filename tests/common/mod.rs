@@ -280,3 +280,4 @@ pub fn streamed_5000_lines() -> Vec<String> {
     lines.push("M30".into());
     lines
 }
+pub mod random_path;
