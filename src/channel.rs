@@ -129,6 +129,8 @@ pub struct ChannelSettings {
     pub cache: CacheLimits,
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
     pub fs_latency: FsLatency,
+    /// Tool radii by D number for G41/G42, mm (`tools.lis`).
+    pub tools: Vec<(u32, f64)>,
 }
 
 /// How a channel's program run finished, for `ncchannel run`.
@@ -270,7 +272,11 @@ impl Channel {
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
             decoder: Decoder::new(s.decoder),
-            motion: Motion::with_planner(s.axes, s.planner),
+            motion: {
+                let mut m = Motion::with_planner(s.axes, s.planner);
+                m.set_tool_radii(s.tools);
+                m
+            },
             program: None,
             search: None,
             last_error: None,
@@ -335,6 +341,12 @@ impl Channel {
     pub fn last_error(&self) -> Option<&(u32, String)> {
         self.last_error.as_ref()
     }
+    /// Blocks the lookahead window holds and may not release yet (the memory effect): what
+    /// the axes wait for during an interrupt.
+    pub fn held_blocks(&self) -> usize {
+        self.motion.held_blocks()
+    }
+
     pub fn position(&self) -> Position {
         self.motion.position()
     }
@@ -893,6 +905,10 @@ impl Channel {
                     self.events
                         .push(tick, self.number, EventKind::Flush { kind: kind.into() });
                 }
+                MotionNote::Error { code, msg } => {
+                    self.raise_error(tick, code, msg, None, None);
+                    break;
+                }
                 MotionNote::End { m, prog } => {
                     self.events.push(
                         tick,
@@ -922,7 +938,7 @@ impl Channel {
             self.set_state(tick, State::Hold);
         }
         if self.state == State::Active
-            && self.ran_any
+            && (self.ran_any || self.motion.held_blocks() > 0)
             && !self.interrupted
             && self.motion.waiting_for_data()
             && self.queue.is_empty()
@@ -931,7 +947,9 @@ impl Channel {
             self.interrupted = true;
             self.stats.interrupts += 1;
             self.motion.note_interrupt();
-            self.events.push(tick, self.number, EventKind::Interrupt);
+            let held = self.motion.held_blocks() as u64;
+            self.events
+                .push(tick, self.number, EventKind::Interrupt { held });
         }
     }
 }

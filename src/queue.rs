@@ -72,6 +72,43 @@ pub enum MoveKind {
     },
 }
 
+/// Tool radius compensation side (G40 / G41 / G42).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CompSide {
+    /// G40.
+    #[default]
+    Off,
+    /// G41: the tool left of the programmed path.
+    Left,
+    /// G42: the tool right of the programmed path.
+    Right,
+}
+
+/// Spline type (`#SPLINE TYPE AKIMA|BSPLINE`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SplineKind {
+    /// Through the programmed points.
+    #[default]
+    Akima,
+    /// Within the control polygon of the programmed points.
+    BSpline,
+}
+
+/// The decoder's cross-block modal state a motion block was programmed under: what motion
+/// needs to plan across blocks (contouring, tool radius compensation, splines).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PathMode {
+    /// Corner blending at this block's end (G261 modal, G61 this block): the largest deviation
+    /// from the programmed corner, mm (`#CONTOUR MODE [DEV PATH_DEV=…]`); `None` = sharp corner.
+    pub contour_dev_mm: Option<f64>,
+    /// G40 / G41 / G42.
+    pub comp: CompSide,
+    /// D word: the tool data set whose radius compensates (0 = none).
+    pub tool_offset: u32,
+    /// G151 / `#SPLINE ON`: the spline type; `None` = G150 / `#SPLINE OFF`.
+    pub spline: Option<SplineKind>,
+}
+
 /// One motion block: start and end positions and how to get there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Move {
@@ -80,6 +117,8 @@ pub struct Move {
     pub end: Position,
     /// Programmed path feed, mm/min (ignored for rapid moves).
     pub feed_mm_per_min: f64,
+    /// Cross-block modal state at this block.
+    pub path: PathMode,
 }
 
 impl Move {

@@ -35,6 +35,7 @@ pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
                 index,
                 max_velocity_mm_per_min: a.max_velocity_mm_per_min,
                 max_accel_mm_per_s2: a.max_acceleration_mm_per_s2,
+                max_jerk_mm_per_s3: a.max_jerk_mm_per_s3,
                 rapid_mm_per_min: a.rapid_mm_per_min,
                 min_mm: a.soft_limit_min_mm,
                 max_mm: a.soft_limit_max_mm,
@@ -86,6 +87,7 @@ pub fn channel_settings(
         axes,
         planner: PlannerSettings {
             lookahead_blocks: rt.planner.lookahead_blocks.max(1) as usize,
+            corner_smoothing_s: rt.planner.corner_smoothing_ms / 1000.0,
         },
         search_dirs,
         streaming_prog: ch.streaming_prog_file.clone(),
@@ -95,6 +97,7 @@ pub fn channel_settings(
             max_file_bytes: u64::from(c.max_file_bytes),
         },
         fs_latency: FsLatency::from_us(rt.fs_latency_us, rt.fs_latency_us_per_kib),
+        tools: config.tools.clone(),
     })
 }
 

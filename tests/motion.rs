@@ -4,13 +4,16 @@
 
 use std::sync::Arc;
 
+mod common;
+use common::random_path::{self, Rng};
+
 use ncchannel::decoder::arc::{ArcError, ArcSpec};
 use ncchannel::lang::block::FlushKind;
 use ncchannel::motion::check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, Plane, Position, QueuedBlock,
+    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
 };
 
 /// The positional form reads best in these tables of cases.
@@ -47,6 +50,7 @@ fn axes(vmax_mm_per_min: f64, accel: f64) -> Vec<AxisLimits> {
             index,
             max_velocity_mm_per_min: vmax_mm_per_min,
             max_accel_mm_per_s2: accel,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: vmax_mm_per_min,
             min_mm: -1000.0,
             max_mm: 1000.0,
@@ -80,6 +84,7 @@ fn line(start: Position, end: Position, feed: f64) -> Action {
         start,
         end,
         feed_mm_per_min: feed,
+        path: PathMode::default(),
     })
 }
 
@@ -252,6 +257,7 @@ fn blocks_are_held_until_the_window_is_full_then_run_without_stopping() {
         axes(30000.0, 2000.0),
         PlannerSettings {
             lookahead_blocks: 4,
+            ..PlannerSettings::default()
         },
     );
     let mut q = BlockQueue::new(64);
@@ -494,20 +500,6 @@ fn reset_stops_at_once_and_forgets_the_window() {
     assert_eq!(m.position()[0], x);
 }
 
-/// A small deterministic generator (no dependency): xorshift64*.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
-
 #[test]
 fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
     // Different limits per axis, so the projections matter.
@@ -516,6 +508,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 0,
             max_velocity_mm_per_min: 12000.0,
             max_accel_mm_per_s2: 1500.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 12000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -524,6 +517,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 1,
             max_velocity_mm_per_min: 9000.0,
             max_accel_mm_per_s2: 1000.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 8000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -532,6 +526,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             index: 2,
             max_velocity_mm_per_min: 6000.0,
             max_accel_mm_per_s2: 600.0,
+            max_jerk_mm_per_s3: None,
             rapid_mm_per_min: 6000.0,
             min_mm: -1e6,
             max_mm: 1e6,
@@ -542,62 +537,26 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
         limits.clone(),
         PlannerSettings {
             lookahead_blocks: 16,
+            ..PlannerSettings::default()
         },
     );
     let mut q = BlockQueue::new(1_000_000);
     let mut at = p(0.0, 0.0, 0.0);
-    let planes = [Plane::Xy, Plane::Zx, Plane::Yz];
     for n in 0..1500u32 {
         let kind = rng.next();
         let feed = rng.range(100.0, 15000.0);
         let action = if kind < 0.1 {
-            let to = p(
-                rng.range(-50.0, 50.0),
-                rng.range(-50.0, 50.0),
-                rng.range(-20.0, 20.0),
-            );
-            let a = Action::Move(Move {
-                kind: MoveKind::Rapid,
-                start: at,
-                end: to,
-                feed_mm_per_min: 0.0,
-            });
-            at = to;
-            a
+            let mv = random_path::rapid(&mut rng, at);
+            at = mv.end;
+            Action::Move(mv)
         } else if kind < 0.55 {
             // Short and long lines, some nearly collinear chains of tiny segments.
-            let len = if rng.next() < 0.5 {
-                rng.range(0.05, 0.5)
-            } else {
-                rng.range(1.0, 20.0)
-            };
-            let (th, ph) = (rng.range(0.0, 6.3), rng.range(-0.5, 0.5));
-            let to = p(
-                at[0] + len * th.cos() * ph.cos(),
-                at[1] + len * th.sin() * ph.cos(),
-                at[2] + len * ph.sin(),
-            );
-            let a = line(at, to, feed);
-            at = to;
-            a
+            let mv = random_path::line(&mut rng, at, feed);
+            at = mv.end;
+            Action::Move(mv)
         } else if kind < 0.9 {
-            let plane = planes[(rng.next() * 3.0) as usize % 3];
-            let (ia, ib, inn) = plane.axes();
-            let r = rng.range(0.5, 15.0);
-            let phi0 = rng.range(0.0, 6.3);
-            let sweep = rng.range(0.1, 6.0);
-            let cw = rng.next() < 0.5;
-            let center = [at[ia] - r * phi0.cos(), at[ib] - r * phi0.sin()];
-            let phi1 = if cw { phi0 - sweep } else { phi0 + sweep };
-            let mut to = at;
-            to[ia] = center[0] + r * phi1.cos();
-            to[ib] = center[1] + r * phi1.sin();
-            to[inn] += rng.range(-2.0, 2.0);
-            let mut ijk = [None; 3];
-            ijk[ia] = Some(center[0] - at[ia]);
-            ijk[ib] = Some(center[1] - at[ib]);
-            let mv = arc_move(plane, at, to, ijk, None, cw, feed, 1e-6).unwrap();
-            at = to;
+            let mv = random_path::arc(&mut rng, at, feed);
+            at = mv.end;
             Action::Move(mv)
         } else if kind < 0.95 {
             Action::None

@@ -95,8 +95,13 @@ fn run_stream(
     (c, events, velocity)
 }
 
+/// Events of `k`'s kind (fields not compared).
 fn count(events: &[(u64, EventKind)], k: &EventKind) -> usize {
-    events.iter().filter(|(_, e)| e == k).count()
+    let d = std::mem::discriminant(k);
+    events
+        .iter()
+        .filter(|(_, e)| std::mem::discriminant(e) == d)
+        .count()
 }
 
 fn blocks(events: &[(u64, EventKind)]) -> Vec<(u64, Option<u64>)> {
@@ -118,7 +123,7 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
     // N10 takes about 0.61 s at F1000. In time: N20 arrives at 0.3 s.
     let (c, ev, v) = run_stream(&s, &[(1, first), (300, next), (1500, end)], 5000);
     assert_eq!(
-        count(&ev, &EventKind::Interrupt),
+        count(&ev, &EventKind::Interrupt { held: 0 }),
         1,
         "only after N20, waiting for M30"
     );
@@ -138,9 +143,13 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
 
     // Late: N20 arrives at 1.0 s, after N10 has stopped: an interrupt, then a resume.
     let (c, ev, _) = run_stream(&s, &[(1, first), (1000, next), (2500, end)], 6000);
-    assert_eq!(count(&ev, &EventKind::Interrupt), 2);
+    assert_eq!(count(&ev, &EventKind::Interrupt { held: 0 }), 2);
     assert_eq!(count(&ev, &EventKind::Resume), 2);
-    let first_interrupt = ev.iter().find(|e| e.1 == EventKind::Interrupt).unwrap().0;
+    let first_interrupt = ev
+        .iter()
+        .find(|e| e.1 == EventKind::Interrupt { held: 0 })
+        .unwrap()
+        .0;
     assert!((600..1000).contains(&first_interrupt), "{first_interrupt}");
     let resume = ev.iter().find(|e| e.1 == EventKind::Resume).unwrap().0;
     assert_eq!(resume, 1000, "resumes when N20 starts");
@@ -160,9 +169,17 @@ fn without_flush_blocks_wait_in_the_window_and_the_program_end_releases_them() {
         .collect();
     let (c, ev, _) = run_stream(&s, &[(1, &text), (400, "M30\r\n")], 3000);
     let b = blocks(&ev);
-    // Held: nothing takes effect until M30 arrives, and no interrupt before the first block.
+    // Held: nothing takes effect until M30 arrives; the standstill is an interrupt that says
+    // the window holds the three blocks.
     assert!(b.iter().all(|x| x.0 >= 400), "{b:?}");
-    assert_eq!(count(&ev, &EventKind::Interrupt), 0);
+    let held: Vec<u64> = ev
+        .iter()
+        .filter_map(|e| match e.1 {
+            EventKind::Interrupt { held } => Some(held),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(held, vec![3]);
     assert_eq!(c.position()[0], 15.0);
 }
 
@@ -189,7 +206,9 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
         events.extend(c.events_mut().events().iter().map(|e| e.kind.clone()));
         c.events_mut().flush_to(&mut EventLog::disabled());
     }
-    assert!(!events.contains(&EventKind::Interrupt));
+    assert!(!events
+        .iter()
+        .any(|e| matches!(e, EventKind::Interrupt { .. })));
     assert_eq!(c.state(), State::Ready);
     assert_eq!(c.position()[0], 100.0);
 }
@@ -379,4 +398,296 @@ fn check_list_file_recognises_a_zero_offset_list() {
     assert_eq!(d.len(), 1, "{d:?}");
     assert_eq!((d[0].line, d[0].col), (1, 27));
     assert!(d[0].message.contains("0.1 µm"), "{}", d[0].message);
+}
+
+#[test]
+fn m5_after_the_last_motion_of_a_paused_stream_takes_effect_when_the_motion_ends() {
+    let s = Setup::new("", "[planner]\nlookahead_blocks = 4\n");
+    // Six moves fill the window (4) and are released; M5 and a dwell follow, then the stream
+    // pauses for 3 s before M30.
+    let mut text: String = (1..=6)
+        .map(|i| format!("N{i} G1 X{} F3000\r\n", i * 5))
+        .collect();
+    text.push_str("N7 M5\r\nN8 G4 X0.2\r\n");
+    let (c, ev, v) = run_stream(&s, &[(1, &text), (3000, "N9 M30\r\n")], 6000);
+    let b = blocks(&ev);
+    let t6 = b.iter().find(|x| x.1 == Some(6)).unwrap().0 as usize;
+    let t7 = b.iter().find(|x| x.1 == Some(7)).unwrap().0 as usize;
+    let t8 = b.iter().find(|x| x.1 == Some(8)).unwrap().0 as usize;
+    // M5 when interpolation reaches it: the axes have just stopped at X30, long before M30.
+    assert!(t7 > t6 && t7 < 2000, "M5 at tick {t7}");
+    assert!(
+        v[t7] == 0.0 && v[t7 - 1] > 0.0,
+        "M5 in the tick the motion ends: {:?}",
+        &v[t7 - 3..t7 + 2]
+    );
+    assert!(t8 >= t7 && t8 < 2000, "G4 at tick {t8}");
+    // Waiting for M30 after the dwell is an interrupt with nothing held.
+    let held: Vec<(u64, u64)> = ev
+        .iter()
+        .filter_map(|e| match e.1 {
+            EventKind::Interrupt { held } => Some((e.0, held)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(held.len(), 1, "{held:?}");
+    assert_eq!(held[0].1, 0);
+    assert!(
+        held[0].0 as usize > t8 + 150,
+        "not during the dwell: {held:?}"
+    );
+    assert_eq!(c.position()[0], 30.0);
+}
+
+/// Run a program file to its end; every tick's position and path velocity.
+fn run_file(s: &Setup, name: &str, text: &str, max_ticks: u64) -> (Vec<[f64; 6]>, Vec<f64>) {
+    s.write(&format!("nc/{name}"), text);
+    let mut c = s.channel();
+    c.start(&tick(0), name).unwrap();
+    let (mut pos, mut vel) = (Vec::new(), Vec::new());
+    for k in 1..max_ticks {
+        c.step(&tick(k));
+        pos.push(c.position());
+        vel.push(c.motion().velocity_mm_per_s());
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    (pos, vel)
+}
+
+/// Distance of (x, y) from the closed polygon through `corners`.
+fn distance_to_polygon(x: f64, y: f64, corners: &[(f64, f64)]) -> f64 {
+    (0..corners.len())
+        .map(|i| {
+            let (a, b) = (corners[i], corners[(i + 1) % corners.len()]);
+            let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+            let t = (((x - a.0) * dx + (y - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            (x - a.0 - t * dx).hypot(y - a.1 - t * dy)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The lowest path velocity between leaving the start and arriving at the end (50 ticks of
+/// acceleration and braking left out).
+fn slowest_while_moving(vel: &[f64]) -> f64 {
+    let first = vel.iter().position(|v| *v > 0.0).unwrap();
+    let last = vel.iter().rposition(|v| *v > 0.0).unwrap();
+    vel[first + 50..last - 50]
+        .iter()
+        .cloned()
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn contoured_square_stays_within_the_deviation_and_does_not_stop_at_corners() {
+    let s = Setup::new("", "");
+    let program = "#CONTOUR MODE [DEV PATH_DEV=0.05]\nG261\nG1 X50 F3000\nY50\nX0\nY0\n\
+                   G260\nM30\n";
+    let (pos, vel) = run_file(&s, "square.nc", program, 20_000);
+    let square = [(0.0, 0.0), (50.0, 0.0), (50.0, 50.0), (0.0, 50.0)];
+    let worst = pos
+        .iter()
+        .map(|p| distance_to_polygon(p[0], p[1], &square))
+        .fold(0.0, f64::max);
+    assert!(worst <= 0.05 + 1e-9, "deviation {worst} mm");
+    // The blend passes the corner point at the permitted deviation (the distance to the
+    // polygon's edges is that times cos 45°).
+    let closest = pos
+        .iter()
+        .map(|p| (p[0] - 50.0).hypot(p[1] - 50.0))
+        .fold(f64::INFINITY, f64::min);
+    assert!((0.0499..=0.0501).contains(&closest), "{closest} mm");
+    assert!(worst > 0.03, "the corners are blended ({worst} mm)");
+    // From leaving the start until arriving back: never standing.
+    let slowest = slowest_while_moving(&vel);
+    assert!(slowest > 5.0, "slowed to {slowest} mm/s");
+    assert_eq!(pos.last().map(|p| (p[0], p[1])), Some((0.0, 0.0)));
+
+    // Without G261 the same square stops at each corner.
+    let sharp = "G1 X50 F3000\nY50\nX0\nY0\nM30\n";
+    let (_, vel) = run_file(&s, "sharp.nc", sharp, 20_000);
+    let slowest = slowest_while_moving(&vel);
+    assert!(slowest < 1.0, "{slowest}");
+}
+
+#[test]
+fn run_trace_writes_a_header_and_one_row_per_stride_ending_at_the_end_point() {
+    let s = Setup::new(
+        "",
+        "[[axes]]\nname = \"X\"\nmax_jerk_mm_per_s3 = 20000.0\n\
+         [[axes]]\nname = \"Y\"\nmax_jerk_mm_per_s3 = 20000.0\n",
+    );
+    let stream = s.write("nc/sq.nc", "G1 X20 F3000\nY20\nM30\n");
+    let csv = s.dir.path().join("trace.csv");
+    let r = run_report(
+        &s,
+        &stream,
+        &["--trace", csv.to_str().unwrap(), "--trace-every", "5"],
+    );
+    let ticks = r["ticks"].as_u64().unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time_s,X_mm,Y_mm,velocity_mm_per_s,acceleration_mm_per_s2,jerk_mm_per_s3")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|f| f.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(
+        rows.len() as u64,
+        ticks.div_ceil(5),
+        "one row every 5 ticks"
+    );
+    assert!(rows
+        .windows(2)
+        .all(|w| (w[1][0] - w[0][0] - 0.005).abs() < 1e-9));
+    let peak_jerk = rows.iter().map(|r| r[5].abs()).fold(0.0, f64::max);
+    assert!(peak_jerk > 1000.0, "jerk is traced ({peak_jerk})");
+    let last = rows.last().unwrap();
+    assert_eq!((last[1], last[2], last[3]), (20.0, 20.0, 0.0));
+}
+
+/// The seed's streaming-spline example (nc/streaming_spline.nc), with the feed the excerpt
+/// leaves out.
+/// Lines end in CR LF, as the stream interface wants them.
+fn streaming_spline_text() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("nc/streaming_spline.nc"))
+        .unwrap()
+        .lines()
+        .map(|l| format!("{l}\r\n"))
+        .collect()
+}
+
+/// The example is a B-spline (`#SPLINE TYPE BSPLINE`, G151): the motion follows the curve
+/// through the streamed points without stopping at them.
+#[test]
+fn streaming_spline_example_in_packets_passes_its_points_without_stopping() {
+    let s = Setup::new("", "");
+    let text = streaming_spline_text();
+    // Packets of two lines, one every 5 ticks: the example arrives while it runs.
+    let lines: Vec<&str> = text.split_inclusive("\r\n").collect();
+    let writes: Vec<(u64, String)> = lines
+        .chunks(2)
+        .enumerate()
+        .map(|(i, c)| (1 + 5 * i as u64, c.concat()))
+        .collect();
+    let refs: Vec<(u64, &str)> = writes.iter().map(|(t, w)| (*t, w.as_str())).collect();
+    let (c, ev, v) = run_stream(&s, &refs, 20_000);
+    assert!(c.errors().is_empty(), "{:?}", c.errors());
+    let b = blocks(&ev);
+    let first = b.iter().find(|x| x.1 == Some(36338)).unwrap().0 as usize;
+    let last = b.iter().find(|x| x.1 == Some(36355)).unwrap().0 as usize;
+    let slowest = v[first..last].iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(
+        slowest > 1.0,
+        "stopped at a programmed point: {slowest} mm/s"
+    );
+    assert!((c.position()[2] - 1.8353).abs() < 1e-9);
+}
+
+#[test]
+fn flush_inside_the_streaming_spline_is_21909() {
+    let s = Setup::new("", "");
+    let text = streaming_spline_text().replace("N36345", "#FLUSH\r\nN36345");
+    let (head, tail) = text.split_at(text.find("N36340").unwrap());
+    let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
+    assert_eq!(c.last_error().map(|e| e.0), Some(21909), "{:?}", c.errors());
+}
+
+/// Distance of (x, y) from the circle of radius `r` around (cx, cy).
+fn distance_to_circle(x: f64, y: f64, cx: f64, cy: f64, r: f64) -> f64 {
+    ((x - cx).hypot(y - cy) - r).abs()
+}
+
+/// Positions of a program run with the tool list D1 = 5 mm, between the first and the last
+/// block whose `N` lies in `from..=to` (the compensated contour without selection and
+/// deselection).
+fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
+    let s = Setup::new("", "");
+    s.write("params/tools.lis", "wz[1].radius 50000\n");
+    s.write("nc/trc.nc", program);
+    let mut c = s.channel();
+    c.start(&tick(0), "trc.nc").unwrap();
+    let (mut inside, mut out) = (false, Vec::new());
+    for k in 1..200_000u64 {
+        c.step(&tick(k));
+        for e in c.events_mut().events() {
+            if let EventKind::Block { n: Some(n), .. } = e.kind {
+                inside = (from..=to).contains(&n);
+            }
+        }
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if inside {
+            out.push(c.position());
+        }
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    out
+}
+
+#[test]
+fn trc_square_and_circle_stay_equidistant_to_the_programmed_path() {
+    let square = [(0.0, 0.0), (50.0, 0.0), (50.0, 50.0), (0.0, 50.0)];
+    for (g, outside) in [("G41", false), ("G42", true)] {
+        // A counter-clockwise square: G41 keeps the tool inside (corners cut at the
+        // intersections), G42 outside (arcs around the corners).
+        let program = format!(
+            "G0 X-20 Y-20\nN1 {g} D1 G1 X0 Y0 F3000\nN2 X50\nN3 Y50\nN4 X0\nN5 Y0\nN6 X10\n\
+             N7 G40 X-20 Y-20\nM30\n"
+        );
+        let pos = trc_run(&program, 3, 5);
+        assert!(pos.len() > 1000);
+        let worst = pos
+            .iter()
+            .map(|p| (distance_to_polygon(p[0], p[1], &square) - 5.0).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-3 * 1.0, "{g}: off by {worst} mm");
+        // Outside the square for G42, inside for G41.
+        let mid = pos[pos.len() / 2];
+        let inside = (0.0..=50.0).contains(&mid[0]) && (0.0..=50.0).contains(&mid[1]);
+        assert_eq!(inside, !outside, "{g}: {mid:?}");
+    }
+    for (g, r) in [("G41", 25.0), ("G42", 35.0)] {
+        // A counter-clockwise full circle of radius 30 around (0, 0), entered from the left.
+        let program = format!(
+            "G0 X-60 Y0\nN1 {g} D1 G1 X-30 Y0 F3000\nN2 G3 X-30 Y0 I30 J0\nN3 G2 X-20 Y-10 R10\n\
+             N4 G40 G1 X-60 Y-40\nM30\n"
+        );
+        let pos = trc_run(&program, 2, 2);
+        assert!(pos.len() > 500);
+        // The arc around the circle's end point (G42: an outer corner towards N3) is
+        // equidistant to that point, not to the circle: left out.
+        let worst = pos
+            .iter()
+            .filter(|p| (p[0] + 30.0).hypot(p[1]) > 5.0 + 1e-6)
+            .map(|p| distance_to_circle(p[0], p[1], 0.0, 0.0, r))
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-3, "{g}: off by {worst} mm");
+    }
+}
+
+#[test]
+fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
+    let s = Setup::new("", "");
+    s.write("params/tools.lis", "wz[1].radius 50000\n");
+    let program = "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F3000\nG3 X6 Y0 I3 J0\nG1 X20\nG40 X30\nM30\n";
+    s.write("nc/bad_trc.nc", program);
+    let mut c = s.channel();
+    c.start(&tick(0), "bad_trc.nc").unwrap();
+    for k in 1..20_000u64 {
+        c.step(&tick(k));
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.state(), State::Error);
+    assert_eq!(c.last_error().map(|e| e.0), Some(90140), "{:?}", c.errors());
 }

@@ -101,7 +101,7 @@ fn every_event_kind_has_the_documented_fields() {
             "error",
             vec!["code", "msg", "prog", "line"],
         ),
-        (EventKind::Interrupt, "interrupt", vec![]),
+        (EventKind::Interrupt { held: 2 }, "interrupt", vec!["held"]),
         (EventKind::Resume, "resume", vec![]),
         (
             EventKind::Cache {
@@ -195,7 +195,7 @@ fn a_disabled_log_takes_events_and_writes_nothing() {
         period: Duration::from_millis(1),
         time: Duration::ZERO,
     };
-    buf.push(&tick, 1, EventKind::Interrupt);
+    buf.push(&tick, 1, EventKind::Interrupt { held: 0 });
     assert!(buf.is_empty());
     buf.flush_to(&mut log);
     assert_eq!(log.finish().unwrap(), 0);

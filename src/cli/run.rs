@@ -63,6 +63,13 @@ pub struct RunArgs {
     /// Draw the tool path and path velocity (interrupts marked) into this SVG file.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Write the interpolated motion to this CSV file: time, axis positions, path velocity,
+    /// acceleration and jerk.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
+    /// One CSV row every this many ticks.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub trace_every: u64,
 }
 
 impl RunArgs {
@@ -84,6 +91,8 @@ impl RunArgs {
             events: None,
             report: None,
             plot: None,
+            trace: None,
+            trace_every: 1,
         }
     }
 }
@@ -181,6 +190,13 @@ pub fn execute(args: RunArgs) -> ExitCode {
             c.motion_mut().enable_trace(PLOT_SAMPLES);
         }
     }
+    if let Some(p) = &args.trace {
+        if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
+            if let Err(e) = c.motion_mut().enable_csv_trace(p, args.trace_every) {
+                return usage(format!("--trace {}: {e}", p.display()));
+            }
+        }
+    }
     let mut machine = Machine::new(channels, log, StopWhen::ProgramsFinished);
     if let Some(f) = feeder {
         machine.attach_feeder(args.channel, f);
@@ -223,6 +239,11 @@ pub fn execute(args: RunArgs) -> ExitCode {
         (Some(RunEnd::MaxTicks), _) => Outcome::MaxTicks,
         _ => Outcome::Error,
     };
+    if let Some(c) = machine.channel_mut(args.channel) {
+        if let Err(e) = c.motion_mut().finish_csv_trace() {
+            eprintln!("ncchannel run: --trace: {e}");
+        }
+    }
     let c = &machine.channels()[args.channel as usize - 1];
     let report = Report {
         outcome,

@@ -80,6 +80,7 @@ pub fn arc_move(
         start,
         end,
         feed_mm_per_min,
+        path: Default::default(),
     })
 }
 

@@ -1054,6 +1054,7 @@ impl Decoder {
                 start: s.from,
                 end: self.modal.pos,
                 feed_mm_per_min: 0.0,
+                path: Default::default(),
             };
             self.emit(info, Action::Move(mv), true, io);
         }
@@ -1202,6 +1203,7 @@ impl Decoder {
                     start,
                     end,
                     feed_mm_per_min: 0.0,
+                    path: Default::default(),
                 },
                 m => {
                     if feed <= 0.0 {
@@ -1216,6 +1218,7 @@ impl Decoder {
                             start,
                             end,
                             feed_mm_per_min: feed,
+                            path: Default::default(),
                         }
                     } else {
                         arc::arc_move(
@@ -1239,6 +1242,8 @@ impl Decoder {
                     }
                 }
             };
+            let mut mv = mv;
+            mv.path = self.modal.path_mode(gs.contour_this_block);
             self.modal.pos = end;
             self.emit(info.clone(), Action::Move(mv), queued_main, io);
             queued_main = true;
@@ -1425,7 +1430,12 @@ impl Decoder {
                 self.modal.hsc = *on;
                 self.emit(info, Action::None, false, io);
             }
-            Command::ContourMode { .. } => self.emit(info, Action::None, false, io),
+            Command::ContourMode { options } => {
+                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                    self.modal.contour_dev_mm = dev;
+                }
+                self.emit(info, Action::None, false, io)
+            }
             Command::Var => self.top().var_block = true,
             Command::EndVar => {}
         }

@@ -55,6 +55,8 @@ pub struct Modal {
     pub radius_comp: RadiusComp,
     /// G261 contouring on (G260 off).
     pub contouring: bool,
+    /// `#CONTOUR MODE [DEV PATH_DEV=…]`: corner deviation for G261/G61, mm.
+    pub contour_dev_mm: f64,
     /// G151 / `#SPLINE ON`.
     pub spline: bool,
     pub spline_type: SplineCommand,
@@ -81,10 +83,30 @@ impl Modal {
             zero_offset: 0,
             radius_comp: RadiusComp::Off,
             contouring: false,
+            contour_dev_mm: crate::motion::contour::DEFAULT_PATH_DEV_MM,
             spline: false,
             spline_type: SplineCommand::TypeAkima,
             hsc: false,
             pos,
+        }
+    }
+
+    /// The cross-block state a motion block carries to motion (`contour_here`: G61 in the
+    /// block).
+    pub fn path_mode(&self, contour_here: bool) -> crate::queue::PathMode {
+        use crate::queue::{CompSide, PathMode, SplineKind};
+        PathMode {
+            contour_dev_mm: (self.contouring || contour_here).then_some(self.contour_dev_mm),
+            comp: match self.radius_comp {
+                RadiusComp::Off => CompSide::Off,
+                RadiusComp::Left => CompSide::Left,
+                RadiusComp::Right => CompSide::Right,
+            },
+            tool_offset: self.tool_offset,
+            spline: self.spline.then_some(match self.spline_type {
+                SplineCommand::TypeBspline => SplineKind::BSpline,
+                _ => SplineKind::Akima,
+            }),
         }
     }
 

@@ -102,8 +102,15 @@ pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> 
             let x_meet = (ve * ve + 2.0 * a * rem - v * v) / (4.0 * a);
             let x_cruise = (vc * vc - v * v) / (2.0 * a);
             let x = x_meet.min(x_cruise).max(0.0);
-            let v1 = (v * v + 2.0 * a * x).sqrt();
-            (a, (v1 - v) / a, v1, false)
+            if x >= rem {
+                // The planned exit lies above what the block can reach (the backward pass
+                // only brakes): accelerate to the block end and hand on the rest of the tick.
+                let v1 = (v * v + 2.0 * a * rem).sqrt();
+                (a, (v1 - v) / a, v1, true)
+            } else {
+                let v1 = (v * v + 2.0 * a * x).sqrt();
+                (a, (v1 - v) / a, v1, false)
+            }
         };
         if dur <= left {
             t += dur;
@@ -253,6 +260,7 @@ mod tests {
             start: [10.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             end: [0.0, 10.0, 0.0, 0.0, 0.0, 0.0],
             feed_mm_per_min: 1000.0,
+            path: Default::default(),
         };
         let l = m.length_mm();
         let t0 = tangent(&m, l, false);

@@ -9,19 +9,24 @@
 //! `#FLUSH WAIT` and the program end do).
 
 pub mod check;
+pub mod contour;
+pub mod filter;
 pub mod interpolator;
 pub mod planner;
+pub mod spline;
 pub mod trace;
+pub mod trc;
 
 use std::sync::Arc;
 
 use crate::lang::block::FlushKind;
 use crate::queue::{BlockInfo, BlockQueue, MoveKind, Position, MAX_AXES};
 
+use filter::{jerk_window_s, AxisFilter};
 use interpolator::{advance, point_at, Profile};
 pub use planner::PlannerSettings;
 use planner::{EntryKind, Planner};
-use trace::{Sample, Trace};
+use trace::{CsvTrace, Sample, Trace};
 
 /// Limits of one axis (runtime.toml `[[axes]]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +37,8 @@ pub struct AxisLimits {
     pub max_velocity_mm_per_min: f64,
     /// Maximum acceleration, mm/s².
     pub max_accel_mm_per_s2: f64,
+    /// Maximum jerk, mm/s³; `None` = no jerk limit.
+    pub max_jerk_mm_per_s3: Option<f64>,
     /// Rapid (G0) rate, mm/min.
     pub rapid_mm_per_min: f64,
     /// Software limits, mm.
@@ -45,6 +52,11 @@ pub enum MotionNote {
     /// A block took effect (started executing): its `block` event.
     Started(BlockInfo),
     Flush(FlushKind),
+    /// Planning found an error (tool radius compensation impossible): the channel stops.
+    Error {
+        code: u32,
+        msg: String,
+    },
     /// The main program's end was reached: everything before it has run.
     End {
         m: u32,
@@ -67,10 +79,20 @@ enum Next {
 pub struct Motion {
     axes: Vec<AxisLimits>,
     planner: Planner,
+    /// Axis positions after the axis filter: where the axes are, mm (rotary: degrees).
     pos: Position,
+    /// Axis positions the interpolator computed (before the axis filter).
+    pos_in: Position,
+    /// Corner and jerk filter between interpolator and axes.
+    filter: AxisFilter,
+    /// Path velocity, acceleration and jerk of the filtered axes over the last tick
+    /// (finite differences; mm/s, mm/s², mm/s³).
+    out_v_mm_per_s: f64,
+    out_a_mm_per_s2: f64,
+    out_j_mm_per_s3: f64,
     /// Path position in the front block, mm.
     s_mm: f64,
-    /// Path velocity, mm/s.
+    /// Path velocity of the interpolator, mm/s.
     v_mm_per_s: f64,
     /// The front entry has begun (its `Started` note is out).
     front_started: bool,
@@ -86,6 +108,7 @@ pub struct Motion {
     /// Channel time this motion has stepped through, s.
     time_s: f64,
     trace: Option<Trace>,
+    csv: Option<CsvTrace>,
 }
 
 impl Motion {
@@ -95,10 +118,20 @@ impl Motion {
     }
 
     pub fn with_planner(axes: Vec<AxisLimits>, settings: PlannerSettings) -> Self {
+        let filter = AxisFilter::new(
+            settings.corner_smoothing_s,
+            jerk_window_s(&axes),
+            [0.0; MAX_AXES],
+        );
         Motion {
             planner: Planner::new(&axes, settings),
             axes,
             pos: [0.0; MAX_AXES],
+            pos_in: [0.0; MAX_AXES],
+            filter,
+            out_v_mm_per_s: 0.0,
+            out_a_mm_per_s2: 0.0,
+            out_j_mm_per_s3: 0.0,
             s_mm: 0.0,
             v_mm_per_s: 0.0,
             front_started: false,
@@ -109,7 +142,13 @@ impl Motion {
             dt_s: 0.001,
             time_s: 0.0,
             trace: None,
+            csv: None,
         }
+    }
+
+    /// Tool radii by D number for tool radius compensation, mm (the tool list).
+    pub fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
+        self.planner.set_tool_radii(tools);
     }
 
     pub fn axes(&self) -> &[AxisLimits] {
@@ -120,9 +159,34 @@ impl Motion {
         self.pos
     }
 
-    /// Path velocity at the end of the last tick, mm/s.
+    /// Path velocity of the axes, mm/s: at the end of the last tick, or with the axis filter
+    /// on, over the last tick (finite difference of the filtered positions).
     pub fn velocity_mm_per_s(&self) -> f64 {
-        self.v_mm_per_s
+        if self.filter.active() {
+            self.out_v_mm_per_s
+        } else {
+            self.v_mm_per_s
+        }
+    }
+
+    /// Path acceleration of the axes over the last tick (change of the path velocity), mm/s².
+    pub fn acceleration_mm_per_s2(&self) -> f64 {
+        self.out_a_mm_per_s2
+    }
+
+    /// Path jerk of the axes over the last tick, mm/s³.
+    pub fn jerk_mm_per_s3(&self) -> f64 {
+        self.out_j_mm_per_s3
+    }
+
+    /// The axis filter's windows together, s: how long the axes lag the interpolator
+    /// (0 without corner smoothing and jerk limits).
+    pub fn filter_lag_s(&self) -> f64 {
+        if self.filter.active() {
+            self.filter.total_window_s()
+        } else {
+            0.0
+        }
     }
 
     /// Nothing in execution and nothing held (the queue may still hold blocks).
@@ -134,7 +198,11 @@ impl Motion {
     /// what the window holds (if anything) waits for the window to fill, a flush or the program
     /// end. Not during a feed hold, not after the program end.
     pub fn waiting_for_data(&self) -> bool {
-        !self.ended && !self.hold && self.planner.released() == 0 && self.v_mm_per_s == 0.0
+        !self.ended
+            && !self.hold
+            && self.planner.released() == 0
+            && self.v_mm_per_s == 0.0
+            && self.filter.settled()
     }
 
     /// Blocks held in the window (not yet released).
@@ -188,6 +256,11 @@ impl Motion {
         self.hold = false;
         self.ended = false;
         self.clear();
+        self.pos_in = self.pos;
+        self.filter.fill(self.pos);
+        self.out_v_mm_per_s = 0.0;
+        self.out_a_mm_per_s2 = 0.0;
+        self.out_j_mm_per_s3 = 0.0;
     }
 
     fn clear(&mut self) {
@@ -201,11 +274,29 @@ impl Motion {
     /// Set the machine position (start-up, or after a reset moved nothing).
     pub fn set_position(&mut self, p: Position) {
         self.pos = p;
+        self.pos_in = p;
+        self.filter.fill(p);
     }
 
     /// Record per-tick samples for a plot, at most `max_samples` (decimated).
     pub fn enable_trace(&mut self, max_samples: usize) {
         self.trace = Some(Trace::new(max_samples));
+    }
+
+    /// Stream every `every`-th tick's axis positions, path velocity, acceleration and jerk to
+    /// a CSV file (`run --trace`).
+    pub fn enable_csv_trace(&mut self, path: &std::path::Path, every: u64) -> std::io::Result<()> {
+        let axes: Vec<usize> = self.axes.iter().map(|a| a.index).collect();
+        self.csv = Some(CsvTrace::create(path, &axes, every)?);
+        Ok(())
+    }
+
+    /// Close the CSV trace (if any): its first write error, if there was one.
+    pub fn finish_csv_trace(&mut self) -> std::io::Result<()> {
+        match self.csv.take() {
+            Some(c) => c.finish(),
+            None => Ok(()),
+        }
     }
 
     pub fn trace(&self) -> Option<&Trace> {
@@ -224,7 +315,9 @@ impl Motion {
         Sample {
             time_s: self.time_s,
             pos: self.pos,
-            velocity_mm_per_s: self.v_mm_per_s,
+            velocity_mm_per_s: self.out_v_mm_per_s,
+            accel_mm_per_s2: self.out_a_mm_per_s2,
+            jerk_mm_per_s3: self.out_j_mm_per_s3,
         }
     }
 
@@ -235,19 +328,49 @@ impl Motion {
             self.dt_s = dt_s;
         }
         self.time_s += dt_s;
+        self.filter.configure(self.dt_s);
         if !self.ended {
+            self.planner.front_busy = self.front_started;
             self.planner.take_from(queue);
+            if let Some(e) = self.planner.take_error() {
+                notes.push(MotionNote::Error {
+                    code: e.code,
+                    msg: e.msg,
+                });
+            }
             self.planner.plan_if_needed(self.override_pct, self.dt_s);
             self.execute(dt_s, notes);
         } else {
             self.v_mm_per_s = 0.0;
         }
-        if self.trace.is_some() {
+        if dt_s > 0.0 {
+            self.filter_step(dt_s);
+        }
+        if self.trace.is_some() || self.csv.is_some() {
             let s = self.sample();
             if let Some(t) = self.trace.as_mut() {
                 t.record(s);
             }
+            if let Some(c) = self.csv.as_mut() {
+                c.record(&s);
+            }
         }
+    }
+
+    /// Move the axes: the interpolated position through the axis filter, and the path
+    /// velocity, acceleration and jerk the axes show.
+    fn filter_step(&mut self, dt_s: f64) {
+        let out = self.filter.push(self.pos_in);
+        let mut d2 = 0.0;
+        for (o, p) in out.iter().zip(&self.pos) {
+            d2 += (o - p) * (o - p);
+        }
+        let v = d2.sqrt() / dt_s;
+        let a = (v - self.out_v_mm_per_s) / dt_s;
+        self.out_j_mm_per_s3 = (a - self.out_a_mm_per_s2) / dt_s;
+        self.out_a_mm_per_s2 = a;
+        self.out_v_mm_per_s = v;
+        self.pos = out;
     }
 
     /// Run released entries for `dt_s` seconds.
@@ -265,6 +388,11 @@ impl Motion {
             };
             if !self.front_started {
                 if matches!(front.kind, EntryKind::Move(_)) && left <= 0.0 {
+                    break;
+                }
+                // A stop (dwell, flush stop, program end) takes effect when the axes stand,
+                // not only the interpolator.
+                if front.kind.is_barrier() && !self.filter.settled() {
                     break;
                 }
                 if let Some(info) = front.info.take() {
@@ -291,10 +419,10 @@ impl Motion {
                     left -= r.used_s;
                     if r.finished {
                         // Snap: the block ends exactly at its programmed end point.
-                        self.pos = seg.mv.end;
+                        self.pos_in = seg.mv.end;
                         Next::Pop
                     } else {
-                        self.pos = point_at(&seg.mv, seg.length_mm, self.s_mm);
+                        self.pos_in = point_at(&seg.mv, seg.length_mm, self.s_mm);
                         Next::Stay
                     }
                 }

@@ -1,13 +1,16 @@
-//! Planner: the lookahead window of blocks held in the channel (the "memory effect" of seed 003
-//! §2.3.1), the rules that release them for execution (`#FLUSH`, a full window, the program
-//! end), and the velocity plan over the released motion blocks.
+//! Planner: the lookahead window of blocks held in the channel (the "memory effect" of ISG
+//! FCT-C19 Data streaming §2.3.1), the rules that release them for execution (`#FLUSH`, a full
+//! window, the program end), contour blends (G261/G61) and the velocity plan over the released
+//! motion blocks.
 //!
-//! Release rules. Blocks taken from the block queue are *held* until one of these releases every
-//! block in the window: the window holds `lookahead_blocks` motion blocks (it is full); the
-//! program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT` enters it.
-//! `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a stream that
-//! delivers it in time continues without a stop (seed: "if the next motion block is presented in
-//! good time before an NC block end, motion is resumed without stopping").
+//! Release rules. Motion blocks taken from the block queue are *held* until one of these
+//! releases every block in the window: the window holds `lookahead_blocks` motion blocks (it is
+//! full); the program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT`
+//! enters it. `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a
+//! stream that delivers it in time continues without a stop ("if the next motion block is
+//! presented in good time before an NC block end, motion is resumed without stopping"). A
+//! non-motion block or a dwell with nothing held before it is released at once: it takes no
+//! part in cross-block planning.
 //!
 //! Velocity plan. Every released motion block gets a nominal velocity (programmed feed, G0 at
 //! the axes' rapid rates, lowered so no axis exceeds its maximum velocity; arcs also so the
@@ -30,9 +33,13 @@
 use std::collections::VecDeque;
 
 use crate::lang::block::FlushKind;
-use crate::queue::{Action, BlockInfo, Move, MoveKind, QueuedBlock, MAX_AXES};
+use crate::queue::{
+    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
+};
 
 use super::interpolator::tangent;
+use super::spline::Spline;
+use super::trc::{Comp, TrcError};
 use super::AxisLimits;
 
 /// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
@@ -50,12 +57,15 @@ const NON_MOTION_PER_BLOCK: usize = 4;
 pub struct PlannerSettings {
     /// Motion blocks held and planned over (lookahead window), at least 1.
     pub lookahead_blocks: usize,
+    /// Corner smoothing window, s (0 = off): see [`super::filter`].
+    pub corner_smoothing_s: f64,
 }
 
 impl Default for PlannerSettings {
     fn default() -> Self {
         PlannerSettings {
             lookahead_blocks: 32,
+            corner_smoothing_s: 0.0,
         }
     }
 }
@@ -84,6 +94,8 @@ pub struct Junction {
     pub k_s2_per_mm: f64,
     /// The shorter of the two blocks, mm.
     pub short_mm: f64,
+    /// The previous block's length, mm.
+    pub prev_length_mm: f64,
     /// The previous block's programmed and limit velocity, mm/s.
     pub prev_programmed_mm_per_s: f64,
     pub prev_limit_mm_per_s: f64,
@@ -96,6 +108,33 @@ impl Junction {
             return f64::INFINITY;
         }
         (dt_s / self.k_s2_per_mm).min((self.short_mm / self.k_s2_per_mm).sqrt())
+    }
+
+    /// The limit when a corner filter of `window_s` spreads the velocity jump (0 = no filter).
+    ///
+    /// Each junction owns the time τ = min(window, time on the previous block, time on the
+    /// next block) at the blocks' cruise velocities; owned times of successive junctions do not
+    /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
+    /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
+    /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
+    pub fn smoothed_limit_mm_per_s(
+        &self,
+        window_s: f64,
+        prev_cruise_mm_per_s: f64,
+        length_mm: f64,
+        cruise_mm_per_s: f64,
+    ) -> f64 {
+        if window_s <= 0.0 {
+            return 0.0;
+        }
+        if self.k_s2_per_mm <= 0.0 {
+            return f64::INFINITY;
+        }
+        let time_on = |l: f64, v: f64| if v > 0.0 { l / v } else { f64::INFINITY };
+        let tau = window_s
+            .min(time_on(self.prev_length_mm, prev_cruise_mm_per_s))
+            .min(time_on(length_mm, cruise_mm_per_s));
+        0.5 * tau / self.k_s2_per_mm
     }
 }
 
@@ -124,7 +163,7 @@ pub enum EntryKind {
 
 impl EntryKind {
     /// The motion stops before anything after this entry runs.
-    fn is_barrier(&self) -> bool {
+    pub fn is_barrier(&self) -> bool {
         matches!(
             self,
             EntryKind::Dwell { .. }
@@ -140,6 +179,9 @@ pub struct Entry {
     /// Taken when the `block` event is emitted (`None` for silent second parts).
     pub info: Option<BlockInfo>,
     pub kind: EntryKind,
+    /// A motion entry that counts towards the lookahead (a programmed block; not a contour
+    /// blend, not the second and later pieces of a spline segment).
+    pub counted: bool,
 }
 
 /// The lookahead window: a prefix of it is released, the rest held.
@@ -157,6 +199,30 @@ pub struct Planner {
     release_next_move: bool,
     /// The plan must be recomputed (new releases, override change).
     dirty: bool,
+    /// Corner smoothing window, s (0 = off).
+    corner_s: f64,
+    /// The front entry is executing (its geometry is fixed).
+    pub front_busy: bool,
+    /// The spline being built (G151), if any.
+    spline: Option<Spline>,
+    /// Spline blocks waiting for their curve: (point number, event).
+    spline_infos: VecDeque<(usize, Option<BlockInfo>)>,
+    /// Plain blocks programmed after spline point n, waiting for its curve.
+    spline_waiting: VecDeque<(usize, Option<BlockInfo>)>,
+    /// Reused buffer of finished curve segments.
+    spline_out: Vec<super::spline::Segment>,
+    /// Tool radius compensation under way (G41/G42), if any.
+    comp: Option<Comp>,
+    /// The event of the block whose element waits in the compensator.
+    comp_info: Option<BlockInfo>,
+    /// Plain blocks programmed after the waiting element.
+    comp_waiting: VecDeque<Option<BlockInfo>>,
+    /// Reused buffer of compensated moves.
+    comp_out: Vec<Move>,
+    /// Tool radii by D number, mm.
+    tool_radii: Vec<(u32, f64)>,
+    /// An error found while planning (compensation impossible), for the channel.
+    error: Option<TrcError>,
 }
 
 impl Planner {
@@ -178,6 +244,22 @@ impl Planner {
             moves: 0,
             release_next_move: false,
             dirty: false,
+            front_busy: false,
+            spline: None,
+            spline_infos: VecDeque::new(),
+            spline_waiting: VecDeque::new(),
+            spline_out: Vec::new(),
+            comp: None,
+            comp_info: None,
+            comp_waiting: VecDeque::new(),
+            comp_out: Vec::new(),
+            tool_radii: Vec::new(),
+            error: None,
+            corner_s: if settings.corner_smoothing_s.is_finite() {
+                settings.corner_smoothing_s.max(0.0)
+            } else {
+                0.0
+            },
         }
     }
 
@@ -194,9 +276,13 @@ impl Planner {
     pub fn released(&self) -> usize {
         self.released
     }
-    /// Entries held back (the memory effect).
+    /// Entries held back (the memory effect), blocks waiting for their spline curve included.
     pub fn held(&self) -> usize {
         self.window.len() - self.released
+            + self.spline_infos.len()
+            + self.spline_waiting.len()
+            + usize::from(self.comp_info.is_some())
+            + self.comp_waiting.len()
     }
     pub fn front(&self) -> Option<&Entry> {
         self.window.front()
@@ -240,6 +326,42 @@ impl Planner {
             action,
             silent,
         } = b;
+        let prog = info.prog.clone();
+        let info = (!silent).then_some(info);
+        // Tool radius compensation: every move while it is on (and the G40 block) goes
+        // through the compensator; splines: G1 points in spline mode go to the spline. A plain
+        // block waits behind the element or point it follows; anything else ends the spline
+        // first, then (unless it is a compensated move) the waiting compensated element.
+        let comp_move = matches!(&action, Action::Move(mv)
+            if mv.path.comp != CompSide::Off || self.comp.is_some());
+        let spline_move = matches!(&action, Action::Move(mv)
+            if !comp_move && mv.path.spline.is_some() && matches!(mv.kind, MoveKind::Line));
+        if matches!(action, Action::None) {
+            if let Some(sp) = self.spline.as_ref() {
+                let at = sp.received();
+                self.spline_waiting.push_back((at, info));
+                return;
+            }
+            if self.comp.is_some() {
+                self.comp_waiting.push_back(info);
+                return;
+            }
+        }
+        if !spline_move {
+            self.finish_spline();
+        }
+        if let Action::Move(mv) = &action {
+            if comp_move {
+                self.comp_move(info, *mv);
+                return;
+            }
+            if let (true, Some(kind)) = (spline_move, mv.path.spline) {
+                self.comp_finish();
+                self.spline_point(info, kind, mv);
+                return;
+            }
+        }
+        self.comp_finish();
         let kind = match action {
             Action::None => EntryKind::Plain,
             Action::Dwell { seconds } => EntryKind::Dwell {
@@ -250,28 +372,39 @@ impl Planner {
                 },
             },
             Action::Flush(k) => EntryKind::Flush(k),
-            Action::End { m } => EntryKind::End {
-                m,
-                prog: info.prog.clone(),
-            },
-            Action::Move(mv) => EntryKind::Move(Box::new(self.segment(mv))),
+            Action::End { m } => EntryKind::End { m, prog },
+            Action::Move(mut mv) => {
+                if let Some(arc) = self.blend_corner(&mut mv) {
+                    self.push_move(None, arc);
+                }
+                EntryKind::Move(Box::new(self.segment(mv)))
+            }
         };
+        self.push_entry(info, kind, true);
+    }
+
+    /// Append one entry and apply the release rules.
+    fn push_entry(&mut self, info: Option<BlockInfo>, kind: EntryKind, counted: bool) {
         let is_move = matches!(kind, EntryKind::Move(_));
+        let counted = counted && is_move;
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
-            _ => false,
+            // Nothing held before it: it takes no part in cross-block planning, so it runs
+            // when interpolation reaches it, not when more motion arrives.
+            EntryKind::Plain | EntryKind::Dwell { .. } => self.held() == 0,
         };
         let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
         self.window.push_back(Entry {
-            info: (!silent).then_some(info),
+            info,
             kind,
+            counted,
         });
-        if is_move {
+        if counted {
             self.moves += 1;
-            if self.release_next_move {
-                self.release_next_move = false;
-            }
+        }
+        if is_move && self.release_next_move {
+            self.release_next_move = false;
         }
         if release {
             self.release_all();
@@ -279,6 +412,235 @@ impl Planner {
         if continue_after {
             self.release_next_move = true;
         }
+    }
+
+    /// A silent motion entry (a contour blend) at the back of the window; it does not count
+    /// towards the lookahead.
+    fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
+        let kind = EntryKind::Move(Box::new(self.segment(mv)));
+        self.window.push_back(Entry {
+            info,
+            kind,
+            counted: false,
+        });
+    }
+
+    /// A G1 point in spline mode: into the spline (a new one if the type changed), and the
+    /// curve it completes into the window.
+    fn spline_point(&mut self, info: Option<BlockInfo>, kind: SplineKind, mv: &Move) {
+        if self.spline.as_ref().is_some_and(|s| s.kind() != kind) {
+            self.finish_spline();
+        }
+        let sp = self
+            .spline
+            .get_or_insert_with(|| Spline::new(kind, mv.start, mv.feed_mm_per_min, mv.path));
+        if mv.end == sp.last() {
+            // No motion: the block takes effect like a plain one, in order.
+            let at = sp.received();
+            self.spline_waiting.push_back((at, info));
+            return;
+        }
+        let at = sp.received() + 1;
+        self.spline_infos.push_back((at, info));
+        let mut out = std::mem::take(&mut self.spline_out);
+        if let Some(sp) = self.spline.as_mut() {
+            sp.push(mv.end, mv.feed_mm_per_min, &mut out);
+        }
+        self.emit_spline(&mut out);
+        self.spline_out = out;
+    }
+
+    /// A move while compensation is on, or the block that switches it on or off.
+    fn comp_move(&mut self, info: Option<BlockInfo>, mv: Move) {
+        let side = mv.path.comp;
+        let mut out = std::mem::take(&mut self.comp_out);
+        let done = match (self.comp.take(), side) {
+            (None, CompSide::Off) => Ok(()),
+            (None, _) => self.comp_select(info, mv),
+            (Some(c), CompSide::Off) => {
+                let r = c.deselect(mv, &mut out);
+                // The G40 line is this block's; what comes before it is the waiting element's.
+                let last = out.pop();
+                let pending = self.comp_info.take();
+                self.emit_comp(&mut out, pending);
+                if let Some(l) = last {
+                    out.push(l);
+                }
+                self.emit_comp(&mut out, info);
+                r
+            }
+            (Some(mut c), s) if s == c.side() => {
+                let r = c.next(mv, &mut out);
+                let pending = std::mem::replace(&mut self.comp_info, info);
+                self.emit_comp(&mut out, pending);
+                self.comp = Some(c);
+                r
+            }
+            (Some(mut c), _) => {
+                let r = c.finish(&mut out);
+                let pending = self.comp_info.take();
+                self.emit_comp(&mut out, pending);
+                r.and_then(|()| self.comp_select(info, mv))
+            }
+        };
+        if let Err(e) = done {
+            self.comp = None;
+            self.comp_info = None;
+            self.comp_waiting.clear();
+            self.error = Some(e);
+        }
+        out.clear();
+        self.comp_out = out;
+    }
+
+    /// G41/G42 switches on with `mv`, the radius of its D word's tool.
+    fn comp_select(&mut self, info: Option<BlockInfo>, mv: Move) -> Result<(), TrcError> {
+        let d = mv.path.tool_offset;
+        let radius = if d == 0 {
+            0.0
+        } else {
+            self.tool_radii
+                .iter()
+                .find(|(n, _)| *n == d)
+                .map(|(_, r)| *r)
+                .ok_or_else(|| TrcError {
+                    code: super::trc::TRC_IMPOSSIBLE,
+                    msg: format!("tool radius compensation: no tool data for D{d}"),
+                })?
+        };
+        self.comp = Some(Comp::select(mv.path.comp, radius, mv));
+        self.comp_info = info;
+        Ok(())
+    }
+
+    /// A stop while compensation is on: the waiting element ends at its own offset end.
+    fn comp_finish(&mut self) {
+        let Some(mut c) = self.comp.take() else {
+            return;
+        };
+        let mut out = std::mem::take(&mut self.comp_out);
+        let r = c.finish(&mut out);
+        let pending = self.comp_info.take();
+        self.emit_comp(&mut out, pending);
+        self.comp = Some(c);
+        if let Err(e) = r {
+            self.comp = None;
+            self.error = Some(e);
+        }
+        self.comp_out = out;
+    }
+
+    /// Compensated moves of one block into the window (its event on the first), then the
+    /// plain blocks that waited behind it.
+    fn emit_comp(&mut self, out: &mut Vec<Move>, info: Option<BlockInfo>) {
+        let mut info = info;
+        for (k, mv) in out.drain(..).enumerate() {
+            if mv.length_mm() <= 0.0 && info.is_none() {
+                continue;
+            }
+            let kind = EntryKind::Move(Box::new(self.segment(mv)));
+            self.push_entry(info.take(), kind, k == 0);
+        }
+        if let Some(i) = info {
+            self.push_entry(Some(i), EntryKind::Plain, false);
+        }
+        while let Some(i) = self.comp_waiting.pop_front() {
+            self.push_entry(i, EntryKind::Plain, false);
+        }
+    }
+
+    /// The error compensation ran into, once.
+    pub fn take_error(&mut self) -> Option<TrcError> {
+        self.error.take()
+    }
+
+    /// Tool radii by D number, mm (the tool list).
+    pub fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
+        self.tool_radii = tools;
+    }
+
+    /// End the spline: the rest of its curve and everything waiting for it.
+    fn finish_spline(&mut self) {
+        let Some(sp) = self.spline.take() else { return };
+        let mut out = std::mem::take(&mut self.spline_out);
+        sp.finish(&mut out);
+        self.emit_spline(&mut out);
+        // Blocks whose curve never came (nothing moved): in order, as plain entries.
+        let mut rest: Vec<(usize, Option<BlockInfo>)> = self
+            .spline_infos
+            .drain(..)
+            .chain(self.spline_waiting.drain(..))
+            .collect();
+        rest.sort_by_key(|(at, _)| *at);
+        for (_, info) in rest {
+            self.push_entry(info, EntryKind::Plain, false);
+        }
+        self.spline_out = out;
+    }
+
+    /// Curve segments into the window: each segment's first piece carries its block's event,
+    /// and plain blocks programmed after that block follow it.
+    fn emit_spline(&mut self, out: &mut Vec<super::spline::Segment>) {
+        for seg in out.drain(..) {
+            let mut info = None;
+            while self
+                .spline_infos
+                .front()
+                .is_some_and(|(at, _)| *at <= seg.point)
+            {
+                if let Some((_, i)) = self.spline_infos.pop_front() {
+                    if info.is_some() {
+                        self.push_entry(i, EntryKind::Plain, false);
+                    } else {
+                        info = i;
+                    }
+                }
+            }
+            for (k, mv) in seg.pieces.into_iter().enumerate() {
+                let kind = EntryKind::Move(Box::new(self.segment(mv)));
+                self.push_entry(if k == 0 { info.take() } else { None }, kind, k == 0);
+            }
+            while self
+                .spline_waiting
+                .front()
+                .is_some_and(|(at, _)| *at <= seg.point)
+            {
+                if let Some((_, i)) = self.spline_waiting.pop_front() {
+                    self.push_entry(i, EntryKind::Plain, false);
+                }
+            }
+        }
+    }
+
+    /// Contouring: if the last motion block in the window ends in a corner it should blend
+    /// (G261 / G61), shorten it and `next` and return the blend arc (see [`super::contour`]).
+    /// The window's front is not changed once it executes.
+    fn blend_corner(&mut self, next: &mut Move) -> Option<Move> {
+        let mut at = None;
+        for (i, e) in self.window.iter().enumerate().rev() {
+            match &e.kind {
+                EntryKind::Move(_) => {
+                    at = Some(i);
+                    break;
+                }
+                k if k.is_barrier() => return None,
+                _ => {}
+            }
+        }
+        let i = at.filter(|&i| i > 0 || !self.front_busy)?;
+        let EntryKind::Move(prev) = &mut self.window[i].kind else {
+            return None;
+        };
+        let dev = prev.mv.path.contour_dev_mm?;
+        let (p1, arc, p2) = super::contour::blend(&prev.mv, next, dev)?;
+        prev.mv.end = p1;
+        prev.length_mm = prev.mv.length_mm();
+        if let Some(j) = prev.junction.as_mut() {
+            j.short_mm = j.short_mm.min(prev.length_mm);
+        }
+        next.start = p2;
+        self.dirty = true;
+        Some(arc)
     }
 
     /// Release every block in the window.
@@ -292,7 +654,7 @@ impl Planner {
     /// Remove the front entry (it has been executed).
     pub fn pop_front(&mut self) -> Option<Entry> {
         let e = self.window.pop_front()?;
-        if matches!(e.kind, EntryKind::Move(_)) {
+        if e.counted {
             self.moves -= 1;
         }
         self.released = self.released.saturating_sub(1);
@@ -302,6 +664,12 @@ impl Planner {
     /// Drop everything (reset, error).
     pub fn clear(&mut self) {
         self.window.clear();
+        self.spline = None;
+        self.spline_infos.clear();
+        self.spline_waiting.clear();
+        self.comp = None;
+        self.comp_info = None;
+        self.comp_waiting.clear();
         self.released = 0;
         self.moves = 0;
         self.release_next_move = false;
@@ -330,9 +698,16 @@ impl Planner {
                         Some(j) => {
                             let prev_cruise = (j.prev_programmed_mm_per_s * override_pct / 100.0)
                                 .min(j.prev_limit_mm_per_s);
+                            let cruise = seg.cruise_mm_per_s(override_pct);
                             j.limit_mm_per_s(dt_s)
+                                .max(j.smoothed_limit_mm_per_s(
+                                    self.corner_s,
+                                    prev_cruise,
+                                    seg.length_mm,
+                                    cruise,
+                                ))
                                 .min(prev_cruise)
-                                .min(seg.cruise_mm_per_s(override_pct))
+                                .min(cruise)
                         }
                     };
                     let reachable = (seg.exit_mm_per_s * seg.exit_mm_per_s
@@ -444,6 +819,7 @@ impl Planner {
                     return Some(Junction {
                         k_s2_per_mm: k,
                         short_mm: length_mm.min(prev.length_mm),
+                        prev_length_mm: prev.length_mm,
                         prev_programmed_mm_per_s: prev.programmed_mm_per_s,
                         prev_limit_mm_per_s: prev.limit_mm_per_s,
                     });

@@ -9,8 +9,12 @@ pub struct Sample {
     /// Channel time since the motion was created, s.
     pub time_s: f64,
     pub pos: Position,
-    /// Path velocity at the end of the tick, mm/s.
+    /// Path velocity over the tick, mm/s.
     pub velocity_mm_per_s: f64,
+    /// Path acceleration (change of the path velocity), mm/s².
+    pub accel_mm_per_s2: f64,
+    /// Path jerk, mm/s³.
+    pub jerk_mm_per_s3: f64,
 }
 
 /// Samples at a stride that doubles whenever the buffer fills; interrupts are kept apart and
@@ -96,11 +100,82 @@ mod tests {
                 time_s: k as f64,
                 pos: [0.0; 6],
                 velocity_mm_per_s: 0.0,
+                accel_mm_per_s2: 0.0,
+                jerk_mm_per_s3: 0.0,
             });
         }
         assert!(t.samples().len() <= 100);
         assert!(t.samples().len() >= 50);
         assert!(t.samples().windows(2).all(|w| w[0].time_s < w[1].time_s));
         assert_eq!(t.samples()[0].time_s, 0.0);
+    }
+}
+
+/// `run --trace FILE.csv`: the interpolated motion streamed to a file, one row every `every`
+/// ticks — channel time, each configured axis' position, path velocity, acceleration and jerk.
+/// Nothing is kept in memory beyond the writer's buffer; the first write error stops the
+/// trace and is reported by [`CsvTrace::finish`].
+#[derive(Debug)]
+pub struct CsvTrace {
+    out: std::io::BufWriter<std::fs::File>,
+    /// Axis indices written, in order.
+    axes: Vec<usize>,
+    every: u64,
+    ticks: u64,
+    error: Option<std::io::Error>,
+}
+
+impl CsvTrace {
+    /// Create `path` and write the header.
+    pub fn create(path: &std::path::Path, axes: &[usize], every: u64) -> std::io::Result<Self> {
+        use std::io::Write;
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut header = String::from("time_s");
+        for &i in axes {
+            let unit = if i < 3 { "mm" } else { "deg" };
+            header.push_str(&format!(
+                ",{}_{unit}",
+                crate::queue::AXIS_LETTERS[i] as char
+            ));
+        }
+        header.push_str(",velocity_mm_per_s,acceleration_mm_per_s2,jerk_mm_per_s3");
+        writeln!(out, "{header}")?;
+        Ok(CsvTrace {
+            out,
+            axes: axes.to_vec(),
+            every: every.max(1),
+            ticks: 0,
+            error: None,
+        })
+    }
+
+    /// One tick; written if it falls on the stride.
+    pub fn record(&mut self, s: &Sample) {
+        use std::io::Write;
+        let keep = self.ticks.is_multiple_of(self.every);
+        self.ticks += 1;
+        if !keep || self.error.is_some() {
+            return;
+        }
+        let mut row = format!("{:.6}", s.time_s);
+        for &i in &self.axes {
+            row.push_str(&format!(",{:.6}", s.pos[i]));
+        }
+        row.push_str(&format!(
+            ",{:.6},{:.3},{:.1}",
+            s.velocity_mm_per_s, s.accel_mm_per_s2, s.jerk_mm_per_s3
+        ));
+        if let Err(e) = writeln!(self.out, "{row}") {
+            self.error = Some(e);
+        }
+    }
+
+    /// Flush; the first error of the whole trace, if any.
+    pub fn finish(mut self) -> std::io::Result<()> {
+        use std::io::Write;
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        self.out.flush()
     }
 }

@@ -31,6 +31,10 @@ pub struct Config {
     pub runtime: RuntimeConfig,
     /// One per channel, in channel order (index 0 = channel 1).
     pub channels: Vec<ChannelConfig>,
+    /// `tools.lis` next to the start-up list, if present.
+    pub tools_file: Option<PathBuf>,
+    /// Tool radii by D number, mm (empty without a tool list).
+    pub tools: super::tools::ToolRadii,
     /// Warnings found on the way (unknown entries, values without effect).
     pub warnings: Vec<Diagnostic>,
 }
@@ -91,7 +95,8 @@ pub fn load(startup_list: &Path) -> Result<Config, ParamError> {
 
 /// Check a start-up list (with its channel lists and runtime.toml), a channel list, or a
 /// runtime.toml, returning every error and warning. The list kind is decided by content:
-/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`.
+/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`, a
+/// tool list `wz[…]`.
 pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
     if path
         .extension()
@@ -108,6 +113,8 @@ pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
         build(list, &mut diags);
     } else if is_zero_offset_list(&list) {
         interpret_zero_offsets(&list, &mut diags);
+    } else if super::tools::is_tool_list(&list) {
+        super::tools::interpret_tools(&list, &mut diags);
     } else {
         // Cache values are not finished here: the start-up list may switch caching on.
         interpret_channel(list, &mut diags);
@@ -132,6 +139,18 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
         (None, Some(RuntimeConfig::default()))
     };
 
+    let tools_path = list_folder(&startup_path).join(super::tools::TOOLS_FILE);
+    let (tools_file, tools) = if tools_path.exists() {
+        match super::tools::read_tools(&tools_path, diags) {
+            Ok(t) => (Some(tools_path), t),
+            Err(e) => {
+                diags.push(e);
+                (Some(tools_path), Vec::new())
+            }
+        }
+    } else {
+        (None, Vec::new())
+    };
     let channels = channels(&startup, diags);
     Some(Config {
         startup_list: startup_path,
@@ -139,6 +158,8 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
         runtime_file,
         runtime: runtime?,
         channels: channels?,
+        tools_file,
+        tools,
         warnings: Vec::new(),
     })
 }

@@ -11,6 +11,7 @@ pub mod list;
 pub mod runtime;
 pub mod search_path;
 pub mod startup;
+pub mod tools;
 pub mod value;
 pub mod zero_offsets;
 

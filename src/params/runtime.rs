@@ -131,12 +131,17 @@ impl Default for DecoderRuntime {
 pub struct PlannerConfig {
     /// Motion blocks the planner looks ahead over (default 32).
     pub lookahead_blocks: u32,
+    /// Corner smoothing window in ms (default 0 = off): a moving average over the axis
+    /// positions that spreads each junction's velocity jump over this time, so corners of fine
+    /// polylines keep speed while every axis keeps its acceleration limit (docs/motion.md).
+    pub corner_smoothing_ms: f64,
 }
 
 impl Default for PlannerConfig {
     fn default() -> Self {
         PlannerConfig {
             lookahead_blocks: 32,
+            corner_smoothing_ms: 0.0,
         }
     }
 }
@@ -471,6 +476,15 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             None,
             "lookahead_blocks",
             format!("{la} is not in 1 ... 100000"),
+        );
+    }
+    let cs = cfg.planner.corner_smoothing_ms;
+    if !(cs.is_finite() && (0.0..=1000.0).contains(&cs)) {
+        fail(
+            "planner",
+            None,
+            "corner_smoothing_ms",
+            format!("{cs} is not in 0 ... 1000"),
         );
     }
     let fb = cfg.ads.max_frame_bytes;

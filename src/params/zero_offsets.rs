@@ -116,7 +116,7 @@ pub fn interpret_zero_offsets(list: &ParamList, diags: &mut Vec<Diagnostic>) -> 
 }
 
 /// A signed 32-bit whole number (the kernel's SGN32), decimal or `0x…`.
-fn int_value(list: &ParamList, e: &Entry) -> Result<i64, Diagnostic> {
+pub(crate) fn int_value(list: &ParamList, e: &Entry) -> Result<i64, Diagnostic> {
     let v = match e.value.kind {
         ValueKind::Int(v) => v,
         ValueKind::Hex(v) => i64::try_from(v).unwrap_or(i64::MAX),

@@ -80,8 +80,11 @@ pub enum EventKind {
         prog: Option<String>,
         line: Option<u64>,
     },
-    /// Motion stopped for lack of stream data.
-    Interrupt,
+    /// Motion stopped for lack of stream data; `held`: blocks the lookahead window holds and
+    /// may not release yet (0 when everything received has run).
+    Interrupt {
+        held: u64,
+    },
     /// Motion resumed after an interrupt.
     Resume,
     /// A file cache operation (`load`, `refresh`, `clear`, `clear_all`, `hit`).
@@ -320,10 +323,10 @@ mod tests {
             e.to_json(),
             r#"{"tick":3,"t":0.003,"ch":1,"ev":"write","bytes":12,"ok":false,"code":11012}"#
         );
-        let e = Event::new(&tick, 2, EventKind::Interrupt);
+        let e = Event::new(&tick, 2, EventKind::Interrupt { held: 0 });
         assert_eq!(
             e.to_json(),
-            r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt"}"#
+            r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt","held":0}"#
         );
     }
 }

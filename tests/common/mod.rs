@@ -305,3 +305,5 @@ pub fn run_client(
     let seen = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
     (seen, events)
 }
+
+pub mod random_path;

@@ -1,0 +1,213 @@
+//! Axis filter: two moving averages in series over the interpolated axis positions — the corner
+//! filter (spreads the velocity jumps at block junctions over `corner_smoothing`) and the jerk
+//! filter (turns the acceleration-limited profile into a jerk-limited one).
+//!
+//! Why a filter after interpolation. A moving average of length T over positions is also a
+//! moving average over their finite differences: the filtered velocity and acceleration of
+//! every axis are means of the unfiltered ones, so they never exceed them, and the filtered
+//! jerk is (a(t) − a(t − T)) / T, at most (max a − min a) / T. With the acceleration in
+//! [−A, A] a window T = 2·A / J bounds every axis' jerk by J on every tick, whatever the
+//! geometry. This is the axis-wise jerk limitation of post-interpolation smoothing ("FIR jerk
+//! filter", e.g. SINUMERIK MD32402 `AX_JERK_MODE` = 2 "filter", FANUC "acceleration/
+//! deceleration after interpolation"); its price is a lag of T and rounded corners (the path
+//! seen through the window), which docs/motion.md quantifies.
+//!
+//! Rounding. The window's sum is kept relative to a nearby origin and recomputed exactly once
+//! per turn of the window, so nothing drifts; once the window holds one position only, the
+//! output is that position exactly, so programmed end points are reached exactly.
+
+use crate::queue::{Position, MAX_AXES};
+
+/// Longest window, ticks (bounds memory and tick work whatever the limits say).
+pub const MAX_WINDOW_TICKS: usize = 4096;
+
+/// One moving average: the last `len` inputs.
+#[derive(Debug, Clone)]
+struct Stage {
+    ring: Vec<Position>,
+    /// Index of the oldest entry (next to be replaced).
+    head: usize,
+    /// Consecutive pushes equal to the newest input (≥ len: settled).
+    same: usize,
+    /// Σ (entry − origin) over the ring; recomputed exactly once per turn of the ring.
+    sum: Position,
+    /// Reference the sum is kept relative to (small terms, small rounding).
+    origin: Position,
+    out: Position,
+}
+
+impl Stage {
+    fn new(len: usize, p: Position) -> Self {
+        Stage {
+            ring: vec![p; len.clamp(1, MAX_WINDOW_TICKS)],
+            head: 0,
+            same: usize::MAX,
+            sum: [0.0; MAX_AXES],
+            origin: p,
+            out: p,
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.ring.len()
+    }
+
+    fn settled(&self) -> bool {
+        self.same >= self.ring.len()
+    }
+
+    fn push(&mut self, p: Position) -> Position {
+        let n = self.ring.len();
+        if n == 1 {
+            self.ring[0] = p;
+            self.out = p;
+            return p;
+        }
+        let newest = (self.head + n - 1) % n;
+        if self.ring[newest] == p {
+            self.same = self.same.saturating_add(1);
+        } else {
+            self.same = 1;
+        }
+        let old = self.ring[self.head];
+        self.ring[self.head] = p;
+        self.head = (self.head + 1) % n;
+        if self.settled() {
+            self.out = p;
+            return p;
+        }
+        if self.head == 0 {
+            // Once per turn: the sum afresh, relative to the newest input (no drift).
+            self.origin = p;
+            for i in 0..MAX_AXES {
+                self.sum[i] = self.ring.iter().map(|q| q[i] - p[i]).sum();
+            }
+        } else {
+            for i in 0..MAX_AXES {
+                self.sum[i] += (p[i] - self.origin[i]) - (old[i] - self.origin[i]);
+            }
+        }
+        let inv = 1.0 / n as f64;
+        let mut out = p;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.origin[i] + self.sum[i] * inv;
+        }
+        self.out = out;
+        out
+    }
+}
+
+/// The corner filter followed by the jerk filter.
+#[derive(Debug, Clone)]
+pub struct AxisFilter {
+    /// Corner smoothing window, s (0 = off).
+    corner_s: f64,
+    /// Jerk window, s (0 = off): 2·aᵢ / jᵢ, the largest over the axes with a jerk limit.
+    jerk_s: f64,
+    /// Tick length the stage lengths were made for, s.
+    dt_s: f64,
+    corner: Stage,
+    jerk: Stage,
+}
+
+impl AxisFilter {
+    pub fn new(corner_s: f64, jerk_s: f64, p: Position) -> Self {
+        let ok = |t: f64| if t.is_finite() { t.max(0.0) } else { 0.0 };
+        AxisFilter {
+            corner_s: ok(corner_s),
+            jerk_s: ok(jerk_s),
+            dt_s: 0.0,
+            corner: Stage::new(1, p),
+            jerk: Stage::new(1, p),
+        }
+    }
+
+    /// Window in ticks for `t_s` at `dt_s`: at least `t_s` long (so the bound holds).
+    fn ticks(t_s: f64, dt_s: f64) -> usize {
+        if t_s <= 0.0 || dt_s <= 0.0 {
+            return 1;
+        }
+        ((t_s / dt_s - 1e-9).ceil() as usize).clamp(1, MAX_WINDOW_TICKS)
+    }
+
+    /// Size the windows for tick length `dt_s`; a change refills them with the current output
+    /// (only the first tick or a changed cycle period does this).
+    pub fn configure(&mut self, dt_s: f64) {
+        if dt_s <= 0.0 || dt_s == self.dt_s {
+            return;
+        }
+        self.dt_s = dt_s;
+        let (nc, nj) = (
+            Self::ticks(self.corner_s, dt_s),
+            Self::ticks(self.jerk_s, dt_s),
+        );
+        if nc != self.corner.len() || nj != self.jerk.len() {
+            let p = self.jerk.out;
+            self.corner = Stage::new(nc, p);
+            self.jerk = Stage::new(nj, p);
+        }
+    }
+
+    /// Corner window actually used, s (whole ticks).
+    pub fn corner_window_s(&self) -> f64 {
+        self.corner.len() as f64 * self.dt_s
+    }
+
+    /// Both windows, s: the lag of a stop and the time the output takes to settle.
+    pub fn total_window_s(&self) -> f64 {
+        (self.corner.len() + self.jerk.len()) as f64 * self.dt_s
+    }
+
+    /// One tick's interpolated position in, the filtered position out.
+    pub fn push(&mut self, p: Position) -> Position {
+        let c = self.corner.push(p);
+        self.jerk.push(c)
+    }
+
+    pub fn output(&self) -> Position {
+        self.jerk.out
+    }
+
+    /// The output equals the last input: the axes stand where the interpolator stands.
+    pub fn settled(&self) -> bool {
+        self.corner.settled() && self.jerk.settled()
+    }
+
+    /// Stop at once at `p` (reset, start-up position).
+    pub fn fill(&mut self, p: Position) {
+        let (nc, nj) = (self.corner.len(), self.jerk.len());
+        self.corner = Stage::new(nc, p);
+        self.jerk = Stage::new(nj, p);
+    }
+
+    /// Filtering does anything at all.
+    pub fn active(&self) -> bool {
+        self.corner_s > 0.0 || self.jerk_s > 0.0
+    }
+}
+
+/// Jerk window for these axes, s: max over axes with a jerk limit of 2·aᵢ / jᵢ (0 if none).
+pub fn jerk_window_s(axes: &[super::AxisLimits]) -> f64 {
+    axes.iter()
+        .filter_map(|a| {
+            let j = a.max_jerk_mm_per_s3?;
+            (j.is_finite() && j > 0.0).then(|| 2.0 * a.max_accel_mm_per_s2.max(0.0) / j)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_step_becomes_a_ramp_and_settles_exactly() {
+        let mut f = AxisFilter::new(0.0, 0.004, [0.0; MAX_AXES]);
+        f.configure(0.001);
+        let mut p = [0.0; MAX_AXES];
+        p[0] = 1.0;
+        let outs: Vec<f64> = (0..6).map(|_| f.push(p)[0]).collect();
+        assert_eq!(outs, vec![0.25, 0.5, 0.75, 1.0, 1.0, 1.0]);
+        assert!(f.settled());
+    }
+}

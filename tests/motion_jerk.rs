@@ -1,0 +1,339 @@
+//! Jerk limits and the corner filter, driven directly: blocks into a `BlockQueue`,
+//! `Motion::step` per tick, the axes' positions checked by finite differences — every axis'
+//! velocity, acceleration and jerk on every tick of random programs, the rest-to-rest time,
+//! polylines against the true arc, the memory effect's non-motion blocks.
+
+use std::sync::Arc;
+
+mod common;
+use common::random_path::{self, Rng};
+
+use ncchannel::decoder::arc::{arc_move, ArcSpec};
+use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
+use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
+use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
+use ncchannel::queue::{
+    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,
+    QueuedBlock, SplineKind,
+};
+
+const DT: f64 = 0.001;
+
+fn axes(vmax: f64, accel: f64, jerk: Option<f64>) -> Vec<AxisLimits> {
+    (0..3)
+        .map(|index| AxisLimits {
+            index,
+            max_velocity_mm_per_min: vmax,
+            max_accel_mm_per_s2: accel,
+            max_jerk_mm_per_s3: jerk,
+            rapid_mm_per_min: vmax,
+            min_mm: -1e6,
+            max_mm: 1e6,
+        })
+        .collect()
+}
+
+fn settings(lookahead: usize, corner_ms: f64) -> PlannerSettings {
+    PlannerSettings {
+        lookahead_blocks: lookahead,
+        corner_smoothing_s: corner_ms / 1000.0,
+    }
+}
+
+fn block(line: u32, action: Action) -> QueuedBlock {
+    QueuedBlock {
+        info: BlockInfo {
+            prog: Arc::from("t.nc"),
+            line,
+            offset: 0,
+            counter: line as u64,
+            n: None,
+            text: None,
+            stream: false,
+        },
+        action,
+        silent: false,
+    }
+}
+
+fn p(x: f64, y: f64, z: f64) -> Position {
+    [x, y, z, 0.0, 0.0, 0.0]
+}
+
+fn line(start: Position, end: Position, feed: f64) -> Action {
+    Action::Move(Move {
+        kind: MoveKind::Line,
+        start,
+        end,
+        feed_mm_per_min: feed,
+        path: PathMode::default(),
+    })
+}
+
+/// Run until the program end; every tick's position into `check` (if any). Returns the ticks
+/// until the end note and the positions.
+fn run_to_end(
+    m: &mut Motion,
+    q: &mut BlockQueue,
+    mut check: Option<&mut LimitCheck>,
+    max_ticks: usize,
+) -> (usize, Vec<Position>) {
+    let mut notes = Vec::new();
+    let mut positions = Vec::new();
+    if let Some(c) = check.as_deref_mut() {
+        c.record(m.position());
+    }
+    for k in 1..=max_ticks {
+        m.step(DT, q, &mut notes);
+        positions.push(m.position());
+        if let Some(c) = check.as_deref_mut() {
+            c.record(m.position());
+        }
+        if let Some(MotionNote::Error { code, msg }) =
+            notes.iter().find(|n| matches!(n, MotionNote::Error { .. }))
+        {
+            panic!("motion error {code}: {msg}");
+        }
+        if notes.iter().any(|n| matches!(n, MotionNote::End { .. })) {
+            return (k, positions);
+        }
+        notes.clear();
+    }
+    panic!("no program end in {max_ticks} ticks");
+}
+
+/// The R50 circle at F6000 as `n` chords (n = 0: the true arc), then M30; seconds to the end.
+fn circle_time_s(n: usize, axes: &[AxisLimits], s: PlannerSettings) -> f64 {
+    let mut m = Motion::with_planner(axes.to_vec(), s);
+    let mut q = BlockQueue::new(1_000_000);
+    let start = p(50.0, 0.0, 0.0);
+    m.set_position(start);
+    if n == 0 {
+        let mv = arc_move(
+            &ArcSpec {
+                plane: Plane::Xy,
+                ijk: [Some(-50.0), Some(0.0), None],
+                radius: None,
+                cw: false,
+            },
+            start,
+            start,
+            6000.0,
+            1e-6,
+        )
+        .unwrap();
+        q.push(block(1, Action::Move(mv)));
+    } else {
+        let mut at = start;
+        for k in 1..=n {
+            let phi = std::f64::consts::TAU * k as f64 / n as f64;
+            let to = if k == n {
+                start
+            } else {
+                p(50.0 * phi.cos(), 50.0 * phi.sin(), 0.0)
+            };
+            q.push(block(k as u32, line(at, to, 6000.0)));
+            at = to;
+        }
+    }
+    q.push(block(n as u32 + 1, Action::End { m: 30 }));
+    let (ticks, positions) = run_to_end(&mut m, &mut q, None, 200_000);
+    assert_eq!(positions.last().copied(), Some(start));
+    ticks as f64 * DT
+}
+
+#[test]
+fn polylines_of_the_r50_circle_run_near_the_true_arc_time() {
+    // A jerk-limited machine with the corner filter and a window long enough to brake in.
+    let ax = axes(30000.0, 2000.0, Some(20_000.0));
+    let s = settings(128, 50.0);
+    let arc = circle_time_s(0, &ax, s);
+    let t: Vec<f64> = [36, 360, 3600]
+        .iter()
+        .map(|&n| circle_time_s(n, &ax, s))
+        .collect();
+    println!("R50 at F6000: arc {arc:.3} s, 36/360/3600 chords {t:?} s");
+    for (n, ti) in [36, 360, 3600].iter().zip(&t) {
+        assert!(
+            (ti - arc).abs() <= 0.1 * arc,
+            "{n} chords: {ti} s against the arc's {arc} s"
+        );
+    }
+    for w in t.windows(2) {
+        assert!(w[1] <= 1.05 * w[0], "more chords slower: {t:?}");
+    }
+}
+
+#[test]
+fn rest_to_rest_time_is_the_trapezoid_plus_the_jerk_window() {
+    // 100 mm in X at F6000, a = 2000, j = 20000: the path accelerates at 0.75·a (the rest is
+    // the corner reserve), the jerk window is 2·a/j = 0.2 s.
+    let (a, j, v, len) = (2000.0, 20_000.0, 100.0, 100.0);
+    let ax = axes(30000.0, a, Some(j));
+    let mut m = Motion::with_planner(ax.clone(), settings(32, 0.0));
+    let mut q = BlockQueue::new(16);
+    q.push(block(1, line(p(0.0, 0.0, 0.0), p(len, 0.0, 0.0), v * 60.0)));
+    q.push(block(2, Action::End { m: 30 }));
+    let mut check = LimitCheck::new(&ax, DT, FILTERED_EPS);
+    let (ticks, positions) = run_to_end(&mut m, &mut q, Some(&mut check), 100_000);
+    check.verdict().unwrap();
+    assert_eq!(positions.last().copied(), Some(p(len, 0.0, 0.0)));
+    let a_path = (1.0 - JUNCTION_ACCEL_SHARE) * a;
+    let model = len / v + v / a_path + 2.0 * a / j;
+    // The time-optimal jerk-limited profile (a is not reached: peak √(v·j)).
+    let optimum = len / v + 2.0 * (v / j).sqrt();
+    let t = ticks as f64 * DT;
+    println!("rest to rest: {t:.3} s, model {model:.3} s, jerk-limited optimum {optimum:.3} s");
+    // The program end takes effect the tick after the axes settle.
+    assert!((t - model).abs() <= 2.0 * DT, "{t} s against {model} s");
+}
+
+/// Half the lines with G261 (a deviation of 0.01 … 0.5 mm).
+fn contoured(a: Action, rng: &mut Rng) -> Action {
+    match a {
+        Action::Move(mut mv) if rng.next() < 0.5 => {
+            mv.path.contour_dev_mm = Some(rng.range(0.01, 0.5));
+            Action::Move(mv)
+        }
+        a => a,
+    }
+}
+
+/// A random program: rapids, lines (long, short, CAM polylines: a third of them splines, half
+/// of the rest contoured), squares with tool radius compensation, arcs and helices in all
+/// planes, dwells, M30. Returns the end point.
+fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
+    let mut at = p(0.0, 0.0, 0.0);
+    let mut n = 0u32;
+    while n < blocks {
+        n += 1;
+        let kind = rng.next();
+        let feed = rng.range(100.0, 15000.0);
+        if kind < 0.1 {
+            let mv = random_path::rapid(rng, at);
+            at = mv.end;
+            q.push(block(n, Action::Move(mv)));
+        } else if kind < 0.4 {
+            let mv = random_path::line(rng, at, feed);
+            at = mv.end;
+            q.push(block(n, contoured(Action::Move(mv), rng)));
+        } else if kind < 0.6 {
+            // A CAM polyline: 20..200 chords of a circle, radius 5..60 mm.
+            let chords = (rng.range(20.0, 200.0)) as usize;
+            let r = rng.range(5.0, 60.0);
+            let phi0 = rng.range(0.0, 6.3);
+            let sweep = rng.range(0.5, 6.0);
+            let c = [at[0] - r * phi0.cos(), at[1] - r * phi0.sin()];
+            // A third of the polylines as a spline (G151), of either type.
+            let spline = match rng.next() {
+                x if x < 0.17 => Some(SplineKind::Akima),
+                x if x < 0.34 => Some(SplineKind::BSpline),
+                _ => None,
+            };
+            for k in 1..=chords {
+                let phi = phi0 + sweep * k as f64 / chords as f64;
+                let to = p(c[0] + r * phi.cos(), c[1] + r * phi.sin(), at[2]);
+                let a = match (spline, line(at, to, feed)) {
+                    (Some(kind), Action::Move(mut mv)) => {
+                        mv.path.spline = Some(kind);
+                        Action::Move(mv)
+                    }
+                    (_, a) => contoured(a, rng),
+                };
+                q.push(block(n, a));
+                at = to;
+            }
+        } else if kind < 0.66 {
+            // A square with tool radius compensation (D1, radius 1 mm), G41 or G42, then G40.
+            let side = if rng.next() < 0.5 {
+                CompSide::Left
+            } else {
+                CompSide::Right
+            };
+            let l = rng.range(5.0, 30.0);
+            let th = rng.range(0.0, 6.3);
+            let (c, s) = (th.cos(), th.sin());
+            let corners = [(0.0, 0.0), (l, 0.0), (l, l), (0.0, l), (0.0, 0.0)];
+            let base = p(at[0] + 3.0, at[1] + 3.0, at[2]);
+            let pts: Vec<Position> = corners
+                .iter()
+                .map(|(x, y)| p(base[0] + c * x - s * y, base[1] + s * x + c * y, base[2]))
+                .collect();
+            let comp = PathMode {
+                comp: side,
+                tool_offset: 1,
+                ..PathMode::default()
+            };
+            let mut from = at;
+            for to in &pts {
+                q.push(block(
+                    n,
+                    Action::Move(Move {
+                        kind: MoveKind::Line,
+                        start: from,
+                        end: *to,
+                        feed_mm_per_min: feed,
+                        path: comp,
+                    }),
+                ));
+                from = *to;
+            }
+            let off = p(from[0] - 3.0, from[1] - 3.0, from[2]);
+            q.push(block(n, line(from, off, feed)));
+            at = off;
+        } else if kind < 0.95 {
+            let mv = random_path::arc(rng, at, feed);
+            at = mv.end;
+            q.push(block(n, Action::Move(mv)));
+        } else {
+            q.push(block(
+                n,
+                Action::Dwell {
+                    seconds: rng.range(0.0, 0.05),
+                },
+            ));
+        }
+    }
+    q.push(block(n + 1, Action::End { m: 30 }));
+    at
+}
+
+fn limits_hold_on_random_programs(jerk: Option<f64>, corner_ms: f64, seed: u64) {
+    // Different limits per axis, so the projections matter.
+    let mut limits = axes(12000.0, 1500.0, jerk.map(|j| j * 1.5));
+    limits[1].max_velocity_mm_per_min = 9000.0;
+    limits[1].max_accel_mm_per_s2 = 1000.0;
+    limits[1].max_jerk_mm_per_s3 = jerk;
+    limits[1].rapid_mm_per_min = 8000.0;
+    limits[2].max_velocity_mm_per_min = 6000.0;
+    limits[2].max_accel_mm_per_s2 = 600.0;
+    limits[2].max_jerk_mm_per_s3 = jerk.map(|j| j * 0.5);
+    limits[2].rapid_mm_per_min = 6000.0;
+    let mut rng = Rng(seed);
+    let mut m = Motion::with_planner(limits.clone(), settings(24, corner_ms));
+    m.set_tool_radii(vec![(1, 1.0)]);
+    let mut q = BlockQueue::new(1_000_000);
+    let end = random_program(&mut rng, &mut q, 300);
+    let mut check = LimitCheck::new(&limits, DT, FILTERED_EPS);
+    let (_, positions) = run_to_end(&mut m, &mut q, Some(&mut check), 5_000_000);
+    // The end point exactly, no residue of the filter.
+    assert_eq!(positions.last().copied(), Some(end));
+    if let Err(e) = check.verdict() {
+        panic!("jerk {jerk:?}, corner {corner_ms} ms, seed {seed}: {e}");
+    }
+}
+
+#[test]
+fn every_axis_keeps_velocity_acceleration_and_jerk_on_every_tick() {
+    for seed in [0x9E37_79B9_7F4A_7C15, 0x1234_5678_9ABC_DEF1, 77] {
+        limits_hold_on_random_programs(Some(20_000.0), 30.0, seed);
+        limits_hold_on_random_programs(Some(50_000.0), 0.0, seed);
+    }
+}
+
+#[test]
+fn corner_filter_alone_keeps_velocity_and_acceleration_on_every_tick() {
+    for seed in [5, 0xDEAD_BEEF] {
+        limits_hold_on_random_programs(None, 50.0, seed);
+    }
+}
