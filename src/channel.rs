@@ -21,10 +21,7 @@ use crate::source::stream::{StreamBuffer, StreamWriteError};
 /// Errors kept for the report (`ChannelStats::errors` counts all of them).
 pub const MAX_LISTED_ERRORS: usize = 256;
 
-/// Warning raised when a stream write is rejected because the buffer is full.
-pub const WARN_WRITE_REJECTED: u32 = 11012;
-/// Error raised by stream data without CR LF line ends.
-pub const ERR_NO_LINE_END: u32 = 21476;
+pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
 /// Channel modes (REFERENCE §7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
