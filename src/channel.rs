@@ -170,6 +170,8 @@ pub struct Channel {
     /// Block search target for the next start.
     search: Option<SearchTarget>,
     last_error: Option<(u32, String)>,
+    /// The latest `#MSG` text (kept until the next one or a reset).
+    message: Option<String>,
     errors: Vec<(u32, String)>,
     stats: ChannelStats,
     /// Motion stopped for lack of stream data; a `resume` is owed.
@@ -204,6 +206,7 @@ impl Channel {
             program: None,
             search: None,
             last_error: None,
+            message: None,
             errors: Vec::new(),
             stats: ChannelStats::default(),
             interrupted: false,
@@ -256,6 +259,11 @@ impl Channel {
     pub fn errors(&self) -> &[(u32, String)] {
         &self.errors
     }
+    /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
+    pub fn message(&self) -> Option<&str> {
+        self.message.as_deref()
+    }
+
     pub fn last_error(&self) -> Option<&(u32, String)> {
         self.last_error.as_ref()
     }
@@ -545,6 +553,7 @@ impl Channel {
         // A read still pending is abandoned with the program.
         self.store.take_owed();
         self.last_error = None;
+        self.message = None;
         self.interrupted = false;
         self.search = None;
         self.set_state(tick, State::Ready);
@@ -599,6 +608,21 @@ impl Channel {
                         found,
                     },
                 ),
+                Note::Message { text, save } => {
+                    self.events.push(
+                        tick,
+                        self.number,
+                        EventKind::Message {
+                            text: text.clone(),
+                            save,
+                        },
+                    );
+                    self.message = Some(text);
+                }
+                Note::HFunction { h } => {
+                    self.events
+                        .push(tick, self.number, EventKind::HFunction { h })
+                }
                 Note::Cache { op, file } => self.events.push(
                     tick,
                     self.number,

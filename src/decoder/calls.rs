@@ -110,6 +110,29 @@ impl Decoder {
             Command::ContourMode { .. } => self.emit(info, Action::None, false, io),
             Command::Var => self.top().var_block = true,
             Command::EndVar => {}
+            Command::Msg { save, text } => {
+                self.notes.push(Note::Message {
+                    text: text.clone(),
+                    save: *save,
+                });
+                self.emit(info, Action::None, false, io);
+            }
+            Command::Time(v) => {
+                let seconds = match v {
+                    Value::Num(n) => *n,
+                    Value::Expr(e) => self.eval(e)?,
+                };
+                self.emit(
+                    info,
+                    Action::Dwell {
+                        seconds: seconds.max(0.0),
+                    },
+                    false,
+                    io,
+                );
+            }
+            // Accepted without effect (lang::dialect): a block like any other.
+            Command::Inert { .. } => self.emit(info, Action::None, false, io),
         }
         Ok(())
     }

@@ -148,6 +148,15 @@ pub enum Note {
         op: &'static str,
         file: String,
     },
+    /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).
+    Message {
+        text: String,
+        save: bool,
+    },
+    /// An H function (0..=65535) decoded: handed to the PLC side.
+    HFunction {
+        h: u32,
+    },
 }
 
 /// Where the decoder stands.

@@ -144,33 +144,36 @@ pub fn is_word_letter(b: u8) -> bool {
     b.is_ascii_uppercase() && MASK & (1 << (b - b'A')) != 0
 }
 
-/// G functions the parser accepts (REFERENCE §4): motion G0–G3, dwell G4, planes G17–G19,
-/// tool radius compensation G40–G42, zero offsets G53–G59, contouring at block end G61,
-/// absolute/incremental G90/G91, ramp time weighting G132–G134, spline off/on G150/G151,
-/// contouring off/on G260/G261. Everything else is 20131.
+/// The G functions ncchannel implements, the parser's fast path: motion G0–G3, dwell G4,
+/// planes G17–G19, tool radius compensation G40–G42, zero offsets G53–G59, contouring at
+/// block end G61, inch/metric G70/G71, absolute/incremental G90/G91, reference point offset
+/// G92, feed per minute/revolution G94/G95, spindle speed G97, spline off/on G150/G151,
+/// contouring off/on G260/G261. The rest of ISG's list is in [`super::dialect`] (accepted
+/// without effect, or refused by name); a number in neither is 20131.
 pub const KNOWN_G: &[u32] = &[
-    0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 90, 91, 132, 133, 134,
-    150, 151, 260, 261,
+    0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 70, 71, 90, 91, 92, 94,
+    95, 97, 150, 151, 260, 261,
 ];
 
-/// G functions that take a value: `G133=<expr>`, `G134=<expr>` (ISG manual "Weighting the
-/// ramp times"); seed 003 writes it `G134 50`, which we accept too.
-pub const G_WITH_VALUE: &[u32] = &[133, 134];
+/// G functions that take a value: `G133=<expr>`, `G134=<expr>` (TF5200 "Weighting the ramp
+/// times", also written `G134 50`) and the dwell `G04 <seconds>`.
+pub const G_WITH_VALUE: &[u32] = &[4, 133, 134];
 
-/// Is `g` a known G function?
+/// Is `g` one of the implemented G functions ([`KNOWN_G`])?
+#[inline]
 pub fn is_known_g(g: u32) -> bool {
     matches!(
         g,
-        0..=4 | 17..=19 | 40..=42 | 53..=59 | 61 | 90 | 91 | 132..=134 | 150 | 151 | 260 | 261
+        0..=4 | 17..=19 | 40..=42 | 53..=59 | 61 | 70 | 71 | 90..=92 | 94 | 95 | 97 | 150 | 151
+            | 260 | 261
     )
 }
 
-/// M functions the parser accepts: M0–M9 (stop, optional stop, program end, spindle,
-/// tool change, coolant), M17/M29 (subroutine end), M30 (program end) and M10–M99 as user
-/// M functions (handed to the PLC side, no meaning in the emulator). M100 and up, and
-/// fractional M numbers, are 20157.
+/// M functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)"). M0–M9,
+/// M17, M29, M30 have their meaning in the decoder; the others go to the PLC side as
+/// events. Above 65,535 and fractional numbers are 20157.
 pub fn is_known_m(m: u32) -> bool {
-    m <= 99
+    m <= super::dialect::MAX_M_H
 }
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
