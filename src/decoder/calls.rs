@@ -68,28 +68,8 @@ impl Decoder {
                     self.wait_idle = true;
                 }
             }
-            Command::CacheLoad { file } => {
-                let loaded = io.cache.load(file, io.store)?;
-                self.notes.push(Note::Cache {
-                    op: loaded.op(),
-                    file: file.clone(),
-                });
-                self.emit(info, Action::None, false, io);
-            }
-            Command::CacheClear { file } => {
-                io.cache.clear(file)?;
-                self.notes.push(Note::Cache {
-                    op: "clear",
-                    file: file.clone(),
-                });
-                self.emit(info, Action::None, false, io);
-            }
-            Command::CacheClearAll => {
-                io.cache.clear_all()?;
-                self.notes.push(Note::Cache {
-                    op: "clear_all",
-                    file: String::new(),
-                });
+            Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
+                self.exec_cache(c, io)?;
                 self.emit(info, Action::None, false, io);
             }
             Command::CommentBegin => self.top().comment_block = true,
@@ -133,6 +113,35 @@ impl Decoder {
             }
             // Accepted without effect (lang::dialect): a block like any other.
             Command::Inert { .. } => self.emit(info, Action::None, false, io),
+        }
+        Ok(())
+    }
+
+    /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).
+    fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
+        match c {
+            Command::CacheLoad { file } => {
+                let loaded = io.cache.load(file, io.store)?;
+                self.notes.push(Note::Cache {
+                    op: loaded.op(),
+                    file: file.clone(),
+                });
+            }
+            Command::CacheClear { file } => {
+                io.cache.clear(file)?;
+                self.notes.push(Note::Cache {
+                    op: "clear",
+                    file: file.clone(),
+                });
+            }
+            Command::CacheClearAll => {
+                io.cache.clear_all()?;
+                self.notes.push(Note::Cache {
+                    op: "clear_all",
+                    file: String::new(),
+                });
+            }
+            _ => {}
         }
         Ok(())
     }

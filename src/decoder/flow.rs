@@ -13,6 +13,7 @@ use super::frame::{self, LabelIndex, LineMeta, LinePos, Source, MAX_SEEN_LABELS}
 use super::vars::VarSlot;
 use super::{whole, DecodeError, Decoder, Res};
 use crate::lang::codes;
+use crate::lang::eval::is_true;
 
 /// One open control structure of a frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -158,42 +159,11 @@ impl Decoder {
     /// One line while skipping. Returns whether the line is to be executed after all (the
     /// label line a forward jump was looking for).
     pub(super) fn skip_line(&mut self, block: &Block) -> Res<bool> {
-        let is_stream = self.top().is_stream();
         let Some(skip) = self.top().skip.clone() else {
             return Ok(true);
         };
         if let SkipUntil::Label(t) = &skip.until {
-            if let Some(l) = &block.label {
-                self.note_label(l)?;
-                if label_matches(l, t) {
-                    self.top().skip = None;
-                    return Ok(true);
-                }
-            }
-            if let Body::Control(c) = &block.body {
-                // Structures opened or closed between jump and label keep the stack right.
-                let top = self.top();
-                match c {
-                    Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
-                    Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
-                    Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
-                        top.flow.pop();
-                    }
-                    Control::EndSwitch
-                        if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) =>
-                    {
-                        top.flow.pop();
-                    }
-                    _ => {}
-                }
-            }
-            if is_stream && block_ends_program(block) {
-                return Err(DecodeError::new(
-                    codes::LABEL_NOT_FOUND,
-                    format!("label {} not found before program end", goto_text(t)),
-                ));
-            }
-            return Ok(false);
+            return self.skip_to_label(block, t);
         }
         if skip.until == SkipUntil::LocalSubroutine {
             if let Body::Items(items) = &block.body {
@@ -206,28 +176,72 @@ impl Decoder {
         let Body::Control(c) = &block.body else {
             return Ok(false);
         };
+        if self.skip_nested(c, skip.depth) {
+            return Ok(false);
+        }
+        self.skip_reaches(&skip.until, c)
+    }
+
+    /// A forward jump (streams): the line with the label runs; structures passed on the way
+    /// keep the flow stack right; a program end before the label is 20840.
+    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget) -> Res<bool> {
+        let is_stream = self.top().is_stream();
+        if let Some(l) = &block.label {
+            self.note_label(l)?;
+            if label_matches(l, t) {
+                self.top().skip = None;
+                return Ok(true);
+            }
+        }
+        if let Body::Control(c) = &block.body {
+            // Structures opened or closed between jump and label keep the stack right.
+            let top = self.top();
+            match c {
+                Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
+                Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
+                Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
+                    top.flow.pop();
+                }
+                Control::EndSwitch if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) => {
+                    top.flow.pop();
+                }
+                _ => {}
+            }
+        }
+        if is_stream && block_ends_program(block) {
+            return Err(DecodeError::new(
+                codes::LABEL_NOT_FOUND,
+                format!("label {} not found before program end", goto_text(t)),
+            ));
+        }
+        Ok(false)
+    }
+
+    /// A structure opened or closed inside the skipped region: counted, and the line is
+    /// skipped. `true` when the line belongs to such a nested structure.
+    fn skip_nested(&mut self, c: &Control, depth: u32) -> bool {
         match nesting(c) {
             Nesting::Open => {
                 if let Some(s) = self.top().skip.as_mut() {
                     s.depth += 1;
                 }
-                return Ok(false);
+                true
             }
-            Nesting::Close if skip.depth > 0 => {
+            Nesting::Close if depth > 0 => {
                 if let Some(s) = self.top().skip.as_mut() {
                     s.depth -= 1;
                 }
-                return Ok(false);
+                true
             }
-            _ => {}
+            _ => depth > 0,
         }
-        if skip.depth > 0 {
-            return Ok(false);
-        }
-        match (&skip.until, c) {
-            (SkipUntil::IfBranch, Control::ElseIf(e))
-                if crate::lang::eval::is_true(self.eval(e)?) =>
-            {
+    }
+
+    /// A statement at the skipped structure's own level: does it end the skip? `true` when
+    /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
+    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control) -> Res<bool> {
+        match (until, c) {
+            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(self.eval(e)?) => {
                 self.top().skip = None;
                 self.set_if_taken();
             }
@@ -305,11 +319,21 @@ impl Decoder {
     }
 
     pub(super) fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
-        use crate::lang::eval::is_true;
-        let here = LinePos {
-            pos: meta.offset as usize,
-            line_no: meta.line - 1,
-        };
+        match c {
+            Control::Break | Control::Continue => self.exec_leave(c),
+            Control::For { .. } | Control::EndFor => self.exec_for(c),
+            Control::While(_)
+            | Control::EndWhile
+            | Control::Do
+            | Control::EndDo(_)
+            | Control::Repeat
+            | Control::Until(_) => self.exec_loop(c, meta),
+            _ => self.exec_branch(c),
+        }
+    }
+
+    /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
+    fn exec_branch(&mut self, c: &Control) -> Res {
         match c {
             Control::If(e) => {
                 let v = is_true(self.eval(e)?);
@@ -318,11 +342,7 @@ impl Decoder {
                     self.skip(SkipUntil::IfBranch);
                 }
             }
-            Control::IfGoto(e, t) => {
-                if is_true(self.eval(e)?) {
-                    self.goto(t)?;
-                }
-            }
+            Control::IfGoto(e, t) if is_true(self.eval(e)?) => self.goto(t)?,
             Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
                 Some(FlowEntry::If { .. }) => self.skip(SkipUntil::IfEnd),
                 _ => return Err(self.stray(c)),
@@ -349,6 +369,15 @@ impl Decoder {
                 }
                 _ => return Err(self.stray(c)),
             },
+            Control::Goto(t) => self.goto(t)?,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$BREAK` and `$CONTINUE`: close the structures they leave, skip to the end.
+    fn exec_leave(&mut self, c: &Control) -> Res {
+        match c {
             Control::Break => {
                 let inner = self
                     .top()
@@ -389,6 +418,14 @@ impl Decoder {
                 }
                 self.skip(SkipUntil::LoopContinue);
             }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$FOR` … `$ENDFOR`.
+    fn exec_for(&mut self, c: &Control) -> Res {
+        match c {
             Control::For {
                 var,
                 start,
@@ -437,6 +474,18 @@ impl Decoder {
                 }
                 _ => return Err(self.stray(c)),
             },
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$WHILE`, `$DO` and `$REPEAT` loops.
+    fn exec_loop(&mut self, c: &Control, meta: LineMeta) -> Res {
+        let here = LinePos {
+            pos: meta.offset as usize,
+            line_no: meta.line - 1,
+        };
+        match c {
             Control::While(e) => {
                 let v = is_true(self.eval(e)?);
                 self.top().flow.push(FlowEntry::While { head: here });
@@ -480,7 +529,7 @@ impl Decoder {
                 }
                 _ => return Err(self.stray(c)),
             },
-            Control::Goto(t) => self.goto(t)?,
+            _ => {}
         }
         Ok(())
     }

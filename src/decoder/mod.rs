@@ -493,20 +493,7 @@ impl Decoder {
             return Ok(());
         }
         if top.is_stream() {
-            if let Body::Control(c) = &block.body {
-                if is_loop_statement(c) {
-                    return Err(DecodeError::new(
-                        codes::STREAM_LOOP,
-                        "loop statement in streaming program; streaming aborted",
-                    ));
-                }
-            }
-            if let Body::Call(Call::Local { .. }) = &block.body {
-                return Err(DecodeError::new(
-                    codes::STREAM_LOCAL_CALL,
-                    "local subroutine call (LL) in streaming program",
-                ));
-            }
+            stream_allows(&block)?;
         }
         if skipping {
             let run_it = self.skip_line(&block)?;
@@ -516,15 +503,8 @@ impl Decoder {
         } else if let Some(l) = &block.label {
             self.note_label(l)?;
         }
-        if let Some(s) = self.search {
-            let hit = match s.target {
-                SearchTarget::BlockNumber(n) => block.n == Some(n),
-                SearchTarget::Counter(k) => self.counter >= k,
-                SearchTarget::Offset(o) => self.frames.len() == 1 && meta.offset >= o,
-            };
-            if hit {
-                self.finish_search(s, &block, text, meta, io);
-            }
+        if self.search.is_some() {
+            self.search_block(&block, text, meta, io);
         }
         if let Some(level) = block.skip_level {
             if self.skip_mask & (1u16 << level.min(15)) != 0 {
@@ -644,4 +624,19 @@ impl Decoder {
 pub(crate) fn whole(v: f64) -> Option<u32> {
     let r = v.round();
     ((v - r).abs() < 1e-9 && (0.0..=u32::MAX as f64).contains(&r)).then_some(r as u32)
+}
+
+/// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).
+fn stream_allows(block: &Block) -> Res {
+    match &block.body {
+        Body::Control(c) if is_loop_statement(c) => Err(DecodeError::new(
+            codes::STREAM_LOOP,
+            "loop statement in streaming program; streaming aborted",
+        )),
+        Body::Call(Call::Local { .. }) => Err(DecodeError::new(
+            codes::STREAM_LOCAL_CALL,
+            "local subroutine call (LL) in streaming program",
+        )),
+        _ => Ok(()),
+    }
 }

@@ -50,6 +50,27 @@ pub(super) struct Search {
 }
 
 impl Decoder {
+    /// A block met during block search: is it the target? Then the search ends here.
+    pub(super) fn search_block(
+        &mut self,
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        io: &mut DecoderIo<'_>,
+    ) {
+        let Some(s) = self.search else {
+            return;
+        };
+        let hit = match s.target {
+            SearchTarget::BlockNumber(n) => block.n == Some(n),
+            SearchTarget::Counter(k) => self.counter >= k,
+            SearchTarget::Offset(o) => self.frames.len() == 1 && meta.offset >= o,
+        };
+        if hit {
+            self.finish_search(s, block, text, meta, io);
+        }
+    }
+
     pub(super) fn finish_search(
         &mut self,
         s: Search,
