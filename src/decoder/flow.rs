@@ -332,15 +332,27 @@ impl Decoder {
         }
     }
 
+    /// Open a structure whose condition decides whether its body runs (`$IF`, `$WHILE`):
+    /// pushed either way, the body skipped when the condition is false.
+    fn open_conditional(
+        &mut self,
+        e: &crate::lang::block::Expr,
+        entry: impl FnOnce(bool) -> FlowEntry,
+        or_skip: SkipUntil,
+    ) -> Res {
+        let v = is_true(self.eval(e)?);
+        self.top().flow.push(entry(v));
+        if !v {
+            self.skip(or_skip);
+        }
+        Ok(())
+    }
+
     /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
     fn exec_branch(&mut self, c: &Control) -> Res {
         match c {
             Control::If(e) => {
-                let v = is_true(self.eval(e)?);
-                self.top().flow.push(FlowEntry::If { taken: v });
-                if !v {
-                    self.skip(SkipUntil::IfBranch);
-                }
+                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch)?
             }
             Control::IfGoto(e, t) if is_true(self.eval(e)?) => self.goto(t)?,
             Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
@@ -487,11 +499,7 @@ impl Decoder {
         };
         match c {
             Control::While(e) => {
-                let v = is_true(self.eval(e)?);
-                self.top().flow.push(FlowEntry::While { head: here });
-                if !v {
-                    self.skip(SkipUntil::LoopExit);
-                }
+                self.open_conditional(e, |_| FlowEntry::While { head: here }, SkipUntil::LoopExit)?
             }
             Control::EndWhile => match self.top().flow.last().cloned() {
                 Some(FlowEntry::While { head }) => {
@@ -501,34 +509,27 @@ impl Decoder {
                 }
                 _ => return Err(self.stray(c)),
             },
-            Control::Do => {
+            Control::Do | Control::Repeat => {
                 let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::Do { body });
+                let entry = match c {
+                    Control::Do => FlowEntry::Do { body },
+                    _ => FlowEntry::Repeat { body },
+                };
+                self.top().flow.push(entry);
             }
-            Control::EndDo(e) => match self.top().flow.last().cloned() {
-                Some(FlowEntry::Do { body }) => {
-                    if is_true(self.eval(e)?) {
-                        self.top().seek(body);
-                    } else {
-                        self.top().flow.pop();
-                    }
+            // `$ENDDO cond` loops while cond holds, `$UNTIL cond` until it holds.
+            Control::EndDo(e) | Control::Until(e) => {
+                let (body, again_if) = match (c, self.top().flow.last()) {
+                    (Control::EndDo(_), Some(FlowEntry::Do { body })) => (*body, true),
+                    (Control::Until(_), Some(FlowEntry::Repeat { body })) => (*body, false),
+                    _ => return Err(self.stray(c)),
+                };
+                if is_true(self.eval(e)?) == again_if {
+                    self.top().seek(body);
+                } else {
+                    self.top().flow.pop();
                 }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Repeat => {
-                let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::Repeat { body });
             }
-            Control::Until(e) => match self.top().flow.last().cloned() {
-                Some(FlowEntry::Repeat { body }) => {
-                    if is_true(self.eval(e)?) {
-                        self.top().flow.pop();
-                    } else {
-                        self.top().seek(body);
-                    }
-                }
-                _ => return Err(self.stray(c)),
-            },
             _ => {}
         }
         Ok(())

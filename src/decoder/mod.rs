@@ -294,7 +294,7 @@ impl Decoder {
     }
 
     /// Start a main program (automatic mode). Channel defaults are restored here — for a
-    /// stream once, at stream start, as seed 003 §2.4 describes.
+    /// stream once, at stream start, as ISG FCT-C19 Data streaming §2.4 describes.
     pub fn start(
         &mut self,
         name: &str,

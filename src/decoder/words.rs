@@ -23,9 +23,13 @@ struct Words {
     gs: [(u32, u32); MAX_GS],
     n_gs: usize,
     /// Axis values as programmed (program units), by `AXIS_LETTERS` index.
-    axes: [Option<f64>; MAX_AXES],
-    /// Columns of the axis words, for errors.
-    axis_cols: [u32; MAX_AXES],
+    /// Plain values and a bit mask rather than `Option`s: this struct is built for every
+    /// block, and reading `Option<f64>`s back showed as store-forwarding stalls in a profile.
+    axes: [f64; MAX_AXES],
+    /// Bit i: axis i is programmed.
+    axes_set: u8,
+    /// Column of an X word on a channel without X: an error unless X is a dwell time.
+    unconfigured_x_col: Option<u32>,
     /// I, J, K as programmed (program units).
     ijk: [Option<f64>; 3],
     /// R as programmed (program units).
@@ -156,8 +160,14 @@ impl Decoder {
                     if !v.is_finite() {
                         return Err(DecodeError::new(codes::BAD_VALUE, "axis value not finite"));
                     }
-                    w.axes[i] = Some(v);
-                    w.axis_cols[i] = col;
+                    if !self.settings.axes[i] {
+                        if letter != b'X' {
+                            return Err(unconfigured(letter));
+                        }
+                        w.unconfigured_x_col = Some(col);
+                    }
+                    w.axes[i] = v;
+                    w.axes_set |= 1 << i;
                 }
                 // E: accepted, no effect in the emulator.
             }
@@ -178,8 +188,11 @@ impl Decoder {
         }
         if gs.dwell {
             // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
-            if let Some(t) = w.axes[0].take().or(w.feed.take().map(|(f, _)| f)) {
-                w.dwell_s = Some(t);
+            if w.axes_set & 1 != 0 {
+                w.axes_set &= !1;
+                w.dwell_s = Some(w.axes[0]);
+            } else if let Some((f, _)) = w.feed.take() {
+                w.dwell_s = Some(f);
             }
         }
         if let Some((f, _)) = w.feed {
@@ -201,17 +214,8 @@ impl Decoder {
         for &m in w.ms() {
             apply_m(&mut self.modal, m);
         }
-        for (i, &col) in w.axis_cols.iter().enumerate() {
-            if w.axes[i].is_some() && !self.settings.axes[i] {
-                return Err(DecodeError::new(
-                    codes::SYNTAX,
-                    format!(
-                        "axis {} is not configured in this channel",
-                        AXIS_LETTERS[i] as char
-                    ),
-                )
-                .at(col));
-            }
+        if let Some(col) = w.unconfigured_x_col.filter(|_| w.axes_set & 1 != 0) {
+            return Err(unconfigured(b'X').at(col));
         }
         Ok(gs)
     }
@@ -234,14 +238,14 @@ impl Decoder {
 
     /// Step 3: the block's end point in machine coordinates, if it programs an axis.
     fn target(&self, w: &Words, gs: BlockGs) -> Option<Position> {
-        if w.axes.iter().all(Option::is_none) {
+        if w.axes_set == 0 {
             return None;
         }
         let start = self.modal.pos;
         let offset = self.program_offset(gs);
         let mut end = start;
-        for (i, v) in w.axes.iter().enumerate() {
-            if let Some(v) = v {
+        for (i, &v) in w.axes.iter().enumerate() {
+            if w.axes_set & (1 << i) != 0 {
                 let v = v * self.length_scale(i);
                 end[i] = if self.modal.absolute {
                     v + offset[i]
@@ -264,8 +268,8 @@ impl Decoder {
     /// G92: the programmed axis values become the current position in program coordinates.
     fn set_reference(&mut self, w: &Words) {
         let zero = self.program_offset(BlockGs::default());
-        for (i, v) in w.axes.iter().enumerate() {
-            if let Some(v) = v {
+        for (i, &v) in w.axes.iter().enumerate() {
+            if w.axes_set & (1 << i) != 0 {
                 let here = self.modal.pos[i] - (zero[i] - self.modal.g92_offset[i]);
                 self.modal.g92_offset[i] = here - v * self.length_scale(i);
             }
@@ -403,6 +407,13 @@ impl Decoder {
             self.check_open_flow()
         }
     }
+}
+
+fn unconfigured(letter: u8) -> DecodeError {
+    DecodeError::new(
+        codes::SYNTAX,
+        format!("axis {} is not configured in this channel", letter as char),
+    )
 }
 
 /// Add an M or H number to the block's list (at most [`MAX_FUNCTIONS`]).

@@ -1,4 +1,4 @@
-//! One NC block as the parser produces it and the decoder interprets it (REFERENCE §4).
+//! One NC block as the parser produces it and the decoder interprets it (TF5200 programming manual; README, "NC language").
 //!
 //! The parser is pure: one line in, one `Block` out. Nothing here knows about channels,
 //! frames or files; the decoder gives these types their meaning. Columns are 1-based

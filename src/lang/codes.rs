@@ -110,7 +110,7 @@ pub const TOO_MANY_VARIABLES: u32 = 90152;
 /// `#CACHE` while the file cache is disabled.
 pub const CACHE_NOT_ENABLED: u32 = 90160;
 
-/// Longest block the parser accepts, in characters without the line end (REFERENCE §4).
+/// Longest block the parser accepts, in characters without the line end (TF5200 programming manual).
 pub const MAX_BLOCK_CHARS: usize = 4000;
 
 /// Deepest nesting of brackets, unary operators, powers and function calls in one
@@ -122,7 +122,7 @@ pub const MAX_EXPR_NESTING: u32 = 64;
 /// this many operators is 20200 "expression too complex".
 pub const MAX_EXPR_HEIGHT: u32 = 256;
 
-/// Address letters of ordinary words. REFERENCE §4 names G M H F S T D X Y Z A B C I J K R E;
+/// Address letters of ordinary words. The TF5200 manual's words are G M H F S T D X Y Z A B C I J K R E;
 /// we add U V W as further axis names (ISG axis names are configurable and U/V/W are the usual
 /// secondary linear axes; `V.` still starts a variable). Q is rejected (20200): ISG uses it for
 /// nothing in this dialect's scope.

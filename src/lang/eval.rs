@@ -94,12 +94,12 @@ impl EvalError {
     }
 }
 
-/// A condition is true when |v| ≥ 0.5 (REFERENCE §4).
+/// A condition is true when |v| ≥ 0.5 (TF5200 programming manual).
 pub fn is_true(v: f64) -> bool {
     v.abs() >= 0.5
 }
 
-/// `$CASE` matches when the values differ by less than 0.001 (REFERENCE §4).
+/// `$CASE` matches when the values differ by less than 0.001 (TF5200 programming manual).
 pub fn case_matches(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.001
 }

@@ -1,5 +1,5 @@
 //! One NC line → [`Block`]: block skip, block number, label, then words and assignments or
-//! one `$` statement, `#` command, call or program head (REFERENCE §4).
+//! one `$` statement, `#` command, call or program head (TF5200 programming manual).
 //!
 //! The hot path — ordinary words with literal numbers, `N123 G01 X12.345 Y-6.789` — is a
 //! byte-level scan with one allocation per block (its item list); everything rarer (commands,
@@ -782,7 +782,7 @@ fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
     fail(i, SYNTAX, "`]` missing")
 }
 
-/// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (seed 002;
+/// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (TF5200 File Caching;
 /// the seed writes no blank before the bracket). Bad form 21560, a second target 21561.
 fn cache(i: &str) -> PResult<'_, Command> {
     let (r, load) = if let Some(r) = keyword(i, "LOAD") {
