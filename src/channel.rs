@@ -22,10 +22,7 @@ use crate::source::stream::{StreamBuffer, StreamWriteError};
 /// Errors kept for the report (`ChannelStats::errors` counts all of them).
 pub const MAX_LISTED_ERRORS: usize = 256;
 
-/// Warning raised when a stream write is rejected because the buffer is full.
-pub const WARN_WRITE_REJECTED: u32 = 11012;
-/// Error raised by stream data without CR LF line ends.
-pub const ERR_NO_LINE_END: u32 = 21476;
+pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
 /// Channel modes (REFERENCE §7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -231,6 +228,8 @@ pub struct Channel {
     /// Block search target for the next start.
     search: Option<SearchTarget>,
     last_error: Option<(u32, String)>,
+    /// The latest `#MSG` text (kept until the next one or a reset).
+    message: Option<String>,
     errors: Vec<(u32, String)>,
     stats: ChannelStats,
     /// Motion stopped for lack of stream data; a `resume` is owed.
@@ -280,6 +279,7 @@ impl Channel {
             program: None,
             search: None,
             last_error: None,
+            message: None,
             errors: Vec::new(),
             stats: ChannelStats::default(),
             interrupted: false,
@@ -338,6 +338,11 @@ impl Channel {
     pub fn errors(&self) -> &[(u32, String)] {
         &self.errors
     }
+    /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
+    pub fn message(&self) -> Option<&str> {
+        self.message.as_deref()
+    }
+
     pub fn last_error(&self) -> Option<&(u32, String)> {
         self.last_error.as_ref()
     }
@@ -762,6 +767,7 @@ impl Channel {
         // A read still pending is abandoned with the program.
         self.store.take_owed();
         self.last_error = None;
+        self.message = None;
         self.interrupted = false;
         self.search = None;
         self.set_state(tick, State::Ready);
@@ -816,6 +822,21 @@ impl Channel {
                         found,
                     },
                 ),
+                Note::Message { text, save } => {
+                    self.events.push(
+                        tick,
+                        self.number,
+                        EventKind::Message {
+                            text: text.clone(),
+                            save,
+                        },
+                    );
+                    self.message = Some(text);
+                }
+                Note::HFunction { h } => {
+                    self.events
+                        .push(tick, self.number, EventKind::HFunction { h })
+                }
                 Note::Cache { op, file } => self.events.push(
                     tick,
                     self.number,

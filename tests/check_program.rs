@@ -204,7 +204,7 @@ fn syntax_errors_inside_var_and_program() {
     );
     assert_eq!(codes("#ENDVAR\n"), vec![(1, 1, 20200)]);
     assert_eq!(
-        codes("G1 X1\nG1 M200\n#CACHE LOAD\n"),
+        codes("G1 X1\nG1 M70000\n#CACHE LOAD\n"),
         vec![(2, 4, 20157), (3, 12, 21560)]
     );
 }

@@ -188,7 +188,7 @@ fn structure_errors_in_files() {
         ("[A] X1 F100\n[A] X2\n$GOTO [A]\nM30\n", 20836),
         ("LL missing\nM30\n", 20373),
         ("G999 X1\nM30\n", 20131),
-        ("M1234\nM30\n", 20157),
+        ("M70000\nM30\n", 20157),
         ("#NOTHING\nM30\n", 20209),
     ] {
         assert_eq!(file_errors(&rig, text), [code], "{text:?}");

@@ -177,7 +177,7 @@ fn every_word_letter() {
     for l in "GMHFSTDXYZABCIJKREUVW".chars() {
         let v = if l == 'G' {
             "1"
-        } else if l == 'M' {
+        } else if l == 'M' || l == 'H' {
             "3"
         } else {
             "2.5"
@@ -201,13 +201,17 @@ fn known_and_unknown_g_and_m() {
         p(&format!("G{g}"));
     }
     assert_eq!(err("N10 G999 X1"), (20131, 5));
-    assert_eq!(err("G1 G5"), (20131, 4));
+    assert_eq!(err("G1 G7"), (20131, 4));
+    // ISG knows G5 (tangential TRC); ncchannel refuses it by name (lang::dialect).
+    assert_eq!(err("G1 G5"), (90133, 4));
     assert_eq!(err("G1.5"), (20131, 1));
     assert_eq!(err("G[P1]"), (20131, 1));
     for m in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 17, 29, 30, 10, 99] {
         p(&format!("M{m}"));
     }
-    assert_eq!(err("S1000 M100"), (20157, 7));
+    // M and H run to 65,535 (TF5200 user M/H functions).
+    p("S1000 M100");
+    assert_eq!(err("S1000 M65536"), (20157, 7));
     assert_eq!(err("M3.5"), (20157, 1));
 }
 
@@ -368,7 +372,7 @@ fn hash_commands() {
         canon(line);
     }
     assert_eq!(err("#FOO"), (20209, 1));
-    assert_eq!(err("N10 #MSG [\"x\"]"), (20209, 5));
+    assert_eq!(err("N10 #NOSUCH [\"x\"]"), (20209, 5));
     assert_eq!(err("#FLUSH X1"), (20200, 8));
     assert_eq!(err("G1 #FLUSH"), (20200, 4));
 }

@@ -110,16 +110,35 @@ fn value() -> impl Strategy<Value = Value> {
     prop_oneof![3 => num().prop_map(Value::Num), 1 => expr().prop_map(Value::Expr)]
 }
 
+/// A letter other than G, M, H at most once per block (a second one is double programming).
+fn once_per_letter(items: Vec<Item>) -> Vec<Item> {
+    let mut seen = Vec::new();
+    items
+        .into_iter()
+        .filter(|it| match it {
+            Item::Word(w) if !matches!(w.letter, b'G' | b'M' | b'H') => {
+                let first = !seen.contains(&w.letter);
+                seen.push(w.letter);
+                first
+            }
+            _ => true,
+        })
+        .collect()
+}
+
 fn item() -> impl Strategy<Value = Item> {
     let letters: Vec<u8> = WORD_LETTERS
         .iter()
         .copied()
-        .filter(|&l| l != b'G' && l != b'M')
+        .filter(|&l| l != b'G' && l != b'M' && l != b'H')
         .collect();
+    // G04 must stand alone in its block: generated blocks leave it out.
+    let gs: Vec<u32> = KNOWN_G.iter().copied().filter(|&g| g != 4).collect();
     prop_oneof![
         4 => (prop::sample::select(letters), value()).prop_map(|(letter, value)| Item::Word(Word { letter, value, col: 0 })),
-        1 => prop::sample::select(KNOWN_G.to_vec()).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
+        1 => prop::sample::select(gs).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
         1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
+        1 => (0u32..=65_535).prop_map(|h| Item::Word(Word { letter: b'H', value: Value::Num(f64::from(h)), col: 0 })),
         1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::Assign { target: Box::new(target), value, col: 0 }),
         1 => (prop::sample::select(vec![133u32, 134]), expr()).prop_map(|(g, e)| Item::GValue {
             g,
@@ -190,6 +209,12 @@ fn command() -> impl Strategy<Value = Command> {
         file().prop_map(|file| CacheClear { file }),
         (any::<bool>(), options()).prop_map(|(on, options)| Hsc { on, options }),
         options().prop_map(|options| ContourMode { options }),
+        (any::<bool>(), "[A-Za-z0-9_ .,:]{0,20}").prop_map(|(save, text)| Msg { save, text }),
+        // `#TIME` reads an expression: a literal comes back as a number, `-3` as a negation.
+        expr().prop_map(|e| Time(match e {
+            Expr::Num(v) => Value::Num(v.abs()),
+            e => Value::Expr(e),
+        })),
     ]
 }
 
@@ -208,7 +233,7 @@ fn call() -> impl Strategy<Value = Call> {
 
 fn body() -> impl Strategy<Value = Body> {
     prop_oneof![
-        4 => prop::collection::vec(item(), 0..6).prop_map(Body::Items),
+        4 => prop::collection::vec(item(), 0..6).prop_map(|items| Body::Items(once_per_letter(items))),
         2 => control().prop_map(Body::Control),
         1 => command().prop_map(Body::Command),
         1 => call().prop_map(Body::Call),

@@ -25,7 +25,9 @@ const PLOT_SAMPLES: usize = 20_000;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
-    /// Program to start (default: the channel's streaming program when --stream is given).
+    /// Program to start: a name found through the channel's search paths, or a file path
+    /// (with a `/`, or absolute), whose folder is then searched first for it and its
+    /// subroutines. Default: the channel's streaming program when --stream is given.
     pub program: Option<String>,
     /// Start-up list.
     #[arg(long, default_value = "params/startup.lis")]
@@ -54,6 +56,10 @@ pub struct RunArgs {
     /// Block search target: n:<N>, count:<K> or offset:<BYTES>.
     #[arg(long)]
     pub search: Option<SearchTarget>,
+    /// Block-skip mask: bit n set skips blocks marked `/n` (`/` is `/1`), so 2 skips `/`
+    /// and `/1`, 0x6 also `/2`. Decimal or 0x hex.
+    #[arg(long, value_parser = parse_skip_mask, default_value = "0")]
+    pub skip_mask: u16,
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
@@ -88,6 +94,7 @@ impl RunArgs {
             realtime: false,
             max_ticks: None,
             search: None,
+            skip_mask: 0,
             events: None,
             report: None,
             plot: None,
@@ -109,12 +116,61 @@ pub(crate) fn locate(p: &Path) -> PathBuf {
     p.to_path_buf()
 }
 
+/// `--skip-mask`: decimal or `0x` hex, 0..=0xFFFF.
+fn parse_skip_mask(s: &str) -> Result<u16, String> {
+    let r = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
+        Some(h) => u16::from_str_radix(h, 16),
+        None => s.parse::<u16>(),
+    };
+    r.map_err(|_| format!("'{s}' is not a mask from 0 to 65535 (decimal or 0x hex)"))
+}
+
+/// A program argument that is a file path rather than a program name: it holds a path
+/// separator or is absolute. Its folder goes first into the channel's search paths (main
+/// programs and subroutines), and the program is started by its file name.
+fn program_path(program: &str) -> Option<(PathBuf, String)> {
+    let p = Path::new(program);
+    if !(p.is_absolute() || program.contains('/') || program.contains('\\')) {
+        return None;
+    }
+    let name = p.file_name()?.to_str()?.to_string();
+    let dir = match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Some((dir, name))
+}
+
+/// Put `dir` first into channel `ch`'s search paths, for main programs and subroutines.
+fn search_first(config: &mut crate::params::Config, ch: usize, dir: PathBuf) {
+    use crate::params::search_path::{SearchPath, MAIN_PROGRAMS, SUBROUTINES};
+    if let Some(c) = config.channels.get_mut(ch) {
+        c.search_paths.insert(
+            0,
+            SearchPath {
+                dir,
+                kinds: MAIN_PROGRAMS | SUBROUTINES,
+                priority: 0,
+                file: PathBuf::from("ncchannel run PROGRAM"),
+                line: 0,
+            },
+        );
+    }
+}
+
 /// Read and check the parameter lists (diagnostics on stderr) and build the channels: what
 /// every command that runs channels does first.
 pub(crate) fn load_channels(
     params: &Path,
     events: bool,
 ) -> Result<(crate::params::Config, Vec<crate::channel::Channel>), String> {
+    let config = load_config(params)?;
+    let channels = crate::setup::channels(&config, events).map_err(|e| e.to_string())?;
+    Ok((config, channels))
+}
+
+/// Read and check the parameter lists (diagnostics on stderr).
+fn load_config(params: &Path) -> Result<crate::params::Config, String> {
     let params = locate(params);
     let config = match crate::params::load(&params) {
         Ok(c) => c,
@@ -128,8 +184,7 @@ pub(crate) fn load_channels(
     for w in &config.warnings {
         eprintln!("{}", w.render());
     }
-    let channels = crate::setup::channels(&config, events).map_err(|e| e.to_string())?;
-    Ok((config, channels))
+    Ok(config)
 }
 
 fn usage(msg: impl std::fmt::Display) -> ExitCode {
@@ -138,9 +193,21 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
 }
 
 pub fn execute(args: RunArgs) -> ExitCode {
-    let (config, channels) = match load_channels(&args.params, args.events.is_some()) {
+    let mut config = match load_config(&args.params) {
         Ok(c) => c,
         Err(msg) => return usage(msg),
+    };
+    let by_path = args.program.as_deref().and_then(program_path);
+    if let Some((dir, _)) = &by_path {
+        search_first(
+            &mut config,
+            (args.channel as usize).wrapping_sub(1),
+            dir.clone(),
+        );
+    }
+    let channels = match crate::setup::channels(&config, args.events.is_some()) {
+        Ok(c) => c,
+        Err(e) => return usage(e),
     };
     let nch = channels.len();
     let Some(ch_config) = config.channels.get((args.channel as usize).wrapping_sub(1)) else {
@@ -149,9 +216,10 @@ pub fn execute(args: RunArgs) -> ExitCode {
             args.channel
         ));
     };
-    let program = match (&args.program, &args.stream) {
-        (Some(p), _) => p.clone(),
-        (None, Some(_)) => match &ch_config.streaming_prog_file {
+    let program = match (&by_path, &args.program, &args.stream) {
+        (Some((_, name)), _, _) => name.clone(),
+        (None, Some(p), _) => p.clone(),
+        (None, None, Some(_)) => match &ch_config.streaming_prog_file {
             Some(s) => s.clone(),
             None => {
                 return usage(format!(
@@ -160,7 +228,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
                 ))
             }
         },
-        (None, None) => return usage("name a PROGRAM or give --stream FILE"),
+        (None, None, None) => return usage("name a PROGRAM or give --stream FILE"),
     };
     let feeder = match &args.stream {
         None => None,
@@ -209,6 +277,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
     let mut start_failed = false;
     if let Some(c) = machine.channel_mut(args.channel) {
         c.set_search(args.search);
+        c.decoder_mut().set_skip_mask(args.skip_mask);
         if let Err(e) = c.start(&tick0, &program) {
             eprintln!("ncchannel run: {e}");
             start_failed = true;

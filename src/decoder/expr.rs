@@ -5,10 +5,11 @@ use crate::lang::eval::{self, VarKey, Vars};
 
 use super::vars::{VarSlot, VarStore};
 use super::DecodeError;
+use crate::lang::codes;
 
 /// Index bound of the store's keys: ISG arrays have at most three dimensions.
-fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
-    fn idx(v: &[u32]) -> Option<([i64; 3], u8)> {
+pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
+    pub(super) fn idx(v: &[u32]) -> Option<([i64; 3], u8)> {
         if v.len() > 3 {
             return None;
         }
@@ -50,8 +51,8 @@ impl Vars for VarStore {
     }
 }
 
-fn err(e: eval::EvalError) -> DecodeError {
-    DecodeError::new(e.code(), e.to_string())
+pub(super) fn err(e: eval::EvalError) -> DecodeError {
+    e.into()
 }
 
 pub fn eval(e: &Expr, vars: &VarStore) -> Result<f64, DecodeError> {
@@ -60,10 +61,6 @@ pub fn eval(e: &Expr, vars: &VarStore) -> Result<f64, DecodeError> {
 
 pub fn resolve(v: &VarRef, vars: &VarStore) -> Result<VarSlot, DecodeError> {
     let k = eval::resolve(v, vars).map_err(err)?;
-    slot(&k).ok_or_else(|| {
-        DecodeError::new(
-            super::own_codes::BAD_VALUE,
-            format!("{k}: more than three indices"),
-        )
-    })
+    slot(&k)
+        .ok_or_else(|| DecodeError::new(codes::BAD_VALUE, format!("{k}: more than three indices")))
 }

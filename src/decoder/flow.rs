@@ -4,10 +4,16 @@
 //! or a forward jump only sets a skip state, and the lines that follow are examined one by one
 //! as they arrive — which is what makes these statements work across stream packets.
 
-use crate::lang::block::{Control, GotoTarget};
+use std::sync::Arc;
 
-use super::frame::LinePos;
+use crate::lang::block::{Block, Body, Command, Control, GotoTarget, Item, Label, Value};
+use crate::lang::{is_comment_end, parse_block};
+
+use super::frame::{self, LabelIndex, LineMeta, LinePos, Source, MAX_SEEN_LABELS};
 use super::vars::VarSlot;
+use super::{whole, DecodeError, Decoder, Res};
+use crate::lang::codes;
+use crate::lang::eval::is_true;
 
 /// One open control structure of a frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,7 +110,7 @@ pub fn nesting(c: &Control) -> Nesting {
     }
 }
 
-/// Statements that are loops: not allowed in a stream (21478).
+/// Statements that are loops: not allowed in a stream (codes::STREAM_LOOP).
 pub fn is_loop_statement(c: &Control) -> bool {
     matches!(
         c,
@@ -128,4 +134,577 @@ pub fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
             | (FlowEntry::Do { .. }, Control::EndDo(_))
             | (FlowEntry::Repeat { .. }, Control::Until(_))
     )
+}
+
+impl Decoder {
+    /// Record a label passed in a stream: a label seen twice is codes::LABEL_TWICE; a later `$GOTO` to a
+    /// seen label is a backward jump.
+    pub(super) fn note_label(&mut self, l: &Label) -> Res {
+        let top = self.top();
+        if !top.is_stream() {
+            return Ok(());
+        }
+        if top.seen_labels.contains(l) {
+            return Err(DecodeError::new(
+                codes::LABEL_TWICE,
+                format!("label {} defined twice", label_text(l)),
+            ));
+        }
+        if top.seen_labels.len() < MAX_SEEN_LABELS {
+            top.seen_labels.insert(l.clone());
+        }
+        Ok(())
+    }
+
+    /// One line while skipping. Returns whether the line is to be executed after all (the
+    /// label line a forward jump was looking for).
+    pub(super) fn skip_line(&mut self, block: &Block) -> Res<bool> {
+        let Some(skip) = self.top().skip.clone() else {
+            return Ok(true);
+        };
+        if let SkipUntil::Label(t) = &skip.until {
+            return self.skip_to_label(block, t);
+        }
+        if skip.until == SkipUntil::LocalSubroutine {
+            if let Body::Items(items) = &block.body {
+                if items_have_m(items, &[17, 29]) {
+                    self.top().skip = None;
+                }
+            }
+            return Ok(false);
+        }
+        let Body::Control(c) = &block.body else {
+            return Ok(false);
+        };
+        if self.skip_nested(c, skip.depth) {
+            return Ok(false);
+        }
+        self.skip_reaches(&skip.until, c)
+    }
+
+    /// A forward jump (streams): the line with the label runs; structures passed on the way
+    /// keep the flow stack right; a program end before the label is 20840.
+    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget) -> Res<bool> {
+        let is_stream = self.top().is_stream();
+        if let Some(l) = &block.label {
+            self.note_label(l)?;
+            if label_matches(l, t) {
+                self.top().skip = None;
+                return Ok(true);
+            }
+        }
+        if let Body::Control(c) = &block.body {
+            // Structures opened or closed between jump and label keep the stack right.
+            let top = self.top();
+            match c {
+                Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
+                Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
+                Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
+                    top.flow.pop();
+                }
+                Control::EndSwitch if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) => {
+                    top.flow.pop();
+                }
+                _ => {}
+            }
+        }
+        if is_stream && block_ends_program(block) {
+            return Err(DecodeError::new(
+                codes::LABEL_NOT_FOUND,
+                format!("label {} not found before program end", goto_text(t)),
+            ));
+        }
+        Ok(false)
+    }
+
+    /// A structure opened or closed inside the skipped region: counted, and the line is
+    /// skipped. `true` when the line belongs to such a nested structure.
+    fn skip_nested(&mut self, c: &Control, depth: u32) -> bool {
+        match nesting(c) {
+            Nesting::Open => {
+                if let Some(s) = self.top().skip.as_mut() {
+                    s.depth += 1;
+                }
+                true
+            }
+            Nesting::Close if depth > 0 => {
+                if let Some(s) = self.top().skip.as_mut() {
+                    s.depth -= 1;
+                }
+                true
+            }
+            _ => depth > 0,
+        }
+    }
+
+    /// A statement at the skipped structure's own level: does it end the skip? `true` when
+    /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
+    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control) -> Res<bool> {
+        match (until, c) {
+            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(self.eval(e)?) => {
+                self.top().skip = None;
+                self.set_if_taken();
+            }
+            (SkipUntil::IfBranch, Control::Else) => {
+                self.top().skip = None;
+                self.set_if_taken();
+            }
+            (SkipUntil::IfBranch | SkipUntil::IfEnd, Control::EndIf) => {
+                let top = self.top();
+                top.skip = None;
+                top.flow.pop();
+            }
+            (SkipUntil::Case, Control::Case(e)) => {
+                let v = self.eval(e)?;
+                if let Some(FlowEntry::Switch { value }) = self.top().flow.last() {
+                    if crate::lang::eval::case_matches(*value, v) {
+                        self.top().skip = None;
+                    }
+                }
+            }
+            (SkipUntil::Case, Control::Default) => self.top().skip = None,
+            (SkipUntil::Case | SkipUntil::SwitchEnd, Control::EndSwitch) => {
+                let top = self.top();
+                top.skip = None;
+                top.flow.pop();
+            }
+            (SkipUntil::LoopExit, c) => {
+                let top = self.top();
+                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                    top.skip = None;
+                    top.flow.pop();
+                }
+            }
+            (SkipUntil::LoopContinue, c) => {
+                let top = self.top();
+                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                    top.skip = None;
+                    return Ok(true);
+                }
+            }
+            _ => {}
+        }
+        Ok(false)
+    }
+
+    pub(super) fn set_if_taken(&mut self) {
+        if let Some(FlowEntry::If { taken }) = self.top().flow.last_mut() {
+            *taken = true;
+        }
+    }
+
+    pub(super) fn skip(&mut self, until: SkipUntil) {
+        self.top().skip = Some(Skip::new(until));
+    }
+
+    pub(super) fn stray(&self, c: &Control) -> DecodeError {
+        use crate::lang::codes::StrayKind as K;
+        let kind = match c {
+            Control::Else => Some(K::Else),
+            Control::ElseIf(_) => Some(K::ElseIf),
+            Control::EndIf => Some(K::EndIf),
+            Control::Case(_) => Some(K::Case),
+            Control::Default => Some(K::Default),
+            Control::Break => Some(K::Break),
+            Control::EndSwitch => Some(K::EndSwitch),
+            Control::EndFor => Some(K::EndFor),
+            Control::EndWhile => Some(K::EndWhile),
+            Control::EndDo(_) => Some(K::EndDo),
+            Control::Until(_) => Some(K::Until),
+            Control::Continue => Some(K::Continue),
+            _ => None,
+        };
+        let code = kind.map_or(codes::SYNTAX, K::code);
+        DecodeError::new(code, format!("unexpected {}", control_name(c)))
+    }
+
+    pub(super) fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
+        match c {
+            Control::Break | Control::Continue => self.exec_leave(c),
+            Control::For { .. } | Control::EndFor => self.exec_for(c),
+            Control::While(_)
+            | Control::EndWhile
+            | Control::Do
+            | Control::EndDo(_)
+            | Control::Repeat
+            | Control::Until(_) => self.exec_loop(c, meta),
+            _ => self.exec_branch(c),
+        }
+    }
+
+    /// Open a structure whose condition decides whether its body runs (`$IF`, `$WHILE`):
+    /// pushed either way, the body skipped when the condition is false.
+    fn open_conditional(
+        &mut self,
+        e: &crate::lang::block::Expr,
+        entry: impl FnOnce(bool) -> FlowEntry,
+        or_skip: SkipUntil,
+    ) -> Res {
+        let v = is_true(self.eval(e)?);
+        self.top().flow.push(entry(v));
+        if !v {
+            self.skip(or_skip);
+        }
+        Ok(())
+    }
+
+    /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
+    fn exec_branch(&mut self, c: &Control) -> Res {
+        match c {
+            Control::If(e) => {
+                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch)?
+            }
+            Control::IfGoto(e, t) if is_true(self.eval(e)?) => self.goto(t)?,
+            Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
+                Some(FlowEntry::If { .. }) => self.skip(SkipUntil::IfEnd),
+                _ => return Err(self.stray(c)),
+            },
+            Control::EndIf => match self.top().flow.last() {
+                Some(FlowEntry::If { .. }) => {
+                    self.top().flow.pop();
+                }
+                _ => return Err(self.stray(c)),
+            },
+            Control::Switch(e) => {
+                let value = self.eval(e)?;
+                self.top().flow.push(FlowEntry::Switch { value });
+                self.skip(SkipUntil::Case);
+            }
+            // Executing into a later case: fall through (no `$BREAK` before it).
+            Control::Case(_) | Control::Default => match self.top().flow.last() {
+                Some(FlowEntry::Switch { .. }) => {}
+                _ => return Err(self.stray(c)),
+            },
+            Control::EndSwitch => match self.top().flow.last() {
+                Some(FlowEntry::Switch { .. }) => {
+                    self.top().flow.pop();
+                }
+                _ => return Err(self.stray(c)),
+            },
+            Control::Goto(t) => self.goto(t)?,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$BREAK` and `$CONTINUE`: close the structures they leave, skip to the end.
+    fn exec_leave(&mut self, c: &Control) -> Res {
+        match c {
+            Control::Break => {
+                let inner = self
+                    .top()
+                    .flow
+                    .iter()
+                    .rev()
+                    .find(|e| e.is_loop() || matches!(e, FlowEntry::Switch { .. }))
+                    .cloned();
+                match inner {
+                    Some(FlowEntry::Switch { .. }) => {
+                        // Close inner $IFs between the $BREAK and its switch.
+                        while matches!(self.top().flow.last(), Some(FlowEntry::If { .. })) {
+                            self.top().flow.pop();
+                        }
+                        self.skip(SkipUntil::SwitchEnd);
+                    }
+                    Some(_) => {
+                        while matches!(
+                            self.top().flow.last(),
+                            Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
+                        ) {
+                            self.top().flow.pop();
+                        }
+                        self.skip(SkipUntil::LoopExit);
+                    }
+                    None => return Err(self.stray(c)),
+                }
+            }
+            Control::Continue => {
+                if !self.top().flow.iter().any(FlowEntry::is_loop) {
+                    return Err(self.stray(c));
+                }
+                while matches!(
+                    self.top().flow.last(),
+                    Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
+                ) {
+                    self.top().flow.pop();
+                }
+                self.skip(SkipUntil::LoopContinue);
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$FOR` … `$ENDFOR`.
+    fn exec_for(&mut self, c: &Control) -> Res {
+        match c {
+            Control::For {
+                var,
+                start,
+                end,
+                step,
+            } => {
+                let key = self.resolve(var)?;
+                let start = self.eval(start)?;
+                let end = self.eval(end)?;
+                let step = match step {
+                    Some(s) => self.eval(s)?,
+                    None => 1.0,
+                };
+                if step == 0.0 || !step.is_finite() {
+                    return Err(DecodeError::new(
+                        codes::BAD_VALUE,
+                        "$FOR step must not be 0",
+                    ));
+                }
+                self.set_var(key.clone(), start)?;
+                let body = self.top().line_pos();
+                self.top().flow.push(FlowEntry::For {
+                    var: key,
+                    end,
+                    step,
+                    body,
+                });
+                if !for_continues(start, end, step) {
+                    self.skip(SkipUntil::LoopExit);
+                }
+            }
+            Control::EndFor => match self.top().flow.last().cloned() {
+                Some(FlowEntry::For {
+                    var,
+                    end,
+                    step,
+                    body,
+                }) => {
+                    let v = self.vars.get(&var).unwrap_or(0.0) + step;
+                    self.set_var(var, v)?;
+                    if for_continues(v, end, step) {
+                        self.top().seek(body);
+                    } else {
+                        self.top().flow.pop();
+                    }
+                }
+                _ => return Err(self.stray(c)),
+            },
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `$WHILE`, `$DO` and `$REPEAT` loops.
+    fn exec_loop(&mut self, c: &Control, meta: LineMeta) -> Res {
+        let here = LinePos {
+            pos: meta.offset as usize,
+            line_no: meta.line - 1,
+        };
+        match c {
+            Control::While(e) => {
+                self.open_conditional(e, |_| FlowEntry::While { head: here }, SkipUntil::LoopExit)?
+            }
+            Control::EndWhile => match self.top().flow.last().cloned() {
+                Some(FlowEntry::While { head }) => {
+                    // Back to the $WHILE line, which evaluates and pushes again.
+                    self.top().flow.pop();
+                    self.top().seek(head);
+                }
+                _ => return Err(self.stray(c)),
+            },
+            Control::Do | Control::Repeat => {
+                let body = self.top().line_pos();
+                let entry = match c {
+                    Control::Do => FlowEntry::Do { body },
+                    _ => FlowEntry::Repeat { body },
+                };
+                self.top().flow.push(entry);
+            }
+            // `$ENDDO cond` loops while cond holds, `$UNTIL cond` until it holds.
+            Control::EndDo(e) | Control::Until(e) => {
+                let (body, again_if) = match (c, self.top().flow.last()) {
+                    (Control::EndDo(_), Some(FlowEntry::Do { body })) => (*body, true),
+                    (Control::Until(_), Some(FlowEntry::Repeat { body })) => (*body, false),
+                    _ => return Err(self.stray(c)),
+                };
+                if is_true(self.eval(e)?) == again_if {
+                    self.top().seek(body);
+                } else {
+                    self.top().flow.pop();
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    pub(super) fn goto(&mut self, t: &GotoTarget) -> Res {
+        let top = self.top();
+        if top.is_stream() {
+            let key = goto_label(t);
+            if top.seen_labels.contains(&key) {
+                return Err(DecodeError::new(
+                    codes::STREAM_BACKWARD_JUMP,
+                    format!("backward jump to {} in streaming program", goto_text(t)),
+                ));
+            }
+            top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
+            return Ok(());
+        }
+        let index = self.label_index()?;
+        let Some((at, depth)) = index.find(t) else {
+            return Err(DecodeError::new(
+                codes::LABEL_NOT_FOUND,
+                format!("label {} not found", goto_text(t)),
+            ));
+        };
+        let top = self.top();
+        top.seek(at);
+        // The label's structural depth decides which open structures the jump leaves.
+        top.flow.truncate(depth);
+        while top.flow.len() < depth {
+            top.flow.push(FlowEntry::If { taken: true });
+        }
+        Ok(())
+    }
+
+    /// The label index of the top file frame, built once per program text.
+    pub(super) fn label_index(&mut self) -> Res<Arc<LabelIndex>> {
+        let top = self.top();
+        if let Some(i) = &top.label_index {
+            return Ok(i.clone());
+        }
+        let Source::File(p) = &top.source else {
+            return Ok(Arc::new(LabelIndex::default()));
+        };
+        let index = Arc::new(build_label_index(&p.text)?);
+        self.top().label_index = Some(index.clone());
+        Ok(index)
+    }
+
+    pub(super) fn check_open_flow(&mut self) -> Res {
+        if !self.top().flow.is_empty() {
+            return Err(DecodeError::new(
+                codes::OPEN_CONTROL_BLOCK,
+                "open control blocks at program end",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Scan a whole file once for labels (position and structural depth) and `%L` sections.
+pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
+    let mut index = LabelIndex::default();
+    let mut pos = 0usize;
+    let mut line_no = 0u32;
+    let mut depth = 0usize;
+    let mut comment = false;
+    let mut line = String::new();
+    loop {
+        let at = LinePos { pos, line_no };
+        let Some(next) = frame::cut_line(text, pos, &mut line, true) else {
+            break;
+        };
+        pos = next;
+        line_no += 1;
+        if comment {
+            if is_comment_end(&line) {
+                comment = false;
+            }
+            continue;
+        }
+        let Ok(block) = parse_block(&line) else {
+            continue;
+        };
+        if let Some(l) = &block.label {
+            if index.labels.insert(l.clone(), (at, depth)).is_some() {
+                return Err(DecodeError::new(
+                    codes::LABEL_TWICE,
+                    format!("label {} defined twice (line {})", label_text(l), line_no),
+                ));
+            }
+        }
+        match &block.body {
+            Body::Command(Command::CommentBegin) => comment = true,
+            Body::ProgramHead { name, local: true } => {
+                index
+                    .local_subs
+                    .insert(name.to_ascii_uppercase(), LinePos { pos, line_no });
+            }
+            Body::Control(c) => match nesting(c) {
+                Nesting::Open => depth += 1,
+                Nesting::Close => depth = depth.saturating_sub(1),
+                Nesting::Neither => {}
+            },
+            _ => {}
+        }
+    }
+    Ok(index)
+}
+
+pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {
+    if step > 0.0 {
+        v <= end + 1e-9
+    } else {
+        v >= end - 1e-9
+    }
+}
+
+pub(super) fn items_have_m(items: &[Item], codes: &[u32]) -> bool {
+    items.iter().any(|i| match i {
+        Item::Word(w) if w.letter == b'M' => match w.value {
+            Value::Num(v) => whole(v).is_some_and(|m| codes.contains(&m)),
+            Value::Expr(_) => false,
+        },
+        _ => false,
+    })
+}
+
+pub(super) fn block_ends_program(b: &Block) -> bool {
+    matches!(&b.body, Body::Items(items) if items_have_m(items, &[2, 30]))
+}
+
+pub(super) fn goto_label(t: &GotoTarget) -> Label {
+    match t {
+        GotoTarget::Number(n) => Label::Number(*n),
+        GotoTarget::Name(s) => Label::Name(s.clone()),
+    }
+}
+
+pub(super) fn label_matches(l: &Label, t: &GotoTarget) -> bool {
+    *l == goto_label(t)
+}
+
+pub(super) fn label_text(l: &Label) -> String {
+    match l {
+        Label::Number(n) => format!("N{n}"),
+        Label::Name(s) => format!("[{s}]"),
+    }
+}
+
+pub(super) fn goto_text(t: &GotoTarget) -> String {
+    label_text(&goto_label(t))
+}
+
+pub(super) fn control_name(c: &Control) -> &'static str {
+    match c {
+        Control::If(_) => "$IF",
+        Control::IfGoto(..) => "$IF … $GOTO",
+        Control::ElseIf(_) => "$ELSEIF",
+        Control::Else => "$ELSE",
+        Control::EndIf => "$ENDIF",
+        Control::Switch(_) => "$SWITCH",
+        Control::Case(_) => "$CASE",
+        Control::Default => "$DEFAULT",
+        Control::Break => "$BREAK",
+        Control::EndSwitch => "$ENDSWITCH",
+        Control::For { .. } => "$FOR",
+        Control::EndFor => "$ENDFOR",
+        Control::While(_) => "$WHILE",
+        Control::EndWhile => "$ENDWHILE",
+        Control::Do => "$DO",
+        Control::EndDo(_) => "$ENDDO",
+        Control::Repeat => "$REPEAT",
+        Control::Until(_) => "$UNTIL",
+        Control::Continue => "$CONTINUE",
+        Control::Goto(_) => "$GOTO",
+    }
 }

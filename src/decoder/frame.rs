@@ -3,7 +3,7 @@
 //!
 //! A file frame holds its whole text in memory; a stream frame reads the channel's current
 //! stream segment and pulls the next segment from the stream buffer only when it has decoded
-//! the last line of the previous one (seed 003 §2.2: one read extracts all data present).
+//! the last line of the previous one (ISG FCT-C19 Data streaming §2.2: one read extracts all data present).
 
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -260,7 +260,7 @@ impl StreamReader {
         }
     }
 
-    /// Drop the rest of the current segment (program end inside a segment, seed 003 §2.2).
+    /// Drop the rest of the current segment (program end inside a segment, ISG FCT-C19 Data streaming §2.2).
     /// Data still in the stream buffer stays. Returns the bytes dropped.
     pub fn discard_rest(&mut self) -> usize {
         let n = self.remaining();

@@ -6,19 +6,21 @@
 //! the channel's back-pressure.
 
 pub mod arc;
+mod calls;
 mod expr;
 pub mod flow;
 pub mod frame;
 pub mod modal;
+mod search;
 pub mod vars;
+mod words;
 
 use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::lang::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, Value,
-};
+use crate::lang::block::{Block, Body, Call, Command, FlushKind, Item, SplineCommand, Value};
+use crate::lang::codes;
 use crate::lang::{is_comment_end, parse_block, parse_var_declaration};
 use crate::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
@@ -27,25 +29,15 @@ use crate::source::cache::Cache;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::source::stream::StreamBuffer;
 
-use flow::{closes_loop, is_loop_statement, nesting, FlowEntry, Nesting, Skip, SkipUntil};
+use flow::{goto_text, is_loop_statement, Skip, SkipUntil};
 use frame::{
-    read_file_line, Frame, FrameKind, LabelIndex, LineMeta, LinePos, LineRead, Source, StreamNote,
-    StreamReader, MAX_SEEN_LABELS,
+    read_file_line, Frame, FrameKind, LineMeta, LineRead, Source, StreamNote, StreamReader,
 };
 use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
 use vars::{VarSlot, VarStore};
 
-/// Error numbers of our own range, where the ISG number is not known (README, "Error numbers").
-pub mod own_codes {
-    pub const NESTING_TOO_DEEP: u32 = 90101;
-    pub const STREAM_ALREADY_ACTIVE: u32 = 90102;
-    pub const MAIN_END_MISSING: u32 = 90103;
-    pub const SUB_END_MISSING: u32 = 90104;
-    pub const ARC_INCONSISTENT: u32 = 90130;
-    pub const NO_FEED: u32 = 90131;
-    pub const BAD_VALUE: u32 = 90132;
-    pub const TOO_MANY_VARIABLES: u32 = 90152;
-}
+use search::Search;
+pub use search::SearchTarget;
 
 /// What the decoder needs from the configuration.
 #[derive(Debug, Clone)]
@@ -95,56 +87,33 @@ impl DecodeError {
     }
 }
 
+/// A parser error keeps its number, message and column.
+impl From<crate::lang::SyntaxError> for DecodeError {
+    fn from(e: crate::lang::SyntaxError) -> Self {
+        DecodeError::new(e.code, e.message).at(e.col)
+    }
+}
+
+/// Each error type that carries an ISG (or our) number converts with its number and text.
+macro_rules! numbered_error {
+    ($($t:ty),*) => {$(
+        impl From<$t> for DecodeError {
+            fn from(e: $t) -> Self {
+                DecodeError::new(e.code(), e.to_string())
+            }
+        }
+    )*};
+}
+numbered_error!(
+    crate::source::store::StoreError,
+    crate::source::cache::CacheError,
+    crate::lang::EvalError
+);
+
 impl fmt::Display for DecodeError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{} {}", self.code, self.msg)
     }
-}
-
-/// Block search target (seed 003 §2.3.5).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SearchTarget {
-    /// The first block with this N number.
-    BlockNumber(u32),
-    /// The block with this block counter.
-    Counter(u64),
-    /// The first block starting at or after this byte offset of the main program / stream.
-    Offset(u64),
-}
-
-impl fmt::Display for SearchTarget {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            SearchTarget::BlockNumber(n) => write!(f, "n:{n}"),
-            SearchTarget::Counter(k) => write!(f, "count:{k}"),
-            SearchTarget::Offset(o) => write!(f, "offset:{o}"),
-        }
-    }
-}
-
-impl std::str::FromStr for SearchTarget {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        let (kind, v) = s.split_once(':').ok_or_else(|| {
-            format!("search target '{s}': expected n:<N>, count:<K> or offset:<BYTES>")
-        })?;
-        let bad = |_| format!("search target '{s}': '{v}' is not a whole number");
-        match kind {
-            "n" => v.parse().map(SearchTarget::BlockNumber).map_err(bad),
-            "count" => v.parse().map(SearchTarget::Counter).map_err(bad),
-            "offset" => v.parse().map(SearchTarget::Offset).map_err(bad),
-            _ => Err(format!(
-                "search target '{s}': kind must be n, count or offset"
-            )),
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Search {
-    target: SearchTarget,
-    /// Machine position when the search began: the positioning move starts here.
-    from: Position,
 }
 
 /// What the decoder reports besides queued blocks; the channel turns these into events.
@@ -178,6 +147,15 @@ pub enum Note {
     Cache {
         op: &'static str,
         file: String,
+    },
+    /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).
+    Message {
+        text: String,
+        save: bool,
+    },
+    /// An H function (0..=65535) decoded: handed to the PLC side.
+    HFunction {
+        h: u32,
     },
 }
 
@@ -316,7 +294,7 @@ impl Decoder {
     }
 
     /// Start a main program (automatic mode). Channel defaults are restored here — for a
-    /// stream once, at stream start, as seed 003 §2.4 describes.
+    /// stream once, at stream start, as ISG FCT-C19 Data streaming §2.4 describes.
     pub fn start(
         &mut self,
         name: &str,
@@ -338,9 +316,7 @@ impl Decoder {
             target,
             from: machine_pos,
         });
-        let opened = store
-            .open(name, ProgramKind::Main)
-            .map_err(|e| DecodeError::new(e.code(), e.to_string()))?;
+        let opened = store.open(name, ProgramKind::Main)?;
         match opened {
             Opened::File(p) => {
                 let prog = p.name.clone();
@@ -501,7 +477,7 @@ impl Decoder {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error.
             Err(_) if skipping => return Ok(()),
-            Err(e) => return Err(DecodeError::new(e.code, e.message.clone()).at(e.col)),
+            Err(e) => return Err(e.into()),
         };
         let top = self.top();
         if top.var_block {
@@ -510,28 +486,14 @@ impl Decoder {
                 // Blank and comment-only lines declare nothing.
                 Body::Items(ref items) if items.is_empty() => {}
                 _ => {
-                    let d = parse_var_declaration(text)
-                        .map_err(|e| DecodeError::new(e.code, e.message.clone()).at(e.col))?;
+                    let d = parse_var_declaration(text)?;
                     self.declare(&d)?;
                 }
             }
             return Ok(());
         }
         if top.is_stream() {
-            if let Body::Control(c) = &block.body {
-                if is_loop_statement(c) {
-                    return Err(DecodeError::new(
-                        21478,
-                        "loop statement in streaming program; streaming aborted",
-                    ));
-                }
-            }
-            if let Body::Call(Call::Local { .. }) = &block.body {
-                return Err(DecodeError::new(
-                    21479,
-                    "local subroutine call (LL) in streaming program",
-                ));
-            }
+            stream_allows(&block)?;
         }
         if skipping {
             let run_it = self.skip_line(&block)?;
@@ -541,15 +503,8 @@ impl Decoder {
         } else if let Some(l) = &block.label {
             self.note_label(l)?;
         }
-        if let Some(s) = self.search {
-            let hit = match s.target {
-                SearchTarget::BlockNumber(n) => block.n == Some(n),
-                SearchTarget::Counter(k) => self.counter >= k,
-                SearchTarget::Offset(o) => self.frames.len() == 1 && meta.offset >= o,
-            };
-            if hit {
-                self.finish_search(s, &block, text, meta, io);
-            }
+        if self.search.is_some() {
+            self.search_block(&block, text, meta, io);
         }
         if let Some(level) = block.skip_level {
             if self.skip_mask & (1u16 << level.min(15)) != 0 {
@@ -572,437 +527,10 @@ impl Decoder {
         }
     }
 
-    /// Record a label passed in a stream: a label seen twice is 20836; a later `$GOTO` to a
-    /// seen label is a backward jump.
-    fn note_label(&mut self, l: &Label) -> Res {
-        let top = self.top();
-        if !top.is_stream() {
-            return Ok(());
-        }
-        if top.seen_labels.contains(l) {
-            return Err(DecodeError::new(
-                20836,
-                format!("label {} defined twice", label_text(l)),
-            ));
-        }
-        if top.seen_labels.len() < MAX_SEEN_LABELS {
-            top.seen_labels.insert(l.clone());
-        }
-        Ok(())
-    }
-
-    /// One line while skipping. Returns whether the line is to be executed after all (the
-    /// label line a forward jump was looking for).
-    fn skip_line(&mut self, block: &Block) -> Res<bool> {
-        let is_stream = self.top().is_stream();
-        let Some(skip) = self.top().skip.clone() else {
-            return Ok(true);
-        };
-        if let SkipUntil::Label(t) = &skip.until {
-            if let Some(l) = &block.label {
-                self.note_label(l)?;
-                if label_matches(l, t) {
-                    self.top().skip = None;
-                    return Ok(true);
-                }
-            }
-            if let Body::Control(c) = &block.body {
-                // Structures opened or closed between jump and label keep the stack right.
-                let top = self.top();
-                match c {
-                    Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
-                    Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
-                    Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
-                        top.flow.pop();
-                    }
-                    Control::EndSwitch
-                        if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) =>
-                    {
-                        top.flow.pop();
-                    }
-                    _ => {}
-                }
-            }
-            if is_stream && block_ends_program(block) {
-                return Err(DecodeError::new(
-                    20840,
-                    format!("label {} not found before program end", goto_text(t)),
-                ));
-            }
-            return Ok(false);
-        }
-        if skip.until == SkipUntil::LocalSubroutine {
-            if let Body::Items(items) = &block.body {
-                if items_have_m(items, &[17, 29]) {
-                    self.top().skip = None;
-                }
-            }
-            return Ok(false);
-        }
-        let Body::Control(c) = &block.body else {
-            return Ok(false);
-        };
-        match nesting(c) {
-            Nesting::Open => {
-                if let Some(s) = self.top().skip.as_mut() {
-                    s.depth += 1;
-                }
-                return Ok(false);
-            }
-            Nesting::Close if skip.depth > 0 => {
-                if let Some(s) = self.top().skip.as_mut() {
-                    s.depth -= 1;
-                }
-                return Ok(false);
-            }
-            _ => {}
-        }
-        if skip.depth > 0 {
-            return Ok(false);
-        }
-        match (&skip.until, c) {
-            (SkipUntil::IfBranch, Control::ElseIf(e))
-                if crate::lang::eval::is_true(self.eval(e)?) =>
-            {
-                self.top().skip = None;
-                self.set_if_taken();
-            }
-            (SkipUntil::IfBranch, Control::Else) => {
-                self.top().skip = None;
-                self.set_if_taken();
-            }
-            (SkipUntil::IfBranch | SkipUntil::IfEnd, Control::EndIf) => {
-                let top = self.top();
-                top.skip = None;
-                top.flow.pop();
-            }
-            (SkipUntil::Case, Control::Case(e)) => {
-                let v = self.eval(e)?;
-                if let Some(FlowEntry::Switch { value }) = self.top().flow.last() {
-                    if crate::lang::eval::case_matches(*value, v) {
-                        self.top().skip = None;
-                    }
-                }
-            }
-            (SkipUntil::Case, Control::Default) => self.top().skip = None,
-            (SkipUntil::Case | SkipUntil::SwitchEnd, Control::EndSwitch) => {
-                let top = self.top();
-                top.skip = None;
-                top.flow.pop();
-            }
-            (SkipUntil::LoopExit, c) => {
-                let top = self.top();
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
-                    top.skip = None;
-                    top.flow.pop();
-                }
-            }
-            (SkipUntil::LoopContinue, c) => {
-                let top = self.top();
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
-                    top.skip = None;
-                    return Ok(true);
-                }
-            }
-            _ => {}
-        }
-        Ok(false)
-    }
-
-    fn set_if_taken(&mut self) {
-        if let Some(FlowEntry::If { taken }) = self.top().flow.last_mut() {
-            *taken = true;
-        }
-    }
-
-    fn skip(&mut self, until: SkipUntil) {
-        self.top().skip = Some(Skip::new(until));
-    }
-
-    fn stray(&self, c: &Control) -> DecodeError {
-        use crate::lang::codes::StrayKind as K;
-        let kind = match c {
-            Control::Else => Some(K::Else),
-            Control::ElseIf(_) => Some(K::ElseIf),
-            Control::EndIf => Some(K::EndIf),
-            Control::Case(_) => Some(K::Case),
-            Control::Default => Some(K::Default),
-            Control::Break => Some(K::Break),
-            Control::EndSwitch => Some(K::EndSwitch),
-            Control::EndFor => Some(K::EndFor),
-            Control::EndWhile => Some(K::EndWhile),
-            Control::EndDo(_) => Some(K::EndDo),
-            Control::Until(_) => Some(K::Until),
-            Control::Continue => Some(K::Continue),
-            _ => None,
-        };
-        let code = kind.map_or(20200, K::code);
-        DecodeError::new(code, format!("unexpected {}", control_name(c)))
-    }
-
-    fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
-        use crate::lang::eval::is_true;
-        let here = LinePos {
-            pos: meta.offset as usize,
-            line_no: meta.line - 1,
-        };
-        match c {
-            Control::If(e) => {
-                let v = is_true(self.eval(e)?);
-                self.top().flow.push(FlowEntry::If { taken: v });
-                if !v {
-                    self.skip(SkipUntil::IfBranch);
-                }
-            }
-            Control::IfGoto(e, t) => {
-                if is_true(self.eval(e)?) {
-                    self.goto(t)?;
-                }
-            }
-            Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
-                Some(FlowEntry::If { .. }) => self.skip(SkipUntil::IfEnd),
-                _ => return Err(self.stray(c)),
-            },
-            Control::EndIf => match self.top().flow.last() {
-                Some(FlowEntry::If { .. }) => {
-                    self.top().flow.pop();
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Switch(e) => {
-                let value = self.eval(e)?;
-                self.top().flow.push(FlowEntry::Switch { value });
-                self.skip(SkipUntil::Case);
-            }
-            // Executing into a later case: fall through (no `$BREAK` before it).
-            Control::Case(_) | Control::Default => match self.top().flow.last() {
-                Some(FlowEntry::Switch { .. }) => {}
-                _ => return Err(self.stray(c)),
-            },
-            Control::EndSwitch => match self.top().flow.last() {
-                Some(FlowEntry::Switch { .. }) => {
-                    self.top().flow.pop();
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Break => {
-                let inner = self
-                    .top()
-                    .flow
-                    .iter()
-                    .rev()
-                    .find(|e| e.is_loop() || matches!(e, FlowEntry::Switch { .. }))
-                    .cloned();
-                match inner {
-                    Some(FlowEntry::Switch { .. }) => {
-                        // Close inner $IFs between the $BREAK and its switch.
-                        while matches!(self.top().flow.last(), Some(FlowEntry::If { .. })) {
-                            self.top().flow.pop();
-                        }
-                        self.skip(SkipUntil::SwitchEnd);
-                    }
-                    Some(_) => {
-                        while matches!(
-                            self.top().flow.last(),
-                            Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
-                        ) {
-                            self.top().flow.pop();
-                        }
-                        self.skip(SkipUntil::LoopExit);
-                    }
-                    None => return Err(self.stray(c)),
-                }
-            }
-            Control::Continue => {
-                if !self.top().flow.iter().any(FlowEntry::is_loop) {
-                    return Err(self.stray(c));
-                }
-                while matches!(
-                    self.top().flow.last(),
-                    Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
-                ) {
-                    self.top().flow.pop();
-                }
-                self.skip(SkipUntil::LoopContinue);
-            }
-            Control::For {
-                var,
-                start,
-                end,
-                step,
-            } => {
-                let key = self.resolve(var)?;
-                let start = self.eval(start)?;
-                let end = self.eval(end)?;
-                let step = match step {
-                    Some(s) => self.eval(s)?,
-                    None => 1.0,
-                };
-                if step == 0.0 || !step.is_finite() {
-                    return Err(DecodeError::new(
-                        own_codes::BAD_VALUE,
-                        "$FOR step must not be 0",
-                    ));
-                }
-                self.set_var(key.clone(), start)?;
-                let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::For {
-                    var: key,
-                    end,
-                    step,
-                    body,
-                });
-                if !for_continues(start, end, step) {
-                    self.skip(SkipUntil::LoopExit);
-                }
-            }
-            Control::EndFor => match self.top().flow.last().cloned() {
-                Some(FlowEntry::For {
-                    var,
-                    end,
-                    step,
-                    body,
-                }) => {
-                    let v = self.vars.get(&var).unwrap_or(0.0) + step;
-                    self.set_var(var, v)?;
-                    if for_continues(v, end, step) {
-                        self.top().seek(body);
-                    } else {
-                        self.top().flow.pop();
-                    }
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::While(e) => {
-                let v = is_true(self.eval(e)?);
-                self.top().flow.push(FlowEntry::While { head: here });
-                if !v {
-                    self.skip(SkipUntil::LoopExit);
-                }
-            }
-            Control::EndWhile => match self.top().flow.last().cloned() {
-                Some(FlowEntry::While { head }) => {
-                    // Back to the $WHILE line, which evaluates and pushes again.
-                    self.top().flow.pop();
-                    self.top().seek(head);
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Do => {
-                let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::Do { body });
-            }
-            Control::EndDo(e) => match self.top().flow.last().cloned() {
-                Some(FlowEntry::Do { body }) => {
-                    if is_true(self.eval(e)?) {
-                        self.top().seek(body);
-                    } else {
-                        self.top().flow.pop();
-                    }
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Repeat => {
-                let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::Repeat { body });
-            }
-            Control::Until(e) => match self.top().flow.last().cloned() {
-                Some(FlowEntry::Repeat { body }) => {
-                    if is_true(self.eval(e)?) {
-                        self.top().flow.pop();
-                    } else {
-                        self.top().seek(body);
-                    }
-                }
-                _ => return Err(self.stray(c)),
-            },
-            Control::Goto(t) => self.goto(t)?,
-        }
-        Ok(())
-    }
-
-    fn goto(&mut self, t: &GotoTarget) -> Res {
-        let top = self.top();
-        if top.is_stream() {
-            let key = goto_label(t);
-            if top.seen_labels.contains(&key) {
-                return Err(DecodeError::new(
-                    21477,
-                    format!("backward jump to {} in streaming program", goto_text(t)),
-                ));
-            }
-            top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
-            return Ok(());
-        }
-        let index = self.label_index()?;
-        let Some((at, depth)) = index.find(t) else {
-            return Err(DecodeError::new(
-                20840,
-                format!("label {} not found", goto_text(t)),
-            ));
-        };
-        let top = self.top();
-        top.seek(at);
-        // The label's structural depth decides which open structures the jump leaves.
-        top.flow.truncate(depth);
-        while top.flow.len() < depth {
-            top.flow.push(FlowEntry::If { taken: true });
-        }
-        Ok(())
-    }
-
-    /// The label index of the top file frame, built once per program text.
-    fn label_index(&mut self) -> Res<Arc<LabelIndex>> {
-        let top = self.top();
-        if let Some(i) = &top.label_index {
-            return Ok(i.clone());
-        }
-        let Source::File(p) = &top.source else {
-            return Ok(Arc::new(LabelIndex::default()));
-        };
-        let index = Arc::new(build_label_index(&p.text)?);
-        self.top().label_index = Some(index.clone());
-        Ok(index)
-    }
-
-    fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
-        let init = match &d.init {
-            Some(e) => self.eval(e)?,
-            None => 0.0,
-        };
-        let total: u64 = d.dims.iter().map(|&n| n as u64).product::<u64>().max(1);
-        if d.dims.len() > 3 || total > 100_000 {
-            return Err(DecodeError::new(
-                own_codes::BAD_VALUE,
-                format!("array V.{}.{} too large", scope_letter(d.scope), d.name),
-            ));
-        }
-        let dims = d.dims.len() as u8;
-        for flat in 0..total {
-            let mut indices = [0i64; 3];
-            let mut rest = flat;
-            for k in (0..d.dims.len()).rev() {
-                let n = d.dims[k] as u64;
-                indices[k] = (rest % n) as i64;
-                rest /= n;
-            }
-            self.set_var(
-                VarSlot::V {
-                    scope: d.scope,
-                    name: d.name.as_str().into(),
-                    indices,
-                    dims,
-                },
-                init,
-            )?;
-        }
-        Ok(())
-    }
-
     fn set_var(&mut self, k: VarSlot, v: f64) -> Res {
         self.vars
             .set(k, v)
-            .map_err(|_| DecodeError::new(own_codes::TOO_MANY_VARIABLES, "too many variables"))
+            .map_err(|_| DecodeError::new(codes::TOO_MANY_VARIABLES, "too many variables"))
     }
 
     fn info(&self, block: &Block, text: &str, meta: LineMeta, io: &DecoderIo<'_>) -> BlockInfo {
@@ -1034,291 +562,6 @@ impl Decoder {
         });
     }
 
-    fn finish_search(
-        &mut self,
-        s: Search,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
-        io: &mut DecoderIo<'_>,
-    ) {
-        self.search = None;
-        self.notes.push(Note::Search {
-            target: s.target,
-            found: true,
-        });
-        if s.from != self.modal.pos {
-            let info = self.info(block, text, meta, io);
-            let mv = Move {
-                kind: MoveKind::Rapid,
-                start: s.from,
-                end: self.modal.pos,
-                feed_mm_per_min: 0.0,
-                path: Default::default(),
-            };
-            self.emit(info, Action::Move(mv), true, io);
-        }
-    }
-
-    fn exec_items(
-        &mut self,
-        items: &[Item],
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
-        io: &mut DecoderIo<'_>,
-    ) -> Res {
-        let mut gs = BlockGs::default();
-        let mut axes: [Option<f64>; MAX_AXES] = [None; MAX_AXES];
-        let mut ijk: [Option<f64>; 3] = [None; 3];
-        let mut radius: Option<f64> = None;
-        let mut ms: [u32; 8] = [0; 8];
-        let mut n_ms = 0usize;
-        for it in items {
-            match it {
-                Item::Assign { target, value, col } => {
-                    let key = self.resolve(target).map_err(|e| e.at(*col))?;
-                    let v = self.eval(value).map_err(|e| e.at(*col))?;
-                    self.set_var(key, v)?;
-                }
-                Item::GValue { g, value, col } => {
-                    // G132..G134 with a weighting value: evaluated, accepted, no motion effect.
-                    if let Value::Expr(e) = value {
-                        self.eval(e).map_err(|e| e.at(*col))?;
-                    }
-                    if !apply_g(&mut self.modal, *g, &mut gs) {
-                        return Err(
-                            DecodeError::new(20131, format!("unknown G function G{g}")).at(*col)
-                        );
-                    }
-                }
-                Item::Word(w) => {
-                    let v = match &w.value {
-                        Value::Num(n) => *n,
-                        Value::Expr(e) => self.eval(e).map_err(|e| e.at(w.col))?,
-                    };
-                    match w.letter {
-                        b'G' => {
-                            let g = whole(v).ok_or_else(|| {
-                                DecodeError::new(20131, format!("G{v} is not a G function"))
-                                    .at(w.col)
-                            })?;
-                            if !apply_g(&mut self.modal, g, &mut gs) {
-                                return Err(DecodeError::new(
-                                    20131,
-                                    format!("unknown G function G{g}"),
-                                )
-                                .at(w.col));
-                            }
-                        }
-                        b'M' => {
-                            let m = whole(v).ok_or_else(|| {
-                                DecodeError::new(20157, format!("M{v} is not an M function"))
-                                    .at(w.col)
-                            })?;
-                            if n_ms == ms.len() {
-                                return Err(DecodeError::new(
-                                    20200,
-                                    "too many M functions in one block",
-                                )
-                                .at(w.col));
-                            }
-                            ms[n_ms] = m;
-                            n_ms += 1;
-                            apply_m(&mut self.modal, m);
-                        }
-                        b'F' => {
-                            if !(v >= 0.0 && v.is_finite()) {
-                                return Err(DecodeError::new(
-                                    own_codes::BAD_VALUE,
-                                    format!("feed F{v} out of range"),
-                                )
-                                .at(w.col));
-                            }
-                            self.modal.feed_mm_per_min = v;
-                        }
-                        b'S' => self.modal.spindle_rpm = v,
-                        b'T' => self.modal.tool = whole(v).unwrap_or(0),
-                        b'D' => self.modal.tool_offset = whole(v).unwrap_or(0),
-                        b'I' => ijk[0] = Some(v),
-                        b'J' => ijk[1] = Some(v),
-                        b'K' => ijk[2] = Some(v),
-                        b'R' => radius = Some(v),
-                        letter => {
-                            if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == letter) {
-                                if !v.is_finite() {
-                                    return Err(DecodeError::new(
-                                        own_codes::BAD_VALUE,
-                                        "axis value not finite",
-                                    )
-                                    .at(w.col));
-                                }
-                                if !(self.settings.axes[i] || gs.dwell && letter == b'X') {
-                                    return Err(DecodeError::new(
-                                        20200,
-                                        format!(
-                                            "axis {} is not configured in this channel",
-                                            letter as char
-                                        ),
-                                    )
-                                    .at(w.col));
-                                }
-                                axes[i] = Some(v);
-                            }
-                            // H and E: accepted, no effect in the emulator.
-                        }
-                    }
-                }
-            }
-        }
-        let ms = &ms[..n_ms];
-        let info = self.info(block, text, meta, io);
-        let mut queued_main = false;
-        if gs.dwell {
-            let seconds = axes[0].take().unwrap_or(0.0).max(0.0);
-            self.emit(info.clone(), Action::Dwell { seconds }, false, io);
-            queued_main = true;
-        }
-        if axes.iter().any(Option::is_some) {
-            let start = self.modal.pos;
-            let mut end = start;
-            let offset = if gs.machine_coords || self.modal.zero_offset == 0 {
-                [0.0; MAX_AXES]
-            } else {
-                self.settings.zero_offsets[self.modal.zero_offset - 1]
-            };
-            for i in 0..MAX_AXES {
-                if let Some(v) = axes[i] {
-                    end[i] = if self.modal.absolute {
-                        v + offset[i]
-                    } else {
-                        start[i] + v
-                    };
-                }
-            }
-            let feed = self.modal.feed_mm_per_min;
-            let mv = match self.modal.motion {
-                MotionMode::Rapid => Move {
-                    kind: MoveKind::Rapid,
-                    start,
-                    end,
-                    feed_mm_per_min: 0.0,
-                    path: Default::default(),
-                },
-                m => {
-                    if feed <= 0.0 {
-                        return Err(DecodeError::new(
-                            own_codes::NO_FEED,
-                            "no feed programmed (F) for G1/G2/G3",
-                        ));
-                    }
-                    if m == MotionMode::Linear {
-                        Move {
-                            kind: MoveKind::Line,
-                            start,
-                            end,
-                            feed_mm_per_min: feed,
-                            path: Default::default(),
-                        }
-                    } else {
-                        arc::arc_move(
-                            &arc::ArcSpec {
-                                plane: self.modal.plane,
-                                ijk,
-                                radius,
-                                cw: m == MotionMode::ArcCw,
-                            },
-                            start,
-                            end,
-                            feed,
-                            self.settings.arc_tolerance_mm,
-                        )
-                        .map_err(|e| {
-                            DecodeError::new(
-                                own_codes::ARC_INCONSISTENT,
-                                format!("circle not consistent: {e:?}"),
-                            )
-                        })?
-                    }
-                }
-            };
-            let mut mv = mv;
-            mv.path = self.modal.path_mode(gs.contour_this_block);
-            self.modal.pos = end;
-            self.emit(info.clone(), Action::Move(mv), queued_main, io);
-            queued_main = true;
-        }
-        let end_m = ms.iter().copied().find(|m| matches!(m, 2 | 30 | 17 | 29));
-        match end_m {
-            Some(m @ (17 | 29)) => {
-                if self.top().kind == FrameKind::Main {
-                    return Err(DecodeError::new(
-                        20376,
-                        format!("unexpected M{m} in main program"),
-                    ));
-                }
-                if !queued_main {
-                    self.emit(info, Action::None, false, io);
-                }
-                self.check_open_flow()?;
-                self.return_from_subroutine();
-            }
-            Some(m) => {
-                if self.search.is_some() {
-                    return Err(DecodeError::new(
-                        21532,
-                        format!(
-                            "block search target {} not found",
-                            self.search
-                                .map(|s| s.target.to_string())
-                                .unwrap_or_default()
-                        ),
-                    ));
-                }
-                if self.top().kind != FrameKind::Main {
-                    self.notes.push(Note::Warning {
-                        code: 20377,
-                        msg: format!("M{m} in a subroutine: the program ends"),
-                    });
-                } else {
-                    self.check_open_flow()?;
-                }
-                if !queued_main {
-                    self.emit(info.clone(), Action::None, false, io);
-                }
-                self.emit(info, Action::End { m }, true, io);
-                self.end_program();
-            }
-            None => {
-                if !queued_main {
-                    self.emit(info, Action::None, false, io);
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn check_open_flow(&mut self) -> Res {
-        if !self.top().flow.is_empty() {
-            return Err(DecodeError::new(
-                20375,
-                "open control blocks at program end",
-            ));
-        }
-        Ok(())
-    }
-
-    /// M17/M29: back to the caller, past the call line.
-    fn return_from_subroutine(&mut self) {
-        if let Some(f) = self.frames.pop() {
-            if f.is_stream() {
-                self.discard_stream_rest();
-                self.stream_active = false;
-            }
-            self.vars.pop_level();
-        }
-    }
-
     /// M30/M2: the program ends; in a stream the rest of the current segment goes.
     fn end_program(&mut self) {
         if self.stream_active {
@@ -1346,202 +589,25 @@ impl Decoder {
         }) = &top.skip
         {
             return Err(DecodeError::new(
-                20840,
+                codes::LABEL_NOT_FOUND,
                 format!("label {} not found", goto_text(t)),
             ));
         }
         if searching {
-            return Err(DecodeError::new(21532, "block search target not found"));
+            return Err(DecodeError::new(
+                codes::SEARCH_NOT_FOUND,
+                "block search target not found",
+            ));
         }
         match top.kind {
             FrameKind::Main => Err(DecodeError::new(
-                own_codes::MAIN_END_MISSING,
+                codes::MAIN_END_MISSING,
                 "end of main program without M30/M02",
             )),
             _ => Err(DecodeError::new(
-                own_codes::SUB_END_MISSING,
+                codes::SUB_END_MISSING,
                 "end of subroutine without M17/M29",
             )),
-        }
-    }
-
-    fn exec_command(
-        &mut self,
-        c: &Command,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
-        io: &mut DecoderIo<'_>,
-    ) -> Res {
-        let info = self.info(block, text, meta, io);
-        match c {
-            Command::Flush(kind) => {
-                if self.modal.cross_block_active() {
-                    return Err(DecodeError::new(21909, "#FLUSH while a cross-block function is active (TRC, contouring, spline, HSC)"));
-                }
-                self.emit(info, Action::Flush(*kind), false, io);
-                if *kind == FlushKind::Wait && self.search.is_none() {
-                    self.wait_idle = true;
-                }
-            }
-            Command::CacheLoad { file } => {
-                let loaded = io
-                    .cache
-                    .load(file, io.store)
-                    .map_err(|e| DecodeError::new(e.code(), e.to_string()))?;
-                self.notes.push(Note::Cache {
-                    op: loaded.op(),
-                    file: file.clone(),
-                });
-                self.emit(info, Action::None, false, io);
-            }
-            Command::CacheClear { file } => {
-                io.cache
-                    .clear(file)
-                    .map_err(|e| DecodeError::new(e.code(), e.to_string()))?;
-                self.notes.push(Note::Cache {
-                    op: "clear",
-                    file: file.clone(),
-                });
-                self.emit(info, Action::None, false, io);
-            }
-            Command::CacheClearAll => {
-                io.cache
-                    .clear_all()
-                    .map_err(|e| DecodeError::new(e.code(), e.to_string()))?;
-                self.notes.push(Note::Cache {
-                    op: "clear_all",
-                    file: String::new(),
-                });
-                self.emit(info, Action::None, false, io);
-            }
-            Command::CommentBegin => self.top().comment_block = true,
-            // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
-            Command::CommentEnd => {}
-            Command::Spline(s) => {
-                match s {
-                    SplineCommand::On => self.modal.spline = true,
-                    SplineCommand::Off => self.modal.spline = false,
-                    t => self.modal.spline_type = *t,
-                }
-                self.emit(info, Action::None, false, io);
-            }
-            Command::Hsc { on, .. } => {
-                self.modal.hsc = *on;
-                self.emit(info, Action::None, false, io);
-            }
-            Command::ContourMode { options } => {
-                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
-                    self.modal.contour_dev_mm = dev;
-                }
-                self.emit(info, Action::None, false, io)
-            }
-            Command::Var => self.top().var_block = true,
-            Command::EndVar => {}
-        }
-        Ok(())
-    }
-
-    fn exec_call(
-        &mut self,
-        c: &Call,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
-        io: &mut DecoderIo<'_>,
-    ) -> Res {
-        if self.frames.len() > self.settings.max_depth {
-            return Err(DecodeError::new(
-                own_codes::NESTING_TOO_DEEP,
-                format!("subroutine nesting deeper than {}", self.settings.max_depth),
-            ));
-        }
-        let info = self.info(block, text, meta, io);
-        match c {
-            Call::Global { file } => {
-                let frame = self.open_subroutine(file, FrameKind::Global, io)?;
-                self.emit(info, Action::None, false, io);
-                self.vars.push_level(Vec::new());
-                self.frames.push(frame);
-            }
-            Call::Cycle { name, params } => {
-                let mut values = Vec::with_capacity(params.len());
-                for (n, e) in params {
-                    values.push((*n, self.eval(e)?));
-                }
-                let frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
-                self.emit(info, Action::None, false, io);
-                self.vars.push_level(values);
-                self.frames.push(frame);
-            }
-            Call::Local { name } => {
-                let index = self.label_index()?;
-                let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
-                    return Err(DecodeError::new(
-                        20373,
-                        format!("local subroutine {name} not found"),
-                    ));
-                };
-                let top = self.top();
-                let Source::File(p) = &top.source else {
-                    return Err(DecodeError::new(
-                        21479,
-                        "local subroutine call (LL) in streaming program",
-                    ));
-                };
-                let mut frame =
-                    Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
-                frame.label_index = Some(index);
-                frame.seek(at);
-                self.emit(info, Action::None, false, io);
-                self.vars.push_level(Vec::new());
-                self.frames.push(frame);
-            }
-        }
-        Ok(())
-    }
-
-    /// A global subroutine or cycle: the cache first, then the file system, then the stream.
-    fn open_subroutine(
-        &mut self,
-        name: &str,
-        kind: FrameKind,
-        io: &mut DecoderIo<'_>,
-    ) -> Res<Frame> {
-        if let Some(p) = io.cache.get(name) {
-            if io.want_text {
-                // Only with events on: the hot call path stays free of the allocation.
-                self.notes.push(Note::Cache {
-                    op: "hit",
-                    file: name.to_string(),
-                });
-            }
-            let prog = p.name.clone();
-            return Ok(Frame::new(kind, Source::File(p), prog));
-        }
-        match io
-            .store
-            .open(name, ProgramKind::Subroutine)
-            .map_err(|e| DecodeError::new(e.code(), e.to_string()))?
-        {
-            Opened::File(p) => {
-                let prog: Arc<str> = p.name.clone();
-                Ok(Frame::new(kind, Source::File(p), prog))
-            }
-            Opened::Stream { name } => {
-                if self.stream_active {
-                    return Err(DecodeError::new(
-                        own_codes::STREAM_ALREADY_ACTIVE,
-                        "the streaming program is already running",
-                    ));
-                }
-                self.begin_stream();
-                self.notes.push(Note::ProgramStart {
-                    prog: name.clone(),
-                    stream: true,
-                });
-                Ok(Frame::new(kind, Source::Stream, name))
-            }
         }
     }
 
@@ -1554,137 +620,23 @@ impl Decoder {
     }
 }
 
-/// Scan a whole file once for labels (position and structural depth) and `%L` sections.
-fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
-    let mut index = LabelIndex::default();
-    let mut pos = 0usize;
-    let mut line_no = 0u32;
-    let mut depth = 0usize;
-    let mut comment = false;
-    let mut line = String::new();
-    loop {
-        let at = LinePos { pos, line_no };
-        let Some(next) = frame::cut_line(text, pos, &mut line, true) else {
-            break;
-        };
-        pos = next;
-        line_no += 1;
-        if comment {
-            if is_comment_end(&line) {
-                comment = false;
-            }
-            continue;
-        }
-        let Ok(block) = parse_block(&line) else {
-            continue;
-        };
-        if let Some(l) = &block.label {
-            if index.labels.insert(l.clone(), (at, depth)).is_some() {
-                return Err(DecodeError::new(
-                    20836,
-                    format!("label {} defined twice (line {})", label_text(l), line_no),
-                ));
-            }
-        }
-        match &block.body {
-            Body::Command(Command::CommentBegin) => comment = true,
-            Body::ProgramHead { name, local: true } => {
-                index
-                    .local_subs
-                    .insert(name.to_ascii_uppercase(), LinePos { pos, line_no });
-            }
-            Body::Control(c) => match nesting(c) {
-                Nesting::Open => depth += 1,
-                Nesting::Close => depth = depth.saturating_sub(1),
-                Nesting::Neither => {}
-            },
-            _ => {}
-        }
-    }
-    Ok(index)
-}
-
-fn for_continues(v: f64, end: f64, step: f64) -> bool {
-    if step > 0.0 {
-        v <= end + 1e-9
-    } else {
-        v >= end - 1e-9
-    }
-}
-
 /// A whole number written as a float (`G01` parses as 1.0).
-fn whole(v: f64) -> Option<u32> {
+pub(crate) fn whole(v: f64) -> Option<u32> {
     let r = v.round();
     ((v - r).abs() < 1e-9 && (0.0..=u32::MAX as f64).contains(&r)).then_some(r as u32)
 }
 
-fn items_have_m(items: &[Item], codes: &[u32]) -> bool {
-    items.iter().any(|i| match i {
-        Item::Word(w) if w.letter == b'M' => match w.value {
-            Value::Num(v) => whole(v).is_some_and(|m| codes.contains(&m)),
-            Value::Expr(_) => false,
-        },
-        _ => false,
-    })
-}
-
-fn block_ends_program(b: &Block) -> bool {
-    matches!(&b.body, Body::Items(items) if items_have_m(items, &[2, 30]))
-}
-
-fn goto_label(t: &GotoTarget) -> Label {
-    match t {
-        GotoTarget::Number(n) => Label::Number(*n),
-        GotoTarget::Name(s) => Label::Name(s.clone()),
-    }
-}
-
-fn label_matches(l: &Label, t: &GotoTarget) -> bool {
-    *l == goto_label(t)
-}
-
-fn label_text(l: &Label) -> String {
-    match l {
-        Label::Number(n) => format!("N{n}"),
-        Label::Name(s) => format!("[{s}]"),
-    }
-}
-
-fn goto_text(t: &GotoTarget) -> String {
-    label_text(&goto_label(t))
-}
-
-fn scope_letter(s: crate::lang::block::VScope) -> char {
-    use crate::lang::block::VScope;
-    match s {
-        VScope::Program => 'P',
-        VScope::Local => 'L',
-        VScope::SelfRetaining => 'S',
-        VScope::External => 'E',
-    }
-}
-
-fn control_name(c: &Control) -> &'static str {
-    match c {
-        Control::If(_) => "$IF",
-        Control::IfGoto(..) => "$IF … $GOTO",
-        Control::ElseIf(_) => "$ELSEIF",
-        Control::Else => "$ELSE",
-        Control::EndIf => "$ENDIF",
-        Control::Switch(_) => "$SWITCH",
-        Control::Case(_) => "$CASE",
-        Control::Default => "$DEFAULT",
-        Control::Break => "$BREAK",
-        Control::EndSwitch => "$ENDSWITCH",
-        Control::For { .. } => "$FOR",
-        Control::EndFor => "$ENDFOR",
-        Control::While(_) => "$WHILE",
-        Control::EndWhile => "$ENDWHILE",
-        Control::Do => "$DO",
-        Control::EndDo(_) => "$ENDDO",
-        Control::Repeat => "$REPEAT",
-        Control::Until(_) => "$UNTIL",
-        Control::Continue => "$CONTINUE",
-        Control::Goto(_) => "$GOTO",
+/// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).
+fn stream_allows(block: &Block) -> Res {
+    match &block.body {
+        Body::Control(c) if is_loop_statement(c) => Err(DecodeError::new(
+            codes::STREAM_LOOP,
+            "loop statement in streaming program; streaming aborted",
+        )),
+        Body::Call(Call::Local { .. }) => Err(DecodeError::new(
+            codes::STREAM_LOCAL_CALL,
+            "local subroutine call (LL) in streaming program",
+        )),
+        _ => Ok(()),
     }
 }

@@ -2,6 +2,7 @@
 //! coolant, tool, position), re-initialised at program start and collected by block search.
 
 use crate::lang::block::SplineCommand;
+use crate::lang::dialect::{g_support, Support};
 use crate::queue::{Plane, Position, MAX_AXES};
 
 /// Motion G group.
@@ -30,6 +31,44 @@ pub enum RadiusComp {
     Right,
 }
 
+/// Units of programmed lengths and feeds (G70 / G71).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    /// G71: mm (the channel default).
+    Metric,
+    /// G70: inch; lengths and feeds are scaled by 25.4 at decode time.
+    Inch,
+}
+
+impl Units {
+    /// mm per programmed length unit.
+    pub fn mm_per_unit(self) -> f64 {
+        match self {
+            Units::Metric => 1.0,
+            Units::Inch => 25.4,
+        }
+    }
+}
+
+/// Meaning of the F word (G94 / G95).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeedMode {
+    /// G94: length per minute (the default).
+    PerMinute,
+    /// G95: length per spindle revolution; the path feed is F × S, computed at decode time.
+    PerRevolution,
+}
+
+/// Exact-stop / velocity mode at block ends (G60, G08, G09, G359/G360, G900/G901). Kept as
+/// state only: the planner does not read it yet (docs/nc-language.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BlockEnd {
+    /// Default: continuous path.
+    Continuous,
+    /// G360: exact stop at every block end (G359 deselects).
+    ExactStop,
+}
+
 /// Everything modal the emulator tracks. Block search compares these between a full run and a
 /// search run, so every field is plain data.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,8 +77,16 @@ pub struct Modal {
     pub plane: Plane,
     /// G90 (true) / G91 (false).
     pub absolute: bool,
-    /// Modal path feed, mm/min; 0 = none programmed yet.
+    /// Modal path feed under G94, mm/min; 0 = none programmed yet.
     pub feed_mm_per_min: f64,
+    /// Modal feed under G95, mm per spindle revolution; 0 = none programmed yet.
+    pub feed_mm_per_rev: f64,
+    pub feed_mode: FeedMode,
+    pub units: Units,
+    /// G92 reference point offset per axis, mm / degrees, added to programmed absolute
+    /// positions after the zero offset.
+    pub g92_offset: [f64; MAX_AXES],
+    pub block_end: BlockEnd,
     pub spindle: Spindle,
     /// Programmed spindle speed, rpm.
     pub spindle_rpm: f64,
@@ -74,6 +121,11 @@ impl Modal {
             plane: Plane::Xy,
             absolute: true,
             feed_mm_per_min: 0.0,
+            feed_mm_per_rev: 0.0,
+            feed_mode: FeedMode::PerMinute,
+            units: Units::Metric,
+            g92_offset: [0.0; MAX_AXES],
+            block_end: BlockEnd::Continuous,
             spindle: Spindle::Off,
             spindle_rpm: 0.0,
             coolant_mist: false,
@@ -125,9 +177,14 @@ pub struct BlockGs {
     pub machine_coords: bool,
     /// G61: contouring at this block's end only.
     pub contour_this_block: bool,
+    /// G92: the block's axis words set the reference point offset; no motion.
+    pub set_reference: bool,
+    /// G60 / G09 / G900 / G901: stop at this block's end (state only, as `BlockEnd`).
+    pub stop_this_block: bool,
 }
 
-/// Apply one G code. `false` for a G code the channel does not know (20131).
+/// Apply one G code. `false` for a G code the channel does not know or refuses (the parser
+/// has already said which).
 #[must_use]
 pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
     match g {
@@ -148,15 +205,24 @@ pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
         }
         54..=59 => m.zero_offset = (g - 53) as usize,
         61 => b.contour_this_block = true,
+        60 | 9 | 900 | 901 => b.stop_this_block = true,
+        70 => m.units = Units::Inch,
+        71 => m.units = Units::Metric,
         90 => m.absolute = true,
         91 => m.absolute = false,
-        // Ramp time weighting: accepted, no effect on the emulated motion.
-        132..=134 => {}
+        92 => b.set_reference = true,
+        94 => m.feed_mode = FeedMode::PerMinute,
+        95 => m.feed_mode = FeedMode::PerRevolution,
+        // S is a spindle speed: the only meaning ncchannel has for it (G96 is refused).
+        97 => {}
+        359 => m.block_end = BlockEnd::Continuous,
+        360 => m.block_end = BlockEnd::ExactStop,
         150 => m.spline = false,
         151 => m.spline = true,
         260 => m.contouring = false,
         261 => m.contouring = true,
-        _ => return false,
+        // The rest of ISG's list that ncchannel accepts without effect (lang::dialect).
+        _ => return matches!(g_support(g), Some((Support::Inert, _))),
     }
     true
 }

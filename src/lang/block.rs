@@ -1,4 +1,4 @@
-//! One NC block as the parser produces it and the decoder interprets it (REFERENCE §4).
+//! One NC block as the parser produces it and the decoder interprets it (TF5200 programming manual; README, "NC language").
 //!
 //! The parser is pure: one line in, one `Block` out. Nothing here knows about channels,
 //! frames or files; the decoder gives these types their meaning. Columns are 1-based
@@ -54,8 +54,9 @@ pub enum Item {
         value: Expr,
         col: u32,
     },
-    /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent).
-    /// Seed 003 writes `G134 50`; both forms parse to this item. `col` is the G's column.
+    /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent), and
+    /// the dwell `G04 2.5` / `G04=2.5` / `G04 P2.5` (seconds). `G134 50` and `G134=50` both
+    /// parse to this item. `col` is the G's column.
     GValue {
         g: u32,
         value: Value,
@@ -248,6 +249,19 @@ pub enum Command {
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,
+    /// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]`: an operator message;
+    /// the bracket text is kept verbatim (quotes removed when it is one quoted string).
+    Msg {
+        save: bool,
+        text: String,
+    },
+    /// `#TIME <seconds>`: a dwell (TF5200 "Dwell time").
+    Time(Value),
+    /// A `#` command of ISG's list that ncchannel accepts without effect
+    /// (`super::dialect`); the whole command text after `#` is kept verbatim.
+    Inert {
+        text: String,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,7 +2,7 @@
 //! line cannot show — control blocks opened and closed, labels unique, `$GOTO` targets found.
 //!
 //! Program levels: each `%name` / `%L name` head starts a new level; labels are searched and
-//! control blocks must close within their level (REFERENCE §4). The check reads files the
+//! control blocks must close within their level (TF5200 programming manual). The check reads files the
 //! way the decoder runs them (both jump directions allowed); streaming's extra limits
 //! (no loops, forward jumps only) are the decoder's business.
 

@@ -317,6 +317,12 @@ impl Display for Command {
             }
             Command::Var => f.write_str("#VAR"),
             Command::EndVar => f.write_str("#ENDVAR"),
+            Command::Msg { save, text } => {
+                f.write_str(if *save { "#MSG SAVE" } else { "#MSG" })?;
+                write!(f, " [\"{text}\"]")
+            }
+            Command::Time(v) => write!(f, "#TIME {v}"),
+            Command::Inert { text } => write!(f, "#{text}"),
         }
     }
 }

@@ -4,7 +4,7 @@
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("error {code} at column {col}: {message}")]
 pub struct SyntaxError {
-    /// ISG error number (REFERENCE §5), e.g. 20131 unknown G function.
+    /// ISG error number (`super::codes`), e.g. 20131 unknown G function.
     pub code: u32,
     /// 1-based character column of the offending token.
     pub col: u32,

@@ -81,24 +81,25 @@ impl EvalError {
     /// negative number, 90003 ASIN/ACOS outside -1..1, 90004 LN/LOG of a non-positive number,
     /// 90005 undefined variable, 90006 invalid index, 90007 result not finite.
     pub fn code(&self) -> u32 {
+        use super::codes;
         match self {
-            EvalError::DivisionByZero => 90001,
-            EvalError::SqrtNegative(_) => 90002,
-            EvalError::OutOfDomain { .. } => 90003,
-            EvalError::LogNonPositive(_) => 90004,
-            EvalError::Undefined(_) => 90005,
-            EvalError::BadIndex(_) => 90006,
-            EvalError::NotFinite => 90007,
+            EvalError::DivisionByZero => codes::EVAL_DIVISION_BY_ZERO,
+            EvalError::SqrtNegative(_) => codes::EVAL_SQRT_NEGATIVE,
+            EvalError::OutOfDomain { .. } => codes::EVAL_OUT_OF_DOMAIN,
+            EvalError::LogNonPositive(_) => codes::EVAL_LOG_NON_POSITIVE,
+            EvalError::Undefined(_) => codes::EVAL_UNDEFINED,
+            EvalError::BadIndex(_) => codes::EVAL_BAD_INDEX,
+            EvalError::NotFinite => codes::EVAL_NOT_FINITE,
         }
     }
 }
 
-/// A condition is true when |v| ≥ 0.5 (REFERENCE §4).
+/// A condition is true when |v| ≥ 0.5 (TF5200 programming manual).
 pub fn is_true(v: f64) -> bool {
     v.abs() >= 0.5
 }
 
-/// `$CASE` matches when the values differ by less than 0.001 (REFERENCE §4).
+/// `$CASE` matches when the values differ by less than 0.001 (TF5200 programming manual).
 pub fn case_matches(a: f64, b: f64) -> bool {
     (a - b).abs() < 0.001
 }

@@ -193,6 +193,25 @@ impl<'a> Ctx<'a> {
         u32::try_from(chars + 1).unwrap_or(u32::MAX)
     }
 
+    /// A committed error at 1-based character column `col` (found after the scan passed it).
+    pub(crate) fn err_at(
+        &self,
+        col: u32,
+        code: u32,
+        msg: impl Into<Cow<'static, str>>,
+    ) -> nom::Err<PErr<'a>> {
+        let k = (col as usize).saturating_sub(1);
+        let off = if self.ascii {
+            k.min(self.line.len())
+        } else {
+            self.line
+                .char_indices()
+                .nth(k)
+                .map_or(self.line.len(), |(o, _)| o)
+        };
+        perr(&self.line[off..], code, msg)
+    }
+
     pub fn to_error(&self, e: nom::Err<PErr<'_>>) -> SyntaxError {
         match e {
             nom::Err::Error(p) | nom::Err::Failure(p) => {

@@ -8,6 +8,7 @@
 pub mod block;
 pub mod check;
 pub mod codes;
+pub mod dialect;
 mod display;
 pub mod error;
 pub mod eval;

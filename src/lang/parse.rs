@@ -1,5 +1,5 @@
 //! One NC line → [`Block`]: block skip, block number, label, then words and assignments or
-//! one `$` statement, `#` command, call or program head (REFERENCE §4).
+//! one `$` statement, `#` command, call or program head (TF5200 programming manual).
 //!
 //! The hot path — ordinary words with literal numbers, `N123 G01 X12.345 Y-6.789` — is a
 //! byte-level scan with one allocation per block (its item list); everything rarer (commands,
@@ -13,9 +13,11 @@ use super::block::{
     Value, VarDecl, VarRef, Word,
 };
 use super::codes::{
-    is_known_g, is_known_m, is_word_letter, CACHE_DOUBLE, CACHE_SYNTAX, G_WITH_VALUE,
-    MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
+    is_known_g, is_known_m, is_word_letter, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
+    DWELL_NOT_ALONE, G_WITH_VALUE, MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
+    UNSUPPORTED, WORD_TWICE,
 };
+use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
 use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
 use super::number::scan_unsigned;
@@ -188,7 +190,7 @@ fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> 
     let body = match i.as_bytes().first() {
         None => Body::Items(Vec::new()),
         Some(b'#') => {
-            let (r, c) = command(i)?;
+            let (r, c) = command(ctx, i)?;
             end_of_block(r, "nothing may follow a # command in its block")?;
             Body::Command(c)
         }
@@ -253,16 +255,32 @@ fn item_capacity(i: &str) -> usize {
 
 fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
     let mut items = Vec::with_capacity(item_capacity(i));
+    // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
+    let mut seen = 0u32;
+    let mut dwell = false;
     loop {
         i = gap(i);
         let bytes = i.as_bytes();
         let Some(&b) = bytes.first() else {
+            if dwell {
+                dwell_alone(ctx, &items)?;
+            }
             return Ok(items);
         };
         let up = b.to_ascii_uppercase();
         let dot_follows = bytes.get(1) == Some(&b'.');
         if is_word_letter(up) && !(up == b'V' && dot_follows) {
+            let at = i;
             i = word(ctx, i, up, &mut items)?;
+            if let b'G' | b'M' | b'H' = up {
+                dwell |= up == b'G' && items.last().is_some_and(is_dwell);
+            } else {
+                let bit = 1u32 << (up - b'A');
+                if seen & bit != 0 {
+                    return Err(twice(at, up));
+                }
+                seen |= bit;
+            }
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
             let (r, target) = ctx.var_ref(i)?;
@@ -289,6 +307,58 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             return Err(perr(i, SYNTAX, msg));
         }
     }
+}
+
+/// Is this item the dwell `G04` (with or without its value)?
+fn is_dwell(it: &Item) -> bool {
+    match it {
+        Item::GValue { g, .. } => *g == 4,
+        Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
+        Item::Assign { .. } => false,
+    }
+}
+
+/// A letter programmed a second time in its block: 20203 for an axis, ours for the rest.
+fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
+    let l = letter as char;
+    if crate::queue::AXIS_LETTERS.contains(&letter) {
+        perr(
+            at,
+            AXIS_TWICE,
+            format!("axis {l} programmed twice in the block"),
+        )
+    } else {
+        perr(at, WORD_TWICE, format!("{l} programmed twice in the block"))
+    }
+}
+
+/// A dwell stands alone in its block (TF5200 G04): besides `G04` only its time, as `G04 <t>`,
+/// `G04 P<t>`, `G04 X<t>` or `G04 F<t>`. Anything else — a second G, an M, another axis —
+/// is refused rather than executed as a move or a feed.
+fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a>>> {
+    let mut time_given = items
+        .iter()
+        .any(|it| matches!(it, Item::GValue { g: 4, .. }));
+    for it in items {
+        if is_dwell(it) {
+            continue;
+        }
+        let (col, what) = match it {
+            Item::Word(w) if matches!(w.letter, b'X' | b'F') && !time_given => {
+                time_given = true;
+                continue;
+            }
+            Item::Word(w) => (w.col, format!("{}", w.letter as char)),
+            Item::Assign { col, .. } => (*col, "an assignment".to_string()),
+            Item::GValue { g, col, .. } => (*col, format!("G{g}")),
+        };
+        return Err(ctx.err_at(
+            col,
+            DWELL_NOT_ALONE,
+            format!("G04 must stand alone in its block: {what} found with it"),
+        ));
+    }
+    Ok(())
 }
 
 /// One address word at `i` (letter `up`), pushed onto `items`; returns the rest.
@@ -325,11 +395,14 @@ fn word<'a>(
     let rest = &after[skip + n..];
     match up {
         b'G' => {
-            let Some(g) = integer_code(v).filter(|&g| is_known_g(g)) else {
+            let Some(g) = integer_code(v) else {
                 return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
+            if !is_known_g(g) {
+                dialect_g(i, g)?;
+            }
             if G_WITH_VALUE.contains(&g) {
-                if let Some((r, value)) = g_value(ctx, rest)? {
+                if let Some((r, value)) = g_value(ctx, rest, g == 4)? {
                     items.push(Item::GValue { g, value, col });
                     return Ok(r);
                 }
@@ -337,6 +410,13 @@ fn word<'a>(
         }
         b'M' if !integer_code(v).is_some_and(is_known_m) => {
             return Err(perr(i, UNKNOWN_M, format!("unknown M function M{v}")));
+        }
+        b'H' if !integer_code(v).is_some_and(is_known_m) => {
+            return Err(perr(
+                i,
+                UNKNOWN_M,
+                format!("H function H{v} outside 0 to 65535"),
+            ));
         }
         _ => {}
     }
@@ -361,6 +441,7 @@ fn word_expr<'a>(
     match up {
         b'G' => return Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
         b'M' => return Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
+        b'H' => return Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
         _ => {}
     }
     let (rest, e) = ctx.bracketed(bracket)?;
@@ -377,6 +458,20 @@ fn word_expr<'a>(
     Ok(rest)
 }
 
+/// A G function outside the implemented fast path: one ISG lists and ncchannel accepts
+/// without effect passes; one it refuses is [`UNSUPPORTED`] by name; any other is 20131.
+fn dialect_g(i: &str, g: u32) -> Result<(), nom::Err<PErr<'_>>> {
+    match g_support(g) {
+        Some((Support::Implemented | Support::Inert, _)) => Ok(()),
+        Some((Support::Refused, name)) => Err(perr(
+            i,
+            UNSUPPORTED,
+            format!("G{g} ({name}) is not supported by ncchannel"),
+        )),
+        None => Err(perr(i, UNKNOWN_G, format!("unknown G function G{g}"))),
+    }
+}
+
 fn word_value_msg(letter: u8) -> String {
     format!("number or [expression] expected after {}", letter as char)
 }
@@ -386,12 +481,24 @@ fn integer_code(n: f64) -> Option<u32> {
     (n >= 0.0 && n.fract() == 0.0 && n <= f64::from(u32::MAX)).then_some(n as u32)
 }
 
-/// The value of `G133=<expr>` / `G134=<expr>`, also written `G134 50` (seed 003).
-fn g_value<'a>(ctx: &Ctx<'a>, i: &'a str) -> Result<Option<(&'a str, Value)>, nom::Err<PErr<'a>>> {
+/// The value of `G133=<expr>` / `G134=<expr>`, also written `G134 50`; with `dwell_p` (G04)
+/// also `P<seconds>`.
+fn g_value<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    dwell_p: bool,
+) -> Result<Option<(&'a str, Value)>, nom::Err<PErr<'a>>> {
     let j = ws(i);
     if let Some(r) = j.strip_prefix('=') {
         let (r, e) = ctx.expr(ws(r))?;
         return Ok(Some((r, expr_value(e))));
+    }
+    if dwell_p {
+        if let Some(p) = j.strip_prefix(['P', 'p']) {
+            if let Some((v, n)) = scan_unsigned(p.as_bytes()) {
+                return Ok(Some((&p[n..], Value::Num(v))));
+            }
+        }
     }
     let jb = j.as_bytes();
     let (neg, k) = match jb.first() {
@@ -533,7 +640,7 @@ fn goto_target(i: &str) -> PResult<'_, GotoTarget> {
 // # commands
 // ---------------------------------------------------------------------------------------
 
-fn command<'a>(i: &'a str) -> PResult<'a, Command> {
+fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
     let after = &i[1..];
     let mut buf = [0u8; 16];
     let Some((rest, len)) = keyword_after(after, &mut buf) else {
@@ -600,12 +707,57 @@ fn command<'a>(i: &'a str) -> PResult<'a, Command> {
         }
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
-        _ => fail(
-            i,
-            UNKNOWN_COMMAND,
-            format!("unknown NC command #{}", &after[..after.len() - rest.len()]),
-        ),
+        b"MSG" => msg(r),
+        b"TIME" => {
+            let (r, v) = ctx.expr(r)?;
+            Ok((r, Command::Time(expr_value(v))))
+        }
+        kw => dialect_command(i, kw, &after[..after.len() - rest.len()]),
     }
+}
+
+/// A `#` command of ISG's list that the parser has no rule for: accepted verbatim when
+/// ncchannel treats it as a no-op, refused by name when it does not support it, 20209 when
+/// ISG's list does not have it either.
+fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command> {
+    match command_support(kw) {
+        Some(Support::Inert) => {
+            // The whole command to the comment: options in brackets may hold anything.
+            let text = i[1..].split([';', '(']).next().unwrap_or("").trim_end();
+            Ok((
+                &i[1 + text.len()..],
+                Command::Inert {
+                    text: text.to_string(),
+                },
+            ))
+        }
+        Some(_) => fail(
+            i,
+            UNSUPPORTED,
+            format!("#{word} is an ISG command ncchannel does not support"),
+        ),
+        None => fail(i, UNKNOWN_COMMAND, format!("unknown NC command #{word}")),
+    }
+}
+
+/// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]` (TF5200 "#MSG").
+fn msg(i: &str) -> PResult<'_, Command> {
+    let (r, save) = if let Some(r) = keyword(i, "SAVE") {
+        (ws(r), true)
+    } else if let Some(r) = keyword(i, "INFO") {
+        (ws(r), false)
+    } else {
+        (i, false)
+    };
+    if !r.starts_with('[') {
+        return fail(r, SYNTAX, "#MSG takes [\"text\"]");
+    }
+    let (rest, text) = verbatim_options(r, r)?;
+    let text = match text.strip_prefix('"').and_then(|t| t.strip_suffix('"')) {
+        Some(t) if !t.contains('"') => t.to_string(),
+        _ => text,
+    };
+    Ok((rest, Command::Msg { save, text }))
 }
 
 /// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
@@ -630,7 +782,7 @@ fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
     fail(i, SYNTAX, "`]` missing")
 }
 
-/// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (seed 002;
+/// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (TF5200 File Caching;
 /// the seed writes no blank before the bracket). Bad form 21560, a second target 21561.
 fn cache(i: &str) -> PResult<'_, Command> {
     let (r, load) = if let Some(r) = keyword(i, "LOAD") {

@@ -15,8 +15,7 @@
 
 use crate::queue::{CompSide, Move, MoveKind, Plane, Position};
 
-/// Tool radius compensation impossible (ours, in the kernel's 9xxxx range of this emulator).
-pub const TRC_IMPOSSIBLE: u32 = 90140;
+pub use crate::lang::codes::TRC_IMPOSSIBLE;
 /// Below this two points are one, mm.
 const EPS_MM: f64 = 1e-9;
 

@@ -101,6 +101,15 @@ pub enum EventKind {
         target: String,
         found: bool,
     },
+    /// `#MSG` (`save`: `#MSG SAVE`): an operator message from the NC program.
+    Message {
+        text: String,
+        save: bool,
+    },
+    /// An H function decoded (0..=65535), for the PLC side.
+    HFunction {
+        h: u32,
+    },
 }
 
 impl Event {

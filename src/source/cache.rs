@@ -33,12 +33,13 @@ pub enum CacheError {
 impl CacheError {
     /// ISG error number (REFERENCE §2, §5); 90160 is ours (no ISG number known).
     pub fn code(&self) -> u32 {
+        use crate::lang::codes;
         match self {
-            CacheError::NotEnabled => 90160,
-            CacheError::Full { .. } => 21562,
-            CacheError::NotFound(_) => 21563,
-            CacheError::TooLarge { .. } => 21564,
-            CacheError::Unreadable { .. } => 21563,
+            CacheError::NotEnabled => codes::CACHE_NOT_ENABLED,
+            CacheError::Full { .. } => codes::CACHE_FULL,
+            CacheError::NotFound(_) => codes::CACHE_FILE_NOT_FOUND,
+            CacheError::TooLarge { .. } => codes::CACHE_FILE_TOO_LARGE,
+            CacheError::Unreadable { .. } => codes::CACHE_FILE_NOT_FOUND,
         }
     }
 }

@@ -86,13 +86,14 @@ pub enum StoreError {
 impl StoreError {
     /// The ISG error number (REFERENCE §5).
     pub fn code(&self) -> u32 {
+        use crate::lang::codes;
         match self {
-            StoreError::MainNotFound(_) => 20368,
-            StoreError::SubroutineNotFound(_) => 20369,
+            StoreError::MainNotFound(_) => codes::MAIN_NOT_FOUND,
+            StoreError::SubroutineNotFound(_) => codes::SUBROUTINE_NOT_FOUND,
             // No ISG number known for these: our own range (README, "Error numbers").
-            StoreError::TooLarge { .. } => 90110,
-            StoreError::Unreadable { .. } => 90111,
-            StoreError::BadName(_) => 90112,
+            StoreError::TooLarge { .. } => codes::PROGRAM_TOO_LARGE,
+            StoreError::Unreadable { .. } => codes::PROGRAM_UNREADABLE,
+            StoreError::BadName(_) => codes::PROGRAM_BAD_NAME,
         }
     }
 }

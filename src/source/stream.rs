@@ -17,9 +17,9 @@ pub const MAX_PROGRAM_STREAM_SIZE: usize = 4094;
 pub const MAX_PROGRAM_STREAM_INPUT_SIZE: usize = 992;
 
 /// ISG error number for a stream line without a correct CR LF end marker.
-pub const ERR_NO_LINE_END: u32 = 21476;
+pub use crate::lang::codes::NO_LINE_END as ERR_NO_LINE_END;
 /// ISG warning number for a write the channel cannot accept now ("Error writing the object").
-pub const WARN_WRITE_REJECTED: u32 = 11012;
+pub use crate::lang::codes::WRITE_REJECTED as WARN_WRITE_REJECTED;
 
 /// Why a write was refused. In every case the buffer is left exactly as it was.
 ///

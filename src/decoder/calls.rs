@@ -1,0 +1,262 @@
+//! Subroutine and cycle calls, their return, and the `#` commands (`#FLUSH`, `#CACHE`,
+//! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
+
+use super::*;
+
+impl Decoder {
+    pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
+        let init = match &d.init {
+            Some(e) => self.eval(e)?,
+            None => 0.0,
+        };
+        let total: u64 = d.dims.iter().map(|&n| n as u64).product::<u64>().max(1);
+        if d.dims.len() > 3 || total > 100_000 {
+            return Err(DecodeError::new(
+                codes::BAD_VALUE,
+                format!("array V.{}.{} too large", scope_letter(d.scope), d.name),
+            ));
+        }
+        let dims = d.dims.len() as u8;
+        for flat in 0..total {
+            let mut indices = [0i64; 3];
+            let mut rest = flat;
+            for k in (0..d.dims.len()).rev() {
+                let n = d.dims[k] as u64;
+                indices[k] = (rest % n) as i64;
+                rest /= n;
+            }
+            self.set_var(
+                VarSlot::V {
+                    scope: d.scope,
+                    name: d.name.as_str().into(),
+                    indices,
+                    dims,
+                },
+                init,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// M17/M29: back to the caller, past the call line.
+    pub(super) fn return_from_subroutine(&mut self) {
+        if let Some(f) = self.frames.pop() {
+            if f.is_stream() {
+                self.discard_stream_rest();
+                self.stream_active = false;
+            }
+            self.vars.pop_level();
+        }
+    }
+
+    pub(super) fn exec_command(
+        &mut self,
+        c: &Command,
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let info = self.info(block, text, meta, io);
+        match c {
+            Command::Flush(kind) => {
+                if self.modal.cross_block_active() {
+                    return Err(DecodeError::new(codes::FLUSH_CROSS_BLOCK, "#FLUSH while a cross-block function is active (TRC, contouring, spline, HSC)"));
+                }
+                self.emit(info, Action::Flush(*kind), false, io);
+                if *kind == FlushKind::Wait && self.search.is_none() {
+                    self.wait_idle = true;
+                }
+            }
+            Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
+                self.exec_cache(c, io)?;
+                self.emit(info, Action::None, false, io);
+            }
+            Command::CommentBegin => self.top().comment_block = true,
+            // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
+            Command::CommentEnd => {}
+            Command::Spline(s) => {
+                match s {
+                    SplineCommand::On => self.modal.spline = true,
+                    SplineCommand::Off => self.modal.spline = false,
+                    t => self.modal.spline_type = *t,
+                }
+                self.emit(info, Action::None, false, io);
+            }
+            Command::Hsc { on, .. } => {
+                self.modal.hsc = *on;
+                self.emit(info, Action::None, false, io);
+            }
+            Command::ContourMode { options } => {
+                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                    self.modal.contour_dev_mm = dev;
+                }
+                self.emit(info, Action::None, false, io)
+            }
+            Command::Var => self.top().var_block = true,
+            Command::EndVar => {}
+            Command::Msg { save, text } => {
+                self.notes.push(Note::Message {
+                    text: text.clone(),
+                    save: *save,
+                });
+                self.emit(info, Action::None, false, io);
+            }
+            Command::Time(v) => {
+                let seconds = match v {
+                    Value::Num(n) => *n,
+                    Value::Expr(e) => self.eval(e)?,
+                };
+                self.emit(
+                    info,
+                    Action::Dwell {
+                        seconds: seconds.max(0.0),
+                    },
+                    false,
+                    io,
+                );
+            }
+            // Accepted without effect (lang::dialect): a block like any other.
+            Command::Inert { .. } => self.emit(info, Action::None, false, io),
+        }
+        Ok(())
+    }
+
+    /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).
+    fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
+        match c {
+            Command::CacheLoad { file } => {
+                let loaded = io.cache.load(file, io.store)?;
+                self.notes.push(Note::Cache {
+                    op: loaded.op(),
+                    file: file.clone(),
+                });
+            }
+            Command::CacheClear { file } => {
+                io.cache.clear(file)?;
+                self.notes.push(Note::Cache {
+                    op: "clear",
+                    file: file.clone(),
+                });
+            }
+            Command::CacheClearAll => {
+                io.cache.clear_all()?;
+                self.notes.push(Note::Cache {
+                    op: "clear_all",
+                    file: String::new(),
+                });
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    pub(super) fn exec_call(
+        &mut self,
+        c: &Call,
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        if self.frames.len() > self.settings.max_depth {
+            return Err(DecodeError::new(
+                codes::NESTING_TOO_DEEP,
+                format!("subroutine nesting deeper than {}", self.settings.max_depth),
+            ));
+        }
+        let info = self.info(block, text, meta, io);
+        match c {
+            Call::Global { file } => {
+                let frame = self.open_subroutine(file, FrameKind::Global, io)?;
+                self.emit(info, Action::None, false, io);
+                self.vars.push_level(Vec::new());
+                self.frames.push(frame);
+            }
+            Call::Cycle { name, params } => {
+                let mut values = Vec::with_capacity(params.len());
+                for (n, e) in params {
+                    values.push((*n, self.eval(e)?));
+                }
+                let frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
+                self.emit(info, Action::None, false, io);
+                self.vars.push_level(values);
+                self.frames.push(frame);
+            }
+            Call::Local { name } => {
+                let index = self.label_index()?;
+                let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
+                    return Err(DecodeError::new(
+                        codes::LOCAL_SUB_NOT_FOUND,
+                        format!("local subroutine {name} not found"),
+                    ));
+                };
+                let top = self.top();
+                let Source::File(p) = &top.source else {
+                    return Err(DecodeError::new(
+                        codes::STREAM_LOCAL_CALL,
+                        "local subroutine call (LL) in streaming program",
+                    ));
+                };
+                let mut frame =
+                    Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
+                frame.label_index = Some(index);
+                frame.seek(at);
+                self.emit(info, Action::None, false, io);
+                self.vars.push_level(Vec::new());
+                self.frames.push(frame);
+            }
+        }
+        Ok(())
+    }
+
+    /// A global subroutine or cycle: the cache first, then the file system, then the stream.
+    pub(super) fn open_subroutine(
+        &mut self,
+        name: &str,
+        kind: FrameKind,
+        io: &mut DecoderIo<'_>,
+    ) -> Res<Frame> {
+        if let Some(p) = io.cache.get(name) {
+            if io.want_text {
+                // Only with events on: the hot call path stays free of the allocation.
+                self.notes.push(Note::Cache {
+                    op: "hit",
+                    file: name.to_string(),
+                });
+            }
+            let prog = p.name.clone();
+            return Ok(Frame::new(kind, Source::File(p), prog));
+        }
+        match io.store.open(name, ProgramKind::Subroutine)? {
+            Opened::File(p) => {
+                let prog: Arc<str> = p.name.clone();
+                Ok(Frame::new(kind, Source::File(p), prog))
+            }
+            Opened::Stream { name } => {
+                if self.stream_active {
+                    return Err(DecodeError::new(
+                        codes::STREAM_ALREADY_ACTIVE,
+                        "the streaming program is already running",
+                    ));
+                }
+                self.begin_stream();
+                self.notes.push(Note::ProgramStart {
+                    prog: name.clone(),
+                    stream: true,
+                });
+                Ok(Frame::new(kind, Source::Stream, name))
+            }
+        }
+    }
+}
+
+pub(super) fn scope_letter(s: crate::lang::block::VScope) -> char {
+    use crate::lang::block::VScope;
+    match s {
+        VScope::Program => 'P',
+        VScope::Local => 'L',
+        VScope::SelfRetaining => 'S',
+        VScope::External => 'E',
+    }
+}

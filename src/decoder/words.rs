@@ -1,0 +1,434 @@
+//! An ordinary block's words, executed in steps the way grbl's `gc_execute_line` does:
+//! 1. collect the words (assignments run in written order, expressions are evaluated),
+//! 2. modal changes (G groups, F, S, T, D, M's modal part),
+//! 3. the target position (units, zero offset, G92, absolute/incremental),
+//! 4. the move or action (dwell, G92, linear, arc),
+//! 5. the end of block (H functions, program and subroutine ends).
+//!
+//! The parser has already refused what a block may not hold (a letter twice, a dwell with
+//! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
+
+use super::modal::FeedMode;
+use super::*;
+
+/// M or H functions one block may hold.
+const MAX_FUNCTIONS: usize = 8;
+/// G functions one block may hold (a CAM header writes six or seven).
+const MAX_GS: usize = 16;
+
+/// Step 1's result: the block's words by meaning, values evaluated, not yet applied.
+#[derive(Debug, Default)]
+struct Words {
+    /// G numbers in written order, with their columns.
+    gs: [(u32, u32); MAX_GS],
+    n_gs: usize,
+    /// Axis values as programmed (program units), by `AXIS_LETTERS` index.
+    /// Plain values and a bit mask rather than `Option`s: this struct is built for every
+    /// block, and reading `Option<f64>`s back showed as store-forwarding stalls in a profile.
+    axes: [f64; MAX_AXES],
+    /// Bit i: axis i is programmed.
+    axes_set: u8,
+    /// Column of an X word on a channel without X: an error unless X is a dwell time.
+    unconfigured_x_col: Option<u32>,
+    /// I, J, K as programmed (program units).
+    ijk: [Option<f64>; 3],
+    /// R as programmed (program units).
+    radius: Option<f64>,
+    /// F as programmed, with its column.
+    feed: Option<(f64, u32)>,
+    /// S, rpm.
+    spindle_rpm: Option<f64>,
+    tool: Option<u32>,
+    tool_offset: Option<u32>,
+    /// `G04 <t>` / `G04 P<t>`: the dwell time in seconds.
+    dwell_s: Option<f64>,
+    ms: [u32; MAX_FUNCTIONS],
+    n_ms: usize,
+    hs: [u32; MAX_FUNCTIONS],
+    n_hs: usize,
+}
+
+impl Words {
+    fn push_g(&mut self, g: u32, col: u32) -> Res {
+        if self.n_gs == MAX_GS {
+            return Err(DecodeError::new(
+                codes::SYNTAX,
+                "too many G functions in one block",
+            ));
+        }
+        self.gs[self.n_gs] = (g, col);
+        self.n_gs += 1;
+        Ok(())
+    }
+    fn gs(&self) -> &[(u32, u32)] {
+        &self.gs[..self.n_gs]
+    }
+    fn ms(&self) -> &[u32] {
+        &self.ms[..self.n_ms]
+    }
+    fn hs(&self) -> &[u32] {
+        &self.hs[..self.n_hs]
+    }
+}
+
+impl Decoder {
+    pub(super) fn exec_items(
+        &mut self,
+        items: &[Item],
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let mut w = Words::default();
+        for it in items {
+            self.collect(it, &mut w)?;
+        }
+        let gs = self.modal_changes(&mut w)?;
+        let info = self.info(block, text, meta, io);
+        let mut queued = false;
+        if gs.dwell {
+            let seconds = w.dwell_s.unwrap_or(0.0).max(0.0);
+            self.emit(info.clone(), Action::Dwell { seconds }, false, io);
+            queued = true;
+        } else if gs.set_reference {
+            self.set_reference(&w);
+        } else if let Some(end) = self.target(&w, gs) {
+            let mut mv = self.motion(&w, end)?;
+            mv.path = self.modal.path_mode(gs.contour_this_block);
+            self.modal.pos = end;
+            self.emit(info.clone(), Action::Move(mv), false, io);
+            queued = true;
+        }
+        self.end_of_block(&w, info, queued, io)
+    }
+
+    /// Step 1: one item. Assignments take effect at once, in written order, so a later word
+    /// of the block may read them.
+    fn collect(&mut self, it: &Item, w: &mut Words) -> Res {
+        match it {
+            Item::Assign { target, value, col } => {
+                let key = self.resolve(target).map_err(|e| e.at(*col))?;
+                let v = self.eval(value).map_err(|e| e.at(*col))?;
+                self.set_var(key, v)
+            }
+            Item::GValue { g, value, col } => {
+                // G132..G134 weight ramps (no effect here); G04's value is its time.
+                let v = match value {
+                    Value::Num(n) => *n,
+                    Value::Expr(e) => self.eval(e).map_err(|e| e.at(*col))?,
+                };
+                if *g == 4 {
+                    w.dwell_s = Some(v);
+                }
+                w.push_g(*g, *col).map_err(|e| e.at(*col))
+            }
+            Item::Word(word) => {
+                let v = match &word.value {
+                    Value::Num(n) => *n,
+                    Value::Expr(e) => self.eval(e).map_err(|e| e.at(word.col))?,
+                };
+                self.collect_word(word.letter, v, word.col, w)
+                    .map_err(|e| e.at(word.col))
+            }
+        }
+    }
+
+    fn collect_word(&mut self, letter: u8, v: f64, col: u32, w: &mut Words) -> Res {
+        match letter {
+            // The parser takes G, M and H as literal whole numbers only.
+            b'G' => w.push_g(whole(v).unwrap_or(u32::MAX), col)?,
+            b'M' => push_function(&mut w.ms, &mut w.n_ms, v, 'M')?,
+            b'H' => push_function(&mut w.hs, &mut w.n_hs, v, 'H')?,
+            b'F' => {
+                if !(v >= 0.0 && v.is_finite()) {
+                    return Err(DecodeError::new(
+                        codes::BAD_VALUE,
+                        format!("feed F{v} out of range"),
+                    ));
+                }
+                w.feed = Some((v, col));
+            }
+            b'S' => w.spindle_rpm = Some(v),
+            b'T' => w.tool = Some(whole(v).unwrap_or(0)),
+            b'D' => w.tool_offset = Some(whole(v).unwrap_or(0)),
+            b'I' => w.ijk[0] = Some(v),
+            b'J' => w.ijk[1] = Some(v),
+            b'K' => w.ijk[2] = Some(v),
+            b'R' => w.radius = Some(v),
+            letter => {
+                if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == letter) {
+                    if !v.is_finite() {
+                        return Err(DecodeError::new(codes::BAD_VALUE, "axis value not finite"));
+                    }
+                    if !self.settings.axes[i] {
+                        if letter != b'X' {
+                            return Err(unconfigured(letter));
+                        }
+                        w.unconfigured_x_col = Some(col);
+                    }
+                    w.axes[i] = v;
+                    w.axes_set |= 1 << i;
+                }
+                // E: accepted, no effect in the emulator.
+            }
+        }
+        Ok(())
+    }
+
+    /// Step 2: G groups, then F (in the feed mode just set), S, T, D and the M functions'
+    /// modal part (spindle, coolant).
+    fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
+        let mut gs = BlockGs::default();
+        for &(g, col) in w.gs() {
+            if !apply_g(&mut self.modal, g, &mut gs) {
+                return Err(
+                    DecodeError::new(codes::UNKNOWN_G, format!("unknown G function G{g}")).at(col),
+                );
+            }
+        }
+        if gs.dwell {
+            // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
+            if w.axes_set & 1 != 0 {
+                w.axes_set &= !1;
+                w.dwell_s = Some(w.axes[0]);
+            } else if let Some((f, _)) = w.feed.take() {
+                w.dwell_s = Some(f);
+            }
+        }
+        if let Some((f, _)) = w.feed {
+            let mm = f * self.modal.units.mm_per_unit();
+            match self.modal.feed_mode {
+                FeedMode::PerMinute => self.modal.feed_mm_per_min = mm,
+                FeedMode::PerRevolution => self.modal.feed_mm_per_rev = mm,
+            }
+        }
+        if let Some(s) = w.spindle_rpm {
+            self.modal.spindle_rpm = s;
+        }
+        if let Some(t) = w.tool {
+            self.modal.tool = t;
+        }
+        if let Some(d) = w.tool_offset {
+            self.modal.tool_offset = d;
+        }
+        for &m in w.ms() {
+            apply_m(&mut self.modal, m);
+        }
+        if let Some(col) = w.unconfigured_x_col.filter(|_| w.axes_set & 1 != 0) {
+            return Err(unconfigured(b'X').at(col));
+        }
+        Ok(gs)
+    }
+
+    /// The offset from program to machine coordinates of axis `i` (zero offset and G92;
+    /// none under G53 in this block).
+    fn program_offset(&self, gs: BlockGs) -> [f64; MAX_AXES] {
+        if gs.machine_coords {
+            return [0.0; MAX_AXES];
+        }
+        let mut off = self.modal.g92_offset;
+        if self.modal.zero_offset > 0 {
+            let zero = self.settings.zero_offsets[self.modal.zero_offset - 1];
+            for (o, z) in off.iter_mut().zip(zero) {
+                *o += z;
+            }
+        }
+        off
+    }
+
+    /// Step 3: the block's end point in machine coordinates, if it programs an axis.
+    fn target(&self, w: &Words, gs: BlockGs) -> Option<Position> {
+        if w.axes_set == 0 {
+            return None;
+        }
+        let start = self.modal.pos;
+        let offset = self.program_offset(gs);
+        let mut end = start;
+        for (i, &v) in w.axes.iter().enumerate() {
+            if w.axes_set & (1 << i) != 0 {
+                let v = v * self.length_scale(i);
+                end[i] = if self.modal.absolute {
+                    v + offset[i]
+                } else {
+                    start[i] + v
+                };
+            }
+        }
+        Some(end)
+    }
+
+    /// mm per programmed unit on axis `i`: inch scales the linear axes, not A, B, C.
+    fn length_scale(&self, i: usize) -> f64 {
+        match AXIS_LETTERS[i] {
+            b'A' | b'B' | b'C' => 1.0,
+            _ => self.modal.units.mm_per_unit(),
+        }
+    }
+
+    /// G92: the programmed axis values become the current position in program coordinates.
+    fn set_reference(&mut self, w: &Words) {
+        let zero = self.program_offset(BlockGs::default());
+        for (i, &v) in w.axes.iter().enumerate() {
+            if w.axes_set & (1 << i) != 0 {
+                let here = self.modal.pos[i] - (zero[i] - self.modal.g92_offset[i]);
+                self.modal.g92_offset[i] = here - v * self.length_scale(i);
+            }
+        }
+    }
+
+    /// The path feed for G1/G2/G3, mm/min: F under G94, F × S under G95.
+    fn path_feed(&self) -> Res<f64> {
+        let feed = match self.modal.feed_mode {
+            FeedMode::PerMinute => self.modal.feed_mm_per_min,
+            FeedMode::PerRevolution => {
+                if self.modal.spindle_rpm <= 0.0 {
+                    return Err(DecodeError::new(
+                        codes::NO_FEED,
+                        "G95 feed per revolution needs a spindle speed (S)",
+                    ));
+                }
+                self.modal.feed_mm_per_rev * self.modal.spindle_rpm
+            }
+        };
+        if feed <= 0.0 {
+            return Err(DecodeError::new(
+                codes::NO_FEED,
+                "no feed programmed (F) for G1/G2/G3",
+            ));
+        }
+        Ok(feed)
+    }
+
+    /// Step 4: the move from the last programmed position to `end`.
+    fn motion(&self, w: &Words, end: Position) -> Res<Move> {
+        let start = self.modal.pos;
+        let m = self.modal.motion;
+        if m == MotionMode::Rapid {
+            return Ok(Move {
+                kind: MoveKind::Rapid,
+                start,
+                end,
+                feed_mm_per_min: 0.0,
+                path: Default::default(),
+            });
+        }
+        let feed = self.path_feed()?;
+        if m == MotionMode::Linear {
+            return Ok(Move {
+                kind: MoveKind::Line,
+                start,
+                end,
+                feed_mm_per_min: feed,
+                path: Default::default(),
+            });
+        }
+        let unit = self.modal.units.mm_per_unit();
+        let scaled = |v: Option<f64>| v.map(|v| v * unit);
+        arc::arc_move(
+            &arc::ArcSpec {
+                plane: self.modal.plane,
+                ijk: w.ijk.map(scaled),
+                radius: scaled(w.radius),
+                cw: m == MotionMode::ArcCw,
+            },
+            start,
+            end,
+            feed,
+            self.settings.arc_tolerance_mm,
+        )
+        .map_err(|e| {
+            DecodeError::new(
+                codes::ARC_INCONSISTENT,
+                format!("circle not consistent: {e:?}"),
+            )
+        })
+    }
+
+    /// Step 5: H functions are reported; M17/M29 return, M2/M30 end the program; a block
+    /// that queued nothing yet is queued as a block without motion.
+    fn end_of_block(
+        &mut self,
+        w: &Words,
+        info: BlockInfo,
+        queued: bool,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        for &h in w.hs() {
+            self.notes.push(Note::HFunction { h });
+        }
+        let end_m = w
+            .ms()
+            .iter()
+            .copied()
+            .find(|m| matches!(m, 2 | 30 | 17 | 29));
+        if let Some(m @ (17 | 29)) = end_m {
+            if self.top().kind == FrameKind::Main {
+                return Err(DecodeError::new(
+                    codes::UNEXPECTED_SUB_END,
+                    format!("unexpected M{m} in main program"),
+                ));
+            }
+            if !queued {
+                self.emit(info, Action::None, false, io);
+            }
+            self.check_open_flow()?;
+            self.return_from_subroutine();
+            return Ok(());
+        }
+        let Some(m) = end_m else {
+            if !queued {
+                self.emit(info, Action::None, false, io);
+            }
+            return Ok(());
+        };
+        self.program_end_checks(m)?;
+        if !queued {
+            self.emit(info.clone(), Action::None, false, io);
+        }
+        self.emit(info, Action::End { m }, true, io);
+        self.end_program();
+        Ok(())
+    }
+
+    /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in
+    /// the main program every control block must be closed.
+    fn program_end_checks(&mut self, m: u32) -> Res {
+        if let Some(s) = self.search {
+            return Err(DecodeError::new(
+                codes::SEARCH_NOT_FOUND,
+                format!("block search target {} not found", s.target),
+            ));
+        }
+        if self.top().kind != FrameKind::Main {
+            self.notes.push(Note::Warning {
+                code: codes::UNEXPECTED_PROGRAM_END,
+                msg: format!("M{m} in a subroutine: the program ends"),
+            });
+            Ok(())
+        } else {
+            self.check_open_flow()
+        }
+    }
+}
+
+fn unconfigured(letter: u8) -> DecodeError {
+    DecodeError::new(
+        codes::SYNTAX,
+        format!("axis {} is not configured in this channel", letter as char),
+    )
+}
+
+/// Add an M or H number to the block's list (at most [`MAX_FUNCTIONS`]).
+fn push_function(list: &mut [u32; MAX_FUNCTIONS], n: &mut usize, v: f64, letter: char) -> Res {
+    if *n == list.len() {
+        return Err(DecodeError::new(
+            codes::SYNTAX,
+            format!("too many {letter} functions in one block"),
+        ));
+    }
+    // The parser admits only whole numbers 0..=65535 for M and H.
+    list[*n] = whole(v).unwrap_or(0);
+    *n += 1;
+    Ok(())
+}
