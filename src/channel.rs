@@ -164,6 +164,8 @@ pub struct ChannelStats {
 pub struct HmiCommands {
     /// `mc_command_single_block_w`: one block per start.
     pub single_block: bool,
+    /// `mc_command_M01_stop_enable_w`: M01 stops like M00.
+    pub optional_stop: bool,
     /// `mc_command_block_ignore_w`: skip levels 1–10 as the kernel's mask (level n = bit n−1).
     pub skip_levels: u32,
     /// `mc_command_execution_mode_w`: bit 0 = block search at the next start.
@@ -651,6 +653,12 @@ impl Channel {
     pub fn ipo_blocks(&self) -> usize {
         self.motion.released_blocks() + self.motion.held_blocks() + self.single_gate.len()
     }
+    /// `mc_command_M01_stop_enable_w`: M01 holds the channel while on.
+    pub fn set_optional_stop(&mut self, on: bool) {
+        self.hmi.optional_stop = on;
+        self.motion.set_optional_stop(on);
+    }
+
     /// `mc_command_single_block_w`: stop after each block until the next start.
     pub fn set_single_block(&mut self, on: bool) {
         self.hmi.single_block = on;
@@ -925,6 +933,14 @@ impl Channel {
                     };
                     self.events
                         .push(tick, self.number, EventKind::Flush { kind: kind.into() });
+                }
+                MotionNote::ProgramStop { optional } => {
+                    let m = u32::from(optional);
+                    self.events
+                        .push(tick, self.number, EventKind::ProgramStop { m });
+                    if self.state == State::Active {
+                        self.set_state(tick, State::Hold);
+                    }
                 }
                 MotionNote::Error { code, msg } => {
                     self.raise_error(tick, code, msg, None, None);

@@ -43,6 +43,8 @@ pub enum Op {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HmiOp {
     SingleBlock(bool),
+    /// The M01 switch.
+    OptionalStop(bool),
     SkipLevels(u32),
     ExecutionMode(i32),
     Search(SearchCommand),
@@ -117,6 +119,8 @@ pub struct Status {
     pub errors_total: u64,
     /// Positions in the programming coordinate system (mm / degrees), as `positions`.
     pub pcs_positions: Vec<(char, f64)>,
+    /// The latest operator message of `#MSG` (empty after a reset).
+    pub message: Option<String>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -268,6 +272,10 @@ impl Machine {
                     c.set_single_block(on);
                     Ok(())
                 }
+                HmiOp::OptionalStop(on) => {
+                    c.set_optional_stop(on);
+                    Ok(())
+                }
                 HmiOp::SkipLevels(mask) => {
                     c.set_skip_levels(mask);
                     Ok(())
@@ -324,6 +332,7 @@ pub fn status_of(c: &Channel) -> Status {
         ipo_blocks: c.ipo_blocks(),
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
+        message: c.message().map(str::to_string),
     }
 }
 

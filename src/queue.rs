@@ -196,6 +196,11 @@ pub enum Action {
     },
     /// `#FLUSH …`: release the held blocks (planner rules, Stage 5).
     Flush(FlushKind),
+    /// M00 (programmed stop) or M01 (optional stop): the axes come to rest, then the channel
+    /// holds until the next start; M01 only while the operator's M01 switch is on.
+    Stop {
+        optional: bool,
+    },
     /// M30/M2 of the main program: the program ends when everything before it has run.
     End {
         m: u32,

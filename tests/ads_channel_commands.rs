@@ -192,3 +192,65 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
     drop(c);
     served.finish();
 }
+
+#[test]
+fn the_last_msg_text_is_read_at_mc_message_r() {
+    let rig = common::Rig::new();
+    rig.program(
+        "msg.nc",
+        "N10 #MSG [\"Insert the clamp\"]\nN20 G04 0.5\nN30 #MSG [\"Clamp closed\"]\nN40 M30\n",
+    );
+    let served = common::Served::start(&rig);
+    let c = client(&served);
+    let com = com_device(&c);
+    assert_eq!(
+        com.string(0x1F, 120),
+        "",
+        "no message before a program sent one"
+    );
+    com.start("msg.nc");
+    com.wait_state(3);
+    assert_eq!(com.string(0x1F, 120), "Clamp closed");
+    drop(c);
+    let (_, events) = served.finish();
+    let texts: Vec<&str> = common::of(&events, "message")
+        .iter()
+        .filter_map(|e| e["text"].as_str())
+        .collect();
+    assert_eq!(texts, ["Insert the clamp", "Clamp closed"]);
+}
+
+#[test]
+fn m00_always_holds_and_m01_only_with_the_m01_switch() {
+    let program = "N10 G01 X1 F6000\nN20 M00\nN30 X2\nN40 M01\nN50 X3\nN60 M30\n";
+    for switch in [false, true] {
+        let rig = common::Rig::new();
+        rig.program("stops.nc", program);
+        let served = common::Served::start(&rig);
+        let c = client(&served);
+        let com = com_device(&c);
+        com.write(0x07, &[u8::from(switch)]);
+        let mut b = [0u8; 1];
+        com.0.read_exact(CH, 0x08, &mut b).unwrap();
+        assert_eq!(b, [u8::from(switch)], "mc_command_M01_stop_enable_r");
+        com.start("stops.nc");
+        let stops: &[u32] = if switch { &[20, 40] } else { &[20] };
+        for &n in stops {
+            com.wait_state(5);
+            assert_eq!(com.u32(0x0E), n, "held at N{n}");
+            std::thread::sleep(Duration::from_millis(30));
+            assert_eq!(com.state(), 5, "still held at N{n}");
+            assert_eq!(com.u32(0x0E), n);
+            com.write(0x105, &4i32.to_le_bytes());
+        }
+        com.wait_state(3);
+        drop(c);
+        let (_, events) = served.finish();
+        assert_eq!(block_ns(&events), [10, 20, 30, 40, 50, 60]);
+        let stop_ms: Vec<u64> = common::of(&events, "program_stop")
+            .iter()
+            .filter_map(|e| e["m"].as_u64())
+            .collect();
+        assert_eq!(stop_ms, if switch { vec![0, 1] } else { vec![0] });
+    }
+}

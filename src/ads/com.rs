@@ -79,6 +79,7 @@ enum Field {
     TimeReset,
     SingleBlockCommand,
     SingleBlockActive,
+    OptionalStop,
     SkipCommand,
     SkipActive,
     OverrideCommand,
@@ -92,6 +93,7 @@ enum Field {
     CommandFeed,
     ActiveFeed,
     ErrorMessage,
+    Message,
     ChannelNumber,
     ChannelAxes,
     ExecutionModeCommand,
@@ -186,6 +188,8 @@ static TABLE: &[Def] = &[
     d(CH, 0x01, "mc_command_single_block_w", Bool, 1, W, "", SRC_TS, F::SingleBlockCommand),
     d(CH, 0x02, "mc_command_single_block_r", Bool, 1, R, "", SRC_DUMP, F::SingleBlockCommand),
     d(CH, 0x03, "mc_active_single_block_r", Bool, 1, R, "", SRC_TS, F::SingleBlockActive),
+    d(CH, 0x07, "mc_command_M01_stop_enable_w", Bool, 1, W, "", SRC_TS, F::OptionalStop),
+    d(CH, 0x08, "mc_command_M01_stop_enable_r", Bool, 1, R, "", SRC_DUMP, F::OptionalStop),
     d(CH, 0x04, "mc_command_block_ignore_w", Dword, 4, W, "skip levels 1–10 = bits 0–9", SRC_TS, F::SkipCommand),
     d(CH, 0x05, "mc_command_block_ignore_r", Dword, 4, R, "skip levels 1–10 = bits 0–9", SRC_TS, F::SkipCommand),
     d(CH, 0x06, "mc_active_block_ignore_r", Dword, 4, R, "skip levels 1–10 = bits 0–9", SRC_DUMP, F::SkipActive),
@@ -201,6 +205,7 @@ static TABLE: &[Def] = &[
     d(CH, 0x12, "mc_active_program_name_r", String, 84, R, "", SRC_DUMP, F::ActiveProgramName),
     d(CH, 0x13, "mc_command_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::CommandFeed),
     d(CH, 0x14, "mc_active_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::ActiveFeed),
+    d(CH, 0x1F, "mc_message_r", String, 120, R, "last #MSG text", SRC_DUMP, F::Message),
     d(CH, 0x26, "mc_error_message_r", String, 1330, R, "", SRC_DUMP, F::ErrorMessage),
     d(CH, 0x2B, "mc_actual_logical_axes_number_r", Dword, 4, R, "", SRC_DUMP, F::ChannelAxes),
     d(CH, 0x2C, "mc_channel_number_r", Word, 2, R, "", SRC_DUMP, F::ChannelNumber),
@@ -535,6 +540,7 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
     let bytes = match def.field {
         Field::SingleBlockCommand => vec![u8::from(h.single_block)],
         Field::SingleBlockActive => vec![u8::from(h.single_block)],
+        Field::OptionalStop => vec![u8::from(h.optional_stop)],
         Field::SkipCommand | Field::SkipActive => h.skip_levels.to_le_bytes().to_vec(),
         Field::OverrideCommand | Field::OverrideActive => {
             override_tenths(v.override_pct).to_le_bytes().to_vec()
@@ -562,6 +568,7 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
                 .unwrap_or_default();
             return Ok(text(&msg, def.size, length));
         }
+        Field::Message => return Ok(text(v.message.as_deref().unwrap_or(""), def.size, length)),
         Field::ChannelAxes => (v.positions.len() as u32).to_le_bytes().to_vec(),
         Field::ChannelNumber => ch.to_le_bytes().to_vec(),
         Field::ExecutionModeCommand => h.execution_mode.to_le_bytes().to_vec(),
@@ -697,6 +704,7 @@ pub fn write(
             }
         }
         Field::SingleBlockCommand => unit(backend.hmi(ch, HmiOp::SingleBlock(bool_arg(data)?))),
+        Field::OptionalStop => unit(backend.hmi(ch, HmiOp::OptionalStop(bool_arg(data)?))),
         Field::SkipCommand => {
             let mask = uint_arg(data)?;
             if mask & !0x3FF != 0 {

@@ -331,6 +331,7 @@ impl CncBackend for MemoryBackend {
         let mut c = self.ch(ch)?;
         match op {
             HmiOp::SingleBlock(on) => c.hmi.single_block = on,
+            HmiOp::OptionalStop(on) => c.hmi.optional_stop = on,
             HmiOp::SkipLevels(mask) => c.hmi.skip_levels = mask & 0x3FF,
             HmiOp::ExecutionMode(m) if m & !1 == 0 => c.hmi.execution_mode = m,
             HmiOp::ExecutionMode(_) => return Err(DeviceError::InvalidValue),
@@ -375,6 +376,7 @@ impl MemChannel {
             ipo_blocks: 0,
             errors_total: self.errors_total,
             pcs_positions: ['X', 'Y', 'Z'].into_iter().zip(self.positions_mm).collect(),
+            message: None,
         }
     }
 }

@@ -357,6 +357,18 @@ impl Decoder {
         for &h in w.hs() {
             self.notes.push(Note::HFunction { h });
         }
+        let stop = w.ms().iter().copied().find(|m| matches!(m, 0 | 1));
+        let queued = match stop {
+            Some(m) => {
+                if !queued {
+                    self.emit(info.clone(), Action::None, false, io);
+                }
+                let optional = m == 1;
+                self.emit(info.clone(), Action::Stop { optional }, true, io);
+                true
+            }
+            None => queued,
+        };
         let end_m = w
             .ms()
             .iter()

@@ -52,6 +52,10 @@ pub enum MotionNote {
     /// A block took effect (started executing): its `block` event.
     Started(BlockInfo),
     Flush(FlushKind),
+    /// M00, or M01 with the M01 switch on, was reached with the axes at rest: motion holds.
+    ProgramStop {
+        optional: bool,
+    },
     /// Planning found an error (tool radius compensation impossible): the channel stops.
     Error {
         code: u32,
@@ -72,6 +76,8 @@ enum Next {
     Stay,
     /// The program ended.
     End,
+    /// Done, and motion holds here (a programmed stop).
+    PopAndHold,
 }
 
 /// The executor of one channel.
@@ -101,6 +107,8 @@ pub struct Motion {
     /// Feed override, percent (0–200).
     override_pct: f64,
     hold: bool,
+    /// M01 stops (the operator's optional-stop switch).
+    optional_stop: bool,
     /// The program end was executed; nothing more runs until the next start.
     ended: bool,
     /// Tick length seen last, s (junction limits depend on it).
@@ -138,6 +146,7 @@ impl Motion {
             dwell_done_s: 0.0,
             override_pct: 100.0,
             hold: false,
+            optional_stop: false,
             ended: false,
             dt_s: 0.001,
             time_s: 0.0,
@@ -238,6 +247,11 @@ impl Motion {
     /// Feed hold: brake on the path to a stop; `false` resumes.
     pub fn set_hold(&mut self, hold: bool) {
         self.hold = hold;
+    }
+
+    /// The operator's M01 switch (`mc_command_M01_stop_enable_w`): M01 stops only while on.
+    pub fn set_optional_stop(&mut self, on: bool) {
+        self.optional_stop = on;
     }
 
     pub fn hold(&self) -> bool {
@@ -390,6 +404,11 @@ impl Motion {
                 if matches!(front.kind, EntryKind::Move(_)) && left <= 0.0 {
                     break;
                 }
+                // Held at rest (feed hold that has braked, a programmed stop): the next
+                // block does not start until the hold is released.
+                if self.hold && self.v_mm_per_s == 0.0 {
+                    break;
+                }
                 // A stop (dwell, flush stop, program end) takes effect when the axes stand,
                 // not only the interpolator.
                 if front.kind.is_barrier() && !self.filter.settled() {
@@ -442,6 +461,16 @@ impl Motion {
                     }
                 }
                 EntryKind::Plain => Next::Pop,
+                EntryKind::Stop { optional } => {
+                    if *optional && !self.optional_stop {
+                        Next::Pop
+                    } else {
+                        notes.push(MotionNote::ProgramStop {
+                            optional: *optional,
+                        });
+                        Next::PopAndHold
+                    }
+                }
                 EntryKind::Flush(k) => {
                     notes.push(MotionNote::Flush(*k));
                     Next::Pop
@@ -456,6 +485,11 @@ impl Motion {
             };
             match next {
                 Next::Pop => self.finish_front(),
+                Next::PopAndHold => {
+                    self.finish_front();
+                    self.hold = true;
+                    break;
+                }
                 Next::Stay => break,
                 Next::End => {
                     self.ended = true;

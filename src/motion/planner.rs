@@ -154,6 +154,10 @@ pub enum EntryKind {
     },
     /// Takes effect without motion (assignments, M/S/T functions, modal changes).
     Plain,
+    /// M00 / M01: the axes at rest, then the channel holds (if the stop applies).
+    Stop {
+        optional: bool,
+    },
     Flush(FlushKind),
     End {
         m: u32,
@@ -167,6 +171,7 @@ impl EntryKind {
         matches!(
             self,
             EntryKind::Dwell { .. }
+                | EntryKind::Stop { .. }
                 | EntryKind::End { .. }
                 | EntryKind::Flush(FlushKind::Stop | FlushKind::Wait)
         )
@@ -372,6 +377,7 @@ impl Planner {
                 },
             },
             Action::Flush(k) => EntryKind::Flush(k),
+            Action::Stop { optional } => EntryKind::Stop { optional },
             Action::End { m } => EntryKind::End { m, prog },
             Action::Move(mut mv) => {
                 if let Some(arc) = self.blend_corner(&mut mv) {
@@ -388,7 +394,7 @@ impl Planner {
         let is_move = matches!(kind, EntryKind::Move(_));
         let counted = counted && is_move;
         let release = match &kind {
-            EntryKind::Flush(_) | EntryKind::End { .. } => true,
+            EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
             // Nothing held before it: it takes no part in cross-block planning, so it runs
             // when interpolation reaches it, not when more motion arrives.

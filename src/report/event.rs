@@ -110,6 +110,11 @@ pub enum EventKind {
     HFunction {
         h: u32,
     },
+    /// M00 (`m` 0) or M01 (`m` 1, M01 switch on) reached: the channel holds until the next
+    /// start.
+    ProgramStop {
+        m: u32,
+    },
 }
 
 impl Event {
