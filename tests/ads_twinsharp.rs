@@ -257,12 +257,15 @@ fn new_cnc_sequence_of_twinsharp_succeeds_on_the_wire() {
         "µs"
     );
     assert!(text(&read_named(&com, &dict, "cnc_version_r", 24)).starts_with("ncchannel"));
-    for name in ["mc_command_block_ignore_w", "mc_command_execution_mode_w"] {
+    for name in [
+        "mc_command_block_ignore_w",
+        "mc_command_execution_mode_w",
+        "mc_command_M01_stop_enable_w",
+    ] {
         assert!(dict[name].writable, "{name}");
     }
     // Not modelled, so not listed (TwinSharp's getters for them would throw).
     for name in [
-        "mc_command_M01_stop_enable_r",
         "mc_cmd_bs_covered_distance_r",
         "mc_cmd_bs_distance_prog_start_r",
     ] {
