@@ -117,6 +117,9 @@ pub struct Runtime<C: Cycle> {
     period: Duration,
     clock: Clock,
     stop: Arc<AtomicBool>,
+    /// A flag set from outside (SIGINT/SIGTERM): stops every run while it is set, unlike
+    /// `stop`, which one run consumes.
+    external_stop: Option<Arc<AtomicBool>>,
     next_index: u64,
     stats: CycleStats,
 }
@@ -137,6 +140,7 @@ impl<C: Cycle> Runtime<C> {
             period,
             clock,
             stop: Arc::new(AtomicBool::new(false)),
+            external_stop: None,
             next_index: 0,
             stats: CycleStats::default(),
         };
@@ -146,6 +150,11 @@ impl<C: Cycle> Runtime<C> {
     /// A handle that stops the run from any thread.
     pub fn stop_handle(&self) -> StopHandle {
         StopHandle(Arc::clone(&self.stop))
+    }
+
+    /// Also stop, at a tick boundary, whenever `flag` is set (a signal handler's flag).
+    pub fn stop_on(&mut self, flag: Arc<AtomicBool>) {
+        self.external_stop = Some(flag);
     }
 
     pub fn period(&self) -> Duration {
@@ -201,7 +210,12 @@ impl<C: Cycle> Runtime<C> {
             if max_ticks.is_some_and(|m| k >= m) {
                 break RunEnd::MaxTicks;
             }
-            if self.stop.swap(false, Ordering::AcqRel) {
+            if self.stop.swap(false, Ordering::AcqRel)
+                || self
+                    .external_stop
+                    .as_ref()
+                    .is_some_and(|f| f.load(Ordering::Acquire))
+            {
                 break RunEnd::StopRequested;
             }
             let tick = Tick {

@@ -93,6 +93,10 @@ pub fn execute(args: ServeArgs) -> ExitCode {
         net_id.map(|n| n.to_string()).unwrap_or_default(),
         period.as_micros()
     );
+    match super::signal::StopSignal::install() {
+        Ok(sig) => rt.stop_on(sig.flag()),
+        Err(e) => eprintln!("ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"),
+    }
     let stop = rt.stop_handle();
     if let Some(s) = args.seconds {
         let d = Duration::from_secs_f64(s.max(0.0));
@@ -102,14 +106,24 @@ pub fn execute(args: ServeArgs) -> ExitCode {
         });
     }
     let summary = rt.run(None);
+    // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
     let (mut machine, stats) = rt.into_inner();
-    let _ = machine.finish_log();
+    let log = machine.finish_log();
+    let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
     eprintln!(
-        "stopped after {} ticks ({:.1} s); {}",
+        "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     );
+    match log {
+        Ok(lines) if args.events.is_some() => eprintln!("event log: {lines} lines"),
+        Ok(_) => {}
+        Err(e) => {
+            eprintln!("ncchannel serve: event log: {e}");
+            return ExitCode::from(exit::CHANNEL_ERROR);
+        }
+    }
     ExitCode::from(exit::OK)
 }
