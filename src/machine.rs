@@ -59,6 +59,10 @@ pub enum Reply {
     Status(Box<Status>),
     /// No channel with that number.
     NoChannel,
+    /// A stream write refused without touching the buffer: the channel is in ERROR, so
+    /// nothing will drain it before a reset (which deletes the buffer). ADS 0x707, not 0x708:
+    /// retrying cannot succeed (docs/exactly-once.md).
+    StreamNotReady,
 }
 
 /// A request with its own way back: answered in the tick that serves it.
@@ -186,6 +190,7 @@ impl Machine {
             return Reply::NoChannel;
         };
         match op {
+            Op::WriteStream(_) if c.state() == State::Error => Reply::StreamNotReady,
             Op::WriteStream(data) => Reply::Stream(c.write_stream(tick, &data)),
             Op::CommandMode(v) => Reply::Command(c.command_mode(tick, v)),
             Op::CommandState(v) => Reply::Command(c.command_state(tick, v)),

@@ -132,15 +132,23 @@ fn write_retrying(dev: &ads::Device, packet: &[u8], deadline: Duration) -> u32 {
 fn wait_state(dev: &ads::Device, want: i32, limit: Duration) {
     let start = Instant::now();
     while state(dev) != want {
-        assert!(start.elapsed() < limit, "state {} never became {want}", state(dev));
+        assert!(
+            start.elapsed() < limit,
+            "state {} never became {want}",
+            state(dev)
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
 
 fn start(dev: &ads::Device, program: &str) {
     dev.write_value(CH1, offset::COMMAND_MODE, &2i32).unwrap();
-    dev.write(CH1, offset::COMMAND_PROGRAM, format!("{program}\0").as_bytes())
-        .unwrap();
+    dev.write(
+        CH1,
+        offset::COMMAND_PROGRAM,
+        format!("{program}\0").as_bytes(),
+    )
+    .unwrap();
     dev.write_value(CH1, offset::COMMAND_STATE, &4i32).unwrap();
     // Let the runtime enter the tick that runs the program start.
     std::thread::sleep(Duration::from_millis(20));
@@ -202,6 +210,12 @@ fn five_thousand_lines_through_multi_second_ticks_exactly_once_in_order() {
     let mut expected = Vec::new();
     let mut busy_total = 0;
     for chunk in lines.chunks(1000) {
+        // Each chunk is its own streaming program: it sets its feed first.
+        let mut chunk = chunk.to_vec();
+        if !chunk[0].contains('F') {
+            chunk.insert(0, "G01 F30000".to_string());
+        }
+        let chunk = &chunk[..];
         // Slow tick first; meanwhile a whole packet of lines is written and retried.
         start(&dev, "slow.nc");
         let mut packet = Vec::new();
@@ -218,10 +232,7 @@ fn five_thousand_lines_through_multi_second_ticks_exactly_once_in_order() {
         wait_state(&dev, 3, Duration::from_secs(300));
         // Then the streaming program runs the packet and the rest of the chunk.
         start(&dev, "streaming.nc");
-        let rest: Vec<&String> = chunk[held.len()..]
-            .iter()
-            .filter(|l| *l != "M30")
-            .collect();
+        let rest: Vec<&String> = chunk[held.len()..].iter().filter(|l| *l != "M30").collect();
         let mut cur = Vec::new();
         for l in rest {
             let line = format!("{l}\r\n");
@@ -230,6 +241,10 @@ fn five_thousand_lines_through_multi_second_ticks_exactly_once_in_order() {
                 cur.clear();
             }
             cur.extend_from_slice(line.as_bytes());
+        }
+        if cur.len() + 5 > 992 {
+            write_retrying(&dev, &cur, Duration::from_secs(300));
+            cur.clear();
         }
         cur.extend_from_slice(b"M30\r\n");
         write_retrying(&dev, &cur, Duration::from_secs(300));

@@ -31,7 +31,14 @@ fn long_program(rig: &Rig) {
 /// starts), with the moment it said so.
 fn serve(rig: &Rig, events: &std::path::Path) -> (Child, Instant, std::thread::JoinHandle<String>) {
     let mut child = Command::new(bin())
-        .args(["serve", "--bind", "127.0.0.1:0", "--start", "long.nc", "--params"])
+        .args([
+            "serve",
+            "--bind",
+            "127.0.0.1:0",
+            "--start",
+            "long.nc",
+            "--params",
+        ])
         .arg(rig.startup())
         .arg("--events")
         .arg(events)
@@ -67,7 +74,10 @@ fn wait(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
         if let Some(s) = child.try_wait().unwrap() {
             return s;
         }
-        assert!(start.elapsed() < limit, "serve did not stop within {limit:?}");
+        assert!(
+            start.elapsed() < limit,
+            "serve did not stop within {limit:?}"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -81,7 +91,11 @@ fn check_stopped_log(log: &str, stderr: &str) {
         .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
         .collect();
     let blocks: Vec<&Value> = events.iter().filter(|e| e["ev"] == "block").collect();
-    assert!(blocks.len() > 10, "the program ran: {} blocks", blocks.len());
+    assert!(
+        blocks.len() > 10,
+        "the program ran: {} blocks",
+        blocks.len()
+    );
     let summary = stderr
         .lines()
         .find(|l| l.starts_with("stopped after"))
@@ -166,7 +180,11 @@ fn a_tailing_reader_sees_each_block_within_200_ms_of_its_tick() {
     kill(&child, "-INT");
     wait(&mut child, Duration::from_secs(30));
     let _ = stderr.join();
-    assert!(latencies_ms.len() > 20, "{} blocks seen", latencies_ms.len());
+    assert!(
+        latencies_ms.len() > 20,
+        "{} blocks seen",
+        latencies_ms.len()
+    );
     latencies_ms.sort_by(f64::total_cmp);
     let q = |p: f64| latencies_ms[((latencies_ms.len() - 1) as f64 * p) as usize];
     eprintln!(

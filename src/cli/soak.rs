@@ -89,11 +89,13 @@ pub fn execute(args: SoakArgs) -> ExitCode {
             return ExitCode::from(exit::USAGE);
         }
     }
-    ExitCode::from(if report.all_held && signal.as_ref().is_some_and(|s| s.raised()) {
-        exit::STOPPED
-    } else if report.all_held {
-        exit::OK
-    } else {
-        exit::CHANNEL_ERROR
-    })
+    ExitCode::from(
+        if report.all_held && signal.as_ref().is_some_and(|s| s.raised()) {
+            exit::STOPPED
+        } else if report.all_held {
+            exit::OK
+        } else {
+            exit::CHANNEL_ERROR
+        },
+    )
 }

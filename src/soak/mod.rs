@@ -213,7 +213,9 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         if warmup_kib.is_none() && f >= scenario.invariants.warmup {
             warmup_kib = resident_kib();
         }
-        if matches!(s.end, RunEnd::Stopped | RunEnd::StopRequested) || wall_limit.is_some_and(|w| wall >= w) {
+        if matches!(s.end, RunEnd::Stopped | RunEnd::StopRequested)
+            || wall_limit.is_some_and(|w| wall >= w)
+        {
             break;
         }
         if progress && last_progress.elapsed() >= Duration::from_millis(500) {
