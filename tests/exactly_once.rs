@@ -262,3 +262,23 @@ fn five_thousand_lines_through_multi_second_ticks_exactly_once_in_order() {
     assert_eq!(streamed.len(), expected.len());
     assert_eq!(streamed, expected, "every line exactly once, in order");
 }
+
+/// In ERROR nothing drains the stream until a reset deletes it: a write answers 0x707 (not
+/// 0x708, which a client retries for ever) and leaves the buffer as it was.
+#[test]
+fn stream_writes_in_error_are_refused_not_ready() {
+    let rig = Rig::new();
+    let s = setup(&rig, Duration::from_secs(2));
+    let dev = s.client.device(target());
+    dev.write_value(CH1, offset::COMMAND_MODE, &2i32).unwrap();
+    dev.write(CH1, offset::COMMAND_PROGRAM, b"missing.nc\0").unwrap();
+    let _ = dev.write_value(CH1, offset::COMMAND_STATE, &4i32);
+    assert_eq!(state(&dev), 6, "a missing program puts the channel in ERROR");
+    match dev.write(CH1, offset::STREAM, b"N1 X1\r\n") {
+        Err(ads::Error::Ads(_, _, code)) => assert_eq!(code, 0x707),
+        other => panic!("expected 0x707, got {other:?}"),
+    }
+    assert_eq!(stream_used(&dev), 0, "nothing entered the buffer");
+    let events = s.finish();
+    assert!(of(&events, "write").is_empty(), "no write was applied");
+}
