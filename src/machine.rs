@@ -185,7 +185,8 @@ impl Machine {
         }
     }
 
-    fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
+    /// Apply one request to its channel (the runtime serves requests through this).
+    pub fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
         let Some(c) = self.channel_mut(channel) else {
             return Reply::NoChannel;
         };

@@ -271,9 +271,14 @@ fn stream_writes_in_error_are_refused_not_ready() {
     let s = setup(&rig, Duration::from_secs(2));
     let dev = s.client.device(target());
     dev.write_value(CH1, offset::COMMAND_MODE, &2i32).unwrap();
-    dev.write(CH1, offset::COMMAND_PROGRAM, b"missing.nc\0").unwrap();
+    dev.write(CH1, offset::COMMAND_PROGRAM, b"missing.nc\0")
+        .unwrap();
     let _ = dev.write_value(CH1, offset::COMMAND_STATE, &4i32);
-    assert_eq!(state(&dev), 6, "a missing program puts the channel in ERROR");
+    assert_eq!(
+        state(&dev),
+        6,
+        "a missing program puts the channel in ERROR"
+    );
     match dev.write(CH1, offset::STREAM, b"N1 X1\r\n") {
         Err(ads::Error::Ads(_, _, code)) => assert_eq!(code, 0x707),
         other => panic!("expected 0x707, got {other:?}"),

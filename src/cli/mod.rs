@@ -11,6 +11,7 @@ pub mod check;
 pub mod receive;
 pub mod run;
 pub mod serve;
+pub mod serve_soak;
 pub mod signal;
 pub mod soak;
 pub mod stream;

@@ -11,6 +11,8 @@ use crate::ads::{AmsNetId, ServerConfig};
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, Runtime, Tick};
+use crate::soak::external::{load_external, Supervised};
+use crate::soak::scenario::Scenario;
 
 use super::exit;
 
@@ -34,22 +36,48 @@ pub struct ServeArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Stop after this many seconds (default: run until killed).
+    /// Stop after this many seconds (default: run until SIGINT/SIGTERM).
     #[arg(long)]
     pub seconds: Option<f64>,
+    /// Soak external clients: inject the scenario's [faults] and check the invariants on what
+    /// they write (the scenario's `params` replaces --params). Exit 1 on a violation.
+    #[arg(long)]
+    pub soak: Option<PathBuf>,
+    /// With --soak: write the report as JSON here.
+    #[arg(long, requires = "soak")]
+    pub report: Option<PathBuf>,
 }
 
-fn usage(msg: impl std::fmt::Display) -> ExitCode {
+fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
+    load_external(&super::run::locate(p))
+}
+
+pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
     eprintln!("ncchannel serve: {msg}");
     ExitCode::from(exit::USAGE)
 }
 
-pub fn execute(args: ServeArgs) -> ExitCode {
-    let (config, channels) = match super::run::load_channels(&args.params, args.events.is_some()) {
+pub fn execute(mut args: ServeArgs) -> ExitCode {
+    let scenario = match &args.soak {
+        None => None,
+        Some(p) => match load_scenario(p) {
+            Ok(s) => {
+                args.params = s.params_path();
+                Some(s)
+            }
+            Err(msg) => return usage(msg),
+        },
+    };
+    let (config, channels) = match super::run::load_channels(
+        &args.params,
+        args.events.is_some() || scenario.is_some(),
+    ) {
         Ok(c) => c,
         Err(msg) => return usage(msg),
     };
     let log = match &args.events {
+        // The soak's checks need the channels' events; without --events they go nowhere.
+        None if scenario.is_some() => EventLog::to_writer(Box::new(std::io::sink())),
         None => EventLog::disabled(),
         Some(t) => match EventLog::open(t) {
             Ok(l) => l,
@@ -70,6 +98,24 @@ pub fn execute(args: ServeArgs) -> ExitCode {
                 eprintln!("ncchannel serve: --start {p}: {e}");
             }
         }
+    }
+    if let Some(sc) = scenario {
+        let soft_limits = config
+            .runtime
+            .axes
+            .iter()
+            .filter_map(|a| {
+                let c = a.name.chars().next()?;
+                Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
+            })
+            .collect();
+        let programs = config
+            .channels
+            .iter()
+            .map(|c| c.streaming_prog_file.clone())
+            .collect();
+        let cycle = Supervised::new(machine, &sc, soft_limits, programs);
+        return super::serve_soak::run(cycle, &sc, &args, &config, period, nch);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
     let ads = &config.runtime.ads;

@@ -3,6 +3,7 @@
 //! `ncchannel soak` and the README section "Soak and bench".
 
 pub mod driver;
+pub mod external;
 pub mod feed;
 pub mod generator;
 pub mod invariants;
