@@ -231,3 +231,50 @@ fn slow_feeder_scenario_starves_the_channel() {
     let c = &report.channels[0];
     assert!(c.interrupts > 50, "{} interrupts", c.interrupts);
 }
+
+/// `receive --listen` stops in order on SIGTERM: the transfers so far are filed and counted,
+/// the summary printed, exit 0.
+#[test]
+fn receive_listen_stops_in_order_on_sigterm() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("prog");
+    let mut child = Command::new(bin())
+        .args([
+            "receive",
+            "--listen",
+            "127.0.0.1:0",
+            "--start",
+            "%",
+            "--end",
+            "M30",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    err.read_line(&mut line).unwrap();
+    let port: u16 = line.trim().rsplit(':').next().unwrap().parse().unwrap();
+    {
+        let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+        s.write_all(b"%A\nN1 X1\nM30\n").unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    kill(&child, "-TERM");
+    let status = wait(&mut child, Duration::from_secs(10));
+    let mut stdout = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+    assert_eq!(status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("1 program(s) filed"), "{stdout}");
+    assert!(stdout.contains("1 transfer(s)"), "{stdout}");
+    assert!(out.join("A.nc").exists());
+}
