@@ -52,6 +52,19 @@ fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
     load_external(&super::run::locate(p))
 }
 
+/// The ADS server's settings: the command line over runtime.toml's `[ads]`.
+pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConfig {
+    let ads = &config.runtime.ads;
+    ServerConfig {
+        bind: args.bind.unwrap_or(ads.bind.0),
+        allow_non_loopback: args.allow_non_loopback,
+        net_id: Some(args.net_id.unwrap_or(ads.net_id)),
+        max_frame_bytes: ads.max_frame_bytes as usize,
+        allow: ads.allowed_clients.clone(),
+        ..ServerConfig::default()
+    }
+}
+
 pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
     eprintln!("ncchannel serve: {msg}");
     ExitCode::from(exit::USAGE)
@@ -118,15 +131,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         return super::serve_soak::run(cycle, &sc, &args, &config, period, nch);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
-    let ads = &config.runtime.ads;
-    let server_config = ServerConfig {
-        bind: args.bind.unwrap_or(ads.bind.0),
-        allow_non_loopback: args.allow_non_loopback,
-        net_id: Some(args.net_id.unwrap_or(ads.net_id)),
-        max_frame_bytes: ads.max_frame_bytes as usize,
-        allow: ads.allowed_clients.clone(),
-        ..ServerConfig::default()
-    };
+    let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
     let server =
         match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {

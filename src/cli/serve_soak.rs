@@ -10,7 +10,6 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use crate::ads::channel_backend::ChannelBackend;
-use crate::ads::ServerConfig;
 use crate::runtime::{Clock, RunEnd, Runtime};
 use crate::soak::external::{resident, ExternalCounters, Supervised};
 use crate::soak::invariants::{Tally, Verdict};
@@ -72,15 +71,7 @@ pub fn run(
     nch: u16,
 ) -> ExitCode {
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let ads = &config.runtime.ads;
-    let server_config = ServerConfig {
-        bind: args.bind.unwrap_or(ads.bind.0),
-        allow_non_loopback: args.allow_non_loopback,
-        net_id: Some(args.net_id.unwrap_or(ads.net_id)),
-        max_frame_bytes: ads.max_frame_bytes as usize,
-        allow: ads.allowed_clients.clone(),
-        ..ServerConfig::default()
-    };
+    let server_config = super::serve::server_config(args, config);
     let server =
         match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
             Ok(s) => s,

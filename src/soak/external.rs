@@ -8,6 +8,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use super::driver::draw;
 use super::feed::Owed;
 use super::invariants::{check_blocks, resident_kib, Checksum, Tally, Verdict};
 use super::rng::SplitMix64;
@@ -75,10 +76,6 @@ struct Schedule {
     override_at: Option<u64>,
     reject_at: Option<u64>,
     reject_until: Option<u64>,
-}
-
-fn draw(rng: &mut SplitMix64, now: u64, r: Option<[u64; 2]>) -> Option<u64> {
-    r.map(|[a, b]| now.saturating_add(rng.range(a, b)))
 }
 
 /// Counters of one channel, as the report shows them.
