@@ -4,6 +4,8 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crossbeam_channel::Sender;
@@ -137,6 +139,10 @@ pub enum Reply {
     },
     /// No channel with that number.
     NoChannel,
+    /// A stream write refused without touching the buffer: the channel is in ERROR, so
+    /// nothing will drain it before a reset (which deletes the buffer). ADS 0x707, not 0x708:
+    /// retrying cannot succeed (docs/exactly-once.md).
+    StreamNotReady,
 }
 
 /// A request with its own way back: answered in the tick that serves it.
@@ -146,6 +152,39 @@ pub struct Request {
     pub channel: u32,
     pub op: Op,
     pub reply: Sender<Reply>,
+    /// Who decides this request's fate: the runtime (it applies it) or the waiting caller (it
+    /// gave up and answers "not applied"). Whoever takes the claim first wins; the other side
+    /// then knows, so a request is never both applied and answered as not applied
+    /// (docs/exactly-once.md).
+    pub claim: Claim,
+}
+
+impl Request {
+    /// A request and the caller's half of its claim.
+    pub fn new(channel: u32, op: Op, reply: Sender<Reply>) -> (Self, Claim) {
+        let claim = Claim::default();
+        let caller = claim.clone();
+        (
+            Request {
+                channel,
+                op,
+                reply,
+                claim,
+            },
+            caller,
+        )
+    }
+}
+
+/// A one-shot flag shared by a request and the thread waiting for its reply.
+#[derive(Debug, Clone, Default)]
+pub struct Claim(Arc<AtomicBool>);
+
+impl Claim {
+    /// Take the claim; true when this side got it (the other side had not taken it yet).
+    pub fn take(&self) -> bool {
+        !self.0.swap(true, Ordering::AcqRel)
+    }
 }
 
 /// A built-in client streaming a file into one channel.
@@ -228,7 +267,8 @@ impl Machine {
         }
     }
 
-    fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
+    /// Apply one request to its channel (the runtime serves requests through this).
+    pub fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
         if op == Op::Hmi(HmiOp::ResetCycleTimes) {
             self.cycle_times = CycleTimes::default();
             return Reply::Done;
@@ -238,6 +278,7 @@ impl Machine {
             return Reply::NoChannel;
         };
         match op {
+            Op::WriteStream(_) if c.state() == State::Error => Reply::StreamNotReady,
             Op::WriteStream(data) => Reply::Stream(c.write_stream(tick, &data)),
             Op::CommandMode(v) => Reply::Command(c.command_mode(tick, v)),
             Op::CommandState(v) => Reply::Command(c.command_state(tick, v)),
@@ -340,6 +381,10 @@ impl Cycle for Machine {
     type Request = Request;
 
     fn serve(&mut self, req: Request, tick: &Tick) {
+        // The caller gave up waiting and already answered "not applied": leave it so.
+        if !req.claim.take() {
+            return;
+        }
         let reply = self.apply(tick, req.channel, req.op);
         // A client that went away no longer needs its answer.
         let _ = req.reply.send(reply);

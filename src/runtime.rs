@@ -117,6 +117,13 @@ pub struct Runtime<C: Cycle> {
     period: Duration,
     clock: Clock,
     stop: Arc<AtomicBool>,
+    /// A flag set from outside (SIGINT/SIGTERM): stops every run while it is set, unlike
+    /// `stop`, which one run consumes.
+    external_stop: Option<Arc<AtomicBool>>,
+    /// Real time: the deadline of the next tick when the last run ended at `max_ticks`, so a
+    /// run cut into chunks (soak, `serve --soak`) keeps one schedule and does not gain a tick
+    /// per chunk.
+    resume_at: Option<Instant>,
     next_index: u64,
     stats: CycleStats,
 }
@@ -137,6 +144,8 @@ impl<C: Cycle> Runtime<C> {
             period,
             clock,
             stop: Arc::new(AtomicBool::new(false)),
+            external_stop: None,
+            resume_at: None,
             next_index: 0,
             stats: CycleStats::default(),
         };
@@ -146,6 +155,11 @@ impl<C: Cycle> Runtime<C> {
     /// A handle that stops the run from any thread.
     pub fn stop_handle(&self) -> StopHandle {
         StopHandle(Arc::clone(&self.stop))
+    }
+
+    /// Also stop, at a tick boundary, whenever `flag` is set (a signal handler's flag).
+    pub fn stop_on(&mut self, flag: Arc<AtomicBool>) {
+        self.external_stop = Some(flag);
     }
 
     pub fn period(&self) -> Duration {
@@ -188,12 +202,14 @@ impl<C: Cycle> Runtime<C> {
     /// [`StopHandle`] fires. A stop request is consumed: a later `run` starts afresh. Tick
     /// numbers and channel time continue across calls.
     ///
-    /// In real time, deadlines are absolute (`start + k × period` from this call's start), so
+    /// In real time, deadlines are absolute (`start + k × period`, `start` this call's start or, after a
+    /// run that ended at `max_ticks`, the deadline where it left off), so
     /// sleeping never drifts; a late tick runs at once and the next deadlines stay where they
     /// were, so a hiccup is caught up by ticks running back to back, and channel time stays
     /// `index × period`.
     pub fn run(&mut self, max_ticks: Option<u64>) -> RunSummary {
         let wall_start = Instant::now();
+        let base = self.resume_at.take().unwrap_or(wall_start);
         let first = self.next_index;
         let mut requests = 0u64;
         let end = loop {
@@ -201,7 +217,12 @@ impl<C: Cycle> Runtime<C> {
             if max_ticks.is_some_and(|m| k >= m) {
                 break RunEnd::MaxTicks;
             }
-            if self.stop.swap(false, Ordering::AcqRel) {
+            if self.stop.swap(false, Ordering::AcqRel)
+                || self
+                    .external_stop
+                    .as_ref()
+                    .is_some_and(|f| f.load(Ordering::Acquire))
+            {
                 break RunEnd::StopRequested;
             }
             let tick = Tick {
@@ -212,7 +233,7 @@ impl<C: Cycle> Runtime<C> {
             let (started, late) = match self.clock {
                 Clock::Virtual => (Instant::now(), None),
                 Clock::RealTime => {
-                    let ideal = wall_start + mul_duration(self.period, k);
+                    let ideal = base + mul_duration(self.period, k);
                     requests += self.serve_until(ideal, &tick);
                     spin_sleep::sleep_until(ideal);
                     let now = Instant::now();
@@ -234,6 +255,9 @@ impl<C: Cycle> Runtime<C> {
                 break RunEnd::Stopped;
             }
         };
+        if end == RunEnd::MaxTicks && self.clock == Clock::RealTime {
+            self.resume_at = Some(base + mul_duration(self.period, self.next_index - first));
+        }
         RunSummary {
             end,
             ticks: self.next_index - first,

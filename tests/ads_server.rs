@@ -632,7 +632,7 @@ fn notifications_on_unreadable_objects_are_refused_and_handles_are_bounded() {
         }
         invoke += 1;
     }
-    assert_eq!(results, [0, 0, 0x710]);
+    assert_eq!(results, [0, 0, 0x716]);
     // Cyclic samples keep coming although nothing changes.
     let mut samples = 0;
     let deadline = Instant::now() + Duration::from_secs(2);

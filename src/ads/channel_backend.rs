@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use crossbeam_channel::Sender;
+use crossbeam_channel::{RecvTimeoutError, Sender};
 
 use super::backend::{CncBackend, DeviceError, ErrorRecord, HmiOp, StreamFill, StreamWriteOutcome};
 use crate::channel::CommandError;
@@ -12,31 +12,50 @@ use crate::source::stream::StreamWriteError;
 
 /// How long a connection thread waits for the runtime. A tick answers within one period;
 /// far longer means the runtime is stopped or hopelessly late, and the client hears "busy".
-const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+pub const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
 
 pub struct ChannelBackend {
     requests: Sender<Request>,
     channels: u16,
+    /// How long a call waits before answering "busy, not applied" ([`REPLY_TIMEOUT`]).
+    reply_timeout: Duration,
 }
 
 impl ChannelBackend {
     pub fn new(requests: Sender<Request>, channels: u16) -> Self {
-        ChannelBackend { requests, channels }
+        ChannelBackend {
+            requests,
+            channels,
+            reply_timeout: REPLY_TIMEOUT,
+        }
     }
 
+    /// The same backend answering "busy" after `timeout` instead of [`REPLY_TIMEOUT`].
+    pub fn with_reply_timeout(mut self, timeout: Duration) -> Self {
+        self.reply_timeout = timeout;
+        self
+    }
+
+    /// One request, answered exactly once: by the runtime's reply when the runtime took the
+    /// request's claim, or by "busy" (0x708, not applied) when this side took it first after
+    /// `reply_timeout`. Once the runtime holds the claim its reply is waited for without a
+    /// limit: it is being applied in the tick running now, and answering "busy" then would
+    /// make a retrying client apply it twice.
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
         let (tx, rx) = crossbeam_channel::bounded(1);
-        self.requests
-            .send(Request {
-                channel: u32::from(ch),
-                op,
-                reply: tx,
-            })
-            .map_err(|_| DeviceError::NotReady)?;
-        match rx.recv_timeout(REPLY_TIMEOUT) {
-            Ok(Reply::NoChannel) => Err(DeviceError::NotFound),
+        let (req, claim) = Request::new(u32::from(ch), op, tx);
+        self.requests.send(req).map_err(|_| DeviceError::NotReady)?;
+        let reply = match rx.recv_timeout(self.reply_timeout) {
             Ok(r) => Ok(r),
-            Err(_) => Err(DeviceError::Busy),
+            Err(RecvTimeoutError::Timeout) if claim.take() => return Err(DeviceError::Busy),
+            // The runtime has it: the answer comes when its serve returns.
+            Err(RecvTimeoutError::Timeout) => rx.recv().map_err(|_| DeviceError::NotReady),
+            // The runtime stopped and dropped the request unapplied.
+            Err(RecvTimeoutError::Disconnected) => Err(DeviceError::NotReady),
+        }?;
+        match reply {
+            Reply::NoChannel => Err(DeviceError::NotFound),
+            r => Ok(r),
         }
     }
 

@@ -353,6 +353,16 @@ pub fn start_program(client: &mut AdsClient, channel: u16, name: &str) -> Result
     client.write(g, offset::COMMAND_STATE, &state::ACTIVE.to_le_bytes())
 }
 
+/// Whether the channel runs a program (ACTIVE or HOLD), which will drain the stream buffer.
+fn program_running(client: &mut AdsClient, channel: u16) -> Result<bool, ClientError> {
+    let ms = client.read(group(channel), offset::MODE_STATE, 8)?;
+    let [_, _, _, _, a, b, c, d] = ms[..] else {
+        return Ok(false);
+    };
+    let s = i32::from_le_bytes([a, b, c, d]);
+    Ok(s == state::ACTIVE || s == state::HOLD)
+}
+
 /// The channel's error text when it is in state ERROR.
 fn channel_error(client: &mut AdsClient, channel: u16) -> Result<Option<String>, ClientError> {
     let g = group(channel);
@@ -406,6 +416,13 @@ pub fn stream_text(
                 }
                 Err(ClientError::Ads(AdsResult::BUSY)) => {
                     p.rejections += 1;
+                    // The stall timer counts only while nothing will take the data: a
+                    // running program drains the buffer, however long its current move.
+                    if last_accept.elapsed() > opts.stall_timeout / 2
+                        && program_running(client, opts.channel)?
+                    {
+                        last_accept = Instant::now();
+                    }
                     if last_accept.elapsed() > opts.stall_timeout {
                         return Err(StreamError::Stalled(opts.stall_timeout));
                     }
@@ -470,7 +487,10 @@ fn wait_empty(
         if used == 0 {
             return Ok(());
         }
-        if used != last_used {
+        if used != last_used
+            || (last_change.elapsed() > opts.stall_timeout / 2
+                && program_running(client, opts.channel)?)
+        {
             last_used = used;
             last_change = Instant::now();
         } else if last_change.elapsed() > opts.stall_timeout {

@@ -29,8 +29,9 @@ impl AdsResult {
     pub const BUSY: AdsResult = AdsResult(0x708);
     /// 0x70C: not found (e.g. an unknown V.E. variable or notification handle).
     pub const NOT_FOUND: AdsResult = AdsResult(0x70C);
-    /// 0x710: no more notification handles (per-connection bound reached).
-    pub const NO_MORE_HANDLES: AdsResult = AdsResult(0x710);
+    /// 0x716 ADSERR_DEVICE_NOMOREHDLS: no more notification handles (per-connection bound
+    /// reached). Not 0x710, which is "symbol not found" (Beckhoff ADS return codes).
+    pub const NO_MORE_HANDLES: AdsResult = AdsResult(0x716);
     /// 0x714: invalid notification handle.
     pub const INVALID_HANDLE: AdsResult = AdsResult(0x714);
 
@@ -51,7 +52,7 @@ impl AdsResult {
             0x707 => "device not ready",
             0x708 => "device busy",
             0x70C => "not found",
-            0x710 => "no more notification handles",
+            0x716 => "no more notification handles",
             0x714 => "invalid notification handle",
             6 => "target port not found",
             7 => "target machine not found",

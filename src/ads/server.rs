@@ -78,7 +78,7 @@ pub struct ServerConfig {
     pub max_frame_bytes: usize,
     /// Simultaneous connections; more are closed at once.
     pub max_connections: usize,
-    /// Notification handles per connection; more are answered 0x710.
+    /// Notification handles per connection; more are answered 0x716.
     pub max_notifications: usize,
     /// Route allow-list; empty = allow all. A client is served when its peer IP or the
     /// source NetId of its frame is listed; others are dropped silently (after a log line),
@@ -284,7 +284,15 @@ struct Notification {
     on_change: bool,
     next_due: Instant,
     last: Option<Vec<u8>>,
+    /// False until the AddDeviceNotification response is written: no sample goes out before
+    /// the client knows the handle.
+    armed: bool,
 }
+
+/// After the AddDeviceNotification response is written, the first sample waits this long, so
+/// the client has registered the handle (Beckhoff's AdsLib adds it to its table only after
+/// the response returns; a sample before that is dropped).
+const FIRST_SAMPLE_DELAY: Duration = Duration::from_millis(20);
 
 /// Per-connection notification table, polled by the notifier thread.
 struct Notifications {
@@ -366,7 +374,20 @@ fn request_loop(
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
                         send(writer, &reply)?;
+                        if header.command == CommandId::AddDeviceNotification {
+                            arm_notifications(notifs);
+                        }
                     }
+                }
+                Frame::Router {
+                    command: PORT_CLOSE,
+                    body,
+                } => {
+                    // The client's port is gone: its notifications end, and the connection
+                    // is closed, as the TwinCAT router does, so the client's disconnect()
+                    // (which waits for the close) returns at once.
+                    close_port(notifs, &body);
+                    return Ok(());
                 }
                 Frame::Router { command, body } => {
                     if let Some(reply) = handle_router(command, &body, peer, shared) {
@@ -387,6 +408,28 @@ fn request_loop(
             Err(e) => return Err(e.into()),
         };
         buf.extend_from_slice(&chunk[..n]);
+    }
+}
+
+/// AMS/TCP command 0x0001: a client closes its AMS port (body: the port, u16 LE).
+const PORT_CLOSE: u16 = 0x0001;
+
+/// Drop the notifications of the port a 0x0001 frame closes (all of them when the body does
+/// not name a port).
+fn close_port(notifs: &Notifications, body: &[u8]) {
+    let port = match body {
+        [a, b, ..] => Some(u16::from_le_bytes([*a, *b])),
+        _ => None,
+    };
+    lock(&notifs.table).retain(|_, n| port.is_some_and(|p| n.client.port != p));
+}
+
+/// Let the notifications just added send their first sample, [`FIRST_SAMPLE_DELAY`] from now.
+fn arm_notifications(notifs: &Notifications) {
+    let due = Instant::now() + FIRST_SAMPLE_DELAY;
+    for n in lock(&notifs.table).values_mut().filter(|n| !n.armed) {
+        n.armed = true;
+        n.next_due = due;
     }
 }
 
@@ -554,9 +597,10 @@ fn add_notification(
             req,
             cycle,
             on_change,
-            // The first sample goes out right after the response.
-            next_due: Instant::now() + Duration::from_millis(1),
+            // Armed once the response is written (arm_notifications).
+            next_due: Instant::now() + MAX_NOTIFICATION_CYCLE,
             last: None,
+            armed: false,
         },
     );
     drop(table);
@@ -589,7 +633,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
         {
             let mut table = lock(&notifs.table);
             for (&handle, n) in table.iter_mut() {
-                if n.next_due <= now {
+                if n.armed && n.next_due <= now {
                     n.next_due = now + n.cycle;
                     let read =
                         shared

@@ -11,6 +11,8 @@ pub mod check;
 pub mod receive;
 pub mod run;
 pub mod serve;
+pub mod serve_soak;
+pub mod signal;
 pub mod soak;
 pub mod stream;
 
@@ -24,6 +26,12 @@ pub mod exit {
     pub const USAGE: u8 = 2;
     /// `--max-ticks` reached before the program ended.
     pub const MAX_TICKS: u8 = 3;
+    /// SIGINT or SIGTERM stopped `run --realtime` or `soak --realtime` before the end (the
+    /// log, report and summary are complete up to the stop).
+    pub const STOPPED: u8 = 4;
+    /// A second SIGINT/SIGTERM during the orderly stop: exit at once, as a shell reports a
+    /// process killed by SIGINT (128 + 2).
+    pub const SECOND_SIGNAL: u8 = 130;
 }
 
 #[derive(Debug, Parser)]

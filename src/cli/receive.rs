@@ -154,14 +154,31 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
             .local_addr()
             .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
         eprintln!("listening on {local}");
-        dnc::receive_connections(
-            &listener,
-            args.max_transfers,
-            idle,
-            &mut splitter,
-            &mut writer,
-            |r| total.add(r),
-        )?;
+        // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
+        let signal = super::signal::StopSignal::install().ok();
+        if let Some(sig) = &signal {
+            wake_on_signal(sig.clone(), local);
+        }
+        let mut count = 0usize;
+        while args.max_transfers.is_none_or(|m| count < m) {
+            let mut last = None;
+            dnc::receive_connections(&listener, Some(1), idle, &mut splitter, &mut writer, |r| {
+                last = Some(r.clone())
+            })?;
+            let stopping = signal
+                .as_ref()
+                .is_some_and(super::signal::StopSignal::raised);
+            if let Some(r) = last {
+                // After a signal, the empty wake-up connection is not a transfer.
+                if !(stopping && r.split.bytes_in == 0) {
+                    total.add(&r);
+                    count += 1;
+                }
+            }
+            if stopping {
+                break;
+            }
+        }
     } else {
         let report = match args.input.as_deref() {
             None => dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?,
@@ -181,6 +198,23 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     } else {
         exit::CHANNEL_ERROR
     })
+}
+
+/// A blocking `accept` does not return for a signal; once the stop flag is set, one
+/// connection to our own port wakes it (the std listener has no other portable wake-up).
+fn wake_on_signal(signal: super::signal::StopSignal, local: SocketAddr) {
+    let mut target = local;
+    if target.ip().is_unspecified() {
+        target.set_ip(std::net::Ipv4Addr::LOCALHOST.into());
+    }
+    let _ = std::thread::Builder::new()
+        .name("receive-stop".into())
+        .spawn(move || {
+            while !signal.raised() {
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            let _ = std::net::TcpStream::connect_timeout(&target, Duration::from_secs(1));
+        });
 }
 
 /// `PORT` → loopback, `ADDR:PORT` as given.

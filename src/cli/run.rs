@@ -38,8 +38,8 @@ pub struct RunArgs {
     /// Feed this file through the stream interface.
     #[arg(long)]
     pub stream: Option<PathBuf>,
-    /// Largest packet the feeder writes, bytes (at most 992).
-    #[arg(long, default_value_t = 992)]
+    /// Largest packet the feeder writes, bytes (1..=992).
+    #[arg(value_parser = packet_bytes, long, default_value_t = 992)]
     pub packet: usize,
     /// One write attempt every this many ticks.
     #[arg(long, default_value_t = 1)]
@@ -289,6 +289,12 @@ pub fn execute(args: RunArgs) -> ExitCode {
         Clock::Virtual
     };
     let (mut rt, _requests) = Runtime::new(machine, period, clock);
+    if args.realtime {
+        match super::signal::StopSignal::install() {
+            Ok(sig) => rt.stop_on(sig.flag()),
+            Err(e) => eprintln!("ncchannel run: cannot handle SIGINT/SIGTERM: {e}"),
+        }
+    }
     let summary = if start_failed {
         None
     } else {
@@ -306,6 +312,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
         (_, Some(Finish::Ended)) => Outcome::Ended,
         (_, Some(Finish::Error)) => Outcome::Error,
         (Some(RunEnd::MaxTicks), _) => Outcome::MaxTicks,
+        (Some(RunEnd::StopRequested), _) => Outcome::Stopped,
         _ => Outcome::Error,
     };
     if let Some(c) = machine.channel_mut(args.channel) {
@@ -371,7 +378,19 @@ pub fn execute(args: RunArgs) -> ExitCode {
         Outcome::Ended => exit::OK,
         Outcome::Error => exit::CHANNEL_ERROR,
         Outcome::MaxTicks => exit::MAX_TICKS,
+        Outcome::Stopped => exit::STOPPED,
     })
+}
+
+/// `--packet`: 1..=992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE, ISG FCT-C19 Data streaming);
+/// a larger packet would be refused by every write, so it is refused here, up front.
+pub fn packet_bytes(s: &str) -> Result<usize, String> {
+    let max = crate::ads::client::MAX_PACKET_BYTES;
+    match s.parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        Ok(n) => Err(format!("{n} is not in 1..={max}")),
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {

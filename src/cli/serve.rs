@@ -11,6 +11,8 @@ use crate::ads::{AmsNetId, ServerConfig};
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, Runtime, Tick};
+use crate::soak::external::{load_external, Supervised};
+use crate::soak::scenario::Scenario;
 
 use super::exit;
 
@@ -34,22 +36,61 @@ pub struct ServeArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Stop after this many seconds (default: run until killed).
+    /// Stop after this many seconds (default: run until SIGINT/SIGTERM).
     #[arg(long)]
     pub seconds: Option<f64>,
+    /// Soak external clients: inject the scenario's [faults] and check the invariants on what
+    /// they write (the scenario's `params` replaces --params). Exit 1 on a violation.
+    #[arg(long)]
+    pub soak: Option<PathBuf>,
+    /// With --soak: write the report as JSON here.
+    #[arg(long, requires = "soak")]
+    pub report: Option<PathBuf>,
 }
 
-fn usage(msg: impl std::fmt::Display) -> ExitCode {
+fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
+    load_external(&super::run::locate(p))
+}
+
+/// The ADS server's settings: the command line over runtime.toml's `[ads]`.
+pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConfig {
+    let ads = &config.runtime.ads;
+    ServerConfig {
+        bind: args.bind.unwrap_or(ads.bind.0),
+        allow_non_loopback: args.allow_non_loopback,
+        net_id: Some(args.net_id.unwrap_or(ads.net_id)),
+        max_frame_bytes: ads.max_frame_bytes as usize,
+        allow: ads.allowed_clients.clone(),
+        ..ServerConfig::default()
+    }
+}
+
+pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
     eprintln!("ncchannel serve: {msg}");
     ExitCode::from(exit::USAGE)
 }
 
-pub fn execute(args: ServeArgs) -> ExitCode {
-    let (config, channels) = match super::run::load_channels(&args.params, args.events.is_some()) {
+pub fn execute(mut args: ServeArgs) -> ExitCode {
+    let scenario = match &args.soak {
+        None => None,
+        Some(p) => match load_scenario(p) {
+            Ok(s) => {
+                args.params = s.params_path();
+                Some(s)
+            }
+            Err(msg) => return usage(msg),
+        },
+    };
+    let (config, channels) = match super::run::load_channels(
+        &args.params,
+        args.events.is_some() || scenario.is_some(),
+    ) {
         Ok(c) => c,
         Err(msg) => return usage(msg),
     };
     let log = match &args.events {
+        // The soak's checks need the channels' events; without --events they go nowhere.
+        None if scenario.is_some() => EventLog::to_writer(Box::new(std::io::sink())),
         None => EventLog::disabled(),
         Some(t) => match EventLog::open(t) {
             Ok(l) => l,
@@ -71,16 +112,26 @@ pub fn execute(args: ServeArgs) -> ExitCode {
             }
         }
     }
+    if let Some(sc) = scenario {
+        let soft_limits = config
+            .runtime
+            .axes
+            .iter()
+            .filter_map(|a| {
+                let c = a.name.chars().next()?;
+                Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
+            })
+            .collect();
+        let programs = config
+            .channels
+            .iter()
+            .map(|c| c.streaming_prog_file.clone())
+            .collect();
+        let cycle = Supervised::new(machine, &sc, soft_limits, programs);
+        return super::serve_soak::run(cycle, &sc, &args, &config, period, nch);
+    }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
-    let ads = &config.runtime.ads;
-    let server_config = ServerConfig {
-        bind: args.bind.unwrap_or(ads.bind.0),
-        allow_non_loopback: args.allow_non_loopback,
-        net_id: Some(args.net_id.unwrap_or(ads.net_id)),
-        max_frame_bytes: ads.max_frame_bytes as usize,
-        allow: ads.allowed_clients.clone(),
-        ..ServerConfig::default()
-    };
+    let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
     let server =
         match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
@@ -93,6 +144,10 @@ pub fn execute(args: ServeArgs) -> ExitCode {
         net_id.map(|n| n.to_string()).unwrap_or_default(),
         period.as_micros()
     );
+    match super::signal::StopSignal::install() {
+        Ok(sig) => rt.stop_on(sig.flag()),
+        Err(e) => eprintln!("ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"),
+    }
     let stop = rt.stop_handle();
     if let Some(s) = args.seconds {
         let d = Duration::from_secs_f64(s.max(0.0));
@@ -102,14 +157,24 @@ pub fn execute(args: ServeArgs) -> ExitCode {
         });
     }
     let summary = rt.run(None);
+    // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
     let (mut machine, stats) = rt.into_inner();
-    let _ = machine.finish_log();
+    let log = machine.finish_log();
+    let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
     eprintln!(
-        "stopped after {} ticks ({:.1} s); {}",
+        "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     );
+    match log {
+        Ok(lines) if args.events.is_some() => eprintln!("event log: {lines} lines"),
+        Ok(_) => {}
+        Err(e) => {
+            eprintln!("ncchannel serve: event log: {e}");
+            return ExitCode::from(exit::CHANNEL_ERROR);
+        }
+    }
     ExitCode::from(exit::OK)
 }

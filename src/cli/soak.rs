@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use crate::soak::scenario::{Length, Scenario};
+use crate::soak::scenario::{ClockSpec, Length, Scenario};
 use crate::soak::{run, Options};
 
 use super::exit;
@@ -59,7 +59,20 @@ pub fn execute(args: SoakArgs) -> ExitCode {
             sim_seconds: None,
             wall_seconds: args.wall_seconds,
         });
+    // Virtual time runs to its end (seconds); real time stops in order on SIGINT/SIGTERM.
+    let signal = if args.realtime || scenario.clock == ClockSpec::Realtime {
+        match super::signal::StopSignal::install() {
+            Ok(s) => Some(s),
+            Err(e) => {
+                eprintln!("ncchannel soak: cannot handle SIGINT/SIGTERM: {e}");
+                None
+            }
+        }
+    } else {
+        None
+    };
     let opts = Options {
+        stop: signal.as_ref().map(super::signal::StopSignal::flag),
         realtime: args.realtime,
         progress: !args.quiet,
         length,
@@ -76,9 +89,13 @@ pub fn execute(args: SoakArgs) -> ExitCode {
             return ExitCode::from(exit::USAGE);
         }
     }
-    ExitCode::from(if report.all_held {
-        exit::OK
-    } else {
-        exit::CHANNEL_ERROR
-    })
+    ExitCode::from(
+        if report.all_held && signal.as_ref().is_some_and(|s| s.raised()) {
+            exit::STOPPED
+        } else if report.all_held {
+            exit::OK
+        } else {
+            exit::CHANNEL_ERROR
+        },
+    )
 }

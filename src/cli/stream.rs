@@ -27,7 +27,7 @@ pub struct StreamArgs {
     #[arg(long, default_value_t = 1)]
     pub channel: u16,
     /// Largest packet in bytes (whole lines), 1..=992.
-    #[arg(long, default_value_t = MAX_PACKET_BYTES)]
+    #[arg(long, value_parser = super::run::packet_bytes, default_value_t = MAX_PACKET_BYTES)]
     pub packet: usize,
     /// Start the streaming program first (AUTOMATIC, program name, ACTIVE).
     #[arg(long)]
@@ -35,7 +35,8 @@ pub struct StreamArgs {
     /// The channel's streaming program name (`streaming_prog_file`), used with --start.
     #[arg(long, default_value = "streaming.nc")]
     pub program: String,
-    /// Give up after this many seconds without progress.
+    /// Give up after this many seconds in which data waited and the channel ran no program
+    /// to take it (a long move that keeps the buffer full is not a stall).
     #[arg(long, default_value_t = 30)]
     pub stall_secs: u64,
 }

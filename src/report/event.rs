@@ -9,8 +9,9 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
-use crossbeam_channel::{Receiver, Sender};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
 use crate::runtime::Tick;
@@ -187,6 +188,19 @@ impl EventBuffer {
 /// `Vec`s run out and new ones are allocated.
 const RECYCLE_BATCHES: usize = 16;
 
+/// A file's buffered lines reach the file at least this often, so a `tail -f` of the log
+/// lags the channel by no more than this plus a tick.
+pub const FLUSH_INTERVAL: Duration = Duration::from_millis(100);
+
+/// When the writer thread hands its buffer to the operating system.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlushPolicy {
+    /// After every batch (one tick's events): a pipe's reader sees each tick at once.
+    EveryBatch,
+    /// At most [`FLUSH_INTERVAL`] after an event was emitted (files: fewer writes).
+    Interval,
+}
+
 /// The sink: a writer thread serialising batches of events as JSON Lines, in the order they
 /// were emitted. Dropping it or calling [`EventLog::finish`] writes everything out and joins.
 pub struct EventLog {
@@ -205,15 +219,20 @@ impl EventLog {
         EventLog { inner: None }
     }
 
-    /// Write to a file (created or truncated).
+    /// Write to a file (created or truncated); a named pipe is flushed at every batch.
     pub fn to_file(path: &Path) -> io::Result<Self> {
         let f = File::create(path)?;
-        Ok(Self::to_writer(Box::new(f)))
+        let policy = if is_pipe(&f) {
+            FlushPolicy::EveryBatch
+        } else {
+            FlushPolicy::Interval
+        };
+        Ok(Self::to_writer_with(Box::new(f), policy))
     }
 
-    /// Write to standard output.
+    /// Write to standard output, flushed at every batch (usually a pipe or a terminal).
     pub fn stdout() -> Self {
-        Self::to_writer(Box::new(io::stdout()))
+        Self::to_writer_with(Box::new(io::stdout()), FlushPolicy::EveryBatch)
     }
 
     /// `-` is standard output, anything else a file path (the `--events` option).
@@ -225,8 +244,16 @@ impl EventLog {
         }
     }
 
-    /// Write to any writer, buffered, on a thread of its own.
+    /// Write to any writer, buffered, on a thread of its own, flushed every
+    /// [`FLUSH_INTERVAL`].
     pub fn to_writer(w: Box<dyn Write + Send>) -> Self {
+        Self::to_writer_with(w, FlushPolicy::Interval)
+    }
+
+    /// Write to any writer, buffered, on a thread of its own, flushed as `policy` says.
+    /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
+    /// [`EventLog::finish`] never leaves a cut line.
+    pub fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
         let (tx, rx) = crossbeam_channel::unbounded::<Vec<Event>>();
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
         let thread = std::thread::Builder::new()
@@ -234,7 +261,22 @@ impl EventLog {
             .spawn(move || -> io::Result<u64> {
                 let mut out = BufWriter::new(w);
                 let mut lines = 0u64;
-                for mut batch in rx {
+                // When the oldest unflushed line was written; None when all is flushed.
+                let mut dirty_since: Option<Instant> = None;
+                loop {
+                    let wait = dirty_since.map_or(Duration::from_secs(3600), |t| {
+                        FLUSH_INTERVAL.saturating_sub(t.elapsed())
+                    });
+                    let mut batch = match rx.recv_timeout(wait) {
+                        Ok(b) => b,
+                        Err(RecvTimeoutError::Timeout) => {
+                            if dirty_since.take().is_some() {
+                                out.flush()?;
+                            }
+                            continue;
+                        }
+                        Err(RecvTimeoutError::Disconnected) => break,
+                    };
                     for ev in batch.drain(..) {
                         serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
                         out.write_all(b"\n")?;
@@ -242,6 +284,11 @@ impl EventLog {
                     }
                     // Hand the empty Vec back; if the tick has enough spares, let it go.
                     let _ = recycle_tx.try_send(batch);
+                    let since = *dirty_since.get_or_insert_with(Instant::now);
+                    if policy == FlushPolicy::EveryBatch || since.elapsed() >= FLUSH_INTERVAL {
+                        out.flush()?;
+                        dirty_since = None;
+                    }
                 }
                 out.flush()?;
                 Ok(lines)
@@ -304,6 +351,17 @@ impl EventLog {
             }
         }
     }
+}
+
+#[cfg(unix)]
+fn is_pipe(f: &File) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    f.metadata().is_ok_and(|m| m.file_type().is_fifo())
+}
+
+#[cfg(not(unix))]
+fn is_pipe(_: &File) -> bool {
+    false
 }
 
 impl Drop for EventLog {

@@ -20,6 +20,8 @@ pub enum Outcome {
     Error,
     /// `--max-ticks` ran out first.
     MaxTicks,
+    /// SIGINT or SIGTERM stopped it (an orderly stop).
+    Stopped,
 }
 
 /// Stream interface totals.
@@ -129,6 +131,7 @@ impl Report {
             Outcome::Ended => "program ended",
             Outcome::Error => "channel error",
             Outcome::MaxTicks => "stopped at --max-ticks",
+            Outcome::Stopped => "stopped by a signal",
         };
         writeln!(w, "outcome:    {outcome}")?;
         for e in &self.errors {

@@ -30,7 +30,8 @@ struct Schedule {
     reject_until: Option<u64>,
 }
 
-fn draw(rng: &mut SplitMix64, now: u64, r: Option<[u64; 2]>) -> Option<u64> {
+/// The tick of the next fault: `now` plus a draw from the range, or never.
+pub(crate) fn draw(rng: &mut SplitMix64, now: u64, r: Option<[u64; 2]>) -> Option<u64> {
     r.map(|[a, b]| now.saturating_add(rng.range(a, b)))
 }
 

@@ -3,6 +3,7 @@
 //! `ncchannel soak` and the README section "Soak and bench".
 
 pub mod driver;
+pub mod external;
 pub mod feed;
 pub mod generator;
 pub mod invariants;
@@ -48,6 +49,8 @@ pub struct Options {
     /// Replace the scenario's `[length]` (the CI's short runs).
     pub length: Option<Length>,
     pub seed: Option<u64>,
+    /// Stop early when this flag is set (SIGINT/SIGTERM); the report covers the run so far.
+    pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Build the cycle of a scenario: its channels, clients and fault schedules.
@@ -164,6 +167,9 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         Clock::Virtual
     };
     let (mut rt, _tx) = Runtime::new(cycle, period, clock);
+    if let Some(flag) = &opts.stop {
+        rt.stop_on(std::sync::Arc::clone(flag));
+    }
 
     let period_s = period.as_secs_f64();
     let tick_limit = [
@@ -208,7 +214,9 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         if warmup_kib.is_none() && f >= scenario.invariants.warmup {
             warmup_kib = resident_kib();
         }
-        if s.end == RunEnd::Stopped || wall_limit.is_some_and(|w| wall >= w) {
+        if matches!(s.end, RunEnd::Stopped | RunEnd::StopRequested)
+            || wall_limit.is_some_and(|w| wall >= w)
+        {
             break;
         }
         if progress && last_progress.elapsed() >= Duration::from_millis(500) {

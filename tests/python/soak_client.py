@@ -1,0 +1,77 @@
+"""An external streaming client for `ncchannel serve --soak`, written with unmodified pyads:
+writes numbered, self-contained NC lines (every move carries its feed, so a line after an
+injected reset runs on its own) into channel 1's stream for SECONDS, retrying on 0x708 as
+every client must, and ignoring 0x707 while the server resets the channel. The server starts
+the streaming program and restarts it after each reset. With --duplicate it writes one
+acknowledged packet a second time on purpose (the exactly-once check must catch it).
+Prints one JSON line of counts.
+
+    NCCHANNEL_ADS_ADDR=127.0.0.1:48898 python tests/python/soak_client.py SECONDS [--duplicate]
+"""
+
+import ctypes
+import json
+import os
+import sys
+import time
+
+import pyads
+
+ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
+NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
+GROUP = 0x20101
+OFF_STREAM = 0x90
+BUSY, NOT_READY = 0x708, 0x707
+
+
+def lines():
+    n = 1
+    while True:
+        if n % 4 == 0:
+            x, y = (n % 40) * 0.05, (n % 17) * 0.05
+            yield f"N{n} G01 X{x:.3f} Y{y:.3f} F20000\r\n".encode()
+        else:
+            yield f"N{n} P{1 + n % 9}={n}\r\n".encode()
+        n += 1
+
+
+def main():
+    seconds = float(sys.argv[1])
+    duplicate = "--duplicate" in sys.argv
+    pyads.open_port()
+    pyads.set_local_address("10.1.2.3.1.1")
+    plc = pyads.Connection(NETID, 553, ADDR)
+    plc.open()
+    gen = lines()
+    end = time.monotonic() + seconds
+    busy = refused = writes = line_count = 0
+    duplicated = False
+    while time.monotonic() < end:
+        p = b""
+        while len(p) < 600:
+            p += next(gen)
+        while time.monotonic() < end:
+            try:
+                plc.write(GROUP, OFF_STREAM, list(p), ctypes.c_uint8 * len(p))
+                writes += 1
+                line_count += p.count(b"\n")
+                if duplicate and not duplicated and writes == 20:
+                    plc.write(GROUP, OFF_STREAM, list(p), ctypes.c_uint8 * len(p))
+                    duplicated = True
+                break
+            except pyads.ADSError as e:
+                if e.err_code == BUSY:
+                    busy += 1
+                    time.sleep(0.002)
+                elif e.err_code == NOT_READY:
+                    refused += 1
+                    time.sleep(0.01)
+                else:
+                    raise
+    plc.close()
+    print(json.dumps({"writes": writes, "lines": line_count, "busy": busy,
+                      "not_ready": refused, "duplicated": duplicated}))
+
+
+if __name__ == "__main__":
+    main()
