@@ -320,6 +320,11 @@ impl Channel {
     pub fn cache(&self) -> &Cache {
         &self.cache
     }
+    /// Can a streaming program ever run here (and so drain the stream buffer)?
+    pub fn streaming_enabled(&self) -> bool {
+        self.store.streaming_enabled()
+    }
+
     pub fn stream(&self) -> &StreamBuffer {
         &self.stream
     }

@@ -140,7 +140,8 @@ pub enum Reply {
     /// No channel with that number.
     NoChannel,
     /// A stream write refused without touching the buffer: the channel is in ERROR, so
-    /// nothing will drain it before a reset (which deletes the buffer). ADS 0x707, not 0x708:
+    /// nothing will drain it before a reset (which deletes the buffer), or it has no streaming
+    /// program (`streaming_prog_file` unset), so nothing ever will. ADS 0x707, not 0x708:
     /// retrying cannot succeed (docs/exactly-once.md).
     StreamNotReady,
 }
@@ -278,7 +279,9 @@ impl Machine {
             return Reply::NoChannel;
         };
         match op {
-            Op::WriteStream(_) if c.state() == State::Error => Reply::StreamNotReady,
+            Op::WriteStream(_) if c.state() == State::Error || !c.streaming_enabled() => {
+                Reply::StreamNotReady
+            }
             Op::WriteStream(data) => Reply::Stream(c.write_stream(tick, &data)),
             Op::CommandMode(v) => Reply::Command(c.command_mode(tick, v)),
             Op::CommandState(v) => Reply::Command(c.command_state(tick, v)),

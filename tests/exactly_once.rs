@@ -287,3 +287,21 @@ fn stream_writes_in_error_are_refused_not_ready() {
     let events = s.finish();
     assert!(of(&events, "write").is_empty(), "no write was applied");
 }
+
+#[test]
+fn stream_writes_without_a_streaming_program_are_refused_not_ready() {
+    let rig = Rig::new();
+    // A channel list without `streaming_prog_file`: streaming is off for this channel.
+    std::fs::write(rig.dir.path().join("params/channel1.lis"), "\n").unwrap();
+    let s = setup(&rig, Duration::from_secs(2));
+    let dev = s.client.device(target());
+    for _ in 0..3 {
+        match dev.write(CH1, offset::STREAM, b"N1 X1\r\n") {
+            Err(ads::Error::Ads(_, _, code)) => assert_eq!(code, 0x707),
+            other => panic!("expected 0x707, got {other:?}"),
+        }
+    }
+    assert_eq!(stream_used(&dev), 0, "nothing entered the buffer");
+    let events = s.finish();
+    assert!(of(&events, "write").is_empty(), "no write was applied");
+}

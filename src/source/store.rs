@@ -188,6 +188,11 @@ impl ProgramStore {
         &self.dirs
     }
 
+    /// Whether the channel has a streaming program at all (`streaming_prog_file` set).
+    pub fn streaming_enabled(&self) -> bool {
+        self.streaming_prog.is_some()
+    }
+
     /// Whether `name` is the virtual streaming program (case-insensitive, as program names are).
     pub fn is_streaming_program(&self, name: &str) -> bool {
         self.streaming_prog
