@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use crate::lang::block::{Block, Body, Command, Control, GotoTarget, Item, Label, Value};
-use crate::lang::{is_comment_end, parse_block};
+use crate::lang::{is_comment_end, parse_block, Expr, VarRef};
 
 use super::frame::{self, LabelIndex, LineMeta, LinePos, Source, MAX_SEEN_LABELS};
 use super::vars::VarSlot;
@@ -321,7 +321,13 @@ impl Decoder {
     pub(super) fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
         match c {
             Control::Break | Control::Continue => self.exec_leave(c),
-            Control::For { .. } | Control::EndFor => self.exec_for(c),
+            Control::For {
+                var,
+                start,
+                end,
+                step,
+            } => self.exec_for(var, start, end, step.as_deref()),
+            Control::EndFor => self.exec_end_for(c),
             Control::While(_)
             | Control::EndWhile
             | Control::Do
@@ -435,58 +441,53 @@ impl Decoder {
         Ok(())
     }
 
-    /// `$FOR` … `$ENDFOR`.
-    fn exec_for(&mut self, c: &Control) -> Res {
-        match c {
-            Control::For {
+    /// `$FOR`: set the variable to its start and enter the body, or skip it.
+    fn exec_for(&mut self, var: &VarRef, start: &Expr, end: &Expr, step: Option<&Expr>) -> Res {
+        let key = self.resolve(var)?;
+        let start = self.eval(start)?;
+        let end = self.eval(end)?;
+        let step = match step {
+            Some(s) => self.eval(s)?,
+            None => 1.0,
+        };
+        if step == 0.0 || !step.is_finite() {
+            return Err(DecodeError::new(
+                codes::BAD_VALUE,
+                "$FOR step must not be 0",
+            ));
+        }
+        self.set_var(key.clone(), start)?;
+        let body = self.top().line_pos();
+        self.top().flow.push(FlowEntry::For {
+            var: key,
+            end,
+            step,
+            body,
+        });
+        if !for_continues(start, end, step) {
+            self.skip(SkipUntil::LoopExit);
+        }
+        Ok(())
+    }
+
+    /// `$ENDFOR`: step the variable and go round again, or leave the loop.
+    fn exec_end_for(&mut self, c: &Control) -> Res {
+        match self.top().flow.last().cloned() {
+            Some(FlowEntry::For {
                 var,
-                start,
                 end,
                 step,
-            } => {
-                let key = self.resolve(var)?;
-                let start = self.eval(start)?;
-                let end = self.eval(end)?;
-                let step = match step {
-                    Some(s) => self.eval(s)?,
-                    None => 1.0,
-                };
-                if step == 0.0 || !step.is_finite() {
-                    return Err(DecodeError::new(
-                        codes::BAD_VALUE,
-                        "$FOR step must not be 0",
-                    ));
-                }
-                self.set_var(key.clone(), start)?;
-                let body = self.top().line_pos();
-                self.top().flow.push(FlowEntry::For {
-                    var: key,
-                    end,
-                    step,
-                    body,
-                });
-                if !for_continues(start, end, step) {
-                    self.skip(SkipUntil::LoopExit);
+                body,
+            }) => {
+                let v = self.vars.get(&var).unwrap_or(0.0) + step;
+                self.set_var(var, v)?;
+                if for_continues(v, end, step) {
+                    self.top().seek(body);
+                } else {
+                    self.top().flow.pop();
                 }
             }
-            Control::EndFor => match self.top().flow.last().cloned() {
-                Some(FlowEntry::For {
-                    var,
-                    end,
-                    step,
-                    body,
-                }) => {
-                    let v = self.vars.get(&var).unwrap_or(0.0) + step;
-                    self.set_var(var, v)?;
-                    if for_continues(v, end, step) {
-                        self.top().seek(body);
-                    } else {
-                        self.top().flow.pop();
-                    }
-                }
-                _ => return Err(self.stray(c)),
-            },
-            _ => {}
+            _ => return Err(self.stray(c)),
         }
         Ok(())
     }
