@@ -54,9 +54,9 @@ impl Display for Block {
             Body::Call(c) => write!(f, "{sep}{c}"),
             Body::ProgramHead { name, local } => {
                 if *local {
-                    write!(f, "{sep}%L {name}")
+                    write!(f, "{sep}%L {}", FileName(name))
                 } else {
-                    write!(f, "{sep}%{name}")
+                    write!(f, "{sep}%{}", FileName(name))
                 }
             }
         }
@@ -284,7 +284,9 @@ struct FileName<'s>(&'s str);
 impl Display for FileName<'_> {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
         let s = self.0;
-        if s.is_empty() || s.starts_with('"') || s.contains([' ', '\t', ']', '(', ';']) {
+        // A name with a quote inside was read unquoted (a quoted name ends at its first
+        // quote), so it holds no separator and prints as it is.
+        if !s.contains('"') && (s.is_empty() || s.contains([' ', '\t', ']', '(', ';'])) {
             write!(f, "\"{s}\"")
         } else {
             f.write_str(s)
@@ -319,7 +321,12 @@ impl Display for Command {
             Command::EndVar => f.write_str("#ENDVAR"),
             Command::Msg { save, text } => {
                 f.write_str(if *save { "#MSG SAVE" } else { "#MSG" })?;
-                write!(f, " [\"{text}\"]")
+                // A text with a quote inside was kept as written between the brackets.
+                if text.contains('"') {
+                    write!(f, " [{text}]")
+                } else {
+                    write!(f, " [\"{text}\"]")
+                }
             }
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),

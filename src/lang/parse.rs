@@ -849,12 +849,15 @@ fn cache(i: &str) -> PResult<'_, Command> {
 }
 
 /// A file name: `"quoted"` or a run of characters up to a blank, comment start or, inside
-/// brackets, `]`.
+/// brackets, `]`. An opening quote without its closing one gives no name (the caller's
+/// "name expected" error at the quote): a name never starts with `"`, so the canonical text
+/// of every name parses back to the same name.
 fn file_name(i: &str, in_bracket: bool) -> (&str, &str) {
     if let Some(q) = i.strip_prefix('"') {
-        if let Some(end) = q.find('"') {
-            return (&q[end + 1..], &q[..end]);
-        }
+        return match q.find('"') {
+            Some(end) => (&q[end + 1..], &q[..end]),
+            None => (i, ""),
+        };
     }
     let end = i
         .find(|c: char| c == ' ' || c == '\t' || c == '(' || c == ';' || (in_bracket && c == ']'))
