@@ -330,20 +330,3 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         cycle: CycleFigures::new(period.as_secs_f64() * 1e6, &stats),
     })
 }
-
-/// The scenarios shipped in `params/soak/`, for the CI and the tests.
-pub fn shipped_scenarios() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| {
-            p.extension().is_some_and(|e| e == "toml")
-                && p.file_name().is_some_and(|n| n != "runtime.toml")
-        })
-        .collect();
-    v.sort();
-    v
-}
