@@ -1,12 +1,13 @@
 //! `ncchannel stream`: feed an NC file into a channel's stream interface over ADS.
 
-use std::io::Write;
 use std::net::{SocketAddr, ToSocketAddrs};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
 use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress, MAX_PACKET_BYTES};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
 use crate::ads::frame::{AmsAddr, AmsNetId};
 use crate::ads::objects::PORT_CNC_COM;
 
@@ -41,29 +42,30 @@ pub struct StreamArgs {
     pub stall_secs: u64,
 }
 
-fn print_progress(p: &StreamProgress) {
-    let mut err = std::io::stderr().lock();
-    let _ = write!(
-        err,
-        "\rstream: {}/{} bytes, {} packets, {:.0} B/s, {} rejected (busy)   ",
-        p.bytes_sent,
-        p.bytes_total,
+/// The progress bar over the file's bytes; indicatif draws it only when stderr is a terminal,
+/// so a log or a pipe gets the final line alone.
+fn progress_bar(total_bytes: u64) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(total_bytes), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("stream: [{bar:30}] {bytes}/{total_bytes}  {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("#>."),
+    );
+    bar
+}
+
+fn show_progress(bar: &ProgressBar, p: &StreamProgress) {
+    bar.set_position(p.bytes_sent);
+    bar.set_message(format!(
+        "{} packets, {:.0} B/s, {} rejected (busy)",
         p.packets_sent,
         p.bytes_per_second(),
         p.rejections
-    );
-    let _ = err.flush();
+    ));
 }
 
 pub fn execute(args: StreamArgs) -> ExitCode {
     use super::exit;
-    if args.packet == 0 || args.packet > MAX_PACKET_BYTES {
-        eprintln!(
-            "ncchannel stream: --packet {} out of range 1..=992",
-            args.packet
-        );
-        return ExitCode::from(exit::USAGE);
-    }
     if args.channel == 0 {
         eprintln!("ncchannel stream: --channel is 1-based");
         return ExitCode::from(exit::USAGE);
@@ -107,9 +109,11 @@ pub fn execute(args: StreamArgs) -> ExitCode {
         stall_timeout: Duration::from_secs(args.stall_secs),
         ..StreamOptions::default()
     };
-    match client::stream_text(&mut client, &text, &opts, &mut print_progress) {
+    let bar = progress_bar(text.len() as u64);
+    let result = client::stream_text(&mut client, &text, &opts, &mut |p| show_progress(&bar, p));
+    bar.finish_and_clear();
+    match result {
         Ok(p) => {
-            eprintln!();
             eprintln!(
                 "stream: done: {} bytes in {} packets, {:.3} s, {:.0} B/s, {} writes rejected busy (warning 11012), write round trip p50 {:.0} µs p99 {:.0} µs",
                 p.bytes_sent,
@@ -123,7 +127,6 @@ pub fn execute(args: StreamArgs) -> ExitCode {
             ExitCode::from(exit::OK)
         }
         Err(e) => {
-            eprintln!();
             eprintln!("ncchannel stream: {}: {e}", args.file.display());
             ExitCode::from(exit::CHANNEL_ERROR)
         }

@@ -12,10 +12,10 @@ pub mod report;
 pub mod rng;
 pub mod scenario;
 
-use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use thiserror::Error;
 
 use crate::runtime::{Clock, RunEnd, Runtime};
@@ -28,6 +28,8 @@ use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
 
 /// Largest file a scenario streams.
+/// Resolution of the progress bar (per mille of the run).
+const PROGRESS_STEPS: u64 = 1000;
 const MAX_STREAM_FILE_BYTES: u64 = 16 << 20;
 
 #[derive(Debug, Error)]
@@ -185,7 +187,17 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     } else {
         2048
     };
-    let progress = opts.progress && std::io::stderr().is_terminal();
+    // indicatif draws only when stderr is a terminal, so a log or a pipe gets no progress line.
+    let bar = if opts.progress {
+        ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("#>."),
+    );
     let fraction = |rt: &Runtime<SoakCycle>, wall: Duration| -> f64 {
         let mut f: f64 = 0.0;
         if let Some(b) = length.blocks {
@@ -201,7 +213,6 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     };
 
     let start = Instant::now();
-    let mut last_progress = start;
     let mut warmup_kib = None;
     loop {
         let n = tick_limit.map_or(chunk, |t| chunk.min(t.saturating_sub(rt.ticks())));
@@ -219,25 +230,14 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         {
             break;
         }
-        if progress && last_progress.elapsed() >= Duration::from_millis(500) {
-            last_progress = Instant::now();
-            let blocks = rt.cycle().total_blocks;
-            let width = 30;
-            let done = (f * width as f64) as usize;
-            eprint!(
-                "\r[{}{}] {:5.1}%  {} blocks  {:.0} blocks/s  ",
-                "#".repeat(done),
-                ".".repeat(width - done),
-                f * 100.0,
-                blocks,
-                blocks as f64 / wall.as_secs_f64().max(1e-9)
-            );
-            let _ = std::io::stderr().flush();
-        }
+        let blocks = rt.cycle().total_blocks;
+        bar.set_position((f * PROGRESS_STEPS as f64) as u64);
+        bar.set_message(format!(
+            "{blocks} blocks  {:.0} blocks/s",
+            blocks as f64 / wall.as_secs_f64().max(1e-9)
+        ));
     }
-    if progress {
-        eprint!("\r{:70}\r", "");
-    }
+    bar.finish_and_clear();
     let wall = start.elapsed();
     let end_kib = resident_kib();
     let warmup_kib = warmup_kib.or(end_kib);
