@@ -1,26 +1,24 @@
 //! Cycle statistics: bounded-memory latency histograms of tick work time and lateness.
 //!
-//! The histogram is log-linear (the HDR idea): values below 128 ns get one bucket per
-//! nanosecond, above that every power of two is split into 64 buckets, so any recorded value
-//! is known to within 1/64 (1.6 %) over the whole `u64` nanosecond range in 3 776 buckets
-//! (30 KiB). That resolves a 2 µs spin_sleep lateness as well as a 40 ms hiccup, which a
-//! 1 µs-bucket linear table would not; the exact maximum and minimum are kept on the side.
+//! The histogram is `hdrhistogram` (Gil Tene's HdrHistogram, the Rust port) with two
+//! significant digits from 1 ns to one hour: every recorded value is known to within 1 %
+//! (a 2 µs spin_sleep lateness as well as a 40 ms hiccup) in a fixed ~36 KiB, allocated once
+//! when the histogram is made, never in the tick. Longer values are counted at one hour; the
+//! exact minimum and maximum are kept on the side.
 
 use std::time::Duration;
 
-/// Buckets per power of two above the linear range.
-const SUB_BUCKETS: u64 = 64;
-const SUB_BITS: u32 = 6;
-/// Values below this get one bucket each.
-const LINEAR_LIMIT: u64 = 2 * SUB_BUCKETS;
-/// Total buckets: the linear range plus 64 per remaining power of two up to 2^64.
-const BUCKETS: usize = (LINEAR_LIMIT + (64 - (SUB_BITS as u64 + 1)) * SUB_BUCKETS) as usize;
+use hdrhistogram::Histogram as Hdr;
+
+/// Significant decimal digits kept: 2 (at most 1 % above the value).
+const SIGNIFICANT_DIGITS: u8 = 2;
+/// Largest value the buckets cover, ns (one hour); longer values count at this value.
+const HIGHEST_NS: u64 = 3_600_000_000_000;
 
 /// A latency histogram over nanoseconds with fixed memory.
 #[derive(Clone)]
 pub struct Histogram {
-    counts: Box<[u64]>,
-    count: u64,
+    hdr: Hdr<u64>,
     sum_ns: u128,
     min_ns: u64,
     max_ns: u64,
@@ -29,7 +27,7 @@ pub struct Histogram {
 impl std::fmt::Debug for Histogram {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Histogram")
-            .field("count", &self.count)
+            .field("count", &self.count())
             .field("min_ns", &self.min_ns)
             .field("max_ns", &self.max_ns)
             .finish()
@@ -42,37 +40,17 @@ impl Default for Histogram {
     }
 }
 
-fn bucket_of(v: u64) -> usize {
-    if v < LINEAR_LIMIT {
-        return v as usize;
-    }
-    // v >= 128: top bit position b >= 7; keep the 6 bits below it.
-    let b = 63 - v.leading_zeros();
-    let shift = b - SUB_BITS;
-    let mantissa = (v >> shift) - SUB_BUCKETS; // 0..64
-    (LINEAR_LIMIT + (u64::from(shift) - 1) * SUB_BUCKETS + mantissa) as usize
-}
-
-/// The largest value that lands in bucket `i`.
-fn bucket_high(i: usize) -> u64 {
-    let i = i as u64;
-    if i < LINEAR_LIMIT {
-        return i;
-    }
-    let k = i - LINEAR_LIMIT;
-    let shift = k / SUB_BUCKETS + 1;
-    let mantissa = k % SUB_BUCKETS + SUB_BUCKETS;
-    // Saturate at the very top of the range.
-    (((mantissa + 1) as u128) << shift)
-        .saturating_sub(1)
-        .min(u64::MAX as u128) as u64
+/// The bucket layout every histogram shares, so any two can be merged.
+fn empty_hdr() -> Hdr<u64> {
+    // Constants inside hdrhistogram's accepted range (low ≥ 1, high ≥ 2·low, digits ≤ 5).
+    Hdr::new_with_bounds(1, HIGHEST_NS, SIGNIFICANT_DIGITS)
+        .expect("constant histogram bounds are valid")
 }
 
 impl Histogram {
     pub fn new() -> Self {
         Histogram {
-            counts: vec![0; BUCKETS].into_boxed_slice(),
-            count: 0,
+            hdr: empty_hdr(),
             sum_ns: 0,
             min_ns: u64::MAX,
             max_ns: 0,
@@ -81,8 +59,8 @@ impl Histogram {
 
     /// Record one value in nanoseconds.
     pub fn record_ns(&mut self, ns: u64) {
-        self.counts[bucket_of(ns)] += 1;
-        self.count += 1;
+        // 0 ns (a tick that took no measurable time) counts in the lowest bucket.
+        self.hdr.saturating_record(ns.max(1));
         self.sum_ns += u128::from(ns);
         self.min_ns = self.min_ns.min(ns);
         self.max_ns = self.max_ns.max(ns);
@@ -95,17 +73,21 @@ impl Histogram {
 
     /// Add another histogram's samples to this one.
     pub fn merge(&mut self, other: &Histogram) {
-        for (a, b) in self.counts.iter_mut().zip(other.counts.iter()) {
-            *a += *b;
+        // Same layout on both sides (`empty_hdr`), so `add` has nothing to refuse; were it
+        // ever to, the samples are added one bucket at a time instead of being lost.
+        if self.hdr.add(&other.hdr).is_err() {
+            for v in other.hdr.iter_recorded() {
+                self.hdr
+                    .saturating_record_n(v.value_iterated_to(), v.count_at_value());
+            }
         }
-        self.count += other.count;
         self.sum_ns += other.sum_ns;
         self.min_ns = self.min_ns.min(other.min_ns);
         self.max_ns = self.max_ns.max(other.max_ns);
     }
 
     pub fn count(&self) -> u64 {
-        self.count
+        self.hdr.len()
     }
 
     /// Largest value recorded (exact), 0 when empty.
@@ -115,7 +97,7 @@ impl Histogram {
 
     /// Smallest value recorded (exact), 0 when empty.
     pub fn min_ns(&self) -> u64 {
-        if self.count == 0 {
+        if self.count() == 0 {
             0
         } else {
             self.min_ns
@@ -124,29 +106,23 @@ impl Histogram {
 
     /// Mean in nanoseconds, 0 when empty.
     pub fn mean_ns(&self) -> f64 {
-        if self.count == 0 {
-            0.0
-        } else {
-            self.sum_ns as f64 / self.count as f64
+        match self.count() {
+            0 => 0.0,
+            n => self.sum_ns as f64 / n as f64,
         }
     }
 
-    /// The value at quantile `q` (0..=1): the smallest bucket top that at least `q` of the
-    /// samples lie at or below, capped by the exact maximum. Errs high by at most 1/64, so a
+    /// The value at quantile `q` (0..=1): the top of the bucket that at least `q` of the
+    /// samples lie at or below, capped by the exact maximum. Errs high by at most 1 %, so a
     /// reported p99 is never optimistic. 0 when empty.
     pub fn quantile_ns(&self, q: f64) -> u64 {
-        if self.count == 0 {
+        if self.count() == 0 {
             return 0;
         }
-        let rank = ((q.clamp(0.0, 1.0) * self.count as f64).ceil() as u64).max(1);
-        let mut seen = 0;
-        for (i, &c) in self.counts.iter().enumerate() {
-            seen += c;
-            if seen >= rank {
-                return bucket_high(i).min(self.max_ns).max(self.min_ns);
-            }
-        }
-        self.max_ns
+        self.hdr
+            .value_at_quantile(q.clamp(0.0, 1.0))
+            .min(self.max_ns)
+            .max(self.min_ns)
     }
 
     /// [`Histogram::quantile_ns`] in microseconds.
@@ -162,11 +138,9 @@ impl Histogram {
     /// The non-empty buckets as (largest value in the bucket in ns, count), ascending: what a
     /// plot of the distribution needs.
     pub fn buckets(&self) -> impl Iterator<Item = (u64, u64)> + '_ {
-        self.counts
-            .iter()
-            .enumerate()
-            .filter(|(_, &c)| c > 0)
-            .map(|(i, &c)| (bucket_high(i), c))
+        self.hdr
+            .iter_recorded()
+            .map(|v| (v.value_iterated_to(), v.count_at_value()))
     }
 }
 
@@ -205,39 +179,33 @@ mod tests {
     use super::*;
 
     #[test]
-    fn buckets_are_monotonic_and_contain_their_values() {
-        let mut last = 0;
-        for v in (0..5000u64).chain([1 << 20, (1 << 40) + 12345, u64::MAX]) {
-            let b = bucket_of(v);
-            assert!(b < BUCKETS, "{v} -> {b}");
-            assert!(b >= last, "bucket index falls at {v}");
-            last = b;
-            assert!(
-                bucket_high(b) >= v,
-                "{v} above its bucket top {}",
-                bucket_high(b)
-            );
-            if b > 0 {
-                assert!(bucket_high(b - 1) < v, "{v} in the wrong bucket");
-            }
-        }
-        assert_eq!(bucket_of(u64::MAX), BUCKETS - 1);
-    }
-
-    #[test]
     fn quantiles_within_resolution() {
         let mut h = Histogram::new();
         for v in 1..=10_000u64 {
             h.record_ns(v * 10);
         }
         let p50 = h.quantile_ns(0.5);
-        assert!((50_000..=50_000 + 50_000 / 64).contains(&p50), "{p50}");
+        assert!((50_000..=50_000 + 50_000 / 100).contains(&p50), "{p50}");
         let p99 = h.quantile_ns(0.99);
-        assert!((99_000..=99_000 + 99_000 / 64).contains(&p99), "{p99}");
+        assert!((99_000..=99_000 + 99_000 / 100).contains(&p99), "{p99}");
         assert_eq!(h.quantile_ns(1.0), 100_000);
         assert_eq!(h.max_ns(), 100_000);
         assert_eq!(h.min_ns(), 10);
         assert_eq!(Histogram::new().quantile_ns(0.99), 0);
+    }
+
+    #[test]
+    fn small_and_huge_values_keep_their_resolution() {
+        let mut h = Histogram::new();
+        h.record_ns(2_000); // a 2 µs spin_sleep lateness
+        h.record_ns(40_000_000); // a 40 ms hiccup
+        h.record_ns(u64::MAX); // beyond an hour: counted, maximum exact
+        let tops: Vec<u64> = h.buckets().map(|(top, _)| top).collect();
+        assert_eq!(tops.len(), 3, "{tops:?}");
+        assert!((2_000..=2_020).contains(&tops[0]), "{tops:?}");
+        assert!((40_000_000..=40_400_000).contains(&tops[1]), "{tops:?}");
+        assert_eq!(h.max_ns(), u64::MAX);
+        assert_eq!(h.count(), 3);
     }
 
     #[test]

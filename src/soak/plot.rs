@@ -1,27 +1,29 @@
 //! The lateness histogram of `ncchannel bench --plot`: runtime and bare loop on one log-scaled
-//! time axis, as plain SVG text (no plotting dependency), with each p99 marked.
+//! time axis with decade ticks, units and a legend, each p99 marked — drawn with `plotters`
+//! (SVG backend).
 
-use std::fmt::Write as _;
 use std::time::Duration;
+
+use plotters::prelude::*;
 
 use crate::report::stats::Histogram;
 
-const W: f64 = 800.0;
-const H: f64 = 420.0;
-const LEFT: f64 = 60.0;
-const RIGHT: f64 = 20.0;
-const TOP: f64 = 40.0;
-const BOTTOM: f64 = 50.0;
+const WIDTH: u32 = 900;
+const HEIGHT: u32 = 480;
 /// Bins per decade of the time axis.
 const PER_DECADE: f64 = 10.0;
+/// The time axis starts here, µs (0.1 µs: below any tick's lateness we can measure).
+const LOWEST_US: f64 = 0.1;
+const RUNTIME: RGBColor = RGBColor(214, 39, 40);
+const BARE: RGBColor = RGBColor(31, 95, 191);
 
-/// Share of samples per log-spaced bin from `lo_us` (10^k) up, `bins` bins.
-fn shares(h: &Histogram, lo_exp: f64, bins: usize) -> Vec<f64> {
+/// Share of samples per log-spaced bin (`PER_DECADE` a decade) from [`LOWEST_US`] up.
+fn shares(h: &Histogram, bins: usize) -> Vec<f64> {
     let mut v = vec![0.0; bins];
     let n = h.count().max(1) as f64;
     for (high_ns, c) in h.buckets() {
-        let us = (high_ns as f64 / 1000.0).max(1e-3);
-        let b = ((us.log10() - lo_exp) * PER_DECADE).floor();
+        let us = (high_ns as f64 / 1000.0).max(LOWEST_US);
+        let b = ((us / LOWEST_US).log10() * PER_DECADE).floor();
         let b = (b.max(0.0) as usize).min(bins - 1);
         v[b] += c as f64 / n;
     }
@@ -30,84 +32,86 @@ fn shares(h: &Histogram, lo_exp: f64, bins: usize) -> Vec<f64> {
 
 /// The SVG document.
 pub fn lateness_svg(runtime: &Histogram, bare: &Histogram, period: Duration) -> String {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (WIDTH, HEIGHT)).into_drawing_area();
+        // Drawing into a string cannot fail for I/O; a plotting error leaves a partial plot,
+        // which is still a valid SVG document.
+        let _ = draw(&root, runtime, bare, period);
+        let _ = root.present();
+    }
+    svg
+}
+
+type DrawResult = Result<(), Box<dyn std::error::Error>>;
+
+fn draw(
+    root: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    runtime: &Histogram,
+    bare: &Histogram,
+    period: Duration,
+) -> DrawResult {
+    root.fill(&WHITE)?;
     let max_us = runtime.max_us().max(bare.max_us()).max(1.0);
-    let lo_exp = -1.0; // 0.1 µs
-    let hi_exp = max_us.log10().ceil().max(lo_exp + 1.0);
-    let bins = ((hi_exp - lo_exp) * PER_DECADE) as usize;
-    let a = shares(runtime, lo_exp, bins);
-    let b = shares(bare, lo_exp, bins);
-    let top = a.iter().chain(&b).cloned().fold(0.0, f64::max).max(1e-9);
-    let pw = W - LEFT - RIGHT;
-    let ph = H - TOP - BOTTOM;
-    let x_of = |exp: f64| LEFT + (exp - lo_exp) / (hi_exp - lo_exp) * pw;
-    let y_of = |share: f64| TOP + ph - share / top * ph;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" font-family="sans-serif" font-size="12">"#
-    );
-    let _ = writeln!(s, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
-    let _ = writeln!(
-        s,
-        r#"<text x="{LEFT}" y="20" font-size="14">Tick lateness at {} µs: runtime (red) vs bare spin_sleep loop (blue)</text>"#,
-        period.as_micros()
-    );
-    // Axes and decade ticks.
-    let _ = writeln!(
-        s,
-        r#"<path d="M{LEFT},{TOP} V{} H{}" stroke="black" fill="none"/>"#,
-        TOP + ph,
-        LEFT + pw
-    );
-    let mut e = lo_exp;
-    while e <= hi_exp + 1e-9 {
-        let x = x_of(e);
-        let label = 10f64.powf(e);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{}" stroke="#ddd"/><text x="{x:.1}" y="{}" text-anchor="middle">{label} µs</text>"##,
-            TOP + ph,
-            TOP + ph + 18.0
-        );
-        e += 1.0;
+    let decades = (max_us / LOWEST_US).log10().ceil().max(1.0);
+    let hi_us = LOWEST_US * 10f64.powf(decades);
+    let bins = (decades * PER_DECADE) as usize;
+    let series = [
+        ("runtime", RUNTIME, shares(runtime, bins), runtime),
+        ("bare spin_sleep loop", BARE, shares(bare, bins), bare),
+    ];
+    let top_pct = series
+        .iter()
+        .flat_map(|s| s.2.iter())
+        .fold(0.0f64, |a, &b| a.max(b))
+        .max(1e-9)
+        * 100.0
+        * 1.1;
+    let mut chart = ChartBuilder::on(&root.margin(10, 20, 10, 10))
+        .caption(
+            format!("Tick lateness at a {} µs cycle", period.as_micros()),
+            ("sans-serif", 18),
+        )
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((LOWEST_US..hi_us).log_scale(), 0.0..top_pct)?;
+    chart
+        .configure_mesh()
+        .x_desc("lateness against the ideal tick start (µs, log scale)")
+        .y_desc("share of ticks (%)")
+        .x_label_formatter(&|v| format!("{v}"))
+        .draw()?;
+    let bin_edge = |i: usize| LOWEST_US * 10f64.powf(i as f64 / PER_DECADE);
+    for (name, color, shares, h) in &series {
+        let color = *color;
+        // A step line: each bin's share held across the bin.
+        let steps = shares.iter().enumerate().flat_map(|(i, &s)| {
+            [(bin_edge(i), s * 100.0), (bin_edge(i + 1), s * 100.0)]
+        });
+        chart
+            .draw_series(LineSeries::new(steps, color.stroke_width(2)))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        let p99 = h.quantile_us(0.99).clamp(LOWEST_US, hi_us);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(p99, 0.0), (p99, top_pct)],
+                6,
+                4,
+                color.stroke_width(1),
+            ))?
+            .label(format!("{name} p99 {p99:.1} µs"))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], color)
+            });
     }
-    let _ = writeln!(
-        s,
-        r#"<text x="15" y="{}" transform="rotate(-90 15 {})" text-anchor="middle">share of ticks (max {:.1} %)</text>"#,
-        TOP + ph / 2.0,
-        TOP + ph / 2.0,
-        top * 100.0
-    );
-    for (series, color) in [(&a, "red"), (&b, "blue")] {
-        let mut d = format!("M{:.1},{:.1}", x_of(lo_exp), y_of(0.0));
-        for (i, v) in series.iter().enumerate() {
-            let x0 = x_of(lo_exp + i as f64 / PER_DECADE);
-            let x1 = x_of(lo_exp + (i + 1) as f64 / PER_DECADE);
-            let y = y_of(*v);
-            let _ = write!(d, " L{x0:.1},{y:.1} L{x1:.1},{y:.1}");
-        }
-        let _ = write!(d, " L{:.1},{:.1}", x_of(hi_exp), y_of(0.0));
-        let _ = writeln!(
-            s,
-            r#"<path d="{d}" stroke="{color}" stroke-width="1.5" fill="none"/>"#
-        );
-    }
-    for (h, color, name, dy) in [
-        (runtime, "red", "runtime", 0.0),
-        (bare, "blue", "bare", 14.0),
-    ] {
-        let p99 = h.quantile_us(0.99).max(0.1);
-        let x = x_of(p99.log10().clamp(lo_exp, hi_exp));
-        let _ = writeln!(
-            s,
-            r#"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{}" stroke="{color}" stroke-dasharray="4 3"/><text x="{:.1}" y="{}" fill="{color}">{name} p99 {p99:.1} µs</text>"#,
-            TOP + ph,
-            x + 4.0,
-            TOP + 12.0 + dy
-        );
-    }
-    s.push_str("</svg>\n");
-    s
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -115,7 +119,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn svg_holds_both_series_and_p99_marks() {
+    fn svg_holds_both_series_axes_and_p99_marks() {
         let mut a = Histogram::new();
         let mut b = Histogram::new();
         for i in 0..1000u64 {
@@ -124,8 +128,14 @@ mod tests {
         }
         let svg = lateness_svg(&a, &b, Duration::from_millis(1));
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
-        assert_eq!(svg.matches("stroke=\"red\" stroke-width").count(), 1);
-        assert_eq!(svg.matches("stroke=\"blue\" stroke-width").count(), 1);
-        assert!(svg.contains("runtime p99"), "{svg}");
+        for label in [
+            "Tick lateness at a 1000 µs cycle",
+            "share of ticks (%)",
+            "µs, log scale",
+            "runtime p99",
+            "bare spin_sleep loop p99",
+        ] {
+            assert!(svg.contains(label), "{label} missing");
+        }
     }
 }
