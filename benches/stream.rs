@@ -4,11 +4,15 @@
 use std::time::Duration;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use ncchannel::cli::bench::{generated_program, StreamingLoad};
+
 use ncchannel::feeder::Feeder;
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Cycle, Tick};
 use ncchannel::source::stream::StreamBuffer;
+
+#[path = "../tests/common/streaming_load.rs"]
+mod streaming_load;
+use streaming_load::{generated_program, StreamingLoad};
 
 fn stream(c: &mut Criterion) {
     let text = generated_program(200);

@@ -4,7 +4,6 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use ncchannel::cli::bench::{generated_program, StreamingLoad};
 use ncchannel::report::event::{Event, EventKind, EventLog};
 use ncchannel::report::stats::CycleStats;
 use ncchannel::report::summary::{
@@ -12,6 +11,10 @@ use ncchannel::report::summary::{
 };
 use ncchannel::runtime::{Clock, RunEnd, Runtime, Tick};
 use serde_json::Value;
+
+#[path = "common/streaming_load.rs"]
+mod streaming_load;
+use streaming_load::{generated_program, StreamingLoad};
 
 fn keys(line: &str) -> Vec<String> {
     // Field names as a sorted set; the order of the leading four is checked on the text.

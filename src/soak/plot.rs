@@ -85,9 +85,10 @@ fn draw(
     for (name, color, shares, h) in &series {
         let color = *color;
         // A step line: each bin's share held across the bin.
-        let steps = shares.iter().enumerate().flat_map(|(i, &s)| {
-            [(bin_edge(i), s * 100.0), (bin_edge(i + 1), s * 100.0)]
-        });
+        let steps = shares
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &s)| [(bin_edge(i), s * 100.0), (bin_edge(i + 1), s * 100.0)]);
         chart
             .draw_series(LineSeries::new(steps, color.stroke_width(2)))?
             .label(*name)
