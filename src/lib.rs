@@ -5,6 +5,7 @@
 //! README's architecture section for who may talk to whom.
 
 pub mod ads;
+pub mod bounded;
 pub mod channel;
 pub mod cli;
 pub mod decoder;

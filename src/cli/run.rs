@@ -234,7 +234,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
         None => None,
         Some(f) => {
             let f = locate(f);
-            let text = match read_bounded(&f) {
+            let text = match crate::bounded::read_file(&f, MAX_STREAM_FILE_BYTES) {
                 Ok(t) => t,
                 Err(e) => return usage(format!("{}: {e}", f.display())),
             };
@@ -391,17 +391,4 @@ pub fn packet_bytes(s: &str) -> Result<usize, String> {
         Ok(n) => Err(format!("{n} is not in 1..={max}")),
         Err(e) => Err(e.to_string()),
     }
-}
-
-fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
-    use std::io::Read;
-    let f = std::fs::File::open(p)?;
-    let mut buf = Vec::new();
-    f.take(MAX_STREAM_FILE_BYTES + 1).read_to_end(&mut buf)?;
-    if buf.len() as u64 > MAX_STREAM_FILE_BYTES {
-        return Err(std::io::Error::other(format!(
-            "larger than {MAX_STREAM_FILE_BYTES} bytes"
-        )));
-    }
-    Ok(buf)
 }

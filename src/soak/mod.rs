@@ -12,7 +12,6 @@ pub mod report;
 pub mod rng;
 pub mod scenario;
 
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -108,7 +107,7 @@ pub fn build(
         let source = match &spec.file {
             Some(f) => {
                 let path = scenario.dir.join(f);
-                let text = read_bounded(&path)
+                let text = crate::bounded::read_file(&path, MAX_STREAM_FILE_BYTES)
                     .map_err(|e| SoakError::Setup(format!("{}: {e}", path.display())))?;
                 Source::file(&text)
                     .map_err(|e| SoakError::Setup(format!("{}: {e}", path.display())))?
@@ -140,18 +139,6 @@ pub fn build(
         cycle,
         Duration::from_micros(config.runtime.cycle_period_us.max(1)),
     ))
-}
-
-fn read_bounded(p: &Path) -> std::io::Result<Vec<u8>> {
-    use std::io::Read;
-    let mut buf = Vec::new();
-    std::fs::File::open(p)?
-        .take(MAX_STREAM_FILE_BYTES + 1)
-        .read_to_end(&mut buf)?;
-    if buf.len() as u64 > MAX_STREAM_FILE_BYTES {
-        return Err(std::io::Error::other("larger than 16 MiB"));
-    }
-    Ok(buf)
 }
 
 /// Run a scenario to its end and report.

@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use thiserror::Error;
 
+use crate::bounded::BoundedReadError;
+
 use super::feed::FeederSpec;
 use super::generator::ProgramSpec;
 
@@ -168,23 +170,21 @@ fn range_ok(r: Option<[u64; 2]>) -> bool {
 
 impl Scenario {
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
-        use std::io::Read;
         let p = path.display().to_string();
-        let io = |source| ScenarioError::Io {
+        let bytes = crate::bounded::read_file(path, MAX_SCENARIO_BYTES).map_err(|e| match e {
+            BoundedReadError::Io(source) => ScenarioError::Io {
+                path: p.clone(),
+                source,
+            },
+            e @ BoundedReadError::TooLarge { .. } => ScenarioError::Invalid {
+                path: p.clone(),
+                msg: e.to_string(),
+            },
+        })?;
+        let text = String::from_utf8(bytes).map_err(|_| ScenarioError::Invalid {
             path: p.clone(),
-            source,
-        };
-        let f = std::fs::File::open(path).map_err(io)?;
-        let mut text = String::new();
-        f.take(MAX_SCENARIO_BYTES + 1)
-            .read_to_string(&mut text)
-            .map_err(io)?;
-        if text.len() as u64 > MAX_SCENARIO_BYTES {
-            return Err(ScenarioError::Invalid {
-                path: p,
-                msg: format!("larger than {MAX_SCENARIO_BYTES} bytes"),
-            });
-        }
+            msg: "not UTF-8 text".to_string(),
+        })?;
         let mut s = Scenario::parse(&text).map_err(|msg| ScenarioError::Toml {
             path: p.clone(),
             msg,

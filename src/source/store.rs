@@ -11,12 +11,13 @@
 //! read completes at channel time T" (decoding waits, motion keeps running what is queued).
 
 use std::fs;
-use std::io::Read;
 use std::path::{Component, Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
 
 use thiserror::Error;
+
+use crate::bounded::BoundedReadError;
 
 /// Largest program the store reads into memory. A bound, so a mistaken path to a huge file
 /// cannot exhaust memory; real NC programs that large are streamed instead.
@@ -299,32 +300,17 @@ fn find_case_insensitive(dir: &Path, rel: &Path) -> Option<PathBuf> {
 }
 
 fn read_bounded(path: &Path, name: &str) -> Result<Vec<u8>, StoreError> {
-    let unreadable = |e: std::io::Error| StoreError::Unreadable {
-        name: name.to_string(),
-        reason: e.to_string(),
-    };
-    let f = fs::File::open(path).map_err(unreadable)?;
-    let len = f.metadata().map_err(unreadable)?.len();
-    if len > MAX_PROGRAM_BYTES {
-        return Err(StoreError::TooLarge {
+    crate::bounded::read_file(path, MAX_PROGRAM_BYTES).map_err(|e| match e {
+        BoundedReadError::TooLarge { bytes, limit } => StoreError::TooLarge {
             name: name.to_string(),
-            bytes: len,
-            limit: MAX_PROGRAM_BYTES,
-        });
-    }
-    let mut buf = Vec::with_capacity(len as usize);
-    // take(): the file may grow between stat and read; the bound holds anyway.
-    f.take(MAX_PROGRAM_BYTES + 1)
-        .read_to_end(&mut buf)
-        .map_err(unreadable)?;
-    if buf.len() as u64 > MAX_PROGRAM_BYTES {
-        return Err(StoreError::TooLarge {
+            bytes,
+            limit,
+        },
+        BoundedReadError::Io(e) => StoreError::Unreadable {
             name: name.to_string(),
-            bytes: buf.len() as u64,
-            limit: MAX_PROGRAM_BYTES,
-        });
-    }
-    Ok(buf)
+            reason: e.to_string(),
+        },
+    })
 }
 
 #[cfg(test)]
