@@ -11,6 +11,8 @@ use std::ops::Range;
 
 use thiserror::Error;
 
+use crate::source::packets::{lines, LineTooLong, Packer};
+
 /// Why a file cannot be fed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum FeederError {
@@ -18,8 +20,8 @@ pub enum FeederError {
     #[error("packet size must be at least 1 byte")]
     ZeroPacket,
     /// One line (with its CR LF) is longer than a packet; the feeder never splits a line.
-    #[error("line {line}: {len} bytes with CR LF do not fit into a packet of {max} bytes")]
-    LineTooLong { line: usize, len: usize, max: usize },
+    #[error(transparent)]
+    LineTooLong(#[from] LineTooLong),
     /// A form-feed line whose rest is not a tick count.
     #[error("line {line}: a form-feed line may only hold a number of ticks to pause")]
     BadPause { line: usize },
@@ -180,31 +182,12 @@ impl Feeder {
     }
 }
 
-/// Normalise `text` to CR LF lines and cut it into packets of whole lines and pauses.
-///
-/// A last line without a line end gets CR LF too: a file without a final newline is common
-/// and not the error 21476 is about. A lone CR inside a line is kept as it is (the channel
-/// then reports 21476, as it would for any client sending it).
+/// Normalise `text` to CR LF lines and cut it into packets of whole lines and pauses
+/// (form-feed lines, see the module header).
 fn cut_lines(text: &[u8], packet_max: usize) -> Result<(Vec<u8>, Vec<Item>), FeederError> {
-    let mut data = Vec::with_capacity(text.len() + text.len() / 16 + 2);
+    let mut packer = Packer::new(packet_max, text.len());
     let mut items = Vec::new();
-    let mut packet_start = 0usize;
-    let close = |items: &mut Vec<Item>, start: &mut usize, end: usize| {
-        if end > *start {
-            items.push(Item::Packet(*start..end));
-        }
-        *start = end;
-    };
-    let mut rest = text;
-    let mut line_no = 0usize;
-    while !rest.is_empty() {
-        line_no += 1;
-        let (line, next) = match rest.iter().position(|&b| b == b'\n') {
-            Some(i) => (&rest[..i], &rest[i + 1..]),
-            None => (rest, &rest[rest.len()..]),
-        };
-        rest = next;
-        let content = line.strip_suffix(b"\r").unwrap_or(line);
+    for (line_no, content) in lines(text) {
         if let Some(after) = content.strip_prefix(b"\x0c") {
             let arg = std::str::from_utf8(after)
                 .map_err(|_| FeederError::BadPause { line: line_no })?
@@ -215,24 +198,12 @@ fn cut_lines(text: &[u8], packet_max: usize) -> Result<(Vec<u8>, Vec<Item>), Fee
                 arg.parse::<u64>()
                     .map_err(|_| FeederError::BadPause { line: line_no })?
             };
-            close(&mut items, &mut packet_start, data.len());
+            items.extend(packer.close().map(Item::Packet));
             items.push(Item::Pause(ticks));
             continue;
         }
-        let len = content.len() + 2;
-        if len > packet_max {
-            return Err(FeederError::LineTooLong {
-                line: line_no,
-                len,
-                max: packet_max,
-            });
-        }
-        if data.len() + len - packet_start > packet_max {
-            close(&mut items, &mut packet_start, data.len());
-        }
-        data.extend_from_slice(content);
-        data.extend_from_slice(b"\r\n");
+        items.extend(packer.push(line_no, content)?.map(Item::Packet));
     }
-    close(&mut items, &mut packet_start, data.len());
-    Ok((data, items))
+    items.extend(packer.close().map(Item::Packet));
+    Ok((packer.into_data(), items))
 }

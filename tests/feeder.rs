@@ -1,6 +1,7 @@
 //! The built-in feeder: whole lines, CR LF, packet limits, form-feed pauses, retries, raw.
 
 use ncchannel::feeder::{Feeder, FeederError};
+use ncchannel::source::packets::LineTooLong;
 
 /// Drive the feeder for `ticks` ticks accepting every write; (tick, packet) per write.
 fn run(f: &mut Feeder, ticks: u64) -> Vec<(u64, Vec<u8>)> {
@@ -56,11 +57,11 @@ fn a_line_longer_than_a_packet_is_an_error_up_front() {
     let e = Feeder::new(b"N1\nN2 XXXXXXXXXXXX\n".to_vec(), 10, 1, false).unwrap_err();
     assert_eq!(
         e,
-        FeederError::LineTooLong {
+        FeederError::LineTooLong(LineTooLong {
             line: 2,
-            len: 17,
+            bytes: 17,
             max: 10
-        }
+        })
     );
     assert_eq!(
         Feeder::new(b"N1\n".to_vec(), 0, 1, false).unwrap_err(),

@@ -225,48 +225,7 @@ impl AdsClient {
     }
 }
 
-/// A line longer than one packet can carry cannot be streamed as a whole line.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("line {line} is {bytes} bytes with CR LF; one stream write carries at most {max}")]
-pub struct LineTooLong {
-    pub line: usize,
-    pub bytes: usize,
-    pub max: usize,
-}
-
-/// Cut NC text into stream packets: every line ends with CR LF (a bare LF or a missing final
-/// line end becomes CR LF), and each packet holds as many whole lines as fit in `max_bytes`.
-pub fn packets(text: &[u8], max_bytes: usize) -> Result<Vec<Vec<u8>>, LineTooLong> {
-    let mut out = Vec::new();
-    let mut packet: Vec<u8> = Vec::with_capacity(max_bytes);
-    let mut lines = text.split(|&b| b == b'\n').enumerate().peekable();
-    while let Some((i, raw)) = lines.next() {
-        if raw.is_empty() && lines.peek().is_none() {
-            break; // the text ended with a line end
-        }
-        let body = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let len = body.len() + 2;
-        if len > max_bytes {
-            return Err(LineTooLong {
-                line: i + 1,
-                bytes: len,
-                max: max_bytes,
-            });
-        }
-        if packet.len() + len > max_bytes {
-            out.push(std::mem::replace(
-                &mut packet,
-                Vec::with_capacity(max_bytes),
-            ));
-        }
-        packet.extend_from_slice(body);
-        packet.extend_from_slice(b"\r\n");
-    }
-    if !packet.is_empty() {
-        out.push(packet);
-    }
-    Ok(out)
-}
+pub use crate::source::packets::{packets, LineTooLong};
 
 /// Settings of one streaming run.
 #[derive(Debug, Clone)]
@@ -513,22 +472,5 @@ pub fn default_target() -> AmsAddr {
     AmsAddr {
         net_id: AmsNetId::LOCAL,
         port: PORT_CNC_COM,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn packets_hold_whole_crlf_lines() {
-        let p = packets(b"N10 X1\nN20 Y2\r\nN30 Z3", 992).unwrap();
-        assert_eq!(p, vec![b"N10 X1\r\nN20 Y2\r\nN30 Z3\r\n".to_vec()]);
-        let p = packets(b"AAAA\nBBBB\nCCCC\n", 12).unwrap();
-        assert_eq!(p, vec![b"AAAA\r\nBBBB\r\n".to_vec(), b"CCCC\r\n".to_vec()]);
-        assert_eq!(packets(b"", 992).unwrap(), Vec::<Vec<u8>>::new());
-        assert_eq!(packets(b"\n\n", 992).unwrap(), vec![b"\r\n\r\n".to_vec()]);
-        let e = packets(b"ok\nTOO LONG LINE\n", 8).unwrap_err();
-        assert_eq!(e.line, 2);
     }
 }

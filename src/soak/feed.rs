@@ -8,6 +8,7 @@ use serde::Deserialize;
 
 use super::generator::{Generator, MAX_LINE_BYTES};
 use super::rng::SplitMix64;
+use crate::source::packets;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 /// How the client writes (scenario `[feeder]`).
@@ -93,22 +94,16 @@ impl Source {
             return Err("the file is empty".into());
         }
         let mut lines = Vec::new();
-        for (i, raw) in text.split(|&b| b == b'\n').enumerate() {
-            let l = raw.strip_suffix(b"\r").unwrap_or(raw);
+        for (no, l) in packets::lines(text) {
             if l.len() + 2 > MAX_LINE_BYTES {
                 return Err(format!(
-                    "line {}: longer than {} bytes",
-                    i + 1,
+                    "line {no}: longer than {} bytes",
                     MAX_LINE_BYTES - 2
                 ));
             }
             let mut v = l.to_vec();
             v.extend_from_slice(b"\r\n");
             lines.push(v);
-        }
-        // A final newline leaves one empty piece behind: not a line.
-        if text.ends_with(b"\n") {
-            lines.pop();
         }
         if lines.is_empty() {
             return Err("the file holds no lines".into());

@@ -2,5 +2,6 @@
 //! search paths, and the file cache.
 
 pub mod cache;
+pub mod packets;
 pub mod store;
 pub mod stream;
