@@ -15,8 +15,7 @@ use super::objects::{offset, GROUP_CHANNEL, PORT_CNC_COM};
 use super::payload::{self, request};
 use super::result::AdsResult;
 
-/// Largest packet one stream write may carry (MAX_PROGRAM_STREAM_INPUT_SIZE).
-pub const MAX_PACKET_BYTES: usize = 992;
+use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 /// What went wrong talking to the device.
 #[derive(Debug, thiserror::Error)]
@@ -248,7 +247,7 @@ impl Default for StreamOptions {
     fn default() -> Self {
         StreamOptions {
             channel: 1,
-            packet_bytes: MAX_PACKET_BYTES,
+            packet_bytes: MAX_PROGRAM_STREAM_INPUT_SIZE,
             retry: Duration::from_micros(250),
             start_program: None,
             stall_timeout: Duration::from_secs(30),
@@ -295,7 +294,7 @@ pub enum StreamError {
     Stalled(Duration),
     #[error("channel error: {0}")]
     Channel(String),
-    #[error("packet size {0} out of range 1..=992")]
+    #[error("packet size {0} out of range 1..={MAX_PROGRAM_STREAM_INPUT_SIZE}")]
     PacketSize(usize),
 }
 
@@ -345,7 +344,7 @@ pub fn stream_text(
     opts: &StreamOptions,
     progress: &mut dyn FnMut(&StreamProgress),
 ) -> Result<StreamProgress, StreamError> {
-    if opts.packet_bytes == 0 || opts.packet_bytes > MAX_PACKET_BYTES {
+    if opts.packet_bytes == 0 || opts.packet_bytes > MAX_PROGRAM_STREAM_INPUT_SIZE {
         return Err(StreamError::PacketSize(opts.packet_bytes));
     }
     let packets = packets(text, opts.packet_bytes)?;

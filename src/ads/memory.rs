@@ -16,11 +16,8 @@ use super::backend::{
     StreamWriteOutcome,
 };
 use crate::channel::{HmiCommands, Mode, State};
+use crate::source::stream::{MAX_PROGRAM_STREAM_INPUT_SIZE, MAX_PROGRAM_STREAM_SIZE};
 
-/// MAX_PROGRAM_STREAM_SIZE: bytes the stream buffer holds.
-pub const STREAM_BUFFER_BYTES: usize = 4094;
-/// MAX_PROGRAM_STREAM_INPUT_SIZE: bytes one write may carry.
-pub const STREAM_INPUT_BYTES: usize = 992;
 /// Message of error 21476.
 pub const MSG_21476: &str = "21476 Streaming data does not contain a correct line end marker";
 
@@ -65,7 +62,7 @@ struct MemChannel {
 impl MemChannel {
     fn new() -> Self {
         MemChannel {
-            buffer: VecDeque::with_capacity(STREAM_BUFFER_BYTES),
+            buffer: VecDeque::with_capacity(MAX_PROGRAM_STREAM_SIZE),
             mode: mode::STANDBY,
             state: state::READY,
             program: String::new(),
@@ -203,7 +200,7 @@ impl CncBackend for MemoryBackend {
             Ok(c) => c,
             Err(e) => return StreamWriteOutcome::Refused(e),
         };
-        if data.is_empty() || data.len() > STREAM_INPUT_BYTES {
+        if data.is_empty() || data.len() > MAX_PROGRAM_STREAM_INPUT_SIZE {
             return StreamWriteOutcome::BadSize;
         }
         if !lines_end_with_crlf(data) {
@@ -213,7 +210,7 @@ impl CncBackend for MemoryBackend {
             c.buffer.clear();
             return StreamWriteOutcome::NoLineEnd;
         }
-        if c.buffer.len() + data.len() > STREAM_BUFFER_BYTES {
+        if c.buffer.len() + data.len() > MAX_PROGRAM_STREAM_SIZE {
             c.warnings_11012 += 1;
             return StreamWriteOutcome::Full;
         }
@@ -293,7 +290,7 @@ impl CncBackend for MemoryBackend {
         let c = self.ch(ch)?;
         Ok(StreamFill {
             used_bytes: c.buffer.len() as u32,
-            free_bytes: (STREAM_BUFFER_BYTES - c.buffer.len()) as u32,
+            free_bytes: (MAX_PROGRAM_STREAM_SIZE - c.buffer.len()) as u32,
         })
     }
 
@@ -359,7 +356,7 @@ impl MemChannel {
             state: State::from_i32(self.state).unwrap_or(State::Ready),
             block_counter: self.block_counter,
             stream_used: self.buffer.len(),
-            stream_free: STREAM_BUFFER_BYTES - self.buffer.len(),
+            stream_free: MAX_PROGRAM_STREAM_SIZE - self.buffer.len(),
             positions: ['X', 'Y', 'Z'].into_iter().zip(self.positions_mm).collect(),
             last_error: (!self.last_error.is_empty()).then(|| (21476, MSG_21476.to_string())),
             override_pct: self.override_percent,
@@ -403,7 +400,10 @@ mod tests {
         }
         assert_eq!(b.stream_write(1, &line), StreamWriteOutcome::Full);
         assert_eq!(b.warnings_11012(1), 1);
-        assert_eq!(b.stream_fill(1).unwrap().free_bytes, 4094 - 4 * 992);
+        assert_eq!(
+            b.stream_fill(1).unwrap().free_bytes as usize,
+            MAX_PROGRAM_STREAM_SIZE - 4 * MAX_PROGRAM_STREAM_INPUT_SIZE
+        );
         assert_eq!(b.stream_write(1, &[b'X'; 993]), StreamWriteOutcome::BadSize);
     }
 }

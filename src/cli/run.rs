@@ -15,6 +15,7 @@ use crate::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
 };
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
+use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 use super::exit;
 
@@ -39,7 +40,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub stream: Option<PathBuf>,
     /// Largest packet the feeder writes, bytes (1..=992).
-    #[arg(value_parser = packet_bytes, long, default_value_t = 992)]
+    #[arg(value_parser = packet_bytes, long, default_value_t = MAX_PROGRAM_STREAM_INPUT_SIZE)]
     pub packet: usize,
     /// One write attempt every this many ticks.
     #[arg(long, default_value_t = 1)]
@@ -86,7 +87,7 @@ impl RunArgs {
             params: PathBuf::from("params/startup.lis"),
             channel: 1,
             stream: Some(PathBuf::from("nc/demo.nc")),
-            packet: 992,
+            packet: MAX_PROGRAM_STREAM_INPUT_SIZE,
             // A client offering a packet every 250 ms, as a PLC task might: the demo meets
             // a full buffer a few times instead of on every tick.
             every: 250,
@@ -385,7 +386,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
 /// `--packet`: 1..=992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE, ISG FCT-C19 Data streaming);
 /// a larger packet would be refused by every write, so it is refused here, up front.
 pub fn packet_bytes(s: &str) -> Result<usize, String> {
-    let max = crate::ads::client::MAX_PACKET_BYTES;
+    let max = MAX_PROGRAM_STREAM_INPUT_SIZE;
     match s.parse::<usize>() {
         Ok(n) if (1..=max).contains(&n) => Ok(n),
         Ok(n) => Err(format!("{n} is not in 1..={max}")),

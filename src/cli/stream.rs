@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress, MAX_PACKET_BYTES};
+use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress};
+use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::ads::frame::{AmsAddr, AmsNetId};
@@ -28,7 +29,7 @@ pub struct StreamArgs {
     #[arg(long, default_value_t = 1)]
     pub channel: u16,
     /// Largest packet in bytes (whole lines), 1..=992.
-    #[arg(long, value_parser = super::run::packet_bytes, default_value_t = MAX_PACKET_BYTES)]
+    #[arg(long, value_parser = super::run::packet_bytes, default_value_t = MAX_PROGRAM_STREAM_INPUT_SIZE)]
     pub packet: usize,
     /// Start the streaming program first (AUTOMATIC, program name, ACTIVE).
     #[arg(long)]
