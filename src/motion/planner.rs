@@ -331,7 +331,9 @@ impl Planner {
             action,
             silent,
         } = b;
-        let prog = info.prog.clone();
+        // Only the program end keeps its program's name: no reference count traffic for the
+        // other blocks.
+        let prog = matches!(action, Action::End { .. }).then(|| info.prog.clone());
         let info = (!silent).then_some(info);
         // Tool radius compensation: every move while it is on (and the G40 block) goes
         // through the compensator; splines: G1 points in spline mode go to the spline. A plain
@@ -378,7 +380,10 @@ impl Planner {
             },
             Action::Flush(k) => EntryKind::Flush(k),
             Action::Stop { optional } => EntryKind::Stop { optional },
-            Action::End { m } => EntryKind::End { m, prog },
+            Action::End { m } => EntryKind::End {
+                m,
+                prog: prog.unwrap_or_else(|| std::sync::Arc::from("")),
+            },
             Action::Move(mut mv) => {
                 if let Some(arc) = self.blend_corner(&mut mv) {
                     self.push_move(None, arc);
