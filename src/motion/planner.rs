@@ -526,6 +526,11 @@ impl Planner {
 
     /// A stop while compensation is on: the waiting element ends at its own offset end.
     fn comp_finish(&mut self) {
+        // Checked before `take`: taking moves the whole (large) option even when it is empty,
+        // and this runs for every block.
+        if self.comp.is_none() {
+            return;
+        }
         let Some(mut c) = self.comp.take() else {
             return;
         };
@@ -572,6 +577,10 @@ impl Planner {
 
     /// End the spline: the rest of its curve and everything waiting for it.
     fn finish_spline(&mut self) {
+        // As in `comp_finish`: no move of the empty option for every block.
+        if self.spline.is_none() {
+            return;
+        }
         let Some(sp) = self.spline.take() else { return };
         let mut out = std::mem::take(&mut self.spline_out);
         sp.finish(&mut out);
