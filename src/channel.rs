@@ -947,8 +947,9 @@ impl Channel {
                         self.set_state(tick, State::Hold);
                     }
                 }
-                MotionNote::Error { code, msg } => {
-                    self.raise_error(tick, code, msg, None, None);
+                MotionNote::Error { code, msg, block } => {
+                    let (prog, line) = block.unzip();
+                    self.raise_error(tick, code, msg, prog, line);
                     break;
                 }
                 MotionNote::End { m, prog } => {

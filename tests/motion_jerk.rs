@@ -89,7 +89,7 @@ fn run_to_end(
         if let Some(c) = check.as_deref_mut() {
             c.record(m.position());
         }
-        if let Some(MotionNote::Error { code, msg }) =
+        if let Some(MotionNote::Error { code, msg, .. }) =
             notes.iter().find(|n| matches!(n, MotionNote::Error { .. }))
         {
             panic!("motion error {code}: {msg}");

@@ -1,5 +1,6 @@
 //! `ncchannel serve`: the channels in real time behind an ADS server, for real clients.
 
+use std::io::Write;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -36,9 +37,9 @@ pub struct ServeArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Stop after this many seconds (default: run until SIGINT/SIGTERM).
-    #[arg(long)]
-    pub seconds: Option<f64>,
+    /// Stop after this many seconds, 0 to 1e9 (default: run until SIGINT/SIGTERM).
+    #[arg(long, value_parser = run_seconds)]
+    pub seconds: Option<Duration>,
     /// Soak external clients: inject the scenario's [faults] and check the invariants on what
     /// they write (the scenario's `params` replaces --params). Exit 1 on a violation.
     #[arg(long)]
@@ -149,8 +150,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         Err(e) => eprintln!("ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"),
     }
     let stop = rt.stop_handle();
-    if let Some(s) = args.seconds {
-        let d = Duration::from_secs_f64(s.max(0.0));
+    if let Some(d) = args.seconds {
         std::thread::spawn(move || {
             std::thread::sleep(d);
             stop.stop();
@@ -160,21 +160,39 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
     let (mut machine, stats) = rt.into_inner();
+    // The log first, then the words: `writeln!` rather than `eprintln!`, whose panic on a
+    // closed stderr (a supervisor that went away) would lose the stop's exit code.
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    eprintln!(
+    let mut err = std::io::stderr().lock();
+    let _ = writeln!(
+        err,
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     );
     match log {
-        Ok(lines) if args.events.is_some() => eprintln!("event log: {lines} lines"),
+        Ok(lines) if args.events.is_some() => {
+            let _ = writeln!(err, "event log: {lines} lines");
+        }
         Ok(_) => {}
         Err(e) => {
-            eprintln!("ncchannel serve: event log: {e}");
+            let _ = writeln!(err, "ncchannel serve: event log: {e}");
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }
     ExitCode::from(exit::OK)
+}
+
+/// `--seconds`: a finite number of seconds from 0 to 1e9 (about 31 years); "inf", NaN or a
+/// negative number is a usage error rather than a panic or a silent default.
+fn run_seconds(s: &str) -> Result<Duration, String> {
+    let v: f64 = s.trim().parse().map_err(|e| format!("{e}"))?;
+    if !(0.0..=1e9).contains(&v) {
+        return Err(format!(
+            "{v} is not a number of seconds from 0 to 1e9 (leave --seconds out to run until stopped)"
+        ));
+    }
+    Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
 }

@@ -87,7 +87,7 @@ pub fn run(
     if let Some(s) = &signal {
         rt.stop_on(s.flag());
     }
-    let limit = args.seconds.map(|s| Duration::from_secs_f64(s.max(0.0)));
+    let limit = args.seconds;
     let warmup = limit.map_or(Duration::from_secs(10), |l| {
         l.mul_f64(scenario.invariants.warmup)
     });

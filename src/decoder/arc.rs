@@ -4,14 +4,25 @@ use std::f64::consts::TAU;
 
 use crate::queue::{Move, MoveKind, Plane, Position};
 
-#[derive(Debug, Clone, PartialEq)]
+/// Largest circle radius accepted, mm (1 km): beyond any machine's travel, so a larger value
+/// is a typing or post-processor error, and a circle of 1e18 mm would never end.
+pub const MAX_ARC_RADIUS_MM: f64 = 1.0e6;
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ArcError {
     /// Start and end radius differ by more than the tolerance.
+    #[error("start radius {r_start_mm} mm and end radius {r_end_mm} mm differ")]
     Inconsistent { r_start_mm: f64, r_end_mm: f64 },
     /// R smaller than half the chord.
+    #[error("R {r_mm} mm is smaller than half the chord of {chord_mm} mm")]
     RadiusTooSmall { r_mm: f64, chord_mm: f64 },
     /// Neither centre nor radius, or a zero radius.
+    #[error("no centre (I/J/K) or radius (R), or a zero radius")]
     NoCenter,
+    /// A centre or radius no real circle has: not finite, or larger than
+    /// [`MAX_ARC_RADIUS_MM`].
+    #[error("radius {r_mm} mm is not a circle a machine can run (at most 1000000 mm)")]
+    TooLarge { r_mm: f64 },
 }
 
 /// What a G2/G3 block programs besides its end point.
@@ -43,6 +54,14 @@ pub fn arc_move(
     } = *spec;
     let (a, b, _) = plane.axes();
     let (sa, sb, ea, eb) = (start[a], start[b], end[a], end[b]);
+    let too_large = |v: f64| !v.is_finite() || v.abs() > MAX_ARC_RADIUS_MM;
+    if let Some(v) = [ijk[a], ijk[b], r]
+        .into_iter()
+        .flatten()
+        .find(|&v| too_large(v))
+    {
+        return Err(ArcError::TooLarge { r_mm: v.abs() });
+    }
     let center = if ijk[a].is_some() || ijk[b].is_some() {
         [sa + ijk[a].unwrap_or(0.0), sb + ijk[b].unwrap_or(0.0)]
     } else if let Some(r) = r {
@@ -54,6 +73,9 @@ pub fn arc_move(
     let r1 = (ea - center[0]).hypot(eb - center[1]);
     if r0 <= f64::EPSILON {
         return Err(ArcError::NoCenter);
+    }
+    if too_large(r0) {
+        return Err(ArcError::TooLarge { r_mm: r0 });
     }
     if (r0 - r1).abs() > tolerance_mm {
         return Err(ArcError::Inconsistent {

@@ -337,12 +337,7 @@ impl Decoder {
             feed,
             self.settings.arc_tolerance_mm,
         )
-        .map_err(|e| {
-            DecodeError::new(
-                codes::ARC_INCONSISTENT,
-                format!("circle not consistent: {e:?}"),
-            )
-        })
+        .map_err(|e| DecodeError::new(codes::ARC_INCONSISTENT, format!("circle: {e}")))
     }
 
     /// Step 5: H functions are reported; M17/M29 return, M2/M30 end the program; a block

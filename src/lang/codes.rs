@@ -108,6 +108,11 @@ pub const WORD_TWICE: u32 = 90135;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
 /// elements do not meet, no tool data for the D word, or compensation outside G17.
 pub const TRC_IMPOSSIBLE: u32 = 90140;
+/// A programmed move leaves an axis' software limits (runtime.toml `soft_limit_min_mm` /
+/// `soft_limit_max_mm`, the kernel's P-AXIS-00177 / P-AXIS-00178): refused in path
+/// preparation, before the move starts, as the kernel's default behaviour ERROR
+/// (P-AXIS-00554) does. ISG's own number for this is not public.
+pub const SOFT_LIMIT: u32 = 90141;
 /// More variables than the store holds.
 pub const TOO_MANY_VARIABLES: u32 = 90152;
 /// `#CACHE` while the file cache is disabled.

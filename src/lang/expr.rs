@@ -343,7 +343,11 @@ impl<'a> Ctx<'a> {
                     self.height.set(0);
                     Ok((&i[n..], Expr::Num(v)))
                 }
-                None => fail(i, SYNTAX, "number expected"),
+                None => fail(
+                    i,
+                    SYNTAX,
+                    "number expected (a number has at most 308 integer digits)",
+                ),
             },
             b'@' => {
                 let (rest, v) = self.var_ref(i)?;

@@ -61,7 +61,9 @@ pub fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
     // `str::parse` accepts anyway).
     let text = std::str::from_utf8(&s[..i]).ok()?;
     let v: f64 = text.parse().ok()?;
-    Some((v, i))
+    // More than 308 integer digits: beyond f64, and no machine value. Not a literal (the
+    // callers refuse it as 20200) rather than an infinity every later step must guard.
+    v.is_finite().then_some((v, i))
 }
 
 #[cfg(test)]

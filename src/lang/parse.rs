@@ -473,7 +473,10 @@ fn dialect_g(i: &str, g: u32) -> Result<(), nom::Err<PErr<'_>>> {
 }
 
 fn word_value_msg(letter: u8) -> String {
-    format!("number or [expression] expected after {}", letter as char)
+    format!(
+        "number or [expression] expected after {} (a number has at most 308 integer digits)",
+        letter as char
+    )
 }
 
 /// A G or M number: a non-negative whole number.

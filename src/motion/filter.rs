@@ -73,6 +73,10 @@ impl Stage {
         self.ring[self.head] = p;
         self.head = (self.head + 1) % n;
         if self.settled() {
+            // Every entry is p: the sum relative to p is exactly 0. Keeping the old sum would
+            // leave out this push's update, an offset the first output after rest carries.
+            self.origin = p;
+            self.sum = [0.0; MAX_AXES];
             self.out = p;
             return p;
         }
@@ -199,6 +203,38 @@ pub fn jerk_window_s(axes: &[super::AxisLimits]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The mean of the last `n` inputs, the ring starting full of `start`.
+    fn naive_means(n: usize, start: f64, inputs: &[f64]) -> Vec<f64> {
+        let mut all = vec![start; n];
+        all.extend_from_slice(inputs);
+        (0..inputs.len())
+            .map(|k| all[k + 1..k + 1 + n].iter().sum::<f64>() / n as f64)
+            .collect()
+    }
+
+    #[test]
+    fn leaving_rest_after_settling_starts_from_the_exact_mean() {
+        // Move, stand long enough to settle, move again: every output is the plain mean of
+        // the window. (The settled pushes once skipped the running sum's update, so the first
+        // output after rest was off by one update.)
+        let n = 5;
+        // Every length of rest, so the departure falls at every place of the ring.
+        for hold in n..3 * n {
+            let mut inputs: Vec<f64> = (1..=7).map(|k| k as f64 * 0.3).collect();
+            inputs.extend(std::iter::repeat_n(2.1, hold));
+            inputs.extend((1..=9).map(|k| 2.1 - k as f64 * 0.7));
+            let mut st = Stage::new(n, [0.0; MAX_AXES]);
+            let want = naive_means(n, 0.0, &inputs);
+            for (k, (&x, &w)) in inputs.iter().zip(&want).enumerate() {
+                let got = st.push([x, 0.0, 0.0, 0.0, 0.0, 0.0])[0];
+                assert!(
+                    (got - w).abs() < 1e-12,
+                    "rest {hold}, push {k}: {got} against the mean {w}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn a_step_becomes_a_ramp_and_settles_exactly() {

@@ -60,6 +60,8 @@ pub enum MotionNote {
     Error {
         code: u32,
         msg: String,
+        /// Program and line of the block it is about, where known.
+        block: Option<(String, u64)>,
     },
     /// The main program's end was reached: everything before it has run.
     End {
@@ -350,6 +352,7 @@ impl Motion {
                 notes.push(MotionNote::Error {
                     code: e.code,
                     msg: e.msg,
+                    block: e.block,
                 });
             }
             self.planner.plan_if_needed(self.override_pct, self.dt_s);

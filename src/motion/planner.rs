@@ -33,13 +33,14 @@
 use std::collections::VecDeque;
 
 use crate::lang::block::FlushKind;
+use crate::lang::codes::SOFT_LIMIT;
 use crate::queue::{
-    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
+    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, AXIS_LETTERS, MAX_AXES,
 };
 
 use super::interpolator::tangent;
 use super::spline::Spline;
-use super::trc::{Comp, TrcError};
+use super::trc::{Comp, PlanError};
 use super::AxisLimits;
 
 /// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
@@ -227,7 +228,7 @@ pub struct Planner {
     /// Tool radii by D number, mm.
     tool_radii: Vec<(u32, f64)>,
     /// An error found while planning (compensation impossible), for the channel.
-    error: Option<TrcError>,
+    error: Option<PlanError>,
 }
 
 impl Planner {
@@ -312,6 +313,49 @@ impl Planner {
         self.dirty = true;
     }
 
+    /// Software limit check of a programmed move (TF5200 "Software limit switches": the
+    /// command positions are checked in path preparation): its end point and, for an arc,
+    /// the extreme points of the swept circle. Reaching a limit is allowed, crossing it is not.
+    fn within_soft_limits(&self, mv: &Move) -> Result<(), PlanError> {
+        let check = |axis: usize, v: f64| -> Result<(), PlanError> {
+            match &self.axes[axis] {
+                Some(a) if v < a.min_mm || v > a.max_mm => Err(PlanError {
+                    code: SOFT_LIMIT,
+                    msg: format!(
+                        "axis {} would move to {v:.4} mm, outside its software limits {} .. {} mm",
+                        AXIS_LETTERS[axis] as char, a.min_mm, a.max_mm
+                    ),
+                    block: None,
+                }),
+                _ => Ok(()),
+            }
+        };
+        for (axis, &v) in mv.end.iter().enumerate() {
+            check(axis, v)?;
+        }
+        if let MoveKind::Arc {
+            plane,
+            center,
+            radius_mm,
+            cw,
+            sweep_rad,
+        } = mv.kind
+        {
+            let (a, b, _) = plane.axes();
+            let a0 = (mv.start[b] - center[1]).atan2(mv.start[a] - center[0]);
+            // The four axis-parallel extremes of the circle, where the swept part holds them.
+            for k in 0..4 {
+                let theta = f64::from(k) * std::f64::consts::FRAC_PI_2;
+                let from_start = if cw { a0 - theta } else { theta - a0 };
+                if from_start.rem_euclid(std::f64::consts::TAU) <= sweep_rad {
+                    check(a, center[0] + radius_mm * theta.cos())?;
+                    check(b, center[1] + radius_mm * theta.sin())?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Take blocks from the queue into the window while it has room, applying the release
     /// rules.
     pub fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
@@ -358,6 +402,15 @@ impl Planner {
             self.finish_spline();
         }
         if let Action::Move(mv) = &action {
+            if let Err(mut e) = self.within_soft_limits(mv) {
+                // Refused before it enters the window: this move never starts; the channel
+                // goes to ERROR, naming the block.
+                e.block = info
+                    .as_ref()
+                    .map(|i| (i.prog.to_string(), u64::from(i.line)));
+                self.error = Some(e);
+                return;
+            }
             if comp_move {
                 self.comp_move(info, *mv);
                 return;
@@ -505,7 +558,7 @@ impl Planner {
     }
 
     /// G41/G42 switches on with `mv`, the radius of its D word's tool.
-    fn comp_select(&mut self, info: Option<BlockInfo>, mv: Move) -> Result<(), TrcError> {
+    fn comp_select(&mut self, info: Option<BlockInfo>, mv: Move) -> Result<(), PlanError> {
         let d = mv.path.tool_offset;
         let radius = if d == 0 {
             0.0
@@ -514,9 +567,10 @@ impl Planner {
                 .iter()
                 .find(|(n, _)| *n == d)
                 .map(|(_, r)| *r)
-                .ok_or_else(|| TrcError {
+                .ok_or_else(|| PlanError {
                     code: super::trc::TRC_IMPOSSIBLE,
                     msg: format!("tool radius compensation: no tool data for D{d}"),
+                    block: None,
                 })?
         };
         self.comp = Some(Comp::select(mv.path.comp, radius, mv));
@@ -566,7 +620,7 @@ impl Planner {
     }
 
     /// The error compensation ran into, once.
-    pub fn take_error(&mut self) -> Option<TrcError> {
+    pub fn take_error(&mut self) -> Option<PlanError> {
         self.error.take()
     }
 

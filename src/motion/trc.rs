@@ -19,17 +19,21 @@ pub use crate::lang::codes::TRC_IMPOSSIBLE;
 /// Below this two points are one, mm.
 const EPS_MM: f64 = 1e-9;
 
-/// Why compensation failed.
+/// Why planning a block failed (compensation impossible, a software limit crossed): an
+/// error number from `lang::codes` and its text, for the channel's error.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TrcError {
+pub struct PlanError {
     pub code: u32,
     pub msg: String,
+    /// The program and line of the refused block, where known.
+    pub block: Option<(String, u64)>,
 }
 
-fn impossible(msg: String) -> TrcError {
-    TrcError {
+fn impossible(msg: String) -> PlanError {
+    PlanError {
         code: TRC_IMPOSSIBLE,
         msg,
+        block: None,
     }
 }
 
@@ -70,7 +74,7 @@ impl Comp {
     }
 
     /// The next compensated block `mv` (same side): moves for the window, in order.
-    pub fn next(&mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), TrcError> {
+    pub fn next(&mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
         let b = self.offset(&mv)?;
         match std::mem::replace(&mut self.pending, Pending::Rest { at: mv.end }) {
             Pending::Selection(sel) => {
@@ -92,7 +96,7 @@ impl Comp {
     }
 
     /// A stop or the end of compensation: the waiting element ends at its own offset end.
-    pub fn finish(&mut self, out: &mut Vec<Move>) -> Result<(), TrcError> {
+    pub fn finish(&mut self, out: &mut Vec<Move>) -> Result<(), PlanError> {
         match std::mem::replace(&mut self.pending, Pending::Rest { at: [0.0; 6] }) {
             Pending::Selection(sel) => {
                 let end = self.offset_point(&sel, true);
@@ -110,7 +114,7 @@ impl Comp {
     }
 
     /// Deselection by the G40 block `mv`: the waiting element, then a line to `mv`'s end.
-    pub fn deselect(mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), TrcError> {
+    pub fn deselect(mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
         self.finish(out)?;
         if let Pending::Rest { at } = self.pending {
             out.push(line(at, mv.end, &mv));
@@ -147,7 +151,7 @@ impl Comp {
     }
 
     /// The offset element of `m`.
-    fn offset(&mut self, m: &Move) -> Result<Move, TrcError> {
+    fn offset(&mut self, m: &Move) -> Result<Move, PlanError> {
         let mut o = *m;
         match m.kind {
             MoveKind::Arc {
@@ -203,7 +207,7 @@ impl Comp {
         prog_a: &Move,
         mut b: Move,
         out: &mut Vec<Move>,
-    ) -> Result<Move, TrcError> {
+    ) -> Result<Move, PlanError> {
         if dist2(&a.end, &b.start) <= EPS_MM {
             b.start = a.end;
             out.push(a);
