@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::io::{self, Read, Write};
 use std::net::{IpAddr, Ipv4Addr, Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::str::FromStr;
-use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -30,6 +30,19 @@ pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALH
 pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
 /// Default bound on notification handles per connection.
 pub const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
+/// Default budget of notification samples per second for the whole server: every handle costs
+/// 1 / cycle, and a handle that would exceed the budget is answered 0x716, so notifications
+/// can never cost the cycle its period, however many connections ask (docs/ads-limits.md).
+pub const DEFAULT_MAX_NOTIFICATION_RATE_PER_S: u64 = 20_000;
+/// A new connection must send its first whole frame within this time, and a frame once begun
+/// must arrive whole within it: a silent or trickling client cannot hold a connection slot.
+/// A client that has sent a frame may then stay idle as long as it likes (HMIs do).
+pub const FRAME_DEADLINE: Duration = Duration::from_secs(10);
+/// How often a blocked read wakes to check the deadline and the server's stop.
+const READ_POLL: Duration = Duration::from_millis(500);
+/// Distinct unrouted NetIds / unknown router commands logged per connection; after that, one
+/// last line says further ones are not logged (log lines per frame would be a log flood).
+const MAX_LOGGED_PER_CONNECTION: usize = 8;
 /// Notification cycle times are clamped to this range.
 pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
 pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
@@ -80,6 +93,9 @@ pub struct ServerConfig {
     pub max_connections: usize,
     /// Notification handles per connection; more are answered 0x716.
     pub max_notifications: usize,
+    /// Notification samples per second, all connections together; a handle that would
+    /// exceed it is answered 0x716.
+    pub max_notification_rate_per_s: u64,
     /// Route allow-list; empty = allow all. A client is served when its peer IP or the
     /// source NetId of its frame is listed; others are dropped silently (after a log line),
     /// as a router without a route drops them.
@@ -95,6 +111,7 @@ impl Default for ServerConfig {
             max_frame_bytes: frame::DEFAULT_MAX_FRAME_BYTES,
             max_connections: DEFAULT_MAX_CONNECTIONS,
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
+            max_notification_rate_per_s: DEFAULT_MAX_NOTIFICATION_RATE_PER_S,
             allow: Vec::new(),
         }
     }
@@ -161,6 +178,33 @@ struct Shared {
     sockets: Mutex<HashMap<u64, TcpStream>>,
     /// Next AMS port handed out by the router "port connect" command.
     next_router_port: AtomicU16,
+    /// Notification samples per 1000 s of all handles of all connections (Σ 1000 / cycle).
+    notification_load: AtomicU64,
+}
+
+/// A handle's share of the notification budget: samples per 1000 s.
+fn notification_cost(cycle: Duration) -> u64 {
+    (1_000_000_000 / cycle.as_micros().max(1)) as u64
+}
+
+impl Shared {
+    /// Reserve `cost` of the notification budget; false when it would be exceeded.
+    fn reserve_notification(&self, cost: u64) -> bool {
+        let budget = self.config.max_notification_rate_per_s.saturating_mul(1000);
+        self.notification_load
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |load| {
+                (load + cost <= budget).then_some(load + cost)
+            })
+            .is_ok()
+    }
+
+    fn release_notifications(&self, cost: u64) {
+        let _ = self
+            .notification_load
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |load| {
+                Some(load.saturating_sub(cost))
+            });
+    }
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
@@ -197,6 +241,7 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
         active: AtomicUsize::new(0),
         sockets: Mutex::new(HashMap::new()),
         next_router_port: AtomicU16::new(32768),
+        notification_load: AtomicU64::new(0),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -287,6 +332,8 @@ struct Notification {
     /// False until the AddDeviceNotification response is written: no sample goes out before
     /// the client knows the handle.
     armed: bool,
+    /// Its share of the server's notification budget ([`notification_cost`]).
+    cost: u64,
 }
 
 /// After the AddDeviceNotification response is written, the first sample waits this long, so
@@ -309,6 +356,8 @@ enum ConnError {
     Frame(#[from] frame::FrameError),
     #[error("{0}")]
     Io(#[from] io::Error),
+    #[error("no whole frame within {0:?}: connection closed")]
+    Slow(Duration),
 }
 
 fn serve_connection(
@@ -319,6 +368,7 @@ fn serve_connection(
 ) -> Result<(), ConnError> {
     stream.set_nodelay(true)?;
     stream.set_write_timeout(Some(Duration::from_secs(5)))?;
+    stream.set_read_timeout(Some(READ_POLL))?;
     let writer: Writer = Arc::new(Mutex::new(stream.try_clone()?));
     let notifs = Arc::new(Notifications {
         table: Mutex::new(HashMap::new()),
@@ -328,6 +378,9 @@ fn serve_connection(
     });
     let result = request_loop(stream, peer, ip_routed, shared, &writer, &notifs);
     notifs.closed.store(true, Ordering::SeqCst);
+    // The connection's handles give their share of the budget back.
+    let freed: u64 = lock(&notifs.table).drain().map(|(_, n)| n.cost).sum();
+    shared.release_notifications(freed);
     let notifier = lock(&notifs.notifier).take();
     if let Some(h) = notifier {
         let _ = h.join();
@@ -348,6 +401,9 @@ fn request_loop(
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
     let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
+    let mut logged_router: Vec<u16> = Vec::new();
+    // The deadline of the frame being received (the first one from the connection's start).
+    let mut frame_deadline = Some(Instant::now() + FRAME_DEADLINE);
     loop {
         // Cut every complete frame out of the buffer (rule 1) before reading more; the
         // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
@@ -363,13 +419,12 @@ fn request_loop(
                             .allow
                             .contains(&RouteEntry::NetId(header.source.net_id));
                     if !routed {
-                        if !logged_unrouted.contains(&header.source.net_id) {
-                            log(format_args!(
+                        log_once(&mut logged_unrouted, header.source.net_id, || {
+                            format!(
                                 "{peer}: no route for source NetId {}: frames dropped",
                                 header.source.net_id
-                            ));
-                            logged_unrouted.push(header.source.net_id);
-                        }
+                            )
+                        });
                         continue;
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
@@ -386,10 +441,15 @@ fn request_loop(
                     // The client's port is gone: its notifications end, and the connection
                     // is closed, as the TwinCAT router does, so the client's disconnect()
                     // (which waits for the close) returns at once.
-                    close_port(notifs, &body);
+                    close_port(notifs, &body, shared);
                     return Ok(());
                 }
                 Frame::Router { command, body } => {
+                    if command != ROUTER_PORT_CONNECT {
+                        log_once(&mut logged_router, command, || {
+                            format!("{peer}: AMS router command 0x{command:04X} ignored")
+                        });
+                    }
                     if let Some(reply) = handle_router(command, &body, peer, shared) {
                         send(writer, &reply)?;
                     }
@@ -397,13 +457,27 @@ fn request_loop(
             }
         }
         buf.drain(..used);
+        if used > 0 {
+            frame_deadline = None;
+        }
+        if !buf.is_empty() && frame_deadline.is_none() {
+            frame_deadline = Some(Instant::now() + FRAME_DEADLINE);
+        }
         let n = match stream.read(&mut chunk) {
             Ok(0) => return Ok(()),
             Ok(n) => n,
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-            Err(e) if shared.stopping.load(Ordering::SeqCst) => {
-                let _ = e;
-                return Ok(());
+            Err(_) if shared.stopping.load(Ordering::SeqCst) => return Ok(()),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
+                ) =>
+            {
+                if frame_deadline.is_some_and(|d| Instant::now() >= d) {
+                    return Err(ConnError::Slow(FRAME_DEADLINE));
+                }
+                continue;
             }
             Err(e) => return Err(e.into()),
         };
@@ -411,17 +485,41 @@ fn request_loop(
     }
 }
 
+/// Log a line for `key` the first time it is seen on this connection, up to
+/// [`MAX_LOGGED_PER_CONNECTION`] keys; then one line that further ones are not logged.
+fn log_once<K: PartialEq>(seen: &mut Vec<K>, key: K, line: impl FnOnce() -> String) {
+    if seen.contains(&key) || seen.len() > MAX_LOGGED_PER_CONNECTION {
+        return;
+    }
+    if seen.len() == MAX_LOGGED_PER_CONNECTION {
+        log("further ones on this connection are not logged");
+    } else {
+        log(line());
+    }
+    seen.push(key);
+}
+
 /// AMS/TCP command 0x0001: a client closes its AMS port (body: the port, u16 LE).
 const PORT_CLOSE: u16 = 0x0001;
+/// AMS/TCP command 0x1000: a client asks the router for a port.
+const ROUTER_PORT_CONNECT: u16 = 0x1000;
 
 /// Drop the notifications of the port a 0x0001 frame closes (all of them when the body does
 /// not name a port).
-fn close_port(notifs: &Notifications, body: &[u8]) {
+fn close_port(notifs: &Notifications, body: &[u8], shared: &Shared) {
     let port = match body {
         [a, b, ..] => Some(u16::from_le_bytes([*a, *b])),
         _ => None,
     };
-    lock(&notifs.table).retain(|_, n| port.is_some_and(|p| n.client.port != p));
+    let mut freed = 0;
+    lock(&notifs.table).retain(|_, n| {
+        let keep = port.is_some_and(|p| n.client.port != p);
+        if !keep {
+            freed += n.cost;
+        }
+        keep
+    });
+    shared.release_notifications(freed);
 }
 
 /// Let the notifications just added send their first sample, [`FIRST_SAMPLE_DELAY`] from now.
@@ -437,10 +535,7 @@ fn arm_notifications(notifs: &Notifications) {
 /// e.g. the `ads` crate's `Source::Request`) gets a NetId made from the peer's IPv4 address
 /// plus `.1.1` and a fresh port; everything else is ignored.
 fn handle_router(command: u16, _body: &[u8], peer: SocketAddr, shared: &Shared) -> Option<Vec<u8>> {
-    if command != 0x1000 {
-        log(format_args!(
-            "{peer}: AMS router command 0x{command:04X} ignored"
-        ));
+    if command != ROUTER_PORT_CONNECT {
         return None;
     }
     let ip = match peer.ip() {
@@ -544,7 +639,11 @@ fn handle_request(
                 response::handle(result, handle)
             }
             Request::DelNotification { handle } => {
-                let removed = lock(&notifs.table).remove(&handle).is_some();
+                let removed = lock(&notifs.table).remove(&handle);
+                if let Some(n) = &removed {
+                    shared.release_notifications(n.cost);
+                }
+                let removed = removed.is_some();
                 response::result_only(if removed {
                     AdsResult::OK
                 } else {
@@ -585,7 +684,8 @@ fn add_notification(
     let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
         .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
     let mut table = lock(&notifs.table);
-    if table.len() >= shared.config.max_notifications {
+    let cost = notification_cost(cycle);
+    if table.len() >= shared.config.max_notifications || !shared.reserve_notification(cost) {
         return (AdsResult::NO_MORE_HANDLES, 0);
     }
     let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);
@@ -601,6 +701,7 @@ fn add_notification(
             next_due: Instant::now() + MAX_NOTIFICATION_CYCLE,
             last: None,
             armed: false,
+            cost,
         },
     );
     drop(table);

@@ -62,7 +62,9 @@ pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) ->
         net_id: Some(args.net_id.unwrap_or(ads.net_id)),
         max_frame_bytes: ads.max_frame_bytes as usize,
         allow: ads.allowed_clients.clone(),
-        ..ServerConfig::default()
+        max_connections: ads.max_connections as usize,
+        max_notifications: ads.max_notifications_per_connection as usize,
+        max_notification_rate_per_s: u64::from(ads.max_notification_rate_per_s),
     }
 }
 

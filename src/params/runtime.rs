@@ -158,6 +158,12 @@ pub struct AdsConfig {
     pub max_frame_bytes: u32,
     /// Clients allowed to connect: AMS NetIds or IP addresses (default empty = everyone).
     pub allowed_clients: Vec<RouteEntry>,
+    /// Simultaneous connections (default 64); more are closed at once.
+    pub max_connections: u32,
+    /// Notification handles per connection (default 256); more are answered 0x716.
+    pub max_notifications_per_connection: u32,
+    /// Notification samples per second, all connections together (default 20000).
+    pub max_notification_rate_per_s: u32,
 }
 
 impl Default for AdsConfig {
@@ -167,6 +173,9 @@ impl Default for AdsConfig {
             net_id: AmsNetId([127, 0, 0, 1, 1, 1]),
             max_frame_bytes: 65536,
             allowed_clients: Vec::new(),
+            max_connections: 64,
+            max_notifications_per_connection: 256,
+            max_notification_rate_per_s: 20_000,
         }
     }
 }
@@ -496,6 +505,23 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             "max_frame_bytes",
             format!("{fb} is not in 64 ... 16777216"),
         );
+    }
+    for (key, v, max) in [
+        ("max_connections", cfg.ads.max_connections, 1024),
+        (
+            "max_notifications_per_connection",
+            cfg.ads.max_notifications_per_connection,
+            4096,
+        ),
+        (
+            "max_notification_rate_per_s",
+            cfg.ads.max_notification_rate_per_s,
+            1_000_000,
+        ),
+    ] {
+        if !(1..=max).contains(&v) {
+            fail("ads", None, key, format!("{v} is not in 1 ... {max}"));
+        }
     }
     errs
 }
