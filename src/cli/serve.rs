@@ -164,6 +164,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     // The log first, then the words: `writeln!` rather than `eprintln!`, whose panic on a
     // closed stderr (a supervisor that went away) would lose the stop's exit code.
+    let dropped = machine.events_dropped();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
     let mut err = std::io::stderr().lock();
@@ -177,6 +178,13 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     match log {
         Ok(lines) if args.events.is_some() => {
             let _ = writeln!(err, "event log: {lines} lines");
+            if dropped > 0 {
+                let _ = writeln!(
+                    err,
+                    "event log: {dropped} events dropped: its reader fell more than {} ticks behind",
+                    crate::report::event::MAX_PENDING_BATCHES
+                );
+            }
         }
         Ok(_) => {}
         Err(e) => {

@@ -8,10 +8,12 @@
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError};
 use serde::Serialize;
 
 use crate::runtime::Tick;
@@ -211,6 +213,20 @@ struct Writer {
     batches: Sender<Vec<Event>>,
     recycled: Receiver<Vec<Event>>,
     thread: JoinHandle<io::Result<u64>>,
+    dropped: Arc<Dropped>,
+}
+
+/// Batches (ticks) waiting for the writer at most. A reader that stops reading (a pipe nobody
+/// drains) must neither block the cycle nor grow memory without bound: beyond this backlog
+/// (about 4 s of ticks at 1 ms) batches are dropped, counted, and the log says so in a line
+/// `{"ev":"events_dropped","count":N}` where the gap is.
+pub const MAX_PENDING_BATCHES: usize = 4096;
+
+/// Events dropped because the writer was behind: in all, and since the last marker line.
+#[derive(Debug, Default)]
+struct Dropped {
+    total: AtomicU64,
+    unmarked: AtomicU64,
 }
 
 impl EventLog {
@@ -254,8 +270,10 @@ impl EventLog {
     /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
     /// [`EventLog::finish`] never leaves a cut line.
     pub fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
-        let (tx, rx) = crossbeam_channel::unbounded::<Vec<Event>>();
+        let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_PENDING_BATCHES);
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
+        let dropped = Arc::new(Dropped::default());
+        let gap = Arc::clone(&dropped);
         let thread = std::thread::Builder::new()
             .name("ncchannel-events".into())
             .spawn(move || -> io::Result<u64> {
@@ -277,6 +295,7 @@ impl EventLog {
                         }
                         Err(RecvTimeoutError::Disconnected) => break,
                     };
+                    write_gap(&mut out, &gap)?;
                     for ev in batch.drain(..) {
                         serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
                         out.write_all(b"\n")?;
@@ -290,6 +309,7 @@ impl EventLog {
                         dirty_since = None;
                     }
                 }
+                write_gap(&mut out, &gap)?;
                 out.flush()?;
                 Ok(lines)
             });
@@ -299,6 +319,7 @@ impl EventLog {
                     batches: tx,
                     recycled: recycle_rx,
                     thread,
+                    dropped,
                 }),
             },
             // Without a thread there is no log; the run itself must not fail for it.
@@ -327,11 +348,24 @@ impl EventLog {
             Some(w) => {
                 let spare = w.recycled.try_recv().unwrap_or_default();
                 let batch = std::mem::replace(events, spare);
-                // The writer only goes away on an I/O error; then events are lost, and
-                // `finish` reports the error.
-                let _ = w.batches.send(batch);
+                // Never wait for the writer: a full backlog drops the batch (counted, and
+                // marked in the log). The writer only goes away on an I/O error; then events
+                // are lost, and `finish` reports the error.
+                if let Err(TrySendError::Full(b)) = w.batches.try_send(batch) {
+                    let n = b.len() as u64;
+                    w.dropped.total.fetch_add(n, Ordering::Relaxed);
+                    w.dropped.unmarked.fetch_add(n, Ordering::Relaxed);
+                }
             }
         }
+    }
+
+    /// Events dropped so far because the log's reader was too slow (see
+    /// [`MAX_PENDING_BATCHES`]).
+    pub fn dropped(&self) -> u64 {
+        self.inner
+            .as_ref()
+            .map_or(0, |w| w.dropped.total.load(Ordering::Relaxed))
     }
 
     /// Write out everything emitted so far, join the writer and return the lines written.
@@ -351,6 +385,15 @@ impl EventLog {
             }
         }
     }
+}
+
+/// The marker line of a gap: events dropped since the last marker, if any.
+fn write_gap(out: &mut impl Write, dropped: &Dropped) -> io::Result<()> {
+    let n = dropped.unmarked.swap(0, Ordering::Relaxed);
+    if n > 0 {
+        writeln!(out, "{{\"ev\":\"events_dropped\",\"count\":{n}}}")?;
+    }
+    Ok(())
 }
 
 #[cfg(unix)]
@@ -399,6 +442,69 @@ mod tests {
         assert_eq!(
             e.to_json(),
             r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt","held":0}"#
+        );
+    }
+
+    /// A writer whose reader does not read: blocked until the gate opens.
+    struct Stalled {
+        gate: crossbeam_channel::Receiver<()>,
+        out: std::sync::Arc<std::sync::Mutex<Vec<u8>>>,
+        opened: bool,
+    }
+
+    impl Write for Stalled {
+        fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+            if !self.opened {
+                let _ = self.gate.recv();
+                self.opened = true;
+            }
+            self.out
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_reader_that_does_not_read_costs_bounded_memory_and_the_gap_is_marked() {
+        let (open, gate) = crossbeam_channel::bounded(1);
+        let out = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let w = Stalled {
+            gate,
+            out: std::sync::Arc::clone(&out),
+            opened: false,
+        };
+        let mut log = EventLog::to_writer_with(Box::new(w), FlushPolicy::EveryBatch);
+        let tick = Tick {
+            index: 0,
+            period: Duration::from_millis(1),
+            time: Duration::ZERO,
+        };
+        let extra = 100;
+        // One batch the writer holds while blocked, the backlog, then `extra` that cannot wait.
+        for _ in 0..1 + MAX_PENDING_BATCHES + extra {
+            let mut batch = vec![Event::new(&tick, 1, EventKind::Interrupt { held: 0 })];
+            log.emit(&mut batch);
+        }
+        // The writer holds the first batch, or has not taken it yet.
+        let dropped = log.dropped();
+        // Open the gate before asserting: a failed assertion must not leave the writer
+        // blocked while the log's drop waits for it.
+        let _ = open.send(());
+        let lines = log.finish().unwrap();
+        assert!(
+            (extra as u64..=extra as u64 + 1).contains(&dropped),
+            "{dropped} dropped"
+        );
+        assert_eq!(lines + dropped, (1 + MAX_PENDING_BATCHES + extra) as u64);
+        let text = String::from_utf8(out.lock().unwrap().clone()).unwrap();
+        assert!(
+            text.contains(&format!(r#"{{"ev":"events_dropped","count":{dropped}}}"#)),
+            "the gap is marked"
         );
     }
 }
