@@ -36,7 +36,7 @@ pub struct ServeArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Stop after this many seconds (default: run until SIGINT/SIGTERM).
+    /// Stop after this many seconds (default, or `inf`: run until SIGINT/SIGTERM).
     #[arg(long)]
     pub seconds: Option<f64>,
     /// Soak external clients: inject the scenario's [faults] and check the invariants on what
@@ -65,12 +65,33 @@ pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) ->
     }
 }
 
+/// `--seconds`: `None` runs until a signal (no value, `inf`, or longer than `Duration` holds);
+/// a negative or NaN value is a usage error. `Duration::from_secs_f64` would panic on those.
+pub(crate) fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String> {
+    match seconds {
+        None => Ok(None),
+        Some(s) if s.is_nan() || s < 0.0 => Err(format!("--seconds {s}: not a duration")),
+        Some(s) => Ok(Duration::try_from_secs_f64(s).ok()),
+    }
+}
+
+/// A report line on standard error that never panics: with stderr a closed pipe `eprintln!`
+/// would, after the event log is safe the run's outcome must not depend on it.
+pub(crate) fn report(msg: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{msg}");
+}
+
 pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
-    eprintln!("ncchannel serve: {msg}");
+    report(format_args!("ncchannel serve: {msg}"));
     ExitCode::from(exit::USAGE)
 }
 
 pub fn execute(mut args: ServeArgs) -> ExitCode {
+    let limit = match run_limit(args.seconds) {
+        Ok(l) => l,
+        Err(msg) => return usage(msg),
+    };
     let scenario = match &args.soak {
         None => None,
         Some(p) => match load_scenario(p) {
@@ -108,7 +129,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         };
         if let Some(c) = machine.channel_mut(1) {
             if let Err(e) = c.start(&tick0, p) {
-                eprintln!("ncchannel serve: --start {p}: {e}");
+                report(format_args!("ncchannel serve: --start {p}: {e}"));
             }
         }
     }
@@ -138,19 +159,20 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             Ok(s) => s,
             Err(e) => return usage(format!("cannot listen: {e}")),
         };
-    eprintln!(
+    report(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),
         period.as_micros()
-    );
+    ));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
-        Err(e) => eprintln!("ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"),
+        Err(e) => report(format_args!(
+            "ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"
+        )),
     }
     let stop = rt.stop_handle();
-    if let Some(s) = args.seconds {
-        let d = Duration::from_secs_f64(s.max(0.0));
+    if let Some(d) = limit {
         std::thread::spawn(move || {
             std::thread::sleep(d);
             stop.stop();
@@ -162,17 +184,17 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    eprintln!(
+    report(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
-    );
+    ));
     match log {
-        Ok(lines) if args.events.is_some() => eprintln!("event log: {lines} lines"),
+        Ok(lines) if args.events.is_some() => report(format_args!("event log: {lines} lines")),
         Ok(_) => {}
         Err(e) => {
-            eprintln!("ncchannel serve: event log: {e}");
+            report(format_args!("ncchannel serve: event log: {e}"));
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }
