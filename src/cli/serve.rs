@@ -9,7 +9,7 @@ use std::time::Duration;
 use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::{AmsNetId, ServerConfig};
 use crate::machine::{Machine, StopWhen};
-use crate::report::event::EventLog;
+use crate::report::event::{Backlog, EventLog};
 use crate::runtime::{Clock, Runtime, Tick};
 use crate::soak::external::{load_external, Supervised};
 use crate::soak::scenario::Scenario;
@@ -43,6 +43,10 @@ pub struct ServeArgs {
     /// they write (the scenario's `params` replaces --params). Exit 1 on a violation.
     #[arg(long)]
     pub soak: Option<PathBuf>,
+    /// Close an ADS connection that completed no frame for this many seconds while in the
+    /// middle of a frame or holding no notification handles (default 60; docs/ads-limits.md).
+    #[arg(long, value_name = "SECONDS")]
+    pub ads_idle_timeout: Option<f64>,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
@@ -61,6 +65,11 @@ pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) ->
         net_id: Some(args.net_id.unwrap_or(ads.net_id)),
         max_frame_bytes: ads.max_frame_bytes as usize,
         allow: ads.allowed_clients.clone(),
+        idle_timeout: args
+            .ads_idle_timeout
+            .and_then(|s| Duration::try_from_secs_f64(s).ok())
+            .filter(|d| !d.is_zero())
+            .unwrap_or(crate::ads::server::DEFAULT_IDLE_TIMEOUT),
         ..ServerConfig::default()
     }
 }
@@ -92,6 +101,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         Ok(l) => l,
         Err(msg) => return usage(msg),
     };
+    if let Some(s) = args.ads_idle_timeout {
+        if !(s.is_finite() && s > 0.0) {
+            return usage(format!("--ads-idle-timeout {s}: not a positive time"));
+        }
+    }
     let scenario = match &args.soak {
         None => None,
         Some(p) => match load_scenario(p) {
@@ -113,8 +127,9 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         // The soak's checks need the channels' events; without --events they go nowhere.
         None if scenario.is_some() => EventLog::to_writer(Box::new(std::io::sink())),
         None => EventLog::disabled(),
+        // Real time: a reader that falls behind loses events (counted), never the cycle's pace.
         Some(t) => match EventLog::open(t) {
-            Ok(l) => l,
+            Ok(l) => l.with_backlog(Backlog::Drop),
             Err(e) => return usage(format!("--events {t}: {e}")),
         },
     };

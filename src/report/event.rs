@@ -4,10 +4,18 @@
 //! buffer's batch leaves through [`EventLog::emit`] to a writer thread that serialises and
 //! writes in order. With logging off, [`EventBuffer::enabled`] is false and the channel skips
 //! building events at all.
+//!
+//! The queue to the writer is bounded ([`MAX_QUEUED_BATCHES`]). When it is full (the log's
+//! reader does not keep up: a pipe nobody reads), [`Backlog::Block`] makes the tick wait —
+//! right in virtual time, where nothing is late — and [`Backlog::Drop`] (real time, `serve`)
+//! drops the batch and counts it: the writer puts an `events_dropped` line into the log when
+//! it catches up, and on stderr at the end. Memory stays bounded either way.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -188,6 +196,22 @@ impl EventBuffer {
 /// `Vec`s run out and new ones are allocated.
 const RECYCLE_BATCHES: usize = 16;
 
+/// Batches (one tick's events each) waiting for the writer at most; see [`Backlog`].
+pub const MAX_QUEUED_BATCHES: usize = 4096;
+
+/// With [`Backlog::Drop`], how long [`EventLog::finish`] waits for a writer that is stuck
+/// on a reader that does not read before giving up on it.
+pub const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// What [`EventLog::emit`] does when [`MAX_QUEUED_BATCHES`] batches wait for the writer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backlog {
+    /// Wait for the writer (virtual time: the log is complete, the run slows down).
+    Block,
+    /// Drop the batch and count its events (real time: the cycle never waits for a reader).
+    Drop,
+}
+
 /// A file's buffered lines reach the file at least this often, so a `tail -f` of the log
 /// lags the channel by no more than this plus a tick.
 pub const FLUSH_INTERVAL: Duration = Duration::from_millis(100);
@@ -211,6 +235,9 @@ struct Writer {
     batches: Sender<Vec<Event>>,
     recycled: Receiver<Vec<Event>>,
     thread: JoinHandle<io::Result<u64>>,
+    backlog: Backlog,
+    /// Events dropped and not yet reported in the log.
+    dropped: Arc<AtomicU64>,
 }
 
 impl EventLog {
@@ -254,13 +281,27 @@ impl EventLog {
     /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
     /// [`EventLog::finish`] never leaves a cut line.
     pub fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
-        let (tx, rx) = crossbeam_channel::unbounded::<Vec<Event>>();
+        let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_QUEUED_BATCHES);
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
+        let dropped = Arc::new(AtomicU64::new(0));
+        let dropped_w = Arc::clone(&dropped);
         let thread = std::thread::Builder::new()
             .name("ncchannel-events".into())
             .spawn(move || -> io::Result<u64> {
                 let mut out = BufWriter::new(w);
                 let mut lines = 0u64;
+                let mut dropped_total = 0u64;
+                let mut note_dropped = |out: &mut BufWriter<Box<dyn Write + Send>>,
+                                        lines: &mut u64|
+                 -> io::Result<()> {
+                    let n = dropped_w.swap(0, Ordering::Relaxed);
+                    if n > 0 {
+                        dropped_total += n;
+                        writeln!(out, "{{\"ev\":\"events_dropped\",\"events\":{n}}}")?;
+                        *lines += 1;
+                    }
+                    Ok(())
+                };
                 // When the oldest unflushed line was written; None when all is flushed.
                 let mut dirty_since: Option<Instant> = None;
                 loop {
@@ -277,6 +318,7 @@ impl EventLog {
                         }
                         Err(RecvTimeoutError::Disconnected) => break,
                     };
+                    note_dropped(&mut out, &mut lines)?;
                     for ev in batch.drain(..) {
                         serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
                         out.write_all(b"\n")?;
@@ -290,7 +332,14 @@ impl EventLog {
                         dirty_since = None;
                     }
                 }
+                note_dropped(&mut out, &mut lines)?;
                 out.flush()?;
+                if dropped_total > 0 {
+                    let _ = writeln!(
+                        io::stderr().lock(),
+                        "ncchannel: event log: {dropped_total} events dropped (its reader did not keep up); the log marks where"
+                    );
+                }
                 Ok(lines)
             });
         match thread {
@@ -299,11 +348,21 @@ impl EventLog {
                     batches: tx,
                     recycled: recycle_rx,
                     thread,
+                    backlog: Backlog::Block,
+                    dropped,
                 }),
             },
             // Without a thread there is no log; the run itself must not fail for it.
             Err(_) => EventLog::disabled(),
         }
+    }
+
+    /// The same log with `backlog` for a full queue (default [`Backlog::Block`]).
+    pub fn with_backlog(mut self, backlog: Backlog) -> Self {
+        if let Some(w) = &mut self.inner {
+            w.backlog = backlog;
+        }
+        self
     }
 
     /// Whether events are written anywhere.
@@ -329,7 +388,19 @@ impl EventLog {
                 let batch = std::mem::replace(events, spare);
                 // The writer only goes away on an I/O error; then events are lost, and
                 // `finish` reports the error.
-                let _ = w.batches.send(batch);
+                match w.backlog {
+                    Backlog::Block => {
+                        let _ = w.batches.send(batch);
+                    }
+                    Backlog::Drop => {
+                        if let Err(e) = w.batches.try_send(batch) {
+                            let mut batch = e.into_inner();
+                            w.dropped.fetch_add(batch.len() as u64, Ordering::Relaxed);
+                            batch.clear();
+                            *events = batch;
+                        }
+                    }
+                }
             }
         }
     }
@@ -344,6 +415,21 @@ impl EventLog {
             None => Ok(0),
             Some(w) => {
                 drop(w.batches);
+                if w.backlog == Backlog::Drop {
+                    // A writer stuck on a reader that never reads would hold the stop for
+                    // ever; after FINISH_TIMEOUT it is left behind and the loss reported.
+                    let until = Instant::now() + FINISH_TIMEOUT;
+                    while !w.thread.is_finished() && Instant::now() < until {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                    if !w.thread.is_finished() {
+                        let queued = w.dropped.load(Ordering::Relaxed);
+                        return Err(io::Error::other(format!(
+                            "the log's reader did not read for {} s: the rest of the log was not written ({queued} events dropped besides)",
+                            FINISH_TIMEOUT.as_secs()
+                        )));
+                    }
+                }
                 match w.thread.join() {
                     Ok(r) => r,
                     Err(_) => Err(io::Error::other("event writer thread panicked")),
