@@ -41,8 +41,16 @@ pub struct ReceiveArgs {
     #[arg(long, value_name = "N")]
     pub max_transfers: Option<usize>,
     /// With --listen: end a connection silent for this many seconds (a broken transfer).
-    #[arg(long, value_name = "SECONDS")]
-    pub idle_timeout: Option<f64>,
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_IDLE_TIMEOUT_S)]
+    pub idle_timeout: f64,
+    /// Bytes one transfer may carry; beyond, the transfer ends and the program in progress is
+    /// cut off (default with --listen: 256 MiB; unbounded for a file or standard input).
+    #[arg(long, value_name = "BYTES")]
+    pub max_transfer_bytes: Option<u64>,
+    /// Programs one transfer may deliver; the next is dropped and the transfer ends
+    /// (default with --listen: 1000; unbounded for a file or standard input).
+    #[arg(long, value_name = "N")]
+    pub max_programs: Option<usize>,
     /// Replace existing program files (default: keep them and drop the received program).
     #[arg(long)]
     pub overwrite: bool,
@@ -65,6 +73,12 @@ pub struct ReceiveArgs {
 
 /// Where programs go without `--out`: the channel's first main-program search path, from the
 /// parameter lists, so received programs are ready to run.
+/// `--listen` defaults: a silent sender frees the port after 30 s; one transfer carries at
+/// most 256 MiB and 1000 programs (docs/ads-limits.md, "receive --listen").
+pub const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
+pub const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
+pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
+
 pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let params = super::run::locate(params);
     let config = crate::params::load(&params).map_err(|e| {
@@ -118,21 +132,28 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     } else {
         Anchor::Anywhere
     };
-    if args.listen.is_none() && (args.max_transfers.is_some() || args.idle_timeout.is_some()) {
-        return Err(Failure::Usage(
-            "--max-transfers and --idle-timeout need --listen".to_string(),
-        ));
+    if args.listen.is_none() && args.max_transfers.is_some() {
+        return Err(Failure::Usage("--max-transfers needs --listen".to_string()));
     }
     let markers = Markers::new(&args.start, &args.end, anchor)?;
     let template = NameTemplate::parse(&args.name_template)?;
     let idle = match args.idle_timeout {
-        None => None,
-        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => {
+        s if s.is_finite() && s > 0.0 && s < 1e9 => Duration::from_secs_f64(s),
+        s => {
             return Err(Failure::Usage(format!(
                 "--idle-timeout {s}: not a positive time"
             )))
         }
+    };
+    let listening = args.listen.is_some();
+    let limits = dnc::TransferLimits {
+        idle_timeout: Some(idle),
+        max_bytes: args
+            .max_transfer_bytes
+            .or(listening.then_some(DEFAULT_MAX_TRANSFER_BYTES)),
+        max_programs: args
+            .max_programs
+            .or(listening.then_some(DEFAULT_MAX_PROGRAMS)),
     };
     let out = match args.out.clone() {
         Some(o) => o,
@@ -161,10 +182,19 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         }
         let mut count = 0usize;
         while args.max_transfers.is_none_or(|m| count < m) {
-            let mut last = None;
-            dnc::receive_connections(&listener, Some(1), idle, &mut splitter, &mut writer, |r| {
-                last = Some(r.clone())
-            })?;
+            // One transfer's failure (a name the disk refuses, a full disk) refuses that
+            // transfer, with the reason; the port keeps serving the next sender.
+            let last = match dnc::receive_connection(&listener, &limits, &mut splitter, &mut writer)
+            {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    eprintln!("ncchannel receive: transfer refused: {e}");
+                    total.refused += 1;
+                    count += 1;
+                    std::thread::sleep(Duration::from_millis(10));
+                    None
+                }
+            };
             let stopping = signal
                 .as_ref()
                 .is_some_and(super::signal::StopSignal::raised);
@@ -181,23 +211,25 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         }
     } else {
         let report = match args.input.as_deref() {
-            None => dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?,
+            None => dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?,
             Some(p) if p == Path::new("-") => {
-                dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?
+                dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?
             }
             Some(p) => {
                 let f = File::open(p).map_err(|e| Failure::Io(format!("{}: {e}", p.display())))?;
-                dnc::receive(f, &mut splitter, &mut writer)?
+                dnc::receive_limited(f, &limits, &mut splitter, &mut writer)?
             }
         };
         total.add(&report);
     }
     total.print(&out);
-    Ok(if total.filed > 0 && total.cut_off == 0 {
-        exit::OK
-    } else {
-        exit::CHANNEL_ERROR
-    })
+    Ok(
+        if total.filed > 0 && total.cut_off == 0 && total.refused == 0 {
+            exit::OK
+        } else {
+            exit::CHANNEL_ERROR
+        },
+    )
 }
 
 /// A blocking `accept` does not return for a signal; once the stop flag is set, one
@@ -235,6 +267,7 @@ fn log_line(p: &ReceivedProgram) {
         Disposition::CutOffDropped => "cut off, dropped",
         Disposition::CutOffKept => "cut off, kept",
         Disposition::NameUnusable => "not filed",
+        Disposition::OverLimit => "over the limit, dropped",
     };
     let mut out = io::stdout().lock();
     let _ = writeln!(
@@ -267,6 +300,11 @@ fn log_line(p: &ReceivedProgram) {
             p.path.display(),
             p.reason.as_deref().unwrap_or("name unusable")
         ),
+        Disposition::OverLimit => eprintln!(
+            "ncchannel receive: the program from line {} was dropped: {}",
+            p.first_line,
+            p.reason.as_deref().unwrap_or("limit reached")
+        ),
         _ => {}
     }
 }
@@ -277,6 +315,8 @@ struct Totals {
     filed: usize,
     kept: usize,
     cut_off: usize,
+    /// Transfers refused by an error of the receiver (nothing of them filed).
+    refused: usize,
     bytes: u64,
 }
 
@@ -304,18 +344,22 @@ impl Totals {
                 eprintln!("ncchannel receive: transfer{from} timed out")
             }
             TransferEnd::Broken(e) => eprintln!("ncchannel receive: transfer{from} broke: {e}"),
+            TransferEnd::LimitReached(l) => eprintln!(
+                "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
+            ),
         }
     }
 
     fn print(&self, out: &Path) {
         println!(
-            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off",
+            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off, {} transfer(s) refused",
             self.filed,
             out.display(),
             self.transfers,
             self.bytes,
             self.kept,
-            self.cut_off
+            self.cut_off,
+            self.refused
         );
     }
 }

@@ -118,6 +118,9 @@ pub enum Disposition {
     /// The program could not be filed under its name (the name is taken by a directory, or a
     /// workpiece folder's name by a file); it was dropped and the transfer went on.
     NameUnusable,
+    /// The transfer had delivered its limit of programs; this one was dropped and the
+    /// transfer ended (`TransferLimits::max_programs`).
+    OverLimit,
 }
 
 /// One line of the receive log.
@@ -162,6 +165,10 @@ pub struct ProgramWriter {
     next_number: u32,
     records: Vec<ReceivedProgram>,
     log: Option<LogFn>,
+    /// Programs this transfer may still deliver (`None`: no limit).
+    programs_left: Option<usize>,
+    /// A program was dropped because `programs_left` was 0.
+    over_limit: bool,
 }
 
 impl ProgramWriter {
@@ -172,7 +179,21 @@ impl ProgramWriter {
             next_number: 1,
             records: Vec::new(),
             log: None,
+            programs_left: None,
+            over_limit: false,
         }
+    }
+
+    /// Deliver at most `max` more programs; the next ones are dropped as
+    /// [`Disposition::OverLimit`]. `None` lifts the limit.
+    pub fn limit_programs(&mut self, max: Option<usize>) {
+        self.programs_left = max;
+        self.over_limit = false;
+    }
+
+    /// Was a program dropped for the limit of [`ProgramWriter::limit_programs`]?
+    pub fn over_limit(&self) -> bool {
+        self.over_limit
     }
 
     /// Called for every program as soon as it is filed (or dropped).
@@ -225,6 +246,23 @@ impl ProgramWriter {
         let Some(tmp) = self.current.take() else {
             return Ok(());
         };
+        if self.programs_left == Some(0) {
+            self.over_limit = true;
+            let name = end.name.file_name().map_or_else(String::new, |(_, n)| n);
+            self.record(ReceivedProgram {
+                path: self.cfg.out_dir.join(name),
+                bytes: end.bytes,
+                first_line: end.first_line,
+                last_line: end.last_line,
+                disposition: Disposition::OverLimit,
+                rejected_names: end.name.rejected.clone(),
+                reason: Some("the transfer's limit of programs was reached".to_string()),
+            });
+            return Ok(());
+        }
+        if let Some(left) = self.programs_left.as_mut() {
+            *left -= 1;
+        }
         let tmp = finish_temp(tmp)?;
         let (dir, name) = match end.name.file_name() {
             Some(n) => n,
