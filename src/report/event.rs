@@ -197,7 +197,7 @@ impl EventBuffer {
 const RECYCLE_BATCHES: usize = 16;
 
 /// Batches (one tick's events each) waiting for the writer at most; see [`Backlog`].
-pub const MAX_QUEUED_BATCHES: usize = 4096;
+pub const MAX_QUEUED_BATCHES: usize = 1024;
 
 /// With [`Backlog::Drop`], how long [`EventLog::finish`] waits for a writer that is stuck
 /// on a reader that does not read before giving up on it.
@@ -486,5 +486,69 @@ mod tests {
             e.to_json(),
             r#"{"tick":3,"t":0.003,"ch":2,"ev":"interrupt","held":0}"#
         );
+    }
+
+    /// A writer that takes nothing until `open` is set, then keeps what it is given.
+    struct Gate {
+        open: Arc<std::sync::atomic::AtomicBool>,
+        got: Arc<std::sync::Mutex<Vec<u8>>>,
+    }
+
+    impl Write for Gate {
+        fn write(&mut self, b: &[u8]) -> io::Result<usize> {
+            while !self.open.load(Ordering::Acquire) {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            self.got
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_reader_that_does_not_read_costs_counted_events_not_memory_or_the_tick() {
+        let open = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let got = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let gate = Gate {
+            open: Arc::clone(&open),
+            got: Arc::clone(&got),
+        };
+        let mut log = EventLog::to_writer_with(Box::new(gate), FlushPolicy::EveryBatch)
+            .with_backlog(Backlog::Drop);
+        let tick = Tick {
+            index: 0,
+            period: Duration::from_millis(1),
+            time: Duration::ZERO,
+        };
+        let batches = MAX_QUEUED_BATCHES * 3;
+        for _ in 0..batches {
+            // Would block for ever here with `Backlog::Block`: the gate is shut.
+            let mut events = vec![Event::new(&tick, 1, EventKind::Interrupt { held: 0 })];
+            log.emit(&mut events);
+        }
+        open.store(true, Ordering::Release);
+        let lines = log
+            .finish()
+            .expect("the writer finishes once the reader reads");
+        let text = String::from_utf8(got.lock().unwrap_or_else(|p| p.into_inner()).clone())
+            .expect("utf-8");
+        let written = text.matches("\"interrupt\"").count();
+        let dropped: usize = text
+            .lines()
+            .filter_map(|l| l.strip_prefix(r#"{"ev":"events_dropped","events":"#))
+            .filter_map(|n| n.trim_end_matches('}').parse::<usize>().ok())
+            .sum();
+        assert!(dropped > 0, "some batches were dropped");
+        assert_eq!(written + dropped, batches, "every event written or counted");
+        assert!(
+            written <= MAX_QUEUED_BATCHES + 2,
+            "the queue stayed bounded"
+        );
+        assert_eq!(lines as usize, text.lines().count());
     }
 }
