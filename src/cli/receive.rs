@@ -19,6 +19,8 @@ use crate::dnc::{
 };
 
 use super::exit;
+// Operator messages never panic on a closed stderr (`eprintln!` would, mid-transfer).
+use super::serve::report as say;
 
 #[derive(Debug, clap::Args)]
 pub struct ReceiveArgs {
@@ -83,7 +85,7 @@ pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let params = super::run::locate(params);
     let config = crate::params::load(&params).map_err(|e| {
         for d in e.diagnostics() {
-            eprintln!("{}", d.render());
+            say(format_args!("{}", d.render()));
         }
         format!(
             "no --out, and the parameter lists in {} are refused",
@@ -102,11 +104,11 @@ pub fn execute(args: ReceiveArgs) -> ExitCode {
     match run(args) {
         Ok(code) => ExitCode::from(code),
         Err(Failure::Usage(msg)) => {
-            eprintln!("ncchannel receive: {msg}");
+            say(format_args!("ncchannel receive: {msg}"));
             ExitCode::from(exit::USAGE)
         }
         Err(Failure::Io(msg)) => {
-            eprintln!("ncchannel receive: {msg}");
+            say(format_args!("ncchannel receive: {msg}"));
             ExitCode::from(exit::CHANNEL_ERROR)
         }
     }
@@ -174,7 +176,7 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         let local = listener
             .local_addr()
             .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
-        eprintln!("listening on {local}");
+        say(format_args!("listening on {local}"));
         // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
         let signal = super::signal::StopSignal::install().ok();
         if let Some(sig) = &signal {
@@ -188,7 +190,7 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
             {
                 Ok(r) => Some(r),
                 Err(e) => {
-                    eprintln!("ncchannel receive: transfer refused: {e}");
+                    say(format_args!("ncchannel receive: transfer refused: {e}"));
                     total.refused += 1;
                     count += 1;
                     std::thread::sleep(Duration::from_millis(10));
@@ -280,31 +282,31 @@ fn log_line(p: &ReceivedProgram) {
     );
     let _ = out.flush();
     for name in &p.rejected_names {
-        eprintln!(
+        say(format_args!(
             "ncchannel receive: name `{name}` in lines {}-{} is not a plain file name; numbered instead",
             p.first_line, p.last_line
-        );
+        ));
     }
     match p.disposition {
-        Disposition::KeptExisting => eprintln!(
+        Disposition::KeptExisting => say(format_args!(
             "ncchannel receive: {} exists and was kept; the received program was dropped (use --overwrite)",
             p.path.display()
-        ),
-        Disposition::CutOffDropped => eprintln!(
+        )),
+        Disposition::CutOffDropped => say(format_args!(
             "ncchannel receive: the transfer ended inside the program from line {}; it was dropped (--keep-partial keeps it)",
             p.first_line
-        ),
-        Disposition::NameUnusable => eprintln!(
+        )),
+        Disposition::NameUnusable => say(format_args!(
             "ncchannel receive: the program from line {} cannot be filed as {}: {}; it was dropped",
             p.first_line,
             p.path.display(),
             p.reason.as_deref().unwrap_or("name unusable")
-        ),
-        Disposition::OverLimit => eprintln!(
+        )),
+        Disposition::OverLimit => say(format_args!(
             "ncchannel receive: the program from line {} was dropped: {}",
             p.first_line,
             p.reason.as_deref().unwrap_or("limit reached")
-        ),
+        )),
         _ => {}
     }
 }
@@ -333,25 +335,28 @@ impl Totals {
         self.bytes += r.split.bytes_in;
         let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
         if r.split.no_start_marker() {
-            eprintln!(
+            say(format_args!(
                 "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
                 r.split.bytes_in
-            );
+            ));
         }
         match &r.end {
             TransferEnd::Complete => {}
             TransferEnd::IdleTimeout => {
-                eprintln!("ncchannel receive: transfer{from} timed out")
+                say(format_args!("ncchannel receive: transfer{from} timed out"))
             }
-            TransferEnd::Broken(e) => eprintln!("ncchannel receive: transfer{from} broke: {e}"),
-            TransferEnd::LimitReached(l) => eprintln!(
+            TransferEnd::Broken(e) => {
+                say(format_args!("ncchannel receive: transfer{from} broke: {e}"))
+            }
+            TransferEnd::LimitReached(l) => say(format_args!(
                 "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
-            ),
+            )),
         }
     }
 
     fn print(&self, out: &Path) {
-        println!(
+        let _ = writeln!(
+            io::stdout().lock(),
             "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off, {} transfer(s) refused",
             self.filed,
             out.display(),
