@@ -8,11 +8,14 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
+use std::process::{Child, ChildStdout, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame};
+
+mod common;
 
 /// How much the server's resident set may grow over one abuse.
 const RSS_GROWTH_BOUND_KIB: u64 = 64 * 1024;
@@ -28,24 +31,26 @@ struct Serve {
     net_id: AmsNetId,
     period: Duration,
     stderr: Arc<Mutex<String>>,
+    /// Held and never read (`--events -` into a pipe nobody reads).
+    _stdout: Option<ChildStdout>,
 }
 
 impl Serve {
     fn start(extra: &[&str]) -> Serve {
+        Self::start_with(Path::new("params/startup.lis"), extra)
+    }
+
+    fn start_with(params: &Path, extra: &[&str]) -> Serve {
         let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
             .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args([
-                "serve",
-                "--bind",
-                "127.0.0.1:0",
-                "--params",
-                "params/startup.lis",
-            ])
+            .args(["serve", "--bind", "127.0.0.1:0", "--params"])
+            .arg(params)
             .args(extra)
-            .stdout(Stdio::null())
+            .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
             .expect("ncchannel serve starts");
+        let stdout = child.stdout.take();
         let mut err = BufReader::new(child.stderr.take().expect("stderr"));
         let mut first = String::new();
         err.read_line(&mut first).expect("first line");
@@ -74,6 +79,7 @@ impl Serve {
             net_id,
             period: Duration::from_micros(cycle),
             stderr,
+            _stdout: stdout,
         }
     }
 
@@ -578,4 +584,64 @@ fn idle_connections_are_closed_after_the_idle_timeout() {
         freed.as_secs_f64()
     );
     srv.check_healthy("64 idle connections", rss);
+}
+
+/// Send `signal` to the serve process and wait for its exit status.
+fn stop(srv: &mut Serve, signal: &str, within: Duration) -> std::process::ExitStatus {
+    let ok = Command::new("kill")
+        .args([signal, &srv.child.id().to_string()])
+        .status()
+        .expect("kill runs")
+        .success();
+    assert!(ok, "kill {signal}");
+    let until = Instant::now() + within;
+    loop {
+        if let Some(s) = srv.child.try_wait().expect("try_wait") {
+            return s;
+        }
+        assert!(
+            Instant::now() < until,
+            "serve did not stop within {within:?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn serve_seconds_inf_runs_until_a_signal() {
+    let mut srv = Serve::start(&["--seconds", "inf"]);
+    let rss = srv.rss_kib();
+    srv.check_healthy("--seconds inf", rss);
+    let status = stop(&mut srv, "-TERM", Duration::from_secs(10));
+    assert!(status.success(), "{status:?}\n{}", srv.log());
+    std::thread::sleep(Duration::from_millis(100));
+    assert!(srv.log().contains("stopped after"), "{}", srv.log());
+}
+
+#[test]
+fn events_into_a_pipe_nobody_reads_cost_counted_events_not_memory() {
+    let rig = common::Rig::new();
+    // Blocks without motion: some 40 a tick, each an event.
+    rig.program("many.nc", &("G90\n".repeat(2_000_000) + "M30\n"));
+    let mut srv = Serve::start_with(&rig.startup(), &["--start", "many.nc", "--events", "-"]);
+    std::thread::sleep(Duration::from_secs(2));
+    let rss = srv.rss_kib();
+    std::thread::sleep(Duration::from_secs(4));
+    let rss_later = srv.rss_kib();
+    println!("ABUSE events into a pipe nobody reads: RSS {rss} KiB at 2 s, {rss_later} KiB at 6 s");
+    assert!(
+        rss_later <= rss + 16 * 1024,
+        "the event queue grew from {rss} to {rss_later} KiB"
+    );
+    srv.check_healthy("--events - into a pipe nobody reads", rss);
+    // The writer is stuck on the pipe: the stop gives it 5 s, then says what was lost.
+    let status = stop(&mut srv, "-TERM", Duration::from_secs(20));
+    std::thread::sleep(Duration::from_millis(100));
+    let log = srv.log();
+    assert_eq!(status.code(), Some(1), "{log}");
+    assert!(
+        log.contains("the rest of the log was not written") && log.contains("events dropped"),
+        "{log}"
+    );
+    assert!(log.contains("stopped after"), "{log}");
 }
