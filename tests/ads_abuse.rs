@@ -645,3 +645,42 @@ fn events_into_a_pipe_nobody_reads_cost_counted_events_not_memory() {
     );
     assert!(log.contains("stopped after"), "{log}");
 }
+
+#[test]
+fn frames_from_thousands_of_unrouted_net_ids_are_dropped_with_a_bounded_log() {
+    // Only the normal client's NetId is routed; the rig's runtime.toml says so.
+    let rig = common::Rig::with_runtime("[ads]\nallowed_clients = [\"127.0.0.1.1.1\"]\n");
+    let srv = Serve::start_with(&rig.startup(), &[]);
+    let rss = srv.rss_kib();
+    let mut c = srv.connect();
+    let mut bytes = Vec::new();
+    for i in 0..20_000u32 {
+        let [a, b, d, e] = i.to_le_bytes();
+        let source = AmsAddr {
+            net_id: AmsNetId([10, a, b, d, e, 1]),
+            port: 40001,
+        };
+        bytes.extend(frame::encode(
+            &AmsHeader {
+                target: srv.device(),
+                source,
+                command: CommandId::ReadDeviceInfo,
+                state_flags: frame::FLAGS_REQUEST,
+                error: 0,
+                invoke_id: i,
+            },
+            &[],
+        ));
+    }
+    c.send(&bytes).expect("send");
+    // The same connection, from the routed NetId, is still served.
+    assert!(
+        c.read_tick().is_some(),
+        "routed frames after the unrouted ones"
+    );
+    let named = srv.log().matches("no route for source NetId").count();
+    println!("ABUSE 20 000 unrouted source NetIds on one connection: {named} named in the log");
+    assert!(named <= 16, "{named} NetIds logged");
+    assert!(srv.log().contains("no more are logged"), "{}", srv.log());
+    srv.check_healthy("20 000 unrouted source NetIds", rss);
+}
