@@ -6,7 +6,7 @@
 //! figures (`ABUSE …` lines; `cargo test --test ads_abuse -- --nocapture` shows them). The
 //! limits are explained in docs/ads-limits.md.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::path::Path;
 use std::process::{Child, ChildStdout, Command, Stdio};
@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame};
 
+mod abuse_common;
 mod common;
 
 /// How much the server's resident set may grow over one abuse.
@@ -51,9 +52,7 @@ impl Serve {
             .spawn()
             .expect("ncchannel serve starts");
         let stdout = child.stdout.take();
-        let mut err = BufReader::new(child.stderr.take().expect("stderr"));
-        let mut first = String::new();
-        err.read_line(&mut first).expect("first line");
+        let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
         // "listening on 127.0.0.1:PORT (AMS NetId a.b.c.d.e.f, port 553, N channel(s), cycle P µs)"
         let words: Vec<&str> = first.split_whitespace().collect();
         assert_eq!(words.get(..2), Some(&["listening", "on"][..]), "{first}");
@@ -64,15 +63,6 @@ impl Serve {
             .position(|w| *w == "cycle")
             .and_then(|i| words[i + 1].parse::<u64>().ok())
             .expect("cycle");
-        let stderr = Arc::new(Mutex::new(String::new()));
-        let sink = Arc::clone(&stderr);
-        std::thread::spawn(move || {
-            let mut line = String::new();
-            while err.read_line(&mut line).is_ok_and(|n| n > 0) {
-                sink.lock().unwrap().push_str(&line);
-                line.clear();
-            }
-        });
         Serve {
             child,
             addr,
@@ -84,13 +74,7 @@ impl Serve {
     }
 
     fn rss_kib(&self) -> u64 {
-        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id()))
-            .expect("/proc status");
-        status
-            .lines()
-            .find_map(|l| l.strip_prefix("VmRSS:"))
-            .and_then(|v| v.split_whitespace().next()?.parse().ok())
-            .expect("VmRSS")
+        abuse_common::rss_kib(self.child.id())
     }
 
     fn log(&self) -> String {
@@ -272,20 +256,6 @@ impl Conn {
     }
 }
 
-/// A small deterministic generator for random bytes (xorshift64*).
-struct Bytes(u64);
-
-impl Bytes {
-    fn fill(&mut self, out: &mut [u8]) {
-        for b in out {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            *b = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 56) as u8;
-        }
-    }
-}
-
 /// Wait until the server answers a normal client again (a refused connection is closed at
 /// once; the slots of closed connections free within a moment).
 fn served_again(srv: &Serve, within: Duration) -> bool {
@@ -457,7 +427,7 @@ fn malformed_frames_close_their_connection_only() {
 fn random_bytes_never_hurt_the_server() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();
-    let mut gen = Bytes(0x9E37_79B9_7F4A_7C15);
+    let mut gen = abuse_common::RandomBytes(0x9E37_79B9_7F4A_7C15);
     for i in 0..32 {
         let mut c = srv.connect();
         c.stream

@@ -5,12 +5,14 @@
 //! temporary file left, the receiver's resident set within a bound, and the next sender's
 //! program filed at once. Figures print as `ABUSE …` lines (`-- --nocapture`).
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::net::{Shutdown, SocketAddr, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
+
+mod abuse_common;
 
 const RSS_GROWTH_BOUND_KIB: u64 = 64 * 1024;
 
@@ -44,23 +46,12 @@ impl Receiver {
             .stderr(Stdio::piped())
             .spawn()
             .expect("receive starts");
-        let mut err = BufReader::new(child.stderr.take().expect("stderr"));
-        let mut first = String::new();
-        err.read_line(&mut first).expect("first line");
+        let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
         let addr = first
             .trim()
             .strip_prefix("listening on ")
             .and_then(|a| a.parse().ok())
             .unwrap_or_else(|| panic!("{first}"));
-        let stderr = Arc::new(Mutex::new(String::new()));
-        let sink = Arc::clone(&stderr);
-        std::thread::spawn(move || {
-            let mut line = String::new();
-            while err.read_line(&mut line).is_ok_and(|n| n > 0) {
-                sink.lock().unwrap().push_str(&line);
-                line.clear();
-            }
-        });
         Receiver {
             child,
             addr,
@@ -79,13 +70,7 @@ impl Receiver {
     }
 
     fn rss_kib(&self) -> u64 {
-        let status = std::fs::read_to_string(format!("/proc/{}/status", self.child.id()))
-            .expect("/proc status");
-        status
-            .lines()
-            .find_map(|l| l.strip_prefix("VmRSS:"))
-            .and_then(|v| v.split_whitespace().next()?.parse().ok())
-            .expect("VmRSS")
+        abuse_common::rss_kib(self.child.id())
     }
 
     /// One transfer: connect, send, close.
@@ -219,14 +204,8 @@ fn huge_lines_and_binary_garbage_are_survived() {
     between.extend_from_slice(b"\r\n");
     r.send(&between);
     r.check_serving("32 MiB lines", rss);
-    let mut state = 0x2545_F491_4F6C_DD1Du64;
     let mut junk = vec![0u8; 8 << 20];
-    for b in junk.iter_mut() {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        *b = (state >> 32) as u8;
-    }
+    abuse_common::RandomBytes(0x2545_F491_4F6C_DD1D).fill(&mut junk);
     r.send(&junk);
     r.check_serving("8 MiB of binary garbage", rss);
 }
