@@ -430,10 +430,7 @@ impl Outbox {
     }
 
     fn close(&self, why: Closed) {
-        let mut st = lock(&self.state);
-        if st.closed.is_none() || why != Closed::Done {
-            st.closed.get_or_insert(why);
-        }
+        lock(&self.state).closed.get_or_insert(why);
         self.ready.notify_all();
     }
 

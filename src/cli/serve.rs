@@ -84,8 +84,8 @@ pub(crate) fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String
     }
 }
 
-/// A report line on standard error that never panics: with stderr a closed pipe `eprintln!`
-/// would, after the event log is safe the run's outcome must not depend on it.
+/// A line on standard error, best effort. `eprintln!` panics when stderr is a closed pipe;
+/// a message must never cost the run its event log or its exit code.
 pub(crate) fn report(msg: std::fmt::Arguments<'_>) {
     use std::io::Write;
     let _ = writeln!(std::io::stderr().lock(), "{msg}");
