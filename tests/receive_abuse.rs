@@ -211,12 +211,29 @@ fn huge_lines_and_binary_garbage_are_survived() {
 }
 
 #[test]
-fn a_silent_sender_frees_the_port_after_the_idle_timeout() {
-    let mut r = Receiver::start(&["--idle-timeout", "1"]);
+fn silent_senders_do_not_hold_up_the_others() {
+    // Default idle timeout (30 s): three silent senders hold three of the four slots.
+    let mut r = Receiver::start(&["--max-concurrent", "4"]);
+    let rss = r.rss_kib();
+    let _silent: Vec<TcpStream> = (0..3)
+        .map(|_| TcpStream::connect(r.addr).expect("connect"))
+        .collect();
+    std::thread::sleep(Duration::from_millis(200));
+    let asked = Instant::now();
+    r.check_serving("3 silent senders, 4 concurrent transfers", rss);
+    assert!(
+        asked.elapsed() < Duration::from_secs(10),
+        "filed while the silent senders wait for their 30 s timeout"
+    );
+}
+
+#[test]
+fn a_silent_sender_frees_its_slot_after_the_idle_timeout() {
+    let mut r = Receiver::start(&["--idle-timeout", "1", "--max-concurrent", "1"]);
     let rss = r.rss_kib();
     let _silent = TcpStream::connect(r.addr).expect("connect");
     std::thread::sleep(Duration::from_millis(200));
-    r.check_serving("a silent sender (idle timeout 1 s)", rss);
+    r.check_serving("a silent sender in the only slot (idle timeout 1 s)", rss);
     assert!(r.log().contains("timed out"), "{}", r.log());
 }
 
@@ -252,4 +269,34 @@ fn transfers_beyond_their_limits_end_and_the_receiver_goes_on() {
     let log = r.log();
     assert!(log.contains("more than 3 programs"), "{log}");
     assert!(log.contains("more than 4096 bytes"), "{log}");
+}
+
+#[test]
+fn concurrent_transfers_of_unnamed_programs_get_distinct_numbers() {
+    let mut r = Receiver::start(&[]);
+    let rss = r.rss_kib();
+    std::thread::scope(|s| {
+        for t in 0..4 {
+            let r = &r;
+            s.spawn(move || {
+                let data: String = (0..5)
+                    .map(|i| format!("%\r\nG01 X{t}{i}\r\nM30\r\n"))
+                    .collect();
+                r.send(data.as_bytes());
+            });
+        }
+    });
+    r.check_serving("4 concurrent transfers × 5 unnamed programs", rss);
+    let mut bodies: Vec<String> = files(&r.out())
+        .iter()
+        .filter(|p| p.to_string_lossy().contains("received_"))
+        .map(|p| std::fs::read_to_string(p).expect("read"))
+        .collect();
+    bodies.sort();
+    bodies.dedup();
+    assert_eq!(
+        bodies.len(),
+        20,
+        "every program filed under a number of its own"
+    );
 }

@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
+use std::sync::Arc;
+
 use crate::dnc::{
     self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
     TransferEnd, TransferReport, WriterConfig,
@@ -49,6 +51,10 @@ pub struct ReceiveArgs {
     /// cut off (default with --listen: 256 MiB; unbounded for a file or standard input).
     #[arg(long, value_name = "BYTES")]
     pub max_transfer_bytes: Option<u64>,
+    /// With --listen: transfers taken at the same time (a silent or slow sender holds one).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CONCURRENT,
+          value_parser = clap::value_parser!(u16).range(1..=64))]
+    pub max_concurrent: u16,
     /// Programs one transfer may deliver; the next is dropped and the transfer ends
     /// (default with --listen: 1000; unbounded for a file or standard input).
     #[arg(long, value_name = "N")]
@@ -80,6 +86,7 @@ pub struct ReceiveArgs {
 pub const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
 pub const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
 pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
+pub const DEFAULT_MAX_CONCURRENT: u16 = 4;
 
 pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let params = super::run::locate(params);
@@ -165,8 +172,8 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     cfg.overwrite = args.overwrite;
     cfg.keep_partial = args.keep_partial;
     cfg.template = template;
-    let mut writer = ProgramWriter::new(cfg).with_log(log_line);
-    let mut splitter = Splitter::new(markers);
+    let mut writer = ProgramWriter::new(cfg.clone()).with_log(log_line);
+    let mut splitter = Splitter::new(markers.clone());
 
     let mut total = Totals::default();
     if let Some(addr) = &args.listen {
@@ -182,34 +189,81 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         if let Some(sig) = &signal {
             wake_on_signal(sig.clone(), local);
         }
-        let mut count = 0usize;
-        while args.max_transfers.is_none_or(|m| count < m) {
-            // One transfer's failure (a name the disk refuses, a full disk) refuses that
-            // transfer, with the reason; the port keeps serving the next sender.
-            let last = match dnc::receive_connection(&listener, &limits, &mut splitter, &mut writer)
-            {
-                Ok(r) => Some(r),
+        let numbers = writer.numbers();
+        let (done_tx, done) = std::sync::mpsc::channel();
+        let mut active = 0usize;
+        let mut accepted = 0usize;
+        // Whatever a transfer came to: filed programs, or refused with its reason (a name
+        // the disk refuses, a full disk); the port keeps serving the others.
+        let settle = |r: Result<TransferReport, dnc::DncError>, total: &mut Totals| match r {
+            Ok(r) => total.add(&r),
+            Err(e) => {
+                say(format_args!("ncchannel receive: transfer refused: {e}"));
+                total.refused += 1;
+            }
+        };
+        while args.max_transfers.is_none_or(|m| accepted < m) {
+            while active >= usize::from(args.max_concurrent) {
+                match done.recv() {
+                    Ok(r) => settle(r, &mut total),
+                    Err(_) => break,
+                }
+                active -= 1;
+            }
+            while let Ok(r) = done.try_recv() {
+                settle(r, &mut total);
+                active -= 1;
+            }
+            let (stream, peer) = match listener.accept() {
+                Ok(s) => s,
                 Err(e) => {
-                    say(format_args!("ncchannel receive: transfer refused: {e}"));
-                    total.refused += 1;
-                    count += 1;
-                    std::thread::sleep(Duration::from_millis(10));
-                    None
+                    if !matches!(
+                        e.kind(),
+                        io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
+                    ) {
+                        say(format_args!("ncchannel receive: accept on {local}: {e}"));
+                        std::thread::sleep(Duration::from_millis(50));
+                    }
+                    continue;
                 }
             };
-            let stopping = signal
+            // After a signal, the wake-up connection is not a transfer.
+            if signal
                 .as_ref()
-                .is_some_and(super::signal::StopSignal::raised);
-            if let Some(r) = last {
-                // After a signal, the empty wake-up connection is not a transfer.
-                if !(stopping && r.split.bytes_in == 0) {
-                    total.add(&r);
-                    count += 1;
-                }
-            }
-            if stopping {
+                .is_some_and(super::signal::StopSignal::raised)
+            {
                 break;
             }
+            accepted += 1;
+            let (markers, cfg, numbers, tx) = (
+                markers.clone(),
+                cfg.clone(),
+                Arc::clone(&numbers),
+                done_tx.clone(),
+            );
+            let spawned = std::thread::Builder::new()
+                .name(format!("receive-{peer}"))
+                .spawn(move || {
+                    let mut splitter = Splitter::new(markers);
+                    let mut writer = ProgramWriter::new(cfg)
+                        .with_log(log_line)
+                        .with_numbers(numbers);
+                    let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
+                    let _ = tx.send(r);
+                });
+            match spawned {
+                Ok(_) => active += 1,
+                Err(e) => settle(Err(dnc::DncError::io(peer.to_string(), e)), &mut total),
+            }
+        }
+        // The transfers in progress complete (each within its idle timeout).
+        drop(done_tx);
+        while active > 0 {
+            match done.recv() {
+                Ok(r) => settle(r, &mut total),
+                Err(_) => break,
+            }
+            active -= 1;
         }
     } else {
         let report = match args.input.as_deref() {

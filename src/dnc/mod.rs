@@ -17,7 +17,7 @@ pub use error::DncError;
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
 pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
 pub use transfer::{
-    receive, receive_connection, receive_connections, receive_limited, Limit, TransferEnd,
-    TransferLimits, TransferReport,
+    receive, receive_connection, receive_connections, receive_limited, receive_stream, Limit,
+    TransferEnd, TransferLimits, TransferReport,
 };
 pub use writer::{Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig};

@@ -3,7 +3,7 @@
 //! serial-over-IP DNC port.
 
 use std::io::{self, Read};
-use std::net::{SocketAddr, TcpListener};
+use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::time::Duration;
 
 use super::error::DncError;
@@ -197,11 +197,22 @@ pub fn receive_connection(
             }
             Err(e) => return Err(DncError::io(&local, e)),
         };
-        stream
-            .set_read_timeout(limits.idle_timeout)
-            .map_err(|e| DncError::io(peer.to_string(), e))?;
-        let mut report = receive_limited(stream, limits, splitter, writer)?;
-        report.peer = Some(peer);
-        return Ok(report);
+        return receive_stream(stream, peer, limits, splitter, writer);
     }
+}
+
+/// One accepted TCP transfer within `limits`.
+pub fn receive_stream(
+    stream: TcpStream,
+    peer: SocketAddr,
+    limits: &TransferLimits,
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+) -> Result<TransferReport, DncError> {
+    stream
+        .set_read_timeout(limits.idle_timeout)
+        .map_err(|e| DncError::io(peer.to_string(), e))?;
+    let mut report = receive_limited(stream, limits, splitter, writer)?;
+    report.peer = Some(peer);
+    Ok(report)
 }

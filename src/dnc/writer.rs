@@ -9,6 +9,8 @@
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Arc;
 
 use tempfile::NamedTempFile;
 
@@ -162,7 +164,9 @@ type TempProgram = BufWriter<NamedTempFile>;
 pub struct ProgramWriter {
     cfg: WriterConfig,
     current: Option<TempProgram>,
-    next_number: u32,
+    /// The next number for a program the data names not; shared by the writers of
+    /// concurrent transfers so no two pick the same one.
+    next_number: Arc<AtomicU32>,
     records: Vec<ReceivedProgram>,
     log: Option<LogFn>,
     /// Programs this transfer may still deliver (`None`: no limit).
@@ -176,7 +180,7 @@ impl ProgramWriter {
         ProgramWriter {
             cfg,
             current: None,
-            next_number: 1,
+            next_number: Arc::new(AtomicU32::new(1)),
             records: Vec::new(),
             log: None,
             programs_left: None,
@@ -194,6 +198,18 @@ impl ProgramWriter {
     /// Was a program dropped for the limit of [`ProgramWriter::limit_programs`]?
     pub fn over_limit(&self) -> bool {
         self.over_limit
+    }
+
+    /// Number unnamed programs from `numbers`, shared with other writers (concurrent
+    /// transfers into one folder).
+    pub fn with_numbers(mut self, numbers: Arc<AtomicU32>) -> Self {
+        self.next_number = numbers;
+        self
+    }
+
+    /// The counter [`ProgramWriter::with_numbers`] shares.
+    pub fn numbers(&self) -> Arc<AtomicU32> {
+        Arc::clone(&self.next_number)
     }
 
     /// Called for every program as soon as it is filed (or dropped).
@@ -230,8 +246,13 @@ impl ProgramWriter {
     fn numbered(&mut self) -> String {
         let mut probes = 0;
         loop {
-            let name = self.cfg.template.render(self.next_number);
-            self.next_number = self.next_number.saturating_add(1);
+            let n = self
+                .next_number
+                .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                    Some(n.saturating_add(1))
+                })
+                .unwrap_or(u32::MAX);
+            let name = self.cfg.template.render(n);
             probes += 1;
             if self.cfg.overwrite
                 || probes >= MAX_NUMBER_PROBES
