@@ -654,3 +654,36 @@ fn frames_from_thousands_of_unrouted_net_ids_are_dropped_with_a_bounded_log() {
     assert!(srv.log().contains("no more are logged"), "{}", srv.log());
     srv.check_healthy("20 000 unrouted source NetIds", rss);
 }
+
+#[test]
+fn a_client_that_never_reads_its_notifications_is_dropped() {
+    let srv = Serve::start(&[]);
+    let rss = srv.rss_kib();
+    let mut c = srv.connect();
+    let mut add = read_payload(TICK_GROUP, TICK_OFFSET, 4);
+    for v in [3u32, 0, 10_000] {
+        add.extend_from_slice(&v.to_le_bytes()); // cyclic, max delay, 1 ms
+    }
+    add.extend_from_slice(&[0; 16]);
+    let mut granted = 0;
+    for _ in 0..10 {
+        let d = c
+            .call(CommandId::AddDeviceNotification, &add)
+            .expect("answered");
+        granted += usize::from(u32_at(&d, 0) == 0);
+    }
+    assert!(granted > 0, "some 1 ms handles granted");
+    // From now on nothing is read: the samples pile up in the kernel, then in the queue.
+    let started = Instant::now();
+    while !srv.log().contains("does not read") && started.elapsed() < Duration::from_secs(90) {
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    let log = srv.log();
+    assert!(log.contains("does not read"), "{log}");
+    println!(
+        "ABUSE notifications never read: {granted} handles at 1 ms, connection dropped after {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
+    drop(c);
+    srv.check_healthy("a client that never reads its notifications", rss);
+}

@@ -485,7 +485,10 @@ fn closed_error(c: Closed, limit: usize) -> io::Error {
         Closed::Overflow => format!(
             "more than {limit} bytes of responses and notifications unread: the client does not read; connection dropped"
         ),
-        Closed::WriteFailed => "write failed or timed out: connection dropped".to_string(),
+        Closed::WriteFailed => format!(
+            "a write took over {} s or failed (the client does not read?): connection dropped",
+            WRITE_TIMEOUT.as_secs()
+        ),
         Closed::Done => "connection closed".to_string(),
     })
 }
@@ -653,7 +656,13 @@ fn request_loop(
             return Err(closed_error(c, writer.limit_bytes).into());
         }
         let n = match stream.read(&mut chunk) {
-            Ok(0) => return Ok(()),
+            // The writer shut the socket (write stall): say why, not just "closed".
+            Ok(0) => {
+                return match writer.closed() {
+                    Some(c) if c != Closed::Done => Err(closed_error(c, writer.limit_bytes).into()),
+                    _ => Ok(()),
+                }
+            }
             Ok(n) => n,
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
             Err(e)
@@ -682,7 +691,13 @@ fn request_loop(
                 let _ = e;
                 return Ok(());
             }
-            Err(e) => return Err(e.into()),
+            Err(e) => {
+                return Err(match writer.closed() {
+                    Some(c) if c != Closed::Done => closed_error(c, writer.limit_bytes),
+                    _ => e,
+                }
+                .into())
+            }
         };
         buf.extend_from_slice(&chunk[..n]);
     }
