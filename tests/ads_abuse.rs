@@ -174,6 +174,26 @@ fn read_payload(group: u32, offset: u32, length: u32) -> Vec<u8> {
         .collect()
 }
 
+/// A Read of the tick counter.
+fn tick_request(device: AmsAddr, invoke: u32) -> Vec<u8> {
+    request(
+        device,
+        CommandId::Read,
+        invoke,
+        &read_payload(TICK_GROUP, TICK_OFFSET, 4),
+    )
+}
+
+/// AddDeviceNotification of the tick counter: cyclic (mode 3), no max delay, `cycle_100ns`.
+fn add_notification_payload(cycle_100ns: u32) -> Vec<u8> {
+    let mut add = read_payload(TICK_GROUP, TICK_OFFSET, 4);
+    for v in [3u32, 0, cycle_100ns] {
+        add.extend_from_slice(&v.to_le_bytes());
+    }
+    add.extend_from_slice(&[0; 16]);
+    add
+}
+
 fn u32_at(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
 }
@@ -345,12 +365,7 @@ fn a_client_that_never_reads_is_dropped_with_bounded_memory() {
 fn a_client_sending_one_byte_a_second_is_served_and_holds_no_one_up() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();
-    let bytes = request(
-        srv.device(),
-        CommandId::Read,
-        7,
-        &read_payload(TICK_GROUP, TICK_OFFSET, 4),
-    );
+    let bytes = tick_request(srv.device(), 7);
     let mut slow = srv.connect();
     for (i, b) in bytes.iter().enumerate() {
         slow.send(&[*b]).expect("slow byte");
@@ -377,12 +392,7 @@ fn a_client_sending_one_byte_a_second_is_served_and_holds_no_one_up() {
 fn malformed_frames_close_their_connection_only() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();
-    let good = request(
-        srv.device(),
-        CommandId::Read,
-        1,
-        &read_payload(TICK_GROUP, TICK_OFFSET, 4),
-    );
+    let good = tick_request(srv.device(), 1);
     let mut inconsistent = good.clone();
     inconsistent[6 + 20] = 99; // AMS data length 99, AMS/TCP length says 12
     let cases: Vec<(&str, Vec<u8>)> = vec![
@@ -453,11 +463,7 @@ fn thousands_of_notification_requests_meet_the_whole_server_budget() {
     let connections = 16;
     let per_connection = 200; // below the per-connection limit of 256
     let cycle_100ns = 100_000u32; // 10 ms: 100 samples/s a handle
-    let mut add = read_payload(TICK_GROUP, TICK_OFFSET, 4);
-    for v in [3u32, 0, cycle_100ns] {
-        add.extend_from_slice(&v.to_le_bytes()); // cyclic, max delay, cycle
-    }
-    add.extend_from_slice(&[0; 16]);
+    let add = add_notification_payload(cycle_100ns);
     let results: Vec<(usize, usize, Conn)> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..connections)
             .map(|_| {
@@ -660,11 +666,7 @@ fn a_client_that_never_reads_its_notifications_is_dropped() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();
     let mut c = srv.connect();
-    let mut add = read_payload(TICK_GROUP, TICK_OFFSET, 4);
-    for v in [3u32, 0, 10_000] {
-        add.extend_from_slice(&v.to_le_bytes()); // cyclic, max delay, 1 ms
-    }
-    add.extend_from_slice(&[0; 16]);
+    let add = add_notification_payload(10_000); // 1 ms
     let mut granted = 0;
     for _ in 0..10 {
         let d = c
