@@ -251,11 +251,6 @@ impl Machine {
     }
 
     /// Hand the remaining events to the log and wait for it to write them.
-    /// Events the log dropped because its reader was too slow (call before `finish_log`).
-    pub fn events_dropped(&self) -> u64 {
-        self.log.dropped()
-    }
-
     pub fn finish_log(&mut self) -> std::io::Result<u64> {
         for c in &mut self.channels {
             c.events_mut().flush_to(&mut self.log);

@@ -2,16 +2,18 @@
 //! table, and pushes DeviceNotification frames.
 //!
 //! One thread per connection (at most `max_connections`, default 64; more are closed at once
-//! with a log line), plus one notification thread per connection that has notification
-//! handles. Channel calls may block for up to a runtime tick; that only holds up the
-//! connection that asked. Compatibility rules are REFERENCE §8; each is marked `rule n` below.
+//! with a log line), one writer thread per connection draining its bounded send queue, plus
+//! one notification thread per connection that has notification handles. Channel calls may
+//! block for up to a runtime tick; that only holds up the connection that asked. The limits
+//! that keep a hostile or careless client from hurting the others or the cycle are explained
+//! in docs/ads-limits.md. Compatibility rules are REFERENCE §8; each is marked `rule n` below.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::io::{self, Read, Write};
 use std::net::{IpAddr, Ipv4Addr, Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::str::FromStr;
-use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -30,19 +32,21 @@ pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALH
 pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
 /// Default bound on notification handles per connection.
 pub const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
-/// Default budget of notification samples per second for the whole server: every handle costs
-/// 1 / cycle, and a handle that would exceed the budget is answered 0x716, so notifications
-/// can never cost the cycle its period, however many connections ask (docs/ads-limits.md).
-pub const DEFAULT_MAX_NOTIFICATION_RATE_PER_S: u64 = 20_000;
-/// A new connection must send its first whole frame within this time, and a frame once begun
-/// must arrive whole within it: a silent or trickling client cannot hold a connection slot.
-/// A client that has sent a frame may then stay idle as long as it likes (HMIs do).
-pub const FRAME_DEADLINE: Duration = Duration::from_secs(10);
-/// How often a blocked read wakes to check the deadline and the server's stop.
-const READ_POLL: Duration = Duration::from_millis(500);
-/// Distinct unrouted NetIds / unknown router commands logged per connection; after that, one
-/// last line says further ones are not logged (log lines per frame would be a log flood).
-const MAX_LOGGED_PER_CONNECTION: usize = 8;
+/// Default bound on notification handles over the whole server.
+pub const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
+/// Default budget of notification samples per second over the whole server. Each sample is a
+/// read served by the runtime; 10 000/s is 10 reads a tick at 1 ms, well inside
+/// `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never cost the cycle its period.
+pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 = 10_000;
+/// Default idle timeout (see [`ServerConfig::idle_timeout`]).
+pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
+/// Default bound on the bytes waiting in one connection's send queue.
+pub const DEFAULT_MAX_SEND_QUEUE_BYTES: usize = 1 << 20;
+/// A write to a client that takes longer than this (its receive window stays shut) ends
+/// the connection.
+pub const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+/// Distinct unrouted source NetIds logged per connection; beyond that one summary line.
+const MAX_LOGGED_UNROUTED: usize = 16;
 /// Notification cycle times are clamped to this range.
 pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
 pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
@@ -93,9 +97,18 @@ pub struct ServerConfig {
     pub max_connections: usize,
     /// Notification handles per connection; more are answered 0x716.
     pub max_notifications: usize,
-    /// Notification samples per second, all connections together; a handle that would
-    /// exceed it is answered 0x716.
-    pub max_notification_rate_per_s: u64,
+    /// Notification handles over all connections; more are answered 0x716.
+    pub max_notifications_total: usize,
+    /// Notification samples per second over all connections (each handle costs one sample
+    /// per cycle time); a handle that would exceed it is answered 0x716.
+    pub notification_samples_per_s: u64,
+    /// A connection that has not completed a frame for this long is closed when it is in the
+    /// middle of a frame (a slow or stalled sender) or holds no notification handles (an
+    /// idle client holding a slot). A client with notifications may stay silent for ever.
+    pub idle_timeout: Duration,
+    /// Bytes of responses and notifications waiting for one client; a client that lets
+    /// more pile up (it does not read) is disconnected, with a log line.
+    pub max_send_queue_bytes: usize,
     /// Route allow-list; empty = allow all. A client is served when its peer IP or the
     /// source NetId of its frame is listed; others are dropped silently (after a log line),
     /// as a router without a route drops them.
@@ -111,7 +124,10 @@ impl Default for ServerConfig {
             max_frame_bytes: frame::DEFAULT_MAX_FRAME_BYTES,
             max_connections: DEFAULT_MAX_CONNECTIONS,
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
-            max_notification_rate_per_s: DEFAULT_MAX_NOTIFICATION_RATE_PER_S,
+            max_notifications_total: DEFAULT_MAX_NOTIFICATIONS_TOTAL,
+            notification_samples_per_s: DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+            idle_timeout: DEFAULT_IDLE_TIMEOUT,
+            max_send_queue_bytes: DEFAULT_MAX_SEND_QUEUE_BYTES,
             allow: Vec::new(),
         }
     }
@@ -178,32 +194,85 @@ struct Shared {
     sockets: Mutex<HashMap<u64, TcpStream>>,
     /// Next AMS port handed out by the router "port connect" command.
     next_router_port: AtomicU16,
-    /// Notification samples per 1000 s of all handles of all connections (Σ 1000 / cycle).
-    notification_load: AtomicU64,
+    /// Notification handles and sample rate in use over all connections.
+    budget: Mutex<NotifyBudget>,
+    /// Log lines that a client can provoke at will, at most one a second each.
+    refused_log: RateLimitedLog,
+    router_log: RateLimitedLog,
 }
 
-/// A handle's share of the notification budget: samples per 1000 s.
-fn notification_cost(cycle: Duration) -> u64 {
-    (1_000_000_000 / cycle.as_micros().max(1)) as u64
+/// What the notification handles of all connections cost together.
+#[derive(Debug, Default)]
+struct NotifyBudget {
+    handles: usize,
+    /// Samples per second, in millihertz (a 1 ms handle costs 1 000 000).
+    rate_mhz: u64,
+}
+
+/// The sample rate of one handle in millihertz.
+fn rate_mhz(cycle: Duration) -> u64 {
+    let ns = cycle.as_nanos().max(1);
+    u64::try_from(1_000_000_000_000u128 / ns).unwrap_or(u64::MAX)
 }
 
 impl Shared {
-    /// Reserve `cost` of the notification budget; false when it would be exceeded.
-    fn reserve_notification(&self, cost: u64) -> bool {
-        let budget = self.config.max_notification_rate_per_s.saturating_mul(1000);
-        self.notification_load
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |load| {
-                (load + cost <= budget).then_some(load + cost)
-            })
-            .is_ok()
+    /// Take one handle of `cycle` from the server's budget, or say it is spent.
+    fn reserve(&self, cycle: Duration) -> bool {
+        let mut b = lock(&self.budget);
+        let rate = rate_mhz(cycle);
+        let limit = self.config.notification_samples_per_s.saturating_mul(1000);
+        if b.handles >= self.config.max_notifications_total
+            || b.rate_mhz.saturating_add(rate) > limit
+        {
+            return false;
+        }
+        b.handles += 1;
+        b.rate_mhz += rate;
+        true
     }
 
-    fn release_notifications(&self, cost: u64) {
-        let _ = self
-            .notification_load
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |load| {
-                Some(load.saturating_sub(cost))
-            });
+    /// Give back what removed handles took.
+    fn release<'a>(&self, removed: impl IntoIterator<Item = &'a Notification>) {
+        let mut b = lock(&self.budget);
+        for n in removed {
+            b.handles = b.handles.saturating_sub(1);
+            b.rate_mhz = b.rate_mhz.saturating_sub(rate_mhz(n.cycle));
+        }
+    }
+}
+
+/// A log line a client can trigger as often as it sends: written at most once a second,
+/// with the count of the lines left out since.
+struct RateLimitedLog {
+    state: Mutex<(Option<Instant>, u64)>,
+}
+
+impl RateLimitedLog {
+    const EVERY: Duration = Duration::from_secs(1);
+
+    fn new() -> Self {
+        RateLimitedLog {
+            state: Mutex::new((None, 0)),
+        }
+    }
+
+    fn log(&self, msg: impl std::fmt::Display) {
+        let mut st = lock(&self.state);
+        let now = Instant::now();
+        if st.0.is_some_and(|t| now.duration_since(t) < Self::EVERY) {
+            st.1 += 1;
+            return;
+        }
+        let skipped = std::mem::take(&mut st.1);
+        st.0 = Some(now);
+        drop(st);
+        if skipped > 0 {
+            log(format_args!(
+                "{msg} (and {skipped} more like it not logged)"
+            ));
+        } else {
+            log(msg);
+        }
     }
 }
 
@@ -241,7 +310,9 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
         active: AtomicUsize::new(0),
         sockets: Mutex::new(HashMap::new()),
         next_router_port: AtomicU16::new(32768),
-        notification_load: AtomicU64::new(0),
+        budget: Mutex::new(NotifyBudget::default()),
+        refused_log: RateLimitedLog::new(),
+        router_log: RateLimitedLog::new(),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -276,12 +347,14 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
         let ip_listed = cfg.allow.contains(&RouteEntry::Ip(peer.ip()));
         let any_netid_routes = cfg.allow.iter().any(|r| matches!(r, RouteEntry::NetId(_)));
         if !cfg.allow.is_empty() && !ip_listed && !any_netid_routes {
-            log(format_args!("no route for {peer}: connection closed"));
+            shared
+                .refused_log
+                .log(format_args!("no route for {peer}: connection closed"));
             let _ = stream.shutdown(Shutdown::Both);
             continue;
         }
         if shared.active.load(Ordering::SeqCst) >= cfg.max_connections {
-            log(format_args!(
+            shared.refused_log.log(format_args!(
                 "{peer}: connection limit {} reached: connection closed",
                 cfg.max_connections
             ));
@@ -312,11 +385,112 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
     }
 }
 
-/// The writing half of a connection, shared by the request loop and the notifier.
-type Writer = Arc<Mutex<TcpStream>>;
+/// The writing half of a connection, shared by the request loop and the notifier: a queue
+/// bounded in bytes, drained by the connection's writer thread. Nothing that answers a
+/// request or samples a notification ever waits for the client to read.
+struct Outbox {
+    state: Mutex<OutboxState>,
+    ready: Condvar,
+    limit_bytes: usize,
+}
 
+#[derive(Default)]
+struct OutboxState {
+    frames: VecDeque<Vec<u8>>,
+    /// Bytes in `frames`.
+    bytes: usize,
+    /// Why the connection must end, once it must.
+    closed: Option<Closed>,
+}
+
+/// Why a connection's sending side gave up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Closed {
+    /// The request loop ended; the writer finishes what is queued.
+    Done,
+    /// More than the queue's limit waited: the client does not read.
+    Overflow,
+    /// A write failed or timed out.
+    WriteFailed,
+}
+
+type Writer = Arc<Outbox>;
+
+impl Outbox {
+    fn new(limit_bytes: usize) -> Self {
+        Outbox {
+            state: Mutex::new(OutboxState::default()),
+            ready: Condvar::new(),
+            limit_bytes,
+        }
+    }
+
+    fn closed(&self) -> Option<Closed> {
+        lock(&self.state).closed
+    }
+
+    fn close(&self, why: Closed) {
+        lock(&self.state).closed.get_or_insert(why);
+        self.ready.notify_all();
+    }
+
+    /// Drain the queue into `stream` until the connection ends.
+    fn write_loop(&self, mut stream: TcpStream) {
+        loop {
+            let frame = {
+                let mut st = lock(&self.state);
+                loop {
+                    if st.closed.is_some_and(|c| c != Closed::Done) {
+                        return;
+                    }
+                    if let Some(f) = st.frames.pop_front() {
+                        st.bytes -= f.len();
+                        break f;
+                    }
+                    if st.closed.is_some() {
+                        return;
+                    }
+                    st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+                }
+            };
+            if stream.write_all(&frame).is_err() {
+                self.close(Closed::WriteFailed);
+                let _ = stream.shutdown(Shutdown::Both);
+                return;
+            }
+        }
+    }
+}
+
+/// Queue one frame for the client; an error when the connection is over (the queue
+/// overflowed now or earlier, or a write failed).
 fn send(writer: &Writer, bytes: &[u8]) -> io::Result<()> {
-    lock(writer).write_all(bytes)
+    let mut st = lock(&writer.state);
+    if let Some(c) = st.closed {
+        return Err(closed_error(c, writer.limit_bytes));
+    }
+    if st.bytes + bytes.len() > writer.limit_bytes {
+        st.closed = Some(Closed::Overflow);
+        writer.ready.notify_all();
+        return Err(closed_error(Closed::Overflow, writer.limit_bytes));
+    }
+    st.bytes += bytes.len();
+    st.frames.push_back(bytes.to_vec());
+    writer.ready.notify_all();
+    Ok(())
+}
+
+fn closed_error(c: Closed, limit: usize) -> io::Error {
+    io::Error::other(match c {
+        Closed::Overflow => format!(
+            "more than {limit} bytes of responses and notifications unread: the client does not read; connection dropped"
+        ),
+        Closed::WriteFailed => format!(
+            "a write took over {} s or failed (the client does not read?): connection dropped",
+            WRITE_TIMEOUT.as_secs()
+        ),
+        Closed::Done => "connection closed".to_string(),
+    })
 }
 
 /// One notification handle.
@@ -332,8 +506,6 @@ struct Notification {
     /// False until the AddDeviceNotification response is written: no sample goes out before
     /// the client knows the handle.
     armed: bool,
-    /// Its share of the server's notification budget ([`notification_cost`]).
-    cost: u64,
 }
 
 /// After the AddDeviceNotification response is written, the first sample waits this long, so
@@ -356,8 +528,8 @@ enum ConnError {
     Frame(#[from] frame::FrameError),
     #[error("{0}")]
     Io(#[from] io::Error),
-    #[error("no whole frame within {0:?}: connection closed")]
-    Slow(Duration),
+    #[error("{0}: connection closed")]
+    Idle(String),
 }
 
 fn serve_connection(
@@ -367,25 +539,45 @@ fn serve_connection(
     shared: &Arc<Shared>,
 ) -> Result<(), ConnError> {
     stream.set_nodelay(true)?;
-    stream.set_write_timeout(Some(Duration::from_secs(5)))?;
-    stream.set_read_timeout(Some(READ_POLL))?;
-    let writer: Writer = Arc::new(Mutex::new(stream.try_clone()?));
+    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
+    // Poll often enough to notice an idle timeout or an overflowed send queue.
+    let poll = shared
+        .config
+        .idle_timeout
+        .clamp(Duration::from_millis(50), Duration::from_millis(500));
+    stream.set_read_timeout(Some(poll))?;
+    let writer: Writer = Arc::new(Outbox::new(shared.config.max_send_queue_bytes));
+    let write_half = stream.try_clone()?;
+    let write_thread = {
+        let w = Arc::clone(&writer);
+        std::thread::Builder::new()
+            .name("ads-write".into())
+            .spawn(move || w.write_loop(write_half))?
+    };
     let notifs = Arc::new(Notifications {
         table: Mutex::new(HashMap::new()),
         next_handle: AtomicU32::new(1),
         closed: AtomicBool::new(false),
         notifier: Mutex::new(None),
     });
-    let result = request_loop(stream, peer, ip_routed, shared, &writer, &notifs);
+    let result = request_loop(
+        stream.try_clone()?,
+        peer,
+        ip_routed,
+        shared,
+        &writer,
+        &notifs,
+    );
     notifs.closed.store(true, Ordering::SeqCst);
-    // The connection's handles give their share of the budget back.
-    let freed: u64 = lock(&notifs.table).drain().map(|(_, n)| n.cost).sum();
-    shared.release_notifications(freed);
     let notifier = lock(&notifs.notifier).take();
     if let Some(h) = notifier {
         let _ = h.join();
     }
-    let _ = lock(&writer).shutdown(Shutdown::Both);
+    shared.release(lock(&notifs.table).values());
+    lock(&notifs.table).clear();
+    writer.close(Closed::Done);
+    let _ = write_thread.join();
+    let _ = stream.shutdown(Shutdown::Both);
     result
 }
 
@@ -401,9 +593,7 @@ fn request_loop(
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
     let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
-    let mut logged_router: Vec<u16> = Vec::new();
-    // The deadline of the frame being received (the first one from the connection's start).
-    let mut frame_deadline = Some(Instant::now() + FRAME_DEADLINE);
+    let mut last_frame = Instant::now();
     loop {
         // Cut every complete frame out of the buffer (rule 1) before reading more; the
         // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
@@ -411,6 +601,7 @@ fn request_loop(
         let mut used = 0;
         while let Some((frame, n)) = frame::decode(&buf[used..], max)? {
             used += n;
+            last_frame = Instant::now();
             match frame {
                 Frame::Ams { header, data } => {
                     let routed = ip_routed
@@ -419,12 +610,21 @@ fn request_loop(
                             .allow
                             .contains(&RouteEntry::NetId(header.source.net_id));
                     if !routed {
-                        log_once(&mut logged_unrouted, header.source.net_id, || {
-                            format!(
-                                "{peer}: no route for source NetId {}: frames dropped",
-                                header.source.net_id
-                            )
-                        });
+                        let id = header.source.net_id;
+                        if logged_unrouted.len() <= MAX_LOGGED_UNROUTED
+                            && !logged_unrouted.contains(&id)
+                        {
+                            if logged_unrouted.len() == MAX_LOGGED_UNROUTED {
+                                log(format_args!(
+                                    "{peer}: more than {MAX_LOGGED_UNROUTED} unrouted source NetIds: no more are logged"
+                                ));
+                            } else {
+                                log(format_args!(
+                                    "{peer}: no route for source NetId {id}: frames dropped"
+                                ));
+                            }
+                            logged_unrouted.push(id);
+                        }
                         continue;
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
@@ -441,15 +641,10 @@ fn request_loop(
                     // The client's port is gone: its notifications end, and the connection
                     // is closed, as the TwinCAT router does, so the client's disconnect()
                     // (which waits for the close) returns at once.
-                    close_port(notifs, &body, shared);
+                    close_port(shared, notifs, &body);
                     return Ok(());
                 }
                 Frame::Router { command, body } => {
-                    if command != ROUTER_PORT_CONNECT {
-                        log_once(&mut logged_router, command, || {
-                            format!("{peer}: AMS router command 0x{command:04X} ignored")
-                        });
-                    }
                     if let Some(reply) = handle_router(command, &body, peer, shared) {
                         send(writer, &reply)?;
                     }
@@ -457,69 +652,75 @@ fn request_loop(
             }
         }
         buf.drain(..used);
-        if used > 0 {
-            frame_deadline = None;
-        }
-        if !buf.is_empty() && frame_deadline.is_none() {
-            frame_deadline = Some(Instant::now() + FRAME_DEADLINE);
+        if let Some(c) = writer.closed() {
+            return Err(closed_error(c, writer.limit_bytes).into());
         }
         let n = match stream.read(&mut chunk) {
-            Ok(0) => return Ok(()),
+            // The writer shut the socket (write stall): say why, not just "closed".
+            Ok(0) => {
+                return match writer.closed() {
+                    Some(c) if c != Closed::Done => Err(closed_error(c, writer.limit_bytes).into()),
+                    _ => Ok(()),
+                }
+            }
             Ok(n) => n,
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-            Err(_) if shared.stopping.load(Ordering::SeqCst) => return Ok(()),
             Err(e)
                 if matches!(
                     e.kind(),
                     io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
                 ) =>
             {
-                if frame_deadline.is_some_and(|d| Instant::now() >= d) {
-                    return Err(ConnError::Slow(FRAME_DEADLINE));
+                let idle = last_frame.elapsed();
+                let waiting = !buf.is_empty() || lock(&notifs.table).is_empty();
+                if idle >= shared.config.idle_timeout && waiting {
+                    let what = if buf.is_empty() {
+                        "idle"
+                    } else {
+                        "frame incomplete"
+                    };
+                    return Err(ConnError::Idle(format!(
+                        "{what} for {} s (idle timeout {} s)",
+                        idle.as_secs(),
+                        shared.config.idle_timeout.as_secs_f64()
+                    )));
                 }
                 continue;
             }
-            Err(e) => return Err(e.into()),
+            Err(e) if shared.stopping.load(Ordering::SeqCst) => {
+                let _ = e;
+                return Ok(());
+            }
+            Err(e) => {
+                return Err(match writer.closed() {
+                    Some(c) if c != Closed::Done => closed_error(c, writer.limit_bytes),
+                    _ => e,
+                }
+                .into())
+            }
         };
         buf.extend_from_slice(&chunk[..n]);
     }
 }
 
-/// Log a line for `key` the first time it is seen on this connection, up to
-/// [`MAX_LOGGED_PER_CONNECTION`] keys; then one line that further ones are not logged.
-fn log_once<K: PartialEq>(seen: &mut Vec<K>, key: K, line: impl FnOnce() -> String) {
-    if seen.contains(&key) || seen.len() > MAX_LOGGED_PER_CONNECTION {
-        return;
-    }
-    if seen.len() == MAX_LOGGED_PER_CONNECTION {
-        log("further ones on this connection are not logged");
-    } else {
-        log(line());
-    }
-    seen.push(key);
-}
-
 /// AMS/TCP command 0x0001: a client closes its AMS port (body: the port, u16 LE).
 const PORT_CLOSE: u16 = 0x0001;
-/// AMS/TCP command 0x1000: a client asks the router for a port.
-const ROUTER_PORT_CONNECT: u16 = 0x1000;
 
 /// Drop the notifications of the port a 0x0001 frame closes (all of them when the body does
 /// not name a port).
-fn close_port(notifs: &Notifications, body: &[u8], shared: &Shared) {
+fn close_port(shared: &Shared, notifs: &Notifications, body: &[u8]) {
     let port = match body {
         [a, b, ..] => Some(u16::from_le_bytes([*a, *b])),
         _ => None,
     };
-    let mut freed = 0;
-    lock(&notifs.table).retain(|_, n| {
-        let keep = port.is_some_and(|p| n.client.port != p);
-        if !keep {
-            freed += n.cost;
-        }
-        keep
-    });
-    shared.release_notifications(freed);
+    let mut table = lock(&notifs.table);
+    let gone: Vec<u32> = table
+        .iter()
+        .filter(|(_, n)| port.is_none_or(|p| n.client.port == p))
+        .map(|(&h, _)| h)
+        .collect();
+    let removed: Vec<Notification> = gone.iter().filter_map(|h| table.remove(h)).collect();
+    shared.release(&removed);
 }
 
 /// Let the notifications just added send their first sample, [`FIRST_SAMPLE_DELAY`] from now.
@@ -535,7 +736,10 @@ fn arm_notifications(notifs: &Notifications) {
 /// e.g. the `ads` crate's `Source::Request`) gets a NetId made from the peer's IPv4 address
 /// plus `.1.1` and a fresh port; everything else is ignored.
 fn handle_router(command: u16, _body: &[u8], peer: SocketAddr, shared: &Shared) -> Option<Vec<u8>> {
-    if command != ROUTER_PORT_CONNECT {
+    if command != 0x1000 {
+        shared.router_log.log(format_args!(
+            "{peer}: AMS router command 0x{command:04X} ignored"
+        ));
         return None;
     }
     let ip = match peer.ip() {
@@ -640,11 +844,8 @@ fn handle_request(
             }
             Request::DelNotification { handle } => {
                 let removed = lock(&notifs.table).remove(&handle);
-                if let Some(n) = &removed {
-                    shared.release_notifications(n.cost);
-                }
-                let removed = removed.is_some();
-                response::result_only(if removed {
+                shared.release(removed.as_ref());
+                response::result_only(if removed.is_some() {
                     AdsResult::OK
                 } else {
                     AdsResult::INVALID_HANDLE
@@ -684,8 +885,9 @@ fn add_notification(
     let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
         .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
     let mut table = lock(&notifs.table);
-    let cost = notification_cost(cycle);
-    if table.len() >= shared.config.max_notifications || !shared.reserve_notification(cost) {
+    // 0x716 (no more handles) both for the connection's limit and the whole server's budget:
+    // the one error a client already handles when a table is full.
+    if table.len() >= shared.config.max_notifications || !shared.reserve(cycle) {
         return (AdsResult::NO_MORE_HANDLES, 0);
     }
     let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);
@@ -701,7 +903,6 @@ fn add_notification(
             next_due: Instant::now() + MAX_NOTIFICATION_CYCLE,
             last: None,
             armed: false,
-            cost,
         },
     );
     drop(table);

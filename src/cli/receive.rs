@@ -13,12 +13,16 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
+use std::sync::Arc;
+
 use crate::dnc::{
     self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
     TransferEnd, TransferReport, WriterConfig,
 };
 
 use super::exit;
+// Operator messages never panic on a closed stderr (`eprintln!` would, mid-transfer).
+use super::serve::report as say;
 
 #[derive(Debug, clap::Args)]
 pub struct ReceiveArgs {
@@ -41,8 +45,20 @@ pub struct ReceiveArgs {
     #[arg(long, value_name = "N")]
     pub max_transfers: Option<usize>,
     /// With --listen: end a connection silent for this many seconds (a broken transfer).
-    #[arg(long, value_name = "SECONDS")]
-    pub idle_timeout: Option<f64>,
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_IDLE_TIMEOUT_S)]
+    pub idle_timeout: f64,
+    /// Bytes one transfer may carry; beyond, the transfer ends and the program in progress is
+    /// cut off (default with --listen: 256 MiB; unbounded for a file or standard input).
+    #[arg(long, value_name = "BYTES")]
+    pub max_transfer_bytes: Option<u64>,
+    /// With --listen: transfers taken at the same time (a silent or slow sender holds one).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CONCURRENT,
+          value_parser = clap::value_parser!(u16).range(1..=64))]
+    pub max_concurrent: u16,
+    /// Programs one transfer may deliver; the next is dropped and the transfer ends
+    /// (default with --listen: 1000; unbounded for a file or standard input).
+    #[arg(long, value_name = "N")]
+    pub max_programs: Option<usize>,
     /// Replace existing program files (default: keep them and drop the received program).
     #[arg(long)]
     pub overwrite: bool,
@@ -65,11 +81,18 @@ pub struct ReceiveArgs {
 
 /// Where programs go without `--out`: the channel's first main-program search path, from the
 /// parameter lists, so received programs are ready to run.
+/// `--listen` defaults: a silent sender frees the port after 30 s; one transfer carries at
+/// most 256 MiB and 1000 programs (docs/ads-limits.md, "receive --listen").
+pub const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
+pub const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
+pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
+pub const DEFAULT_MAX_CONCURRENT: u16 = 4;
+
 pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let params = super::run::locate(params);
     let config = crate::params::load(&params).map_err(|e| {
         for d in e.diagnostics() {
-            eprintln!("{}", d.render());
+            say(format_args!("{}", d.render()));
         }
         format!(
             "no --out, and the parameter lists in {} are refused",
@@ -88,11 +111,11 @@ pub fn execute(args: ReceiveArgs) -> ExitCode {
     match run(args) {
         Ok(code) => ExitCode::from(code),
         Err(Failure::Usage(msg)) => {
-            eprintln!("ncchannel receive: {msg}");
+            say(format_args!("ncchannel receive: {msg}"));
             ExitCode::from(exit::USAGE)
         }
         Err(Failure::Io(msg)) => {
-            eprintln!("ncchannel receive: {msg}");
+            say(format_args!("ncchannel receive: {msg}"));
             ExitCode::from(exit::CHANNEL_ERROR)
         }
     }
@@ -118,21 +141,28 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     } else {
         Anchor::Anywhere
     };
-    if args.listen.is_none() && (args.max_transfers.is_some() || args.idle_timeout.is_some()) {
-        return Err(Failure::Usage(
-            "--max-transfers and --idle-timeout need --listen".to_string(),
-        ));
+    if args.listen.is_none() && args.max_transfers.is_some() {
+        return Err(Failure::Usage("--max-transfers needs --listen".to_string()));
     }
     let markers = Markers::new(&args.start, &args.end, anchor)?;
     let template = NameTemplate::parse(&args.name_template)?;
     let idle = match args.idle_timeout {
-        None => None,
-        Some(s) if s.is_finite() && s > 0.0 && s < 1e9 => Some(Duration::from_secs_f64(s)),
-        Some(s) => {
+        s if s.is_finite() && s > 0.0 && s < 1e9 => Duration::from_secs_f64(s),
+        s => {
             return Err(Failure::Usage(format!(
                 "--idle-timeout {s}: not a positive time"
             )))
         }
+    };
+    let listening = args.listen.is_some();
+    let limits = dnc::TransferLimits {
+        idle_timeout: Some(idle),
+        max_bytes: args
+            .max_transfer_bytes
+            .or(listening.then_some(DEFAULT_MAX_TRANSFER_BYTES)),
+        max_programs: args
+            .max_programs
+            .or(listening.then_some(DEFAULT_MAX_PROGRAMS)),
     };
     let out = match args.out.clone() {
         Some(o) => o,
@@ -142,8 +172,8 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     cfg.overwrite = args.overwrite;
     cfg.keep_partial = args.keep_partial;
     cfg.template = template;
-    let mut writer = ProgramWriter::new(cfg).with_log(log_line);
-    let mut splitter = Splitter::new(markers);
+    let mut writer = ProgramWriter::new(cfg.clone()).with_log(log_line);
+    let mut splitter = Splitter::new(markers.clone());
 
     let mut total = Totals::default();
     if let Some(addr) = &args.listen {
@@ -153,51 +183,109 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         let local = listener
             .local_addr()
             .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
-        eprintln!("listening on {local}");
+        say(format_args!("listening on {local}"));
         // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
         let signal = super::signal::StopSignal::install().ok();
         if let Some(sig) = &signal {
             wake_on_signal(sig.clone(), local);
         }
-        let mut count = 0usize;
-        while args.max_transfers.is_none_or(|m| count < m) {
-            let mut last = None;
-            dnc::receive_connections(&listener, Some(1), idle, &mut splitter, &mut writer, |r| {
-                last = Some(r.clone())
-            })?;
-            let stopping = signal
-                .as_ref()
-                .is_some_and(super::signal::StopSignal::raised);
-            if let Some(r) = last {
-                // After a signal, the empty wake-up connection is not a transfer.
-                if !(stopping && r.split.bytes_in == 0) {
-                    total.add(&r);
-                    count += 1;
-                }
+        let numbers = writer.numbers();
+        let (done_tx, done) = std::sync::mpsc::channel();
+        let mut active = 0usize;
+        let mut accepted = 0usize;
+        // Whatever a transfer came to: filed programs, or refused with its reason (a name
+        // the disk refuses, a full disk); the port keeps serving the others.
+        let settle = |r: Result<TransferReport, dnc::DncError>, total: &mut Totals| match r {
+            Ok(r) => total.add(&r),
+            Err(e) => {
+                say(format_args!("ncchannel receive: transfer refused: {e}"));
+                total.refused += 1;
             }
-            if stopping {
+        };
+        while args.max_transfers.is_none_or(|m| accepted < m) {
+            while active >= usize::from(args.max_concurrent) {
+                match done.recv() {
+                    Ok(r) => settle(r, &mut total),
+                    Err(_) => break,
+                }
+                active -= 1;
+            }
+            while let Ok(r) = done.try_recv() {
+                settle(r, &mut total);
+                active -= 1;
+            }
+            let (stream, peer) = match listener.accept() {
+                Ok(s) => s,
+                Err(e) => {
+                    if !matches!(
+                        e.kind(),
+                        io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
+                    ) {
+                        say(format_args!("ncchannel receive: accept on {local}: {e}"));
+                        std::thread::sleep(Duration::from_millis(50));
+                    }
+                    continue;
+                }
+            };
+            // After a signal, the wake-up connection is not a transfer.
+            if signal
+                .as_ref()
+                .is_some_and(super::signal::StopSignal::raised)
+            {
                 break;
             }
+            accepted += 1;
+            let (markers, cfg, numbers, tx) = (
+                markers.clone(),
+                cfg.clone(),
+                Arc::clone(&numbers),
+                done_tx.clone(),
+            );
+            let spawned = std::thread::Builder::new()
+                .name(format!("receive-{peer}"))
+                .spawn(move || {
+                    let mut splitter = Splitter::new(markers);
+                    let mut writer = ProgramWriter::new(cfg)
+                        .with_log(log_line)
+                        .with_numbers(numbers);
+                    let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
+                    let _ = tx.send(r);
+                });
+            match spawned {
+                Ok(_) => active += 1,
+                Err(e) => settle(Err(dnc::DncError::io(peer.to_string(), e)), &mut total),
+            }
+        }
+        // The transfers in progress complete (each within its idle timeout).
+        drop(done_tx);
+        while active > 0 {
+            match done.recv() {
+                Ok(r) => settle(r, &mut total),
+                Err(_) => break,
+            }
+            active -= 1;
         }
     } else {
         let report = match args.input.as_deref() {
-            None => dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?,
+            None => dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?,
             Some(p) if p == Path::new("-") => {
-                dnc::receive(io::stdin().lock(), &mut splitter, &mut writer)?
+                dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?
             }
             Some(p) => {
                 let f = File::open(p).map_err(|e| Failure::Io(format!("{}: {e}", p.display())))?;
-                dnc::receive(f, &mut splitter, &mut writer)?
+                dnc::receive_limited(f, &limits, &mut splitter, &mut writer)?
             }
         };
         total.add(&report);
     }
     total.print(&out);
-    Ok(if total.filed > 0 && total.cut_off == 0 {
-        exit::OK
-    } else {
-        exit::CHANNEL_ERROR
-    })
+    Ok(
+        if total.filed > 0 && total.cut_off == 0 && total.refused == 0 {
+            exit::OK
+        } else {
+            exit::CHANNEL_ERROR
+        },
+    )
 }
 
 /// A blocking `accept` does not return for a signal; once the stop flag is set, one
@@ -235,6 +323,7 @@ fn log_line(p: &ReceivedProgram) {
         Disposition::CutOffDropped => "cut off, dropped",
         Disposition::CutOffKept => "cut off, kept",
         Disposition::NameUnusable => "not filed",
+        Disposition::OverLimit => "over the limit, dropped",
     };
     let mut out = io::stdout().lock();
     let _ = writeln!(
@@ -247,26 +336,31 @@ fn log_line(p: &ReceivedProgram) {
     );
     let _ = out.flush();
     for name in &p.rejected_names {
-        eprintln!(
+        say(format_args!(
             "ncchannel receive: name `{name}` in lines {}-{} is not a plain file name; numbered instead",
             p.first_line, p.last_line
-        );
+        ));
     }
     match p.disposition {
-        Disposition::KeptExisting => eprintln!(
+        Disposition::KeptExisting => say(format_args!(
             "ncchannel receive: {} exists and was kept; the received program was dropped (use --overwrite)",
             p.path.display()
-        ),
-        Disposition::CutOffDropped => eprintln!(
+        )),
+        Disposition::CutOffDropped => say(format_args!(
             "ncchannel receive: the transfer ended inside the program from line {}; it was dropped (--keep-partial keeps it)",
             p.first_line
-        ),
-        Disposition::NameUnusable => eprintln!(
+        )),
+        Disposition::NameUnusable => say(format_args!(
             "ncchannel receive: the program from line {} cannot be filed as {}: {}; it was dropped",
             p.first_line,
             p.path.display(),
             p.reason.as_deref().unwrap_or("name unusable")
-        ),
+        )),
+        Disposition::OverLimit => say(format_args!(
+            "ncchannel receive: the program from line {} was dropped: {}",
+            p.first_line,
+            p.reason.as_deref().unwrap_or("limit reached")
+        )),
         _ => {}
     }
 }
@@ -277,6 +371,8 @@ struct Totals {
     filed: usize,
     kept: usize,
     cut_off: usize,
+    /// Transfers refused by an error of the receiver (nothing of them filed).
+    refused: usize,
     bytes: u64,
 }
 
@@ -293,29 +389,36 @@ impl Totals {
         self.bytes += r.split.bytes_in;
         let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
         if r.split.no_start_marker() {
-            eprintln!(
+            say(format_args!(
                 "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
                 r.split.bytes_in
-            );
+            ));
         }
         match &r.end {
             TransferEnd::Complete => {}
             TransferEnd::IdleTimeout => {
-                eprintln!("ncchannel receive: transfer{from} timed out")
+                say(format_args!("ncchannel receive: transfer{from} timed out"))
             }
-            TransferEnd::Broken(e) => eprintln!("ncchannel receive: transfer{from} broke: {e}"),
+            TransferEnd::Broken(e) => {
+                say(format_args!("ncchannel receive: transfer{from} broke: {e}"))
+            }
+            TransferEnd::LimitReached(l) => say(format_args!(
+                "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
+            )),
         }
     }
 
     fn print(&self, out: &Path) {
-        println!(
-            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off",
+        let _ = writeln!(
+            io::stdout().lock(),
+            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off, {} transfer(s) refused",
             self.filed,
             out.display(),
             self.transfers,
             self.bytes,
             self.kept,
-            self.cut_off
+            self.cut_off,
+            self.refused
         );
     }
 }

@@ -1,6 +1,5 @@
 //! `ncchannel serve`: the channels in real time behind an ADS server, for real clients.
 
-use std::io::Write;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,7 +9,7 @@ use std::time::Duration;
 use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::{AmsNetId, ServerConfig};
 use crate::machine::{Machine, StopWhen};
-use crate::report::event::EventLog;
+use crate::report::event::{Backlog, EventLog};
 use crate::runtime::{Clock, Runtime, Tick};
 use crate::soak::external::{load_external, Supervised};
 use crate::soak::scenario::Scenario;
@@ -37,13 +36,17 @@ pub struct ServeArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Stop after this many seconds, 0 to 1e9 (default: run until SIGINT/SIGTERM).
-    #[arg(long, value_parser = run_seconds)]
-    pub seconds: Option<Duration>,
+    /// Stop after this many seconds (default, or `inf`: run until SIGINT/SIGTERM).
+    #[arg(long)]
+    pub seconds: Option<f64>,
     /// Soak external clients: inject the scenario's [faults] and check the invariants on what
     /// they write (the scenario's `params` replaces --params). Exit 1 on a violation.
     #[arg(long)]
     pub soak: Option<PathBuf>,
+    /// Close an ADS connection that completed no frame for this many seconds while in the
+    /// middle of a frame or holding no notification handles (default 60; docs/ads-limits.md).
+    #[arg(long, value_name = "SECONDS")]
+    pub ads_idle_timeout: Option<f64>,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
@@ -64,16 +67,49 @@ pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) ->
         allow: ads.allowed_clients.clone(),
         max_connections: ads.max_connections as usize,
         max_notifications: ads.max_notifications_per_connection as usize,
-        max_notification_rate_per_s: u64::from(ads.max_notification_rate_per_s),
+        max_notifications_total: ads.max_notifications_total as usize,
+        notification_samples_per_s: u64::from(ads.notification_samples_per_s),
+        idle_timeout: args
+            .ads_idle_timeout
+            .and_then(|s| Duration::try_from_secs_f64(s).ok())
+            .filter(|d| !d.is_zero())
+            .unwrap_or(Duration::from_secs(u64::from(ads.idle_timeout_s))),
+        ..ServerConfig::default()
     }
 }
 
+/// `--seconds`: `None` runs until a signal (no value, `inf`, or longer than `Duration` holds);
+/// a negative or NaN value is a usage error. `Duration::from_secs_f64` would panic on those.
+pub(crate) fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String> {
+    match seconds {
+        None => Ok(None),
+        Some(s) if s.is_nan() || s < 0.0 => Err(format!("--seconds {s}: not a duration")),
+        Some(s) => Ok(Duration::try_from_secs_f64(s).ok()),
+    }
+}
+
+/// A line on standard error, best effort. `eprintln!` panics when stderr is a closed pipe;
+/// a message must never cost the run its event log or its exit code.
+pub(crate) fn report(msg: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{msg}");
+}
+
 pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
-    eprintln!("ncchannel serve: {msg}");
+    report(format_args!("ncchannel serve: {msg}"));
     ExitCode::from(exit::USAGE)
 }
 
 pub fn execute(mut args: ServeArgs) -> ExitCode {
+    let limit = match run_limit(args.seconds) {
+        Ok(l) => l,
+        Err(msg) => return usage(msg),
+    };
+    if let Some(s) = args.ads_idle_timeout {
+        if !(s.is_finite() && s > 0.0) {
+            return usage(format!("--ads-idle-timeout {s}: not a positive time"));
+        }
+    }
     let scenario = match &args.soak {
         None => None,
         Some(p) => match load_scenario(p) {
@@ -95,8 +131,9 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         // The soak's checks need the channels' events; without --events they go nowhere.
         None if scenario.is_some() => EventLog::to_writer(Box::new(std::io::sink())),
         None => EventLog::disabled(),
+        // Real time: a reader that falls behind loses events (counted), never the cycle's pace.
         Some(t) => match EventLog::open(t) {
-            Ok(l) => l,
+            Ok(l) => l.with_backlog(Backlog::Drop),
             Err(e) => return usage(format!("--events {t}: {e}")),
         },
     };
@@ -111,7 +148,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         };
         if let Some(c) = machine.channel_mut(1) {
             if let Err(e) = c.start(&tick0, p) {
-                eprintln!("ncchannel serve: --start {p}: {e}");
+                report(format_args!("ncchannel serve: --start {p}: {e}"));
             }
         }
     }
@@ -141,18 +178,20 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             Ok(s) => s,
             Err(e) => return usage(format!("cannot listen: {e}")),
         };
-    eprintln!(
+    report(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),
         period.as_micros()
-    );
+    ));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
-        Err(e) => eprintln!("ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"),
+        Err(e) => report(format_args!(
+            "ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"
+        )),
     }
     let stop = rt.stop_handle();
-    if let Some(d) = args.seconds {
+    if let Some(d) = limit {
         std::thread::spawn(move || {
             std::thread::sleep(d);
             stop.stop();
@@ -162,47 +201,21 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
     let (mut machine, stats) = rt.into_inner();
-    // The log first, then the words: `writeln!` rather than `eprintln!`, whose panic on a
-    // closed stderr (a supervisor that went away) would lose the stop's exit code.
-    let dropped = machine.events_dropped();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    let mut err = std::io::stderr().lock();
-    let _ = writeln!(
-        err,
+    report(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
-    );
+    ));
     match log {
-        Ok(lines) if args.events.is_some() => {
-            let _ = writeln!(err, "event log: {lines} lines");
-            if dropped > 0 {
-                let _ = writeln!(
-                    err,
-                    "event log: {dropped} events dropped: its reader fell more than {} ticks behind",
-                    crate::report::event::MAX_PENDING_BATCHES
-                );
-            }
-        }
+        Ok(lines) if args.events.is_some() => report(format_args!("event log: {lines} lines")),
         Ok(_) => {}
         Err(e) => {
-            let _ = writeln!(err, "ncchannel serve: event log: {e}");
+            report(format_args!("ncchannel serve: event log: {e}"));
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }
     ExitCode::from(exit::OK)
-}
-
-/// `--seconds`: a finite number of seconds from 0 to 1e9 (about 31 years); "inf", NaN or a
-/// negative number is a usage error rather than a panic or a silent default.
-fn run_seconds(s: &str) -> Result<Duration, String> {
-    let v: f64 = s.trim().parse().map_err(|e| format!("{e}"))?;
-    if !(0.0..=1e9).contains(&v) {
-        return Err(format!(
-            "{v} is not a number of seconds from 0 to 1e9 (leave --seconds out to run until stopped)"
-        ));
-    }
-    Duration::try_from_secs_f64(v).map_err(|e| e.to_string())
 }

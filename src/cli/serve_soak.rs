@@ -16,7 +16,7 @@ use crate::soak::invariants::{Tally, Verdict};
 use crate::soak::scenario::Scenario;
 
 use super::exit;
-use super::serve::{usage, ServeArgs};
+use super::serve::{report as say, run_limit, usage, ServeArgs};
 
 /// The report of one `serve --soak` run (`--report` writes it as JSON).
 #[derive(Debug, Serialize)]
@@ -70,6 +70,10 @@ pub fn run(
     period: Duration,
     nch: u16,
 ) -> ExitCode {
+    let limit = match run_limit(args.seconds) {
+        Ok(l) => l,
+        Err(msg) => return usage(msg),
+    };
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
     let server_config = super::serve::server_config(args, config);
     let server =
@@ -77,17 +81,16 @@ pub fn run(
             Ok(s) => s,
             Err(e) => return usage(format!("cannot listen: {e}")),
         };
-    eprintln!(
+    say(format_args!(
         "listening on {} (soak {}, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         scenario.path.display(),
         period.as_micros()
-    );
+    ));
     let signal = super::signal::StopSignal::install().ok();
     if let Some(s) = &signal {
         rt.stop_on(s.flag());
     }
-    let limit = args.seconds;
     let warmup = limit.map_or(Duration::from_secs(10), |l| {
         l.mul_f64(scenario.invariants.warmup)
     });
@@ -133,7 +136,7 @@ pub fn run(
     ));
     let mut machine = cycle.into_machine();
     if let Err(e) = machine.finish_log() {
-        eprintln!("ncchannel serve: event log: {e}");
+        say(format_args!("ncchannel serve: event log: {e}"));
     }
     let all_held = invariants.iter().all(|v| v.held);
     let report = ServeSoakReport {
@@ -146,12 +149,15 @@ pub fn run(
         resident_kib_at_end: end_kib,
         all_held,
     };
-    eprintln!();
+    say(format_args!(""));
     let _ = report.print_human(&mut std::io::stdout());
     if let Some(p) = &args.report {
         let json = serde_json::to_string_pretty(&report).unwrap_or_default();
         if let Err(e) = std::fs::write(p, json + "\n") {
-            eprintln!("ncchannel serve: --report {}: {e}", p.display());
+            say(format_args!(
+                "ncchannel serve: --report {}: {e}",
+                p.display()
+            ));
             return ExitCode::from(exit::USAGE);
         }
     }

@@ -16,5 +16,8 @@ pub use control_line::{NameInfo, SinumerikName};
 pub use error::DncError;
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
 pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
-pub use transfer::{receive, receive_connections, TransferEnd, TransferReport};
+pub use transfer::{
+    receive, receive_connection, receive_connections, receive_limited, receive_stream, Limit,
+    TransferEnd, TransferLimits, TransferReport,
+};
 pub use writer::{Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig};

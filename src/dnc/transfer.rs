@@ -3,7 +3,7 @@
 //! serial-over-IP DNC port.
 
 use std::io::{self, Read};
-use std::net::{SocketAddr, TcpListener};
+use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::time::Duration;
 
 use super::error::DncError;
@@ -22,6 +22,29 @@ pub enum TransferEnd {
     IdleTimeout,
     /// A read failed (connection reset, device error).
     Broken(String),
+    /// The transfer reached one of its [`TransferLimits`]; the rest was not read.
+    LimitReached(Limit),
+}
+
+/// Which of the [`TransferLimits`] ended a transfer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum Limit {
+    #[error("more than {0} bytes")]
+    Bytes(u64),
+    #[error("more than {0} programs")]
+    Programs(usize),
+}
+
+/// Bounds on one transfer, so one sender cannot fill the disk or hold the port for ever.
+/// `None` is unbounded (a file or standard input the operator chose).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TransferLimits {
+    /// A connection silent this long ends as [`TransferEnd::IdleTimeout`].
+    pub idle_timeout: Option<Duration>,
+    /// Bytes read at most; the program in progress at the limit is cut off.
+    pub max_bytes: Option<u64>,
+    /// Programs delivered at most; the next one is dropped and the transfer ends.
+    pub max_programs: Option<usize>,
 }
 
 /// One transfer's outcome.
@@ -44,17 +67,40 @@ impl TransferReport {
 /// Receive one transfer to its end. The writer's errors (disk full, no permission) stop the
 /// transfer with `Err`; the program being written is then dropped, never half filed.
 pub fn receive<R: Read>(
+    input: R,
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+) -> Result<TransferReport, DncError> {
+    receive_limited(input, &TransferLimits::default(), splitter, writer)
+}
+
+/// [`receive`] within `limits` (the idle timeout is the reader's own: a socket's read
+/// timeout, set by the caller).
+pub fn receive_limited<R: Read>(
     mut input: R,
+    limits: &TransferLimits,
     splitter: &mut Splitter,
     writer: &mut ProgramWriter,
 ) -> Result<TransferReport, DncError> {
     let mut buf = vec![0u8; READ_CHUNK];
+    let mut bytes: u64 = 0;
+    writer.limit_programs(limits.max_programs);
     let end = loop {
+        if let Some(max) = limits.max_programs.filter(|_| writer.over_limit()) {
+            break TransferEnd::LimitReached(Limit::Programs(max));
+        }
         match input.read(&mut buf) {
             Ok(0) => break TransferEnd::Complete,
             Ok(n) => {
-                if let Err(e) = splitter.feed(&buf[..n], writer) {
+                let allowed = limits
+                    .max_bytes
+                    .map_or(n, |m| n.min(usize::try_from(m - bytes).unwrap_or(n)));
+                if let Err(e) = splitter.feed(&buf[..allowed], writer) {
                     return Err(reset(splitter, writer, e));
+                }
+                bytes += allowed as u64;
+                if allowed < n {
+                    break TransferEnd::LimitReached(Limit::Bytes(bytes));
                 }
             }
             Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
@@ -71,6 +117,7 @@ pub fn receive<R: Read>(
         _ => splitter.abort(writer),
     };
     let split = split.map_err(|e| reset(splitter, writer, e))?;
+    writer.limit_programs(None);
     Ok(TransferReport {
         split,
         programs: writer.take_records(),
@@ -113,12 +160,31 @@ pub fn receive_connections(
     writer: &mut ProgramWriter,
     mut on_transfer: impl FnMut(&TransferReport),
 ) -> Result<usize, DncError> {
+    let limits = TransferLimits {
+        idle_timeout,
+        ..TransferLimits::default()
+    };
+    let mut count = 0;
+    while max_transfers.is_none_or(|m| count < m) {
+        let report = receive_connection(listener, &limits, splitter, writer)?;
+        on_transfer(&report);
+        count += 1;
+    }
+    Ok(count)
+}
+
+/// Take the next TCP transfer within `limits`.
+pub fn receive_connection(
+    listener: &TcpListener,
+    limits: &TransferLimits,
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+) -> Result<TransferReport, DncError> {
     let local = listener
         .local_addr()
         .map(|a| a.to_string())
         .unwrap_or_else(|_| "listener".to_string());
-    let mut count = 0;
-    while max_transfers.is_none_or(|m| count < m) {
+    loop {
         let (stream, peer) = match listener.accept() {
             Ok(s) => s,
             Err(e)
@@ -131,13 +197,22 @@ pub fn receive_connections(
             }
             Err(e) => return Err(DncError::io(&local, e)),
         };
-        stream
-            .set_read_timeout(idle_timeout)
-            .map_err(|e| DncError::io(peer.to_string(), e))?;
-        let mut report = receive(stream, splitter, writer)?;
-        report.peer = Some(peer);
-        on_transfer(&report);
-        count += 1;
+        return receive_stream(stream, peer, limits, splitter, writer);
     }
-    Ok(count)
+}
+
+/// One accepted TCP transfer within `limits`.
+pub fn receive_stream(
+    stream: TcpStream,
+    peer: SocketAddr,
+    limits: &TransferLimits,
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+) -> Result<TransferReport, DncError> {
+    stream
+        .set_read_timeout(limits.idle_timeout)
+        .map_err(|e| DncError::io(peer.to_string(), e))?;
+    let mut report = receive_limited(stream, limits, splitter, writer)?;
+    report.peer = Some(peer);
+    Ok(report)
 }

@@ -9,6 +9,8 @@
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::Arc;
 
 use tempfile::NamedTempFile;
 
@@ -118,6 +120,9 @@ pub enum Disposition {
     /// The program could not be filed under its name (the name is taken by a directory, or a
     /// workpiece folder's name by a file); it was dropped and the transfer went on.
     NameUnusable,
+    /// The transfer had delivered its limit of programs; this one was dropped and the
+    /// transfer ended (`TransferLimits::max_programs`).
+    OverLimit,
 }
 
 /// One line of the receive log.
@@ -159,9 +164,15 @@ type TempProgram = BufWriter<NamedTempFile>;
 pub struct ProgramWriter {
     cfg: WriterConfig,
     current: Option<TempProgram>,
-    next_number: u32,
+    /// The next number for a program the data names not; shared by the writers of
+    /// concurrent transfers so no two pick the same one.
+    next_number: Arc<AtomicU32>,
     records: Vec<ReceivedProgram>,
     log: Option<LogFn>,
+    /// Programs this transfer may still deliver (`None`: no limit).
+    programs_left: Option<usize>,
+    /// A program was dropped because `programs_left` was 0.
+    over_limit: bool,
 }
 
 impl ProgramWriter {
@@ -169,10 +180,36 @@ impl ProgramWriter {
         ProgramWriter {
             cfg,
             current: None,
-            next_number: 1,
+            next_number: Arc::new(AtomicU32::new(1)),
             records: Vec::new(),
             log: None,
+            programs_left: None,
+            over_limit: false,
         }
+    }
+
+    /// Deliver at most `max` more programs; the next ones are dropped as
+    /// [`Disposition::OverLimit`]. `None` lifts the limit.
+    pub fn limit_programs(&mut self, max: Option<usize>) {
+        self.programs_left = max;
+        self.over_limit = false;
+    }
+
+    /// Was a program dropped for the limit of [`ProgramWriter::limit_programs`]?
+    pub fn over_limit(&self) -> bool {
+        self.over_limit
+    }
+
+    /// Number unnamed programs from `numbers`, shared with other writers (concurrent
+    /// transfers into one folder).
+    pub fn with_numbers(mut self, numbers: Arc<AtomicU32>) -> Self {
+        self.next_number = numbers;
+        self
+    }
+
+    /// The counter [`ProgramWriter::with_numbers`] shares.
+    pub fn numbers(&self) -> Arc<AtomicU32> {
+        Arc::clone(&self.next_number)
     }
 
     /// Called for every program as soon as it is filed (or dropped).
@@ -209,8 +246,13 @@ impl ProgramWriter {
     fn numbered(&mut self) -> String {
         let mut probes = 0;
         loop {
-            let name = self.cfg.template.render(self.next_number);
-            self.next_number = self.next_number.saturating_add(1);
+            let n = self
+                .next_number
+                .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                    Some(n.saturating_add(1))
+                })
+                .unwrap_or(u32::MAX);
+            let name = self.cfg.template.render(n);
             probes += 1;
             if self.cfg.overwrite
                 || probes >= MAX_NUMBER_PROBES
@@ -225,6 +267,23 @@ impl ProgramWriter {
         let Some(tmp) = self.current.take() else {
             return Ok(());
         };
+        if self.programs_left == Some(0) {
+            self.over_limit = true;
+            let name = end.name.file_name().map_or_else(String::new, |(_, n)| n);
+            self.record(ReceivedProgram {
+                path: self.cfg.out_dir.join(name),
+                bytes: end.bytes,
+                first_line: end.first_line,
+                last_line: end.last_line,
+                disposition: Disposition::OverLimit,
+                rejected_names: end.name.rejected.clone(),
+                reason: Some("the transfer's limit of programs was reached".to_string()),
+            });
+            return Ok(());
+        }
+        if let Some(left) = self.programs_left.as_mut() {
+            *left -= 1;
+        }
         let tmp = finish_temp(tmp)?;
         let (dir, name) = match end.name.file_name() {
             Some(n) => n,

@@ -162,8 +162,13 @@ pub struct AdsConfig {
     pub max_connections: u32,
     /// Notification handles per connection (default 256); more are answered 0x716.
     pub max_notifications_per_connection: u32,
-    /// Notification samples per second, all connections together (default 20000).
-    pub max_notification_rate_per_s: u32,
+    /// Notification handles, all connections together (default 1024).
+    pub max_notifications_total: u32,
+    /// Notification samples per second, all connections together (default 10000).
+    pub notification_samples_per_s: u32,
+    /// Seconds without a whole frame after which a connection in the middle of a frame, or
+    /// without notification handles, is closed (default 60).
+    pub idle_timeout_s: u32,
 }
 
 impl Default for AdsConfig {
@@ -175,7 +180,9 @@ impl Default for AdsConfig {
             allowed_clients: Vec::new(),
             max_connections: 64,
             max_notifications_per_connection: 256,
-            max_notification_rate_per_s: 20_000,
+            max_notifications_total: 1024,
+            notification_samples_per_s: 10_000,
+            idle_timeout_s: 60,
         }
     }
 }
@@ -514,10 +521,16 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             4096,
         ),
         (
-            "max_notification_rate_per_s",
-            cfg.ads.max_notification_rate_per_s,
+            "max_notifications_total",
+            cfg.ads.max_notifications_total,
+            65_536,
+        ),
+        (
+            "notification_samples_per_s",
+            cfg.ads.notification_samples_per_s,
             1_000_000,
         ),
+        ("idle_timeout_s", cfg.ads.idle_timeout_s, 86_400),
     ] {
         if !(1..=max).contains(&v) {
             fail("ads", None, key, format!("{v} is not in 1 ... {max}"));

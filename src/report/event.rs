@@ -4,6 +4,12 @@
 //! buffer's batch leaves through [`EventLog::emit`] to a writer thread that serialises and
 //! writes in order. With logging off, [`EventBuffer::enabled`] is false and the channel skips
 //! building events at all.
+//!
+//! The queue to the writer is bounded ([`MAX_QUEUED_BATCHES`]). When it is full (the log's
+//! reader does not keep up: a pipe nobody reads), [`Backlog::Block`] makes the tick wait —
+//! right in virtual time, where nothing is late — and [`Backlog::Drop`] (real time, `serve`)
+//! drops the batch and counts it: the writer puts an `events_dropped` line into the log when
+//! it catches up, and on stderr at the end. Memory stays bounded either way.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -13,7 +19,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError};
+use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
 use crate::runtime::Tick;
@@ -190,6 +196,22 @@ impl EventBuffer {
 /// `Vec`s run out and new ones are allocated.
 const RECYCLE_BATCHES: usize = 16;
 
+/// Batches (one tick's events each) waiting for the writer at most; see [`Backlog`].
+pub const MAX_QUEUED_BATCHES: usize = 1024;
+
+/// With [`Backlog::Drop`], how long [`EventLog::finish`] waits for a writer that is stuck
+/// on a reader that does not read before giving up on it.
+pub const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// What [`EventLog::emit`] does when [`MAX_QUEUED_BATCHES`] batches wait for the writer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backlog {
+    /// Wait for the writer (virtual time: the log is complete, the run slows down).
+    Block,
+    /// Drop the batch and count its events (real time: the cycle never waits for a reader).
+    Drop,
+}
+
 /// A file's buffered lines reach the file at least this often, so a `tail -f` of the log
 /// lags the channel by no more than this plus a tick.
 pub const FLUSH_INTERVAL: Duration = Duration::from_millis(100);
@@ -213,20 +235,9 @@ struct Writer {
     batches: Sender<Vec<Event>>,
     recycled: Receiver<Vec<Event>>,
     thread: JoinHandle<io::Result<u64>>,
-    dropped: Arc<Dropped>,
-}
-
-/// Batches (ticks) waiting for the writer at most. A reader that stops reading (a pipe nobody
-/// drains) must neither block the cycle nor grow memory without bound: beyond this backlog
-/// (about 4 s of ticks at 1 ms) batches are dropped, counted, and the log says so in a line
-/// `{"ev":"events_dropped","count":N}` where the gap is.
-pub const MAX_PENDING_BATCHES: usize = 4096;
-
-/// Events dropped because the writer was behind: in all, and since the last marker line.
-#[derive(Debug, Default)]
-struct Dropped {
-    total: AtomicU64,
-    unmarked: AtomicU64,
+    backlog: Backlog,
+    /// Events dropped and not yet reported in the log.
+    dropped: Arc<AtomicU64>,
 }
 
 impl EventLog {
@@ -270,15 +281,27 @@ impl EventLog {
     /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
     /// [`EventLog::finish`] never leaves a cut line.
     pub fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
-        let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_PENDING_BATCHES);
+        let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_QUEUED_BATCHES);
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
-        let dropped = Arc::new(Dropped::default());
-        let gap = Arc::clone(&dropped);
+        let dropped = Arc::new(AtomicU64::new(0));
+        let dropped_w = Arc::clone(&dropped);
         let thread = std::thread::Builder::new()
             .name("ncchannel-events".into())
             .spawn(move || -> io::Result<u64> {
                 let mut out = BufWriter::new(w);
                 let mut lines = 0u64;
+                let mut dropped_total = 0u64;
+                let mut note_dropped = |out: &mut BufWriter<Box<dyn Write + Send>>,
+                                        lines: &mut u64|
+                 -> io::Result<()> {
+                    let n = dropped_w.swap(0, Ordering::Relaxed);
+                    if n > 0 {
+                        dropped_total += n;
+                        writeln!(out, "{{\"ev\":\"events_dropped\",\"events\":{n}}}")?;
+                        *lines += 1;
+                    }
+                    Ok(())
+                };
                 // When the oldest unflushed line was written; None when all is flushed.
                 let mut dirty_since: Option<Instant> = None;
                 loop {
@@ -295,7 +318,7 @@ impl EventLog {
                         }
                         Err(RecvTimeoutError::Disconnected) => break,
                     };
-                    write_gap(&mut out, &gap)?;
+                    note_dropped(&mut out, &mut lines)?;
                     for ev in batch.drain(..) {
                         serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
                         out.write_all(b"\n")?;
@@ -309,8 +332,14 @@ impl EventLog {
                         dirty_since = None;
                     }
                 }
-                write_gap(&mut out, &gap)?;
+                note_dropped(&mut out, &mut lines)?;
                 out.flush()?;
+                if dropped_total > 0 {
+                    let _ = writeln!(
+                        io::stderr().lock(),
+                        "ncchannel: event log: {dropped_total} events dropped (its reader did not keep up); the log marks where"
+                    );
+                }
                 Ok(lines)
             });
         match thread {
@@ -319,12 +348,21 @@ impl EventLog {
                     batches: tx,
                     recycled: recycle_rx,
                     thread,
+                    backlog: Backlog::Block,
                     dropped,
                 }),
             },
             // Without a thread there is no log; the run itself must not fail for it.
             Err(_) => EventLog::disabled(),
         }
+    }
+
+    /// The same log with `backlog` for a full queue (default [`Backlog::Block`]).
+    pub fn with_backlog(mut self, backlog: Backlog) -> Self {
+        if let Some(w) = &mut self.inner {
+            w.backlog = backlog;
+        }
+        self
     }
 
     /// Whether events are written anywhere.
@@ -348,24 +386,23 @@ impl EventLog {
             Some(w) => {
                 let spare = w.recycled.try_recv().unwrap_or_default();
                 let batch = std::mem::replace(events, spare);
-                // Never wait for the writer: a full backlog drops the batch (counted, and
-                // marked in the log). The writer only goes away on an I/O error; then events
-                // are lost, and `finish` reports the error.
-                if let Err(TrySendError::Full(b)) = w.batches.try_send(batch) {
-                    let n = b.len() as u64;
-                    w.dropped.total.fetch_add(n, Ordering::Relaxed);
-                    w.dropped.unmarked.fetch_add(n, Ordering::Relaxed);
+                // The writer only goes away on an I/O error; then events are lost, and
+                // `finish` reports the error.
+                match w.backlog {
+                    Backlog::Block => {
+                        let _ = w.batches.send(batch);
+                    }
+                    Backlog::Drop => {
+                        if let Err(e) = w.batches.try_send(batch) {
+                            let mut batch = e.into_inner();
+                            w.dropped.fetch_add(batch.len() as u64, Ordering::Relaxed);
+                            batch.clear();
+                            *events = batch;
+                        }
+                    }
                 }
             }
         }
-    }
-
-    /// Events dropped so far because the log's reader was too slow (see
-    /// [`MAX_PENDING_BATCHES`]).
-    pub fn dropped(&self) -> u64 {
-        self.inner
-            .as_ref()
-            .map_or(0, |w| w.dropped.total.load(Ordering::Relaxed))
     }
 
     /// Write out everything emitted so far, join the writer and return the lines written.
@@ -378,6 +415,21 @@ impl EventLog {
             None => Ok(0),
             Some(w) => {
                 drop(w.batches);
+                if w.backlog == Backlog::Drop {
+                    // A writer stuck on a reader that never reads would hold the stop for
+                    // ever; after FINISH_TIMEOUT it is left behind and the loss reported.
+                    let until = Instant::now() + FINISH_TIMEOUT;
+                    while !w.thread.is_finished() && Instant::now() < until {
+                        std::thread::sleep(Duration::from_millis(10));
+                    }
+                    if !w.thread.is_finished() {
+                        let queued = w.dropped.load(Ordering::Relaxed);
+                        return Err(io::Error::other(format!(
+                            "the log's reader did not read for {} s: the rest of the log was not written ({queued} events dropped besides)",
+                            FINISH_TIMEOUT.as_secs()
+                        )));
+                    }
+                }
                 match w.thread.join() {
                     Ok(r) => r,
                     Err(_) => Err(io::Error::other("event writer thread panicked")),
@@ -385,15 +437,6 @@ impl EventLog {
             }
         }
     }
-}
-
-/// The marker line of a gap: events dropped since the last marker, if any.
-fn write_gap(out: &mut impl Write, dropped: &Dropped) -> io::Result<()> {
-    let n = dropped.unmarked.swap(0, Ordering::Relaxed);
-    if n > 0 {
-        writeln!(out, "{{\"ev\":\"events_dropped\",\"count\":{n}}}")?;
-    }
-    Ok(())
 }
 
 #[cfg(unix)]
@@ -445,20 +488,18 @@ mod tests {
         );
     }
 
-    /// A writer whose reader does not read: blocked until the gate opens.
-    struct Stalled {
-        gate: crossbeam_channel::Receiver<()>,
-        out: std::sync::Arc<std::sync::Mutex<Vec<u8>>>,
-        opened: bool,
+    /// A writer that takes nothing until `open` is set, then keeps what it is given.
+    struct Gate {
+        open: Arc<std::sync::atomic::AtomicBool>,
+        got: Arc<std::sync::Mutex<Vec<u8>>>,
     }
 
-    impl Write for Stalled {
+    impl Write for Gate {
         fn write(&mut self, b: &[u8]) -> io::Result<usize> {
-            if !self.opened {
-                let _ = self.gate.recv();
-                self.opened = true;
+            while !self.open.load(Ordering::Acquire) {
+                std::thread::sleep(Duration::from_millis(1));
             }
-            self.out
+            self.got
                 .lock()
                 .unwrap_or_else(|p| p.into_inner())
                 .extend_from_slice(b);
@@ -470,41 +511,44 @@ mod tests {
     }
 
     #[test]
-    fn a_reader_that_does_not_read_costs_bounded_memory_and_the_gap_is_marked() {
-        let (open, gate) = crossbeam_channel::bounded(1);
-        let out = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
-        let w = Stalled {
-            gate,
-            out: std::sync::Arc::clone(&out),
-            opened: false,
+    fn a_reader_that_does_not_read_costs_counted_events_not_memory_or_the_tick() {
+        let open = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let got = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let gate = Gate {
+            open: Arc::clone(&open),
+            got: Arc::clone(&got),
         };
-        let mut log = EventLog::to_writer_with(Box::new(w), FlushPolicy::EveryBatch);
+        let mut log = EventLog::to_writer_with(Box::new(gate), FlushPolicy::EveryBatch)
+            .with_backlog(Backlog::Drop);
         let tick = Tick {
             index: 0,
             period: Duration::from_millis(1),
             time: Duration::ZERO,
         };
-        let extra = 100;
-        // One batch the writer holds while blocked, the backlog, then `extra` that cannot wait.
-        for _ in 0..1 + MAX_PENDING_BATCHES + extra {
-            let mut batch = vec![Event::new(&tick, 1, EventKind::Interrupt { held: 0 })];
-            log.emit(&mut batch);
+        let batches = MAX_QUEUED_BATCHES * 3;
+        for _ in 0..batches {
+            // Would block for ever here with `Backlog::Block`: the gate is shut.
+            let mut events = vec![Event::new(&tick, 1, EventKind::Interrupt { held: 0 })];
+            log.emit(&mut events);
         }
-        // The writer holds the first batch, or has not taken it yet.
-        let dropped = log.dropped();
-        // Open the gate before asserting: a failed assertion must not leave the writer
-        // blocked while the log's drop waits for it.
-        let _ = open.send(());
-        let lines = log.finish().unwrap();
+        open.store(true, Ordering::Release);
+        let lines = log
+            .finish()
+            .expect("the writer finishes once the reader reads");
+        let text = String::from_utf8(got.lock().unwrap_or_else(|p| p.into_inner()).clone())
+            .expect("utf-8");
+        let written = text.matches("\"interrupt\"").count();
+        let dropped: usize = text
+            .lines()
+            .filter_map(|l| l.strip_prefix(r#"{"ev":"events_dropped","events":"#))
+            .filter_map(|n| n.trim_end_matches('}').parse::<usize>().ok())
+            .sum();
+        assert!(dropped > 0, "some batches were dropped");
+        assert_eq!(written + dropped, batches, "every event written or counted");
         assert!(
-            (extra as u64..=extra as u64 + 1).contains(&dropped),
-            "{dropped} dropped"
+            written <= MAX_QUEUED_BATCHES + 2,
+            "the queue stayed bounded"
         );
-        assert_eq!(lines + dropped, (1 + MAX_PENDING_BATCHES + extra) as u64);
-        let text = String::from_utf8(out.lock().unwrap().clone()).unwrap();
-        assert!(
-            text.contains(&format!(r#"{{"ev":"events_dropped","count":{dropped}}}"#)),
-            "the gap is marked"
-        );
+        assert_eq!(lines as usize, text.lines().count());
     }
 }

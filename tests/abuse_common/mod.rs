@@ -1,0 +1,50 @@
+//! Helpers shared by the abuse tests (`ads_abuse`, `receive_abuse`): a spawned process's
+//! resident set, its standard error collected as it comes, and deterministic random bytes.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader, Read};
+use std::sync::{Arc, Mutex};
+
+/// `VmRSS` of process `pid` in KiB, from /proc/<pid>/status.
+pub fn rss_kib(pid: u32) -> u64 {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("/proc status");
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.split_whitespace().next()?.parse().ok())
+        .expect("VmRSS")
+}
+
+/// Read `err` line by line on a thread of its own, after its `first` line (returned), into
+/// the shared string (so a test can look at the log while the process runs).
+pub fn collect(err: impl Read + Send + 'static) -> (String, Arc<Mutex<String>>) {
+    let mut err = BufReader::new(err);
+    let mut first = String::new();
+    err.read_line(&mut first).expect("first line");
+    let text = Arc::new(Mutex::new(String::new()));
+    let sink = Arc::clone(&text);
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        while err.read_line(&mut line).is_ok_and(|n| n > 0) {
+            sink.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push_str(&line);
+            line.clear();
+        }
+    });
+    (first, text)
+}
+
+/// Deterministic random bytes (xorshift64*), so a failing run can be repeated.
+pub struct RandomBytes(pub u64);
+
+impl RandomBytes {
+    pub fn fill(&mut self, out: &mut [u8]) {
+        for b in out {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            *b = (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 56) as u8;
+        }
+    }
+}
