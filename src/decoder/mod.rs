@@ -221,6 +221,8 @@ pub struct Decoder {
     line: String,
     notes: Vec<Note>,
     stats: DecoderStats,
+    /// The word collection of the block being executed, kept between blocks.
+    words: Option<Box<words::Words>>,
 }
 
 type Res<T = ()> = Result<T, DecodeError>;
@@ -244,6 +246,7 @@ impl Decoder {
             line: String::new(),
             notes: Vec::new(),
             stats: DecoderStats::default(),
+            words: None,
         }
     }
 

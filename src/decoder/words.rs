@@ -18,7 +18,7 @@ const MAX_GS: usize = 16;
 
 /// Step 1's result: the block's words by meaning, values evaluated, not yet applied.
 #[derive(Debug, Default)]
-struct Words {
+pub(super) struct Words {
     /// G numbers in written order, with their columns.
     gs: [(u32, u32); MAX_GS],
     n_gs: usize,
@@ -49,6 +49,23 @@ struct Words {
 }
 
 impl Words {
+    /// Empty again for the next block. The fixed arrays keep their stale entries: only the
+    /// first `n_*` count, so clearing them would be a memset per block for nothing.
+    fn clear(&mut self) {
+        self.n_gs = 0;
+        self.axes_set = 0;
+        self.unconfigured_x_col = None;
+        self.ijk = [None; 3];
+        self.radius = None;
+        self.feed = None;
+        self.spindle_rpm = None;
+        self.tool = None;
+        self.tool_offset = None;
+        self.dwell_s = None;
+        self.n_ms = 0;
+        self.n_hs = 0;
+    }
+
     fn push_g(&mut self, g: u32, col: u32) -> Res {
         if self.n_gs == MAX_GS {
             return Err(DecodeError::new(
@@ -80,11 +97,29 @@ impl Decoder {
         meta: LineMeta,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let mut w = Words::default();
+        // One `Words` reused from block to block (see `Words::clear`), boxed so taking it
+        // out of the decoder moves a pointer.
+        let mut w = self.words.take().unwrap_or_default();
+        w.clear();
+        let r = self.exec_words(items, block, text, meta, io, &mut w);
+        self.words = Some(w);
+        r
+    }
+
+    /// Steps 1 to 5 over the block's words.
+    fn exec_words(
+        &mut self,
+        items: &[Item],
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        io: &mut DecoderIo<'_>,
+        w: &mut Words,
+    ) -> Res {
         for it in items {
-            self.collect(it, &mut w)?;
+            self.collect(it, w)?;
         }
-        let gs = self.modal_changes(&mut w)?;
+        let gs = self.modal_changes(w)?;
         let info = self.info(block, text, meta, io);
         let mut queued = false;
         if gs.dwell {
@@ -92,15 +127,15 @@ impl Decoder {
             self.emit(info.clone(), Action::Dwell { seconds }, false, io);
             queued = true;
         } else if gs.set_reference {
-            self.set_reference(&w);
-        } else if let Some(end) = self.target(&w, gs) {
-            let mut mv = self.motion(&w, end)?;
+            self.set_reference(w);
+        } else if let Some(end) = self.target(w, gs) {
+            let mut mv = self.motion(w, end)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
             self.modal.pos = end;
             self.emit(info.clone(), Action::Move(mv), false, io);
             queued = true;
         }
-        self.end_of_block(&w, info, queued, io)
+        self.end_of_block(w, info, queued, io)
     }
 
     /// Step 1: one item. Assignments take effect at once, in written order, so a later word

@@ -579,12 +579,16 @@ impl Planner {
     }
 
     /// A stop while compensation is on: the waiting element ends at its own offset end.
+    /// Finish the element waiting in the compensator, if any. Inlined check: this runs for
+    /// every block, and almost always finds nothing.
+    #[inline]
     fn comp_finish(&mut self) {
-        // Checked before `take`: taking moves the whole (large) option even when it is empty,
-        // and this runs for every block.
-        if self.comp.is_none() {
-            return;
+        if self.comp.is_some() {
+            self.comp_finish_now();
         }
+    }
+
+    fn comp_finish_now(&mut self) {
         let Some(mut c) = self.comp.take() else {
             return;
         };
@@ -630,11 +634,15 @@ impl Planner {
     }
 
     /// End the spline: the rest of its curve and everything waiting for it.
+    /// Finish the spline being built, if any (inlined check, as `comp_finish`).
+    #[inline]
     fn finish_spline(&mut self) {
-        // As in `comp_finish`: no move of the empty option for every block.
-        if self.spline.is_none() {
-            return;
+        if self.spline.is_some() {
+            self.finish_spline_now();
         }
+    }
+
+    fn finish_spline_now(&mut self) {
         let Some(sp) = self.spline.take() else { return };
         let mut out = std::mem::take(&mut self.spline_out);
         sp.finish(&mut out);
