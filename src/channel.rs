@@ -1,4 +1,4 @@
-//! One NC channel: the mode and state machine of REFERENCE §7 around the parts it owns —
+//! One NC channel: the ISG mode and state machine (HLI mode/state numbers) around the parts it owns —
 //! stream interface, program store, file cache, decoder, block queue and motion.
 //!
 //! Everything a client does to a channel (stream writes, commands) and everything the tick
@@ -24,7 +24,7 @@ pub const MAX_LISTED_ERRORS: usize = 256;
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
-/// Channel modes (REFERENCE §7).
+/// Channel modes: the ISG HLI numbers (`HLI_IMCM_*`; docs/ads.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     Standby = 1,
@@ -34,7 +34,7 @@ pub enum Mode {
     Reference = 5,
 }
 
-/// Channel states (REFERENCE §7).
+/// Channel states: the ISG HLI numbers (docs/ads.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum State {
     Deselected = 1,

@@ -20,7 +20,7 @@ pub struct Diagnostic {
     pub file: PathBuf,
     pub line: usize,
     pub col: usize,
-    /// ISG error number (REFERENCE §5) where one exists.
+    /// ISG error number (TF5200 diagnosis list, `lang::codes`) where one exists.
     pub code: Option<u32>,
     pub message: String,
     /// The offending line's text, for the caret display (without line end).

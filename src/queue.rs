@@ -194,7 +194,7 @@ pub enum Action {
     Dwell {
         seconds: f64,
     },
-    /// `#FLUSH …`: release the held blocks (planner rules, Stage 5).
+    /// `#FLUSH …`: release the held blocks (the planner's release rules, `motion::planner`).
     Flush(FlushKind),
     /// M00 (programmed stop) or M01 (optional stop): the axes come to rest, then the channel
     /// holds until the next start; M01 only while the operator's M01 switch is on.

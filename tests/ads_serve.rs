@@ -1,4 +1,4 @@
-//! Stage 6 end to end: the real channels in real time at 1 ms behind the ADS server, driven by
+//! End to end: the real channels in real time at 1 ms behind the ADS server, driven by
 //! the independent `ads` crate client exactly as a streaming client drives a real controller.
 
 mod common;

@@ -1,5 +1,5 @@
 //! The ADS server on the wire: framing, address swap, echo, exact sizes, bad frames, limits,
-//! notifications and the route allow-list (REFERENCE §8), against the in-memory backend.
+//! notifications and the route allow-list (docs/ads-wire.md), against the in-memory backend.
 
 mod ads_common;
 

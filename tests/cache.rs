@@ -1,4 +1,4 @@
-//! Stage 4: the file cache (`#CACHE`, TF5200 File Caching) through the channel, in virtual time.
+//! The file cache (`#CACHE`, TF5200 File Caching) through the channel, in virtual time.
 
 mod common;
 

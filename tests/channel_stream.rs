@@ -1,4 +1,4 @@
-//! Stage 2: the channel with its stream interface, driven through the library in virtual time.
+//! The channel with its stream interface, driven through the library in virtual time.
 
 mod common;
 

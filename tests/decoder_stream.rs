@@ -1,4 +1,4 @@
-//! Stage 3: what a streamed program may and may not do (seed 003 §2.3), compared with the same
+//! What a streamed program may and may not do (ISG FCT-C19 Data streaming §2.3), compared with the same
 //! program run from a file, under every packetisation.
 
 mod common;

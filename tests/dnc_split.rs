@@ -1,4 +1,4 @@
-//! The splitter against the rules of REFERENCE §3 (SINUMERIK Manage MyPrograms), fed in chunks
+//! The splitter against the rules of SINUMERIK Manage MyPrograms, fed in chunks
 //! of every size: same files whatever the chunking.
 
 use ncchannel::dnc::{

@@ -1,4 +1,4 @@
-//! The block parser against REFERENCE §4: every construct, its canonical text and its errors.
+//! The block parser against the TF5200 programming manual's syntax: every construct, its canonical text and its errors.
 
 use ncchannel::lang::*;
 

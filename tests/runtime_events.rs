@@ -1,5 +1,5 @@
 //! The event log and the report as files users parse: one JSON object a line with the field
-//! names of DESIGN.md, nothing lost at shutdown, identical logs from identical virtual runs.
+//! names of the README, nothing lost at shutdown, identical logs from identical virtual runs.
 
 use std::collections::BTreeMap;
 use std::time::Duration;

@@ -13,7 +13,7 @@ use super::result::AdsResult;
 
 pub use crate::machine::{HmiOp, Status};
 
-/// Channel modes (REFERENCE §7).
+/// Channel modes (ISG HLI numbers).
 pub mod mode {
     pub const STANDBY: i32 = 1;
     pub const AUTOMATIC: i32 = 2;
@@ -22,7 +22,7 @@ pub mod mode {
     pub const REFERENCE: i32 = 5;
 }
 
-/// Channel states (REFERENCE §7).
+/// Channel states (ISG HLI numbers).
 pub mod state {
     pub const DESELECTED: i32 = 1;
     pub const SELECTED: i32 = 2;
@@ -101,7 +101,7 @@ pub trait CncBackend: Send + Sync + 'static {
     fn channel_count(&self) -> u16;
     /// Offer one packet (one or more whole CR LF lines) to the stream buffer.
     fn stream_write(&self, ch: u16, data: &[u8]) -> StreamWriteOutcome;
-    /// Current (mode, state), REFERENCE §7 numbers.
+    /// Current (mode, state), ISG HLI numbers.
     fn mode_state(&self, ch: u16) -> Result<(i32, i32), DeviceError>;
     /// Command a mode (`mode::*`).
     fn command_mode(&self, ch: u16, mode: i32) -> Result<(), DeviceError>;

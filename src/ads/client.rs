@@ -1,6 +1,6 @@
 //! A synchronous ADS/TCP client and the stream feeder behind `ncchannel stream`.
 //!
-//! The feeder does what the driver in the streaming documentation (seed 003 §5) does, better:
+//! The feeder does what the driver in the streaming documentation (ISG FCT-C19 Data streaming §5) does, better:
 //! whole lines, LF normalised to CR LF, packets of up to 992 bytes of whole lines instead of
 //! one line per write, and a rejected write (0x708, buffer full) retried after about 1 ms
 //! instead of a fixed 500 ms sleep, so the buffer never runs dry while the client sleeps.

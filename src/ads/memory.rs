@@ -3,7 +3,7 @@
 //!
 //! It is small but honest about the stream interface: a real 4094-byte buffer, the 992-byte
 //! packet limit, CR LF checking (error 21476, state ERROR), 11012 warnings counted on full
-//! writes, a mode/state machine as in REFERENCE §7, and a drain thread that consumes whole
+//! writes, a mode/state machine with the ISG HLI numbers, and a drain thread that consumes whole
 //! lines while the channel is ACTIVE (block counter, X/Y/Z positions from the words, M2/M30
 //! ends the program). It does not interpret NC; the runtime does that.
 

@@ -191,7 +191,7 @@ pub fn decode_request(command: u16, data: &[u8]) -> Option<Result<Request, Paylo
     Some(r)
 }
 
-/// Responses, encoded exactly as long as clients expect (REFERENCE §8 rule 4).
+/// Responses, encoded exactly as long as clients expect (docs/ads-wire.md, rule 4).
 pub mod response {
     use super::AdsResult;
 

@@ -6,7 +6,7 @@
 //! one notification thread per connection that has notification handles. Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
-//! in docs/ads-limits.md. Compatibility rules are REFERENCE §8; each is marked `rule n` below.
+//! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
 
 use std::collections::{HashMap, VecDeque};
 use std::io::{self, Read, Write};

@@ -16,7 +16,7 @@ pub mod signal;
 pub mod soak;
 pub mod stream;
 
-/// Exit codes of the command-line contract (DESIGN.md).
+/// Exit codes of the command-line contract (README "Two commands").
 pub mod exit {
     /// The program ended normally (or the check found nothing).
     pub const OK: u8 = 0;

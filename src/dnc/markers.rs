@@ -17,10 +17,10 @@ use super::error::DncError;
 pub const MAX_MARKERS: usize = 3;
 
 /// How many bytes at the head of a line are searched for markers and name lines. NC blocks
-/// are at most 4000 characters (REFERENCE §4), so real lines always fit.
+/// are at most 4000 characters (TF5200 programming manual), so real lines always fit.
 pub const LINE_WINDOW: usize = 64 * 1024;
 
-/// Which markers were configured decides how the data is cut (REFERENCE §3).
+/// Which markers were configured decides how the data is cut (SINUMERIK "Manage MyPrograms").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     /// A start line opens a program; the program runs to the next start line or the end of data.

@@ -226,7 +226,7 @@ impl Splitter {
         }
     }
 
-    /// The rules of REFERENCE §3 for one line, given the marker hits in its head.
+    /// The rules of SINUMERIK "Manage MyPrograms" (start/end markers) for one line, given the marker hits in its head.
     fn step(&self, head: &[u8], start_hit: bool, end_hit: bool) -> Action {
         let split = || {
             self.open

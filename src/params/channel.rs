@@ -8,7 +8,7 @@ use super::startup::{shape, warn_duplicates, warn_unknown};
 use super::value::{string_value, uint_value};
 use crate::diag::Diagnostic;
 
-/// Longest `streaming_prog_file` (REFERENCE §1: a string of up to 83 characters).
+/// Longest `streaming_prog_file` (ISG FCT-C19 Data streaming: a string of up to 83 characters).
 pub const MAX_STREAMING_PROG_CHARS: usize = 83;
 
 /// A channel list, checked.

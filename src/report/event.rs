@@ -36,7 +36,7 @@ pub struct Event {
     pub kind: EventKind,
 }
 
-/// The event vocabulary of DESIGN.md; the variant name in snake_case is the `ev` field.
+/// The event vocabulary (README "Stream interface, runtime, feeder and events"); the variant name in snake_case is the `ev` field.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(tag = "ev", rename_all = "snake_case")]
 pub enum EventKind {

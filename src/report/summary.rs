@@ -1,4 +1,4 @@
-//! The end-of-run report: the `--report` JSON of DESIGN.md and the human summary printed at
+//! The end-of-run report: the `--report` JSON and the human summary printed at
 //! the end of `run` and the demo.
 
 use std::collections::BTreeMap;
@@ -107,7 +107,7 @@ pub struct Report {
     pub interrupts: u64,
     pub errors: Vec<ErrorReport>,
     pub cycle: CycleReport,
-    /// File-system opens, bytes read and cache hits (absent in reports from before Stage 4).
+    /// File-system opens, bytes read and cache hits (absent in reports of versions without the file cache).
     #[serde(default)]
     pub files: FilesReport,
 }

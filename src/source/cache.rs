@@ -31,7 +31,7 @@ pub enum CacheError {
 }
 
 impl CacheError {
-    /// ISG error number (REFERENCE §2, §5); 90160 is ours (no ISG number known).
+    /// ISG error number (TF5200 File Caching, diagnosis list); 90160 is ours (no ISG number known).
     pub fn code(&self) -> u32 {
         use crate::lang::codes;
         match self {
@@ -175,7 +175,7 @@ impl Cache {
         Ok(())
     }
 
-    /// Channel reset: the cache empties (seed 002, RESET).
+    /// Channel reset: the cache empties (TF5200 File Caching: RESET).
     pub fn reset(&mut self) {
         self.entries.clear();
     }

@@ -3,7 +3,7 @@
 //! The real channel reads a program from the file system when it is opened as main program or
 //! called as a subroutine; that read is what the file cache (#CACHE) saves, so every open and
 //! every byte read is counted here. The name in `streaming_prog_file` is not a file at all: it
-//! opens the channel's stream interface instead, transparently (seed 003 §2.2).
+//! opens the channel's stream interface instead, transparently (ISG FCT-C19 Data streaming §2.2).
 //!
 //! A slow drive or network share is modelled by [`FsLatency`]: every file-system read is
 //! charged `per_open + per_kib × KiB` of channel time. The store never sleeps; it only adds the
@@ -85,7 +85,7 @@ pub enum StoreError {
 }
 
 impl StoreError {
-    /// The ISG error number (REFERENCE §5).
+    /// The ISG error number (TF5200 diagnosis list).
     pub fn code(&self) -> u32 {
         use crate::lang::codes;
         match self {

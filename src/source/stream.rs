@@ -1,7 +1,7 @@
 //! The data-streaming interface of one channel: a 4094-byte buffer that clients write whole
 //! CR LF-terminated NC lines into and the decoder empties one program segment at a time.
 //!
-//! Facts from the ISG documentation (REFERENCE.md §1): the buffer holds
+//! Facts from ISG FCT-C19 Data streaming: the buffer holds
 //! [`MAX_PROGRAM_STREAM_SIZE`] bytes, one write carries at most
 //! [`MAX_PROGRAM_STREAM_INPUT_SIZE`] bytes, packets queue in write order, and one read extracts
 //! *all* data present as one segment. A write is accepted whole or rejected whole.
