@@ -12,24 +12,29 @@
 use super::result::AdsResult;
 
 pub use crate::machine::{HmiOp, Status};
+#[cfg(doc)]
+use crate::channel::{Mode, State};
 
-/// Channel modes (ISG HLI numbers).
+/// Channel modes as the ADS objects carry them (SGN32): the numbers of [`Mode`], defined once
+/// there.
 pub mod mode {
-    pub const STANDBY: i32 = 1;
-    pub const AUTOMATIC: i32 = 2;
-    pub const MDI: i32 = 3;
-    pub const MANUAL: i32 = 4;
-    pub const REFERENCE: i32 = 5;
+    use crate::channel::Mode;
+    pub const STANDBY: i32 = Mode::Standby as i32;
+    pub const AUTOMATIC: i32 = Mode::Automatic as i32;
+    pub const MDI: i32 = Mode::Mdi as i32;
+    pub const MANUAL: i32 = Mode::Manual as i32;
+    pub const REFERENCE: i32 = Mode::Reference as i32;
 }
 
-/// Channel states (ISG HLI numbers).
+/// Channel states as the ADS objects carry them: the numbers of [`State`].
 pub mod state {
-    pub const DESELECTED: i32 = 1;
-    pub const SELECTED: i32 = 2;
-    pub const READY: i32 = 3;
-    pub const ACTIVE: i32 = 4;
-    pub const HOLD: i32 = 5;
-    pub const ERROR: i32 = 6;
+    use crate::channel::State;
+    pub const DESELECTED: i32 = State::Deselected as i32;
+    pub const SELECTED: i32 = State::Selected as i32;
+    pub const READY: i32 = State::Ready as i32;
+    pub const ACTIVE: i32 = State::Active as i32;
+    pub const HOLD: i32 = State::Hold as i32;
+    pub const ERROR: i32 = State::Error as i32;
 }
 
 /// How one stream write (offset 0x90) went.
