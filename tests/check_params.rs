@@ -58,3 +58,54 @@ fn the_shipped_folders_pass_as_the_issue_names_them() {
     let (code, out) = check(&refs);
     assert_eq!(code, 0, "{out}");
 }
+
+/// `ncchannel run --params` on `dir`'s start-up list: exit code and everything printed.
+fn run_with(dir: &std::path::Path) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args(["run", "--params"])
+        .arg(dir.join("startup.lis"))
+        .arg("--max-ticks")
+        .arg("10")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
+    )
+}
+
+#[test]
+fn check_and_run_refuse_the_same_bad_files_with_the_same_words() {
+    // Each runtime.toml is refused by both, naming the same key; a good one passes both.
+    let cases = [
+        ("[[axes]]\nname = \"X2\"\n", "axes[0].name"),
+        ("[[axes]]\nname = \"U\"\n", "axes[0].name"),
+        (
+            "[decoder]\nblocks_per_tick = 0\n",
+            "decoder.blocks_per_tick",
+        ),
+        ("[ads]\nmax_connections = 0\n", "ads.max_connections"),
+    ];
+    for (runtime, key) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("startup.lis"),
+            "kanal_anzahl 1\nsda_mds[0] channel1.lis\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("channel1.lis"),
+            "streaming_prog_file s.nc\n",
+        )
+        .unwrap();
+        let toml = dir.path().join("runtime.toml");
+        std::fs::write(&toml, runtime).unwrap();
+        let (code, out) = check(&[toml.to_str().unwrap()]);
+        assert_eq!(code, 1, "check {runtime}: {out}");
+        assert!(out.contains(key), "check {runtime}: {out}");
+        let (code, out) = run_with(dir.path());
+        assert_eq!(code, 2, "run {runtime}: {out}");
+        assert!(out.contains(key), "run {runtime}: {out}");
+    }
+}

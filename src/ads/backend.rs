@@ -11,9 +11,9 @@
 
 use super::result::AdsResult;
 
-pub use crate::machine::{HmiOp, Status};
 #[cfg(doc)]
 use crate::channel::{Mode, State};
+pub use crate::machine::{HmiOp, Status};
 
 /// Channel modes as the ADS objects carry them (SGN32): the numbers of [`Mode`], defined once
 /// there.

@@ -11,8 +11,7 @@ use crate::diag::Diagnostic;
 
 /// Largest runtime.toml we read; the real one is a few KiB.
 pub const MAX_RUNTIME_BYTES: u64 = 1024 * 1024;
-/// Most axes one channel drives.
-pub const MAX_AXES: usize = 32;
+use crate::queue::{AXIS_LETTERS, MAX_AXES};
 
 /// The emulator's own settings.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -53,7 +52,8 @@ impl Default for RuntimeConfig {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisConfig {
-    /// Axis name as programmed (`X`, `Y`, `Z`, `A`, `X2` …). Required.
+    /// Axis name as programmed: one of `X Y Z A B C` (the axes the interpolator drives).
+    /// Required.
     pub name: String,
     /// Largest programmed feed in mm/min (default 30000).
     #[serde(default = "default_velocity")]
@@ -405,16 +405,19 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
     }
     for (i, a) in cfg.axes.iter().enumerate().take(MAX_AXES) {
         let at = Some(i);
-        let name_ok = a.name.len() <= 8
-            && a.name.starts_with(|c: char| c.is_ascii_alphabetic())
-            && a.name.chars().all(|c| c.is_ascii_alphanumeric());
+        // The one rule `setup` relies on: a name is one of the interpolator's axis letters,
+        // so `check` refuses exactly what `run` could not build.
+        let name_ok = a.name.trim().len() == 1
+            && AXIS_LETTERS
+                .iter()
+                .any(|&l| a.name.trim().eq_ignore_ascii_case(&(l as char).to_string()));
         if !name_ok {
             fail(
                 "axes",
                 at,
                 "name",
                 format!(
-                    "`{}` is not an axis name (a letter, then letters or digits, at most 8)",
+                    "`{}` is not an axis name ncchannel drives (one of X Y Z A B C)",
                     a.name
                 ),
             );
