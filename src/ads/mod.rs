@@ -17,10 +17,12 @@ pub mod memory;
 pub mod objects;
 pub mod payload;
 pub mod result;
+pub mod route;
 pub mod sda;
 pub mod server;
 
 pub use backend::{CncBackend, DeviceError, StreamFill, StreamWriteOutcome};
 pub use frame::{AmsAddr, AmsNetId};
 pub use result::AdsResult;
-pub use server::{spawn, RouteEntry, ServerConfig, ServerHandle};
+pub use route::RouteEntry;
+pub use server::{spawn, ServerConfig, ServerHandle};

@@ -11,7 +11,6 @@
 use std::collections::{HashMap, VecDeque};
 use std::io::{self, Read, Write};
 use std::net::{IpAddr, Ipv4Addr, Shutdown, SocketAddr, TcpListener, TcpStream};
-use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
@@ -25,6 +24,7 @@ use super::frame::{
 use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
+use super::route::RouteEntry;
 
 /// Default bind address: loopback only, the standard ADS/TCP port.
 pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), 48898);
@@ -50,35 +50,6 @@ const MAX_LOGGED_UNROUTED: usize = 16;
 /// Notification cycle times are clamped to this range.
 pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
 pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
-
-/// One entry of the route allow-list: a client NetId or a peer IP address.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
-#[serde(try_from = "String")]
-pub enum RouteEntry {
-    NetId(AmsNetId),
-    Ip(IpAddr),
-}
-
-impl TryFrom<String> for RouteEntry {
-    type Error = String;
-    fn try_from(s: String) -> Result<Self, String> {
-        s.parse()
-    }
-}
-
-impl FromStr for RouteEntry {
-    type Err = String;
-
-    /// `a.b.c.d.e.f` is a NetId; anything `IpAddr` parses is an address.
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        if let Ok(id) = s.parse::<AmsNetId>() {
-            return Ok(RouteEntry::NetId(id));
-        }
-        s.parse::<IpAddr>()
-            .map(RouteEntry::Ip)
-            .map_err(|_| format!("route {s:?} is neither an AMS NetId nor an IP address"))
-    }
-}
 
 /// Server settings (the runtime config's `[ads]` table maps onto this).
 #[derive(Debug, Clone)]

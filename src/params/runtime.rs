@@ -203,7 +203,7 @@ impl TryFrom<String> for SocketAddrText {
 
 /// NetIds and route entries are the ADS room's types: one parser, one meaning.
 pub use crate::ads::frame::AmsNetId;
-pub use crate::ads::server::RouteEntry;
+pub use crate::ads::route::RouteEntry;
 
 /// Parse and check runtime.toml text. Errors name the key (`ads.net_id`, `axes[1].name`).
 pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {
