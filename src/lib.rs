@@ -22,3 +22,4 @@ pub mod runtime;
 pub mod setup;
 pub mod soak;
 pub mod source;
+pub mod tick;

@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
 use crate::report::stats::{CycleStats, Histogram};
+pub use crate::tick::Tick;
 
 /// Requests served per tick at most. A flood of requests (say a client hammering the stream
 /// object from many connections) then delays its own answers, never the tick: the rest wait
@@ -22,24 +23,6 @@ pub const MAX_REQUESTS_PER_TICK: usize = 64;
 /// Real time: no request is started closer than this to a tick's deadline. A request costs a
 /// few microseconds; the margin keeps the tick's start on time.
 pub const SERVE_MARGIN: Duration = Duration::from_micros(250);
-
-/// The tick being run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Tick {
-    /// Tick number, from 0.
-    pub index: u64,
-    /// The cycle time.
-    pub period: Duration,
-    /// Channel time at this tick: `index × period`, in either clock.
-    pub time: Duration,
-}
-
-impl Tick {
-    /// Channel time in seconds, as the events carry it.
-    pub fn seconds(&self) -> f64 {
-        self.time.as_secs_f64()
-    }
-}
 
 /// Whether the runtime goes on after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

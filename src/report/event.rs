@@ -22,7 +22,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
-use crate::runtime::Tick;
+use crate::tick::Tick;
 
 /// One event: when, where, what. Serialises as `{"tick":…,"t":…,"ch":…,"ev":"…",…fields}`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
