@@ -240,7 +240,7 @@ fn toml_error(file: &Path, text: &str, e: &toml::de::Error) -> Diagnostic {
     };
     let (line, col) = line_col(text, span.start);
     let line_text = text.lines().nth(line - 1).unwrap_or("");
-    let key = key_at(text, line);
+    let key = Spans::parse(text).and_then(|s| s.key_at(span.start));
     let message = match key {
         Some(k) if !msg.contains(&format!("`{k}`")) => format!("{k}: {msg}"),
         _ => msg,
@@ -258,68 +258,67 @@ fn line_col(text: &str, off: usize) -> (usize, usize) {
     (line, col)
 }
 
-/// The table header in force on every line: `headers[line_table[i]]` for 0-based line `i`,
-/// e.g. `("axes", Some(1))` inside the second `[[axes]]`. One pass, so lookups stay linear.
-struct Tables {
-    headers: Vec<(String, Option<usize>)>,
-    line_table: Vec<usize>,
-    header_line: Vec<usize>,
+/// Where things are written in runtime.toml: the spans `toml_edit` (the parser under `toml`)
+/// keeps for every key, value and table header, so a diagnostic points at the text itself.
+struct Spans<'a> {
+    doc: toml_edit::ImDocument<&'a str>,
 }
 
-impl Tables {
-    fn new(text: &str) -> Self {
-        let mut t = Tables {
-            headers: vec![(String::new(), None)],
-            line_table: Vec::new(),
-            header_line: vec![0],
-        };
-        let mut counts: std::collections::HashMap<String, usize> = Default::default();
-        for (i, l) in text.lines().enumerate() {
-            let s = l.trim();
-            let header = if let Some(name) = s.strip_prefix("[[").and_then(|r| r.split("]]").next())
-            {
-                let name = name.trim().to_string();
-                let n = counts.entry(name.clone()).or_insert(0);
-                let h = (name, Some(*n));
-                *n += 1;
-                Some(h)
-            } else {
-                s.strip_prefix('[')
-                    .and_then(|r| r.split(']').next())
-                    .map(|name| (name.trim().to_string(), None))
-            };
-            if let Some(h) = header {
-                t.headers.push(h);
-                t.header_line.push(i + 1);
-            }
-            t.line_table.push(t.headers.len() - 1);
+impl<'a> Spans<'a> {
+    fn parse(text: &'a str) -> Option<Self> {
+        toml_edit::ImDocument::parse(text)
+            .ok()
+            .map(|doc| Spans { doc })
+    }
+
+    /// The table `table` (entry `index` of an array of tables); `""` is the root.
+    fn table(&self, table: &str, index: Option<usize>) -> Option<&toml_edit::Table> {
+        let root = self.doc.as_table();
+        if table.is_empty() {
+            return Some(root);
         }
-        t
+        match (root.get(table)?, index) {
+            (item, Some(i)) => item.as_array_of_tables()?.get(i),
+            (item, None) => item.as_table(),
+        }
     }
 
-    /// Table of 1-based `line`.
-    fn at(&self, line: usize) -> (&str, Option<usize>) {
-        let id = line
-            .checked_sub(1)
-            .and_then(|i| self.line_table.get(i))
-            .copied()
-            .unwrap_or(0);
-        let (name, index) = &self.headers[id];
-        (name.as_str(), *index)
+    /// Byte offset of `key` in its table; a key left at its default points at its table's
+    /// header; `None` when the table is not written either.
+    fn offset_of(&self, table: &str, index: Option<usize>, key: &str) -> Option<usize> {
+        let t = self.table(table, index)?;
+        t.key(key)
+            .and_then(|k| k.span())
+            .or_else(|| t.span())
+            .map(|r| r.start)
     }
-}
 
-/// The dotted key on `line` (1-based), with its table: `ads.net_id`, `axes[1].name`.
-fn key_at(text: &str, line: usize) -> Option<String> {
-    let l = text.lines().nth(line.checked_sub(1)?)?;
-    let (key, _) = l.split_once('=')?;
-    let key = key.trim().trim_matches('"');
-    if key.is_empty() || key.starts_with('[') {
-        return None;
+    /// The dotted key whose value holds byte `offset`: `ads.net_id`, `axes[1].name`.
+    fn key_at(&self, offset: usize) -> Option<String> {
+        let holds = |item: &toml_edit::Item| item.span().is_some_and(|r| r.contains(&offset));
+        let in_table = |t: &toml_edit::Table, prefix: &str| {
+            t.iter()
+                .find(|(_, v)| holds(v))
+                .map(|(k, _)| format!("{prefix}{k}"))
+        };
+        let root = self.doc.as_table();
+        for (name, item) in root.iter() {
+            if let Some(t) = item.as_table() {
+                if let Some(k) = in_table(t, &format!("{name}.")) {
+                    return Some(k);
+                }
+            } else if let Some(a) = item.as_array_of_tables() {
+                for (i, t) in a.iter().enumerate() {
+                    if let Some(k) = in_table(t, &format!("{name}[{i}].")) {
+                        return Some(k);
+                    }
+                }
+            } else if holds(item) {
+                return Some(name.to_string());
+            }
+        }
+        None
     }
-    let tables = Tables::new(text);
-    let (table, index) = tables.at(line);
-    Some(join_key(table, index, key))
 }
 
 fn join_key(table: &str, index: Option<usize>, key: &str) -> String {
@@ -330,41 +329,18 @@ fn join_key(table: &str, index: Option<usize>, key: &str) -> String {
     }
 }
 
-/// Where `key` of `table` (entry `index` of an array of tables) is written. A key left at its
-/// default points at its table's header, or at 1:1 when the table is not written either.
-fn locate(
-    text: &str,
-    tables: &Tables,
-    table: &str,
-    index: Option<usize>,
-    key: &str,
-) -> (usize, usize, String) {
-    for (i, l) in text.lines().enumerate() {
-        let Some((k, _)) = l.split_once('=') else {
-            continue;
-        };
-        if k.trim().trim_matches('"') == key && tables.at(i + 1) == (table, index) {
-            let col = l.chars().take_while(|c| c.is_whitespace()).count() + 1;
-            return (i + 1, col, l.to_string());
-        }
-    }
-    if !table.is_empty() {
-        for (id, (name, idx)) in tables.headers.iter().enumerate() {
-            if name == table && *idx == index {
-                let line = tables.header_line[id];
-                let src = text.lines().nth(line - 1).unwrap_or("").to_string();
-                return (line, 1, src);
-            }
-        }
-    }
-    (1, 1, String::new())
-}
-
 fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
     let mut errs = Vec::new();
-    let tables = Tables::new(text);
+    let spans = Spans::parse(text);
     let mut fail = |table: &str, index: Option<usize>, key: &str, why: String| {
-        let (line, col, src) = locate(text, &tables, table, index, key);
+        let (line, col, src) = match spans.as_ref().and_then(|s| s.offset_of(table, index, key)) {
+            Some(off) => {
+                let (line, col) = line_col(text, off);
+                let src = text.lines().nth(line - 1).unwrap_or("").to_string();
+                (line, col, src)
+            }
+            None => (1, 1, String::new()),
+        };
         let mut d = Diagnostic::error(
             file,
             line,
@@ -610,5 +586,22 @@ mod tests {
         assert!(
             parse_runtime(Path::new("r.toml"), "[ads]\nallowed_clients = [\"foo\"]\n").is_err()
         );
+    }
+
+    #[test]
+    fn diagnostics_point_at_the_key_where_it_is_written() {
+        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"U\"\n\n[decoder]\nx = 1\nblocks_per_tick = 0\n";
+        let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
+        // `x` is an unknown key: a toml error at its own place, named with its table.
+        assert_eq!((errs[0].line, errs[0].col), (10, 1), "{errs:?}");
+        assert!(errs[0].message.contains("x"), "{errs:?}");
+        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"U\"\n\n[decoder]\nblocks_per_tick = 0\n";
+        let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
+        let at: Vec<(usize, usize, &str)> = errs
+            .iter()
+            .map(|d| (d.line, d.col, d.message.split(':').next().unwrap_or("")))
+            .collect();
+        assert!(at.contains(&(7, 3, "axes[1].name")), "{at:?}");
+        assert!(at.contains(&(10, 1, "decoder.blocks_per_tick")), "{at:?}");
     }
 }
