@@ -121,7 +121,54 @@ pub struct Move {
     pub path: PathMode,
 }
 
+/// The circle of an arc move, in its plane: what point, tangent and extent computations need.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcGeom {
+    /// The plane's first and second axis (indices into a `Position`).
+    pub a: usize,
+    pub b: usize,
+    pub center: [f64; 2],
+    pub radius_mm: f64,
+    /// +1 counter-clockwise (G3), −1 clockwise (G2).
+    pub dir: f64,
+    /// Swept angle, radians (> 0).
+    pub sweep_rad: f64,
+    /// Angle of the start point around the centre, radians.
+    pub start_rad: f64,
+}
+
+impl ArcGeom {
+    /// Angle at fraction `u` (0..=1) of the sweep, radians.
+    pub fn angle_at(&self, u: f64) -> f64 {
+        self.start_rad + self.dir * self.sweep_rad * u
+    }
+}
+
 impl Move {
+    /// The circle, for an arc move.
+    pub fn arc(&self) -> Option<ArcGeom> {
+        let MoveKind::Arc {
+            plane,
+            center,
+            radius_mm,
+            cw,
+            sweep_rad,
+        } = self.kind
+        else {
+            return None;
+        };
+        let (a, b, _) = plane.axes();
+        Some(ArcGeom {
+            a,
+            b,
+            center,
+            radius_mm,
+            dir: if cw { -1.0 } else { 1.0 },
+            sweep_rad,
+            start_rad: (self.start[b] - center[1]).atan2(self.start[a] - center[0]),
+        })
+    }
+
     /// Path length in mm (axes' Euclidean length; arcs: helix length).
     pub fn length_mm(&self) -> f64 {
         match self.kind {
@@ -159,26 +206,13 @@ impl Move {
         for (pi, (s, e)) in p.iter_mut().zip(self.start.iter().zip(&self.end)) {
             *pi = s + (e - s) * u;
         }
-        if let MoveKind::Arc {
-            plane,
-            center,
-            radius_mm,
-            cw,
-            sweep_rad,
-        } = self.kind
-        {
+        if let Some(c) = self.arc() {
             if u >= 1.0 {
                 return self.end;
             }
-            let (a, b, _) = plane.axes();
-            let a0 = (self.start[b] - center[1]).atan2(self.start[a] - center[0]);
-            let ang = if cw {
-                a0 - sweep_rad * u
-            } else {
-                a0 + sweep_rad * u
-            };
-            p[a] = center[0] + radius_mm * ang.cos();
-            p[b] = center[1] + radius_mm * ang.sin();
+            let ang = c.angle_at(u);
+            p[c.a] = c.center[0] + c.radius_mm * ang.cos();
+            p[c.b] = c.center[1] + c.radius_mm * ang.sin();
         }
         p
     }

@@ -300,23 +300,14 @@ fn each_double_programming_and_refusal_is_its_error_at_its_column_in_check_and_r
     }
 }
 
-fn position(r: &common::RunResult, axis: char) -> f64 {
-    r.machine.channels()[0]
-        .axis_positions()
-        .into_iter()
-        .find(|(a, _)| *a == axis)
-        .map(|(_, v)| v)
-        .unwrap()
-}
-
 #[test]
 fn inch_scales_positions_and_feeds_and_g71_returns_to_mm() {
     let rig = Rig::new();
     rig.program("inch.nc", "G70 G1 X1 F10\nG71 G1 Y2\nM30\n");
     let r = rig.run("inch.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
-    assert!((position(&r, 'X') - 25.4).abs() < 1e-6);
-    assert!((position(&r, 'Y') - 2.0).abs() < 1e-6);
+    assert!((r.position('X') - 25.4).abs() < 1e-6);
+    assert!((r.position('Y') - 2.0).abs() < 1e-6);
     // 25.4 mm at 254 mm/min: 6 s (plus ramps).
     let t = block_duration(&r, "G70 G1 X1 F10");
     assert!((6.0..6.5).contains(&t), "{t} s");
@@ -349,8 +340,8 @@ fn g92_makes_the_current_position_the_programmed_one() {
     rig.program("g92.nc", "G0 X10 Y5\nG92 X0 Y0\nG0 X5\nG53 G0 Y1\nM30\n");
     let r = rig.run("g92.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
-    assert!((position(&r, 'X') - 15.0).abs() < 1e-9);
-    assert!((position(&r, 'Y') - 1.0).abs() < 1e-9);
+    assert!((r.position('X') - 15.0).abs() < 1e-9);
+    assert!((r.position('Y') - 1.0).abs() < 1e-9);
 }
 
 #[test]

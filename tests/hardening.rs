@@ -10,15 +10,6 @@ use common::Rig;
 use ncchannel::channel::Finish;
 use ncchannel::lang::{check_program, codes, parse_block};
 
-fn position(r: &common::RunResult, axis: char) -> f64 {
-    r.machine.channels()[0]
-        .axis_positions()
-        .into_iter()
-        .find(|(a, _)| *a == axis)
-        .map(|(_, v)| v)
-        .unwrap()
-}
-
 #[test]
 fn circles_no_machine_can_run_are_refused_and_the_program_ends() {
     let nines = "9".repeat(300);
@@ -42,7 +33,7 @@ fn circles_no_machine_can_run_are_refused_and_the_program_ends() {
             "{what}: {}",
             r.log
         );
-        assert!(position(&r, 'X').is_finite() && position(&r, 'Y').is_finite());
+        assert!(r.position('X').is_finite() && r.position('Y').is_finite());
     }
 }
 
@@ -93,7 +84,7 @@ fn a_move_beyond_the_software_limits_is_an_error_before_it_starts() {
             r.log
         );
         for a in ['X', 'Y', 'Z'] {
-            let v = position(&r, a);
+            let v = r.position(a);
             assert!((0.0..=10.0).contains(&v), "{block}: {a} at {v}");
         }
     }

@@ -111,8 +111,8 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         return usage("--seconds must be in (0, 3600]".into());
     }
-    let params = super::run::locate(&args.params);
-    let (cycle, _) = match streaming_channels(&params, args.channels, args.seed) {
+    let params = &args.params;
+    let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),
     };

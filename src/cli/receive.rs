@@ -89,8 +89,7 @@ pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
 pub const DEFAULT_MAX_CONCURRENT: u16 = 4;
 
 pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
-    let params = super::run::locate(params);
-    let config = crate::params::load(&params).map_err(|e| {
+    let config = crate::params::load(params).map_err(|e| {
         for d in e.diagnostics() {
             say(format_args!("{}", d.render()));
         }

@@ -105,18 +105,6 @@ impl RunArgs {
     }
 }
 
-/// A relative default path that is not where we are run from is looked up in the crate's
-/// folder, so `cargo run` works from any directory of the checkout.
-pub(crate) fn locate(p: &Path) -> PathBuf {
-    if p.is_relative() && !p.exists() {
-        let alt = Path::new(env!("CARGO_MANIFEST_DIR")).join(p);
-        if alt.exists() {
-            return alt;
-        }
-    }
-    p.to_path_buf()
-}
-
 /// `--skip-mask`: decimal or `0x` hex, 0..=0xFFFF.
 fn parse_skip_mask(s: &str) -> Result<u16, String> {
     let r = match s.strip_prefix("0x").or_else(|| s.strip_prefix("0X")) {
@@ -172,8 +160,7 @@ pub(crate) fn load_channels(
 
 /// Read and check the parameter lists (diagnostics on stderr).
 fn load_config(params: &Path) -> Result<crate::params::Config, String> {
-    let params = locate(params);
-    let config = match crate::params::load(&params) {
+    let config = match crate::params::load(params) {
         Ok(c) => c,
         Err(e) => {
             for d in e.diagnostics() {
@@ -234,8 +221,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
     let feeder = match &args.stream {
         None => None,
         Some(f) => {
-            let f = locate(f);
-            let text = match crate::bounded::read_file(&f, MAX_STREAM_FILE_BYTES) {
+            let text = match crate::bounded::read_file(f, MAX_STREAM_FILE_BYTES) {
                 Ok(t) => t,
                 Err(e) => return usage(format!("{}: {e}", f.display())),
             };

@@ -53,7 +53,7 @@ pub struct ServeArgs {
 }
 
 fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
-    load_external(&super::run::locate(p))
+    load_external(p)
 }
 
 /// The ADS server's settings: the command line over runtime.toml's `[ads]`.

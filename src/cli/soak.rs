@@ -47,8 +47,8 @@ pub fn execute(args: SoakArgs) -> ExitCode {
     {
         return usage("--wall-seconds must be in (0, 1e7]".into());
     }
-    let path = super::run::locate(&args.scenario);
-    let scenario = match Scenario::load(&path) {
+    let path = &args.scenario;
+    let scenario = match Scenario::load(path) {
         Ok(s) => s,
         Err(e) => return usage(e.to_string()),
     };

@@ -7,7 +7,7 @@
 //! to the next block, so block end times are exact and a square at F1000 reaches its corners
 //! when the trapezoid says. Time is whatever the caller passes; no clock is read here.
 
-use crate::queue::{Move, MoveKind, Position, MAX_AXES};
+use crate::queue::{Move, Position, MAX_AXES};
 
 /// Below this a remaining length counts as the block end, mm.
 pub const END_EPS_MM: f64 = 1e-9;
@@ -159,22 +159,12 @@ pub fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
     for (i, ti) in t.iter_mut().enumerate() {
         *ti = (m.end[i] - m.start[i]) / length_mm;
     }
-    if let MoveKind::Arc {
-        plane,
-        center,
-        radius_mm,
-        cw,
-        sweep_rad,
-    } = m.kind
-    {
-        let (a, b, _) = plane.axes();
-        let a0 = (m.start[b] - center[1]).atan2(m.start[a] - center[0]);
-        let dir = if cw { -1.0 } else { 1.0 };
-        let ang = if at_end { a0 + dir * sweep_rad } else { a0 };
+    if let Some(c) = m.arc() {
+        let ang = c.angle_at(if at_end { 1.0 } else { 0.0 });
         // d(point)/d(u) of the circle part, divided by the path length.
-        let k = dir * radius_mm * sweep_rad / length_mm;
-        t[a] = -k * ang.sin();
-        t[b] = k * ang.cos();
+        let k = c.dir * c.radius_mm * c.sweep_rad / length_mm;
+        t[c.a] = -k * ang.sin();
+        t[c.b] = k * ang.cos();
     }
     t
 }
@@ -182,7 +172,7 @@ pub fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::queue::Plane;
+    use crate::queue::{MoveKind, Plane};
 
     fn run(p: &Profile, v0: f64, dt: f64) -> (f64, Vec<(f64, f64)>) {
         let (mut s, mut v, mut t) = (0.0, v0, 0.0);

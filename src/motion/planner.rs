@@ -333,23 +333,14 @@ impl Planner {
         for (axis, &v) in mv.end.iter().enumerate() {
             check(axis, v)?;
         }
-        if let MoveKind::Arc {
-            plane,
-            center,
-            radius_mm,
-            cw,
-            sweep_rad,
-        } = mv.kind
-        {
-            let (a, b, _) = plane.axes();
-            let a0 = (mv.start[b] - center[1]).atan2(mv.start[a] - center[0]);
+        if let Some(c) = mv.arc() {
             // The four axis-parallel extremes of the circle, where the swept part holds them.
             for k in 0..4 {
                 let theta = f64::from(k) * std::f64::consts::FRAC_PI_2;
-                let from_start = if cw { a0 - theta } else { theta - a0 };
-                if from_start.rem_euclid(std::f64::consts::TAU) <= sweep_rad {
-                    check(a, center[0] + radius_mm * theta.cos())?;
-                    check(b, center[1] + radius_mm * theta.sin())?;
+                let from_start = c.dir * (theta - c.start_rad);
+                if from_start.rem_euclid(std::f64::consts::TAU) <= c.sweep_rad {
+                    check(c.a, c.center[0] + c.radius_mm * theta.cos())?;
+                    check(c.b, c.center[1] + c.radius_mm * theta.sin())?;
                 }
             }
         }

@@ -75,6 +75,15 @@ impl RunResult {
             .map(|e| e["code"].as_u64().unwrap())
             .collect()
     }
+    /// Where channel 1's `axis` stands at the end, mm.
+    pub fn position(&self, axis: char) -> f64 {
+        self.machine.channels()[0]
+            .axis_positions()
+            .into_iter()
+            .find(|(a, _)| *a == axis)
+            .map(|(_, v)| v)
+            .unwrap()
+    }
 }
 
 impl Rig {
