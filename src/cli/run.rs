@@ -204,32 +204,13 @@ pub fn execute(args: RunArgs) -> ExitCode {
             args.channel
         ));
     };
-    let program = match (&by_path, &args.program, &args.stream) {
-        (Some((_, name)), _, _) => name.clone(),
-        (None, Some(p), _) => p.clone(),
-        (None, None, Some(_)) => match &ch_config.streaming_prog_file {
-            Some(s) => s.clone(),
-            None => {
-                return usage(format!(
-                    "--stream needs streaming_prog_file in {}",
-                    ch_config.list_path.display()
-                ))
-            }
-        },
-        (None, None, None) => return usage("name a PROGRAM or give --stream FILE"),
+    let program = match program_name(&args, by_path.as_ref(), ch_config) {
+        Ok(p) => p,
+        Err(msg) => return usage(msg),
     };
-    let feeder = match &args.stream {
-        None => None,
-        Some(f) => {
-            let text = match crate::bounded::read_file(f, MAX_STREAM_FILE_BYTES) {
-                Ok(t) => t,
-                Err(e) => return usage(format!("{}: {e}", f.display())),
-            };
-            match Feeder::new(text, args.packet, args.every, args.raw) {
-                Ok(fd) => Some(fd),
-                Err(e) => return usage(format!("{}: {e}", f.display())),
-            }
-        }
+    let feeder = match open_feeder(&args) {
+        Ok(f) => f,
+        Err(msg) => return usage(msg),
     };
     let log = match &args.events {
         None => EventLog::disabled(),
@@ -240,22 +221,62 @@ pub fn execute(args: RunArgs) -> ExitCode {
     };
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut channels = channels;
-    if args.plot.is_some() {
-        if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
-            c.motion_mut().enable_trace(PLOT_SAMPLES);
-        }
-    }
-    if let Some(p) = &args.trace {
-        if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
-            if let Err(e) = c.motion_mut().enable_csv_trace(p, args.trace_every) {
-                return usage(format!("--trace {}: {e}", p.display()));
-            }
+    if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
+        if let Err(msg) = enable_traces(c, &args) {
+            return usage(msg);
         }
     }
     let mut machine = Machine::new(channels, log, StopWhen::ProgramsFinished);
     if let Some(f) = feeder {
         machine.attach_feeder(args.channel, f);
     }
+    let (rt, summary) = run_program(machine, &args, &program, period);
+    let ticks = rt.ticks();
+    let time_s = rt.time().as_secs_f64();
+    let (mut machine, stats) = rt.into_inner();
+    let finish = machine
+        .finishes()
+        .get(args.channel as usize - 1)
+        .copied()
+        .flatten();
+    let outcome = outcome_of(summary.as_ref().map(|s| s.end), finish);
+    if let Some(c) = machine.channel_mut(args.channel) {
+        if let Err(e) = c.motion_mut().finish_csv_trace() {
+            eprintln!("ncchannel run: --trace: {e}");
+        }
+    }
+    let report = build_report(
+        &machine,
+        &args,
+        outcome,
+        (ticks, time_s),
+        summary.as_ref(),
+        &stats,
+        period,
+    );
+    let c = &machine.channels()[args.channel as usize - 1];
+    if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
+        let title = format!("ncchannel run {program}");
+        if let Err(e) = crate::report::plot::write_svg(p, trace, &title) {
+            eprintln!("ncchannel run: --plot {}: {e}", p.display());
+        }
+    }
+    write_outputs(&mut machine, &args, &report);
+    ExitCode::from(match outcome {
+        Outcome::Ended => exit::OK,
+        Outcome::Error => exit::CHANNEL_ERROR,
+        Outcome::MaxTicks => exit::MAX_TICKS,
+        Outcome::Stopped => exit::STOPPED,
+    })
+}
+
+/// Start the program on the channel and run until it finishes, `--max-ticks` or a signal.
+fn run_program(
+    mut machine: Machine,
+    args: &RunArgs,
+    program: &str,
+    period: Duration,
+) -> (Runtime<Machine>, Option<crate::runtime::RunSummary>) {
     let tick0 = Tick {
         index: 0,
         period,
@@ -265,7 +286,7 @@ pub fn execute(args: RunArgs) -> ExitCode {
     if let Some(c) = machine.channel_mut(args.channel) {
         c.set_search(args.search);
         c.decoder_mut().set_skip_mask(args.skip_mask);
-        if let Err(e) = c.start(&tick0, &program) {
+        if let Err(e) = c.start(&tick0, program) {
             eprintln!("ncchannel run: {e}");
             start_failed = true;
         }
@@ -287,32 +308,81 @@ pub fn execute(args: RunArgs) -> ExitCode {
     } else {
         Some(rt.run(args.max_ticks))
     };
-    let ticks = rt.ticks();
-    let time_s = rt.time().as_secs_f64();
-    let (mut machine, stats) = rt.into_inner();
-    let finish = machine
-        .finishes()
-        .get(args.channel as usize - 1)
-        .copied()
-        .flatten();
-    let outcome = match (summary.as_ref().map(|s| s.end), finish) {
+    (rt, summary)
+}
+
+/// `--plot` and `--trace`: the motion trace of the channel that runs the program.
+fn enable_traces(c: &mut crate::channel::Channel, args: &RunArgs) -> Result<(), String> {
+    if args.plot.is_some() {
+        c.motion_mut().enable_trace(PLOT_SAMPLES);
+    }
+    if let Some(p) = &args.trace {
+        c.motion_mut()
+            .enable_csv_trace(p, args.trace_every)
+            .map_err(|e| format!("--trace {}: {e}", p.display()))?;
+    }
+    Ok(())
+}
+
+/// How the run ended, from the channel's finish and the runtime's end.
+fn outcome_of(end: Option<RunEnd>, finish: Option<Finish>) -> Outcome {
+    match (end, finish) {
         (_, Some(Finish::Ended)) => Outcome::Ended,
         (_, Some(Finish::Error)) => Outcome::Error,
         (Some(RunEnd::MaxTicks), _) => Outcome::MaxTicks,
         (Some(RunEnd::StopRequested), _) => Outcome::Stopped,
         _ => Outcome::Error,
-    };
-    if let Some(c) = machine.channel_mut(args.channel) {
-        if let Err(e) = c.motion_mut().finish_csv_trace() {
-            eprintln!("ncchannel run: --trace: {e}");
-        }
     }
+}
+
+/// The program to start: a path's file name, the named program, or (with `--stream`) the
+/// channel's streaming program.
+fn program_name(
+    args: &RunArgs,
+    by_path: Option<&(PathBuf, String)>,
+    ch_config: &crate::params::ChannelConfig,
+) -> Result<String, String> {
+    match (by_path, &args.program, &args.stream) {
+        (Some((_, name)), _, _) => Ok(name.clone()),
+        (None, Some(p), _) => Ok(p.clone()),
+        (None, None, Some(_)) => ch_config.streaming_prog_file.clone().ok_or_else(|| {
+            format!(
+                "--stream needs streaming_prog_file in {}",
+                ch_config.list_path.display()
+            )
+        }),
+        (None, None, None) => Err("name a PROGRAM or give --stream FILE".to_string()),
+    }
+}
+
+/// The built-in feeder over `--stream FILE`, if given.
+fn open_feeder(args: &RunArgs) -> Result<Option<Feeder>, String> {
+    let Some(f) = &args.stream else {
+        return Ok(None);
+    };
+    let text = crate::bounded::read_file(f, MAX_STREAM_FILE_BYTES)
+        .map_err(|e| format!("{}: {e}", f.display()))?;
+    Feeder::new(text, args.packet, args.every, args.raw)
+        .map(Some)
+        .map_err(|e| format!("{}: {e}", f.display()))
+}
+
+/// The run's report: outcome, times, the channel's position, stream, errors, cycle and files.
+fn build_report(
+    machine: &Machine,
+    args: &RunArgs,
+    outcome: Outcome,
+    (ticks, time_s): (u64, f64),
+    summary: Option<&crate::runtime::RunSummary>,
+    stats: &crate::report::stats::CycleStats,
+    period: Duration,
+) -> Report {
     let c = &machine.channels()[args.channel as usize - 1];
-    let report = Report {
+    Report {
         outcome,
         ticks,
         time_s,
-        wall_s: summary.as_ref().map_or(0.0, |s| s.wall.as_secs_f64()),
+        wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
         blocks: c.stats().blocks,
         position: c
             .axis_positions()
@@ -329,20 +399,18 @@ pub fn execute(args: RunArgs) -> ExitCode {
                 msg: msg.clone(),
             })
             .collect(),
-        cycle: CycleReport::new(period, &stats),
+        cycle: CycleReport::new(period, stats),
         files: FilesReport {
             opens: c.store_stats().opens,
             bytes_read: c.store_stats().bytes_read,
             cache_hits: c.cache().hits,
             latency_s: c.store_stats().latency.as_secs_f64(),
         },
-    };
-    if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
-        let title = format!("ncchannel run {program}");
-        if let Err(e) = crate::report::plot::write_svg(p, trace, &title) {
-            eprintln!("ncchannel run: --plot {}: {e}", p.display());
-        }
     }
+}
+
+/// The event log written out, the report file and the human summary.
+fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) {
     if let Err(e) = machine.finish_log() {
         eprintln!("ncchannel run: event log: {e}");
     }
@@ -361,12 +429,6 @@ pub fn execute(args: RunArgs) -> ExitCode {
     if let Err(e) = printed {
         eprintln!("ncchannel run: summary: {e}");
     }
-    ExitCode::from(match outcome {
-        Outcome::Ended => exit::OK,
-        Outcome::Error => exit::CHANNEL_ERROR,
-        Outcome::MaxTicks => exit::MAX_TICKS,
-        Outcome::Stopped => exit::STOPPED,
-    })
 }
 
 /// `--packet`: 1..=992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE, ISG FCT-C19 Data streaming);
