@@ -21,7 +21,7 @@ use crate::runtime::{Clock, RunEnd, Runtime};
 use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
-use invariants::{resident_kib, Tally};
+use invariants::{resident_kib, Tally, Verdict};
 use report::{ChannelReport, CycleFigures, MemoryReport, SoakReport};
 use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
@@ -141,6 +141,90 @@ pub fn build(
     ))
 }
 
+/// The progress bar of a run; indicatif draws it only when stderr is a terminal, so a log
+/// or a pipe gets no progress line.
+fn progress_bar(enabled: bool) -> ProgressBar {
+    let bar = if enabled {
+        ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("#>."),
+    );
+    bar
+}
+
+/// The invariants' verdicts at the end of a run (`growth`: resident set after warm-up, KiB).
+fn verdicts(cycle: &SoakCycle, scenario: &Scenario, growth: Option<i64>) -> Vec<Verdict> {
+    let mut memory = Tally::default();
+    let slack = scenario.invariants.memory_slack_kib;
+    if let Some(g) = growth {
+        if g > slack as i64 {
+            memory.violate(|| {
+                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
+            });
+        }
+    }
+    let order_note = format!("{} blocks checked", cycle.total_blocks);
+    vec![
+        cycle.tallies.order.verdict(
+            "every streamed block executed exactly once, in order, between resets",
+            Some(order_note),
+        ),
+        cycle.tallies.errors.verdict(
+            "no channel error but the expected ones",
+            Some(format!(
+                "expected: {:?}",
+                scenario.invariants.expected_errors
+            )),
+        ),
+        cycle
+            .tallies
+            .limits
+            .verdict("positions within the axis soft limits", None),
+        memory.verdict(
+            "memory steady",
+            growth.map(|g| format!("growth {g} KiB ≤ {slack} KiB")),
+        ),
+    ]
+}
+
+/// Each channel's counters for the report.
+fn channel_reports(cycle: &SoakCycle) -> Vec<ChannelReport> {
+    cycle
+        .slots
+        .iter()
+        .map(|s| {
+            let f = s.feeder.counters();
+            let st = s.channel.stats();
+            ChannelReport {
+                number: s.channel.number(),
+                program: s.program.clone(),
+                blocks: s.counters.blocks,
+                resets: s.counters.resets,
+                error_resets: s.counters.error_resets,
+                restarts: s.counters.restarts,
+                holds: s.counters.holds,
+                overrides: s.counters.overrides,
+                forced_rejections: s.counters.forced_rejections,
+                writes_ok: f.writes_ok,
+                writes_rejected: f.writes_rejected,
+                writes_skipped: f.writes_skipped,
+                bytes: f.bytes,
+                lines_written: f.lines,
+                pauses: f.pauses,
+                interrupts: st.interrupts,
+                warnings: st.warnings,
+                errors: s.counters.errors.clone(),
+                checksum: format!("{:016x}", s.counters.checksum.0),
+            }
+        })
+        .collect()
+}
+
 /// Run a scenario to its end and report.
 pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
     let length = opts
@@ -174,17 +258,7 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     } else {
         2048
     };
-    // indicatif draws only when stderr is a terminal, so a log or a pipe gets no progress line.
-    let bar = if opts.progress {
-        ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("#>."),
-    );
+    let bar = progress_bar(opts.progress);
     let fraction = |rt: &Runtime<SoakCycle>, wall: Duration| -> f64 {
         let mut f: f64 = 0.0;
         if let Some(b) = length.blocks {
@@ -232,70 +306,9 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     let sim = rt.time().as_secs_f64();
     let (cycle, stats) = rt.into_inner();
 
-    let growth = match (warmup_kib, end_kib) {
-        (Some(a), Some(b)) => Some(b as i64 - a as i64),
-        _ => None,
-    };
-    let mut memory = Tally::default();
-    let slack = scenario.invariants.memory_slack_kib;
-    if let Some(g) = growth {
-        if g > slack as i64 {
-            memory.violate(|| {
-                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
-            });
-        }
-    }
-    let order_note = format!("{} blocks checked", cycle.total_blocks);
-    let invariants = vec![
-        cycle.tallies.order.verdict(
-            "every streamed block executed exactly once, in order, between resets",
-            Some(order_note),
-        ),
-        cycle.tallies.errors.verdict(
-            "no channel error but the expected ones",
-            Some(format!(
-                "expected: {:?}",
-                scenario.invariants.expected_errors
-            )),
-        ),
-        cycle
-            .tallies
-            .limits
-            .verdict("positions within the axis soft limits", None),
-        memory.verdict(
-            "memory steady",
-            growth.map(|g| format!("growth {g} KiB ≤ {slack} KiB")),
-        ),
-    ];
-    let channels = cycle
-        .slots
-        .iter()
-        .map(|s| {
-            let f = s.feeder.counters();
-            let st = s.channel.stats();
-            ChannelReport {
-                number: s.channel.number(),
-                program: s.program.clone(),
-                blocks: s.counters.blocks,
-                resets: s.counters.resets,
-                error_resets: s.counters.error_resets,
-                restarts: s.counters.restarts,
-                holds: s.counters.holds,
-                overrides: s.counters.overrides,
-                forced_rejections: s.counters.forced_rejections,
-                writes_ok: f.writes_ok,
-                writes_rejected: f.writes_rejected,
-                writes_skipped: f.writes_skipped,
-                bytes: f.bytes,
-                lines_written: f.lines,
-                pauses: f.pauses,
-                interrupts: st.interrupts,
-                warnings: st.warnings,
-                errors: s.counters.errors.clone(),
-                checksum: format!("{:016x}", s.counters.checksum.0),
-            }
-        })
-        .collect();
+    let growth = warmup_kib.zip(end_kib).map(|(a, b)| b as i64 - a as i64);
+    let invariants = verdicts(&cycle, scenario, growth);
+    let channels = channel_reports(&cycle);
     let blocks = cycle.total_blocks;
     Ok(SoakReport {
         scenario: scenario.path.display().to_string(),
