@@ -100,6 +100,26 @@ pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(exit::USAGE)
 }
 
+/// The machine under the soak's supervision: faults injected, invariants checked on what the
+/// external clients make the channels do.
+fn supervised(machine: Machine, sc: &Scenario, config: &crate::params::Config) -> Supervised {
+    let soft_limits = config
+        .runtime
+        .axes
+        .iter()
+        .filter_map(|a| {
+            let c = a.name.chars().next()?;
+            Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
+        })
+        .collect();
+    let programs = config
+        .channels
+        .iter()
+        .map(|c| c.streaming_prog_file.clone())
+        .collect();
+    Supervised::new(machine, sc, soft_limits, programs)
+}
+
 pub fn execute(mut args: ServeArgs) -> ExitCode {
     let limit = match run_limit(args.seconds) {
         Ok(l) => l,
@@ -153,21 +173,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         }
     }
     if let Some(sc) = scenario {
-        let soft_limits = config
-            .runtime
-            .axes
-            .iter()
-            .filter_map(|a| {
-                let c = a.name.chars().next()?;
-                Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
-            })
-            .collect();
-        let programs = config
-            .channels
-            .iter()
-            .map(|c| c.streaming_prog_file.clone())
-            .collect();
-        let cycle = Supervised::new(machine, &sc, soft_limits, programs);
+        let cycle = supervised(machine, &sc, &config);
         return super::serve_soak::run(cycle, &sc, &args, &config, period, nch);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
