@@ -210,14 +210,33 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
                     line_text: line.to_string(),
                 });
             }
-            Err(e) => errors.push(
-                Diagnostic::error(file, line_no, col_of(line, e.offset), None, e.message)
-                    .with_source(line),
-            ),
+            Err(e) => {
+                if errors.len() >= MAX_LIST_ERRORS {
+                    // A file of garbage (16 MiB of bad lines) must not cost gigabytes of
+                    // diagnostics: one run names the first ones, then stops.
+                    errors.push(Diagnostic::error(
+                        file,
+                        line_no,
+                        1,
+                        None,
+                        format!(
+                            "more than {MAX_LIST_ERRORS} bad lines: the rest of the list is not checked"
+                        ),
+                    ));
+                    break;
+                }
+                errors.push(
+                    Diagnostic::error(file, line_no, col_of(line, e.offset), None, e.message)
+                        .with_source(line),
+                )
+            }
         }
     }
     (list, errors)
 }
+
+/// Bad lines reported from one list at most; then the check stops with one more line.
+pub const MAX_LIST_ERRORS: usize = 1000;
 
 /// 1-based character column of byte offset `off` in `line`.
 fn col_of(line: &str, off: usize) -> usize {
@@ -611,5 +630,16 @@ mod tests {
     fn later_entry_wins_in_get() {
         let (list, _) = parse_list(Path::new("t.lis"), "a 1\na 2\n");
         assert_eq!(list.get("a").unwrap().value.as_int(), Some(2));
+    }
+
+    #[test]
+    fn a_list_of_garbage_reports_a_bounded_number_of_lines() {
+        // 16 MiB of bad lines: the first MAX_LIST_ERRORS, then one line that says it stopped.
+        let line = "!!! not a parameter line\n";
+        let text = line.repeat((16 << 20) / line.len());
+        let (list, errors) = parse_list(Path::new("bad.lis"), &text);
+        assert!(list.entries.is_empty());
+        assert_eq!(errors.len(), MAX_LIST_ERRORS + 1);
+        assert!(errors[MAX_LIST_ERRORS].message.contains("not checked"));
     }
 }
