@@ -501,9 +501,13 @@ impl Channel {
             Err(e @ StreamWriteError::NoLineEnd { .. }) => {
                 let msg =
                     format!("Streaming data does not contain a correct line end marker ({e})");
-                if self.decoder.state() == DecoderState::Running {
+                if self.decoder.state() == DecoderState::Running && self.decoder.reads_stream() {
                     self.decoder.abort(ERR_NO_LINE_END, msg.clone());
                     self.drain_decoder_notes(tick);
+                } else if self.running_prog.is_some() && !self.decoder.reads_stream() {
+                    // A file program runs and never reads the stream: the refused write is the
+                    // writer's problem, not the program's (docs/exactly-once.md).
+                    self.warn(tick, ERR_NO_LINE_END, msg);
                 } else {
                     self.raise_error(tick, ERR_NO_LINE_END, msg, None, None);
                 }

@@ -115,3 +115,22 @@ fn serve_seconds_out_of_range_is_a_usage_error_not_a_panic() {
         assert!(err.contains("--seconds"), "--seconds {bad}: {err}");
     }
 }
+
+#[test]
+fn a_bare_lf_written_to_the_stream_does_not_abort_a_running_file_program() {
+    // A file program runs; a client writes a packet with a bare LF into the stream interface.
+    // The write is refused (21476, a warning: no program reads the stream), the file program
+    // runs to its end.
+    let rig = Rig::new();
+    rig.program("file.nc", "G1 X10 F600\nG1 X20\nM30\n");
+    let raw = ncchannel::feeder::Feeder::new(b"N1 X1\n".to_vec(), 992, 1, true).unwrap();
+    let r = rig.run("file.nc", Some(raw), 200_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    assert_eq!(r.position('X'), 20.0);
+    let warned = r
+        .of("warning")
+        .iter()
+        .any(|w| w["code"].as_u64() == Some(u64::from(codes::NO_LINE_END)));
+    assert!(warned, "{}", r.log);
+    assert!(r.error_codes().is_empty(), "{}", r.log);
+}

@@ -253,6 +253,10 @@ impl Decoder {
     pub fn state(&self) -> DecoderState {
         self.state
     }
+    /// The running program reads the stream interface (a stream frame is on the stack).
+    pub fn reads_stream(&self) -> bool {
+        self.stream_active
+    }
     /// Axes the channel has, by `AXIS_LETTERS` index.
     pub fn axes(&self) -> [bool; MAX_AXES] {
         self.settings.axes
