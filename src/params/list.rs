@@ -23,6 +23,11 @@ pub const MAX_LIST_BYTES: u64 = 16 * 1024 * 1024;
 /// Most entries one list may hold. Bounds memory independent of line length.
 pub const MAX_ENTRIES: usize = 100_000;
 
+/// Most malformed lines one list reports. A file of garbage has an error a line; the first
+/// ones say what is wrong, and listing millions cost gigabytes and minutes, so the rest are
+/// counted in one closing diagnostic.
+pub const MAX_LIST_ERRORS: usize = 1000;
+
 /// Largest index inside `[...]`. ISG tables are small; a huge index is a typo.
 pub const MAX_INDEX: u32 = 65_535;
 
@@ -175,6 +180,9 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
         entries: Vec::new(),
     };
     let mut errors = Vec::new();
+    // Malformed lines past MAX_LIST_ERRORS: how many, and the first of them.
+    let mut unlisted = 0usize;
+    let mut first_unlisted = 0usize;
     // A leading byte-order mark is an editor artefact, not part of the first name.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (idx, raw) in text.split('\n').enumerate() {
@@ -210,11 +218,28 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
                     line_text: line.to_string(),
                 });
             }
+            Err(_) if errors.len() >= MAX_LIST_ERRORS => {
+                if unlisted == 0 {
+                    first_unlisted = line_no;
+                }
+                unlisted += 1;
+            }
             Err(e) => errors.push(
                 Diagnostic::error(file, line_no, col_of(line, e.offset), None, e.message)
                     .with_source(line),
             ),
         }
+    }
+    if unlisted > 0 {
+        errors.push(Diagnostic::error(
+            file,
+            first_unlisted,
+            1,
+            None,
+            format!(
+                "{unlisted} more malformed line(s) from here on, not listed (the first {MAX_LIST_ERRORS} are)"
+            ),
+        ));
     }
     (list, errors)
 }
