@@ -501,9 +501,13 @@ impl Channel {
             Err(e @ StreamWriteError::NoLineEnd { .. }) => {
                 let msg =
                     format!("Streaming data does not contain a correct line end marker ({e})");
-                if self.decoder.state() == DecoderState::Running {
+                if self.decoder.state() == DecoderState::Running && self.decoder.streaming() {
                     self.decoder.abort(ERR_NO_LINE_END, msg.clone());
                     self.drain_decoder_notes(tick);
+                } else if self.running_prog.is_some() {
+                    // A file program runs: the refused write never reaches it, so it goes on;
+                    // the writer has its refusal and the log a warning.
+                    self.warn(tick, ERR_NO_LINE_END, msg);
                 } else {
                     self.raise_error(tick, ERR_NO_LINE_END, msg, None, None);
                 }
