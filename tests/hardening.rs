@@ -126,7 +126,7 @@ fn var_declarations_are_spread_over_ticks_and_bounded_in_bytes() {
     assert_eq!(finish, Some(Finish::Ended), "{:?}", h.error_code());
     // All ten were made by the program's end — in their name once each.
     let made = h.channel().decoder().vars().bytes(VarClass::Local);
-    assert!(made >= 10 * 800_000 && made <= CLASS_BYTES, "{made}");
+    assert!((10 * 800_000..=CLASS_BYTES).contains(&made), "{made}");
 }
 
 /// An eleventh such array does not fit the V.L. budget: 20967 (TF5200 "Memory for
