@@ -4,7 +4,7 @@
 use thiserror::Error;
 
 use crate::channel::{Channel, ChannelSettings};
-use crate::decoder::DecoderSettings;
+use crate::decoder::{DecoderSettings, SoftLimits};
 use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
 use crate::queue::{AXIS_LETTERS, MAX_AXES};
@@ -51,8 +51,13 @@ pub fn channel_settings(
 ) -> Result<ChannelSettings, SetupError> {
     let axes = axes(config)?;
     let mut enabled = [false; MAX_AXES];
+    let mut soft_limits_mm = [SoftLimits::default(); MAX_AXES];
     for a in &axes {
         enabled[a.index] = true;
+        soft_limits_mm[a.index] = SoftLimits {
+            min_mm: a.min_mm,
+            max_mm: a.max_mm,
+        };
     }
     let rt = &config.runtime;
     let decoder = DecoderSettings {
@@ -60,6 +65,7 @@ pub fn channel_settings(
         max_depth: rt.decoder.max_subroutine_depth as usize,
         axes: enabled,
         zero_offsets: ch.zero_offsets,
+        soft_limits_mm,
         ..DecoderSettings::default()
     };
     let search_dirs = ch

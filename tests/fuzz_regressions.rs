@@ -24,6 +24,7 @@ const TARGETS: &[Target] = &[
     ("stream_buffer", checks::stream_buffer),
     ("channel_program", checks::channel_program),
     ("param_folder", checks::param_folder),
+    ("machine_requests", checks::machine_requests),
 ];
 
 fn root() -> PathBuf {
@@ -80,5 +81,63 @@ fn shipped_parameter_lists_pass_the_list_target() {
     assert!(!lists.is_empty());
     for file in lists {
         checks::param_list(&fs::read(&file).unwrap());
+    }
+}
+
+/// The machine target on a sequence a client really sends: stream lines written before and
+/// after the start, a hold and resume, a request given up, a reset, a restart. The lines run
+/// in order, each once (the target's assertions), and some run at all.
+#[test]
+fn machine_requests_run_streamed_lines_in_order_through_hold_reset_and_give_up() {
+    use checks::ClientStep::*;
+    let lines = |x| Lines {
+        lines: 5,
+        x,
+        feed: 200,
+        flush: true,
+    };
+    let steps = vec![
+        lines(0),
+        Start,
+        lines(10),
+        Ticks(50),
+        Hold,
+        Ticks(20),
+        lines(20),
+        Resume,
+        Ticks(200),
+        GiveUp,
+        lines(30),
+        Status,
+        Override(50),
+        Ticks(100),
+        Raw(b"G01 X\n".to_vec()),
+        Ticks(10),
+        Reset,
+        lines(40),
+        Start,
+        lines(50),
+        Ticks(255),
+        Ticks(255),
+    ];
+    let executed = checks::machine_steps(steps);
+    assert!(executed >= 10, "only {executed} lines executed");
+}
+
+/// The machine target over a few hundred pseudo-random byte strings, so `cargo test` covers
+/// it without libFuzzer (the numbers come from a fixed linear congruential generator).
+#[test]
+fn machine_requests_survive_pseudo_random_sequences() {
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) as u8
+    };
+    for _ in 0..200 {
+        let len = usize::from(next()) * 4;
+        let data: Vec<u8> = (0..len).map(|_| next()).collect();
+        checks::machine_requests(&data);
     }
 }

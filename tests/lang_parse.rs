@@ -177,7 +177,7 @@ fn every_word_letter() {
     for l in "GMHFSTDXYZABCIJKREUVW".chars() {
         let v = if l == 'G' {
             "1"
-        } else if l == 'M' || l == 'H' {
+        } else if matches!(l, 'M' | 'H' | 'T' | 'D') {
             "3"
         } else {
             "2.5"
@@ -186,6 +186,9 @@ fn every_word_letter() {
         let b = p(&line);
         assert_eq!(words(&b).len(), 1, "{line}");
     }
+    // Tool and tool offset numbers are whole numbers (90132, value out of range).
+    assert_eq!(err("T2.5"), (90132, 1));
+    assert_eq!(err("X1 D-1"), (90132, 4));
     assert_eq!(err("Q5"), (20200, 1));
     assert_eq!(err("X10 O5"), (20200, 5));
     assert_eq!(err("X"), (20200, 2));
@@ -227,7 +230,7 @@ fn ramp_time_weighting_value() {
         }])
     );
     assert_eq!(p("G134=50").body, b.body);
-    assert_eq!(canon("G133 = [P1*2] X1"), "G133=[P1 * 2] X1");
+    assert_eq!(canon("G133 = [P1*2] X1"), "G133=P1 * 2 X1");
     // Without a value G134 stays a plain word.
     assert_eq!(words(&p("G134 X1")), vec![('G', 134.0), ('X', 1.0)]);
 }
@@ -262,10 +265,9 @@ fn assignments() {
     assert!(matches!(targets[6].0, VarRef::CycleParam(1)));
     assert_eq!(
         b.to_string(),
-        "P1=10 P5=[[P1 * 2] + 3] P1[2]=4 P[[P1 + 5]]=3 V.L.X=1 V.P.ARR[1][P2]=2 @P1=7"
-            .replace("P[[P1 + 5]]", "P[P1 + 5]")
+        "P1=10 P5=P1 * 2 + 3 P1[2]=4 P[P1 + 5]=3 V.L.X=1 V.P.ARR[1][P2]=2 @P1=7"
     );
-    assert_eq!(canon("P1 = P2 + 3 X[P1]"), "P1=[P2 + 3] X[P1]");
+    assert_eq!(canon("P1 = P2 + 3 X[P1]"), "P1=P2 + 3 X[P1]");
     assert_eq!(err("P1 10"), (20200, 4));
     assert_eq!(err("V.Q.X=1"), (20200, 3));
 }
@@ -415,7 +417,7 @@ fn calls_and_heads() {
     assert_eq!(params[0], (1, Expr::Num(0.0)));
     assert_eq!(
         b.to_string(),
-        "N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5 * 2]]"
+        "N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=P5 * 2]"
     );
     assert_eq!(
         p("%streaming-spline").body,

@@ -126,6 +126,19 @@ fn once_per_letter(items: Vec<Item>) -> Vec<Item> {
         .collect()
 }
 
+/// A literal moved into its word's range (`lang::range`): the parser refuses the others.
+fn in_range(letter: u8, value: Value) -> Value {
+    let Value::Num(v) = value else { return value };
+    let v = match letter {
+        b'F' | b'S' => v.abs(),
+        b'T' | b'D' => v.abs().round(),
+        b'I' | b'J' | b'K' | b'R' => v.clamp(-200_000.0, 200_000.0),
+        _ => v,
+    };
+    assert!(range::word_value(letter, v).is_ok());
+    Value::Num(v)
+}
+
 fn item() -> impl Strategy<Value = Item> {
     let letters: Vec<u8> = WORD_LETTERS
         .iter()
@@ -135,7 +148,7 @@ fn item() -> impl Strategy<Value = Item> {
     // G04 must stand alone in its block: generated blocks leave it out.
     let gs: Vec<u32> = KNOWN_G.iter().copied().filter(|&g| g != 4).collect();
     prop_oneof![
-        4 => (prop::sample::select(letters), value()).prop_map(|(letter, value)| Item::Word(Word { letter, value, col: 0 })),
+        4 => (prop::sample::select(letters), value()).prop_map(|(letter, value)| Item::Word(Word { letter, value: in_range(letter, value), col: 0 })),
         1 => prop::sample::select(gs).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
         1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
         1 => (0u32..=65_535).prop_map(|h| Item::Word(Word { letter: b'H', value: Value::Num(f64::from(h)), col: 0 })),

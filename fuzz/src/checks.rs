@@ -422,3 +422,248 @@ pub fn param_folder(data: &[u8]) {
         let _ = ncchannel::setup::channels(&config, false);
     }
 }
+
+/// One thing a client does to the machine: a request (through the same `Request` and
+/// `Claim` the ADS server uses) or a number of ticks passing.
+#[derive(Debug, Arbitrary)]
+pub enum ClientStep {
+    /// A packet of `lines` valid NC lines (sequential N numbers, small moves), CR LF ended,
+    /// with `#FLUSH` after them when `flush` (else motion may hold them for its look-ahead).
+    Lines {
+        lines: u8,
+        x: i8,
+        feed: u8,
+        flush: bool,
+    },
+    /// Raw bytes: bad line ends, garbage, empty or oversized packets.
+    Raw(Vec<u8>),
+    /// Automatic mode, the streaming program as command parameter, state ACTIVE.
+    Start,
+    Mode(i8),
+    State(i8),
+    Program(String),
+    Hold,
+    Resume,
+    Reset,
+    Override(i16),
+    WriteExternal(u8, i32),
+    ReadExternal(u8),
+    Status,
+    ErrorRecord(u8),
+    SingleBlock(bool),
+    OptionalStop(bool),
+    SkipLevels(u32),
+    ExecutionMode(i8),
+    ResetCycleTimes,
+    /// The caller gives up on its next request before the tick serves it.
+    GiveUp,
+    Ticks(u8),
+}
+
+/// Ticks one input may run: enough for a few hundred short moves.
+const MAX_MACHINE_TICKS: u64 = 4_000;
+
+/// The machine under random request sequences: no panic; every request answered exactly
+/// once — or, when its caller gave up first, neither answered nor applied; stream lines
+/// executed only when their write was accepted, each at most once, in the order written;
+/// no tick over [`MAX_TICK`].
+pub fn machine_requests(data: &[u8]) {
+    if let Ok(steps) = Vec::<ClientStep>::arbitrary_take_rest(Unstructured::new(data)) {
+        machine_steps(steps);
+    }
+}
+
+/// [`machine_requests`] over steps given directly; returns how many numbered stream lines
+/// were executed (so a test can tell that its sequence reached the interpolator).
+pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
+    use ncchannel::machine::{HmiOp, Machine, Op, Reply, StopWhen};
+    use ncchannel::report::event::EventLog;
+    use ncchannel::runtime::{Cycle, Tick};
+
+    let Some(config) = shipped_config() else {
+        panic!("params/startup.lis not found or refused")
+    };
+    let Ok(channels) = ncchannel::setup::channels(config, false) else {
+        panic!("the shipped parameter lists give no channel")
+    };
+    let Some(stream_prog) = config.channels[0].streaming_prog_file.clone() else {
+        return 0;
+    };
+    let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
+    if let Some(c) = machine.channel_mut(1) {
+        c.observe_stream_blocks(true);
+    }
+    let period = std::time::Duration::from_micros(config.runtime.cycle_period_us);
+    let mut k: u64 = 0;
+    let tick = |index: u64| Tick {
+        index,
+        period,
+        time: period * u32::try_from(index).unwrap_or(u32::MAX),
+    };
+    // N numbers of the lines written so far (never reused), and of those accepted.
+    let mut next_n: u32 = 1;
+    let mut accepted: std::collections::BTreeSet<u32> = Default::default();
+    let mut last_executed: u32 = 0;
+    let executed = std::cell::Cell::new(0usize);
+    let mut give_up = false;
+    let (tx, rx) = crossbeam_channel::unbounded::<Reply>();
+
+    let run_ticks = |machine: &mut Machine,
+                     n: u64,
+                     k: &mut u64,
+                     last: &mut u32,
+                     acc: &std::collections::BTreeSet<u32>| {
+        for _ in 0..n {
+            if *k >= MAX_MACHINE_TICKS {
+                return;
+            }
+            *k += 1;
+            let began = std::time::Instant::now();
+            let _ = machine.step(&tick(*k));
+            let took = began.elapsed();
+            assert!(took <= MAX_TICK, "tick {k} took {took:?}");
+            if let Some(c) = machine.channel_mut(1) {
+                for b in c.drain_executed() {
+                    let Some(n) = b.n else { continue };
+                    assert!(
+                        acc.contains(&n),
+                        "N{n} executed but its write was not accepted"
+                    );
+                    assert!(
+                        n > *last,
+                        "N{n} executed after N{last}: out of order or twice"
+                    );
+                    *last = n;
+                    executed.set(executed.get() + 1);
+                }
+            }
+        }
+    };
+
+    for step in steps.into_iter().take(2_000) {
+        if k >= MAX_MACHINE_TICKS {
+            break;
+        }
+        let op = match step {
+            ClientStep::Ticks(n) => {
+                run_ticks(
+                    &mut machine,
+                    u64::from(n),
+                    &mut k,
+                    &mut last_executed,
+                    &accepted,
+                );
+                continue;
+            }
+            ClientStep::GiveUp => {
+                give_up = true;
+                continue;
+            }
+            ClientStep::Start => {
+                for op in [
+                    Op::CommandMode(2),
+                    Op::SetProgram(stream_prog.clone()),
+                    Op::CommandState(4),
+                ] {
+                    let _ = machine.apply(&tick(k), 1, op);
+                }
+                continue;
+            }
+            ClientStep::Lines {
+                lines,
+                x,
+                feed,
+                flush,
+            } => {
+                let mut packet = Vec::new();
+                let mut ns = Vec::new();
+                for j in 0..lines.min(40) {
+                    let n = next_n;
+                    next_n += 1;
+                    ns.push(n);
+                    let x = i32::from(x) + i32::from(j);
+                    let f = 1000 + u32::from(feed) * 100;
+                    packet.extend_from_slice(format!("N{n} G01 X{x} F{f}\r\n").as_bytes());
+                }
+                if flush {
+                    packet.extend_from_slice(b"#FLUSH\r\n");
+                }
+                let op = Op::WriteStream(packet);
+                let (reply, applied) = serve_request(&mut machine, &tick(k), op, &tx, &rx, give_up);
+                give_up = false;
+                if applied && matches!(reply, Some(Reply::Stream(Ok(())))) {
+                    accepted.extend(ns);
+                }
+                continue;
+            }
+            // No N in raw data: only the generated lines carry block numbers, so the order
+            // check knows every numbered line and whether its write was accepted.
+            ClientStep::Raw(mut bytes) => {
+                bytes.retain(|b| !matches!(b, b'N' | b'n'));
+                Op::WriteStream(bytes)
+            }
+            ClientStep::Mode(v) => Op::CommandMode(i32::from(v)),
+            ClientStep::State(v) => Op::CommandState(i32::from(v)),
+            ClientStep::Program(name) => Op::SetProgram(name),
+            ClientStep::Hold => Op::Hold,
+            ClientStep::Resume => Op::Resume,
+            ClientStep::Reset => Op::Reset,
+            ClientStep::Override(p) => Op::SetOverride(f64::from(p)),
+            ClientStep::WriteExternal(name, v) => {
+                Op::WriteExternal(format!("V{name}"), f64::from(v))
+            }
+            ClientStep::ReadExternal(name) => Op::ReadExternal(format!("V{name}")),
+            ClientStep::Status => Op::Status,
+            ClientStep::ErrorRecord(i) => Op::ErrorRecord(u64::from(i)),
+            ClientStep::SingleBlock(on) => Op::Hmi(HmiOp::SingleBlock(on)),
+            ClientStep::OptionalStop(on) => Op::Hmi(HmiOp::OptionalStop(on)),
+            ClientStep::SkipLevels(m) => Op::Hmi(HmiOp::SkipLevels(m)),
+            ClientStep::ExecutionMode(m) => Op::Hmi(HmiOp::ExecutionMode(i32::from(m))),
+            ClientStep::ResetCycleTimes => Op::Hmi(HmiOp::ResetCycleTimes),
+        };
+        let _ = serve_request(&mut machine, &tick(k), op, &tx, &rx, give_up);
+        give_up = false;
+    }
+    // The rest of the program runs out without a client.
+    run_ticks(
+        &mut machine,
+        MAX_MACHINE_TICKS,
+        &mut k,
+        &mut last_executed,
+        &accepted,
+    );
+    executed.get()
+}
+
+/// Serve one request as the runtime does; returns its reply and whether it was applied.
+/// A request whose caller gave up first must be neither applied nor answered.
+fn serve_request(
+    machine: &mut ncchannel::machine::Machine,
+    tick: &ncchannel::runtime::Tick,
+    op: ncchannel::machine::Op,
+    tx: &crossbeam_channel::Sender<ncchannel::machine::Reply>,
+    rx: &crossbeam_channel::Receiver<ncchannel::machine::Reply>,
+    give_up: bool,
+) -> (Option<ncchannel::machine::Reply>, bool) {
+    use ncchannel::runtime::Cycle;
+    let write = matches!(op, ncchannel::machine::Op::WriteStream(_));
+    let before = machine.channels()[0].stream_fill();
+    let (req, caller) = ncchannel::machine::Request::new(1, op, tx.clone());
+    let gave_up = give_up && caller.take();
+    machine.serve(req, tick);
+    let reply = rx.try_recv().ok();
+    assert!(rx.try_recv().is_err(), "a request answered twice");
+    if gave_up {
+        assert!(reply.is_none(), "answered after its caller gave up");
+        if write {
+            assert_eq!(
+                machine.channels()[0].stream_fill(),
+                before,
+                "a write applied after its caller gave up"
+            );
+        }
+        return (None, false);
+    }
+    assert!(reply.is_some(), "a request not answered");
+    (reply, true)
+}

@@ -119,7 +119,9 @@ pub fn check_file(path: &Path) -> Vec<Diagnostic> {
         Err(msg) => return vec![Diagnostic::error(path, 0, 0, None, msg)],
     };
     let lines: Vec<&str> = text.lines().collect();
-    crate::lang::check_program(&text)
+    let (found, all) = crate::lang::check_program_counted(&text);
+    let listed = found.len();
+    let mut diags: Vec<Diagnostic> = found
         .into_iter()
         .map(|d| {
             let diag = Diagnostic::error(path, d.line, d.col, Some(d.code), d.message);
@@ -128,7 +130,22 @@ pub fn check_file(path: &Path) -> Vec<Diagnostic> {
                 None => diag,
             }
         })
-        .collect()
+        .collect();
+    if all > listed {
+        diags.push(not_listed(path, all - listed));
+    }
+    diags
+}
+
+/// The one diagnostic that stands for the findings past the listing limit.
+fn not_listed(path: &Path, more: usize) -> Diagnostic {
+    Diagnostic::error(
+        path,
+        0,
+        0,
+        None,
+        format!("{more} more error(s) not listed (only the first ones are)"),
+    )
 }
 
 /// Read a file as text; bytes that are not UTF-8 (Latin-1 comments) become U+FFFD.

@@ -1,28 +1,55 @@
-//! Circle geometry of G2/G3 blocks: centre from I/J/K or R, consistency check, swept angle.
+//! Circle geometry of G2/G3 blocks: centre from I/J/K or R, consistency check, swept angle,
+//! and the arc's extent (for the software limits).
+//!
+//! A circle must be a real one: its centre inside the data format (±214,748.3647 mm, as
+//! ISG's 0.1 µm positions in 32 bits; 20020 for I/J/K, 20054 for a centre computed from R),
+//! a full circle only from I/J/K (20034), and the swept angle of an R arc computed from the
+//! chord, not from two nearly equal `atan2` angles — so a huge radius can neither give NaN
+//! positions nor round a short arc into a full circle of that radius.
 
-use std::f64::consts::TAU;
+use std::f64::consts::{PI, TAU};
 
-use crate::queue::{Move, MoveKind, Plane, Position};
-
-/// Largest circle radius accepted, mm (1 km): beyond any machine's travel, so a larger value
-/// is a typing or post-processor error, and a circle of 1e18 mm would never end.
-pub const MAX_ARC_RADIUS_MM: f64 = 1.0e6;
+use crate::lang::codes::{
+    ARC_CENTER_RANGE, ARC_FULL_CIRCLE_BY_RADIUS, ARC_INCONSISTENT, ARC_RADIUS_RANGE, MAX_COORD_MM,
+};
+use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ArcError {
     /// Start and end radius differ by more than the tolerance.
-    #[error("start radius {r_start_mm} mm and end radius {r_end_mm} mm differ")]
+    #[error("circle not consistent: start radius {r_start_mm} mm, end radius {r_end_mm} mm")]
     Inconsistent { r_start_mm: f64, r_end_mm: f64 },
     /// R smaller than half the chord.
-    #[error("R {r_mm} mm is smaller than half the chord of {chord_mm} mm")]
+    #[error("circle radius {r_mm} mm smaller than half the chord ({chord_mm} mm)")]
     RadiusTooSmall { r_mm: f64, chord_mm: f64 },
     /// Neither centre nor radius, or a zero radius.
-    #[error("no centre (I/J/K) or radius (R), or a zero radius")]
+    #[error("circle without centre: no I/J/K or R, or a radius of zero")]
     NoCenter,
-    /// A centre or radius no real circle has: not finite, or larger than
-    /// [`MAX_ARC_RADIUS_MM`].
-    #[error("radius {r_mm} mm is not a circle a machine can run (at most 1000000 mm)")]
-    TooLarge { r_mm: f64 },
+    /// R programmed with the end point on the start point: the centre is undetermined.
+    #[error("full circle programmed with R: program it with I/J/K")]
+    FullCircleByRadius,
+    /// The centre lies outside the data format (`from_radius`: computed from R).
+    #[error("circle centre {coord_mm} mm outside the data format ±{MAX_COORD_MM} mm")]
+    CenterOutOfRange { coord_mm: f64, from_radius: bool },
+}
+
+impl ArcError {
+    /// The number reported: 20020 / 20054 / 20034 (TF5200 diagnosis list), 90130 (ours)
+    /// for an inconsistent circle.
+    pub fn code(&self) -> u32 {
+        match self {
+            ArcError::Inconsistent { .. }
+            | ArcError::RadiusTooSmall { .. }
+            | ArcError::NoCenter => ARC_INCONSISTENT,
+            ArcError::FullCircleByRadius => ARC_FULL_CIRCLE_BY_RADIUS,
+            ArcError::CenterOutOfRange {
+                from_radius: false, ..
+            } => ARC_CENTER_RANGE,
+            ArcError::CenterOutOfRange {
+                from_radius: true, ..
+            } => ARC_RADIUS_RANGE,
+        }
+    }
 }
 
 /// What a G2/G3 block programs besides its end point.
@@ -37,6 +64,10 @@ pub struct ArcSpec {
     /// G2.
     pub cw: bool,
 }
+
+/// Shortest chord an R arc may have, mm: below the control's 0.1 µm resolution by far, the
+/// end point is the start point and the circle undetermined (20034).
+const MIN_CHORD_MM: f64 = 1e-9;
 
 /// Build an arc move from `start` to `end`.
 pub fn arc_move(
@@ -54,28 +85,27 @@ pub fn arc_move(
     } = *spec;
     let (a, b, _) = plane.axes();
     let (sa, sb, ea, eb) = (start[a], start[b], end[a], end[b]);
-    let too_large = |v: f64| !v.is_finite() || v.abs() > MAX_ARC_RADIUS_MM;
-    if let Some(v) = [ijk[a], ijk[b], r]
-        .into_iter()
-        .flatten()
-        .find(|&v| too_large(v))
-    {
-        return Err(ArcError::TooLarge { r_mm: v.abs() });
-    }
-    let center = if ijk[a].is_some() || ijk[b].is_some() {
+    let by_radius = !(ijk[a].is_some() || ijk[b].is_some());
+    let center = if !by_radius {
         [sa + ijk[a].unwrap_or(0.0), sb + ijk[b].unwrap_or(0.0)]
     } else if let Some(r) = r {
         center_from_radius(sa, sb, ea, eb, r, cw, tolerance_mm)?
     } else {
         return Err(ArcError::NoCenter);
     };
+    for c in center {
+        // NaN is refused too: it is not finite.
+        if !c.is_finite() || c.abs() > MAX_COORD_MM {
+            return Err(ArcError::CenterOutOfRange {
+                coord_mm: c,
+                from_radius: by_radius,
+            });
+        }
+    }
     let r0 = (sa - center[0]).hypot(sb - center[1]);
     let r1 = (ea - center[0]).hypot(eb - center[1]);
     if r0 <= f64::EPSILON {
         return Err(ArcError::NoCenter);
-    }
-    if too_large(r0) {
-        return Err(ArcError::TooLarge { r_mm: r0 });
     }
     if (r0 - r1).abs() > tolerance_mm {
         return Err(ArcError::Inconsistent {
@@ -83,14 +113,30 @@ pub fn arc_move(
             r_end_mm: r1,
         });
     }
-    let a0 = (sb - center[1]).atan2(sa - center[0]);
-    let a1 = (eb - center[1]).atan2(ea - center[0]);
-    let mut sweep = if cw { a0 - a1 } else { a1 - a0 };
-    sweep = sweep.rem_euclid(TAU);
-    // Same start and end point: a full circle (only reachable with I/J/K).
-    if sweep <= 1e-12 {
-        sweep = TAU;
-    }
+    let sweep = match r {
+        // From the chord: exact however large R is against it (two `atan2` angles of a
+        // long radius differ by less than their rounding).
+        Some(r) if by_radius => {
+            let half = (ea - sa).hypot(eb - sb) / 2.0;
+            let short = 2.0 * (half / r.abs()).min(1.0).asin();
+            if r < 0.0 {
+                TAU - short
+            } else {
+                short
+            }
+        }
+        _ => {
+            let a0 = (sb - center[1]).atan2(sa - center[0]);
+            let a1 = (eb - center[1]).atan2(ea - center[0]);
+            let sweep = if cw { a0 - a1 } else { a1 - a0 }.rem_euclid(TAU);
+            // Same start and end point: a full circle (only reachable with I/J/K).
+            if sweep <= 1e-12 {
+                TAU
+            } else {
+                sweep
+            }
+        }
+    };
     Ok(Move {
         kind: MoveKind::Arc {
             plane,
@@ -118,8 +164,11 @@ fn center_from_radius(
     let (dx, dy) = (ea - sa, eb - sb);
     let chord = dx.hypot(dy);
     let ra = r.abs();
-    if chord <= f64::EPSILON || ra <= f64::EPSILON {
+    if ra <= f64::EPSILON {
         return Err(ArcError::NoCenter);
+    }
+    if chord <= MIN_CHORD_MM {
+        return Err(ArcError::FullCircleByRadius);
     }
     let half = chord / 2.0;
     let h2 = ra * ra - half * half;
@@ -140,10 +189,47 @@ fn center_from_radius(
     Ok([mx + nx * s, my + ny * s])
 }
 
+/// The smallest and largest value each axis takes along `mv`: the end points, and for an
+/// arc the circle's extreme points in its plane that lie within the swept angle (the axis
+/// normal to the plane and any other axis move linearly).
+pub fn extent(mv: &Move) -> (Position, Position) {
+    let mut lo = [0.0; MAX_AXES];
+    let mut hi = [0.0; MAX_AXES];
+    for i in 0..MAX_AXES {
+        lo[i] = mv.start[i].min(mv.end[i]);
+        hi[i] = mv.start[i].max(mv.end[i]);
+    }
+    if let MoveKind::Arc {
+        plane,
+        center,
+        radius_mm,
+        cw,
+        sweep_rad,
+    } = mv.kind
+    {
+        let (a, b, _) = plane.axes();
+        let a0 = (mv.start[b] - center[1]).atan2(mv.start[a] - center[0]);
+        // The four quadrant points (angle, axis, value), passed when within the sweep.
+        let quadrants = [
+            (0.0, a, center[0] + radius_mm),
+            (PI / 2.0, b, center[1] + radius_mm),
+            (PI, a, center[0] - radius_mm),
+            (1.5 * PI, b, center[1] - radius_mm),
+        ];
+        for (angle, axis, value) in quadrants {
+            let from_start = if cw { a0 - angle } else { angle - a0 };
+            if from_start.rem_euclid(TAU) <= sweep_rad {
+                lo[axis] = lo[axis].min(value);
+                hi[axis] = hi[axis].max(value);
+            }
+        }
+    }
+    (lo, hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// The positional form reads best in these tables of cases.
     #[allow(clippy::too_many_arguments)]
@@ -269,5 +355,119 @@ mod tests {
         };
         assert!((sweep_rad - 2.0 * PI).abs() < 1e-12);
         assert_eq!(m.point_at(1.0), p(10.0, 0.0));
+    }
+
+    #[test]
+    fn a_huge_radius_is_refused_not_nan() {
+        // `G02 X10 Y0 R1e300` from the origin: the centre is beyond any machine.
+        let e = arc_move(
+            Plane::Xy,
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            [None; 3],
+            Some(1e300),
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap_err();
+        assert_eq!(e.code(), ARC_RADIUS_RANGE);
+        // `I1000000000000000000`: a circle of 1e18 mm.
+        let e = arc_move(
+            Plane::Xy,
+            p(0.0, 0.0),
+            p(10.0, 0.0),
+            [Some(1e18), None, None],
+            None,
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap_err();
+        assert_eq!(e.code(), ARC_CENTER_RANGE);
+    }
+
+    #[test]
+    fn a_long_radius_over_a_short_chord_stays_a_short_arc() {
+        // 2e5 mm radius over a 1 µm chord: the two atan2 angles are equal in f64, which
+        // once made this a full circle of 1.3e6 mm.
+        let m = arc_move(
+            Plane::Xy,
+            p(0.0, 0.0),
+            p(0.001, 0.0),
+            [None; 3],
+            Some(200_000.0),
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        assert!(m.length_mm() < 0.0011, "{}", m.length_mm());
+        let e = arc_move(
+            Plane::Xy,
+            p(5.0, 5.0),
+            p(5.0, 5.0),
+            [None; 3],
+            Some(10.0),
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap_err();
+        assert_eq!(e.code(), ARC_FULL_CIRCLE_BY_RADIUS);
+    }
+
+    #[test]
+    fn extent_holds_the_quadrant_points_passed() {
+        // Half circle ccw from (10, 0) around the origin to (-10, 0): passes (0, 10).
+        let m = arc_move(
+            Plane::Xy,
+            p(10.0, 0.0),
+            p(-10.0, 0.0),
+            [Some(-10.0), Some(0.0), None],
+            None,
+            false,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        let (lo, hi) = extent(&m);
+        assert_eq!((lo[0], hi[0]), (-10.0, 10.0));
+        assert!(
+            (hi[1] - 10.0).abs() < 1e-12 && lo[1] == 0.0,
+            "{lo:?} {hi:?}"
+        );
+        // The same half clockwise passes (0, -10) instead.
+        let m = arc_move(
+            Plane::Xy,
+            p(10.0, 0.0),
+            p(-10.0, 0.0),
+            [Some(-10.0), Some(0.0), None],
+            None,
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        let (lo, hi) = extent(&m);
+        assert!(
+            (lo[1] + 10.0).abs() < 1e-12 && hi[1] == 0.0,
+            "{lo:?} {hi:?}"
+        );
+        // A full circle spans its whole box.
+        let m = arc_move(
+            Plane::Xy,
+            p(10.0, 0.0),
+            p(10.0, 0.0),
+            [Some(-10.0), Some(0.0), None],
+            None,
+            true,
+            100.0,
+            0.01,
+        )
+        .unwrap();
+        let (lo, hi) = extent(&m);
+        assert!((lo[0] + 10.0).abs() < 1e-12 && (hi[1] - 10.0).abs() < 1e-12);
+        assert!((lo[1] + 10.0).abs() < 1e-12 && hi[0] == 10.0);
     }
 }

@@ -4,37 +4,18 @@
 use super::*;
 
 impl Decoder {
+    /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
+    /// values it made count against this tick's declaration budget.
     pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
         let init = match &d.init {
             Some(e) => self.eval(e)?,
             None => 0.0,
         };
-        let total: u64 = d.dims.iter().map(|&n| n as u64).product::<u64>().max(1);
-        if d.dims.len() > 3 || total > 100_000 {
-            return Err(DecodeError::new(
-                codes::BAD_VALUE,
-                format!("array V.{}.{} too large", scope_letter(d.scope), d.name),
-            ));
-        }
-        let dims = d.dims.len() as u8;
-        for flat in 0..total {
-            let mut indices = [0i64; 3];
-            let mut rest = flat;
-            for k in (0..d.dims.len()).rev() {
-                let n = d.dims[k] as u64;
-                indices[k] = (rest % n) as i64;
-                rest /= n;
-            }
-            self.set_var(
-                VarSlot::V {
-                    scope: d.scope,
-                    name: d.name.as_str().into(),
-                    indices,
-                    dims,
-                },
-                init,
-            )?;
-        }
+        let made = self
+            .vars
+            .declare(d.scope, &d.name, &d.dims, init)
+            .map_err(var_error)?;
+        self.declared_this_tick += made;
         Ok(())
     }
 
@@ -248,15 +229,5 @@ impl Decoder {
                 Ok(Frame::new(kind, Source::Stream, name))
             }
         }
-    }
-}
-
-pub(super) fn scope_letter(s: crate::lang::block::VScope) -> char {
-    use crate::lang::block::VScope;
-    match s {
-        VScope::Program => 'P',
-        VScope::Local => 'L',
-        VScope::SelfRetaining => 'S',
-        VScope::External => 'E',
     }
 }

@@ -21,7 +21,7 @@ use std::time::Duration;
 
 use crate::lang::block::{Block, Body, Call, Command, FlushKind, Item, SplineCommand, Value};
 use crate::lang::codes;
-use crate::lang::{is_comment_end, parse_block, parse_var_declaration};
+use crate::lang::{is_comment_end, parse_block, parse_var_line, VarLine};
 use crate::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
 };
@@ -51,7 +51,32 @@ pub struct DecoderSettings {
     pub zero_offsets: ZeroOffsets,
     /// How far the end point may lie off the circle, mm.
     pub arc_tolerance_mm: f64,
+    /// Software limits per axis (runtime.toml `soft_limit_min_mm` / `soft_limit_max_mm`),
+    /// mm in machine coordinates, by `AXIS_LETTERS` index: a block whose end point or arc
+    /// lies outside is refused before it moves (21897).
+    pub soft_limits_mm: [SoftLimits; MAX_AXES],
 }
+
+/// One axis's software limits, mm (machine coordinates); unbounded by default.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SoftLimits {
+    pub min_mm: f64,
+    pub max_mm: f64,
+}
+
+impl Default for SoftLimits {
+    fn default() -> Self {
+        SoftLimits {
+            min_mm: f64::NEG_INFINITY,
+            max_mm: f64::INFINITY,
+        }
+    }
+}
+
+/// Values `#VAR` declarations may make in one tick before decoding waits for the next: a
+/// 100,000-element declaration costs ~0.1 ms to fill, so a tick does at most about two
+/// such, whatever the NC text (a line of ten took 15 s in one tick before).
+pub const DECLARED_VALUES_PER_TICK: usize = 100_000;
 
 impl Default for DecoderSettings {
     fn default() -> Self {
@@ -61,6 +86,7 @@ impl Default for DecoderSettings {
             axes: [true, true, true, false, false, false],
             zero_offsets: [[0.0; MAX_AXES]; 6],
             arc_tolerance_mm: 0.01,
+            soft_limits_mm: [SoftLimits::default(); MAX_AXES],
         }
     }
 }
@@ -218,6 +244,8 @@ pub struct Decoder {
     /// Channel time when the last simulated file-system read completes (runtime.toml
     /// `fs_latency_us`). Decoding does nothing before it; motion runs on meanwhile.
     ready_at: Duration,
+    /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
+    declared_this_tick: usize,
     line: String,
     notes: Vec<Note>,
     stats: DecoderStats,
@@ -243,6 +271,7 @@ impl Decoder {
             wait_idle: false,
             starved: false,
             ready_at: Duration::ZERO,
+            declared_this_tick: 0,
             line: String::new(),
             notes: Vec::new(),
             stats: DecoderStats::default(),
@@ -275,10 +304,6 @@ impl Decoder {
     }
     pub fn counter(&self) -> u64 {
         self.counter
-    }
-    /// Streaming mode: a stream frame is being decoded.
-    pub fn streaming(&self) -> bool {
-        self.stream_active
     }
     /// Waiting for stream data that has not arrived.
     pub fn starved(&self) -> bool {
@@ -377,7 +402,11 @@ impl Decoder {
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
         let mut budget = self.settings.blocks_per_tick;
         let tick_end = io.now + io.period;
+        self.declared_this_tick = 0;
         while budget > 0 && self.state == DecoderState::Running {
+            if self.declared_this_tick >= DECLARED_VALUES_PER_TICK {
+                break;
+            }
             let owed = io.store.take_owed();
             if !owed.is_zero() {
                 self.ready_at = self.ready_at.max(io.now) + owed;
@@ -479,6 +508,16 @@ impl Decoder {
             }
             return Ok(());
         }
+        if top.var_block {
+            // The lines of a `#VAR` block are declarations, read exactly as `check` reads
+            // them (`V.P.TABLE[10]` is no ordinary block).
+            match parse_var_line(text)? {
+                VarLine::Blank => {}
+                VarLine::End => top.var_block = false,
+                VarLine::Decl(d) => self.declare(&d)?,
+            }
+            return Ok(());
+        }
         let skipping = top.skip.is_some();
         let block = match parse_block(text) {
             Ok(b) => b,
@@ -486,20 +525,7 @@ impl Decoder {
             Err(_) if skipping => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        let top = self.top();
-        if top.var_block {
-            match block.body {
-                Body::Command(Command::EndVar) => top.var_block = false,
-                // Blank and comment-only lines declare nothing.
-                Body::Items(ref items) if items.is_empty() => {}
-                _ => {
-                    let d = parse_var_declaration(text)?;
-                    self.declare(&d)?;
-                }
-            }
-            return Ok(());
-        }
-        if top.is_stream() {
+        if self.top().is_stream() {
             stream_allows(&block)?;
         }
         if skipping {
@@ -535,9 +561,7 @@ impl Decoder {
     }
 
     fn set_var(&mut self, k: VarSlot, v: f64) -> Res {
-        self.vars
-            .set(k, v)
-            .map_err(|_| DecodeError::new(codes::TOO_MANY_VARIABLES, "too many variables"))
+        self.vars.set(k, v).map_err(var_error)
     }
 
     fn info(&self, block: &Block, text: &str, meta: LineMeta, io: &DecoderIo<'_>) -> BlockInfo {
@@ -628,9 +652,11 @@ impl Decoder {
 }
 
 /// A whole number written as a float (`G01` parses as 1.0).
-pub(crate) fn whole(v: f64) -> Option<u32> {
-    let r = v.round();
-    ((v - r).abs() < 1e-9 && (0.0..=u32::MAX as f64).contains(&r)).then_some(r as u32)
+pub(crate) use crate::lang::range::whole_u32 as whole;
+
+/// The variable store's refusal with its number (20967, 21928, 20974, 90005).
+fn var_error(e: vars::VarError) -> DecodeError {
+    DecodeError::new(e.code(), e.to_string())
 }
 
 /// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).

@@ -3,10 +3,22 @@
 //! Lifetimes follow ISG: V.P. and P are program-global and re-initialised at program start
 //! (streaming: at stream start), V.L. belong to a program level and are seen by its callees,
 //! V.S. survive reset, V.E. are written from outside (channel API, ADS).
+//!
+//! Memory is bounded per variable class in bytes, as ISG bounds it per class (TF5200
+//! diagnosis 20967 "Memory for variables limited", counted per class V.P., V.S., V.E., V.L.):
+//! a variable costs its name, 8 bytes a value and [`ENTRY_BYTES`] of bookkeeping. An array
+//! is one entry — its name once, its values in one block — so declaring 100,000 elements
+//! under a 3,900-character name costs 0.8 MB, not a copy of the name per element (which
+//! cost 395 MB and a 524 ms tick). V.S. survive resets, so their bound is what keeps a
+//! long-running channel from filling up over many programs.
 
 use std::collections::HashMap;
 
 use crate::lang::block::VScope;
+use crate::lang::codes::{
+    ARRAY_INDEX_RANGE, EVAL_UNDEFINED, MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, TOO_MANY_INDICES,
+    VARIABLE_MEMORY_FULL,
+};
 
 /// Array indices of a variable, evaluated. At most three dimensions, as ISG arrays have.
 pub type Indices = [i64; 3];
@@ -31,13 +43,145 @@ pub enum VarSlot {
 /// Most parameters in use are small plain numbers: keep those in a flat table.
 const FLAT_P: usize = 1024;
 
-/// Bound on variables of one kind, so a runaway program cannot eat the host's memory.
-pub const MAX_VARIABLES: usize = 1 << 20;
+/// Bytes each variable class may hold: names, values and [`ENTRY_BYTES`] per entry.
+/// 8 MiB is ten of the largest arrays a declaration may make (100,000 values, 0.8 MB);
+/// real programs use a few kilobytes.
+pub const CLASS_BYTES: usize = 8 << 20;
 
-#[derive(Debug, Clone, PartialEq)]
+/// Bookkeeping charged per entry besides its name and values: a hash-table slot (key and
+/// value, 56 bytes) and allocator headers, rounded.
+pub const ENTRY_BYTES: usize = 64;
+
+/// A variable class: each has its own [`CLASS_BYTES`] budget. ISG counts V.P., V.S., V.E.
+/// and V.L. (diagnosis 20967's class parameter); P parameters outside the flat table are a
+/// class of ours.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarClass {
+    P,
+    Program,
+    Local,
+    SelfRetaining,
+    External,
+}
+
+impl VarClass {
+    fn of(scope: VScope) -> Self {
+        match scope {
+            VScope::Program => VarClass::Program,
+            VScope::Local => VarClass::Local,
+            VScope::SelfRetaining => VarClass::SelfRetaining,
+            VScope::External => VarClass::External,
+        }
+    }
+
+    /// The class as a program writes it.
+    pub fn prefix(self) -> &'static str {
+        match self {
+            VarClass::P => "P",
+            VarClass::Program => "V.P.",
+            VarClass::Local => "V.L.",
+            VarClass::SelfRetaining => "V.S.",
+            VarClass::External => "V.E.",
+        }
+    }
+}
+
+/// Why the store refused a write.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum VarError {
-    Undefined(String),
-    TooMany,
+    #[error("memory for {} variables used up: {used} of {limit} bytes in use, {need} more needed", class.prefix())]
+    Full {
+        class: VarClass,
+        used: usize,
+        need: usize,
+        limit: usize,
+    },
+    #[error("{0}: index outside the declared array")]
+    OutOfRange(String),
+    #[error("{0} is not a declared array")]
+    NotDeclared(String),
+    #[error("{0}: an array has at most {MAX_ARRAY_DIMS} indices")]
+    TooManyIndices(String),
+}
+
+impl VarError {
+    /// 20967 memory used up, 21928 index outside the array, 20974 too many indices (TF5200
+    /// diagnosis list); an element of an undeclared array is undefined (90005).
+    pub fn code(&self) -> u32 {
+        match self {
+            VarError::Full { .. } => VARIABLE_MEMORY_FULL,
+            VarError::OutOfRange(_) => ARRAY_INDEX_RANGE,
+            VarError::NotDeclared(_) => EVAL_UNDEFINED,
+            VarError::TooManyIndices(_) => TOO_MANY_INDICES,
+        }
+    }
+}
+
+/// One V. variable: a scalar (no sizes, one value) or an array, its values row-major.
+#[derive(Debug, Clone)]
+struct Variable {
+    sizes: [u32; 3],
+    dims: u8,
+    values: Box<[f64]>,
+}
+
+impl Variable {
+    fn scalar(v: f64) -> Self {
+        Variable {
+            sizes: [0; 3],
+            dims: 0,
+            values: Box::new([v]),
+        }
+    }
+
+    /// Bytes this variable is charged under `name`.
+    fn bytes(&self, name: &str) -> usize {
+        cost(name, self.values.len())
+    }
+
+    /// The position of an element, if `indices` (of which `dims` count) lie in the array.
+    fn offset(&self, indices: &Indices, dims: u8) -> Option<usize> {
+        if dims != self.dims {
+            return None;
+        }
+        let mut at = 0usize;
+        for (&i, &n) in indices.iter().zip(&self.sizes).take(usize::from(dims)) {
+            let i = usize::try_from(i).ok().filter(|&i| i < n as usize)?;
+            at = at * n as usize + i;
+        }
+        Some(at)
+    }
+}
+
+/// Bytes a variable of `values` values under `name` is charged.
+fn cost(name: &str, values: usize) -> usize {
+    name.len() + values * std::mem::size_of::<f64>() + ENTRY_BYTES
+}
+
+/// The variables of one scope (or one V.L. level), with the bytes they are charged.
+#[derive(Debug, Default)]
+struct Scope {
+    vars: HashMap<Box<str>, Variable>,
+    bytes: usize,
+}
+
+impl Scope {
+    fn get(&self, name: &str, indices: &Indices, dims: u8) -> Option<f64> {
+        let var = self.vars.get(name)?;
+        var.offset(indices, dims).map(|at| var.values[at])
+    }
+
+    fn insert(&mut self, name: &str, var: Variable) {
+        self.bytes += var.bytes(name);
+        if let Some(old) = self.vars.insert(name.into(), var) {
+            self.bytes -= old.bytes(name);
+        }
+    }
+
+    fn clear(&mut self) {
+        self.vars.clear();
+        self.bytes = 0;
+    }
 }
 
 #[derive(Debug, Default)]
@@ -45,11 +189,11 @@ pub struct VarStore {
     /// P1..P1023 without indices; NaN = never assigned.
     p_flat: Vec<f64>,
     p_other: HashMap<VarSlot, f64>,
-    program: HashMap<VarSlot, f64>,
-    /// One map per program level, innermost last.
-    local: Vec<HashMap<VarSlot, f64>>,
-    self_retaining: HashMap<VarSlot, f64>,
-    external: HashMap<VarSlot, f64>,
+    program: Scope,
+    /// One scope per program level, innermost last.
+    local: Vec<Scope>,
+    self_retaining: Scope,
+    external: Scope,
     /// Cycle parameters per level (`@P`), innermost last.
     cycle: Vec<Vec<(u32, f64)>>,
 }
@@ -58,7 +202,7 @@ impl VarStore {
     pub fn new() -> Self {
         VarStore {
             p_flat: vec![f64::NAN; FLAT_P],
-            local: vec![HashMap::new()],
+            local: vec![Scope::default()],
             cycle: vec![Vec::new()],
             ..Default::default()
         }
@@ -70,7 +214,7 @@ impl VarStore {
         self.p_other.clear();
         self.program.clear();
         self.local.clear();
-        self.local.push(HashMap::new());
+        self.local.push(Scope::default());
         self.cycle.clear();
         self.cycle.push(Vec::new());
     }
@@ -82,7 +226,7 @@ impl VarStore {
 
     /// A subroutine or cycle level begins.
     pub fn push_level(&mut self, cycle_params: Vec<(u32, f64)>) {
-        self.local.push(HashMap::new());
+        self.local.push(Scope::default());
         self.cycle.push(cycle_params);
     }
 
@@ -93,12 +237,64 @@ impl VarStore {
         }
     }
 
+    /// Bytes the variables of `class` are charged now.
+    pub fn bytes(&self, class: VarClass) -> usize {
+        match class {
+            VarClass::P => self.p_other.len() * ENTRY_BYTES,
+            VarClass::Program => self.program.bytes,
+            VarClass::Local => self.local.iter().map(|s| s.bytes).sum(),
+            VarClass::SelfRetaining => self.self_retaining.bytes,
+            VarClass::External => self.external.bytes,
+        }
+    }
+
+    /// May `class` take `need` more bytes once `freed` bytes have gone?
+    fn charge(&self, class: VarClass, need: usize, freed: usize) -> Result<(), VarError> {
+        let used = self.bytes(class) - freed;
+        if used + need > CLASS_BYTES {
+            return Err(VarError::Full {
+                class,
+                used,
+                need,
+                limit: CLASS_BYTES,
+            });
+        }
+        Ok(())
+    }
+
     fn flat_index(k: &VarSlot) -> Option<usize> {
         match k {
             VarSlot::P {
                 number, dims: 0, ..
             } if (*number as usize) < FLAT_P => Some(*number as usize),
             _ => None,
+        }
+    }
+
+    /// The scope a V. variable of `scope` named `name` lives in: for V.L. the innermost
+    /// level that has it.
+    fn scope_of(&self, scope: VScope, name: &str) -> Option<&Scope> {
+        match scope {
+            VScope::Program => Some(&self.program),
+            VScope::Local => self.local.iter().rev().find(|s| s.vars.contains_key(name)),
+            VScope::SelfRetaining => Some(&self.self_retaining),
+            VScope::External => Some(&self.external),
+        }
+    }
+
+    /// The scope a new V. variable of `scope` goes into (V.L.: the current level).
+    fn scope_mut(&mut self, scope: VScope) -> &mut Scope {
+        match scope {
+            VScope::Program => &mut self.program,
+            VScope::Local => {
+                if self.local.is_empty() {
+                    self.local.push(Scope::default());
+                }
+                let last = self.local.len() - 1;
+                &mut self.local[last]
+            }
+            VScope::SelfRetaining => &mut self.self_retaining,
+            VScope::External => &mut self.external,
         }
     }
 
@@ -117,48 +313,129 @@ impl VarStore {
                     .find(|l| !l.is_empty())
                     .and_then(|l| l.iter().find(|(m, _)| m == n).map(|(_, v)| *v))
             }
-            VarSlot::V { scope, .. } => match scope {
-                VScope::Program => self.program.get(k).copied(),
-                VScope::Local => self.local.iter().rev().find_map(|m| m.get(k).copied()),
-                VScope::SelfRetaining => self.self_retaining.get(k).copied(),
-                VScope::External => self.external.get(k).copied(),
-            },
+            VarSlot::V {
+                scope,
+                name,
+                indices,
+                dims,
+            } => self.scope_of(*scope, name)?.get(name, indices, *dims),
         }
     }
 
+    /// Assign a value. A V. scalar not yet there is created (in its scope; V.L. in the
+    /// current level); an element needs its array declared, and its indices inside it.
     pub fn set(&mut self, k: VarSlot, v: f64) -> Result<(), VarError> {
         if let Some(i) = Self::flat_index(&k) {
             self.p_flat[i] = v;
             return Ok(());
         }
-        let map = match &k {
-            VarSlot::P { .. } => &mut self.p_other,
+        match k {
+            VarSlot::P { .. } => {
+                if !self.p_other.contains_key(&k) {
+                    self.charge(VarClass::P, ENTRY_BYTES, 0)?;
+                }
+                self.p_other.insert(k, v);
+                Ok(())
+            }
             VarSlot::CycleParam(n) => {
-                let n = *n;
-                let level = self.cycle.last_mut().ok_or(VarError::TooMany)?;
+                if self.cycle.is_empty() {
+                    self.cycle.push(Vec::new());
+                }
+                let last = self.cycle.len() - 1;
+                let level = &mut self.cycle[last];
                 match level.iter_mut().find(|(m, _)| *m == n) {
                     Some(slot) => slot.1 = v,
                     None => level.push((n, v)),
                 }
-                return Ok(());
+                Ok(())
             }
-            VarSlot::V { scope, .. } => match scope {
-                VScope::Program => &mut self.program,
-                VScope::Local => {
-                    // An existing V.L. of a caller is updated where it lives.
-                    let depth = self.local.iter().rposition(|m| m.contains_key(&k));
-                    let idx = depth.unwrap_or(self.local.len() - 1);
-                    &mut self.local[idx]
-                }
-                VScope::SelfRetaining => &mut self.self_retaining,
-                VScope::External => &mut self.external,
-            },
-        };
-        if map.len() >= MAX_VARIABLES && !map.contains_key(&k) {
-            return Err(VarError::TooMany);
+            VarSlot::V {
+                scope,
+                name,
+                indices,
+                dims,
+            } => self.set_v(scope, &name, &indices, dims, v),
         }
-        map.insert(k, v);
+    }
+
+    fn set_v(
+        &mut self,
+        scope: VScope,
+        name: &str,
+        indices: &Indices,
+        dims: u8,
+        v: f64,
+    ) -> Result<(), VarError> {
+        let existing = match scope {
+            VScope::Local => self.local.iter().rposition(|s| s.vars.contains_key(name)),
+            _ => self.scope_mut(scope).vars.contains_key(name).then_some(0),
+        };
+        if let Some(level) = existing {
+            let target = match scope {
+                VScope::Local => &mut self.local[level],
+                _ => self.scope_mut(scope),
+            };
+            let Some(var) = target.vars.get_mut(name) else {
+                return Err(VarError::NotDeclared(v_name(scope, name)));
+            };
+            let Some(at) = var.offset(indices, dims) else {
+                return Err(VarError::OutOfRange(element(scope, name, indices, dims)));
+            };
+            var.values[at] = v;
+            return Ok(());
+        }
+        if dims > 0 {
+            return Err(VarError::NotDeclared(v_name(scope, name)));
+        }
+        self.charge(VarClass::of(scope), cost(name, 1), 0)?;
+        self.scope_mut(scope).insert(name, Variable::scalar(v));
         Ok(())
+    }
+
+    /// `#VAR` declaration: `name` in `scope` with the array `sizes` (empty: a scalar), every
+    /// value `init`. A variable of that name in the same scope (V.L.: the same level) is
+    /// replaced. Returns the number of values made, so the decoder can spread the work of
+    /// large declarations over ticks.
+    pub fn declare(
+        &mut self,
+        scope: VScope,
+        name: &str,
+        sizes: &[u32],
+        init: f64,
+    ) -> Result<usize, VarError> {
+        if sizes.len() > MAX_ARRAY_DIMS {
+            return Err(VarError::TooManyIndices(v_name(scope, name)));
+        }
+        let class = VarClass::of(scope);
+        let elements = sizes
+            .iter()
+            .fold(1u64, |n, &s| n.saturating_mul(u64::from(s)));
+        if elements > MAX_ARRAY_ELEMENTS {
+            // The parser refuses such a declaration already; the store does not rely on it.
+            return Err(VarError::Full {
+                class,
+                used: self.bytes(class),
+                need: usize::try_from(elements)
+                    .unwrap_or(usize::MAX)
+                    .saturating_mul(std::mem::size_of::<f64>()),
+                limit: CLASS_BYTES,
+            });
+        }
+        let elements = elements as usize;
+        let freed = self
+            .scope_mut(scope)
+            .vars
+            .get(name)
+            .map_or(0, |old| old.bytes(name));
+        self.charge(class, cost(name, elements), freed)?;
+        let mut var = Variable {
+            sizes: [0; 3],
+            dims: sizes.len() as u8,
+            values: vec![init; elements].into_boxed_slice(),
+        };
+        var.sizes[..sizes.len()].copy_from_slice(sizes);
+        self.scope_mut(scope).insert(name, var);
+        Ok(elements)
     }
 
     /// V.E. written from outside the channel.
@@ -184,6 +461,18 @@ impl VarStore {
     }
 }
 
+fn v_name(scope: VScope, name: &str) -> String {
+    format!("V.{}.{name}", scope.letter())
+}
+
+fn element(scope: VScope, name: &str, indices: &Indices, dims: u8) -> String {
+    let mut s = v_name(scope, name);
+    for i in &indices[..usize::from(dims).min(3)] {
+        s.push_str(&format!("[{i}]"));
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +490,16 @@ mod tests {
             name: name.into(),
             indices: [0; 3],
             dims: 0,
+        }
+    }
+    fn el(scope: VScope, name: &str, indices: &[i64]) -> VarSlot {
+        let mut i = [0; 3];
+        i[..indices.len()].copy_from_slice(indices);
+        VarSlot::V {
+            scope,
+            name: name.into(),
+            indices: i,
+            dims: indices.len() as u8,
         }
     }
 
@@ -229,9 +528,118 @@ mod tests {
         assert_eq!(s.get(&VarSlot::CycleParam(1)), Some(5.0));
         s.set(v(VScope::Local, "B"), 2.0).unwrap();
         s.set(v(VScope::Local, "A"), 3.0).unwrap();
+        let inner = s.bytes(VarClass::Local);
         s.pop_level();
+        assert!(
+            s.bytes(VarClass::Local) < inner,
+            "B's bytes go with its level"
+        );
         assert_eq!(s.get(&v(VScope::Local, "B")), None);
         assert_eq!(s.get(&v(VScope::Local, "A")), Some(3.0));
         assert_eq!(s.get(&VarSlot::CycleParam(1)), None);
+    }
+
+    #[test]
+    fn an_array_is_one_entry_with_its_name_once() {
+        let mut s = VarStore::new();
+        let name = "N".repeat(3900);
+        assert_eq!(
+            s.declare(VScope::Local, &name, &[100_000], 0.5),
+            Ok(100_000)
+        );
+        assert_eq!(
+            s.bytes(VarClass::Local),
+            3900 + 800_000 + ENTRY_BYTES,
+            "charged once for the name, 8 bytes a value"
+        );
+        assert_eq!(s.get(&el(VScope::Local, &name, &[99_999])), Some(0.5));
+        assert_eq!(s.get(&el(VScope::Local, &name, &[100_000])), None);
+        s.set(el(VScope::Local, &name, &[7]), 2.0).unwrap();
+        assert_eq!(s.get(&el(VScope::Local, &name, &[7])), Some(2.0));
+        let e = s
+            .set(el(VScope::Local, &name, &[100_000]), 1.0)
+            .unwrap_err();
+        assert_eq!(e.code(), ARRAY_INDEX_RANGE);
+        // Indexed as a matrix, or not at all: outside the declared shape.
+        assert_eq!(s.get(&el(VScope::Local, &name, &[0, 0])), None);
+        assert_eq!(s.get(&v(VScope::Local, &name)), None);
+    }
+
+    #[test]
+    fn row_major_elements_of_a_matrix() {
+        let mut s = VarStore::new();
+        s.declare(VScope::Program, "GRID", &[3, 4], 0.0).unwrap();
+        for i in 0..3 {
+            for j in 0..4 {
+                s.set(el(VScope::Program, "GRID", &[i, j]), (i * 10 + j) as f64)
+                    .unwrap();
+            }
+        }
+        assert_eq!(s.get(&el(VScope::Program, "GRID", &[2, 3])), Some(23.0));
+        assert_eq!(s.get(&el(VScope::Program, "GRID", &[1, 0])), Some(10.0));
+        assert_eq!(s.get(&el(VScope::Program, "GRID", &[3, 0])), None);
+    }
+
+    #[test]
+    fn an_element_of_an_undeclared_array_is_refused() {
+        let mut s = VarStore::new();
+        let e = s.set(el(VScope::Local, "NOPE", &[2]), 1.0).unwrap_err();
+        assert_eq!(e.code(), EVAL_UNDEFINED);
+    }
+
+    #[test]
+    fn each_class_is_bounded_in_bytes_and_redeclaring_does_not_grow() {
+        let mut s = VarStore::new();
+        // Redeclaring one name a thousand times replaces it: the bytes stay.
+        for _ in 0..1000 {
+            s.declare(VScope::SelfRetaining, "A", &[100_000], 0.0)
+                .unwrap();
+        }
+        assert_eq!(s.bytes(VarClass::SelfRetaining), cost("A", 100_000));
+        // Ten distinct arrays fit, the eleventh does not: 20967 with the figures.
+        let mut full = None;
+        for k in 0..20 {
+            if let Err(e) = s.declare(VScope::SelfRetaining, &format!("B{k}"), &[100_000], 0.0) {
+                full = Some((k, e));
+                break;
+            }
+        }
+        let (k, e) = full.expect("the V.S. budget refused a declaration");
+        assert!(k >= 9, "only {k} arrays fitted");
+        assert_eq!(e.code(), VARIABLE_MEMORY_FULL);
+        assert!(s.bytes(VarClass::SelfRetaining) <= CLASS_BYTES);
+        // V.S. survive a reset, so the budget is what bounds them across programs.
+        s.reset();
+        assert!(s.bytes(VarClass::SelfRetaining) > CLASS_BYTES / 2);
+        // Other classes have their own budget.
+        assert!(s.declare(VScope::Program, "C", &[100_000], 0.0).is_ok());
+    }
+
+    #[test]
+    fn scalars_and_p_parameters_are_bounded_too() {
+        let mut s = VarStore::new();
+        let long = "L".repeat(3900);
+        let mut refused = None;
+        for k in 0..10_000 {
+            if let Err(e) = s.set(v(VScope::External, &format!("{long}{k}")), 1.0) {
+                refused = Some(e);
+                break;
+            }
+        }
+        assert_eq!(refused.map(|e| e.code()), Some(VARIABLE_MEMORY_FULL));
+        let mut refused = None;
+        for n in 0..1_000_000 {
+            let k = VarSlot::P {
+                number: 5000 + n,
+                indices: [0; 3],
+                dims: 0,
+            };
+            if let Err(e) = s.set(k, 1.0) {
+                refused = Some(e);
+                break;
+            }
+        }
+        assert_eq!(refused.map(|e| e.code()), Some(VARIABLE_MEMORY_FULL));
+        assert!(s.bytes(VarClass::P) <= CLASS_BYTES);
     }
 }

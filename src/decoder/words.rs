@@ -11,6 +11,11 @@
 use super::modal::FeedMode;
 use super::*;
 
+/// How far a computed position may pass a software limit by rounding alone, mm: an arc's
+/// quadrant point computed as centre + radius may lie 1e-13 mm beyond an end point exactly
+/// on the limit, which is allowed (moving *to* a limit is). Far below the 0.1 µm resolution.
+const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
+
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
 /// G functions one block may hold (a CAM header writes six or seven).
@@ -130,6 +135,7 @@ impl Decoder {
             self.set_reference(w);
         } else if let Some(end) = self.target(w, gs) {
             let mut mv = self.motion(w, end)?;
+            self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
             self.modal.pos = end;
             self.emit(info.clone(), Action::Move(mv), false, io);
@@ -170,32 +176,27 @@ impl Decoder {
     }
 
     fn collect_word(&mut self, letter: u8, v: f64, col: u32, w: &mut Words) -> Res {
+        if !matches!(letter, b'G' | b'M' | b'H') {
+            // The parser's range check, again for values computed from expressions.
+            crate::lang::range::word_value(letter, v)
+                .map_err(|e| DecodeError::new(e.code, e.message))?;
+        }
         match letter {
             // The parser takes G, M and H as literal whole numbers only.
             b'G' => w.push_g(whole(v).unwrap_or(u32::MAX), col)?,
             b'M' => push_function(&mut w.ms, &mut w.n_ms, v, 'M')?,
             b'H' => push_function(&mut w.hs, &mut w.n_hs, v, 'H')?,
-            b'F' => {
-                if !(v >= 0.0 && v.is_finite()) {
-                    return Err(DecodeError::new(
-                        codes::BAD_VALUE,
-                        format!("feed F{v} out of range"),
-                    ));
-                }
-                w.feed = Some((v, col));
-            }
+            b'F' => w.feed = Some((v, col)),
             b'S' => w.spindle_rpm = Some(v),
-            b'T' => w.tool = Some(whole(v).unwrap_or(0)),
-            b'D' => w.tool_offset = Some(whole(v).unwrap_or(0)),
+            // Whole numbers: the range check above refused anything else.
+            b'T' => w.tool = whole(v),
+            b'D' => w.tool_offset = whole(v),
             b'I' => w.ijk[0] = Some(v),
             b'J' => w.ijk[1] = Some(v),
             b'K' => w.ijk[2] = Some(v),
             b'R' => w.radius = Some(v),
             letter => {
                 if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == letter) {
-                    if !v.is_finite() {
-                        return Err(DecodeError::new(codes::BAD_VALUE, "axis value not finite"));
-                    }
                     if !self.settings.axes[i] {
                         if letter != b'X' {
                             return Err(unconfigured(letter));
@@ -372,7 +373,41 @@ impl Decoder {
             feed,
             self.settings.arc_tolerance_mm,
         )
-        .map_err(|e| DecodeError::new(codes::ARC_INCONSISTENT, format!("circle: {e}")))
+        .map_err(|e| DecodeError::new(e.code(), e.to_string()))
+    }
+
+    /// Software limits: every axis's end point, and for an arc every point of the arc in
+    /// its plane, inside `[min, max]` of runtime.toml, or the block is refused before any
+    /// of it moves — as a real kernel checks set positions in path preparation.
+    fn within_soft_limits(&self, mv: &Move) -> Res {
+        let (lo, hi) = arc::extent(mv);
+        for (i, limits) in self.settings.soft_limits_mm.iter().enumerate() {
+            if !self.settings.axes[i] {
+                continue;
+            }
+            let (value, bound) = if lo[i] < limits.min_mm - SOFT_LIMIT_SLACK_MM {
+                (lo[i], "below the lower")
+            } else if hi[i] > limits.max_mm + SOFT_LIMIT_SLACK_MM {
+                (hi[i], "above the upper")
+            } else {
+                continue;
+            };
+            let reach = if matches!(mv.kind, MoveKind::Arc { .. }) && value != mv.end[i] {
+                "arc reaches"
+            } else {
+                "end point"
+            };
+            return Err(DecodeError::new(
+                codes::SOFT_LIMIT,
+                format!(
+                    "axis {} {reach} {value} mm, {bound} software limit (limits {} to {} mm)",
+                    char::from(AXIS_LETTERS[i]),
+                    limits.min_mm,
+                    limits.max_mm
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Step 5: H functions are reported; M17/M29 return, M2/M30 end the program; a block

@@ -10,7 +10,12 @@ use std::collections::{HashMap, HashSet};
 
 use super::block::{Body, Command, Control, GotoTarget, Label};
 use super::codes::{StrayKind, LABEL_NOT_FOUND, LABEL_TWICE, OPEN_CONTROL_BLOCK, SYNTAX};
-use super::parse::{is_blank_line, is_comment_end, parse_block, parse_var_declaration};
+use super::parse::{is_comment_end, parse_block, parse_var_line, VarLine};
+
+/// Most findings one check lists. A file of garbage (a binary, a log passed by mistake) has
+/// one finding a line; listing millions of them helps nobody and cost gigabytes, so the
+/// first ones (in reading order) are kept and the rest only counted.
+pub const MAX_PROGRAM_DIAGS: usize = 1000;
 
 /// One finding in a program: 1-based line and character column, ISG error number, message.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -28,6 +33,22 @@ impl ProgramDiag {
             col,
             code,
             message: message.into(),
+        }
+    }
+}
+
+/// The findings of one check: the first [`MAX_PROGRAM_DIAGS`] kept, all counted.
+#[derive(Default)]
+struct Diags {
+    kept: Vec<ProgramDiag>,
+    found: usize,
+}
+
+impl Diags {
+    fn push(&mut self, d: ProgramDiag) {
+        self.found += 1;
+        if self.kept.len() < MAX_PROGRAM_DIAGS {
+            self.kept.push(d);
         }
     }
 }
@@ -84,7 +105,7 @@ struct Level {
 }
 
 impl Level {
-    fn finish(self, diags: &mut Vec<ProgramDiag>) {
+    fn finish(self, diags: &mut Diags) {
         for (kind, line, col) in self.open {
             diags.push(ProgramDiag::new(
                 line,
@@ -120,7 +141,7 @@ impl Level {
         }
     }
 
-    fn stray(&self, kind: StrayKind, line: usize, col: usize, diags: &mut Vec<ProgramDiag>) {
+    fn stray(&self, kind: StrayKind, line: usize, col: usize, diags: &mut Diags) {
         diags.push(ProgramDiag::new(
             line,
             col,
@@ -132,9 +153,9 @@ impl Level {
         ));
     }
 
-    fn control(&mut self, c: &Control, line: usize, col: usize, diags: &mut Vec<ProgramDiag>) {
+    fn control(&mut self, c: &Control, line: usize, col: usize, diags: &mut Diags) {
         let top = self.open.last().map(|o| o.0);
-        let pop_if = |me: &mut Self, want: fn(OpenKind) -> bool, kind, diags: &mut Vec<_>| {
+        let pop_if = |me: &mut Self, want: fn(OpenKind) -> bool, kind, diags: &mut Diags| {
             if top.is_some_and(want) {
                 me.open.pop();
             } else {
@@ -209,9 +230,16 @@ fn col_of(line: &str, needle: &str) -> usize {
         .map_or(1, |b| line[..b].chars().count() + 1)
 }
 
-/// Check a whole program text. Diagnostics come sorted by line and column.
+/// Check a whole program text. Diagnostics come sorted by line and column; at most
+/// [`MAX_PROGRAM_DIAGS`] of them ([`check_program_counted`] also says how many there were).
 pub fn check_program(text: &str) -> Vec<ProgramDiag> {
-    let mut diags = Vec::new();
+    check_program_counted(text).0
+}
+
+/// [`check_program`], and the number of findings in all (more than the list holds when the
+/// list was cut at [`MAX_PROGRAM_DIAGS`]).
+pub fn check_program_counted(text: &str) -> (Vec<ProgramDiag>, usize) {
+    let mut diags = Diags::default();
     let mut level = Level::default();
     let mut comment_from: Option<usize> = None;
     let mut var_from: Option<(usize, usize)> = None;
@@ -224,17 +252,11 @@ pub fn check_program(text: &str) -> Vec<ProgramDiag> {
             continue;
         }
         if var_from.is_some() {
-            if is_blank_line(raw) {
-                continue;
-            }
-            if let Ok(b) = parse_block(raw) {
-                if b.body == Body::Command(Command::EndVar) {
-                    var_from = None;
-                    continue;
-                }
-            }
-            if let Err(e) = parse_var_declaration(raw) {
-                diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message));
+            // The decoder reads these lines with the same function.
+            match parse_var_line(raw) {
+                Ok(VarLine::End) => var_from = None,
+                Ok(VarLine::Blank | VarLine::Decl(_)) => {}
+                Err(e) => diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message)),
             }
             continue;
         }
@@ -303,6 +325,7 @@ pub fn check_program(text: &str) -> Vec<ProgramDiag> {
             "#VAR not closed by #ENDVAR before the program ends",
         ));
     }
-    diags.sort_by_key(|d| (d.line, d.col));
-    diags
+    let Diags { mut kept, found } = diags;
+    kept.sort_by_key(|d| (d.line, d.col));
+    (kept, found)
 }

@@ -11,6 +11,14 @@
 
 /// Warning: error writing the object (stream buffer full, write rejected).
 pub const WRITE_REJECTED: u32 = 11012;
+/// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis 20020).
+pub const ARC_CENTER_RANGE: u32 = 20020;
+/// A full circle programmed with a radius: start and end point coincide, so R leaves the
+/// centre undetermined (TF5200 diagnosis 20034).
+pub const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
+/// The centre computed from R lies outside the data format (TF5200 diagnosis 20054, whose
+/// example is `G02 X1 R1000000`).
+pub const ARC_RADIUS_RANGE: u32 = 20054;
 /// Unknown G function.
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function.
@@ -34,6 +42,11 @@ pub const OPEN_CONTROL_BLOCK: u32 = 20375;
 pub const UNEXPECTED_SUB_END: u32 = 20376;
 /// M30/M02 inside a subroutine (a warning: the program ends).
 pub const UNEXPECTED_PROGRAM_END: u32 = 20377;
+/// Memory for variables of one class (V.P., V.L., V.S., V.E.; ours adds P) used up: a
+/// declaration or a new variable does not fit (TF5200 diagnosis 20967).
+pub const VARIABLE_MEMORY_FULL: u32 = 20967;
+/// An array with more indices than variables have (TF5200 diagnosis 20974).
+pub const TOO_MANY_INDICES: u32 = 20974;
 /// Label defined twice in one program level.
 pub const LABEL_TWICE: u32 = 20836;
 /// `$GOTO` target not found.
@@ -46,6 +59,10 @@ pub const STREAM_BACKWARD_JUMP: u32 = 21477;
 pub const STREAM_LOOP: u32 = 21478;
 /// Local subroutine call (LL) in a streaming program.
 pub const STREAM_LOCAL_CALL: u32 = 21479;
+/// An axis end point (or an arc's extent) outside the axis's software limits: the block is
+/// refused before it moves (TF5200 diagnosis 21897 "Axis position is out of permissible
+/// value range", with the axis, the value and both limits).
+pub const SOFT_LIMIT: u32 = 21897;
 /// Block search target not found.
 pub const SEARCH_NOT_FOUND: u32 = 21532;
 /// Invalid `#CACHE` programming.
@@ -60,6 +77,8 @@ pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
 pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
 /// `#FLUSH` while a cross-block function (TRC, contouring, spline, HSC) is active.
 pub const FLUSH_CROSS_BLOCK: u32 = 21909;
+/// An array index outside the declared array (TF5200 diagnosis 21928).
+pub const ARRAY_INDEX_RANGE: u32 = 21928;
 
 // ---- Our numbers (no ISG number known) ---------------------------------------------------
 
@@ -108,13 +127,6 @@ pub const WORD_TWICE: u32 = 90135;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
 /// elements do not meet, no tool data for the D word, or compensation outside G17.
 pub const TRC_IMPOSSIBLE: u32 = 90140;
-/// A programmed move leaves an axis' software limits (runtime.toml `soft_limit_min_mm` /
-/// `soft_limit_max_mm`, the kernel's P-AXIS-00177 / P-AXIS-00178): refused in path
-/// preparation, before the move starts, as the kernel's default behaviour ERROR
-/// (P-AXIS-00554) does. ISG's own number for this is not public.
-pub const SOFT_LIMIT: u32 = 90141;
-/// More variables than the store holds.
-pub const TOO_MANY_VARIABLES: u32 = 90152;
 /// `#CACHE` while the file cache is disabled.
 pub const CACHE_NOT_ENABLED: u32 = 90160;
 
@@ -124,6 +136,19 @@ pub const MAX_BLOCK_CHARS: usize = 4000;
 /// Deepest nesting of brackets, unary operators, powers and function calls in one
 /// expression. Bounds the parser's recursion so hostile input cannot overflow the stack.
 pub const MAX_EXPR_NESTING: u32 = 64;
+
+/// Largest coordinate a word may carry, mm (or program units): ISG keeps positions in
+/// 0.1 µm as signed 32-bit numbers, so ±214,748.3647 mm is the data format the TF5200
+/// diagnoses 20020 and 20054 speak of. I, J, K beyond it are 20020, R beyond it 20054.
+pub const MAX_COORD_MM: f64 = 214_748.364_7;
+
+/// Most elements one `#VAR` array may have. A bigger declaration is refused at parse time
+/// (20967), so `check` and the decoder agree; together with the per-class byte budgets of
+/// the decoder's variable store it bounds what one line can allocate.
+pub const MAX_ARRAY_ELEMENTS: u64 = 100_000;
+
+/// Most indices (dimensions) of an array variable, as ISG arrays have (20974 beyond).
+pub const MAX_ARRAY_DIMS: usize = 3;
 
 /// Highest expression tree (operators on the longest path from root to a leaf). Bounds the
 /// recursion of evaluating, printing and dropping a tree; a flat chain `1+1+…` of more than

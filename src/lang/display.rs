@@ -1,9 +1,16 @@
 //! Canonical NC text for a parsed block: what the parser reads back to an equal `Block`.
 //!
-//! Canonical means: single blanks between items, keywords and names upper-case, every binary
-//! operation bracketed (`[[P1 + 2] * 3]`), numbers in their shortest round-trip form without
-//! exponent (`0.1`, `-6.789`, `3000`), `G134 50` printed as `G134=50`, `/1` as `/`.
+//! Canonical means: single blanks between items, keywords and names upper-case, brackets
+//! only where precedence or associativity needs them (`[P1 + 2] * 3`, `P1 - [P2 - P3]`, word
+//! values and indices always in their `[ ]`), numbers in their shortest round-trip form
+//! without exponent (`0.1`, `-6.789`, `3000`), `G134 50` printed as `G134=50`, `/1` as `/`.
 //! Non-finite numbers (which the parser never produces) print as Rust does and do not parse.
+//!
+//! Minimal brackets matter beyond looks: every bracket is a nesting level the parser counts
+//! against `MAX_EXPR_NESTING`, so a printer that bracketed every operation turned a long flat
+//! chain the parser had accepted (`P1 >= 3 > 0 <= 0 …`) into text it refuses. The printed
+//! text needs a bracket only where the parsed text had one (or a unary `+`), so it nests no
+//! deeper than what was read.
 
 use std::fmt::{self, Display, Formatter, Write};
 
@@ -111,15 +118,45 @@ impl Display for Num {
     }
 }
 
-/// An expression that must be inside `[ ]` (word values, indices): binary operations carry
-/// their own brackets, everything else gets one pair.
+/// An expression that must be inside `[ ]` (word values, indices, `P[…]`).
 struct Bracketed<'e>(&'e Expr);
 
 impl Display for Bracketed<'_> {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            Expr::Binary(..) => self.0.fmt(f),
-            e => write!(f, "[{e}]"),
+        write!(f, "[{}]", self.0)
+    }
+}
+
+/// How tightly the top of an expression binds as the parser reads it back (higher binds
+/// tighter): binary levels 0 (`||`) to 8 (`* / MOD`), then unary operators, then `**`, then
+/// an operand. A negative literal counts as unary: `-5 ** 2` reads as `-[5 ** 2]`.
+fn strength(e: &Expr) -> u8 {
+    match e {
+        Expr::Num(v) if v.is_sign_negative() => UNARY,
+        Expr::Num(_) | Expr::Var(_) | Expr::Func(..) => OPERAND,
+        Expr::Unary(..) => UNARY,
+        Expr::Binary(BinOp::Pow, ..) => POWER,
+        Expr::Binary(op, ..) => op.level(),
+    }
+}
+
+/// Strength of unary `-`, `NOT`, `INV` (above every binary level).
+const UNARY: u8 = 9;
+/// Strength of `**`: its base is an operand, its exponent a unary expression.
+const POWER: u8 = 10;
+/// Strength of a literal, variable, function call or bracketed expression.
+const OPERAND: u8 = 11;
+
+/// `e` where the parser expects an expression of strength `min` or tighter: bracketed when
+/// it binds looser.
+struct At<'e>(&'e Expr, u8);
+
+impl Display for At<'_> {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        if strength(self.0) < self.1 {
+            write!(f, "[{}]", self.0)
+        } else {
+            self.0.fmt(f)
         }
     }
 }
@@ -138,18 +175,19 @@ impl Display for Expr {
                 match (op, e.as_ref()) {
                     // `-2` would read back as the literal -2, not as negation of 2.
                     (UnOp::Neg, Expr::Num(v)) if !v.is_sign_negative() => write!(f, "[{e}]"),
-                    _ => e.fmt(f),
+                    _ => At(e, UNARY).fmt(f),
                 }
             }
+            // `**` is right-associative and binds tighter than unary minus: the base is an
+            // operand (`[-2] ** 2`, `[2 ** 3] ** 2`), the exponent may be unary (`2 ** -1`).
+            Expr::Binary(BinOp::Pow, a, b) => {
+                write!(f, "{} ** {}", At(a, OPERAND), At(b, UNARY))
+            }
+            // Left-associative: the left operand may be of the same level, the right one
+            // must bind tighter (`P1 - [P2 - P3]`).
             Expr::Binary(op, a, b) => {
-                f.write_char('[')?;
-                match (op, a.as_ref()) {
-                    // `**` binds tighter than unary minus: `-2 ** 2` is `-[2 ** 2]`.
-                    (BinOp::Pow, Expr::Unary(..)) => write!(f, "[{a}]")?,
-                    (BinOp::Pow, Expr::Num(v)) if v.is_sign_negative() => write!(f, "[{a}]")?,
-                    _ => a.fmt(f)?,
-                }
-                write!(f, " {} {b}]", op.symbol())
+                let level = op.level();
+                write!(f, "{} {} {}", At(a, level), op.symbol(), At(b, level + 1))
             }
             Expr::Func(func, args) => {
                 f.write_str(func.name())?;

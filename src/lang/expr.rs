@@ -31,7 +31,7 @@ use nom::IResult;
 use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
 use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX};
 use super::error::SyntaxError;
-use super::number::scan_unsigned;
+use super::number::{scan_unsigned, TOO_LARGE};
 
 /// The parser's internal error: where, which ISG number, what.
 #[derive(Debug, Clone, PartialEq)]
@@ -346,6 +346,7 @@ impl<'a> Ctx<'a> {
         match b {
             b'[' => self.bracketed(i),
             b'0'..=b'9' | b'.' => match scan_unsigned(i.as_bytes()) {
+                Some((v, _)) if !v.is_finite() => fail(i, SYNTAX, TOO_LARGE),
                 Some((v, n)) => {
                     self.height.set(0);
                     Ok((&i[n..], Expr::Num(v)))
@@ -606,6 +607,26 @@ fn binary_op(lvl: usize, i: &str) -> Option<(BinOp, usize)> {
     }
 }
 
+impl BinOp {
+    /// The operator's precedence level as [`binary_op`] reads it: 0 (`||`) binds loosest, 8
+    /// (`* / MOD`) tightest; `**` is 10, above the unary operators' 9 (module table). The
+    /// canonical printer brackets by these levels, so they are spelled once, here.
+    pub(crate) fn level(self) -> u8 {
+        match self {
+            BinOp::Or => 0,
+            BinOp::Xor => 1,
+            BinOp::And => 2,
+            BinOp::BitOr => 3,
+            BinOp::BitXor => 4,
+            BinOp::BitAnd => 5,
+            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge => 6,
+            BinOp::Add | BinOp::Sub => 7,
+            BinOp::Mul | BinOp::Div | BinOp::Mod => 8,
+            BinOp::Pow => 10,
+        }
+    }
+}
+
 impl Func {
     /// Number of arguments: ATAN2 takes two, every other function one.
     pub fn arity(self) -> usize {
@@ -679,4 +700,26 @@ pub fn parse_expr(text: &str) -> Result<Expr, SyntaxError> {
         ));
     }
     Ok(e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The printer's levels are the parser's: every operator is found at its own level.
+    #[test]
+    fn operator_levels_match_the_parser() {
+        use BinOp::*;
+        for op in [
+            Or, Xor, And, BitOr, BitXor, BitAnd, Eq, Ne, Lt, Gt, Le, Ge, Add, Sub, Mul, Div, Mod,
+        ] {
+            let text = format!("{} 1", op.symbol());
+            let found = binary_op(usize::from(op.level()), &text).map(|(o, _)| o);
+            assert_eq!(found, Some(op), "{op:?} at level {}", op.level());
+            assert_eq!(
+                any_binary_op(&text).map(|(o, _, l)| (o, l)),
+                Some((op, usize::from(op.level())))
+            );
+        }
+    }
 }

@@ -15,10 +15,13 @@ pub mod eval;
 pub mod expr;
 mod number;
 pub mod parse;
+pub mod range;
 
 pub use block::*;
-pub use check::{check_program, ProgramDiag};
+pub use check::{check_program, check_program_counted, ProgramDiag, MAX_PROGRAM_DIAGS};
 pub use error::SyntaxError;
 pub use eval::{case_matches, eval, is_true, resolve, EvalError, VarKey, Vars};
 pub use expr::parse_expr;
-pub use parse::{is_blank_line, is_comment_end, parse_block, parse_var_declaration};
+pub use parse::{
+    is_blank_line, is_comment_end, parse_block, parse_var_declaration, parse_var_line, VarLine,
+};

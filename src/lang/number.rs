@@ -5,6 +5,11 @@
 //! an exact power of ten is correctly rounded), anything longer by the standard library; both
 //! give the same, correctly rounded `f64`.
 
+/// Why a literal beyond the largest `f64` (more than 308 digits before the point) is
+/// refused: it would read as infinity, which no word may carry and the canonical text
+/// cannot print back. Error 20200 at the literal.
+pub const TOO_LARGE: &str = "number too large (beyond 1.8e308)";
+
 /// Exact powers of ten representable in an `f64`.
 const POW10: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,

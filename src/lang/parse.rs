@@ -14,13 +14,15 @@ use super::block::{
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
-    DWELL_NOT_ALONE, G_WITH_VALUE, MAX_BLOCK_CHARS, SYNTAX, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M,
-    UNSUPPORTED, WORD_TWICE,
+    DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, SYNTAX,
+    TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    WORD_TWICE,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
 use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
-use super::number::scan_unsigned;
+use super::number::{scan_unsigned, TOO_LARGE};
+use super::range::word_value;
 
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
 /// line, or more than 4000 characters, is error 20200.
@@ -65,6 +67,41 @@ pub fn parse_var_declaration(line: &str) -> Result<VarDecl, SyntaxError> {
     let (line, ascii) = checked_line(line)?;
     let ctx = Ctx::with_ascii(line, ascii);
     var_decl(&ctx, line).map_err(|e| ctx.to_error(e))
+}
+
+/// One line between `#VAR` and `#ENDVAR`, as the static check and the decoder both read it:
+/// so a declaration `check` accepts is one a run accepts, and the other way round.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VarLine {
+    /// Empty or a comment only: declares nothing.
+    Blank,
+    /// `#ENDVAR` (optionally after a block number): the block ends.
+    End,
+    /// A declaration, validated (at most three sizes, at most `MAX_ARRAY_ELEMENTS` elements).
+    Decl(VarDecl),
+}
+
+/// Read one line inside a `#VAR` block.
+pub fn parse_var_line(line: &str) -> Result<VarLine, SyntaxError> {
+    if is_blank_line(line) {
+        return Ok(VarLine::Blank);
+    }
+    if is_var_end(line) {
+        return Ok(VarLine::End);
+    }
+    parse_var_declaration(line).map(VarLine::Decl)
+}
+
+/// Is this line `#ENDVAR`, after an optional block skip, number and label?
+fn is_var_end(line: &str) -> bool {
+    let line = strip_line_end(line);
+    let Ok((i, _)) = prefix(ws(line)) else {
+        return false;
+    };
+    let Some(i) = gap(i).strip_prefix('#') else {
+        return false;
+    };
+    keyword(i, "ENDVAR").is_some_and(|r| gap(r).is_empty())
 }
 
 /// Strip one trailing CR LF, LF or CR.
@@ -391,6 +428,9 @@ fn word<'a>(
     let Some((mag, n)) = scan_unsigned(&ab[skip..]) else {
         return Err(perr(after, SYNTAX, word_value_msg(up)));
     };
+    if !mag.is_finite() {
+        return Err(perr(&after[skip..], SYNTAX, TOO_LARGE));
+    }
     let v = if neg { -mag } else { mag };
     let rest = &after[skip + n..];
     match up {
@@ -418,7 +458,11 @@ fn word<'a>(
                 format!("H function H{v} outside 0 to 65535"),
             ));
         }
-        _ => {}
+        _ => {
+            if let Err(e) = word_value(up, v) {
+                return Err(perr(i, e.code, e.message));
+            }
+        }
     }
     items.push(Item::Word(Word {
         letter: up,
@@ -499,6 +543,9 @@ fn g_value<'a>(
     if dwell_p {
         if let Some(p) = j.strip_prefix(['P', 'p']) {
             if let Some((v, n)) = scan_unsigned(p.as_bytes()) {
+                if !v.is_finite() {
+                    return Err(perr(p, SYNTAX, TOO_LARGE));
+                }
                 return Ok(Some((&p[n..], Value::Num(v))));
             }
         }
@@ -514,6 +561,7 @@ fn g_value<'a>(
         return Ok(None);
     }
     match scan_unsigned(&jb[k..]) {
+        Some((v, _)) if !v.is_finite() => Err(perr(&j[k..], SYNTAX, TOO_LARGE)),
         Some((v, n)) => Ok(Some((&j[k + n..], Value::Num(if neg { -v } else { v })))),
         None => Ok(None),
     }
@@ -1007,20 +1055,45 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             "V.E. variables are not declared in programs",
         ));
     }
+    if indices.len() > MAX_ARRAY_DIMS {
+        return Err(perr(
+            i,
+            TOO_MANY_INDICES,
+            format!(
+                "{} indices declared: an array has at most {MAX_ARRAY_DIMS}",
+                indices.len()
+            ),
+        ));
+    }
     let mut dims = Vec::with_capacity(indices.len());
+    let mut elements: u64 = 1;
     for e in indices {
         match e {
-            super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 && n <= 1.0e6 => {
-                dims.push(n as u32)
+            super::block::Expr::Num(n) if n >= 1.0 && n.fract() == 0.0 => {
+                // Saturating: three sizes of up to 2^32 cannot wrap a u64 product anyway,
+                // and anything above the limit is refused below.
+                let n = n.min(f64::from(u32::MAX)) as u32;
+                elements = elements.saturating_mul(u64::from(n));
+                dims.push(n)
             }
             _ => {
                 return Err(perr(
                     i,
                     SYNTAX,
-                    "array size must be a whole number from 1 to 1000000",
+                    "array size must be a whole number from 1 (a literal)",
                 ))
             }
         }
+    }
+    if elements > MAX_ARRAY_ELEMENTS {
+        return Err(perr(
+            i,
+            VARIABLE_MEMORY_FULL,
+            format!(
+                "array V.{}.{name} of {elements} elements: a variable holds at most {MAX_ARRAY_ELEMENTS}",
+                scope.letter()
+            ),
+        ));
     }
     let j = ws(r);
     let (r, init) = match j.strip_prefix('=') {

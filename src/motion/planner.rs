@@ -33,9 +33,8 @@
 use std::collections::VecDeque;
 
 use crate::lang::block::FlushKind;
-use crate::lang::codes::SOFT_LIMIT;
 use crate::queue::{
-    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, AXIS_LETTERS, MAX_AXES,
+    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
 };
 
 use super::interpolator::tangent;
@@ -313,40 +312,6 @@ impl Planner {
         self.dirty = true;
     }
 
-    /// Software limit check of a programmed move (TF5200 "Software limit switches": the
-    /// command positions are checked in path preparation): its end point and, for an arc,
-    /// the extreme points of the swept circle. Reaching a limit is allowed, crossing it is not.
-    fn within_soft_limits(&self, mv: &Move) -> Result<(), PlanError> {
-        let check = |axis: usize, v: f64| -> Result<(), PlanError> {
-            match &self.axes[axis] {
-                Some(a) if v < a.min_mm || v > a.max_mm => Err(PlanError {
-                    code: SOFT_LIMIT,
-                    msg: format!(
-                        "axis {} would move to {v:.4} mm, outside its software limits {} .. {} mm",
-                        AXIS_LETTERS[axis] as char, a.min_mm, a.max_mm
-                    ),
-                    block: None,
-                }),
-                _ => Ok(()),
-            }
-        };
-        for (axis, &v) in mv.end.iter().enumerate() {
-            check(axis, v)?;
-        }
-        if let Some(c) = mv.arc() {
-            // The four axis-parallel extremes of the circle, where the swept part holds them.
-            for k in 0..4 {
-                let theta = f64::from(k) * std::f64::consts::FRAC_PI_2;
-                let from_start = c.dir * (theta - c.start_rad);
-                if from_start.rem_euclid(std::f64::consts::TAU) <= c.sweep_rad {
-                    check(c.a, c.center[0] + c.radius_mm * theta.cos())?;
-                    check(c.b, c.center[1] + c.radius_mm * theta.sin())?;
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// Take blocks from the queue into the window while it has room, applying the release
     /// rules.
     pub fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
@@ -393,15 +358,6 @@ impl Planner {
             self.finish_spline();
         }
         if let Action::Move(mv) = &action {
-            if let Err(mut e) = self.within_soft_limits(mv) {
-                // Refused before it enters the window: this move never starts; the channel
-                // goes to ERROR, naming the block.
-                e.block = info
-                    .as_ref()
-                    .map(|i| (i.prog.to_string(), u64::from(i.line)));
-                self.error = Some(e);
-                return;
-            }
             if comp_move {
                 self.comp_move(info, *mv);
                 return;
