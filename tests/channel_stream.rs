@@ -226,11 +226,11 @@ fn reset_empties_buffer_and_state() {
     c.start(&t, "streaming.nc").unwrap();
     c.step(&t);
     c.write_stream(&t, &crlf("N3 X5\n")).unwrap();
-    assert!(c.decoder().streaming());
+    assert!(c.decoder().reads_stream());
     c.reset(&t);
     assert_eq!(c.state(), State::Ready);
     assert_eq!(c.stream_fill(), (0, 4094));
-    assert!(!c.decoder().streaming());
+    assert!(!c.decoder().reads_stream());
     assert_eq!(c.block_counter(), 0);
     assert!(c.last_error().is_none());
 }

@@ -646,6 +646,8 @@ mod tests {
         let (list, errors) = parse_list(Path::new("bad.lis"), &text);
         assert!(list.entries.is_empty());
         assert_eq!(errors.len(), MAX_LIST_ERRORS + 1);
-        assert!(errors[MAX_LIST_ERRORS].message.contains("more malformed line(s)"));
+        assert!(errors[MAX_LIST_ERRORS]
+            .message
+            .contains("more malformed line(s)"));
     }
 }
