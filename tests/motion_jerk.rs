@@ -10,7 +10,6 @@ use common::random_path::{self, Rng};
 
 use ncchannel::decoder::arc::{arc_move, ArcSpec};
 use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
-use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,
@@ -164,28 +163,135 @@ fn polylines_of_the_r50_circle_run_near_the_true_arc_time() {
     }
 }
 
-#[test]
-fn rest_to_rest_time_is_the_trapezoid_plus_the_jerk_window() {
-    // 100 mm in X at F6000, a = 2000, j = 20000: the path accelerates at 0.75·a (the rest is
-    // the corner reserve), the jerk window is 2·a/j = 0.2 s.
-    let (a, j, v, len) = (2000.0, 20_000.0, 100.0, 100.0);
-    let ax = axes(30000.0, a, Some(j));
-    let mut m = Motion::with_planner(ax.clone(), settings(32, 0.0));
+/// The time-optimal rest-to-rest profile for a path of `l` mm with velocity, acceleration and
+/// jerk limits `v`, `a`, `j` (j infinite: no jerk limit), s. The textbook cases: both limits
+/// reached (jerk phases a/j), only the acceleration (no cruise), only the velocity (peak
+/// acceleration √(v·j)), neither (four jerk phases of ∛(l/2j)).
+fn optimum_s(l: f64, v: f64, a: f64, j: f64) -> f64 {
+    if !j.is_finite() {
+        return if l >= v * v / a {
+            l / v + v / a
+        } else {
+            2.0 * (l / a).sqrt()
+        };
+    }
+    let neither = 4.0 * (l / (2.0 * j)).cbrt();
+    if v * j >= a * a {
+        if l >= v * (v / a + a / j) {
+            l / v + v / a + a / j
+        } else if l >= 2.0 * a * a * a / (j * j) {
+            // l = u·(u/a + a/j) for the peak velocity u.
+            let u = 0.5 * a * (-a / j + (a * a / (j * j) + 4.0 * l / a).sqrt());
+            2.0 * (u / a + a / j)
+        } else {
+            neither
+        }
+    } else if l >= 2.0 * v * (v / j).sqrt() {
+        l / v + 2.0 * (v / j).sqrt()
+    } else {
+        neither
+    }
+}
+
+/// One straight move from rest to rest (then M30), limits checked every tick: the tick in
+/// which the axes first stand at the end point, s.
+fn rest_to_rest_s(limits: &[AxisLimits], to: Position, feed: f64) -> f64 {
+    let mut m = Motion::with_planner(limits.to_vec(), settings(32, 0.0));
     let mut q = BlockQueue::new(16);
-    q.push(block(1, line(p(0.0, 0.0, 0.0), p(len, 0.0, 0.0), v * 60.0)));
+    q.push(block(1, line(p(0.0, 0.0, 0.0), to, feed)));
     q.push(block(2, Action::End { m: 30 }));
-    let mut check = LimitCheck::new(&ax, DT, FILTERED_EPS);
-    let (ticks, positions) = run_to_end(&mut m, &mut q, Some(&mut check), 100_000);
-    check.verdict().unwrap();
-    assert_eq!(positions.last().copied(), Some(p(len, 0.0, 0.0)));
-    let a_path = (1.0 - JUNCTION_ACCEL_SHARE) * a;
-    let model = len / v + v / a_path + 2.0 * a / j;
-    // The time-optimal jerk-limited profile (a is not reached: peak √(v·j)).
-    let optimum = len / v + 2.0 * (v / j).sqrt();
-    let t = ticks as f64 * DT;
-    println!("rest to rest: {t:.3} s, model {model:.3} s, jerk-limited optimum {optimum:.3} s");
-    // The program end takes effect the tick after the axes settle.
-    assert!((t - model).abs() <= 2.0 * DT, "{t} s against {model} s");
+    let mut check = LimitCheck::new(limits, DT, FILTERED_EPS);
+    let (_, positions) = run_to_end(&mut m, &mut q, Some(&mut check), 100_000);
+    if let Err(e) = check.verdict() {
+        panic!("{to:?} at F{feed}: {e}");
+    }
+    assert_eq!(positions.last().copied(), Some(to));
+    let k = positions.iter().position(|q| *q == to).unwrap();
+    assert!(positions[k..].iter().all(|q| *q == to), "stays at the end");
+    (k + 1) as f64 * DT
+}
+
+#[test]
+fn rest_to_rest_moves_take_the_jerk_limited_optimum_within_one_tick() {
+    // (length mm, feed mm/min, acceleration, jerk): the 100 mm at F6000 (only the
+    // velocity limit is reached), both limits, only the acceleration limit, neither, and the
+    // same move without a jerk limit (the trapezoid at the full acceleration).
+    let cases = [
+        (100.0, 6000.0, 2000.0, Some(20_000.0)),
+        (100.0, 15000.0, 2000.0, Some(20_000.0)),
+        (100.0, 30000.0, 2000.0, Some(20_000.0)),
+        (10.0, 30000.0, 2000.0, Some(20_000.0)),
+        (100.0, 6000.0, 2000.0, None),
+        (1.0, 6000.0, 2000.0, None),
+    ];
+    for (len, feed, a, j) in cases {
+        let ax = axes(30000.0, a, j);
+        let t = rest_to_rest_s(&ax, p(len, 0.0, 0.0), feed);
+        let opt = optimum_s(len, feed / 60.0, a, j.unwrap_or(f64::INFINITY));
+        println!("{len} mm at F{feed}, a {a}, j {j:?}: {t:.3} s, optimum {opt:.4} s");
+        assert!(
+            (t - opt).abs() <= DT + 1e-9,
+            "{len} mm at F{feed}, j {j:?}: {t} s against the optimum {opt} s"
+        );
+    }
+    // A diagonal over axes with different limits: the path limits are the axes' projected.
+    let mut ax = axes(12000.0, 1500.0, Some(30_000.0));
+    ax[1].max_velocity_mm_per_min = 9000.0;
+    ax[1].max_accel_mm_per_s2 = 1000.0;
+    ax[1].max_jerk_mm_per_s3 = Some(8000.0);
+    let (dx, dy) = (80.0_f64, 60.0_f64);
+    let l = dx.hypot(dy);
+    let (tx, ty) = (dx / l, dy / l);
+    let v = (15000.0 / 60.0_f64).min(200.0 / tx).min(150.0 / ty);
+    let a = (1500.0 / tx).min(1000.0 / ty);
+    let j = (30_000.0 / tx).min(8000.0 / ty);
+    let t = rest_to_rest_s(&ax, p(dx, dy, 0.0), 15000.0);
+    let opt = optimum_s(l, v, a, j);
+    println!("diagonal: {t:.3} s, optimum {opt:.4} s");
+    assert!(
+        (t - opt).abs() <= DT + 1e-9,
+        "diagonal: {t} s against {opt} s"
+    );
+}
+
+#[test]
+fn a_lone_move_keeps_its_limits_through_holds_and_override_changes() {
+    let ax = axes(30000.0, 2000.0, Some(20_000.0));
+    for (len, feed) in [(300.0, 12000.0), (40.0, 30000.0)] {
+        for hold_at in [30usize, 80, 150, 400] {
+            let mut m = Motion::with_planner(ax.clone(), settings(32, 0.0));
+            let mut q = BlockQueue::new(16);
+            let end = p(len, 0.0, 0.0);
+            q.push(block(1, line(p(0.0, 0.0, 0.0), end, feed)));
+            q.push(block(2, Action::End { m: 30 }));
+            let mut check = LimitCheck::new(&ax, DT, FILTERED_EPS);
+            check.record(m.position());
+            let mut notes = Vec::new();
+            let mut ended = false;
+            for k in 0..100_000usize {
+                match k {
+                    _ if k == hold_at => m.set_hold(true),
+                    _ if k == hold_at + 120 => m.set_hold(false),
+                    _ if k == hold_at + 200 => m.set_override(40.0),
+                    _ if k == hold_at + 260 => m.set_override(150.0),
+                    _ if k == hold_at + 300 => m.set_override(100.0),
+                    _ => {}
+                }
+                m.step(DT, &mut q, &mut notes);
+                check.record(m.position());
+                if notes.iter().any(|n| matches!(n, MotionNote::End { .. })) {
+                    ended = true;
+                    break;
+                }
+                notes.clear();
+            }
+            assert!(ended);
+            assert_eq!(m.position(), end);
+            if let Err(e) = check.verdict() {
+                panic!("{len} mm at F{feed}, hold at tick {hold_at}: {e}");
+            }
+        }
+    }
 }
 
 /// Half the lines with G261 (a deviation of 0.01 … 0.5 mm).

@@ -127,7 +127,7 @@ impl AxisFilter {
     }
 
     /// Window in ticks for `t_s` at `dt_s`: at least `t_s` long (so the bound holds).
-    fn ticks(t_s: f64, dt_s: f64) -> usize {
+    pub fn ticks(t_s: f64, dt_s: f64) -> usize {
         if t_s <= 0.0 || dt_s <= 0.0 {
             return 1;
         }
@@ -152,9 +152,42 @@ impl AxisFilter {
         }
     }
 
+    /// The windows for tick length `dt_s` with the configured corner and jerk times, ticks.
+    pub fn general_ticks(&self, dt_s: f64) -> (usize, usize) {
+        (
+            Self::ticks(self.corner_s, dt_s),
+            Self::ticks(self.jerk_s, dt_s),
+        )
+    }
+
+    /// Use windows of `corner_ticks` and `jerk_ticks` from now on. Only while settled: the
+    /// output then equals the input, so refilling the windows with it moves nothing and the
+    /// new windows start from rest. Returns whether the windows are the ones asked for.
+    pub fn use_windows(&mut self, corner_ticks: usize, jerk_ticks: usize) -> bool {
+        let (nc, nj) = (
+            corner_ticks.clamp(1, MAX_WINDOW_TICKS),
+            jerk_ticks.clamp(1, MAX_WINDOW_TICKS),
+        );
+        if nc == self.corner.len() && nj == self.jerk.len() {
+            return true;
+        }
+        if !self.settled() {
+            return false;
+        }
+        let p = self.jerk.out;
+        self.corner = Stage::new(nc, p);
+        self.jerk = Stage::new(nj, p);
+        true
+    }
+
     /// Corner window actually used, s (whole ticks).
     pub fn corner_window_s(&self) -> f64 {
         self.corner.len() as f64 * self.dt_s
+    }
+
+    /// Jerk window actually used, ticks.
+    pub fn jerk_ticks(&self) -> usize {
+        self.jerk.len()
     }
 
     /// Both windows, s: the lag of a stop and the time the output takes to settle.
@@ -184,9 +217,9 @@ impl AxisFilter {
         self.jerk = Stage::new(nj, p);
     }
 
-    /// Filtering does anything at all.
+    /// Filtering does anything at all (with the windows now in use).
     pub fn active(&self) -> bool {
-        self.corner_s > 0.0 || self.jerk_s > 0.0
+        self.corner.len() > 1 || self.jerk.len() > 1
     }
 }
 

@@ -39,6 +39,26 @@ pub struct Advanced {
     pub finished: bool,
 }
 
+/// The squared velocity braking at `a` from `v` over `rem` leaves, and the exit the block can
+/// still reach: that velocity where it lies above the planned exit, else the exit.
+///
+/// Why the tolerance: v² − 2·a·rem cancels when braking exactly to the exit, and its rounding
+/// (about 1e-16·v²) turns into a velocity of about 1e-8·v after the square root — enough for
+/// a block "stopped" at its end to creep on (an M00 after it then saw a moving axis). A
+/// squared difference within 1e-9·v² of the exit's counts as the exit.
+fn reachable_exit(v: f64, a: f64, rem: f64, exit_mm_per_s: f64) -> (f64, f64) {
+    let reach2 = v * v - 2.0 * a * rem;
+    let exit2 = exit_mm_per_s * exit_mm_per_s;
+    if reach2 > exit2 + REACH_EPS * v * v {
+        (reach2, reach2.sqrt())
+    } else {
+        (reach2, exit_mm_per_s.max(0.0))
+    }
+}
+
+/// Relative tolerance of a squared velocity (see [`reachable_exit`]).
+const REACH_EPS: f64 = 1e-9;
+
 /// Advance path position `s_mm` and path velocity `v_mm_per_s` along `p` by at most `dt_s`.
 ///
 /// The velocity follows the largest of: accelerate at `a` towards the cruise velocity, cruise,
@@ -63,12 +83,7 @@ pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> 
         }
         let v = *v_mm_per_s;
         // The exit we can still reach, and the braking curve through it at s.
-        let reach2 = v * v - 2.0 * a * rem;
-        let ve = if reach2 > p.exit_mm_per_s * p.exit_mm_per_s {
-            reach2.sqrt()
-        } else {
-            p.exit_mm_per_s.max(0.0)
-        };
+        let (reach2, ve) = reachable_exit(v, a, rem, p.exit_mm_per_s);
         let brake = (ve * ve + 2.0 * a * rem).sqrt();
         let vc = p.cruise_mm_per_s.max(0.0);
         let eps = V_EPS * (1.0 + v.max(vc));
@@ -125,6 +140,208 @@ pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> 
             *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
             *v_mm_per_s = v_end.max(0.0);
         } else {
+            *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
+            *v_mm_per_s = (v + acc * left).max(0.0);
+            t = dt_s;
+            break;
+        }
+    }
+    let finished = p.length_mm - *s_mm <= END_EPS_MM;
+    if finished {
+        *s_mm = p.length_mm;
+    }
+    Advanced {
+        used_s: t.min(dt_s),
+        finished,
+    }
+}
+
+/// The swing rule of a straight rest-to-rest run: between a phase at +a and one at −a (either
+/// order) the profile holds its velocity for at least `window_s`, the jerk window that follows.
+///
+/// Why. A moving average of length T over the positions makes the jerk (a(t) − a(t − T)) / T.
+/// With the acceleration in {−a, 0, +a} and never +a and −a less than T apart, |a(t) − a(t − T)|
+/// is at most a, so a window T = a / j bounds the jerk by j — half the window the general case
+/// needs (2·a / j), and a trapezoid at a filtered by a / j is the time-optimal jerk-limited
+/// profile (docs/motion.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Swing {
+    /// Least time at constant velocity between accelerating and braking, s.
+    pub window_s: f64,
+    /// Seconds since the last accelerating phase ended (0 while in it).
+    pub since_accel_s: f64,
+    /// Seconds since the last braking phase ended (0 while in it).
+    pub since_brake_s: f64,
+}
+
+impl Swing {
+    /// A run that starts at rest: no phase before it.
+    pub fn new(window_s: f64) -> Self {
+        Swing {
+            window_s: window_s.max(0.0),
+            since_accel_s: f64::INFINITY,
+            since_brake_s: f64::INFINITY,
+        }
+    }
+
+    fn pass(&mut self, acc: f64, dur: f64) {
+        if acc > 0.0 {
+            self.since_accel_s = 0.0;
+            self.since_brake_s += dur;
+        } else if acc < 0.0 {
+            self.since_brake_s = 0.0;
+            self.since_accel_s += dur;
+        } else {
+            self.since_accel_s += dur;
+            self.since_brake_s += dur;
+        }
+    }
+
+    /// Seconds until braking is allowed (0: now).
+    fn brake_wait_s(&self) -> f64 {
+        let w = self.window_s - self.since_accel_s;
+        if w > SWING_EPS_S {
+            w
+        } else {
+            0.0
+        }
+    }
+
+    /// Seconds until accelerating is allowed (0: now).
+    fn accel_wait_s(&self) -> f64 {
+        let w = self.window_s - self.since_brake_s;
+        if w > SWING_EPS_S {
+            w
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Waits shorter than this count as over, s (rounding of the phase sums).
+const SWING_EPS_S: f64 = 1e-9;
+
+/// [`advance`] under the swing rule: the same accelerate / cruise / brake phases, but braking
+/// starts only `window_s` after accelerating ended and accelerating only `window_s` after
+/// braking ended; meanwhile the velocity is held. To keep the end reachable, acceleration
+/// stops at the highest velocity from which holding it for `window_s` and then braking still
+/// meets the exit at the block end. A feed hold or a lowered override therefore brakes up to
+/// `window_s` later than in [`advance`], as a jerk-limited machine does.
+pub fn advance_swing(
+    s_mm: &mut f64,
+    v_mm_per_s: &mut f64,
+    p: &Profile,
+    dt_s: f64,
+    sw: &mut Swing,
+) -> Advanced {
+    let a = p.accel_mm_per_s2.max(1e-9);
+    let win = sw.window_s;
+    let mut t = 0.0;
+    for _ in 0..MAX_PHASES {
+        let rem = p.length_mm - *s_mm;
+        if rem <= END_EPS_MM {
+            *s_mm = p.length_mm;
+            return Advanced {
+                used_s: t,
+                finished: true,
+            };
+        }
+        let left = dt_s - t;
+        if left <= 0.0 {
+            break;
+        }
+        let v = *v_mm_per_s;
+        let (reach2, ve) = reachable_exit(v, a, rem, p.exit_mm_per_s);
+        let brake = (ve * ve + 2.0 * a * rem).sqrt();
+        let vc = p.cruise_mm_per_s.max(0.0);
+        let eps = V_EPS * (1.0 + v.max(vc));
+        // Holding `v` for at most `wait`: until the braking curve, or to the block end when
+        // `v` is not above the exit.
+        let hold = |v: f64, wait: f64| -> (f64, f64, f64, bool) {
+            let (d, to_end) = if v > ve {
+                ((rem - (v * v - ve * ve) / (2.0 * a)).max(0.0), false)
+            } else {
+                (rem, true)
+            };
+            let dur = d / v;
+            if dur <= wait {
+                (0.0, dur, v, to_end)
+            } else {
+                (0.0, wait, v, false)
+            }
+        };
+        // (acceleration, duration of the phase, velocity at its end, reaches block end)
+        let (acc, dur, v_end, to_end) = if v >= brake - eps {
+            // On the braking curve: brake to the end. The cap below makes this come at least
+            // `window_s` after accelerating ended; rounding aside, it is never early.
+            (-a, ((v - ve) / a).max(0.0), ve, true)
+        } else if v > vc + eps {
+            let wait = sw.brake_wait_s();
+            if wait > 0.0 {
+                hold(v, wait)
+            } else {
+                let d = (v * v - vc * vc) / (2.0 * a);
+                if d >= rem {
+                    let ve2 = reach2.max(0.0).sqrt();
+                    (-a, ((v - ve2) / a).max(0.0), ve2, true)
+                } else {
+                    (-a, (v - vc) / a, vc, false)
+                }
+            }
+        } else if v >= vc - eps && vc <= V_EPS {
+            // Held (or 0 % override) and standing: time passes, the path does not.
+            *v_mm_per_s = 0.0;
+            sw.pass(0.0, left);
+            return Advanced {
+                used_s: dt_s,
+                finished: false,
+            };
+        } else {
+            let wait = sw.accel_wait_s();
+            // The highest velocity from which holding it for `win` and braking still meets the
+            // exit: accelerate to u, hold u·win, brake — together at most `rem`.
+            let c = rem + (v * v + ve * ve) / (2.0 * a);
+            let cap = 0.5 * a * (-win + (win * win + 4.0 * c / a).sqrt());
+            let target = vc.min(cap);
+            if v < target - eps && wait <= 0.0 {
+                let x = (target * target - v * v) / (2.0 * a);
+                if x >= rem {
+                    let v1 = (v * v + 2.0 * a * rem).sqrt();
+                    (a, (v1 - v) / a, v1, true)
+                } else {
+                    (a, (target - v) / a, target, false)
+                }
+            } else if v <= V_EPS {
+                // Standing, not yet allowed to accelerate: time passes.
+                let w = wait.min(left);
+                sw.pass(0.0, w);
+                t += w;
+                if wait <= left {
+                    continue;
+                }
+                break;
+            } else if v < target - eps {
+                hold(v, wait)
+            } else {
+                // At the cap (or the cruise): hold until the braking curve.
+                hold(v, f64::INFINITY)
+            }
+        };
+        if dur <= left {
+            t += dur;
+            sw.pass(acc, dur);
+            if to_end {
+                *s_mm = p.length_mm;
+                *v_mm_per_s = v_end.max(0.0);
+                return Advanced {
+                    used_s: t,
+                    finished: true,
+                };
+            }
+            *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
+            *v_mm_per_s = v_end.max(0.0);
+        } else {
+            sw.pass(acc, left);
             *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
             *v_mm_per_s = (v + acc * left).max(0.0);
             t = dt_s;

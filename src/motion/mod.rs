@@ -23,7 +23,7 @@ use crate::lang::block::FlushKind;
 use crate::queue::{BlockInfo, BlockQueue, MoveKind, Position, MAX_AXES};
 
 use filter::{jerk_window_s, AxisFilter};
-use interpolator::{advance, point_at, Profile};
+use interpolator::{advance, advance_swing, point_at, Profile, Swing};
 pub use planner::PlannerSettings;
 use planner::{EntryKind, Planner};
 use trace::{CsvTrace, Sample, Trace};
@@ -82,6 +82,19 @@ enum Next {
     PopAndHold,
 }
 
+/// How the present run (the motion from one standstill to the next) is executed; chosen when
+/// it starts, at rest with the axis filter settled, the only moment its windows may change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Run {
+    /// Any path: trapezoids with the junction reserve, the configured corner filter and the
+    /// jerk window 2·a/j (docs/motion.md, "Jerk limits").
+    General,
+    /// One straight move from rest to rest: a trapezoid at `accel_mm_per_s2` under the swing
+    /// rule, filtered by one window — the time-optimal jerk-limited profile (docs/motion.md,
+    /// "Rest to rest").
+    Lone { accel_mm_per_s2: f64, swing: Swing },
+}
+
 /// The executor of one channel.
 #[derive(Debug)]
 pub struct Motion {
@@ -93,6 +106,8 @@ pub struct Motion {
     pos_in: Position,
     /// Corner and jerk filter between interpolator and axes.
     filter: AxisFilter,
+    /// How the present run is executed.
+    run: Run,
     /// Path velocity, acceleration and jerk of the filtered axes over the last tick
     /// (finite differences; mm/s, mm/s², mm/s³).
     out_v_mm_per_s: f64,
@@ -139,6 +154,7 @@ impl Motion {
             pos: [0.0; MAX_AXES],
             pos_in: [0.0; MAX_AXES],
             filter,
+            run: Run::General,
             out_v_mm_per_s: 0.0,
             out_a_mm_per_s2: 0.0,
             out_j_mm_per_s3: 0.0,
@@ -400,6 +416,18 @@ impl Motion {
             if self.planner.released() == 0 {
                 break;
             }
+            // A move starting at rest with the axes settled begins a new run.
+            if !self.front_started
+                && left > 0.0
+                && self.v_mm_per_s == 0.0
+                && self.filter.settled()
+                && matches!(
+                    self.planner.front().map(|e| &e.kind),
+                    Some(EntryKind::Move(_))
+                )
+            {
+                self.begin_run();
+            }
             let Some(front) = self.planner.front_mut() else {
                 break;
             };
@@ -437,7 +465,24 @@ impl Motion {
                         cruise_mm_per_s: seg.cruise_mm_per_s(cruise_pct),
                         exit_mm_per_s: seg.exit_mm_per_s,
                     };
-                    let r = advance(&mut self.s_mm, &mut self.v_mm_per_s, &profile, left);
+                    let r = match &mut self.run {
+                        Run::General => {
+                            advance(&mut self.s_mm, &mut self.v_mm_per_s, &profile, left)
+                        }
+                        Run::Lone {
+                            accel_mm_per_s2,
+                            swing,
+                        } => advance_swing(
+                            &mut self.s_mm,
+                            &mut self.v_mm_per_s,
+                            &Profile {
+                                accel_mm_per_s2: *accel_mm_per_s2,
+                                ..profile
+                            },
+                            left,
+                            swing,
+                        ),
+                    };
                     left -= r.used_s;
                     if r.finished {
                         // Snap: the block ends exactly at its programmed end point.
@@ -522,6 +567,57 @@ impl Motion {
                 .is_some_and(|e| matches!(e.kind, EntryKind::Move(_)));
         if !moving && !continues {
             self.v_mm_per_s = 0.0;
+        }
+    }
+
+    /// A run starts with the front move, at rest with the filter settled: a straight move
+    /// that a stop follows runs as a lone move with the windows of its optimum, anything else
+    /// as a general run with the configured windows.
+    ///
+    /// The lone move's window T is that of the time-optimal profile with the path limits
+    /// v, a, j: the jerk phase a/j when both limits are reached, √(v/j) when only the velocity
+    /// is, ∛(L/2j) when neither is — in whole ticks; the trapezoid under it accelerates at
+    /// min(a, j·T).
+    fn begin_run(&mut self) {
+        let Some(planner::Entry {
+            kind: EntryKind::Move(seg),
+            ..
+        }) = self.planner.front()
+        else {
+            return;
+        };
+        if self.planner.front_is_lone_line() {
+            let (a, j) = self.planner.line_limits(seg);
+            let v = match seg.cruise_mm_per_s(self.override_pct) {
+                v if v > 0.0 => v,
+                _ => seg.limit_mm_per_s,
+            };
+            let (window_s, accel) = if j.is_finite() {
+                let t = (a / j)
+                    .min((v / j).sqrt())
+                    .min((seg.length_mm / (2.0 * j)).cbrt());
+                let n = AxisFilter::ticks(t, self.dt_s);
+                let w = n as f64 * self.dt_s;
+                (w, a.min(j * w))
+            } else {
+                (0.0, a)
+            };
+            let n = if window_s > 0.0 {
+                AxisFilter::ticks(window_s, self.dt_s)
+            } else {
+                1
+            };
+            if self.filter.use_windows(1, n) {
+                self.run = Run::Lone {
+                    accel_mm_per_s2: accel,
+                    swing: Swing::new(window_s),
+                };
+                return;
+            }
+        }
+        let (nc, nj) = self.filter.general_ticks(self.dt_s);
+        if self.filter.use_windows(nc, nj) {
+            self.run = Run::General;
         }
     }
 

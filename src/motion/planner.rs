@@ -303,6 +303,52 @@ impl Planner {
         (self.released > 1).then(|| &self.window[1])
     }
 
+    /// The front entry is a straight move that ends a run: after it, among the released
+    /// entries, the next one that is not a plain block or `#FLUSH CONTINUE` stops the motion
+    /// (dwell, `#FLUSH`, `#FLUSH WAIT`, program end). No later release can join it then.
+    pub fn front_is_lone_line(&self) -> bool {
+        let Some(Entry {
+            kind: EntryKind::Move(seg),
+            ..
+        }) = self.window.front()
+        else {
+            return false;
+        };
+        if !matches!(seg.mv.kind, MoveKind::Line | MoveKind::Rapid) || seg.length_mm <= 0.0 {
+            return false;
+        }
+        for e in self.window.iter().take(self.released).skip(1) {
+            match &e.kind {
+                EntryKind::Plain | EntryKind::Flush(FlushKind::Continue) => {}
+                k => return k.is_barrier(),
+            }
+        }
+        false
+    }
+
+    /// Path acceleration and jerk limits of a straight move with every axis' full
+    /// acceleration (no junction reserve: a lone line has no junction), mm/s², mm/s³
+    /// (infinite: no jerk limit on any moving axis).
+    pub fn line_limits(&self, seg: &Segment) -> (f64, f64) {
+        let t = tangent(&seg.mv, seg.length_mm, false);
+        let (mut accel, mut jerk) = (f64::INFINITY, f64::INFINITY);
+        for (i, ti) in t.iter().enumerate() {
+            let s = ti.abs();
+            if s <= 1e-12 {
+                continue;
+            }
+            let Some(ax) = &self.axes[i] else { continue };
+            accel = accel.min(ax.max_accel_mm_per_s2.max(1e-6) / s);
+            if let Some(j) = ax.max_jerk_mm_per_s3.filter(|j| j.is_finite() && *j > 0.0) {
+                jerk = jerk.min(j / s);
+            }
+        }
+        if !accel.is_finite() {
+            accel = seg.accel_mm_per_s2;
+        }
+        (accel, jerk)
+    }
+
     fn full(&self) -> bool {
         self.moves >= self.lookahead || self.window.len() >= self.max_entries
     }
