@@ -615,9 +615,22 @@ impl Motion {
                 return;
             }
         }
-        let (nc, nj) = self.filter.general_ticks(self.dt_s);
+        let (mut nc, nj) = self.filter.general_ticks(self.dt_s);
+        if seg.mv.path.contour_dev_mm.is_some() {
+            // A contoured run blends its corners into tangent arcs within the programmed
+            // deviation; the corner filter would cut them further inside (0.09 mm instead of
+            // 0.05 on the contoured square), so it runs without one.
+            nc = 1;
+        }
         if self.filter.use_windows(nc, nj) {
             self.run = Run::General;
+            let corner_s = if nc > 1 {
+                self.filter.corner_window_s()
+            } else {
+                0.0
+            };
+            self.planner.set_corner_window_s(corner_s);
+            self.planner.plan_if_needed(self.override_pct, self.dt_s);
         }
     }
 

@@ -271,6 +271,15 @@ impl Planner {
     pub fn lookahead(&self) -> usize {
         self.lookahead
     }
+
+    /// The corner window the axis filter now uses, s (0 = none): junction velocities are
+    /// planned for it, so the plan is recomputed.
+    pub fn set_corner_window_s(&mut self, corner_s: f64) {
+        if corner_s != self.corner_s {
+            self.corner_s = corner_s;
+            self.dirty = true;
+        }
+    }
     pub fn len(&self) -> usize {
         self.window.len()
     }
