@@ -30,6 +30,9 @@ fn sorted(names: &[&str]) -> Vec<String> {
     k
 }
 
+/// One documented event kind: the kind, its `ev` name and its own field names.
+type Case = (EventKind, &'static str, Vec<&'static str>);
+
 #[test]
 fn every_event_kind_has_the_documented_fields() {
     let tick = Tick {
@@ -37,8 +40,29 @@ fn every_event_kind_has_the_documented_fields() {
         period: Duration::from_millis(1),
         time: Duration::from_millis(1500),
     };
-    let s = |x: &str| x.to_string();
-    let cases: Vec<(EventKind, &str, Vec<&str>)> = vec![
+    let mut cases = program_event_cases();
+    cases.extend(message_event_cases());
+    for (kind, ev, fields) in cases {
+        let line = Event::new(&tick, 2, kind).to_json();
+        assert!(!line.contains('\n'));
+        assert!(
+            line.starts_with(&format!(r#"{{"tick":1500,"t":1.5,"ch":2,"ev":"{ev}""#)),
+            "{line}"
+        );
+        let mut want = vec!["tick", "t", "ch", "ev"];
+        want.extend(fields);
+        assert_eq!(keys(&line), sorted(&want), "{line}");
+    }
+}
+
+/// An owned string, to keep the case table short.
+fn s(x: &str) -> String {
+    x.to_string()
+}
+
+/// State, program and stream events.
+fn program_event_cases() -> Vec<Case> {
+    vec![
         (
             EventKind::State {
                 mode: s("automatic"),
@@ -86,6 +110,12 @@ fn every_event_kind_has_the_documented_fields() {
         ),
         (EventKind::Segment { bytes: 10 }, "segment", vec!["bytes"]),
         (EventKind::Discard { bytes: 10 }, "discard", vec!["bytes"]),
+    ]
+}
+
+/// Messages, interruptions, cache, flush and search events.
+fn message_event_cases() -> Vec<Case> {
+    vec![
         (
             EventKind::Warning {
                 code: 11012,
@@ -129,18 +159,7 @@ fn every_event_kind_has_the_documented_fields() {
             "search",
             vec!["target", "found"],
         ),
-    ];
-    for (kind, ev, fields) in cases {
-        let line = Event::new(&tick, 2, kind).to_json();
-        assert!(!line.contains('\n'));
-        assert!(
-            line.starts_with(&format!(r#"{{"tick":1500,"t":1.5,"ch":2,"ev":"{ev}""#)),
-            "{line}"
-        );
-        let mut want = vec!["tick", "t", "ch", "ev"];
-        want.extend(fields);
-        assert_eq!(keys(&line), sorted(&want), "{line}");
-    }
+    ]
 }
 
 /// Run the synthetic streaming load in virtual time with the events going to `path`.

@@ -687,22 +687,54 @@ pub fn write(
         return Err(AdsResult::ACCESS_DENIED);
     }
     let ch = t.ch;
-    let unit = |r: Result<(), DeviceError>| r.map_err(dev);
-    let search = |f: &dyn Fn(&mut crate::channel::SearchCommand)| -> Result<(), AdsResult> {
-        let mut s = backend.view(ch).map_err(dev)?.hmi.search;
-        f(&mut s);
-        unit(backend.hmi(ch, HmiOp::Search(s)))
-    };
     match t.def.field {
         Field::TimeReset => unit(backend.hmi(1, HmiOp::ResetCycleTimes)),
-        Field::Stream => {
-            let r = backend.stream_write(ch, data).result();
-            if r.is_ok() {
-                Ok(())
-            } else {
-                Err(r)
-            }
+        Field::Stream => write_stream(backend, ch, data),
+        Field::SingleBlockCommand
+        | Field::OptionalStop
+        | Field::SkipCommand
+        | Field::OverrideCommand
+        | Field::ExecutionModeCommand => write_switch(backend, ch, t.def.field, data),
+        Field::SearchType
+        | Field::SearchFileOffset
+        | Field::SearchBlockCount
+        | Field::SearchBlockNumber => write_search(backend, ch, t.def.field, data),
+        Field::McmToMode
+        | Field::McmToState
+        | Field::McmFromMode
+        | Field::McmFromState
+        | Field::McmParameter => write_mcm(backend, hli, ch, t.def.field, data),
+        Field::Hold | Field::Resume | Field::Reset => {
+            write_hold_resume_reset(backend, ch, t.def.field, data)
         }
+        _ => Err(AdsResult::ACCESS_DENIED),
+    }
+}
+
+/// A backend command's outcome as an ADS result (the device error's code).
+fn unit(r: Result<(), DeviceError>) -> Result<(), AdsResult> {
+    r.map_err(dev)
+}
+
+/// Write step: stream bytes go to the channel's stream; its refusal is the answer.
+fn write_stream(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
+    let r = backend.stream_write(ch, data).result();
+    if r.is_ok() {
+        Ok(())
+    } else {
+        Err(r)
+    }
+}
+
+/// Write step: HMI switches (single block, optional stop, skip levels, override,
+/// execution mode), each argument range-checked before the backend sees it.
+fn write_switch(
+    backend: &dyn CncBackend,
+    ch: u16,
+    field: Field,
+    data: &[u8],
+) -> Result<(), AdsResult> {
+    match field {
         Field::SingleBlockCommand => unit(backend.hmi(ch, HmiOp::SingleBlock(bool_arg(data)?))),
         Field::OptionalStop => unit(backend.hmi(ch, HmiOp::OptionalStop(bool_arg(data)?))),
         Field::SkipCommand => {
@@ -720,6 +752,24 @@ pub fn write(
             unit(backend.set_override(ch, f64::from(tenths) / 10.0))
         }
         Field::ExecutionModeCommand => unit(backend.hmi(ch, HmiOp::ExecutionMode(i32_arg(data)?))),
+        _ => Err(AdsResult::ACCESS_DENIED),
+    }
+}
+
+/// Write step: one field of the block search command; the argument is checked first, then
+/// the channel's current search command is read, changed and written back whole.
+fn write_search(
+    backend: &dyn CncBackend,
+    ch: u16,
+    field: Field,
+    data: &[u8],
+) -> Result<(), AdsResult> {
+    let search = |f: &dyn Fn(&mut crate::channel::SearchCommand)| -> Result<(), AdsResult> {
+        let mut s = backend.view(ch).map_err(dev)?.hmi.search;
+        f(&mut s);
+        unit(backend.hmi(ch, HmiOp::Search(s)))
+    };
+    match field {
         Field::SearchType => {
             let kind = uint_arg(data)?;
             let kind = u16::try_from(kind).map_err(|_| AdsResult::INVALID_DATA)?;
@@ -740,6 +790,20 @@ pub fn write(
             let n = uint_arg(data)?;
             search(&|s| s.block_number = n)
         }
+        _ => Err(AdsResult::ACCESS_DENIED),
+    }
+}
+
+/// Write step: the HLI mode/state command interface (MCM); mode, state and program
+/// requests go to the PLC when its HLI unit operates them ([`Hli::redirect`]).
+fn write_mcm(
+    backend: &dyn CncBackend,
+    hli: &Hli,
+    ch: u16,
+    field: Field,
+    data: &[u8],
+) -> Result<(), AdsResult> {
+    match field {
         Field::McmToMode => {
             let m = i32_arg(data)?;
             match hli.redirect(ch, HmiRequest::ToMode(m)) {
@@ -773,18 +837,25 @@ pub fn write(
                 None => unit(backend.command_program(ch, name)),
             }
         }
-        Field::Hold | Field::Resume | Field::Reset => {
-            if data.len() > 4 {
-                return Err(AdsResult::INVALID_SIZE);
-            }
-            unit(match t.def.field {
-                Field::Hold => backend.hold(ch),
-                Field::Resume => backend.resume(ch),
-                _ => backend.reset(ch),
-            })
-        }
         _ => Err(AdsResult::ACCESS_DENIED),
     }
+}
+
+/// Write step: hold, resume and reset take no argument beyond an optional 4-byte word.
+fn write_hold_resume_reset(
+    backend: &dyn CncBackend,
+    ch: u16,
+    field: Field,
+    data: &[u8],
+) -> Result<(), AdsResult> {
+    if data.len() > 4 {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    unit(match field {
+        Field::Hold => backend.hold(ch),
+        Field::Resume => backend.resume(ch),
+        _ => backend.reset(ch),
+    })
 }
 
 /// Every COM object in the description table answers at its address with its size.

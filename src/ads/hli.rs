@@ -233,6 +233,16 @@ impl Builder {
 
     fn channel(&mut self, i: usize, ch: u16, axes: usize) -> ChannelAreas {
         let p = format!("HLI_Global_Variables.gpCh[{i}]^");
+        let areas = self.channel_control(&p, ch);
+        self.techno_units(&p);
+        self.path_control_units(&p);
+        self.manual_mode_units(&p, axes);
+        areas
+    }
+
+    /// Channel step 1: mode/state interface, PLC presence and error record, the areas the
+    /// channel's HLI unit serves (laid out first, in the kernel's order).
+    fn channel_control(&mut self, p: &str, ch: u16) -> ChannelAreas {
         let ms = format!("{p}.channel_mc_control.mode_and_state");
         let state = self.root(
             format!("{ms}.state_r"),
@@ -293,7 +303,12 @@ impl Builder {
             "UDINT",
             ADST_UINT32,
         );
-        // Technology units (M/H/S/T handshakes): ncchannel raises none; plain memory.
+        areas
+    }
+
+    /// Channel step 2: technology units (M/H/S/T handshakes): ncchannel raises none; plain
+    /// memory.
+    fn techno_units(&mut self, p: &str) {
         let tu = self.root(
             format!("{p}.techno_unit_std_sync"),
             TECHNO_UNITS * TECHNO_UNIT_BYTES,
@@ -334,7 +349,11 @@ impl Builder {
             ADST_UINT16,
             Role::Plain,
         );
-        // Path control units (TwinSharp BackwardsOnPath.cs, DeleteDistanceToGo.cs).
+    }
+
+    /// Channel step 3: path control units (TwinSharp BackwardsOnPath.cs,
+    /// DeleteDistanceToGo.cs), plain memory.
+    fn path_control_units(&mut self, p: &str) {
         let bahn = format!("{p}.bahn_mc_control");
         for unit in [
             "backward_motion",
@@ -362,7 +381,11 @@ impl Builder {
             ADST_UINT32,
             Role::Plain,
         );
-        // Manual mode units (TwinSharp ManualOperation.cs, Structs.cs sizes).
+    }
+
+    /// Channel step 4: manual mode units (TwinSharp ManualOperation.cs, Structs.cs sizes)
+    /// and each axis's handwheel display, plain memory.
+    fn manual_mode_units(&mut self, p: &str, axes: usize) {
         let hb = format!("{p}.hb_mc_control");
         self.unit(&format!("{hb}.activation"), 12, "HLI_HB_ACTIVATION");
         self.unit(&format!("{hb}.tip_parameter"), 8, "HLI_HB_TIP_PARAMETER");
@@ -390,7 +413,6 @@ impl Builder {
             self.sub(format!("{d}.control_element"), r, 4, 2, "UINT", ADST_UINT16);
             self.sub(format!("{d}.tipp_geschw"), r, 6, 4, "DINT", ADST_INT32);
         }
-        areas
     }
 
     fn axis(&mut self, a: usize) {

@@ -581,21 +581,7 @@ fn request_loop(
                             .allow
                             .contains(&RouteEntry::NetId(header.source.net_id));
                     if !routed {
-                        let id = header.source.net_id;
-                        if logged_unrouted.len() <= MAX_LOGGED_UNROUTED
-                            && !logged_unrouted.contains(&id)
-                        {
-                            if logged_unrouted.len() == MAX_LOGGED_UNROUTED {
-                                log(format_args!(
-                                    "{peer}: more than {MAX_LOGGED_UNROUTED} unrouted source NetIds: no more are logged"
-                                ));
-                            } else {
-                                log(format_args!(
-                                    "{peer}: no route for source NetId {id}: frames dropped"
-                                ));
-                            }
-                            logged_unrouted.push(id);
-                        }
+                        note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
                         continue;
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
@@ -642,20 +628,7 @@ fn request_loop(
                     io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
                 ) =>
             {
-                let idle = last_frame.elapsed();
-                let waiting = !buf.is_empty() || lock(&notifs.table).is_empty();
-                if idle >= shared.config.idle_timeout && waiting {
-                    let what = if buf.is_empty() {
-                        "idle"
-                    } else {
-                        "frame incomplete"
-                    };
-                    return Err(ConnError::Idle(format!(
-                        "{what} for {} s (idle timeout {} s)",
-                        idle.as_secs(),
-                        shared.config.idle_timeout.as_secs_f64()
-                    )));
-                }
+                check_idle(last_frame, &buf, shared, notifs)?;
                 continue;
             }
             Err(e) if shared.stopping.load(Ordering::SeqCst) => {
@@ -672,6 +645,48 @@ fn request_loop(
         };
         buf.extend_from_slice(&chunk[..n]);
     }
+}
+
+/// Log a frame dropped for want of a route, once per source NetId; past
+/// `MAX_LOGGED_UNROUTED` NetIds say so once and log no more (a flood cannot fill the log).
+fn note_unrouted(peer: SocketAddr, logged_unrouted: &mut Vec<AmsNetId>, id: AmsNetId) {
+    if logged_unrouted.len() <= MAX_LOGGED_UNROUTED && !logged_unrouted.contains(&id) {
+        if logged_unrouted.len() == MAX_LOGGED_UNROUTED {
+            log(format_args!(
+                "{peer}: more than {MAX_LOGGED_UNROUTED} unrouted source NetIds: no more are logged"
+            ));
+        } else {
+            log(format_args!(
+                "{peer}: no route for source NetId {id}: frames dropped"
+            ));
+        }
+        logged_unrouted.push(id);
+    }
+}
+
+/// After a read timed out: end the connection when no frame came for the idle timeout and
+/// it is waiting on the client (a frame half sent, or no notifications to keep it alive).
+fn check_idle(
+    last_frame: Instant,
+    buf: &[u8],
+    shared: &Shared,
+    notifs: &Notifications,
+) -> Result<(), ConnError> {
+    let idle = last_frame.elapsed();
+    let waiting = !buf.is_empty() || lock(&notifs.table).is_empty();
+    if idle >= shared.config.idle_timeout && waiting {
+        let what = if buf.is_empty() {
+            "idle"
+        } else {
+            "frame incomplete"
+        };
+        return Err(ConnError::Idle(format!(
+            "{what} for {} s (idle timeout {} s)",
+            idle.as_secs(),
+            shared.config.idle_timeout.as_secs_f64()
+        )));
+    }
+    Ok(())
 }
 
 /// AMS/TCP command 0x0001: a client closes its AMS port (body: the port, u16 LE).

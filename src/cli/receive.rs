@@ -135,6 +135,43 @@ impl From<dnc::DncError> for Failure {
 }
 
 fn run(args: ReceiveArgs) -> Result<u8, Failure> {
+    let (markers, template, limits) = settings(&args)?;
+    let out = match args.out.clone() {
+        Some(o) => o,
+        None => default_out_dir(&args.params, args.channel).map_err(Failure::Usage)?,
+    };
+    let mut cfg = WriterConfig::new(&out);
+    cfg.overwrite = args.overwrite;
+    cfg.keep_partial = args.keep_partial;
+    cfg.template = template;
+    let mut writer = ProgramWriter::new(cfg.clone()).with_log(log_line);
+    let mut splitter = Splitter::new(markers.clone());
+
+    let mut total = Totals::default();
+    if let Some(addr) = &args.listen {
+        let server = Server {
+            markers: &markers,
+            cfg: &cfg,
+            numbers: writer.numbers(),
+            limits,
+        };
+        server.serve(&args, addr, &mut total)?;
+    } else {
+        total.add(&receive_input(&args, &limits, &mut splitter, &mut writer)?);
+    }
+    total.print(&out);
+    Ok(
+        if total.filed > 0 && total.cut_off == 0 && total.refused == 0 {
+            exit::OK
+        } else {
+            exit::CHANNEL_ERROR
+        },
+    )
+}
+
+/// Step 1 of `run`: the arguments checked and turned into markers, name template and
+/// transfer limits (a listening port gets bounded transfers by default).
+fn settings(args: &ReceiveArgs) -> Result<(Markers, NameTemplate, dnc::TransferLimits), Failure> {
     let anchor = if args.at_line_start {
         Anchor::LineStart
     } else {
@@ -163,19 +200,42 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
             .max_programs
             .or(listening.then_some(DEFAULT_MAX_PROGRAMS)),
     };
-    let out = match args.out.clone() {
-        Some(o) => o,
-        None => default_out_dir(&args.params, args.channel).map_err(Failure::Usage)?,
-    };
-    let mut cfg = WriterConfig::new(&out);
-    cfg.overwrite = args.overwrite;
-    cfg.keep_partial = args.keep_partial;
-    cfg.template = template;
-    let mut writer = ProgramWriter::new(cfg.clone()).with_log(log_line);
-    let mut splitter = Splitter::new(markers.clone());
+    Ok((markers, template, limits))
+}
 
-    let mut total = Totals::default();
-    if let Some(addr) = &args.listen {
+/// Step 2 without --listen: one transfer from the input file or standard input.
+fn receive_input(
+    args: &ReceiveArgs,
+    limits: &dnc::TransferLimits,
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+) -> Result<TransferReport, Failure> {
+    Ok(match args.input.as_deref() {
+        None => dnc::receive_limited(io::stdin().lock(), limits, splitter, writer)?,
+        Some(p) if p == Path::new("-") => {
+            dnc::receive_limited(io::stdin().lock(), limits, splitter, writer)?
+        }
+        Some(p) => {
+            let f = File::open(p).map_err(|e| Failure::Io(format!("{}: {e}", p.display())))?;
+            dnc::receive_limited(f, limits, splitter, writer)?
+        }
+    })
+}
+
+/// What every transfer a listening port accepts is split and filed with; the program
+/// numbers are shared so concurrent transfers never take the same one.
+struct Server<'a> {
+    markers: &'a Markers,
+    cfg: &'a WriterConfig,
+    numbers: Arc<std::sync::atomic::AtomicU32>,
+    limits: dnc::TransferLimits,
+}
+
+impl Server<'_> {
+    /// Step 2 with --listen: accept transfers, each on its own thread (at most
+    /// --max-concurrent at once), until --max-transfers or a stop signal; then wait for the
+    /// transfers in progress.
+    fn serve(&self, args: &ReceiveArgs, addr: &str, total: &mut Totals) -> Result<(), Failure> {
         let addr = parse_listen(addr).map_err(Failure::Usage)?;
         let listener =
             TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
@@ -188,43 +248,23 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         if let Some(sig) = &signal {
             wake_on_signal(sig.clone(), local);
         }
-        let numbers = writer.numbers();
         let (done_tx, done) = std::sync::mpsc::channel();
         let mut active = 0usize;
         let mut accepted = 0usize;
-        // Whatever a transfer came to: filed programs, or refused with its reason (a name
-        // the disk refuses, a full disk); the port keeps serving the others.
-        let settle = |r: Result<TransferReport, dnc::DncError>, total: &mut Totals| match r {
-            Ok(r) => total.add(&r),
-            Err(e) => {
-                say(format_args!("ncchannel receive: transfer refused: {e}"));
-                total.refused += 1;
-            }
-        };
         while args.max_transfers.is_none_or(|m| accepted < m) {
             while active >= usize::from(args.max_concurrent) {
                 match done.recv() {
-                    Ok(r) => settle(r, &mut total),
+                    Ok(r) => settle(r, total),
                     Err(_) => break,
                 }
                 active -= 1;
             }
             while let Ok(r) = done.try_recv() {
-                settle(r, &mut total);
+                settle(r, total);
                 active -= 1;
             }
-            let (stream, peer) = match listener.accept() {
-                Ok(s) => s,
-                Err(e) => {
-                    if !matches!(
-                        e.kind(),
-                        io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
-                    ) {
-                        say(format_args!("ncchannel receive: accept on {local}: {e}"));
-                        std::thread::sleep(Duration::from_millis(50));
-                    }
-                    continue;
-                }
+            let Some((stream, peer)) = accept(&listener, local) else {
+                continue;
             };
             // After a signal, the wake-up connection is not a transfer.
             if signal
@@ -234,57 +274,78 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
                 break;
             }
             accepted += 1;
-            let (markers, cfg, numbers, tx) = (
-                markers.clone(),
-                cfg.clone(),
-                Arc::clone(&numbers),
-                done_tx.clone(),
-            );
-            let spawned = std::thread::Builder::new()
-                .name(format!("receive-{peer}"))
-                .spawn(move || {
-                    let mut splitter = Splitter::new(markers);
-                    let mut writer = ProgramWriter::new(cfg)
-                        .with_log(log_line)
-                        .with_numbers(numbers);
-                    let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
-                    let _ = tx.send(r);
-                });
-            match spawned {
+            match self.spawn_transfer(stream, peer, done_tx.clone()) {
                 Ok(_) => active += 1,
-                Err(e) => settle(Err(dnc::DncError::io(peer.to_string(), e)), &mut total),
+                Err(e) => settle(Err(dnc::DncError::io(peer.to_string(), e)), total),
             }
         }
         // The transfers in progress complete (each within its idle timeout).
         drop(done_tx);
         while active > 0 {
             match done.recv() {
-                Ok(r) => settle(r, &mut total),
+                Ok(r) => settle(r, total),
                 Err(_) => break,
             }
             active -= 1;
         }
-    } else {
-        let report = match args.input.as_deref() {
-            None => dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?,
-            Some(p) if p == Path::new("-") => {
-                dnc::receive_limited(io::stdin().lock(), &limits, &mut splitter, &mut writer)?
-            }
-            Some(p) => {
-                let f = File::open(p).map_err(|e| Failure::Io(format!("{}: {e}", p.display())))?;
-                dnc::receive_limited(f, &limits, &mut splitter, &mut writer)?
-            }
-        };
-        total.add(&report);
+        Ok(())
     }
-    total.print(&out);
-    Ok(
-        if total.filed > 0 && total.cut_off == 0 && total.refused == 0 {
-            exit::OK
-        } else {
-            exit::CHANNEL_ERROR
-        },
-    )
+
+    /// One accepted connection received on its own thread, with its own splitter and
+    /// writer; its outcome is sent on `tx`.
+    fn spawn_transfer(
+        &self,
+        stream: std::net::TcpStream,
+        peer: SocketAddr,
+        tx: std::sync::mpsc::Sender<Result<TransferReport, dnc::DncError>>,
+    ) -> io::Result<std::thread::JoinHandle<()>> {
+        let (markers, cfg, numbers, limits) = (
+            self.markers.clone(),
+            self.cfg.clone(),
+            Arc::clone(&self.numbers),
+            self.limits,
+        );
+        std::thread::Builder::new()
+            .name(format!("receive-{peer}"))
+            .spawn(move || {
+                let mut splitter = Splitter::new(markers);
+                let mut writer = ProgramWriter::new(cfg)
+                    .with_log(log_line)
+                    .with_numbers(numbers);
+                let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
+                let _ = tx.send(r);
+            })
+    }
+}
+
+/// Whatever a transfer came to: filed programs, or refused with its reason (a name the disk
+/// refuses, a full disk); the port keeps serving the others.
+fn settle(r: Result<TransferReport, dnc::DncError>, total: &mut Totals) {
+    match r {
+        Ok(r) => total.add(&r),
+        Err(e) => {
+            say(format_args!("ncchannel receive: transfer refused: {e}"));
+            total.refused += 1;
+        }
+    }
+}
+
+/// The next connection, or `None` when accept failed (reported unless merely interrupted
+/// or aborted by the peer, with a short pause so a persistent failure cannot spin).
+fn accept(listener: &TcpListener, local: SocketAddr) -> Option<(std::net::TcpStream, SocketAddr)> {
+    match listener.accept() {
+        Ok(s) => Some(s),
+        Err(e) => {
+            if !matches!(
+                e.kind(),
+                io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
+            ) {
+                say(format_args!("ncchannel receive: accept on {local}: {e}"));
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            None
+        }
+    }
 }
 
 /// A blocking `accept` does not return for a signal; once the stop flag is set, one

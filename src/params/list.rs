@@ -315,35 +315,57 @@ fn ends_token(c: char) -> bool {
 
 /// Parse one line (without line end). `Ok(None)` for blank and comment lines.
 fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
-    let off = |rest: &str| line.len() - rest.len();
-    let err = |rest: &str, message: String| LineError {
+    let (rest, _) = blanks(line).map_err(|_| line_error(line, line, "unreadable line".into()))?;
+    if is_comment(line, rest)? {
+        return Ok(None);
+    }
+    let name_off = line.len() - rest.len();
+    let (name, cur) = parse_name(line, rest)?;
+    let (value, value_off) = parse_value(line, &name.text, cur)?;
+    Ok(Some(ParsedLine {
+        name,
+        name_off,
+        value,
+        value_off,
+    }))
+}
+
+/// A line error at `rest`, the unread tail of `line` (its offset is where `rest` starts).
+fn line_error(line: &str, rest: &str, message: String) -> LineError {
+    LineError {
         offset: line.len() - rest.len(),
         message,
-    };
+    }
+}
 
-    let (rest, _) = blanks(line).map_err(|_| err(line, "unreadable line".into()))?;
+/// Line step 1: whether the line (from its first non-blank, `rest`) is blank or a comment;
+/// a `#` glued to text is an error, not a comment.
+fn is_comment(line: &str, rest: &str) -> Result<bool, LineError> {
     if rest.is_empty() {
-        return Ok(None);
+        return Ok(true);
     }
     // Comments: `#` followed by a blank or nothing (the ISG rule); also `#` runs and rulers
     // such as `#####` or `#----`, and `;` lines as in the source documents' examples.
     if let Some(after) = rest.strip_prefix('#') {
         match after.chars().next() {
-            None | Some(' ' | '\t' | '#' | '-' | '=' | '*') => return Ok(None),
+            None | Some(' ' | '\t' | '#' | '-' | '=' | '*') => return Ok(true),
             Some(_) => {
-                return Err(err(
+                return Err(line_error(
+                    line,
                     rest,
                     "`#` starts a comment only when a blank follows it".into(),
                 ))
             }
         }
     }
-    if rest.starts_with(';') {
-        return Ok(None);
-    }
+    Ok(rest.starts_with(';'))
+}
 
-    // Name: segments separated by dots.
-    let name_off = off(rest);
+/// Line step 2: the name, segments separated by dots, each with an optional `[index]`;
+/// returns it with the rest of the line after it.
+fn parse_name<'a>(line: &'a str, rest: &'a str) -> Result<(Name, &'a str), LineError> {
+    let err = |rest: &str, message: String| line_error(line, rest, message);
+    let name_off = line.len() - rest.len();
     let mut segments = Vec::new();
     let mut cur = rest;
     loop {
@@ -391,12 +413,18 @@ fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
             }
         }
     }
-    let name_text = &line[name_off..off(cur)];
+    let name_text = &line[name_off..line.len() - cur.len()];
     let name = Name {
         text: name_text.to_string(),
         segments,
     };
+    Ok((name, cur))
+}
 
+/// Line step 3: the blank(s) after the name, then the value (quoted string, number or
+/// word) and what may follow it; returns the value with its offset in the line.
+fn parse_value(line: &str, name_text: &str, cur: &str) -> Result<(Value, usize), LineError> {
+    let err = |rest: &str, message: String| line_error(line, rest, message);
     // Blank(s) between name and value.
     let (value_start, sep) = blanks(cur).map_err(|_| err(cur, "unreadable line".into()))?;
     if sep.is_empty() {
@@ -413,7 +441,7 @@ fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
     if value_start.is_empty() {
         return Err(err(value_start, format!("`{name_text}` has no value")));
     }
-    let value_off = off(value_start);
+    let value_off = line.len() - value_start.len();
 
     // Quoted string: up to the closing quote; a `(` comment may follow.
     if let Some(body) = value_start.strip_prefix('"') {
@@ -423,15 +451,11 @@ fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
         let text = &body[..end];
         let after = &body[end + 1..];
         check_string_tail(after).map_err(|at| err(at, tail_message()))?;
-        return Ok(Some(ParsedLine {
-            name,
-            name_off,
-            value: Value {
-                kind: ValueKind::Quoted,
-                text: text.to_string(),
-            },
-            value_off,
-        }));
+        let value = Value {
+            kind: ValueKind::Quoted,
+            text: text.to_string(),
+        };
+        return Ok((value, value_off));
     }
     if value_start.starts_with('(') {
         return Err(err(
@@ -452,28 +476,20 @@ fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
         if after_tok.starts_with('"') {
             return Err(err(after_tok, "unexpected `\"` after a number".into()));
         }
-        return Ok(Some(ParsedLine {
-            name,
-            name_off,
-            value: Value {
-                kind,
-                text: num.to_string(),
-            },
-            value_off,
-        }));
+        let value = Value {
+            kind,
+            text: num.to_string(),
+        };
+        return Ok((value, value_off));
     }
 
     // Unquoted word: only blanks or a `(` comment may follow.
     check_string_tail(after_tok).map_err(|at| err(at, tail_message()))?;
-    Ok(Some(ParsedLine {
-        name,
-        name_off,
-        value: Value {
-            kind: ValueKind::Word,
-            text: token.to_string(),
-        },
-        value_off,
-    }))
+    let value = Value {
+        kind: ValueKind::Word,
+        text: token.to_string(),
+    };
+    Ok((value, value_off))
 }
 
 fn first_char(s: &str) -> char {

@@ -354,6 +354,15 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
         errs.push(d);
     };
 
+    validate_timing(cfg, &mut fail);
+    validate_axes(cfg, &mut fail);
+    validate_decoder_planner(cfg, &mut fail);
+    validate_ads(cfg, &mut fail);
+    errs
+}
+
+/// Validation step 1: the cycle period and the simulated file-system latencies.
+fn validate_timing(cfg: &RuntimeConfig, fail: &mut impl FnMut(&str, Option<usize>, &str, String)) {
     if cfg.cycle_period_us == 0 || cfg.cycle_period_us > 1_000_000 {
         fail(
             "",
@@ -370,7 +379,10 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             fail("", None, key, format!("{v} µs is more than 10 s"));
         }
     }
+}
 
+/// Validation step 2: the axis count, then each axis ([`validate_axis`]).
+fn validate_axes(cfg: &RuntimeConfig, fail: &mut impl FnMut(&str, Option<usize>, &str, String)) {
     if cfg.axes.is_empty() || cfg.axes.len() > MAX_AXES {
         fail(
             "",
@@ -380,77 +392,93 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
         );
     }
     for (i, a) in cfg.axes.iter().enumerate().take(MAX_AXES) {
-        let at = Some(i);
-        // The one rule `setup` relies on: a name is one of the interpolator's axis letters,
-        // so `check` refuses exactly what `run` could not build.
-        let name_ok = a.name.trim().len() == 1
-            && AXIS_LETTERS
-                .iter()
-                .any(|&l| a.name.trim().eq_ignore_ascii_case(&(l as char).to_string()));
-        if !name_ok {
-            fail(
-                "axes",
-                at,
-                "name",
-                format!(
-                    "`{}` is not an axis name ncchannel drives (one of X Y Z A B C)",
-                    a.name
-                ),
-            );
-        }
-        if cfg.axes[..i]
+        validate_axis(cfg, i, a, fail);
+    }
+}
+
+/// Validation step 2, per axis: its name, uniqueness, limits of motion and soft limits.
+fn validate_axis(
+    cfg: &RuntimeConfig,
+    i: usize,
+    a: &AxisConfig,
+    fail: &mut impl FnMut(&str, Option<usize>, &str, String),
+) {
+    let at = Some(i);
+    // The one rule `setup` relies on: a name is one of the interpolator's axis letters,
+    // so `check` refuses exactly what `run` could not build.
+    let name_ok = a.name.trim().len() == 1
+        && AXIS_LETTERS
             .iter()
-            .any(|b| b.name.eq_ignore_ascii_case(&a.name))
-        {
-            fail(
-                "axes",
-                at,
-                "name",
-                format!("axis `{}` is defined twice", a.name),
-            );
-        }
-        let positive = [
-            ("max_velocity_mm_per_min", Some(a.max_velocity_mm_per_min)),
-            (
-                "max_acceleration_mm_per_s2",
-                Some(a.max_acceleration_mm_per_s2),
+            .any(|&l| a.name.trim().eq_ignore_ascii_case(&(l as char).to_string()));
+    if !name_ok {
+        fail(
+            "axes",
+            at,
+            "name",
+            format!(
+                "`{}` is not an axis name ncchannel drives (one of X Y Z A B C)",
+                a.name
             ),
-            ("max_jerk_mm_per_s3", a.max_jerk_mm_per_s3),
-            ("rapid_mm_per_min", Some(a.rapid_mm_per_min)),
-        ];
-        for (key, v) in positive {
-            if let Some(v) = v {
-                if !(v.is_finite() && v > 0.0) {
-                    fail("axes", at, key, format!("{v} must be a positive number"));
-                }
+        );
+    }
+    if cfg.axes[..i]
+        .iter()
+        .any(|b| b.name.eq_ignore_ascii_case(&a.name))
+    {
+        fail(
+            "axes",
+            at,
+            "name",
+            format!("axis `{}` is defined twice", a.name),
+        );
+    }
+    let positive = [
+        ("max_velocity_mm_per_min", Some(a.max_velocity_mm_per_min)),
+        (
+            "max_acceleration_mm_per_s2",
+            Some(a.max_acceleration_mm_per_s2),
+        ),
+        ("max_jerk_mm_per_s3", a.max_jerk_mm_per_s3),
+        ("rapid_mm_per_min", Some(a.rapid_mm_per_min)),
+    ];
+    for (key, v) in positive {
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                fail("axes", at, key, format!("{v} must be a positive number"));
             }
         }
-        if a.max_velocity_mm_per_min > 0.0 && a.rapid_mm_per_min > a.max_velocity_mm_per_min {
-            fail(
-                "axes",
-                at,
-                "rapid_mm_per_min",
-                format!(
-                    "{} mm/min is above max_velocity_mm_per_min {}",
-                    a.rapid_mm_per_min, a.max_velocity_mm_per_min
-                ),
-            );
-        }
-        if !(a.soft_limit_min_mm.is_finite() && a.soft_limit_max_mm.is_finite())
-            || a.soft_limit_min_mm >= a.soft_limit_max_mm
-        {
-            fail(
-                "axes",
-                at,
-                "soft_limit_max_mm",
-                format!(
-                    "soft limits {} ... {} mm: min must be below max",
-                    a.soft_limit_min_mm, a.soft_limit_max_mm
-                ),
-            );
-        }
     }
+    if a.max_velocity_mm_per_min > 0.0 && a.rapid_mm_per_min > a.max_velocity_mm_per_min {
+        fail(
+            "axes",
+            at,
+            "rapid_mm_per_min",
+            format!(
+                "{} mm/min is above max_velocity_mm_per_min {}",
+                a.rapid_mm_per_min, a.max_velocity_mm_per_min
+            ),
+        );
+    }
+    if !(a.soft_limit_min_mm.is_finite() && a.soft_limit_max_mm.is_finite())
+        || a.soft_limit_min_mm >= a.soft_limit_max_mm
+    {
+        fail(
+            "axes",
+            at,
+            "soft_limit_max_mm",
+            format!(
+                "soft limits {} ... {} mm: min must be below max",
+                a.soft_limit_min_mm, a.soft_limit_max_mm
+            ),
+        );
+    }
+}
 
+/// Validation step 3: decoder and planner sizes.
+fn validate_decoder_planner(
+    cfg: &RuntimeConfig,
+    fail: &mut impl FnMut(&str, Option<usize>, &str, String),
+) {
     for (key, v, max) in [
         ("blocks_per_tick", cfg.decoder.blocks_per_tick, 1_000_000),
         ("buffer_blocks", cfg.decoder.buffer_blocks, 1_000_000),
@@ -482,6 +510,10 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             format!("{cs} is not in 0 ... 1000"),
         );
     }
+}
+
+/// Validation step 4: the ADS server's frame size, connection and notification limits.
+fn validate_ads(cfg: &RuntimeConfig, fail: &mut impl FnMut(&str, Option<usize>, &str, String)) {
     let fb = cfg.ads.max_frame_bytes;
     // An AMS/TCP header (6) plus an AMS header (32) must fit; 16 MiB bounds one allocation.
     if !(64..=16 * 1024 * 1024).contains(&fb) {
@@ -515,7 +547,6 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
             fail("ads", None, key, format!("{v} is not in 1 ... {max}"));
         }
     }
-    errs
 }
 
 #[cfg(test)]

@@ -175,32 +175,11 @@ impl<'a> PathCollector<'a> {
                     }
                 },
             };
-            let mut clash = false;
-            for bit in [MAIN_PROGRAMS, SUBROUTINES, MSG_SAVE, DEBUG_DATA] {
-                if kinds & bit == 0 {
-                    continue;
-                }
-                if let Some(first) = claimed.get(&(bit, priority)) {
-                    let pos = if raw.priority.is_some() {
-                        prio_entry.value_pos
-                    } else {
-                        prio_entry.name_pos
-                    };
-                    diags.push(list.error_at(
-                        prio_entry,
-                        pos,
-                        format!(
-                            "{}: priority {priority} is already used by another path of type \
-                             0x{bit:02x} ({}, line {}); two paths of one type need different priorities",
-                            prio_entry.name.text, first.name.text, first.name_pos.line
-                        ),
-                    ));
-                    clash = true;
-                    break;
-                }
-                claimed.insert((bit, priority), dir_entry);
-            }
-            if clash {
+            if let Err((bit, first)) = claim_types(&mut claimed, dir_entry, kinds, priority) {
+                let explicit = raw.priority.is_some();
+                diags.push(priority_clash(
+                    list, prio_entry, explicit, priority, bit, first,
+                ));
                 continue;
             }
             out.push((
@@ -218,6 +197,53 @@ impl<'a> PathCollector<'a> {
         out.sort_by_key(|(prio, index, _)| (*prio, *index));
         out.into_iter().map(|(_, _, p)| p).collect()
     }
+}
+
+/// Claim each type bit of `kinds` at `priority` for `dir_entry`, in bit order; the first
+/// bit another path already holds at that priority is returned with that path's entry (bits
+/// before it stay claimed).
+fn claim_types<'a>(
+    claimed: &mut BTreeMap<(u16, u16), &'a Entry>,
+    dir_entry: &'a Entry,
+    kinds: u16,
+    priority: u16,
+) -> Result<(), (u16, &'a Entry)> {
+    for bit in [MAIN_PROGRAMS, SUBROUTINES, MSG_SAVE, DEBUG_DATA] {
+        if kinds & bit == 0 {
+            continue;
+        }
+        if let Some(first) = claimed.get(&(bit, priority)) {
+            return Err((bit, *first));
+        }
+        claimed.insert((bit, priority), dir_entry);
+    }
+    Ok(())
+}
+
+/// The error for two paths of one type at one priority, at the priority's value (or the
+/// folder's name when the priority is the default).
+fn priority_clash(
+    list: &ParamList,
+    prio_entry: &Entry,
+    explicit: bool,
+    priority: u16,
+    bit: u16,
+    first: &Entry,
+) -> Diagnostic {
+    let pos = if explicit {
+        prio_entry.value_pos
+    } else {
+        prio_entry.name_pos
+    };
+    list.error_at(
+        prio_entry,
+        pos,
+        format!(
+            "{}: priority {priority} is already used by another path of type \
+             0x{bit:02x} ({}, line {}); two paths of one type need different priorities",
+            prio_entry.name.text, first.name.text, first.name_pos.line
+        ),
+    )
 }
 
 /// The folder a list's relative paths are relative to.

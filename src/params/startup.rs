@@ -2,7 +2,7 @@
 //! each channel's list, program search paths and decoder settings per channel.
 
 use std::collections::{BTreeMap, HashMap};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::decoder::{DecoderField, DecoderParams};
 use super::list::{Entry, ParamList};
@@ -93,8 +93,46 @@ pub(crate) fn warn_unknown(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnost
 pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> StartupList {
     warn_duplicates(&list, diags);
     let base = list_folder(&list.file);
+    let channel_count = read_channel_count(&list, diags);
+    // Without a valid count, indices are still checked against the kernel's maximum.
+    let bound = channel_count.unwrap_or(MAX_CHANNELS);
 
-    let channel_count = match list.get("kanal_anzahl") {
+    let mut g = Gathered::default();
+    for e in &list.entries {
+        let s = shape(e);
+        if channel_out_of_range(&list, e, &s, bound, channel_count, diags) {
+            continue;
+        }
+        g.take(&list, &base, e, &s, diags);
+    }
+    let Gathered {
+        channel_lists,
+        zero_offset_lists,
+        zero_offset_default,
+        decoder,
+        collectors,
+    } = g;
+
+    let search_paths = collectors
+        .into_iter()
+        .map(|(i, c)| (i, c.finish(&list, &base, diags)))
+        .collect();
+    check_channel_lists(&list, channel_count, &channel_lists, diags);
+
+    StartupList {
+        list,
+        channel_count,
+        channel_lists,
+        search_paths,
+        decoder,
+        zero_offset_lists,
+        zero_offset_default,
+    }
+}
+
+/// Step 1: `kanal_anzahl`, which must be there and name at least one channel.
+fn read_channel_count(list: &ParamList, diags: &mut Vec<Diagnostic>) -> Option<u32> {
+    match list.get("kanal_anzahl") {
         None => {
             diags.push(Diagnostic::error(
                 &list.file,
@@ -105,7 +143,7 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
             ));
             None
         }
-        Some(e) => match uint_value(&list, e, u64::from(MAX_CHANNELS)) {
+        Some(e) => match uint_value(list, e, u64::from(MAX_CHANNELS)) {
             Ok(0) => {
                 diags.push(list.error_at(
                     e,
@@ -120,125 +158,174 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
                 None
             }
         },
+    }
+}
+
+/// Step 2a: a known per-channel name whose channel index is not below the count (or the
+/// kernel's maximum) is an error and the entry is skipped (`true`).
+fn channel_out_of_range(
+    list: &ParamList,
+    e: &Entry,
+    s: &[(&str, Option<u32>)],
+    bound: u32,
+    channel_count: Option<u32>,
+    diags: &mut Vec<Diagnostic>,
+) -> bool {
+    let channel = match s {
+        [("sda_mds" | "zero_offset_list", Some(i))]
+        | [("pfad", Some(i)), (_, Some(_))]
+        | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
+        _ => None,
     };
-    // Without a valid count, indices are still checked against the kernel's maximum.
-    let bound = channel_count.unwrap_or(MAX_CHANNELS);
-
-    let mut channel_lists = BTreeMap::new();
-    let mut zero_offset_lists = BTreeMap::new();
-    let mut zero_offset_default = None;
-    let mut decoder: BTreeMap<u32, DecoderParams> = BTreeMap::new();
-    let mut collectors: BTreeMap<u32, PathCollector> = BTreeMap::new();
-
-    for e in &list.entries {
-        let s = shape(e);
-        let channel = match s.as_slice() {
-            [("sda_mds" | "zero_offset_list", Some(i))]
-            | [("pfad", Some(i)), (_, Some(_))]
-            | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
-            _ => None,
-        };
-        if let Some(i) = channel {
-            if i >= bound {
-                let why = match channel_count {
-                    Some(n) => format!("not below kanal_anzahl {n}"),
-                    None => format!("not below the maximum of {MAX_CHANNELS} channels"),
-                };
-                // Only indices of names we know; an unknown name is a warning below.
-                if is_known_startup_name(&s) {
-                    diags.push(list.error_at(
-                        e,
-                        e.name_pos,
-                        format!("{}: channel index {i} is {why}", e.name.text),
-                    ));
-                    continue;
-                }
+    if let Some(i) = channel {
+        if i >= bound {
+            let why = match channel_count {
+                Some(n) => format!("not below kanal_anzahl {n}"),
+                None => format!("not below the maximum of {MAX_CHANNELS} channels"),
+            };
+            // Only indices of names we know; an unknown name is a warning below.
+            if is_known_startup_name(s) {
+                diags.push(list.error_at(
+                    e,
+                    e.name_pos,
+                    format!("{}: channel index {i} is {why}", e.name.text),
+                ));
+                return true;
             }
         }
-        match s.as_slice() {
+    }
+    false
+}
+
+/// What the entries of a start-up list name, gathered entry by entry (step 2).
+#[derive(Default)]
+struct Gathered<'l> {
+    channel_lists: BTreeMap<u32, ChannelListRef>,
+    zero_offset_lists: BTreeMap<u32, ChannelListRef>,
+    zero_offset_default: Option<ChannelListRef>,
+    decoder: BTreeMap<u32, DecoderParams>,
+    collectors: BTreeMap<u32, PathCollector<'l>>,
+}
+
+impl<'l> Gathered<'l> {
+    /// Step 2b: one entry (its channel index already checked) read into what it names;
+    /// a name the emulator does not know is warned about and kept out.
+    fn take(
+        &mut self,
+        list: &ParamList,
+        base: &Path,
+        e: &'l Entry,
+        s: &[(&str, Option<u32>)],
+        diags: &mut Vec<Diagnostic>,
+    ) {
+        match s {
             [("kanal_anzahl", None)] => {}
-            [("sda_mds", Some(i))] => match string_value(&list, e, MAX_PATH_CHARS) {
+            [("sda_mds", Some(i))] => match string_value(list, e, MAX_PATH_CHARS) {
                 Ok(p) if p.is_empty() => diags.push(list.error_at(
                     e,
                     e.value_pos,
                     format!("{}: empty channel list path", e.name.text),
                 )),
                 Ok(p) => {
-                    channel_lists.insert(
+                    self.channel_lists.insert(
                         *i,
                         ChannelListRef {
-                            path: resolve(&base, &p),
+                            path: resolve(base, &p),
                             entry: e.clone(),
                         },
                     );
                 }
                 Err(d) => diags.push(d),
             },
-            [("zero_offset_list", index)] => match string_value(&list, e, MAX_PATH_CHARS) {
-                Ok(p) if p.is_empty() => diags.push(list.error_at(
-                    e,
-                    e.value_pos,
-                    format!("{}: empty zero-offset list path", e.name.text),
-                )),
-                Ok(p) => {
-                    let r = ChannelListRef {
-                        path: resolve(&base, &p),
-                        entry: e.clone(),
-                    };
-                    match index {
-                        Some(i) => {
-                            zero_offset_lists.insert(*i, r);
-                        }
-                        None => zero_offset_default = Some(r),
-                    }
-                }
-                Err(d) => diags.push(d),
-            },
-            [("pfad", Some(i)), (field, Some(j))] => {
-                let field = match *field {
-                    "prg" => Some(PathField::Dir),
-                    "typ" => Some(PathField::Kinds),
-                    "prioritaet" => Some(PathField::Priority),
-                    "log_nr" => None,
-                    _ => {
-                        warn_unknown(&list, e, diags);
-                        continue;
-                    }
-                };
-                match field {
-                    Some(f) => collectors
-                        .entry(*i)
-                        .or_default()
-                        .add(&list, e, *j, f, diags),
-                    // Logical path number: the kernel's, meaningless here; checked, not used.
-                    None => {
-                        if let Err(d) = uint_value(&list, e, u64::from(u16::MAX)) {
-                            diags.push(d);
-                        }
-                    }
-                }
-            }
+            [("zero_offset_list", index)] => self.zero_offset_list(list, base, e, *index, diags),
+            [("pfad", Some(i)), (field, Some(j))] => self.path(list, e, *i, field, *j, diags),
             [("configuration", None), ("channel", Some(i)), ("decoder", None), (field, None)] => {
                 let field = match *field {
                     "function" => DecoderField::Function,
                     "max_cache_number" => DecoderField::MaxCacheNumber,
                     "max_cache_size" => DecoderField::MaxCacheSize,
-                    _ => {
-                        warn_unknown(&list, e, diags);
-                        continue;
-                    }
+                    _ => return warn_unknown(list, e, diags),
                 };
-                decoder.entry(*i).or_default().set(&list, e, field, diags);
+                self.decoder
+                    .entry(*i)
+                    .or_default()
+                    .set(list, e, field, diags);
             }
-            _ => warn_unknown(&list, e, diags),
+            _ => warn_unknown(list, e, diags),
         }
     }
 
-    let search_paths = collectors
-        .into_iter()
-        .map(|(i, c)| (i, c.finish(&list, &base, diags)))
-        .collect();
+    /// `zero_offset_list[i]` (channel i's) or `zero_offset_list` (every other channel's).
+    fn zero_offset_list(
+        &mut self,
+        list: &ParamList,
+        base: &Path,
+        e: &Entry,
+        index: Option<u32>,
+        diags: &mut Vec<Diagnostic>,
+    ) {
+        match string_value(list, e, MAX_PATH_CHARS) {
+            Ok(p) if p.is_empty() => diags.push(list.error_at(
+                e,
+                e.value_pos,
+                format!("{}: empty zero-offset list path", e.name.text),
+            )),
+            Ok(p) => {
+                let r = ChannelListRef {
+                    path: resolve(base, &p),
+                    entry: e.clone(),
+                };
+                match index {
+                    Some(i) => {
+                        self.zero_offset_lists.insert(i, r);
+                    }
+                    None => self.zero_offset_default = Some(r),
+                }
+            }
+            Err(d) => diags.push(d),
+        }
+    }
 
+    /// `pfad[i].<field>[j]`: channel i's search path j (folder, types, priority).
+    fn path(
+        &mut self,
+        list: &ParamList,
+        e: &'l Entry,
+        i: u32,
+        field: &str,
+        j: u32,
+        diags: &mut Vec<Diagnostic>,
+    ) {
+        let field = match field {
+            "prg" => Some(PathField::Dir),
+            "typ" => Some(PathField::Kinds),
+            "prioritaet" => Some(PathField::Priority),
+            "log_nr" => None,
+            _ => return warn_unknown(list, e, diags),
+        };
+        match field {
+            Some(f) => self
+                .collectors
+                .entry(i)
+                .or_default()
+                .add(list, e, j, f, diags),
+            // Logical path number: the kernel's, meaningless here; checked, not used.
+            None => {
+                if let Err(d) = uint_value(list, e, u64::from(u16::MAX)) {
+                    diags.push(d);
+                }
+            }
+        }
+    }
+}
+
+/// Step 3: with a valid count, every channel below it needs its channel list.
+fn check_channel_lists(
+    list: &ParamList,
+    channel_count: Option<u32>,
+    channel_lists: &BTreeMap<u32, ChannelListRef>,
+    diags: &mut Vec<Diagnostic>,
+) {
     if let (Some(n), Some(count_entry)) = (channel_count, list.get("kanal_anzahl")) {
         for i in 0..n {
             if !channel_lists.contains_key(&i) {
@@ -252,16 +339,6 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
                 ));
             }
         }
-    }
-
-    StartupList {
-        list,
-        channel_count,
-        channel_lists,
-        search_paths,
-        decoder,
-        zero_offset_lists,
-        zero_offset_default,
     }
 }
 
