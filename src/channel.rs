@@ -867,36 +867,10 @@ impl Channel {
         self.decoder_notes = notes;
     }
 
-    /// One cycle: decode, execute, report.
-    pub fn step(&mut self, tick: &Tick) {
-        if !matches!(self.state, State::Active | State::Hold) {
-            return;
-        }
-        let mut io = DecoderIo {
-            stream: &mut self.stream,
-            store: &mut self.store,
-            cache: &mut self.cache,
-            queue: &mut self.queue,
-            motion_idle: self.motion.idle(),
-            want_text: self.events.enabled(),
-            now: tick.time,
-            period: tick.period,
-        };
-        self.decoder.step(&mut io);
-        self.drain_decoder_notes(tick);
-        if self.state == State::Error {
-            return;
-        }
-        let dt = tick.period.as_secs_f64();
-        let mut notes = std::mem::take(&mut self.notes);
-        if self.hmi.single_block || !self.single_gate.is_empty() {
-            if self.hmi.single_block {
-                self.feed_single_block();
-            }
-            self.motion.step(dt, &mut self.single_gate, &mut notes);
-        } else {
-            self.motion.step(dt, &mut self.queue, &mut notes);
-        }
+    /// What the motion reported this tick, in order: block events and the active block,
+    /// flushes, programmed stops (HOLD), a planning error (ERROR, the rest dropped), the
+    /// program end (READY).
+    fn apply_motion_notes(&mut self, tick: &Tick, notes: &mut Vec<MotionNote>) {
         for n in notes.drain(..) {
             match n {
                 MotionNote::Started(info) => {
@@ -973,6 +947,39 @@ impl Channel {
                 }
             }
         }
+    }
+
+    /// One cycle: decode, execute, report.
+    pub fn step(&mut self, tick: &Tick) {
+        if !matches!(self.state, State::Active | State::Hold) {
+            return;
+        }
+        let mut io = DecoderIo {
+            stream: &mut self.stream,
+            store: &mut self.store,
+            cache: &mut self.cache,
+            queue: &mut self.queue,
+            motion_idle: self.motion.idle(),
+            want_text: self.events.enabled(),
+            now: tick.time,
+            period: tick.period,
+        };
+        self.decoder.step(&mut io);
+        self.drain_decoder_notes(tick);
+        if self.state == State::Error {
+            return;
+        }
+        let dt = tick.period.as_secs_f64();
+        let mut notes = std::mem::take(&mut self.notes);
+        if self.hmi.single_block || !self.single_gate.is_empty() {
+            if self.hmi.single_block {
+                self.feed_single_block();
+            }
+            self.motion.step(dt, &mut self.single_gate, &mut notes);
+        } else {
+            self.motion.step(dt, &mut self.queue, &mut notes);
+        }
+        self.apply_motion_notes(tick, &mut notes);
         self.notes = notes;
         if self.hmi.single_block
             && self.state == State::Active

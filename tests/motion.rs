@@ -501,10 +501,9 @@ fn reset_stops_at_once_and_forgets_the_window() {
     assert_eq!(m.position()[0], x);
 }
 
-#[test]
-fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
-    // Different limits per axis, so the projections matter.
-    let limits = vec![
+/// Different limits per axis, so the projections matter.
+fn mixed_limits() -> Vec<AxisLimits> {
+    vec![
         AxisLimits {
             index: 0,
             max_velocity_mm_per_min: 12000.0,
@@ -532,7 +531,12 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             min_mm: -1e6,
             max_mm: 1e6,
         },
-    ];
+    ]
+}
+
+#[test]
+fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
+    let limits = mixed_limits();
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
     let mut m = Motion::with_planner(
         limits.clone(),

@@ -473,13 +473,64 @@ pub fn machine_requests(data: &[u8]) {
     }
 }
 
+/// The request of a step that is one request as it is; `None` for the steps the caller
+/// handles itself (`Ticks`, `GiveUp`, `Start`, `Lines`).
+fn plain_op(step: ClientStep) -> Option<ncchannel::machine::Op> {
+    use ncchannel::machine::{HmiOp, Op};
+    Some(match step {
+        // No N in raw data: only the generated lines carry block numbers, so the order
+        // check knows every numbered line and whether its write was accepted.
+        ClientStep::Raw(mut bytes) => {
+            bytes.retain(|b| !matches!(b, b'N' | b'n'));
+            Op::WriteStream(bytes)
+        }
+        ClientStep::Mode(v) => Op::CommandMode(i32::from(v)),
+        ClientStep::State(v) => Op::CommandState(i32::from(v)),
+        ClientStep::Program(name) => Op::SetProgram(name),
+        ClientStep::Hold => Op::Hold,
+        ClientStep::Resume => Op::Resume,
+        ClientStep::Reset => Op::Reset,
+        ClientStep::Override(p) => Op::SetOverride(f64::from(p)),
+        ClientStep::WriteExternal(name, v) => Op::WriteExternal(format!("V{name}"), f64::from(v)),
+        ClientStep::ReadExternal(name) => Op::ReadExternal(format!("V{name}")),
+        ClientStep::Status => Op::Status,
+        ClientStep::ErrorRecord(i) => Op::ErrorRecord(u64::from(i)),
+        ClientStep::SingleBlock(on) => Op::Hmi(HmiOp::SingleBlock(on)),
+        ClientStep::OptionalStop(on) => Op::Hmi(HmiOp::OptionalStop(on)),
+        ClientStep::SkipLevels(m) => Op::Hmi(HmiOp::SkipLevels(m)),
+        ClientStep::ExecutionMode(m) => Op::Hmi(HmiOp::ExecutionMode(i32::from(m))),
+        ClientStep::ResetCycleTimes => Op::Hmi(HmiOp::ResetCycleTimes),
+        ClientStep::Ticks(_)
+        | ClientStep::GiveUp
+        | ClientStep::Start
+        | ClientStep::Lines { .. } => return None,
+    })
+}
+
+/// A packet of up to 40 numbered G01 lines (numbers from `next_n`, never reused), with a
+/// `#FLUSH` after them if asked; the packet and its N numbers.
+fn lines_packet(next_n: &mut u32, lines: u8, x: i8, feed: u8, flush: bool) -> (Vec<u8>, Vec<u32>) {
+    let mut packet = Vec::new();
+    let mut ns = Vec::new();
+    for j in 0..lines.min(40) {
+        let n = *next_n;
+        *next_n += 1;
+        ns.push(n);
+        let x = i32::from(x) + i32::from(j);
+        let f = 1000 + u32::from(feed) * 100;
+        packet.extend_from_slice(format!("N{n} G01 X{x} F{f}\r\n").as_bytes());
+    }
+    if flush {
+        packet.extend_from_slice(b"#FLUSH\r\n");
+    }
+    (packet, ns)
+}
+
 /// [`machine_requests`] over steps given directly; returns how many numbered stream lines
 /// were executed (so a test can tell that its sequence reached the interpolator).
 pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
-    use ncchannel::machine::{HmiOp, Machine, Op, Reply, StopWhen};
+    use ncchannel::machine::{Machine, Op, Reply, StopWhen};
     use ncchannel::report::event::EventLog;
-    use ncchannel::runtime::{Cycle, Tick};
-
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
     };
@@ -495,50 +546,12 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
     }
     let period = std::time::Duration::from_micros(config.runtime.cycle_period_us);
     let mut k: u64 = 0;
-    let tick = |index: u64| Tick {
-        index,
-        period,
-        time: period * u32::try_from(index).unwrap_or(u32::MAX),
-    };
-    // N numbers of the lines written so far (never reused), and of those accepted.
+    let tick = |index: u64| tick_at(period, index);
+    // N numbers of the lines written so far (never reused).
     let mut next_n: u32 = 1;
-    let mut accepted: std::collections::BTreeSet<u32> = Default::default();
-    let mut last_executed: u32 = 0;
-    let executed = std::cell::Cell::new(0usize);
+    let mut seen = Observed::default();
     let mut give_up = false;
     let (tx, rx) = crossbeam_channel::unbounded::<Reply>();
-
-    let run_ticks = |machine: &mut Machine,
-                     n: u64,
-                     k: &mut u64,
-                     last: &mut u32,
-                     acc: &std::collections::BTreeSet<u32>| {
-        for _ in 0..n {
-            if *k >= MAX_MACHINE_TICKS {
-                return;
-            }
-            *k += 1;
-            let began = std::time::Instant::now();
-            let _ = machine.step(&tick(*k));
-            let took = began.elapsed();
-            assert!(took <= MAX_TICK, "tick {k} took {took:?}");
-            if let Some(c) = machine.channel_mut(1) {
-                for b in c.drain_executed() {
-                    let Some(n) = b.n else { continue };
-                    assert!(
-                        acc.contains(&n),
-                        "N{n} executed but its write was not accepted"
-                    );
-                    assert!(
-                        n > *last,
-                        "N{n} executed after N{last}: out of order or twice"
-                    );
-                    *last = n;
-                    executed.set(executed.get() + 1);
-                }
-            }
-        }
-    };
 
     for step in steps.into_iter().take(2_000) {
         if k >= MAX_MACHINE_TICKS {
@@ -546,13 +559,7 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
         }
         let op = match step {
             ClientStep::Ticks(n) => {
-                run_ticks(
-                    &mut machine,
-                    u64::from(n),
-                    &mut k,
-                    &mut last_executed,
-                    &accepted,
-                );
+                run_ticks(&mut machine, period, u64::from(n), &mut k, &mut seen);
                 continue;
             }
             ClientStep::GiveUp => {
@@ -575,64 +582,82 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
                 feed,
                 flush,
             } => {
-                let mut packet = Vec::new();
-                let mut ns = Vec::new();
-                for j in 0..lines.min(40) {
-                    let n = next_n;
-                    next_n += 1;
-                    ns.push(n);
-                    let x = i32::from(x) + i32::from(j);
-                    let f = 1000 + u32::from(feed) * 100;
-                    packet.extend_from_slice(format!("N{n} G01 X{x} F{f}\r\n").as_bytes());
-                }
-                if flush {
-                    packet.extend_from_slice(b"#FLUSH\r\n");
-                }
+                let (packet, ns) = lines_packet(&mut next_n, lines, x, feed, flush);
                 let op = Op::WriteStream(packet);
                 let (reply, applied) = serve_request(&mut machine, &tick(k), op, &tx, &rx, give_up);
                 give_up = false;
                 if applied && matches!(reply, Some(Reply::Stream(Ok(())))) {
-                    accepted.extend(ns);
+                    seen.accepted.extend(ns);
                 }
                 continue;
             }
-            // No N in raw data: only the generated lines carry block numbers, so the order
-            // check knows every numbered line and whether its write was accepted.
-            ClientStep::Raw(mut bytes) => {
-                bytes.retain(|b| !matches!(b, b'N' | b'n'));
-                Op::WriteStream(bytes)
-            }
-            ClientStep::Mode(v) => Op::CommandMode(i32::from(v)),
-            ClientStep::State(v) => Op::CommandState(i32::from(v)),
-            ClientStep::Program(name) => Op::SetProgram(name),
-            ClientStep::Hold => Op::Hold,
-            ClientStep::Resume => Op::Resume,
-            ClientStep::Reset => Op::Reset,
-            ClientStep::Override(p) => Op::SetOverride(f64::from(p)),
-            ClientStep::WriteExternal(name, v) => {
-                Op::WriteExternal(format!("V{name}"), f64::from(v))
-            }
-            ClientStep::ReadExternal(name) => Op::ReadExternal(format!("V{name}")),
-            ClientStep::Status => Op::Status,
-            ClientStep::ErrorRecord(i) => Op::ErrorRecord(u64::from(i)),
-            ClientStep::SingleBlock(on) => Op::Hmi(HmiOp::SingleBlock(on)),
-            ClientStep::OptionalStop(on) => Op::Hmi(HmiOp::OptionalStop(on)),
-            ClientStep::SkipLevels(m) => Op::Hmi(HmiOp::SkipLevels(m)),
-            ClientStep::ExecutionMode(m) => Op::Hmi(HmiOp::ExecutionMode(i32::from(m))),
-            ClientStep::ResetCycleTimes => Op::Hmi(HmiOp::ResetCycleTimes),
+            step => match plain_op(step) {
+                Some(op) => op,
+                None => continue,
+            },
         };
         let _ = serve_request(&mut machine, &tick(k), op, &tx, &rx, give_up);
         give_up = false;
     }
     // The rest of the program runs out without a client.
-    run_ticks(
-        &mut machine,
-        MAX_MACHINE_TICKS,
-        &mut k,
-        &mut last_executed,
-        &accepted,
-    );
-    executed.get()
+    run_ticks(&mut machine, period, MAX_MACHINE_TICKS, &mut k, &mut seen);
+    seen.executed
+}
+
+/// What the order check knows: the N numbers of accepted writes, the last executed one and
+/// how many executed.
+#[derive(Default)]
+struct Observed {
+    accepted: std::collections::BTreeSet<u32>,
+    last: u32,
+    executed: usize,
+}
+
+/// Tick `index` of a cycle of `period`.
+fn tick_at(period: std::time::Duration, index: u64) -> ncchannel::runtime::Tick {
+    ncchannel::runtime::Tick {
+        index,
+        period,
+        time: period * u32::try_from(index).unwrap_or(u32::MAX),
+    }
+}
+
+/// Run `n` ticks (at most up to `MAX_MACHINE_TICKS` in all): each within `MAX_TICK`, and every
+/// numbered stream line executed was accepted, once, in order.
+fn run_ticks(
+    machine: &mut ncchannel::machine::Machine,
+    period: std::time::Duration,
+    n: u64,
+    k: &mut u64,
+    seen: &mut Observed,
+) {
+    use ncchannel::runtime::Cycle;
+    for _ in 0..n {
+        if *k >= MAX_MACHINE_TICKS {
+            return;
+        }
+        *k += 1;
+        let began = std::time::Instant::now();
+        let _ = machine.step(&tick_at(period, *k));
+        let took = began.elapsed();
+        assert!(took <= MAX_TICK, "tick {k} took {took:?}");
+        if let Some(c) = machine.channel_mut(1) {
+            for b in c.drain_executed() {
+                let Some(n) = b.n else { continue };
+                assert!(
+                    seen.accepted.contains(&n),
+                    "N{n} executed but its write was not accepted"
+                );
+                let last = seen.last;
+                assert!(
+                    n > last,
+                    "N{n} executed after N{last}: out of order or twice"
+                );
+                seen.last = n;
+                seen.executed += 1;
+            }
+        }
+    }
 }
 
 /// Serve one request as the runtime does; returns its reply and whether it was applied.

@@ -59,6 +59,42 @@ fn reachable_exit(v: f64, a: f64, rem: f64, exit_mm_per_s: f64) -> (f64, f64) {
 /// Relative tolerance of a squared velocity (see [`reachable_exit`]).
 const REACH_EPS: f64 = 1e-9;
 
+/// How much of a phase one call took.
+enum Took {
+    /// All of it, and it reached the block end.
+    Finished,
+    /// All of it; the block goes on.
+    Whole,
+    /// The rest of the tick: the phase goes on in the next.
+    TickOver,
+}
+
+/// Run one phase (acceleration mm/s², duration s, velocity at its end mm/s, whether it reaches
+/// the block end) for at most `left` s, moving `s_mm` and `v_mm_per_s` with it.
+fn take_phase(
+    s_mm: &mut f64,
+    v_mm_per_s: &mut f64,
+    p: &Profile,
+    (acc, dur, v_end, to_end): (f64, f64, f64, bool),
+    left: f64,
+) -> Took {
+    let v = *v_mm_per_s;
+    if dur <= left {
+        if to_end {
+            *s_mm = p.length_mm;
+            *v_mm_per_s = v_end.max(0.0);
+            return Took::Finished;
+        }
+        *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
+        *v_mm_per_s = v_end.max(0.0);
+        Took::Whole
+    } else {
+        *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
+        *v_mm_per_s = (v + acc * left).max(0.0);
+        Took::TickOver
+    }
+}
+
 /// Advance path position `s_mm` and path velocity `v_mm_per_s` along `p` by at most `dt_s`.
 ///
 /// The velocity follows the largest of: accelerate at `a` towards the cruise velocity, cruise,
@@ -127,23 +163,18 @@ pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> 
                 (a, (v1 - v) / a, v1, false)
             }
         };
-        if dur <= left {
-            t += dur;
-            if to_end {
-                *s_mm = p.length_mm;
-                *v_mm_per_s = v_end.max(0.0);
+        match take_phase(s_mm, v_mm_per_s, p, (acc, dur, v_end, to_end), left) {
+            Took::Finished => {
                 return Advanced {
-                    used_s: t,
+                    used_s: t + dur,
                     finished: true,
-                };
+                }
             }
-            *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
-            *v_mm_per_s = v_end.max(0.0);
-        } else {
-            *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
-            *v_mm_per_s = (v + acc * left).max(0.0);
-            t = dt_s;
-            break;
+            Took::Whole => t += dur,
+            Took::TickOver => {
+                t = dt_s;
+                break;
+            }
         }
     }
     let finished = p.length_mm - *s_mm <= END_EPS_MM;
@@ -221,6 +252,22 @@ impl Swing {
 /// Waits shorter than this count as over, s (rounding of the phase sums).
 const SWING_EPS_S: f64 = 1e-9;
 
+/// The phase holding `v` for at most `wait` s: until the braking curve to `ve` at `a`, or to
+/// the block end `rem` mm ahead when `v` is not above the exit.
+fn hold_phase(v: f64, wait: f64, ve: f64, a: f64, rem: f64) -> (f64, f64, f64, bool) {
+    let (d, to_end) = if v > ve {
+        ((rem - (v * v - ve * ve) / (2.0 * a)).max(0.0), false)
+    } else {
+        (rem, true)
+    };
+    let dur = d / v;
+    if dur <= wait {
+        (0.0, dur, v, to_end)
+    } else {
+        (0.0, wait, v, false)
+    }
+}
+
 /// [`advance`] under the swing rule: the same accelerate / cruise / brake phases, but braking
 /// starts only `window_s` after accelerating ended and accelerating only `window_s` after
 /// braking ended; meanwhile the velocity is held. To keep the end reachable, acceleration
@@ -255,21 +302,7 @@ pub fn advance_swing(
         let brake = (ve * ve + 2.0 * a * rem).sqrt();
         let vc = p.cruise_mm_per_s.max(0.0);
         let eps = V_EPS * (1.0 + v.max(vc));
-        // Holding `v` for at most `wait`: until the braking curve, or to the block end when
-        // `v` is not above the exit.
-        let hold = |v: f64, wait: f64| -> (f64, f64, f64, bool) {
-            let (d, to_end) = if v > ve {
-                ((rem - (v * v - ve * ve) / (2.0 * a)).max(0.0), false)
-            } else {
-                (rem, true)
-            };
-            let dur = d / v;
-            if dur <= wait {
-                (0.0, dur, v, to_end)
-            } else {
-                (0.0, wait, v, false)
-            }
-        };
+        let hold = |v: f64, wait: f64| hold_phase(v, wait, ve, a, rem);
         // (acceleration, duration of the phase, velocity at its end, reaches block end)
         let (acc, dur, v_end, to_end) = if v >= brake - eps {
             // On the braking curve: brake to the end. The cap below makes this come at least
@@ -327,25 +360,20 @@ pub fn advance_swing(
                 hold(v, f64::INFINITY)
             }
         };
-        if dur <= left {
-            t += dur;
-            sw.pass(acc, dur);
-            if to_end {
-                *s_mm = p.length_mm;
-                *v_mm_per_s = v_end.max(0.0);
+        let took = take_phase(s_mm, v_mm_per_s, p, (acc, dur, v_end, to_end), left);
+        sw.pass(acc, dur.min(left));
+        match took {
+            Took::Finished => {
                 return Advanced {
-                    used_s: t,
+                    used_s: t + dur,
                     finished: true,
-                };
+                }
             }
-            *s_mm = (*s_mm + (v + v_end) * 0.5 * dur).min(p.length_mm);
-            *v_mm_per_s = v_end.max(0.0);
-        } else {
-            sw.pass(acc, left);
-            *s_mm = (*s_mm + v * left + 0.5 * acc * left * left).min(p.length_mm);
-            *v_mm_per_s = (v + acc * left).max(0.0);
-            t = dt_s;
-            break;
+            Took::Whole => t += dur,
+            Took::TickOver => {
+                t = dt_s;
+                break;
+            }
         }
     }
     let finished = p.length_mm - *s_mm <= END_EPS_MM;

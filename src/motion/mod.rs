@@ -20,7 +20,7 @@ pub mod trc;
 use std::sync::Arc;
 
 use crate::lang::block::FlushKind;
-use crate::queue::{BlockInfo, BlockQueue, MoveKind, Position, MAX_AXES};
+use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind, Position, MAX_AXES};
 
 use filter::{jerk_window_s, AxisFilter};
 use interpolator::{advance, advance_swing, point_at, Profile, Swing};
@@ -428,108 +428,11 @@ impl Motion {
             {
                 self.begin_run();
             }
-            let Some(front) = self.planner.front_mut() else {
+            if !self.front_started && !self.start_front(left, notes) {
                 break;
-            };
-            if !self.front_started {
-                if matches!(front.kind, EntryKind::Move(_)) && left <= 0.0 {
-                    break;
-                }
-                // Held at rest (feed hold that has braked, a programmed stop): the next
-                // block does not start until the hold is released.
-                if self.hold && self.v_mm_per_s == 0.0 {
-                    break;
-                }
-                // A stop (dwell, flush stop, program end) takes effect when the axes stand,
-                // not only the interpolator.
-                if front.kind.is_barrier() && !self.filter.settled() {
-                    break;
-                }
-                if let Some(info) = front.info.take() {
-                    notes.push(MotionNote::Started(info));
-                }
-                self.front_started = true;
-                self.s_mm = 0.0;
-                self.dwell_done_s = 0.0;
-                if let (EntryKind::Move(seg), Some(t)) = (&front.kind, self.trace.as_mut()) {
-                    if let MoveKind::Arc { plane, .. } = seg.mv.kind {
-                        t.set_plane(plane);
-                    }
-                }
             }
-            let next = match &front.kind {
-                EntryKind::Move(seg) => {
-                    let profile = Profile {
-                        length_mm: seg.length_mm,
-                        accel_mm_per_s2: seg.accel_mm_per_s2,
-                        cruise_mm_per_s: seg.cruise_mm_per_s(cruise_pct),
-                        exit_mm_per_s: seg.exit_mm_per_s,
-                    };
-                    let r = match &mut self.run {
-                        Run::General => {
-                            advance(&mut self.s_mm, &mut self.v_mm_per_s, &profile, left)
-                        }
-                        Run::Lone {
-                            accel_mm_per_s2,
-                            swing,
-                        } => advance_swing(
-                            &mut self.s_mm,
-                            &mut self.v_mm_per_s,
-                            &Profile {
-                                accel_mm_per_s2: *accel_mm_per_s2,
-                                ..profile
-                            },
-                            left,
-                            swing,
-                        ),
-                    };
-                    left -= r.used_s;
-                    if r.finished {
-                        // Snap: the block ends exactly at its programmed end point.
-                        self.pos_in = seg.mv.end;
-                        Next::Pop
-                    } else {
-                        self.pos_in = point_at(&seg.mv, seg.length_mm, self.s_mm);
-                        Next::Stay
-                    }
-                }
-                EntryKind::Dwell { seconds } => {
-                    self.v_mm_per_s = 0.0;
-                    if self.hold {
-                        Next::Stay
-                    } else {
-                        let take = (seconds - self.dwell_done_s).min(left).max(0.0);
-                        self.dwell_done_s += take;
-                        left -= take;
-                        if self.dwell_done_s >= seconds - 1e-12 {
-                            Next::Pop
-                        } else {
-                            Next::Stay
-                        }
-                    }
-                }
-                EntryKind::Plain => Next::Pop,
-                EntryKind::Stop { optional } => {
-                    if *optional && !self.optional_stop {
-                        Next::Pop
-                    } else {
-                        notes.push(MotionNote::ProgramStop {
-                            optional: *optional,
-                        });
-                        Next::PopAndHold
-                    }
-                }
-                EntryKind::Flush(k) => {
-                    notes.push(MotionNote::Flush(*k));
-                    Next::Pop
-                }
-                EntryKind::End { m, prog } => {
-                    notes.push(MotionNote::End {
-                        m: *m,
-                        prog: prog.clone(),
-                    });
-                    Next::End
-                }
+            let Some(next) = self.run_front(cruise_pct, &mut left, notes) else {
+                break;
             };
             match next {
                 Next::Pop => self.finish_front(),
@@ -631,6 +534,131 @@ impl Motion {
             };
             self.planner.set_corner_window_s(corner_s);
             self.planner.plan_if_needed(self.override_pct, self.dt_s);
+        }
+    }
+
+    /// STEP 1 of an entry: start the front entry if it may start now — a move only with time
+    /// left in the tick, nothing while held at rest, a stop only once the axes stand. Emits
+    /// its `Started` note. Returns whether it started.
+    fn start_front(&mut self, left: f64, notes: &mut Vec<MotionNote>) -> bool {
+        let Some(front) = self.planner.front_mut() else {
+            return false;
+        };
+        if matches!(front.kind, EntryKind::Move(_)) && left <= 0.0 {
+            return false;
+        }
+        // Held at rest (feed hold that has braked, a programmed stop): the next block does
+        // not start until the hold is released.
+        if self.hold && self.v_mm_per_s == 0.0 {
+            return false;
+        }
+        // A stop (dwell, flush stop, program end) takes effect when the axes stand, not only
+        // the interpolator.
+        if front.kind.is_barrier() && !self.filter.settled() {
+            return false;
+        }
+        if let Some(info) = front.info.take() {
+            notes.push(MotionNote::Started(info));
+        }
+        self.front_started = true;
+        self.s_mm = 0.0;
+        self.dwell_done_s = 0.0;
+        if let (EntryKind::Move(seg), Some(t)) = (&front.kind, self.trace.as_mut()) {
+            if let MoveKind::Arc { plane, .. } = seg.mv.kind {
+                t.set_plane(plane);
+            }
+        }
+        true
+    }
+
+    /// STEP 2 of an entry: run the started front entry for what is `left` of the tick (and
+    /// take the time it used off it); what happens to it next.
+    fn run_front(
+        &mut self,
+        cruise_pct: f64,
+        left: &mut f64,
+        notes: &mut Vec<MotionNote>,
+    ) -> Option<Next> {
+        let front = self.planner.front()?;
+        Some(match &front.kind {
+            EntryKind::Move(seg) => {
+                let profile = Profile {
+                    length_mm: seg.length_mm,
+                    accel_mm_per_s2: seg.accel_mm_per_s2,
+                    cruise_mm_per_s: seg.cruise_mm_per_s(cruise_pct),
+                    exit_mm_per_s: seg.exit_mm_per_s,
+                };
+                let mv = seg.mv;
+                self.run_move(&profile, &mv, left)
+            }
+            EntryKind::Dwell { seconds } => {
+                let seconds = *seconds;
+                self.v_mm_per_s = 0.0;
+                if self.hold {
+                    Next::Stay
+                } else {
+                    let take = (seconds - self.dwell_done_s).min(*left).max(0.0);
+                    self.dwell_done_s += take;
+                    *left -= take;
+                    if self.dwell_done_s >= seconds - 1e-12 {
+                        Next::Pop
+                    } else {
+                        Next::Stay
+                    }
+                }
+            }
+            EntryKind::Plain => Next::Pop,
+            EntryKind::Stop { optional } => {
+                if *optional && !self.optional_stop {
+                    Next::Pop
+                } else {
+                    notes.push(MotionNote::ProgramStop {
+                        optional: *optional,
+                    });
+                    Next::PopAndHold
+                }
+            }
+            EntryKind::Flush(k) => {
+                notes.push(MotionNote::Flush(*k));
+                Next::Pop
+            }
+            EntryKind::End { m, prog } => {
+                notes.push(MotionNote::End {
+                    m: *m,
+                    prog: prog.clone(),
+                });
+                Next::End
+            }
+        })
+    }
+
+    /// Interpolate the front move along `profile` for what is `left` of the tick, by the rule
+    /// of the present run; the axes' input position at the new path position.
+    fn run_move(&mut self, profile: &Profile, mv: &Move, left: &mut f64) -> Next {
+        let r = match &mut self.run {
+            Run::General => advance(&mut self.s_mm, &mut self.v_mm_per_s, profile, *left),
+            Run::Lone {
+                accel_mm_per_s2,
+                swing,
+            } => advance_swing(
+                &mut self.s_mm,
+                &mut self.v_mm_per_s,
+                &Profile {
+                    accel_mm_per_s2: *accel_mm_per_s2,
+                    ..*profile
+                },
+                *left,
+                swing,
+            ),
+        };
+        *left -= r.used_s;
+        if r.finished {
+            // Snap: the block ends exactly at its programmed end point.
+            self.pos_in = mv.end;
+            Next::Pop
+        } else {
+            self.pos_in = point_at(mv, profile.length_mm, self.s_mm);
+            Next::Stay
         }
     }
 

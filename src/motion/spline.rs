@@ -196,52 +196,14 @@ impl Spline {
             slope(ii + 1),
             slope(ii + 2),
         ];
-        // Akima's extrapolation: m[k−1] = 2·m[k] − m[k+1] (and mirrored at the far end).
-        let lin = |a: Position, b: Position| -> Position {
-            let mut r = [0.0; MAX_AXES];
-            for ax in 0..MAX_AXES {
-                r[ax] = 2.0 * a[ax] - b[ax];
-            }
-            r
-        };
-        for k in (0..2).rev() {
-            if m[k].is_none() {
-                if let (Some(a), Some(b)) = (m[k + 1], m[k + 2]) {
-                    m[k] = Some(lin(a, b));
-                } else if let Some(a) = m[k + 1] {
-                    m[k] = Some(a);
-                }
-            }
-        }
-        for k in 3..5 {
-            if m[k].is_none() {
-                if let (Some(a), Some(b)) = (m[k - 1], m[k - 2]) {
-                    m[k] = Some(lin(a, b));
-                } else if let Some(a) = m[k - 1] {
-                    m[k] = Some(a);
-                }
-            }
-        }
+        extrapolate_slopes(&mut m);
         let (Some(ma), Some(mb), Some(mc), Some(md), Some(me)) = (m[0], m[1], m[2], m[3], m[4])
         else {
             self.next_segment += 1;
             return;
         };
-        let tangent = |m1: Position, m2: Position, m3: Position, m4: Position| -> Position {
-            let mut t = [0.0; MAX_AXES];
-            for ax in 0..MAX_AXES {
-                let w1 = (m4[ax] - m3[ax]).abs();
-                let w2 = (m2[ax] - m1[ax]).abs();
-                t[ax] = if w1 + w2 > 1e-12 {
-                    (w1 * m2[ax] + w2 * m3[ax]) / (w1 + w2)
-                } else {
-                    0.5 * (m2[ax] + m3[ax])
-                };
-            }
-            t
-        };
-        let t0 = tangent(ma, mb, mc, md);
-        let t1 = tangent(mb, mc, md, me);
+        let t0 = akima_tangent(ma, mb, mc, md);
+        let t1 = akima_tangent(mb, mc, md, me);
         let f = |s: f64| -> Position {
             let (s2, s3) = (s * s, s * s * s);
             let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
@@ -300,6 +262,52 @@ fn dist(a: &Position, b: &Position) -> f64 {
         s += (b[i] - a[i]) * (b[i] - a[i]);
     }
     s.sqrt()
+}
+
+/// Akima's extrapolation of the slopes missing at the ends of the received points:
+/// m[k−1] = 2·m[k] − m[k+1], mirrored at the far end; one known neighbour is copied.
+fn extrapolate_slopes(m: &mut [Option<Position>; 5]) {
+    let lin = |a: Position, b: Position| -> Position {
+        let mut r = [0.0; MAX_AXES];
+        for ax in 0..MAX_AXES {
+            r[ax] = 2.0 * a[ax] - b[ax];
+        }
+        r
+    };
+    for k in (0..2).rev() {
+        if m[k].is_none() {
+            if let (Some(a), Some(b)) = (m[k + 1], m[k + 2]) {
+                m[k] = Some(lin(a, b));
+            } else if let Some(a) = m[k + 1] {
+                m[k] = Some(a);
+            }
+        }
+    }
+    for k in 3..5 {
+        if m[k].is_none() {
+            if let (Some(a), Some(b)) = (m[k - 1], m[k - 2]) {
+                m[k] = Some(lin(a, b));
+            } else if let Some(a) = m[k - 1] {
+                m[k] = Some(a);
+            }
+        }
+    }
+}
+
+/// Akima's tangent at a point from the slopes of the two chords before it (m1, m2) and the
+/// two after it (m3, m4), per axis (H. Akima, J. ACM 17 (1970)).
+fn akima_tangent(m1: Position, m2: Position, m3: Position, m4: Position) -> Position {
+    let mut t = [0.0; MAX_AXES];
+    for ax in 0..MAX_AXES {
+        let w1 = (m4[ax] - m3[ax]).abs();
+        let w2 = (m2[ax] - m1[ax]).abs();
+        t[ax] = if w1 + w2 > 1e-12 {
+            (w1 * m2[ax] + w2 * m3[ax]) / (w1 + w2)
+        } else {
+            0.5 * (m2[ax] + m3[ax])
+        };
+    }
+    t
 }
 
 #[cfg(test)]
