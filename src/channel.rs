@@ -13,7 +13,7 @@ use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
 use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use crate::queue::{Action, BlockQueue, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES};
-use crate::report::event::{EventBuffer, EventKind};
+use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
 use crate::source::store::{FsLatency, ProgramStore, SearchDir, StoreStats};
@@ -24,72 +24,7 @@ pub const MAX_LISTED_ERRORS: usize = 256;
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
-/// Channel modes: the ISG HLI numbers (`HLI_IMCM_*`; docs/ads.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Mode {
-    Standby = 1,
-    Automatic = 2,
-    Mdi = 3,
-    Manual = 4,
-    Reference = 5,
-}
-
-/// Channel states: the ISG HLI numbers (docs/ads.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum State {
-    Deselected = 1,
-    Selected = 2,
-    Ready = 3,
-    Active = 4,
-    Hold = 5,
-    Error = 6,
-}
-
-impl Mode {
-    pub fn from_i32(v: i32) -> Option<Mode> {
-        Some(match v {
-            1 => Mode::Standby,
-            2 => Mode::Automatic,
-            3 => Mode::Mdi,
-            4 => Mode::Manual,
-            5 => Mode::Reference,
-            _ => return None,
-        })
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Mode::Standby => "STANDBY",
-            Mode::Automatic => "AUTOMATIC",
-            Mode::Mdi => "MDI",
-            Mode::Manual => "MANUAL",
-            Mode::Reference => "REFERENCE",
-        }
-    }
-}
-
-impl State {
-    pub fn from_i32(v: i32) -> Option<State> {
-        Some(match v {
-            1 => State::Deselected,
-            2 => State::Selected,
-            3 => State::Ready,
-            4 => State::Active,
-            5 => State::Hold,
-            6 => State::Error,
-            _ => return None,
-        })
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            State::Deselected => "DESELECTED",
-            State::Selected => "SELECTED",
-            State::Ready => "READY",
-            State::Active => "ACTIVE",
-            State::Hold => "HOLD",
-            State::Error => "ERROR",
-        }
-    }
-}
+pub use crate::mode::{Mode, State};
 
 /// Why a command was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -97,10 +32,7 @@ pub enum CommandError {
     #[error("value {0} is not a mode or state")]
     InvalidValue(i32),
     #[error("not possible in mode {mode} / state {state}")]
-    Busy {
-        mode: &'static str,
-        state: &'static str,
-    },
+    Busy { mode: Mode, state: State },
     #[error("no program selected (command parameter 0x108)")]
     NoProgram,
     #[error("program could not be started: {code} {msg}")]
@@ -428,10 +360,15 @@ impl Channel {
         }
     }
 
+    /// One event of this channel into the tick's buffer (nothing when the log is off).
+    #[inline]
+    fn emit(&mut self, tick: &Tick, kind: EventKind) {
+        self.events.push(tick, self.number, kind);
+    }
+
     fn push_state(&mut self, tick: &Tick) {
-        let (mode, state) = (self.mode.name().to_string(), self.state.name().to_string());
-        self.events
-            .push(tick, self.number, EventKind::State { mode, state });
+        let (mode, state) = (self.mode, self.state);
+        self.emit(tick, EventKind::State { mode, state });
     }
 
     fn raise_error(
@@ -442,9 +379,8 @@ impl Channel {
         prog: Option<String>,
         line: Option<u64>,
     ) {
-        self.events.push(
+        self.emit(
             tick,
-            self.number,
             EventKind::Error {
                 code,
                 msg: msg.clone(),
@@ -473,17 +409,15 @@ impl Channel {
 
     fn warn(&mut self, tick: &Tick, code: u32, msg: String) {
         self.stats.warnings += 1;
-        self.events
-            .push(tick, self.number, EventKind::Warning { code, msg });
+        self.emit(tick, EventKind::Warning { code, msg });
     }
 
     /// A client writes NC lines into the stream interface (`mc_program_stream_w`).
     pub fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
         let r = self.stream.write(packet);
         let code = r.as_ref().err().and_then(|e| e.isg_code());
-        self.events.push(
+        self.emit(
             tick,
-            self.number,
             EventKind::Write {
                 bytes: packet.len() as u64,
                 ok: r.is_ok(),
@@ -532,8 +466,8 @@ impl Channel {
 
     fn busy(&self) -> CommandError {
         CommandError::Busy {
-            mode: self.mode.name(),
-            state: self.state.name(),
+            mode: self.mode,
+            state: self.state,
         }
     }
 
@@ -756,21 +690,19 @@ impl Channel {
     pub fn reset(&mut self, tick: &Tick) {
         let dropped = self.stream.clear();
         if dropped > 0 {
-            self.events.push(
+            self.emit(
                 tick,
-                self.number,
                 EventKind::Discard {
                     bytes: dropped as u64,
                 },
             );
         }
         if let Some(prog) = self.running_prog.take() {
-            self.events.push(
+            self.emit(
                 tick,
-                self.number,
                 EventKind::ProgramEnd {
                     prog: prog.to_string(),
-                    end: "reset".into(),
+                    end: ProgramEndKind::Reset,
                 },
             );
         }
@@ -795,24 +727,21 @@ impl Channel {
         self.decoder.take_notes(&mut notes);
         for n in notes.drain(..) {
             match n {
-                Note::ProgramStart { prog, stream } => self.events.push(
+                Note::ProgramStart { prog, stream } => self.emit(
                     tick,
-                    self.number,
                     EventKind::ProgramStart {
                         prog: prog.to_string(),
                         stream,
                     },
                 ),
-                Note::Segment { bytes } => self.events.push(
+                Note::Segment { bytes } => self.emit(
                     tick,
-                    self.number,
                     EventKind::Segment {
                         bytes: bytes as u64,
                     },
                 ),
-                Note::Discard { bytes } => self.events.push(
+                Note::Discard { bytes } => self.emit(
                     tick,
-                    self.number,
                     EventKind::Discard {
                         bytes: bytes as u64,
                     },
@@ -831,18 +760,16 @@ impl Channel {
                     };
                     self.raise_error(tick, code, msg, Some(prog.to_string()), Some(line as u64));
                 }
-                Note::Search { target, found } => self.events.push(
+                Note::Search { target, found } => self.emit(
                     tick,
-                    self.number,
                     EventKind::Search {
                         target: target.to_string(),
                         found,
                     },
                 ),
                 Note::Message { text, save } => {
-                    self.events.push(
+                    self.emit(
                         tick,
-                        self.number,
                         EventKind::Message {
                             text: text.clone(),
                             save,
@@ -850,15 +777,11 @@ impl Channel {
                     );
                     self.message = Some(text);
                 }
-                Note::HFunction { h } => {
-                    self.events
-                        .push(tick, self.number, EventKind::HFunction { h })
-                }
-                Note::Cache { op, file } => self.events.push(
+                Note::HFunction { h } => self.emit(tick, EventKind::HFunction { h }),
+                Note::Cache { op, file } => self.emit(
                     tick,
-                    self.number,
                     EventKind::Cache {
-                        op: op.to_string(),
+                        op,
                         file: (!file.is_empty()).then_some(file),
                     },
                 ),
@@ -876,7 +799,7 @@ impl Channel {
                 MotionNote::Started(info) => {
                     if self.interrupted {
                         self.interrupted = false;
-                        self.events.push(tick, self.number, EventKind::Resume);
+                        self.emit(tick, EventKind::Resume);
                     }
                     self.ran_any = true;
                     self.stats.blocks += 1;
@@ -888,9 +811,8 @@ impl Channel {
                         });
                     }
                     if self.events.enabled() {
-                        self.events.push(
+                        self.emit(
                             tick,
-                            self.number,
                             EventKind::Block {
                                 prog: info.prog.to_string(),
                                 line: info.line as u64,
@@ -908,19 +830,10 @@ impl Channel {
                     // The flush feed_single_block added: no program event.
                     self.single_flushes -= 1;
                 }
-                MotionNote::Flush(k) => {
-                    let kind = match k {
-                        crate::lang::block::FlushKind::Stop => "plain",
-                        crate::lang::block::FlushKind::Continue => "continue",
-                        crate::lang::block::FlushKind::Wait => "wait",
-                    };
-                    self.events
-                        .push(tick, self.number, EventKind::Flush { kind: kind.into() });
-                }
+                MotionNote::Flush(kind) => self.emit(tick, EventKind::Flush { kind }),
                 MotionNote::ProgramStop { optional } => {
                     let m = u32::from(optional);
-                    self.events
-                        .push(tick, self.number, EventKind::ProgramStop { m });
+                    self.emit(tick, EventKind::ProgramStop { m });
                     if self.state == State::Active {
                         self.set_state(tick, State::Hold);
                     }
@@ -931,12 +844,11 @@ impl Channel {
                     break;
                 }
                 MotionNote::End { m, prog } => {
-                    self.events.push(
+                    self.emit(
                         tick,
-                        self.number,
                         EventKind::ProgramEnd {
                             prog: prog.to_string(),
-                            end: format!("M{m}"),
+                            end: ProgramEndKind::from_m(m),
                         },
                     );
                     self.stats.programs_ended += 1;
@@ -1002,8 +914,7 @@ impl Channel {
             self.stats.interrupts += 1;
             self.motion.note_interrupt();
             let held = self.motion.held_blocks() as u64;
-            self.events
-                .push(tick, self.number, EventKind::Interrupt { held });
+            self.emit(tick, EventKind::Interrupt { held });
         }
     }
 }

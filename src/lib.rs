@@ -14,6 +14,7 @@ pub mod dnc;
 pub mod feeder;
 pub mod lang;
 pub mod machine;
+pub mod mode;
 pub mod motion;
 pub mod params;
 pub mod queue;

@@ -9,7 +9,7 @@ use common::random_path::{self, Rng};
 
 use ncchannel::decoder::arc::{ArcError, ArcSpec};
 use ncchannel::lang::block::FlushKind;
-use ncchannel::motion::check::{LimitCheck, DEFAULT_EPS};
+use common::limit_check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{

@@ -157,7 +157,7 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
     assert!(ev.iter().any(|e| e.1
         == EventKind::ProgramEnd {
             prog: "streaming.nc".into(),
-            end: "M30".into()
+            end: ncchannel::report::event::ProgramEndKind::M30
         }));
 }
 

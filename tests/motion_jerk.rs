@@ -9,7 +9,7 @@ mod common;
 use common::random_path::{self, Rng};
 
 use ncchannel::decoder::arc::{arc_move, ArcSpec};
-use ncchannel::motion::check::{LimitCheck, FILTERED_EPS};
+use common::limit_check::{LimitCheck, FILTERED_EPS};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,

@@ -4,7 +4,9 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use ncchannel::report::event::{Event, EventKind, EventLog};
+use ncchannel::lang::block::FlushKind;
+use ncchannel::mode::{Mode, State};
+use ncchannel::report::event::{CacheOp, Event, EventKind, EventLog, ProgramEndKind};
 use ncchannel::report::stats::CycleStats;
 use ncchannel::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
@@ -65,8 +67,8 @@ fn program_event_cases() -> Vec<Case> {
     vec![
         (
             EventKind::State {
-                mode: s("automatic"),
-                state: s("active"),
+                mode: Mode::Automatic,
+                state: State::Active,
             },
             "state",
             vec!["mode", "state"],
@@ -82,7 +84,7 @@ fn program_event_cases() -> Vec<Case> {
         (
             EventKind::ProgramEnd {
                 prog: s("streaming.nc"),
-                end: s("M30"),
+                end: ProgramEndKind::M30,
             },
             "program_end",
             vec!["prog", "end"],
@@ -138,7 +140,7 @@ fn message_event_cases() -> Vec<Case> {
         (EventKind::Resume, "resume", vec![]),
         (
             EventKind::Cache {
-                op: s("load"),
+                op: CacheOp::Load,
                 file: Some(s("sub.nc")),
             },
             "cache",
@@ -146,7 +148,7 @@ fn message_event_cases() -> Vec<Case> {
         ),
         (
             EventKind::Flush {
-                kind: s("continue"),
+                kind: FlushKind::Continue,
             },
             "flush",
             vec!["kind"],
@@ -312,5 +314,54 @@ fn report_json_has_the_documented_shape() {
         "3 opens, 700 bytes read, 5 cache hits",
     ] {
         assert!(human.contains(want), "{want:?} missing in\n{human}");
+    }
+}
+
+/// The typed fields spell what the log has always said: ISG's mode and state names, the M
+/// function of a program end, `plain` for `#FLUSH`, snake_case cache operations.
+#[test]
+fn typed_fields_serialise_to_the_documented_words() {
+    let tick = Tick {
+        index: 1,
+        period: Duration::from_millis(1),
+        time: Duration::from_millis(1),
+    };
+    let json = |kind: EventKind| -> Value {
+        serde_json::from_str(&Event::new(&tick, 1, kind).to_json()).unwrap()
+    };
+    let v = json(EventKind::State {
+        mode: Mode::Manual,
+        state: State::Hold,
+    });
+    assert_eq!(
+        (v["mode"].as_str(), v["state"].as_str()),
+        (Some("MANUAL"), Some("HOLD"))
+    );
+    for (end, word) in [
+        (ProgramEndKind::M30, "M30"),
+        (ProgramEndKind::M2, "M2"),
+        (ProgramEndKind::Reset, "reset"),
+    ] {
+        let v = json(EventKind::ProgramEnd {
+            prog: "p.nc".into(),
+            end,
+        });
+        assert_eq!(v["end"], word);
+    }
+    for (kind, word) in [
+        (FlushKind::Stop, "plain"),
+        (FlushKind::Continue, "continue"),
+        (FlushKind::Wait, "wait"),
+    ] {
+        assert_eq!(json(EventKind::Flush { kind })["kind"], word);
+    }
+    for (op, word) in [
+        (CacheOp::Load, "load"),
+        (CacheOp::Refresh, "refresh"),
+        (CacheOp::Clear, "clear"),
+        (CacheOp::ClearAll, "clear_all"),
+        (CacheOp::Hit, "hit"),
+    ] {
+        assert_eq!(json(EventKind::Cache { op, file: None })["op"], word);
     }
 }

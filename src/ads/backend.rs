@@ -23,7 +23,6 @@ pub mod mode {
     pub const AUTOMATIC: i32 = Mode::Automatic as i32;
     pub const MDI: i32 = Mode::Mdi as i32;
     pub const MANUAL: i32 = Mode::Manual as i32;
-    pub const REFERENCE: i32 = Mode::Reference as i32;
 }
 
 /// Channel states as the ADS objects carry them: the numbers of [`State`].

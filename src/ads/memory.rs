@@ -224,7 +224,7 @@ impl CncBackend for MemoryBackend {
     }
 
     fn command_mode(&self, ch: u16, m: i32) -> Result<(), DeviceError> {
-        if !(mode::STANDBY..=mode::REFERENCE).contains(&m) {
+        if crate::channel::Mode::from_i32(m).is_none() {
             return Err(DeviceError::InvalidValue);
         }
         let mut c = self.ch(ch)?;

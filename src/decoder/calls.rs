@@ -2,6 +2,7 @@
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
 use super::*;
+use crate::report::event::CacheOp;
 
 impl Decoder {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
@@ -116,14 +117,14 @@ impl Decoder {
             Command::CacheClear { file } => {
                 io.cache.clear(file)?;
                 self.notes.push(Note::Cache {
-                    op: "clear",
+                    op: CacheOp::Clear,
                     file: file.clone(),
                 });
             }
             Command::CacheClearAll => {
                 io.cache.clear_all()?;
                 self.notes.push(Note::Cache {
-                    op: "clear_all",
+                    op: CacheOp::ClearAll,
                     file: String::new(),
                 });
             }
@@ -202,7 +203,7 @@ impl Decoder {
             if io.want_text {
                 // Only with events on: the hot call path stays free of the allocation.
                 self.notes.push(Note::Cache {
-                    op: "hit",
+                    op: CacheOp::Hit,
                     file: name.to_string(),
                 });
             }

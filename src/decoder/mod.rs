@@ -171,7 +171,7 @@ pub enum Note {
         found: bool,
     },
     Cache {
-        op: &'static str,
+        op: crate::report::event::CacheOp,
         file: String,
     },
     /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).

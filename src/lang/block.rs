@@ -264,9 +264,12 @@ pub enum Command {
     },
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// `#FLUSH` variants; in the event log `plain`, `continue`, `wait`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum FlushKind {
     /// `#FLUSH`: release all held blocks, stop at the end of the last.
+    #[serde(rename = "plain")]
     Stop,
     /// `#FLUSH CONTINUE`: release all, no stop if the next block comes in time.
     Continue,

@@ -8,7 +8,6 @@
 //! reaches it (M functions and assignments do not stop the motion; a dwell, `#FLUSH`,
 //! `#FLUSH WAIT` and the program end do).
 
-pub mod check;
 pub mod contour;
 pub mod filter;
 pub mod interpolator;

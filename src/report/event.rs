@@ -22,6 +22,8 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
+use crate::lang::block::FlushKind;
+use crate::mode::{Mode, State};
 use crate::tick::Tick;
 
 /// One event: when, where, what. Serialises as `{"tick":…,"t":…,"ch":…,"ev":"…",…fields}`.
@@ -42,18 +44,18 @@ pub struct Event {
 pub enum EventKind {
     /// Channel mode and state changed.
     State {
-        mode: String,
-        state: String,
+        mode: Mode,
+        state: State,
     },
     /// A program started; `stream` when it reads from the stream interface.
     ProgramStart {
         prog: String,
         stream: bool,
     },
-    /// A program ended; `end` is how (`M30`, `M2`, `M17`, `M29`, `reset`, `error`).
+    /// A program ended; `end` is how.
     ProgramEnd {
         prog: String,
-        end: String,
+        end: ProgramEndKind,
     },
     /// A block that took effect: program, 1-based line, byte offset of the line in the
     /// program (stream: since stream start), block counter, block number (`N`), text.
@@ -96,14 +98,14 @@ pub enum EventKind {
     },
     /// Motion resumed after an interrupt.
     Resume,
-    /// A file cache operation (`load`, `refresh`, `clear`, `clear_all`, `hit`).
+    /// A file cache operation.
     Cache {
-        op: String,
+        op: CacheOp,
         file: Option<String>,
     },
     /// `#FLUSH` of the given kind (`plain`, `continue`, `wait`).
     Flush {
-        kind: String,
+        kind: FlushKind,
     },
     /// Block search: the target and whether it was found.
     Search {
@@ -124,6 +126,45 @@ pub enum EventKind {
     ProgramStop {
         m: u32,
     },
+}
+
+/// How a program ended (`end` of `program_end`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum ProgramEndKind {
+    /// M30: program end with return to its start.
+    M30,
+    /// M2: program end.
+    M2,
+    /// An NC reset ended it.
+    #[serde(rename = "reset")]
+    Reset,
+}
+
+impl ProgramEndKind {
+    /// The end an M function programmed: the decoder ends a program only with M2 or M30.
+    pub fn from_m(m: u32) -> Self {
+        if m == 2 {
+            ProgramEndKind::M2
+        } else {
+            ProgramEndKind::M30
+        }
+    }
+}
+
+/// A file cache operation (TF5200 File Caching; `op` of `cache`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CacheOp {
+    /// `#CACHE LOAD` of a file not yet cached.
+    Load,
+    /// `#CACHE LOAD` of a cached file that changed on disk.
+    Refresh,
+    /// `#CACHE CLEAR`.
+    Clear,
+    /// `#CACHE CLEAR ALL`.
+    ClearAll,
+    /// A subroutine call served from the cache.
+    Hit,
 }
 
 impl Event {

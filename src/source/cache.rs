@@ -1,6 +1,7 @@
 //! The channel's file cache (`#CACHE`, TF5200 File Caching): global subroutines and cycles
 //! held in memory so that calling them no longer touches the file system.
 
+use crate::report::event::CacheOp;
 use thiserror::Error;
 
 use super::store::{ProgramKind, ProgramStore, ProgramText, StoreError};
@@ -55,10 +56,10 @@ pub enum Loaded {
 
 impl Loaded {
     /// The `op` of the `cache` event.
-    pub fn op(self) -> &'static str {
+    pub fn op(self) -> CacheOp {
         match self {
-            Loaded::New => "load",
-            Loaded::Refreshed => "refresh",
+            Loaded::New => CacheOp::Load,
+            Loaded::Refreshed => CacheOp::Refresh,
         }
     }
 }

@@ -315,4 +315,5 @@ pub fn run_client(
     (seen, events)
 }
 
+pub mod limit_check;
 pub mod random_path;

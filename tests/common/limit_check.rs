@@ -1,6 +1,6 @@
 //! Limit check: per-axis velocity, acceleration and jerk from finite differences of the positions
-//! recorded each tick, compared with the axis limits — what the tests (and anyone suspicious of
-//! the planner) run over a whole program.
+//! recorded each tick, compared with the axis limits — what the motion tests run over a whole
+//! program.
 //!
 //! v_k = (p_k − p_{k−1}) / dt is the mean velocity over a tick, so it can never exceed a limit the
 //! motion kept; a_k = (v_k − v_{k−1}) / dt is a weighted mean of the acceleration over two ticks
@@ -10,9 +10,9 @@
 //! junction rule bounds only approximately (several corners inside one tick with unequal block
 //! lengths); with it the bounds are exact and ε is rounding.
 
-use crate::queue::{Position, MAX_AXES};
+use ncchannel::queue::{Position, MAX_AXES};
 
-use super::AxisLimits;
+use ncchannel::motion::AxisLimits;
 
 /// Tolerance for a trapezoid profile without the axis filter: 2 % (see the module header).
 pub const DEFAULT_EPS: f64 = 0.02;
@@ -139,7 +139,7 @@ impl LimitCheck {
                 self.worst_accel[i],
                 self.worst_jerk[i],
             );
-            let letter = crate::queue::AXIS_LETTERS[i] as char;
+            let letter = ncchannel::queue::AXIS_LETTERS[i] as char;
             if wv.ratio > 1.0 + self.eps {
                 bad.push(format!(
                     "{letter}: velocity {:.6} × limit at tick {}",
