@@ -181,6 +181,18 @@ impl<C: Cycle> Runtime<C> {
         (self.cycle, self.stats)
     }
 
+    /// The next real-time run starts a schedule of its own at its start, instead of going on
+    /// where the last run left off: for a caller that spends the time between runs on other
+    /// work (the bench's bare-loop slices), which would otherwise count as lateness.
+    pub fn restart_schedule(&mut self) {
+        self.resume_at = None;
+    }
+
+    /// Whether the next real-time run goes on with the last run's schedule.
+    pub fn continues_schedule(&self) -> bool {
+        self.resume_at.is_some()
+    }
+
     /// Run ticks until the cycle stops, `max_ticks` ticks have run in this call, or a
     /// [`StopHandle`] fires. A stop request is consumed: a later `run` starts afresh. Tick
     /// numbers and channel time continue across calls.

@@ -7,9 +7,9 @@ use std::sync::Arc;
 mod common;
 use common::random_path::{self, Rng};
 
+use common::limit_check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::decoder::arc::{ArcError, ArcSpec};
 use ncchannel::lang::block::FlushKind;
-use common::limit_check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{

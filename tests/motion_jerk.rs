@@ -8,8 +8,8 @@ use std::sync::Arc;
 mod common;
 use common::random_path::{self, Rng};
 
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
 use common::limit_check::{LimitCheck, FILTERED_EPS};
+use ncchannel::decoder::arc::{arc_move, ArcSpec};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,

@@ -234,3 +234,27 @@ fn bare_loop_waits_for_every_deadline() {
     assert!(h.quantile_ns(0.5) <= h.quantile_ns(0.99));
     assert!(h.quantile_ns(0.99) <= h.max_ns());
 }
+
+/// A real-time run cut into chunks keeps one schedule (a soak in chunks gains no ticks); a
+/// caller that spends the time between chunks elsewhere (the bench's bare-loop slices)
+/// restarts it, or every tick of the next chunk counts the pause as lateness.
+#[test]
+fn a_restarted_schedule_does_not_count_the_pause_between_runs_as_lateness() {
+    for restart in [false, true] {
+        let (cycle, _) = Recorder::new(None);
+        let (mut rt, _tx) = Runtime::new(cycle, MS, Clock::RealTime);
+        rt.run(Some(10));
+        assert!(rt.continues_schedule());
+        thread::sleep(Duration::from_millis(200));
+        if restart {
+            rt.restart_schedule();
+        }
+        rt.run(Some(30));
+        let p50_ms = rt.stats().lateness.quantile_ns(0.5) as f64 / 1e6;
+        if restart {
+            assert!(p50_ms < 50.0, "restarted: p50 lateness {p50_ms} ms");
+        } else {
+            assert!(p50_ms >= 150.0, "continued: p50 lateness {p50_ms} ms");
+        }
+    }
+}
