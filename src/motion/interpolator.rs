@@ -102,89 +102,9 @@ fn take_phase(
 /// already too high to brake to the exit (the override was lowered after planning), it brakes
 /// at `a` all the way and ends faster; the next block then brakes on.
 pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> Advanced {
-    let a = p.accel_mm_per_s2.max(1e-9);
-    let mut t = 0.0;
-    for _ in 0..MAX_PHASES {
-        let rem = p.length_mm - *s_mm;
-        if rem <= END_EPS_MM {
-            *s_mm = p.length_mm;
-            return Advanced {
-                used_s: t,
-                finished: true,
-            };
-        }
-        let left = dt_s - t;
-        if left <= 0.0 {
-            break;
-        }
-        let v = *v_mm_per_s;
-        // The exit we can still reach, and the braking curve through it at s.
-        let (reach2, ve) = reachable_exit(v, a, rem, p.exit_mm_per_s);
-        let brake = (ve * ve + 2.0 * a * rem).sqrt();
-        let vc = p.cruise_mm_per_s.max(0.0);
-        let eps = V_EPS * (1.0 + v.max(vc));
-        // (acceleration, duration of the phase, velocity at its end, reaches block end)
-        let (acc, dur, v_end, to_end) = if v >= brake - eps {
-            (-a, ((v - ve) / a).max(0.0), ve, true)
-        } else if v > vc + eps {
-            let d = (v * v - vc * vc) / (2.0 * a);
-            if d >= rem {
-                let ve2 = reach2.max(0.0).sqrt();
-                (-a, ((v - ve2) / a).max(0.0), ve2, true)
-            } else {
-                (-a, (v - vc) / a, vc, false)
-            }
-        } else if v >= vc - eps {
-            if vc <= V_EPS {
-                // Held (or 0 % override) and standing: time passes, the path does not.
-                *v_mm_per_s = 0.0;
-                return Advanced {
-                    used_s: dt_s,
-                    finished: false,
-                };
-            }
-            let d = if vc > ve {
-                rem - (vc * vc - ve * ve) / (2.0 * a)
-            } else {
-                rem
-            };
-            (0.0, (d.max(0.0)) / vc, vc, vc <= ve)
-        } else {
-            let x_meet = (ve * ve + 2.0 * a * rem - v * v) / (4.0 * a);
-            let x_cruise = (vc * vc - v * v) / (2.0 * a);
-            let x = x_meet.min(x_cruise).max(0.0);
-            if x >= rem {
-                // The planned exit lies above what the block can reach (the backward pass
-                // only brakes): accelerate to the block end and hand on the rest of the tick.
-                let v1 = (v * v + 2.0 * a * rem).sqrt();
-                (a, (v1 - v) / a, v1, true)
-            } else {
-                let v1 = (v * v + 2.0 * a * x).sqrt();
-                (a, (v1 - v) / a, v1, false)
-            }
-        };
-        match take_phase(s_mm, v_mm_per_s, p, (acc, dur, v_end, to_end), left) {
-            Took::Finished => {
-                return Advanced {
-                    used_s: t + dur,
-                    finished: true,
-                }
-            }
-            Took::Whole => t += dur,
-            Took::TickOver => {
-                t = dt_s;
-                break;
-            }
-        }
-    }
-    let finished = p.length_mm - *s_mm <= END_EPS_MM;
-    if finished {
-        *s_mm = p.length_mm;
-    }
-    Advanced {
-        used_s: t.min(dt_s),
-        finished,
-    }
+    // The swing rule with no window is exactly this rule: braking and accelerating may follow
+    // each other at once.
+    advance_swing(s_mm, v_mm_per_s, p, dt_s, &mut Swing::new(0.0))
 }
 
 /// The swing rule of a straight rest-to-rest run: between a phase at +a and one at −a (either
