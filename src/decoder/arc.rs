@@ -199,26 +199,16 @@ pub fn extent(mv: &Move) -> (Position, Position) {
         lo[i] = mv.start[i].min(mv.end[i]);
         hi[i] = mv.start[i].max(mv.end[i]);
     }
-    if let MoveKind::Arc {
-        plane,
-        center,
-        radius_mm,
-        cw,
-        sweep_rad,
-    } = mv.kind
-    {
-        let (a, b, _) = plane.axes();
-        let a0 = (mv.start[b] - center[1]).atan2(mv.start[a] - center[0]);
+    if let Some(c) = mv.arc() {
         // The four quadrant points (angle, axis, value), passed when within the sweep.
         let quadrants = [
-            (0.0, a, center[0] + radius_mm),
-            (PI / 2.0, b, center[1] + radius_mm),
-            (PI, a, center[0] - radius_mm),
-            (1.5 * PI, b, center[1] - radius_mm),
+            (0.0, c.a, c.center[0] + c.radius_mm),
+            (PI / 2.0, c.b, c.center[1] + c.radius_mm),
+            (PI, c.a, c.center[0] - c.radius_mm),
+            (1.5 * PI, c.b, c.center[1] - c.radius_mm),
         ];
         for (angle, axis, value) in quadrants {
-            let from_start = if cw { a0 - angle } else { angle - a0 };
-            if from_start.rem_euclid(TAU) <= sweep_rad {
+            if (c.dir * (angle - c.start_rad)).rem_euclid(TAU) <= c.sweep_rad {
                 lo[axis] = lo[axis].min(value);
                 hi[axis] = hi[axis].max(value);
             }
