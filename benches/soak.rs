@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use ncchannel::cli::bench::streaming_channels;
 use ncchannel::runtime::{Cycle, Tick};
+use ncchannel::soak::load::streaming_channels;
 
 fn soak(c: &mut Criterion) {
     let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");

@@ -6,18 +6,13 @@
 //! program at full rate through its own stream interface, decoder and motion (the soak cycle
 //! without faults, so the invariants are checked too).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
 use crate::report::stats::Histogram;
 use crate::runtime::{bare_loop, Clock, Runtime};
-use crate::soak::driver::{Slot, SoakCycle};
-use crate::soak::feed::{FeederSpec, SoakFeeder, Source};
-use crate::soak::generator::{Generator, ProgramSpec};
-use crate::soak::rng::SplitMix64;
-use crate::soak::scenario::Faults;
-use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
+use crate::soak::load::streaming_channels;
 
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
@@ -53,54 +48,6 @@ fn print_hist(name: &str, h: &Histogram) {
         h.max_us(),
         h.count()
     );
-}
-
-/// `n` channels built from the start-up list, each fed its own endless generated program by
-/// a client writing 992-byte packets every tick: the soak cycle without faults.
-pub fn streaming_channels(
-    params: &Path,
-    n: u32,
-    seed: u64,
-) -> Result<(SoakCycle, Duration), String> {
-    let config = crate::params::load(params).map_err(|e| {
-        e.diagnostics()
-            .iter()
-            .map(|d| d.render())
-            .collect::<Vec<_>>()
-            .join("\n")
-    })?;
-    if config.channels.is_empty() {
-        return Err("the start-up list has no channel".into());
-    }
-    let axes = crate::setup::axes(&config).map_err(|e| e.to_string())?;
-    let mut rng = SplitMix64::new(seed);
-    let mut slots = Vec::new();
-    for i in 0..n {
-        let cc = &config.channels[i as usize % config.channels.len()];
-        let mut settings =
-            crate::setup::channel_settings(&config, cc).map_err(|e| e.to_string())?;
-        settings.number = i + 1;
-        let program = settings
-            .streaming_prog
-            .clone()
-            .ok_or_else(|| format!("{}: streaming is off", cc.list_path.display()))?;
-        let mut r = rng.fork(u64::from(i));
-        let feeder = SoakFeeder::new(
-            FeederSpec {
-                packet_bytes: [MAX_PROGRAM_STREAM_INPUT_SIZE, MAX_PROGRAM_STREAM_INPUT_SIZE],
-                ..FeederSpec::default()
-            },
-            r.fork(2),
-            Source::Generated(Generator::new(ProgramSpec::default(), r.fork(1))),
-        );
-        let channel = crate::channel::Channel::new(settings, false);
-        slots.push(Slot::new(channel, program, feeder, &axes, r.fork(3)));
-    }
-    let period = Duration::from_micros(config.runtime.cycle_period_us.max(1));
-    Ok((
-        SoakCycle::new(slots, Faults::default(), Vec::new(), None),
-        period,
-    ))
 }
 
 pub fn execute(args: BenchArgs) -> ExitCode {

@@ -7,6 +7,7 @@ pub mod external;
 pub mod feed;
 pub mod generator;
 pub mod invariants;
+pub mod load;
 pub mod plot;
 pub mod report;
 pub mod rng;
