@@ -651,9 +651,7 @@ impl Hli {
             }
         })();
         if let Err(e) = r {
-            eprintln!(
-                "ncchannel ads: HLI channel {ch}: mode/state command {to_mode}/{to_state} refused: {e}"
-            );
+            log::warn!("HLI channel {ch}: mode/state command {to_mode}/{to_state} refused: {e}");
         }
         img.memory()[areas.command_semaphore][0] = 0;
     }

@@ -251,8 +251,9 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
+/// One line of the server's log (the `log` facade; `ncchannel` writes it to stderr).
 fn log(msg: impl std::fmt::Display) {
-    eprintln!("ncchannel ads: {msg}");
+    log::warn!("{msg}");
 }
 
 /// Bind and start serving `backend`.
@@ -268,7 +269,7 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
             ));
         }
         log(format_args!(
-            "warning: listening on non-loopback {}: any host that reaches it can command the channel",
+            "listening on non-loopback {}: any host that reaches it can command the channel",
             config.bind
         ));
     }

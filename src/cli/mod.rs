@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 pub mod bench;
 pub mod check;
+mod logger;
 pub mod receive;
 pub mod run;
 pub mod serve;
@@ -65,6 +66,7 @@ pub enum Command {
 
 impl Cli {
     pub fn execute(self) -> ExitCode {
+        logger::init();
         match self.command {
             Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
