@@ -1,5 +1,5 @@
-//! The file cache's benefit (Stage 4): a program calling a cycle 100,000 times, with and
-//! without `#CACHE LOAD` first, at `fs_latency_us` 0 and 200, in virtual time. Criterion
+//! The file cache's benefit (TF5200 File Caching): a program calling a cycle 100,000 times,
+//! with and without `#CACHE LOAD` first, at `fs_latency_us` 0 and 200, in virtual time. Criterion
 //! measures the wall time of a whole run (throughput = calls, so it prints calls/s); each case
 //! also prints once its wall time per call, file-system opens and simulated machining time.
 //!
