@@ -185,11 +185,6 @@ impl AxisFilter {
         self.corner.len() as f64 * self.dt_s
     }
 
-    /// Jerk window actually used, ticks.
-    pub fn jerk_ticks(&self) -> usize {
-        self.jerk.len()
-    }
-
     /// Both windows, s: the lag of a stop and the time the output takes to settle.
     pub fn total_window_s(&self) -> f64 {
         (self.corner.len() + self.jerk.len()) as f64 * self.dt_s

@@ -494,20 +494,16 @@ impl Motion {
                 v if v > 0.0 => v,
                 _ => seg.limit_mm_per_s,
             };
-            let (window_s, accel) = if j.is_finite() {
+            // (window in ticks, the same in s, the trapezoid's acceleration)
+            let (n, window_s, accel) = if j.is_finite() {
                 let t = (a / j)
                     .min((v / j).sqrt())
                     .min((seg.length_mm / (2.0 * j)).cbrt());
                 let n = AxisFilter::ticks(t, self.dt_s);
                 let w = n as f64 * self.dt_s;
-                (w, a.min(j * w))
+                (n, w, a.min(j * w))
             } else {
-                (0.0, a)
-            };
-            let n = if window_s > 0.0 {
-                AxisFilter::ticks(window_s, self.dt_s)
-            } else {
-                1
+                (1, 0.0, a)
             };
             if self.filter.use_windows(1, n) {
                 self.run = Run::Lone {

@@ -339,21 +339,29 @@ impl Planner {
     /// acceleration (no junction reserve: a lone line has no junction), mm/s², mm/s³
     /// (infinite: no jerk limit on any moving axis).
     pub fn line_limits(&self, seg: &Segment) -> (f64, f64) {
+        // A line's planned acceleration is the projected axis limits less the reserve
+        // (`segment`): the reserve given back.
+        let full = seg.accel_mm_per_s2 / (1.0 - JUNCTION_ACCEL_SHARE);
+        let accel = if full.is_finite() {
+            full
+        } else {
+            seg.accel_mm_per_s2
+        };
         let t = tangent(&seg.mv, seg.length_mm, false);
-        let (mut accel, mut jerk) = (f64::INFINITY, f64::INFINITY);
+        let mut jerk = f64::INFINITY;
         for (i, ti) in t.iter().enumerate() {
             let s = ti.abs();
             if s <= 1e-12 {
                 continue;
             }
-            let Some(ax) = &self.axes[i] else { continue };
-            accel = accel.min(ax.max_accel_mm_per_s2.max(1e-6) / s);
-            if let Some(j) = ax.max_jerk_mm_per_s3.filter(|j| j.is_finite() && *j > 0.0) {
-                jerk = jerk.min(j / s);
-            }
-        }
-        if !accel.is_finite() {
-            accel = seg.accel_mm_per_s2;
+            let Some(j) = self.axes[i]
+                .as_ref()
+                .and_then(|ax| ax.max_jerk_mm_per_s3)
+                .filter(|j| j.is_finite() && *j > 0.0)
+            else {
+                continue;
+            };
+            jerk = jerk.min(j / s);
         }
         (accel, jerk)
     }
