@@ -35,6 +35,20 @@ def lines():
         n += 1
 
 
+def write_again(plc, p, end):
+    """Write packet `p` a second time, retrying while the buffer is full (BUSY): a full
+    buffer at that moment must not turn the duplicate into a plain retry the flag misses."""
+    while time.monotonic() < end:
+        try:
+            plc.write(GROUP, OFF_STREAM, list(p), ctypes.c_uint8 * len(p))
+            return True
+        except pyads.ADSError as e:
+            if e.err_code != BUSY:
+                raise
+            time.sleep(0.002)
+    return False
+
+
 def main():
     seconds = float(sys.argv[1])
     duplicate = "--duplicate" in sys.argv
@@ -56,8 +70,7 @@ def main():
                 writes += 1
                 line_count += p.count(b"\n")
                 if duplicate and not duplicated and writes == 20:
-                    plc.write(GROUP, OFF_STREAM, list(p), ctypes.c_uint8 * len(p))
-                    duplicated = True
+                    duplicated = write_again(plc, p, end)
                 break
             except pyads.ADSError as e:
                 if e.err_code == BUSY:
