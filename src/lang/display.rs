@@ -173,8 +173,10 @@ impl Display for Expr {
                     UnOp::Inv => f.write_str("INV ")?,
                 }
                 match (op, e.as_ref()) {
-                    // `-2` would read back as the literal -2, not as negation of 2.
-                    (UnOp::Neg, Expr::Num(v)) if !v.is_sign_negative() => write!(f, "[{e}]"),
+                    // `-2` would read back as the literal -2, not as negation of 2; `- 2`
+                    // reads back as the negation, and unlike `-[2]` adds no nesting level
+                    // (64 negations of a literal once printed past the nesting limit).
+                    (UnOp::Neg, Expr::Num(v)) if !v.is_sign_negative() => write!(f, " {e}"),
                     _ => At(e, UNARY).fmt(f),
                 }
             }
