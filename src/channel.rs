@@ -22,6 +22,17 @@ use crate::source::stream::{StreamBuffer, StreamWriteError};
 /// Errors kept for the report (`ChannelStats::errors` counts all of them).
 pub const MAX_LISTED_ERRORS: usize = 256;
 
+/// An error as the channel keeps it: the ISG number and text, and the program and line that
+/// raised it (`None` for errors no program line raised, such as a stream write refused).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorRecord {
+    pub code: u32,
+    pub msg: String,
+    pub prog: Option<String>,
+    /// Line number in `prog`, 1-based.
+    pub line: Option<u64>,
+}
+
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
 pub use crate::mode::{Mode, State};
@@ -161,10 +172,10 @@ pub struct Channel {
     program: Option<String>,
     /// Block search target for the next start.
     search: Option<SearchTarget>,
-    last_error: Option<(u32, String)>,
+    last_error: Option<ErrorRecord>,
     /// The latest `#MSG` text (kept until the next one or a reset).
     message: Option<String>,
-    errors: Vec<(u32, String)>,
+    errors: Vec<ErrorRecord>,
     stats: ChannelStats,
     /// Motion stopped for lack of stream data; a `resume` is owed.
     interrupted: bool,
@@ -274,7 +285,7 @@ impl Channel {
         &mut self.motion
     }
     /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
-    pub fn errors(&self) -> &[(u32, String)] {
+    pub fn errors(&self) -> &[ErrorRecord] {
         &self.errors
     }
     /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
@@ -282,7 +293,7 @@ impl Channel {
         self.message.as_deref()
     }
 
-    pub fn last_error(&self) -> Option<&(u32, String)> {
+    pub fn last_error(&self) -> Option<&ErrorRecord> {
         self.last_error.as_ref()
     }
     /// Blocks the lookahead window holds and may not release yet (the memory effect): what
@@ -379,12 +390,18 @@ impl Channel {
         prog: Option<String>,
         line: Option<u64>,
     ) {
+        let record = ErrorRecord {
+            code,
+            msg,
+            prog,
+            line,
+        };
         self.emit(
             tick,
             EventKind::Error {
                 code,
-                msg: msg.clone(),
-                prog,
+                msg: record.msg.clone(),
+                prog: record.prog.clone(),
                 line,
             },
         );
@@ -392,9 +409,9 @@ impl Channel {
         // The report lists the first errors of a run; a soak raising the same expected
         // error for days must not grow memory, so the list is bounded and the rest counted.
         if self.errors.len() < MAX_LISTED_ERRORS {
-            self.errors.push((code, msg.clone()));
+            self.errors.push(record.clone());
         }
-        self.last_error = Some((code, msg));
+        self.last_error = Some(record);
         // An error stops decoding and motion; only a reset leaves ERROR.
         self.motion.reset();
         self.queue.clear();

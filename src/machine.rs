@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::Sender;
 
 use crate::channel::{
-    ActiveBlock, Channel, CommandError, Finish, HmiCommands, Mode, SearchCommand, State,
+    ActiveBlock, Channel, CommandError, ErrorRecord, Finish, HmiCommands, Mode, SearchCommand,
+    State,
 };
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
@@ -343,11 +344,12 @@ impl Machine {
 /// last error when it is the newest one.
 fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     let i = usize::try_from(index).ok()?;
+    let wire = |e: &ErrorRecord| (e.code, e.msg.clone());
     if let Some(e) = c.errors().get(i) {
-        return Some(e.clone());
+        return Some(wire(e));
     }
     if index + 1 == c.stats().errors {
-        return c.last_error().cloned();
+        return c.last_error().map(wire);
     }
     None
 }
@@ -361,7 +363,7 @@ pub fn status_of(c: &Channel) -> Status {
         stream_used: used,
         stream_free: free,
         positions: c.axis_positions(),
-        last_error: c.last_error().cloned(),
+        last_error: c.last_error().map(|e| (e.code, e.msg.clone())),
         override_pct: c.motion().override_pct(),
         blocks: c.stats().blocks,
         tick: 0,

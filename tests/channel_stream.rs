@@ -271,5 +271,5 @@ fn the_error_list_is_bounded_and_counts_the_rest() {
     }
     assert_eq!(c.stats().errors, 1000);
     assert_eq!(c.errors().len(), ncchannel::channel::MAX_LISTED_ERRORS);
-    assert!(c.errors().iter().all(|(code, _)| *code == 21476));
+    assert!(c.errors().iter().all(|e| e.code == 21476));
 }

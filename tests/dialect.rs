@@ -487,5 +487,9 @@ fn run_takes_a_file_path_and_a_skip_mask_and_check_agrees() {
     assert!(out.contains(":1:7:") && out.contains("20203"), "{out}");
     let (code, out) = cli(&["run", p]);
     assert_eq!(code, 1, "{out}");
-    assert!(out.contains("20203"), "{out}");
+    // The summary names the program line that raised the error, as the event log does.
+    assert!(
+        out.contains("error 20203") && out.contains("(cam.nc, line 1)"),
+        "{out}"
+    );
 }

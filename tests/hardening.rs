@@ -74,7 +74,7 @@ impl Hand {
     }
 
     fn error_code(&mut self) -> Option<u32> {
-        self.channel().last_error().map(|e| e.0)
+        self.channel().last_error().map(|e| e.code)
     }
 
     fn reset(&mut self) {
@@ -307,7 +307,7 @@ fn soft_limits_refuse_the_block_before_it_moves() {
     h.start("far.nc");
     assert_eq!(h.run(200_000).0, Some(Finish::Error));
     assert_eq!(h.error_code(), Some(21897));
-    let msg = h.channel().last_error().unwrap().1.clone();
+    let msg = h.channel().last_error().unwrap().msg.clone();
     assert!(msg.contains("axis X") && msg.contains("5000"), "{msg}");
     let p = h.channel().position();
     assert!(p[0] <= 10.0 + 1e-9 && p[1] <= 10.0 + 1e-9, "{p:?}");

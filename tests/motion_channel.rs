@@ -247,7 +247,7 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
         c.step(&tick(k));
     }
     assert_eq!(c.state(), State::Error);
-    assert_eq!(c.last_error().unwrap().0, 90130);
+    assert_eq!(c.last_error().unwrap().code, 90130);
 }
 
 #[test]
@@ -605,7 +605,12 @@ fn flush_inside_the_streaming_spline_is_21909() {
     let text = streaming_spline_text().replace("N36345", "#FLUSH\r\nN36345");
     let (head, tail) = text.split_at(text.find("N36340").unwrap());
     let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
-    assert_eq!(c.last_error().map(|e| e.0), Some(21909), "{:?}", c.errors());
+    assert_eq!(
+        c.last_error().map(|e| e.code),
+        Some(21909),
+        "{:?}",
+        c.errors()
+    );
 }
 
 /// Distance of (x, y) from the circle of radius `r` around (cx, cy).
@@ -699,5 +704,10 @@ fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
         }
     }
     assert_eq!(c.state(), State::Error);
-    assert_eq!(c.last_error().map(|e| e.0), Some(90140), "{:?}", c.errors());
+    assert_eq!(
+        c.last_error().map(|e| e.code),
+        Some(90140),
+        "{:?}",
+        c.errors()
+    );
 }

@@ -225,14 +225,14 @@ fn a_disabled_log_takes_events_and_writes_nothing() {
     assert_eq!(log.finish().unwrap(), 0);
 }
 
-#[test]
-fn report_json_has_the_documented_shape() {
+/// A report with one of each part: two errors (one raised by a program line), files, cycle.
+fn sample_report() -> Report {
     let mut stats = CycleStats::default();
     for us in [100u64, 120, 130, 900] {
         stats.work.record_ns(us * 1000 / 100);
         stats.lateness.record_ns(us * 10);
     }
-    let r = Report {
+    Report {
         outcome: Outcome::MaxTicks,
         ticks: 4,
         time_s: 0.004,
@@ -245,10 +245,20 @@ fn report_json_has_the_documented_shape() {
             bytes: 120,
         },
         interrupts: 1,
-        errors: vec![ErrorReport {
-            code: 21476,
-            msg: "Streaming data does not contain a correct line end marker".into(),
-        }],
+        errors: vec![
+            ErrorReport {
+                code: 21476,
+                msg: "Streaming data does not contain a correct line end marker".into(),
+                prog: None,
+                line: None,
+            },
+            ErrorReport {
+                code: 21897,
+                msg: "Axis position is out of permissible value range".into(),
+                prog: Some("part.nc".into()),
+                line: Some(12),
+            },
+        ],
         cycle: CycleReport::new(Duration::from_millis(1), &stats),
         files: FilesReport {
             opens: 3,
@@ -256,7 +266,12 @@ fn report_json_has_the_documented_shape() {
             cache_hits: 5,
             latency_s: 0.0006,
         },
-    };
+    }
+}
+
+#[test]
+fn report_json_has_the_documented_shape() {
+    let r = sample_report();
     let v: Value = serde_json::from_str(&r.to_json_pretty()).unwrap();
     assert_eq!(v["outcome"], "max_ticks");
     assert_eq!(
@@ -285,6 +300,10 @@ fn report_json_has_the_documented_shape() {
         sorted(&["writes_ok", "writes_rejected", "bytes"])
     );
     assert_eq!(v["errors"][0]["code"], 21476);
+    // Where no program line raised the error, the report says nothing of one.
+    assert_eq!(keys(&v["errors"][0].to_string()), sorted(&["code", "msg"]));
+    assert_eq!(v["errors"][1]["prog"], "part.nc");
+    assert_eq!(v["errors"][1]["line"], 12);
     assert_eq!(
         keys(&v["cycle"].to_string()),
         sorted(&[
@@ -300,7 +319,11 @@ fn report_json_has_the_documented_shape() {
     assert_eq!(v["cycle"]["work_us_max"], 9.0);
     let back: Report = serde_json::from_value(v).unwrap();
     assert_eq!(back, r);
+}
 
+#[test]
+fn report_summary_names_errors_with_their_program_line() {
+    let r = sample_report();
     let mut human = Vec::new();
     r.print_human(&mut human).unwrap();
     let human = String::from_utf8(human).unwrap();
@@ -310,7 +333,8 @@ fn report_json_has_the_documented_shape() {
         "0.004 s channel time",
         "interrupts: 1",
         "3 writes accepted, 1 rejected",
-        "error 21476",
+        "error 21476: Streaming data does not contain a correct line end marker\n",
+        "error 21897: Axis position is out of permissible value range (part.nc, line 12)\n",
         "3 opens, 700 bytes read, 5 cache hits",
     ] {
         assert!(human.contains(want), "{want:?} missing in\n{human}");

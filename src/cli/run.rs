@@ -394,9 +394,11 @@ fn build_report(
         errors: c
             .errors()
             .iter()
-            .map(|(code, msg)| ErrorReport {
-                code: *code,
-                msg: msg.clone(),
+            .map(|e| ErrorReport {
+                code: e.code,
+                msg: e.msg.clone(),
+                prog: e.prog.clone(),
+                line: e.line,
             })
             .collect(),
         cycle: CycleReport::new(period, stats),

@@ -62,6 +62,12 @@ pub struct FilesReport {
 pub struct ErrorReport {
     pub code: u32,
     pub msg: String,
+    /// The program and 1-based line that raised the error, when one did (absent in reports of
+    /// versions before they were recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prog: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<u64>,
 }
 
 /// Cycle statistics in microseconds.
@@ -135,7 +141,13 @@ impl Report {
         };
         writeln!(w, "outcome:    {outcome}")?;
         for e in &self.errors {
-            writeln!(w, "  error {}: {}", e.code, e.msg)?;
+            let at = match (&e.prog, e.line) {
+                (Some(p), Some(l)) => format!(" ({p}, line {l})"),
+                (None, Some(l)) => format!(" (line {l})"),
+                (Some(p), None) => format!(" ({p})"),
+                (None, None) => String::new(),
+            };
+            writeln!(w, "  error {}: {}{at}", e.code, e.msg)?;
         }
         writeln!(w, "blocks:     {}", self.blocks)?;
         writeln!(

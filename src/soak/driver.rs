@@ -257,9 +257,10 @@ impl Cycle for SoakCycle {
             }
             let errors = slot.channel.errors();
             if errors.len() > slot.errors_seen {
-                for (code, msg) in &errors[slot.errors_seen..] {
-                    *slot.counters.errors.entry(*code).or_default() += 1;
-                    if !self.expected_errors.contains(code) {
+                for e in &errors[slot.errors_seen..] {
+                    let (code, msg) = (e.code, &e.msg);
+                    *slot.counters.errors.entry(code).or_default() += 1;
+                    if !self.expected_errors.contains(&code) {
                         self.tallies
                             .errors
                             .violate(|| format!("channel {number}, tick {t}: error {code}: {msg}"));

@@ -235,9 +235,9 @@ impl Supervised {
             if reset_due || state == State::Error {
                 if let Some(c) = self.machine.channel_mut(ch) {
                     if state == State::Error {
-                        let code = c.last_error().map(|e| e.0).unwrap_or(0);
+                        let code = c.last_error().map(|e| e.code).unwrap_or(0);
                         if !self.expected_errors.contains(&code) {
-                            let msg = c.last_error().map(|e| e.1.clone()).unwrap_or_default();
+                            let msg = c.last_error().map(|e| e.msg.clone()).unwrap_or_default();
                             self.errors
                                 .violate(|| format!("channel {ch}: error {code} {msg}"));
                         }
