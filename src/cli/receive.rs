@@ -79,8 +79,6 @@ pub struct ReceiveArgs {
     pub channel: u32,
 }
 
-/// Where programs go without `--out`: the channel's first main-program search path, from the
-/// parameter lists, so received programs are ready to run.
 /// `--listen` defaults: a silent sender frees the port after 30 s; one transfer carries at
 /// most 256 MiB and 1000 programs (docs/ads-limits.md, "receive --listen").
 pub const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
@@ -88,6 +86,8 @@ pub const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
 pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
 pub const DEFAULT_MAX_CONCURRENT: u16 = 4;
 
+/// Where programs go without `--out`: the channel's first main-program search path, from the
+/// parameter lists, so received programs are ready to run.
 pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let config = crate::params::load(params).map_err(|e| {
         for d in e.diagnostics() {

@@ -588,7 +588,6 @@ impl Planner {
         Ok(())
     }
 
-    /// A stop while compensation is on: the waiting element ends at its own offset end.
     /// Finish the element waiting in the compensator, if any. Inlined check: this runs for
     /// every block, and almost always finds nothing.
     #[inline]
@@ -598,6 +597,7 @@ impl Planner {
         }
     }
 
+    /// A stop while compensation is on: the waiting element ends at its own offset end.
     fn comp_finish_now(&mut self) {
         let Some(mut c) = self.comp.take() else {
             return;
@@ -643,7 +643,6 @@ impl Planner {
         self.tool_radii = tools;
     }
 
-    /// End the spline: the rest of its curve and everything waiting for it.
     /// Finish the spline being built, if any (inlined check, as `comp_finish`).
     #[inline]
     fn finish_spline(&mut self) {
@@ -652,6 +651,7 @@ impl Planner {
         }
     }
 
+    /// End the spline: the rest of its curve and everything waiting for it.
     fn finish_spline_now(&mut self) {
         let Some(sp) = self.spline.take() else { return };
         let mut out = std::mem::take(&mut self.spline_out);

@@ -27,9 +27,9 @@ use report::{ChannelReport, CycleFigures, MemoryReport, SoakReport};
 use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
 
-/// Largest file a scenario streams.
 /// Resolution of the progress bar (per mille of the run).
 const PROGRESS_STEPS: u64 = 1000;
+/// Largest file a scenario streams.
 const MAX_STREAM_FILE_BYTES: u64 = 16 << 20;
 
 #[derive(Debug, Error)]
