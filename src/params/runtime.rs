@@ -172,17 +172,19 @@ pub struct AdsConfig {
 }
 
 impl Default for AdsConfig {
+    /// The ADS server's own defaults (`ads::server`), so each limit has one number.
     fn default() -> Self {
+        use crate::ads::server as srv;
         AdsConfig {
-            bind: SocketAddrText(SocketAddr::from(([127, 0, 0, 1], 48898))),
+            bind: SocketAddrText(srv::DEFAULT_BIND),
             net_id: AmsNetId([127, 0, 0, 1, 1, 1]),
-            max_frame_bytes: 65536,
+            max_frame_bytes: crate::ads::frame::DEFAULT_MAX_FRAME_BYTES as u32,
             allowed_clients: Vec::new(),
-            max_connections: 64,
-            max_notifications_per_connection: 256,
-            max_notifications_total: 1024,
-            notification_samples_per_s: 10_000,
-            idle_timeout_s: 60,
+            max_connections: srv::DEFAULT_MAX_CONNECTIONS as u32,
+            max_notifications_per_connection: srv::DEFAULT_MAX_NOTIFICATIONS as u32,
+            max_notifications_total: srv::DEFAULT_MAX_NOTIFICATIONS_TOTAL as u32,
+            notification_samples_per_s: srv::DEFAULT_NOTIFICATION_SAMPLES_PER_S as u32,
+            idle_timeout_s: srv::DEFAULT_IDLE_TIMEOUT.as_secs() as u32,
         }
     }
 }
