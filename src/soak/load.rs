@@ -18,13 +18,8 @@ pub fn streaming_channels(
     n: u32,
     seed: u64,
 ) -> Result<(SoakCycle, Duration), String> {
-    let config = crate::params::load(params).map_err(|e| {
-        e.diagnostics()
-            .iter()
-            .map(|d| d.render())
-            .collect::<Vec<_>>()
-            .join("\n")
-    })?;
+    // `ParamError` displays every diagnostic, rendered, one a line.
+    let config = crate::params::load(params).map_err(|e| e.to_string())?;
     if config.channels.is_empty() {
         return Err("the start-up list has no channel".into());
     }

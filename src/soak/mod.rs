@@ -64,12 +64,8 @@ pub fn build(
     let params = scenario.params_path();
     let config = crate::params::load(&params).map_err(|e| SoakError::Params {
         path: params.display().to_string(),
-        msg: e
-            .diagnostics()
-            .iter()
-            .map(|d| d.render())
-            .collect::<Vec<_>>()
-            .join("\n"),
+        // `ParamError` displays every diagnostic, rendered, one a line.
+        msg: e.to_string(),
     })?;
     let axes = crate::setup::axes(&config).map_err(|e| SoakError::Setup(e.to_string()))?;
     let specs: Vec<scenario::ChannelSpec> = if scenario.channels.is_empty() {
