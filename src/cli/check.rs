@@ -150,14 +150,13 @@ fn not_listed(path: &Path, more: usize) -> Diagnostic {
 
 /// Read a file as text; bytes that are not UTF-8 (Latin-1 comments) become U+FFFD.
 fn read_text(path: &Path) -> Result<String, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("cannot read file: {e}"))?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "file has {} bytes, more than the {MAX_FILE_BYTES} a program may have",
-            meta.len()
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read file: {e}"))?;
+    use crate::bounded::{read_file, BoundedReadError};
+    let bytes = read_file(path, MAX_FILE_BYTES).map_err(|e| match e {
+        BoundedReadError::TooLarge { bytes, limit } => {
+            format!("file has {bytes} bytes, more than the {limit} a program may have")
+        }
+        BoundedReadError::Io(e) => format!("cannot read file: {e}"),
+    })?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 

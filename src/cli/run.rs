@@ -19,8 +19,8 @@ use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 use super::exit;
 
-/// Largest file the built-in feeder reads: a soak file, not an accident.
-const MAX_STREAM_FILE_BYTES: u64 = 1 << 30;
+/// Largest file the built-in feeder and `ncchannel stream` read: a soak file, not an accident.
+pub(crate) const MAX_STREAM_FILE_BYTES: u64 = 1 << 30;
 /// Points `--plot` keeps at most (the trace decimates beyond).
 const PLOT_SAMPLES: usize = 20_000;
 

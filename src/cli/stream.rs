@@ -81,7 +81,7 @@ pub fn execute(args: StreamArgs) -> ExitCode {
             return ExitCode::from(exit::USAGE);
         }
     };
-    let text = match std::fs::read(&args.file) {
+    let text = match crate::bounded::read_file(&args.file, super::run::MAX_STREAM_FILE_BYTES) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("ncchannel stream: {}: {e}", args.file.display());

@@ -136,25 +136,18 @@ pub fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
     if !meta.is_file() {
         return Err(file_error(file, "cannot read parameter list: not a file"));
     }
-    if meta.len() > MAX_LIST_BYTES {
-        return Err(file_error(
+    use crate::bounded::{read_file, BoundedReadError};
+    let bytes = read_file(file, MAX_LIST_BYTES).map_err(|e| {
+        file_error(
             file,
-            format!(
-                "parameter list is {} bytes, more than the limit of {} bytes",
-                meta.len(),
-                MAX_LIST_BYTES
-            ),
-        ));
-    }
-    let bytes = std::fs::read(file)
-        .map_err(|e| file_error(file, format!("cannot read parameter list: {e}")))?;
-    // The file may have grown between metadata and read.
-    if bytes.len() as u64 > MAX_LIST_BYTES {
-        return Err(file_error(
-            file,
-            "parameter list grew beyond the size limit while reading",
-        ));
-    }
+            match e {
+                BoundedReadError::TooLarge { bytes, limit } => {
+                    format!("parameter list is {bytes} bytes, more than the limit of {limit} bytes")
+                }
+                BoundedReadError::Io(e) => format!("cannot read parameter list: {e}"),
+            },
+        )
+    })?;
     Ok(match String::from_utf8(bytes) {
         Ok(s) => s,
         Err(e) => e.into_bytes().iter().map(|&b| char::from(b)).collect(),

@@ -220,17 +220,18 @@ pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagn
 
 /// Read runtime.toml with the size bound, then parse and check it.
 pub fn read_runtime(file: &Path) -> Result<RuntimeConfig, Vec<Diagnostic>> {
+    use crate::bounded::{read_file, BoundedReadError};
     let err = |m: String| vec![Diagnostic::error(file, 1, 1, None, m)];
-    let meta =
-        std::fs::metadata(file).map_err(|e| err(format!("cannot read runtime.toml: {e}")))?;
-    if meta.len() > MAX_RUNTIME_BYTES {
-        return Err(err(format!(
-            "runtime.toml is {} bytes, more than the limit of {MAX_RUNTIME_BYTES} bytes",
-            meta.len()
-        )));
-    }
-    let text =
-        std::fs::read_to_string(file).map_err(|e| err(format!("cannot read runtime.toml: {e}")))?;
+    let bytes = read_file(file, MAX_RUNTIME_BYTES).map_err(|e| {
+        err(match e {
+            BoundedReadError::TooLarge { bytes, limit } => {
+                format!("runtime.toml is {bytes} bytes, more than the limit of {limit} bytes")
+            }
+            BoundedReadError::Io(e) => format!("cannot read runtime.toml: {e}"),
+        })
+    })?;
+    let text = String::from_utf8(bytes)
+        .map_err(|e| err(format!("cannot read runtime.toml: {}", e.utf8_error())))?;
     parse_runtime(file, &text)
 }
 

@@ -20,20 +20,12 @@ use crate::runtime::{Cycle, Flow, Tick};
 /// Scenario tables that describe the built-in client; an external client has none of them.
 const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
 
-/// Largest scenario file read.
-const MAX_SCENARIO_BYTES: u64 = 1 << 20;
-
 /// Load a scenario for external clients: the soak's format, its client keys refused by name.
 pub fn load_external(path: &Path) -> Result<Scenario, String> {
-    use std::io::Read;
     let shown = path.display();
-    let mut text = String::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_string(&mut text))
+    let bytes = crate::bounded::read_file(path, super::scenario::MAX_SCENARIO_BYTES)
         .map_err(|e| format!("{shown}: {e}"))?;
-    if text.len() as u64 > MAX_SCENARIO_BYTES {
-        return Err(format!("{shown}: larger than {MAX_SCENARIO_BYTES} bytes"));
-    }
+    let text = String::from_utf8(bytes).map_err(|_| format!("{shown}: not UTF-8 text"))?;
     check_external(&text).map_err(|m| format!("{shown}: {m}"))?;
     // The length is serve's --seconds; the soak's parser wants one, so it gets a dummy.
     let mut s = Scenario::parse(&format!("{text}\n[length]\nticks = 1\n"))

@@ -13,7 +13,7 @@ use super::feed::FeederSpec;
 use super::generator::ProgramSpec;
 
 /// Largest scenario file read.
-const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+pub(crate) const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 
 #[derive(Debug, Error)]
 pub enum ScenarioError {
