@@ -545,8 +545,8 @@ fn serve_connection(
     if let Some(h) = notifier {
         let _ = h.join();
     }
-    shared.release(lock(&notifs.table).values());
-    lock(&notifs.table).clear();
+    let ended: Vec<Notification> = lock(&notifs.table).drain().map(|(_, n)| n).collect();
+    shared.release(&ended);
     writer.close(Closed::Done);
     let _ = write_thread.join();
     let _ = stream.shutdown(Shutdown::Both);
@@ -700,13 +700,10 @@ fn close_port(shared: &Shared, notifs: &Notifications, body: &[u8]) {
         [a, b, ..] => Some(u16::from_le_bytes([*a, *b])),
         _ => None,
     };
-    let mut table = lock(&notifs.table);
-    let gone: Vec<u32> = table
-        .iter()
-        .filter(|(_, n)| port.is_none_or(|p| n.client.port == p))
-        .map(|(&h, _)| h)
+    let removed: Vec<Notification> = lock(&notifs.table)
+        .extract_if(|_, n| port.is_none_or(|p| n.client.port == p))
+        .map(|(_, n)| n)
         .collect();
-    let removed: Vec<Notification> = gone.iter().filter_map(|h| table.remove(h)).collect();
     shared.release(&removed);
 }
 
