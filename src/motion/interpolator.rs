@@ -150,17 +150,17 @@ impl Swing {
 
     /// Seconds until braking is allowed (0: now).
     fn brake_wait_s(&self) -> f64 {
-        let w = self.window_s - self.since_accel_s;
-        if w > SWING_EPS_S {
-            w
-        } else {
-            0.0
-        }
+        self.wait_after(self.since_accel_s)
     }
 
     /// Seconds until accelerating is allowed (0: now).
     fn accel_wait_s(&self) -> f64 {
-        let w = self.window_s - self.since_brake_s;
+        self.wait_after(self.since_brake_s)
+    }
+
+    /// What is left of the window `since_s` after the opposite phase ended (0: none).
+    fn wait_after(&self, since_s: f64) -> f64 {
+        let w = self.window_s - since_s;
         if w > SWING_EPS_S {
             w
         } else {
