@@ -340,11 +340,15 @@ impl Machine {
     }
 }
 
+/// An error as the ADS objects carry it: number and text.
+fn wire(e: &ErrorRecord) -> (u32, String) {
+    (e.code, e.msg.clone())
+}
+
 /// The `index`-th error of the channel (0 = first): kept in the channel's error list, or the
 /// last error when it is the newest one.
 fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     let i = usize::try_from(index).ok()?;
-    let wire = |e: &ErrorRecord| (e.code, e.msg.clone());
     if let Some(e) = c.errors().get(i) {
         return Some(wire(e));
     }
@@ -363,7 +367,7 @@ pub fn status_of(c: &Channel) -> Status {
         stream_used: used,
         stream_free: free,
         positions: c.axis_positions(),
-        last_error: c.last_error().map(|e| (e.code, e.msg.clone())),
+        last_error: c.last_error().map(wire),
         override_pct: c.motion().override_pct(),
         blocks: c.stats().blocks,
         tick: 0,
