@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress};
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 
 use crate::ads::frame::{AmsAddr, AmsNetId};
 use crate::ads::objects::PORT_CNC_COM;
@@ -43,16 +43,12 @@ pub struct StreamArgs {
     pub stall_secs: u64,
 }
 
-/// The progress bar over the file's bytes; indicatif draws it only when stderr is a terminal,
-/// so a log or a pipe gets the final line alone.
+/// The progress bar over the file's bytes (a log or a pipe gets the final line alone).
 fn progress_bar(total_bytes: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(total_bytes), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("stream: [{bar:30}] {bytes}/{total_bytes}  {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("#>."),
-    );
-    bar
+    crate::report::progress::bar(
+        total_bytes,
+        "stream: [{bar:30}] {bytes}/{total_bytes}  {msg}",
+    )
 }
 
 fn show_progress(bar: &ProgressBar, p: &StreamProgress) {

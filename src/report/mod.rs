@@ -2,5 +2,6 @@
 
 pub mod event;
 pub mod plot;
+pub mod progress;
 pub mod stats;
 pub mod summary;

@@ -15,7 +15,7 @@ pub mod scenario;
 
 use std::time::{Duration, Instant};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use thiserror::Error;
 
 use crate::runtime::{Clock, RunEnd, Runtime};
@@ -138,20 +138,13 @@ pub fn build(
     ))
 }
 
-/// The progress bar of a run; indicatif draws it only when stderr is a terminal, so a log
-/// or a pipe gets no progress line.
+/// The progress bar of a run (none when `enabled` is false).
 fn progress_bar(enabled: bool) -> ProgressBar {
-    let bar = if enabled {
-        ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::stderr())
+    if enabled {
+        crate::report::progress::bar(PROGRESS_STEPS, "[{bar:30}] {percent:>3}%  {msg}")
     } else {
         ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("[{bar:30}] {percent:>3}%  {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("#>."),
-    );
-    bar
+    }
 }
 
 /// The invariants' verdicts at the end of a run (`growth`: resident set after warm-up, KiB).
