@@ -252,11 +252,7 @@ impl Server<'_> {
         let mut active = 0usize;
         let mut accepted = 0usize;
         while args.max_transfers.is_none_or(|m| accepted < m) {
-            while active >= usize::from(args.max_concurrent) {
-                match done.recv() {
-                    Ok(r) => settle(r, total),
-                    Err(_) => break,
-                }
+            while active >= usize::from(args.max_concurrent) && settle_next(&done, total) {
                 active -= 1;
             }
             while let Ok(r) = done.try_recv() {
@@ -281,11 +277,7 @@ impl Server<'_> {
         }
         // The transfers in progress complete (each within its idle timeout).
         drop(done_tx);
-        while active > 0 {
-            match done.recv() {
-                Ok(r) => settle(r, total),
-                Err(_) => break,
-            }
+        while active > 0 && settle_next(&done, total) {
             active -= 1;
         }
         Ok(())
@@ -315,6 +307,20 @@ impl Server<'_> {
                 let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
                 let _ = tx.send(r);
             })
+    }
+}
+
+/// Wait for the next transfer to end and settle it; `false` when none is left to wait for.
+fn settle_next(
+    done: &std::sync::mpsc::Receiver<Result<TransferReport, dnc::DncError>>,
+    total: &mut Totals,
+) -> bool {
+    match done.recv() {
+        Ok(r) => {
+            settle(r, total);
+            true
+        }
+        Err(_) => false,
     }
 }
 
