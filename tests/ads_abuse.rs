@@ -16,7 +16,10 @@ use std::time::{Duration, Instant};
 use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame};
 
 mod abuse_common;
+mod ads_common;
 mod common;
+
+use ads_common::{read_req, u32_at};
 
 /// How much the server's resident set may grow over one abuse.
 const RSS_GROWTH_BOUND_KIB: u64 = 64 * 1024;
@@ -167,35 +170,24 @@ fn request(device: AmsAddr, command: CommandId, invoke: u32, data: &[u8]) -> Vec
     )
 }
 
-fn read_payload(group: u32, offset: u32, length: u32) -> Vec<u8> {
-    [group, offset, length]
-        .iter()
-        .flat_map(|v| v.to_le_bytes())
-        .collect()
-}
-
 /// A Read of the tick counter.
 fn tick_request(device: AmsAddr, invoke: u32) -> Vec<u8> {
     request(
         device,
         CommandId::Read,
         invoke,
-        &read_payload(TICK_GROUP, TICK_OFFSET, 4),
+        &read_req(TICK_GROUP, TICK_OFFSET, 4),
     )
 }
 
 /// AddDeviceNotification of the tick counter: cyclic (mode 3), no max delay, `cycle_100ns`.
 fn add_notification_payload(cycle_100ns: u32) -> Vec<u8> {
-    let mut add = read_payload(TICK_GROUP, TICK_OFFSET, 4);
+    let mut add = read_req(TICK_GROUP, TICK_OFFSET, 4);
     for v in [3u32, 0, cycle_100ns] {
         add.extend_from_slice(&v.to_le_bytes());
     }
     add.extend_from_slice(&[0; 16]);
     add
-}
-
-fn u32_at(b: &[u8], at: usize) -> u32 {
-    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
 }
 
 impl Conn {
@@ -245,34 +237,13 @@ impl Conn {
     }
 
     fn read_tick(&mut self) -> Option<u32> {
-        let d = self.call(CommandId::Read, &read_payload(TICK_GROUP, TICK_OFFSET, 4))?;
+        let d = self.call(CommandId::Read, &read_req(TICK_GROUP, TICK_OFFSET, 4))?;
         (d.len() >= 12 && u32_at(&d, 0) == 0).then(|| u32_at(&d, 8))
     }
 
     /// True when the server closed the connection within `timeout`.
     fn closed_within(&mut self, timeout: Duration) -> bool {
-        let deadline = Instant::now() + timeout;
-        let mut chunk = [0u8; 8192];
-        loop {
-            let Some(left) = deadline.checked_duration_since(Instant::now()) else {
-                return false;
-            };
-            let _ = self
-                .stream
-                .set_read_timeout(Some(left.max(Duration::from_millis(1))));
-            match self.stream.read(&mut chunk) {
-                Ok(0) => return true,
-                Ok(_) => continue,
-                Err(e) => {
-                    if !matches!(
-                        e.kind(),
-                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                    ) {
-                        return true;
-                    }
-                }
-            }
-        }
+        ads_common::closed_within(&mut self.stream, timeout)
     }
 }
 

@@ -115,20 +115,7 @@ impl Raw {
 
     /// True when the server closed the connection (EOF or reset) within `timeout`.
     pub fn closed_within(&mut self, timeout: Duration) -> bool {
-        self.stream.set_read_timeout(Some(timeout)).unwrap();
-        let mut chunk = [0u8; 64];
-        loop {
-            match self.stream.read(&mut chunk) {
-                Ok(0) => return true,
-                Ok(_) => continue,
-                Err(e) => {
-                    return !matches!(
-                        e.kind(),
-                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                    )
-                }
-            }
-        }
+        closed_within(&mut self.stream, timeout)
     }
 
     /// Send one request from `client_addr(port)` to `device()` and return the response.
@@ -141,6 +128,31 @@ impl Raw {
             data,
         ));
         self.frame()
+    }
+}
+
+/// True when the peer closed `stream` (EOF or reset) within `timeout`; whatever it still
+/// sends meanwhile is read and dropped.
+pub fn closed_within(stream: &mut TcpStream, timeout: Duration) -> bool {
+    let deadline = Instant::now() + timeout;
+    let mut chunk = [0u8; 8192];
+    loop {
+        let Some(left) = deadline.checked_duration_since(Instant::now()) else {
+            return false;
+        };
+        let _ = stream.set_read_timeout(Some(left.max(Duration::from_millis(1))));
+        match stream.read(&mut chunk) {
+            Ok(0) => return true,
+            Ok(_) => continue,
+            Err(e) => {
+                if !matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) {
+                    return true;
+                }
+            }
+        }
     }
 }
 
