@@ -28,6 +28,15 @@ pub struct Worst {
     pub tick: u64,
 }
 
+impl Worst {
+    /// Keep `ratio` at `tick` when it is worse than what was seen.
+    fn note(&mut self, ratio: f64, tick: u64) {
+        if ratio > self.ratio {
+            *self = Worst { ratio, tick };
+        }
+    }
+}
+
 /// Feed it every tick's position; ask for the worst ratios.
 #[derive(Debug, Clone)]
 pub struct LimitCheck {
@@ -83,36 +92,18 @@ impl LimitCheck {
             let mut v = [0.0; MAX_AXES];
             for i in 0..MAX_AXES {
                 v[i] = (p[i] - q[i]) / self.dt_s;
-                let r = v[i].abs() / self.vmax_mm_per_s[i];
-                if r > self.worst_velocity[i].ratio {
-                    self.worst_velocity[i] = Worst {
-                        ratio: r,
-                        tick: self.ticks,
-                    };
-                }
+                self.worst_velocity[i].note(v[i].abs() / self.vmax_mm_per_s[i], self.ticks);
             }
             if let Some(u) = self.prev_v {
                 let mut acc = [0.0; MAX_AXES];
                 for i in 0..MAX_AXES {
                     acc[i] = (v[i] - u[i]) / self.dt_s;
-                    let r = acc[i].abs() / self.amax_mm_per_s2[i];
-                    if r > self.worst_accel[i].ratio {
-                        self.worst_accel[i] = Worst {
-                            ratio: r,
-                            tick: self.ticks,
-                        };
-                    }
+                    self.worst_accel[i].note(acc[i].abs() / self.amax_mm_per_s2[i], self.ticks);
                 }
                 if let Some(b) = self.prev_a {
                     for i in 0..MAX_AXES {
                         let j = (acc[i] - b[i]) / self.dt_s;
-                        let r = j.abs() / self.jmax_mm_per_s3[i];
-                        if r > self.worst_jerk[i].ratio {
-                            self.worst_jerk[i] = Worst {
-                                ratio: r,
-                                tick: self.ticks,
-                            };
-                        }
+                        self.worst_jerk[i].note(j.abs() / self.jmax_mm_per_s3[i], self.ticks);
                     }
                 }
                 self.prev_a = Some(acc);
