@@ -354,7 +354,7 @@ impl<'a> Ctx<'a> {
                 None => fail(
                     i,
                     SYNTAX,
-                    "number expected (a number has at most 308 integer digits)",
+                    format!("number expected ({})", super::number::LITERAL_LIMIT),
                 ),
             },
             b'@' => {

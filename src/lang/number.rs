@@ -71,6 +71,9 @@ pub fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
     v.is_finite().then_some((v, i))
 }
 
+/// What a refused literal may have run into, for the messages that refuse it.
+pub const LITERAL_LIMIT: &str = "a number has at most 308 integer digits";
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -518,8 +518,9 @@ fn dialect_g(i: &str, g: u32) -> Result<(), nom::Err<PErr<'_>>> {
 
 fn word_value_msg(letter: u8) -> String {
     format!(
-        "number or [expression] expected after {} (a number has at most 308 integer digits)",
-        letter as char
+        "number or [expression] expected after {} ({})",
+        letter as char,
+        super::number::LITERAL_LIMIT
     )
 }
 
