@@ -69,6 +69,16 @@ impl Receiver {
         self.stderr.lock().unwrap().clone()
     }
 
+    /// The log once it holds `needle` `times` times (the receiver writes a transfer's lines
+    /// as it ends, and the reading thread appends them a moment later), at most 10 s.
+    fn log_with_n(&self, needle: &str, times: usize) -> String {
+        abuse_common::log_once_it_holds(&self.stderr, needle, times, Duration::from_secs(10))
+    }
+
+    fn log_with(&self, needle: &str) -> String {
+        self.log_with_n(needle, 1)
+    }
+
     fn rss_kib(&self) -> u64 {
         abuse_common::rss_kib(self.child.id())
     }
@@ -185,6 +195,11 @@ fn cut_transfers_leave_no_file_under_a_final_name() {
     let mut s = TcpStream::connect(r.addr).expect("connect");
     s.write_all(b"%_N_CUT3_MPF\r\nG01 X1\r\n").expect("send");
     drop(s); // closed without shutdown, mid-program
+             // The third transfer ends when the receiver sees the close: only then is its temporary
+             // file gone, which check_serving asserts.
+    let dropped = "the transfer ended inside the program from line 1; it was dropped";
+    let log = r.log_with_n(dropped, 3);
+    assert_eq!(log.matches(dropped).count(), 3, "{log}");
     r.check_serving("cut transfers", rss);
     for n in ["CUT1", "CUT2", "CUT3"] {
         assert!(!r.out().join(format!("{n}.mpf")).exists(), "{n} filed");
@@ -234,7 +249,8 @@ fn a_silent_sender_frees_its_slot_after_the_idle_timeout() {
     let _silent = TcpStream::connect(r.addr).expect("connect");
     std::thread::sleep(Duration::from_millis(200));
     r.check_serving("a silent sender in the only slot (idle timeout 1 s)", rss);
-    assert!(r.log().contains("timed out"), "{}", r.log());
+    let log = r.log_with("timed out");
+    assert!(log.contains("timed out"), "{log}");
 }
 
 #[test]
@@ -245,7 +261,8 @@ fn a_workpiece_folder_named_like_a_filed_program_refuses_only_that_program() {
     r.send(b"%_N_PART_MPF\r\n;$PATH=/_N_WKS_DIR/_N_X_WPD\r\nG01 X2\r\nM30\r\n");
     r.check_serving("workpiece folder X_WPD after a program X.wpd", rss);
     assert!(r.out().join("X.wpd").is_file());
-    assert!(r.log().contains("is a file, not a folder"), "{}", r.log());
+    let log = r.log_with("is a file, not a folder");
+    assert!(log.contains("is a file, not a folder"), "{log}");
 }
 
 #[test]
@@ -266,8 +283,9 @@ fn transfers_beyond_their_limits_end_and_the_receiver_goes_on() {
         .collect();
     assert_eq!(filed, [true, true, true, false, false]);
     assert!(!r.out().join("BIG.mpf").exists());
-    let log = r.log();
+    let log = r.log_with("more than 3 programs");
     assert!(log.contains("more than 3 programs"), "{log}");
+    let log = r.log_with("more than 4096 bytes");
     assert!(log.contains("more than 4096 bytes"), "{log}");
 }
 

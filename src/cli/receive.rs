@@ -157,7 +157,9 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
         };
         server.serve(&args, addr, &mut total)?;
     } else {
-        total.add(&receive_input(&args, &limits, &mut splitter, &mut writer)?);
+        let r = receive_input(&args, &limits, &mut splitter, &mut writer)?;
+        log_end(Ok(&r));
+        total.add(&r);
     }
     total.print(&out);
     Ok(
@@ -272,7 +274,11 @@ impl Server<'_> {
             accepted += 1;
             match self.spawn_transfer(stream, peer, done_tx.clone()) {
                 Ok(_) => active += 1,
-                Err(e) => settle(Err(dnc::DncError::io(peer.to_string(), e)), total),
+                Err(e) => {
+                    let r = Err(dnc::DncError::io(peer.to_string(), e));
+                    log_end(r.as_ref());
+                    settle(r, total);
+                }
             }
         }
         // The transfers in progress complete (each within its idle timeout).
@@ -305,6 +311,7 @@ impl Server<'_> {
                     .with_log(log_line)
                     .with_numbers(numbers);
                 let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
+                log_end(r.as_ref());
                 let _ = tx.send(r);
             })
     }
@@ -326,13 +333,37 @@ fn settle_next(
 
 /// Whatever a transfer came to: filed programs, or refused with its reason (a name the disk
 /// refuses, a full disk); the port keeps serving the others.
+/// Its lines were logged by [`log_end`] as it ended; this only counts it.
 fn settle(r: Result<TransferReport, dnc::DncError>, total: &mut Totals) {
     match r {
         Ok(r) => total.add(&r),
-        Err(e) => {
-            say(format_args!("ncchannel receive: transfer refused: {e}"));
-            total.refused += 1;
+        Err(_) => total.refused += 1,
+    }
+}
+
+/// How a transfer ended, logged by the transfer's own thread as it ends: the line must not
+/// wait for the accept loop, which sleeps in `accept` until the next sender connects.
+fn log_end(r: Result<&TransferReport, &dnc::DncError>) {
+    let r = match r {
+        Ok(r) => r,
+        Err(e) => return say(format_args!("ncchannel receive: transfer refused: {e}")),
+    };
+    let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
+    if r.split.no_start_marker() {
+        say(format_args!(
+            "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
+            r.split.bytes_in
+        ));
+    }
+    match &r.end {
+        TransferEnd::Complete => {}
+        TransferEnd::IdleTimeout => {
+            say(format_args!("ncchannel receive: transfer{from} timed out"))
         }
+        TransferEnd::Broken(e) => say(format_args!("ncchannel receive: transfer{from} broke: {e}")),
+        TransferEnd::LimitReached(l) => say(format_args!(
+            "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
+        )),
     }
 }
 
@@ -453,25 +484,6 @@ impl Totals {
             .count();
         self.cut_off += r.split.cut_off;
         self.bytes += r.split.bytes_in;
-        let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
-        if r.split.no_start_marker() {
-            say(format_args!(
-                "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
-                r.split.bytes_in
-            ));
-        }
-        match &r.end {
-            TransferEnd::Complete => {}
-            TransferEnd::IdleTimeout => {
-                say(format_args!("ncchannel receive: transfer{from} timed out"))
-            }
-            TransferEnd::Broken(e) => {
-                say(format_args!("ncchannel receive: transfer{from} broke: {e}"))
-            }
-            TransferEnd::LimitReached(l) => say(format_args!(
-                "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
-            )),
-        }
     }
 
     fn print(&self, out: &Path) {

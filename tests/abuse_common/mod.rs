@@ -35,6 +35,25 @@ pub fn collect(err: impl Read + Send + 'static) -> (String, Arc<Mutex<String>>) 
     (first, text)
 }
 
+/// The collected log once it holds `needle` `times` times, or as it is after `deadline` if it
+/// never does. A process writes its log line when it has done the work, and the reading thread
+/// appends it a moment later: a test that asserts on the line waits for it instead of racing it.
+pub fn log_once_it_holds(
+    log: &Mutex<String>,
+    needle: &str,
+    times: usize,
+    deadline: std::time::Duration,
+) -> String {
+    let until = std::time::Instant::now() + deadline;
+    loop {
+        let text = log.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        if text.matches(needle).count() >= times || std::time::Instant::now() >= until {
+            return text;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
 /// Deterministic random bytes (xorshift64*), so a failing run can be repeated.
 pub struct RandomBytes(pub u64);
 
