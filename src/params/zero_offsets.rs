@@ -130,6 +130,7 @@ pub(crate) fn int_value(list: &ParamList, e: &Entry) -> Result<i64, Diagnostic> 
                 ),
             ))
         }
+        ValueKind::Ref(_) => return Err(super::value::unresolved(list, e)),
         ValueKind::Word | ValueKind::Quoted => {
             return Err(list.error_at(
                 e,
