@@ -95,7 +95,7 @@ fn good_lists_with_two_channels_and_relative_paths() {
     write(
         d,
         "cnc/lists/ch2.lis",
-        "streaming_prog_file \"\"\npath[0].dir ../../own\npath[0].type 0x03\n",
+        "streaming_prog_file \"\"\npath[0].dir ../own\npath[0].type 0x03\n",
     );
     let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
     assert!(cfg.warnings.is_empty(), "{:#?}", cfg.warnings);
@@ -133,10 +133,11 @@ fn good_lists_with_two_channels_and_relative_paths() {
     assert_eq!(c1.index, 1);
     assert_eq!(c1.list_path, cnc.join("lists/ch2.lis"));
     assert_eq!(c1.streaming_prog_file, None, "empty string = streaming off");
-    // The channel list's paths replace pfad[1].*, relative to the channel list's folder.
+    // The channel list's paths replace pfad[1].*, relative to the CNC's working directory
+    // (the start-up list's folder here), not to the channel list's own folder.
     assert!(c1.paths_from_channel_list);
     assert_eq!(c1.search_paths.len(), 1);
-    assert_eq!(c1.search_paths[0].dir, cnc.join("lists/../../own"));
+    assert_eq!(c1.search_paths[0].dir, cnc.join("../own"));
 }
 
 #[test]
@@ -240,15 +241,15 @@ fn malformed_line_is_an_error_at_its_line_and_column() {
         errs[0].render()
     );
 
-    // In the channel list, an unquoted string with blanks.
+    // In the channel list, a string without its closing quote.
     write(
         t.path(),
         "startup.lis",
         "kanal_anzahl 1\nsda_mds[0] ch.lis\n",
     );
-    let ch = write(t.path(), "ch.lis", "streaming_prog_file my stream.nc\n");
+    let ch = write(t.path(), "ch.lis", "streaming_prog_file \"my stream.nc\n");
     let errs = errors_of(params::load(&startup));
-    one_error(&errs, &ch, 1, 24, "quote");
+    one_error(&errs, &ch, 1, 21, "closing");
 }
 
 #[test]
