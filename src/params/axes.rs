@@ -20,11 +20,15 @@
 
 use std::path::PathBuf;
 
+use std::path::Path;
+
 use super::catalog::{self, ListKind, ListSummary, Tally};
+use super::channel::ChannelList;
 use super::list::{Entry, ParamList, ValueKind};
-use super::runtime::{AxisConfig, AxisKind};
+use super::runtime::{axis_index, AxisConfig, AxisKind, RuntimeConfig};
 use super::value::{number_value, unresolved};
-use crate::diag::Diagnostic;
+use crate::diag::{Diagnostic, Severity};
+use crate::queue::MAX_AXES;
 
 /// mm (or °) per kernel position unit: 0.1 µm (P-AXIS-00178: 0.1 µm, 0.0001 °).
 pub const MM_PER_POSITION_UNIT: f64 = 1e-4;
@@ -210,6 +214,176 @@ pub fn interpret_axis(
         axis_type,
         limits,
     }
+}
+
+/// Step: a channel's axis table. Without axis lists, runtime.toml's axes. With them, the
+/// channel list's `gruppe[0].achse[j]` joined by logical number (P-CHAN-00035 = P-AXIS-00016)
+/// to their axis lists, or — when the channel list names no axes — every axis list's axis
+/// under its `kopf.log_achs_name`. `None` when an axis cannot be set up (reported).
+pub fn channel_axes(
+    chan: &ChannelList,
+    axis_lists: &[AxisList],
+    runtime: &RuntimeConfig,
+    diags: &mut Vec<Diagnostic>,
+) -> Option<Vec<AxisConfig>> {
+    let list = &chan.list;
+    if axis_lists.is_empty() {
+        let first = chan.axes.values().next().and_then(|a| {
+            a.name
+                .as_ref()
+                .map(|(_, e)| e)
+                .or(a.logical_number.as_ref().map(|(_, e)| e))
+        });
+        if let Some(e) = first {
+            diags.push(list.warning_at(
+                e,
+                e.name_pos,
+                "the start-up list names no axis lists (achs_mds[i]): the axes come from \
+                 runtime.toml",
+            ));
+        }
+        return Some(runtime.axes.clone());
+    }
+    let before = diags.len();
+    let mut axes: Vec<AxisConfig> = Vec::new();
+    if chan.axes.is_empty() {
+        every_listed_axis(&mut axes, list, axis_lists, diags);
+    } else {
+        named_axes(&mut axes, chan, axis_lists, diags);
+    }
+    if axes.is_empty() || axes.len() > MAX_AXES {
+        diags.push(Diagnostic::error(
+            &list.file,
+            1,
+            1,
+            None,
+            format!(
+                "channel has {} path axes from its axis lists; 1 … {MAX_AXES} are needed",
+                axes.len()
+            ),
+        ));
+    }
+    let failed = diags[before..]
+        .iter()
+        .any(|d| d.severity == Severity::Error);
+    (!failed).then_some(axes)
+}
+
+/// Without `gruppe[0].achse[j]`: every axis list's axis (spindles aside), named by its
+/// `kopf.log_achs_name`.
+fn every_listed_axis(
+    axes: &mut Vec<AxisConfig>,
+    list: &ParamList,
+    axis_lists: &[AxisList],
+    diags: &mut Vec<Diagnostic>,
+) {
+    for a in axis_lists
+        .iter()
+        .filter(|a| a.axis_type != AxisType::Spindle)
+    {
+        let Some((name, e)) = &a.name else {
+            diags.push(Diagnostic::error(
+                &a.file,
+                1,
+                1,
+                None,
+                format!(
+                    "axis {} has no kopf.log_achs_name, and {} names no \
+                     gruppe[0].achse[j].bezeichnung",
+                    a.logical_number,
+                    list.file.display()
+                ),
+            ));
+            continue;
+        };
+        push_axis(axes, name, a, &a.file, e, diags);
+    }
+}
+
+/// `gruppe[0].achse[j]` joined by `log_achs_nr` to the axis list of that `kopf.achs_nr`.
+fn named_axes(
+    axes: &mut Vec<AxisConfig>,
+    chan: &ChannelList,
+    axis_lists: &[AxisList],
+    diags: &mut Vec<Diagnostic>,
+) {
+    let list = &chan.list;
+    for (j, r) in &chan.axes {
+        let Some((nr, nr_entry)) = &r.logical_number else {
+            if let Some((_, e)) = &r.name {
+                diags.push(list.error_at(
+                    e,
+                    e.name_pos,
+                    format!("gruppe[0].achse[{j}] has no log_achs_nr (P-CHAN-00035)"),
+                ));
+            }
+            continue;
+        };
+        let Some(a) = axis_lists.iter().find(|a| a.logical_number == *nr) else {
+            diags.push(list.error_at(
+                nr_entry,
+                nr_entry.value_pos,
+                format!("{}: no axis list has kopf.achs_nr {nr}", nr_entry.name.text),
+            ));
+            continue;
+        };
+        if a.axis_type == AxisType::Spindle {
+            diags.push(list.error_at(
+                nr_entry,
+                nr_entry.value_pos,
+                format!(
+                    "{}: axis {nr} ({}) is a spindle, which cannot be a path axis \
+                     (P-CHAN-00035)",
+                    nr_entry.name.text,
+                    a.file.display()
+                ),
+            ));
+            continue;
+        }
+        match (&r.name, &a.name) {
+            (Some((name, e)), _) => push_axis(axes, name, a, &list.file, e, diags),
+            (None, Some((name, e))) => push_axis(axes, name, a, &a.file, e, diags),
+            (None, None) => diags.push(list.error_at(
+                nr_entry,
+                nr_entry.name_pos,
+                format!(
+                    "gruppe[0].achse[{j}] has no bezeichnung (P-CHAN-00006), and axis {nr} \
+                     no kopf.log_achs_name"
+                ),
+            )),
+        }
+    }
+}
+
+/// Add one axis named `name` (written at `e` in `file`): a letter ncchannel drives, not yet
+/// in the table.
+fn push_axis(
+    axes: &mut Vec<AxisConfig>,
+    name: &str,
+    a: &AxisList,
+    file: &Path,
+    e: &Entry,
+    diags: &mut Vec<Diagnostic>,
+) {
+    let at = |message: String| {
+        Diagnostic::error(file, e.value_pos.line, e.value_pos.col, None, message)
+            .with_source(&e.line_text)
+    };
+    if axis_index(name).is_none() {
+        diags.push(at(format!(
+            "{}: `{name}` is not an axis name ncchannel drives (one of X Y Z A B C)",
+            e.name.text
+        )));
+        return;
+    }
+    if axes.iter().any(|b| b.name.eq_ignore_ascii_case(name)) {
+        diags.push(at(format!("{}: axis `{name}` is named twice", e.name.text)));
+        return;
+    }
+    axes.push(AxisConfig {
+        name: name.to_ascii_uppercase(),
+        ..a.limits.clone()
+    });
 }
 
 /// The jerk limit of an acceleration `a` (mm/s²) built up in `tr_us` µs: a / tr, mm/s³;
