@@ -329,6 +329,20 @@ impl Decoder {
     pub fn depth(&self) -> usize {
         self.frames.len()
     }
+    /// The message reported for error `code`: the kernel's text for it (error text file,
+    /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
+    pub fn reported_message(&self, code: u32, detail: String) -> String {
+        match self
+            .settings
+            .error_texts
+            .as_deref()
+            .and_then(|t| t.get(code))
+        {
+            Some(text) => format!("{text} ({detail})"),
+            None => detail,
+        }
+    }
+
     /// Notes since the last call, oldest first.
     pub fn take_notes(&mut self, into: &mut Vec<Note>) {
         // A swap: both vectors keep their allocations from tick to tick.
