@@ -750,6 +750,20 @@ fn an_installation_in_the_kernels_format_loads_with_its_axes() {
         "{counts:?}"
     );
 
+    // P-CHAN-00260 / -00433: a call configured for MDI only is never made (no MDI here).
+    installation(
+        d,
+        "start_init_prog_file i.nc\nstart_init_prog_file_mode MDI\nfinal_prog_file f.nc\n\
+         final_prog_file_mode AUTOMATIC | MDI\n",
+        AXIS_Y,
+    );
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(cfg.channels[0].implicit.at_start, None);
+    assert_eq!(cfg.channels[0].implicit.at_end.as_deref(), Some("f.nc"));
+    installation(d, "final_prog_file_mode SOMETIMES\n", AXIS_Y);
+    let errs = errors_of(params::load(&startup));
+    one_error(&errs, &d.join("listen/sda_mds1.lis"), 1, 22, "SOMETIMES");
+
     // Without gruppe[0].achse[j], the axis lists' own names.
     installation(d, "streaming_prog_file s.nc\n", AXIS_Y);
     let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));

@@ -97,11 +97,9 @@ impl Decoder {
     }
 
     /// M6 with `m6_prog_file` (P-CHAN-00118) set, outside the M6 subroutine itself: its name.
-    pub(super) fn m6_subroutine(&self, block_has_m6: bool) -> Option<String> {
-        if !block_has_m6 || self.implicit.m6_depth.is_some() {
-            return None;
-        }
-        self.settings.implicit.at_m6.clone()
+    pub(super) fn m6_subroutine(&self, w: &words::Words) -> Option<String> {
+        let name = self.settings.implicit.at_m6.as_ref()?;
+        (self.implicit.m6_depth.is_none() && w.has_m(6)).then(|| name.clone())
     }
 
     /// M6 as the last action of its block: the M6 subroutine is called; an end in the same

@@ -451,9 +451,11 @@ impl Decoder {
             if !io.queue.has_room() {
                 break;
             }
-            if let Err(e) = self.start_subroutine(io) {
-                self.fail(e, LineMeta { line: 0, offset: 0 });
-                break;
+            if self.implicit.start_pending {
+                if let Err(e) = self.start_subroutine(io) {
+                    self.fail(e, LineMeta { line: 0, offset: 0 });
+                    break;
+                }
             }
             let Some(top) = self.frames.last_mut() else {
                 self.state = DecoderState::Idle;

@@ -88,6 +88,9 @@ impl Words {
     fn ms(&self) -> &[u32] {
         &self.ms[..self.n_ms]
     }
+    pub(super) fn has_m(&self, m: u32) -> bool {
+        self.ms().contains(&m)
+    }
     fn hs(&self) -> &[u32] {
         &self.hs[..self.n_hs]
     }
@@ -447,7 +450,7 @@ impl Decoder {
                 ));
             }
         }
-        if let Some(name) = self.m6_subroutine(w.ms().contains(&6)) {
+        if let Some(name) = self.m6_subroutine(w) {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
             }

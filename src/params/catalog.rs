@@ -220,14 +220,6 @@ pub const INERT_CHANNEL: &[(&str, &str)] = &[
         "P-CHAN-00007, P-CHAN-00036 …: spindles are not modelled",
     ),
     (
-        "start_init_prog_file_mode",
-        "P-CHAN-00260: only the AUTOMATIC call exists (no MDI)",
-    ),
-    (
-        "final_prog_file_mode",
-        "P-CHAN-00433: only the AUTOMATIC call exists (no MDI)",
-    ),
-    (
         "configuration.path_preparation.",
         "P-CHAN-00600…604 path preparation functions",
     ),

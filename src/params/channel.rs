@@ -84,6 +84,7 @@ pub fn interpret_channel(
     let mut decoder = DecoderParams::default();
     let mut paths = PathCollector::default();
     let mut tally = Tally::new(ListKind::Channel);
+    let (mut start_mode, mut final_mode) = (CallMode::Automatic, CallMode::Automatic);
 
     for e in &list.entries {
         match shape(e).as_slice() {
@@ -93,6 +94,8 @@ pub fn interpret_channel(
             [("start_init_prog_file", None)] => implicit.at_start = program_name(&list, e, diags),
             [("final_prog_file", None)] => implicit.at_end = program_name(&list, e, diags),
             [("m6_prog_file", None)] => implicit.at_m6 = program_name(&list, e, diags),
+            [("start_init_prog_file_mode", None)] => start_mode = call_mode(&list, e, diags),
+            [("final_prog_file_mode", None)] => final_mode = call_mode(&list, e, diags),
             [("gruppe", Some(0)), ("achse", Some(j)), ("bezeichnung", None)] => {
                 match string_value(&list, e, MAX_AXIS_NAME_CHARS) {
                     Ok(s) => axes.entry(*j).or_insert_with(empty_axis).name = Some((s, e.clone())),
@@ -154,6 +157,13 @@ pub fn interpret_channel(
         Some(paths.finish(&list, cnc_dir, diags))
     };
     let summary = tally.finish(&list);
+    // ncchannel has no MDI: a call configured for MDI only is never made.
+    if start_mode == CallMode::MdiOnly {
+        implicit.at_start = None;
+    }
+    if final_mode == CallMode::MdiOnly {
+        implicit.at_end = None;
+    }
     ChannelList {
         list,
         streaming_prog_file,
@@ -162,6 +172,46 @@ pub fn interpret_channel(
         search_paths,
         decoder,
         summary,
+    }
+}
+
+/// When an implicit subroutine is called (P-CHAN-00260 `start_init_prog_file_mode`,
+/// P-CHAN-00433 `final_prog_file_mode`): `AUTOMATIC` (the default), `MDI`, or both with `|`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum CallMode {
+    /// At NC program start / end (with or without MDI).
+    Automatic,
+    /// Only in MDI, which ncchannel does not have.
+    MdiOnly,
+}
+
+fn call_mode(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) -> CallMode {
+    let mut words = e
+        .value
+        .as_str()
+        .split(['|', ' ', '\t'])
+        .filter(|w| !w.is_empty())
+        .peekable();
+    // No name given: AUTOMATIC, the kernel's basic setting.
+    let mut automatic = words.peek().is_none();
+    for word in words {
+        match word {
+            "AUTOMATIC" => automatic = true,
+            "MDI" => {}
+            other => diags.push(list.error_at(
+                e,
+                e.value_pos,
+                format!(
+                    "{}: `{other}` is not a call mode (AUTOMATIC, MDI, or both with `|`)",
+                    e.name.text
+                ),
+            )),
+        }
+    }
+    if automatic {
+        CallMode::Automatic
+    } else {
+        CallMode::MdiOnly
     }
 }
 
