@@ -383,3 +383,47 @@ fn the_shipped_example_installation_runs_its_part() {
     assert_eq!(progs.last().map(String::as_str), Some("final.nc"));
     assert_eq!(c.position()[2], 100.0, "final.nc retracts to Z100");
 }
+
+#[test]
+fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
+    let i = Installation::new(IMPLICIT);
+    implicit_programs(&i);
+    // M6 and M30 in one block: tool.nc first, then final.nc (before M30), then the end; M6
+    // and M17 in one block of a subroutine: tool.nc, then the return.
+    i.write("prg/sub.nc", "N50 G01 Y1 F6000\nN51 M6 M17\n");
+    i.write("prg/part.nc", "N10 L sub.nc\nN20 M6 M30\n");
+    let mut c = i.channel();
+    c.start(&tick(0), "part.nc").unwrap();
+    let ev = run(&mut c, &[], 20_000);
+    let got: Vec<(String, u64)> = blocks(&ev)
+        .into_iter()
+        .map(|(p, n)| (p, n.unwrap_or(0)))
+        .collect();
+    let want: Vec<(String, u64)> = [
+        ("init.nc", 1),
+        ("init.nc", 2),
+        ("init.nc", 3),
+        ("part.nc", 10),
+        ("sub.nc", 50),
+        ("sub.nc", 51),
+        ("tool.nc", 4),
+        ("tool.nc", 5),
+        ("tool.nc", 6),
+        ("part.nc", 20),
+        ("tool.nc", 4),
+        ("tool.nc", 5),
+        ("tool.nc", 6),
+        ("final.nc", 7),
+        ("final.nc", 8),
+    ]
+    .iter()
+    .map(|(p, n)| (p.to_string(), *n))
+    .collect();
+    assert_eq!(got, want);
+    assert_eq!(c.state(), State::Ready);
+    assert!(ev.iter().any(|(_, e)| *e
+        == EventKind::ProgramEnd {
+            prog: "part.nc".into(),
+            end: ncchannel::report::event::ProgramEndKind::M30
+        }));
+}
