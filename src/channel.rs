@@ -390,6 +390,7 @@ impl Channel {
         prog: Option<String>,
         line: Option<u64>,
     ) {
+        let msg = self.decoder.reported_message(code, msg);
         let record = ErrorRecord {
             code,
             msg,

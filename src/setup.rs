@@ -6,31 +6,37 @@ use thiserror::Error;
 use crate::channel::{Channel, ChannelSettings};
 use crate::decoder::{DecoderSettings, SoftLimits};
 use crate::motion::{AxisLimits, PlannerSettings};
+use crate::params::runtime::axis_index;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
-use crate::queue::{AXIS_LETTERS, MAX_AXES};
+use crate::queue::MAX_AXES;
 use crate::source::cache::CacheLimits;
 use crate::source::store::{FsLatency, SearchDir, PATH_MAIN, PATH_SUB};
 
 #[derive(Debug, Error)]
 pub enum SetupError {
-    #[error("axis '{0}' in runtime.toml: ncchannel knows the axes X Y Z A B C")]
+    #[error("axis '{0}': ncchannel knows the axes X Y Z A B C")]
     UnknownAxis(String),
     #[error("channel {0} does not exist (the start-up list has {1})")]
     NoSuchChannel(u32, usize),
 }
 
-/// Axis limits of the configured axes, by `AXIS_LETTERS` index.
+/// Axis limits of channel 1, the axes a generated soak program moves (every channel's come
+/// from [`channel_axes`]).
 pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
-    config
-        .runtime
-        .axes
+    match config.channels.first() {
+        Some(ch) => channel_axes(ch),
+        None => Err(SetupError::NoSuchChannel(1, 0)),
+    }
+}
+
+/// Axis limits of a channel's axes (its one axis table: axis lists or runtime.toml), by
+/// `AXIS_LETTERS` index.
+pub fn channel_axes(ch: &ChannelConfig) -> Result<Vec<AxisLimits>, SetupError> {
+    ch.axes
         .iter()
         .map(|a| {
-            let letter = a.name.trim().to_ascii_uppercase();
-            let index = AXIS_LETTERS
-                .iter()
-                .position(|&l| letter.len() == 1 && letter.as_bytes()[0] == l)
-                .ok_or_else(|| SetupError::UnknownAxis(a.name.clone()))?;
+            let index =
+                axis_index(&a.name).ok_or_else(|| SetupError::UnknownAxis(a.name.clone()))?;
             Ok(AxisLimits {
                 index,
                 max_velocity_mm_per_min: a.max_velocity_mm_per_min,
@@ -49,7 +55,7 @@ pub fn channel_settings(
     config: &Config,
     ch: &ChannelConfig,
 ) -> Result<ChannelSettings, SetupError> {
-    let axes = axes(config)?;
+    let axes = channel_axes(ch)?;
     let mut enabled = [false; MAX_AXES];
     let mut soft_limits_mm = [SoftLimits::default(); MAX_AXES];
     for a in &axes {
@@ -66,6 +72,8 @@ pub fn channel_settings(
         axes: enabled,
         zero_offsets: ch.zero_offsets,
         soft_limits_mm,
+        implicit: ch.implicit.clone(),
+        error_texts: config.error_texts.clone(),
         ..DecoderSettings::default()
     };
     let search_dirs = ch

@@ -109,3 +109,59 @@ fn check_and_run_refuse_the_same_bad_files_with_the_same_words() {
         assert!(out.contains(key), "run {runtime}: {out}");
     }
 }
+
+#[test]
+fn check_of_the_example_installation_counts_each_lists_entries() {
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args(["check", "params/installation"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    assert!(stdout.is_empty(), "no finding: {stdout}");
+    // Each list once, whether reached from hochlauf.lis or by the folder walk.
+    for line in [
+        "params/installation/listen/hochlauf.lis: start-up list, 16 entries: 13 used, 3 inert, 0 unknown",
+        "params/installation/listen/sda_mds1.lis: channel list, 13 entries: 10 used, 3 inert, 0 unknown",
+        "params/installation/listen/default_mds.lis: axis list, 15 entries: 9 used, 6 inert, 0 unknown",
+        "params/installation/listen/achsmds1.lis: axis list, 4 entries: 4 used, 0 inert, 0 unknown",
+        "params/installation/listen/achsmds3.lis: axis list, 7 entries: 7 used, 0 inert, 0 unknown",
+        "params/installation/listen/tools.lis: tool list, 3 entries: 2 used, 1 inert, 0 unknown",
+    ] {
+        assert_eq!(
+            stderr.matches(line).count(),
+            1,
+            "`{line}` once in:\n{stderr}"
+        );
+    }
+    assert!(stderr.contains("0 error(s), 0 warning(s)"), "{stderr}");
+}
+
+#[test]
+fn unknown_entries_are_counted_and_warned_about() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("achsmds1.lis");
+    std::fs::write(
+        &p,
+        "kopf.achs_nr 1\nlr_param.kv_faktor 1000\nkenngr.mystery 5\n#kenngr.other 1\nEnde\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("check")
+        .arg(&p)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("achsmds1.lis:3:1: warning: unknown parameter kenngr.mystery"),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains("axis list, 3 entries: 1 used, 1 inert, 1 unknown"),
+        "{stderr}"
+    );
+}

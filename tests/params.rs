@@ -95,7 +95,7 @@ fn good_lists_with_two_channels_and_relative_paths() {
     write(
         d,
         "cnc/lists/ch2.lis",
-        "streaming_prog_file \"\"\npath[0].dir ../../own\npath[0].type 0x03\n",
+        "streaming_prog_file \"\"\npath[0].dir ../own\npath[0].type 0x03\n",
     );
     let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
     assert!(cfg.warnings.is_empty(), "{:#?}", cfg.warnings);
@@ -133,10 +133,11 @@ fn good_lists_with_two_channels_and_relative_paths() {
     assert_eq!(c1.index, 1);
     assert_eq!(c1.list_path, cnc.join("lists/ch2.lis"));
     assert_eq!(c1.streaming_prog_file, None, "empty string = streaming off");
-    // The channel list's paths replace pfad[1].*, relative to the channel list's folder.
+    // The channel list's paths replace pfad[1].*, relative to the CNC's working directory
+    // (the start-up list's folder here), not to the channel list's own folder.
     assert!(c1.paths_from_channel_list);
     assert_eq!(c1.search_paths.len(), 1);
-    assert_eq!(c1.search_paths[0].dir, cnc.join("lists/../../own"));
+    assert_eq!(c1.search_paths[0].dir, cnc.join("../own"));
 }
 
 #[test]
@@ -240,15 +241,15 @@ fn malformed_line_is_an_error_at_its_line_and_column() {
         errs[0].render()
     );
 
-    // In the channel list, an unquoted string with blanks.
+    // In the channel list, a string without its closing quote.
     write(
         t.path(),
         "startup.lis",
         "kanal_anzahl 1\nsda_mds[0] ch.lis\n",
     );
-    let ch = write(t.path(), "ch.lis", "streaming_prog_file my stream.nc\n");
+    let ch = write(t.path(), "ch.lis", "streaming_prog_file \"my stream.nc\n");
     let errs = errors_of(params::load(&startup));
-    one_error(&errs, &ch, 1, 24, "quote");
+    one_error(&errs, &ch, 1, 21, "closing");
 }
 
 #[test]
@@ -644,4 +645,245 @@ fn channels_sharing_a_list_report_its_warnings_once() {
     assert_eq!(cfg.channels.len(), 2);
     assert_eq!(cfg.channels[1].streaming_prog_file.as_deref(), Some("s.nc"));
     assert_eq!(cfg.warnings.len(), 1, "{:#?}", cfg.warnings);
+}
+
+/// An installation's lists in a temp folder: `listen/hochlauf.lis` naming `./listen/…`
+/// lists, in Latin-1, with the kernel's constructs.
+fn installation(dir: &Path, channel: &str, axis2: &str) -> PathBuf {
+    let latin1 = |rel: &str, text: &str| {
+        let bytes: Vec<u8> = text.chars().map(|c| c as u32 as u8).collect();
+        let p = dir.join(rel);
+        fs::create_dir_all(p.parent().unwrap()).unwrap();
+        fs::write(&p, bytes).unwrap();
+        p
+    };
+    fs::create_dir_all(dir.join("prg")).unwrap();
+    latin1(
+        "listen/default_mds.lis",
+        "getriebe[0].dynamik.a_max 1500 ( P-AXIS-00008 : [mm/s\u{b2}]\n\
+         getriebe[0].slope_profil.a_beschl P-AXIS-00008.0\nEnde\n",
+    );
+    latin1(
+        "listen/achsmds1.lis",
+        "kopf.achs_nr 1\nkopf.log_achs_name X\nkenngr.swe_pos 15000000 ( P-AXIS-00178 : [0.1um] \
+         Positive software limit switch\nkenngr.swe_neg -15000000\n\
+         getriebe[0].dynamik.vb_max 500000 ( [um/s]\n\
+         getriebe[0].slope_profil.tr_beschl_zu 50000\nEnde\n",
+    );
+    latin1("listen/achsmds2.lis", axis2);
+    latin1("listen/sda_mds1.lis", channel);
+    latin1(
+        "listen/hochlauf.lis",
+        "# Hochlaufliste: Kan\u{e4}le und Achsen\n\
+         kanal_anzahl 1 ( P-STUP-00001\n#hand_mds ./listen/hand_mds.lis\n\
+         default_achs_mds ./listen/default_mds.lis\n\
+         achs_mds[0] ./listen/achsmds1.lis\nachs_mds[1] ./listen/achsmds2.lis\n\
+         sda_mds[0] ./listen/sda_mds1.lis\npfad[0].prg[0] ./prg\npfad[0].typ[0] 0x03\n\
+         configuration.channel[0].decoder.function FCT_DEFAULT | FCT_USE_CACHED_FILES ( P-STUP-00050\n\
+         Ende\n",
+    )
+}
+
+const AXIS_Y: &str = "kopf.achs_nr 2\nkopf.log_achs_name Y\nkenngr.achs_typ 1\nEnde\n";
+
+#[test]
+fn an_installation_in_the_kernels_format_loads_with_its_axes() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    let startup = installation(
+        d,
+        "#spindel[0].range_way 0\ngruppe[0].achse[0].bezeichnung X\n\
+         gruppe[0].achse[0].log_achs_nr 1\ngruppe[0].achse[1].bezeichnung Y\n\
+         gruppe[0].achse[1].log_achs_nr 2 ( P-CHAN-00035\nstreaming_prog_file s.nc\n\
+         m6_prog_file tc.nc\nEnde\n",
+        AXIS_Y,
+    );
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    assert!(cfg.warnings.is_empty(), "{:#?}", cfg.warnings);
+    // The CNC's working directory is the folder above listen/.
+    assert_eq!(cfg.cnc_dir, d);
+    let c = &cfg.channels[0];
+    assert_eq!(c.list_path, d.join("listen/sda_mds1.lis"));
+    assert_eq!(c.search_paths[0].dir, d.join("prg"));
+    assert!(c.decoder.cache.enabled);
+    assert_eq!(c.implicit.at_m6.as_deref(), Some("tc.nc"));
+    assert_eq!(c.implicit.at_start, None);
+    let x = &c.axes[0];
+    assert_eq!(x.name, "X");
+    assert_eq!(x.soft_limit_max_mm, 1500.0);
+    assert_eq!(x.soft_limit_min_mm, -1500.0);
+    assert_eq!(x.max_velocity_mm_per_min, 30000.0);
+    assert_eq!(x.max_acceleration_mm_per_s2, 1500.0);
+    // jerk = a_max / the shortest ramp time: 1500 mm/s² / 0.05 s (tr_beschl_zu, and the
+    // kernel's default 50000 µs for the other three).
+    assert!((x.max_jerk_mm_per_s3.unwrap() - 30000.0).abs() < 1e-6);
+    // Y: the kernel's defaults under the default list: vb_max 200000 µm/s = 12000 mm/min,
+    // vb_eilgang 166666 µm/s, swe ±100000000 × 0.1 µm = ±10000 mm.
+    let y = &c.axes[1];
+    assert_eq!(y.name, "Y");
+    assert_eq!(y.max_velocity_mm_per_min, 12000.0);
+    assert!((y.rapid_mm_per_min - 9999.96).abs() < 1e-9);
+    assert_eq!(y.soft_limit_max_mm, 10000.0);
+    // Every list read is counted.
+    let counts: Vec<(String, usize, usize, usize)> = cfg
+        .lists
+        .iter()
+        .map(|l| {
+            (
+                l.file.file_name().unwrap().to_string_lossy().into_owned(),
+                l.counts.used,
+                l.counts.inert,
+                l.counts.unknown,
+            )
+        })
+        .collect();
+    assert!(
+        counts.contains(&("hochlauf.lis".into(), 8, 0, 0)),
+        "{counts:?}"
+    );
+    assert!(
+        counts.contains(&("default_mds.lis".into(), 1, 1, 0)),
+        "{counts:?}"
+    );
+    assert!(
+        counts.contains(&("sda_mds1.lis".into(), 6, 0, 0)),
+        "{counts:?}"
+    );
+
+    // P-CHAN-00260 / -00433: a call configured for MDI only is never made (no MDI here).
+    installation(
+        d,
+        "start_init_prog_file i.nc\nstart_init_prog_file_mode MDI\nfinal_prog_file f.nc\n\
+         final_prog_file_mode AUTOMATIC | MDI\n",
+        AXIS_Y,
+    );
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(cfg.channels[0].implicit.at_start, None);
+    assert_eq!(cfg.channels[0].implicit.at_end.as_deref(), Some("f.nc"));
+    installation(d, "final_prog_file_mode SOMETIMES\n", AXIS_Y);
+    let errs = errors_of(params::load(&startup));
+    one_error(&errs, &d.join("listen/sda_mds1.lis"), 1, 22, "SOMETIMES");
+
+    // Without gruppe[0].achse[j], the axis lists' own names.
+    installation(d, "streaming_prog_file s.nc\n", AXIS_Y);
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    let names: Vec<&str> = cfg.channels[0]
+        .axes
+        .iter()
+        .map(|a| a.name.as_str())
+        .collect();
+    assert_eq!(names, ["X", "Y"]);
+}
+
+#[test]
+fn axis_list_problems_name_file_line_and_column() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    let chan = |nr: u32, name: &str| {
+        format!(
+            "gruppe[0].achse[0].bezeichnung X\ngruppe[0].achse[0].log_achs_nr 1\n\
+             gruppe[0].achse[1].bezeichnung {name}\ngruppe[0].achse[1].log_achs_nr {nr}\n"
+        )
+    };
+    // A logical axis number no axis list has.
+    let startup = installation(d, &chan(7, "Y"), AXIS_Y);
+    let errs = errors_of(params::load(&startup));
+    one_error(
+        &errs,
+        &d.join("listen/sda_mds1.lis"),
+        4,
+        32,
+        "kopf.achs_nr 7",
+    );
+    // A name ncchannel does not drive.
+    installation(d, &chan(2, "U1"), AXIS_Y);
+    let errs = errors_of(params::load(&startup));
+    one_error(&errs, &d.join("listen/sda_mds1.lis"), 3, 32, "U1");
+    // A spindle as a path axis.
+    installation(
+        d,
+        &chan(2, "Y"),
+        "kopf.achs_nr 2\nkenngr.achs_typ ACHSTYP_SPINDEL\n",
+    );
+    let errs = errors_of(params::load(&startup));
+    one_error(&errs, &d.join("listen/sda_mds1.lis"), 4, 32, "spindle");
+    // Two axis lists with one logical number (and then no axis 2 for Y).
+    installation(d, &chan(2, "Y"), "kopf.achs_nr 1\n");
+    let errs = errors_of(params::load(&startup));
+    one_error(
+        &errs[..1],
+        &d.join("listen/hochlauf.lis"),
+        6,
+        13,
+        "kopf.achs_nr 1",
+    );
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+    // Implausible values in an axis list.
+    installation(
+        d,
+        &chan(2, "Y"),
+        "kopf.achs_nr 2\ngetriebe[0].dynamik.vb_max 1000\ngetriebe[0].vb_eilgang 2000\n",
+    );
+    let errs = errors_of(params::load(&startup));
+    one_error(&errs, &d.join("listen/achsmds2.lis"), 3, 24, "vb_eilgang");
+    // A reference to a parameter no list sets.
+    installation(
+        d,
+        &chan(2, "Y"),
+        "kopf.achs_nr 2\ngetriebe[0].dynamik.vb_max P-AXIS-00211.0\n",
+    );
+    let errs = errors_of(params::load(&startup));
+    one_error(
+        &errs,
+        &d.join("listen/achsmds2.lis"),
+        2,
+        28,
+        "P-AXIS-00211.0",
+    );
+    // An axis list that cannot be read.
+    fs::remove_file(d.join("listen/achsmds2.lis")).unwrap();
+    let errs = errors_of(params::load(&startup));
+    one_error(
+        &errs[..1],
+        &d.join("listen/hochlauf.lis"),
+        6,
+        13,
+        "achs_mds[1]",
+    );
+    assert_eq!(errs.len(), 2, "{errs:#?}");
+}
+
+#[test]
+fn runtime_toml_names_the_cncs_working_directory() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    installation(&d.join("machine"), "streaming_prog_file s.nc\n", AXIS_Y);
+    // The start-up list elsewhere, with runtime.toml beside it naming the installation.
+    fs::create_dir_all(d.join("cfg")).unwrap();
+    let startup = d.join("cfg/hochlauf.lis");
+    fs::copy(d.join("machine/listen/hochlauf.lis"), &startup).unwrap();
+    let errs = errors_of(params::load(&startup));
+    assert!(errs[0].message.contains("cannot be read"), "{errs:#?}");
+    write(d, "cfg/runtime.toml", "cnc_dir = \"../machine\"\n");
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(cfg.cnc_dir, d.join("cfg/../machine"));
+    assert_eq!(
+        cfg.channels[0].list_path,
+        d.join("cfg/../machine/listen/sda_mds1.lis")
+    );
+    // runtime.toml's axes give way to the axis lists, with a warning saying so.
+    write(
+        d,
+        "cfg/runtime.toml",
+        "cnc_dir = \"../machine\"\n[[axes]]\nname = \"A\"\n",
+    );
+    let cfg = params::load(&startup).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(cfg.channels[0].axes.len(), 2);
+    assert!(
+        cfg.warnings
+            .iter()
+            .any(|w| w.message.contains("[[axes]] is not used")),
+        "{:#?}",
+        cfg.warnings
+    );
 }

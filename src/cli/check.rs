@@ -32,8 +32,16 @@ pub fn execute(args: CheckArgs) -> ExitCode {
     for path in &args.files {
         collect(path, true, &mut files, &mut diags);
     }
+    // Each list's counts once, also when a start-up list and a folder walk both reach it.
+    let mut summaries: Vec<crate::params::catalog::ListSummary> = Vec::new();
     for file in &files {
-        diags.extend(check_file(file));
+        let (found, lists) = check_file_summarized(file);
+        diags.extend(found);
+        for l in lists {
+            if !summaries.iter().any(|s| s.file == l.file) {
+                summaries.push(l);
+            }
+        }
     }
     let errors = diags
         .iter()
@@ -41,6 +49,9 @@ pub fn execute(args: CheckArgs) -> ExitCode {
         .count();
     for d in &diags {
         println!("{}", d.render());
+    }
+    for l in &summaries {
+        eprintln!("ncchannel check: {l}");
     }
     eprintln!(
         "ncchannel check: {} file(s), {} error(s), {} warning(s)",
@@ -111,9 +122,24 @@ fn collect(path: &Path, explicit: bool, files: &mut Vec<PathBuf>, diags: &mut Ve
 
 /// Check one file: a parameter list by extension, otherwise an NC program.
 pub fn check_file(path: &Path) -> Vec<Diagnostic> {
+    check_file_summarized(path).0
+}
+
+/// [`check_file`], with the used/inert/unknown counts of every parameter list it read.
+fn check_file_summarized(
+    path: &Path,
+) -> (Vec<Diagnostic>, Vec<crate::params::catalog::ListSummary>) {
     if PARAM_EXTENSIONS.contains(&extension(path).as_str()) {
-        return check_params_file(path);
+        if extension(path) == "toml" {
+            return (check_params_file(path), Vec::new());
+        }
+        return crate::params::config::check_list_file_summarized(path);
     }
+    (check_program_file(path), Vec::new())
+}
+
+/// Check an NC program.
+fn check_program_file(path: &Path) -> Vec<Diagnostic> {
     let text = match read_text(path) {
         Ok(t) => t,
         Err(msg) => return vec![Diagnostic::error(path, 0, 0, None, msg)],

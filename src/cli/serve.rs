@@ -104,9 +104,9 @@ pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
 /// external clients make the channels do.
 fn supervised(machine: Machine, sc: &Scenario, config: &crate::params::Config) -> Supervised {
     let soft_limits = config
-        .runtime
-        .axes
+        .channels
         .iter()
+        .flat_map(|c| &c.axes)
         .filter_map(|a| {
             let c = a.name.chars().next()?;
             Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))

@@ -4,6 +4,38 @@
 use super::*;
 use crate::report::event::CacheOp;
 
+/// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
+/// before it: applied when the frame stack is back at `depth`.
+#[derive(Debug, Clone)]
+pub(super) struct HeldEnd {
+    pub m: u32,
+    pub info: BlockInfo,
+    pub depth: usize,
+}
+
+/// Where the running program stands with its implicit subroutine calls.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ImplicitState {
+    /// The start subroutine (P-CHAN-00119) is still to be called.
+    pub start_pending: bool,
+    /// The end subroutine (P-CHAN-00252) has been called.
+    pub end_called: bool,
+    /// Depth of the running M6 subroutine's frame: an M6 inside it is an ordinary M function,
+    /// as the kernel does not call the tool change from the tool change.
+    pub m6_depth: Option<usize>,
+    /// Ends held back, innermost last (at most one per frame).
+    pub held: Vec<HeldEnd>,
+}
+
+impl ImplicitState {
+    pub fn at_start(calls: &crate::params::channel::ImplicitSubroutines) -> Self {
+        ImplicitState {
+            start_pending: calls.at_start.is_some(),
+            ..Default::default()
+        }
+    }
+}
+
 impl Decoder {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
     /// values it made count against this tick's declaration budget.
@@ -28,6 +60,103 @@ impl Decoder {
                 self.stream_active = false;
             }
             self.vars.pop_level();
+        }
+        if self
+            .implicit
+            .m6_depth
+            .is_some_and(|d| self.frames.len() < d)
+        {
+            self.implicit.m6_depth = None;
+        }
+    }
+
+    /// A global subroutine call without a call line (an implicit call): the frame is pushed,
+    /// its blocks run as those of `L name` would.
+    pub(super) fn call_global(&mut self, name: &str, io: &mut DecoderIo<'_>) -> Res {
+        if self.frames.len() > self.settings.max_depth {
+            return Err(DecodeError::new(
+                codes::NESTING_TOO_DEEP,
+                format!("subroutine nesting deeper than {}", self.settings.max_depth),
+            ));
+        }
+        let frame = self.open_subroutine(name, FrameKind::Global, io)?;
+        self.vars.push_level(Vec::new());
+        self.frames.push(frame);
+        Ok(())
+    }
+
+    /// Program start: `start_init_prog_file` (P-CHAN-00119) is called as the first action.
+    pub(super) fn start_subroutine(&mut self, io: &mut DecoderIo<'_>) -> Res {
+        if !std::mem::take(&mut self.implicit.start_pending) {
+            return Ok(());
+        }
+        match self.settings.implicit.at_start.clone() {
+            Some(name) => self.call_global(&name, io),
+            None => Ok(()),
+        }
+    }
+
+    /// M6 with `m6_prog_file` (P-CHAN-00118) set, outside the M6 subroutine itself: its name.
+    pub(super) fn m6_subroutine(&self, w: &words::Words) -> Option<String> {
+        let name = self.settings.implicit.at_m6.as_ref()?;
+        (self.implicit.m6_depth.is_none() && w.has_m(6)).then(|| name.clone())
+    }
+
+    /// M6 as the last action of its block: the M6 subroutine is called; an end in the same
+    /// block waits for its return.
+    pub(super) fn call_m6(
+        &mut self,
+        name: &str,
+        end_m: Option<u32>,
+        info: BlockInfo,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let depth = self.frames.len();
+        self.call_global(name, io)?;
+        self.implicit.m6_depth = Some(self.frames.len());
+        if let Some(m) = end_m {
+            self.implicit.held.push(HeldEnd { m, info, depth });
+        }
+        Ok(())
+    }
+
+    /// M02/M30 of the main program: first the end subroutine (P-CHAN-00252), once; then the
+    /// end itself.
+    pub(super) fn program_end(&mut self, m: u32, info: BlockInfo, io: &mut DecoderIo<'_>) -> Res {
+        let main = self.top().kind == FrameKind::Main;
+        if main && !self.implicit.end_called {
+            if let Some(name) = self.settings.implicit.at_end.clone() {
+                self.implicit.end_called = true;
+                let depth = self.frames.len();
+                self.call_global(&name, io)?;
+                self.implicit.held.push(HeldEnd { m, info, depth });
+                return Ok(());
+            }
+        }
+        self.emit(info, Action::End { m }, true, io);
+        self.end_program();
+        Ok(())
+    }
+
+    /// After a return: an end held back for the frame now on top is applied.
+    pub(super) fn resume_held_end(&mut self, io: &mut DecoderIo<'_>) -> Res {
+        let held = match self.implicit.held.last() {
+            Some(h) if h.depth == self.frames.len() => self.implicit.held.pop(),
+            _ => None,
+        };
+        let Some(h) = held else {
+            return Ok(());
+        };
+        match h.m {
+            17 | 29 => {
+                self.check_open_flow()?;
+                self.return_from_subroutine();
+                self.resume_held_end(io)
+            }
+            m => {
+                self.program_end_checks(m)?;
+                self.program_end(m, h.info, io)
+            }
         }
     }
 
@@ -150,10 +279,8 @@ impl Decoder {
         let info = self.info(block, text, meta, io);
         match c {
             Call::Global { file } => {
-                let frame = self.open_subroutine(file, FrameKind::Global, io)?;
+                self.call_global(file, io)?;
                 self.emit(info, Action::None, false, io);
-                self.vars.push_level(Vec::new());
-                self.frames.push(frame);
             }
             Call::Cycle { name, params } => {
                 let mut values = Vec::with_capacity(params.len());

@@ -55,6 +55,12 @@ pub struct DecoderSettings {
     /// mm in machine coordinates, by `AXIS_LETTERS` index: a block whose end point or arc
     /// lies outside is refused before it moves (21897).
     pub soft_limits_mm: [SoftLimits; MAX_AXES],
+    /// Global subroutines the channel calls by itself: at program start (P-CHAN-00119), before
+    /// the main program's M02/M30 (P-CHAN-00252) and for M6 (P-CHAN-00118).
+    pub implicit: crate::params::channel::ImplicitSubroutines,
+    /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
+    /// is reported with it, ncchannel's detail after it in parentheses.
+    pub error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
 }
 
 /// One axis's software limits, mm (machine coordinates); unbounded by default.
@@ -87,6 +93,8 @@ impl Default for DecoderSettings {
             zero_offsets: [[0.0; MAX_AXES]; 6],
             arc_tolerance_mm: 0.01,
             soft_limits_mm: [SoftLimits::default(); MAX_AXES],
+            implicit: Default::default(),
+            error_texts: None,
         }
     }
 }
@@ -251,6 +259,8 @@ pub struct Decoder {
     stats: DecoderStats,
     /// The word collection of the block being executed, kept between blocks.
     words: Option<Box<words::Words>>,
+    /// The implicit subroutine calls' state in the running program.
+    implicit: calls::ImplicitState,
 }
 
 type Res<T = ()> = Result<T, DecodeError>;
@@ -276,6 +286,7 @@ impl Decoder {
             notes: Vec::new(),
             stats: DecoderStats::default(),
             words: None,
+            implicit: calls::ImplicitState::default(),
         }
     }
 
@@ -318,6 +329,20 @@ impl Decoder {
     pub fn depth(&self) -> usize {
         self.frames.len()
     }
+    /// The message reported for error `code`: the kernel's text for it (error text file,
+    /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
+    pub fn reported_message(&self, code: u32, detail: String) -> String {
+        match self
+            .settings
+            .error_texts
+            .as_deref()
+            .and_then(|t| t.get(code))
+        {
+            Some(text) => format!("{text} ({detail})"),
+            None => detail,
+        }
+    }
+
     /// Notes since the last call, oldest first.
     pub fn take_notes(&mut self, into: &mut Vec<Note>) {
         // A swap: both vectors keep their allocations from tick to tick.
@@ -344,6 +369,7 @@ impl Decoder {
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
         self.stream_active = false;
+        self.implicit = calls::ImplicitState::at_start(&self.settings.implicit);
         self.search = search.map(|target| Search {
             target,
             from: machine_pos,
@@ -383,6 +409,7 @@ impl Decoder {
         self.counter = 0;
         self.state = DecoderState::Idle;
         self.search = None;
+        self.implicit = calls::ImplicitState::default();
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
@@ -423,6 +450,12 @@ impl Decoder {
             }
             if !io.queue.has_room() {
                 break;
+            }
+            if self.implicit.start_pending {
+                if let Err(e) = self.start_subroutine(io) {
+                    self.fail(e, LineMeta { line: 0, offset: 0 });
+                    break;
+                }
             }
             let Some(top) = self.frames.last_mut() else {
                 self.state = DecoderState::Idle;
@@ -477,9 +510,18 @@ impl Decoder {
             .last()
             .map(|f| f.prog.clone())
             .unwrap_or_else(|| Arc::from(""));
+        let msg = match self
+            .settings
+            .error_texts
+            .as_deref()
+            .and_then(|t| t.get(e.code))
+        {
+            Some(text) => format!("{text} ({})", e.msg),
+            None => e.msg,
+        };
         self.notes.push(Note::Error {
             code: e.code,
-            msg: e.msg,
+            msg,
             prog,
             line: meta.line,
             col: e.col,

@@ -88,6 +88,9 @@ impl Words {
     fn ms(&self) -> &[u32] {
         &self.ms[..self.n_ms]
     }
+    pub(super) fn has_m(&self, m: u32) -> bool {
+        self.ms().contains(&m)
+    }
     fn hs(&self) -> &[u32] {
         &self.hs[..self.n_hs]
     }
@@ -446,12 +449,20 @@ impl Decoder {
                     format!("unexpected M{m} in main program"),
                 ));
             }
+        }
+        if let Some(name) = self.m6_subroutine(w) {
+            if !queued {
+                self.emit(info.clone(), Action::None, false, io);
+            }
+            return self.call_m6(&name, end_m, info, io);
+        }
+        if let Some(17 | 29) = end_m {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
             self.check_open_flow()?;
             self.return_from_subroutine();
-            return Ok(());
+            return self.resume_held_end(io);
         }
         let Some(m) = end_m else {
             if !queued {
@@ -463,14 +474,12 @@ impl Decoder {
         if !queued {
             self.emit(info.clone(), Action::None, false, io);
         }
-        self.emit(info, Action::End { m }, true, io);
-        self.end_program();
-        Ok(())
+        self.program_end(m, info, io)
     }
 
     /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in
     /// the main program every control block must be closed.
-    fn program_end_checks(&mut self, m: u32) -> Res {
+    pub(super) fn program_end_checks(&mut self, m: u32) -> Res {
         if let Some(s) = self.search {
             return Err(DecodeError::new(
                 codes::SEARCH_NOT_FOUND,

@@ -1,14 +1,24 @@
-//! The one entry point: read the start-up list, each channel's list and runtime.toml, combine
-//! them into a [`Config`], or refuse with every problem found.
+//! The one entry point: read runtime.toml, the start-up list, each channel's list, the axis
+//! lists and the error text file, combine them into a [`Config`], or refuse with every
+//! problem found.
+//!
+//! Relative paths in lists are joined to the CNC's working directory, as the kernel does:
+//! runtime.toml's `cnc_dir` if set, else the start-up list's folder — or, when that folder is
+//! called `listen` (the installation layout: `listen/`, `prg/`, `error/` side by side), its
+//! parent.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
-use super::channel::{interpret_channel, ChannelList};
+use super::axes::{interpret_axis, is_axis_list, tally_axis_list, AxisList};
+use super::catalog::ListSummary;
+use super::channel::{interpret_channel, ChannelList, ImplicitSubroutines};
 use super::decoder::{DecoderParams, DecoderSettings};
 use super::error::ParamError;
-use super::list::{parse_list, read_list, read_list_text, ParamList};
-use super::runtime::{read_runtime, RuntimeConfig};
+use super::error_texts::{read_error_texts, ErrorTexts};
+use super::list::{parse_list, read_list, read_list_text, Entry, ParamList};
+use super::runtime::{read_runtime, AxisConfig, RuntimeConfig};
 use super::search_path::{list_folder, SearchPath};
 use super::startup::{interpret_startup, is_startup_list, StartupList};
 use super::zero_offsets::{
@@ -18,6 +28,8 @@ use crate::diag::{Diagnostic, Severity};
 
 /// The file name runtime settings are read from, in the start-up list's folder.
 pub const RUNTIME_FILE: &str = "runtime.toml";
+/// The folder name of an installation's lists; the CNC's working directory is its parent.
+pub const LIST_FOLDER: &str = "listen";
 
 /// Everything the emulator starts from.
 #[derive(Debug, Clone)]
@@ -26,6 +38,8 @@ pub struct Config {
     pub startup_list: PathBuf,
     /// The start-up list's entries, unknown ones included (look them up with `get`).
     pub startup: ParamList,
+    /// The CNC's working directory: relative paths in the lists are joined to it.
+    pub cnc_dir: PathBuf,
     /// The runtime.toml read, or `None` when absent (built-in defaults).
     pub runtime_file: Option<PathBuf>,
     pub runtime: RuntimeConfig,
@@ -35,6 +49,12 @@ pub struct Config {
     pub tools_file: Option<PathBuf>,
     /// Tool radii by D number, mm (empty without a tool list).
     pub tools: super::tools::ToolRadii,
+    /// The error text file the start-up list names (`error_text_of_id`, P-STUP-00168).
+    pub error_text_file: Option<PathBuf>,
+    /// Its texts by error id; `None`: ncchannel's own texts.
+    pub error_texts: Option<Arc<ErrorTexts>>,
+    /// Every list read, with how many entries were used, inert and unknown.
+    pub lists: Vec<ListSummary>,
     /// Warnings found on the way (unknown entries, values without effect).
     pub warnings: Vec<Diagnostic>,
 }
@@ -47,6 +67,11 @@ pub struct ChannelConfig {
     pub list_path: PathBuf,
     /// Name of the virtual streaming program (P-CHAN-00158); `None` = streaming off.
     pub streaming_prog_file: Option<String>,
+    /// The subroutines called at program start and end and at M6.
+    pub implicit: ImplicitSubroutines,
+    /// The channel's axes: from the axis lists where the start-up list names any, else from
+    /// runtime.toml. Motion, the 21897 limit check and the ADS axis objects read this table.
+    pub axes: Vec<AxisConfig>,
     /// Program search paths, highest priority (0) first.
     pub search_paths: Vec<SearchPath>,
     /// `true` when the channel list's `path[j].*` replaced the start-up list's paths.
@@ -82,50 +107,84 @@ impl ChannelConfig {
 /// folder; built-in defaults when absent). Any error refuses the whole configuration.
 pub fn load(startup_list: &Path) -> Result<Config, ParamError> {
     let (list, mut diags) = read_list(startup_list).map_err(ParamError::File)?;
-    let config = build(list, &mut diags);
+    let mut lists = Vec::new();
+    let config = build(list, &mut diags, &mut lists);
     let has_errors = diags.iter().any(|d| d.severity == Severity::Error);
     match config {
         Some(c) if !has_errors => Ok(Config {
             warnings: diags,
+            lists,
             ..c
         }),
         _ => Err(ParamError::Invalid(diags)),
     }
 }
 
-/// Check a start-up list (with its channel lists and runtime.toml), a channel list, or a
-/// runtime.toml, returning every error and warning. The list kind is decided by content:
-/// a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset list `np_grp[…]`, a
-/// tool list `wz[…]`.
+/// Check a start-up list (with every list and file it names, and runtime.toml), a channel
+/// list, an axis list, a tool or zero-offset list, or a runtime.toml, returning every error
+/// and warning.
 pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
+    check_list_file_summarized(path).0
+}
+
+/// [`check_list_file`], with the used/inert/unknown counts of every list read. The list kind
+/// is decided by content: a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset
+/// list `np_grp[…]`, a tool list `wz[…]`, an axis list `kopf.*`, `kenngr.*` or `getriebe[…]`.
+pub fn check_list_file_summarized(path: &Path) -> (Vec<Diagnostic>, Vec<ListSummary>) {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
     {
-        return read_runtime(path).err().unwrap_or_default();
+        return (read_runtime(path).err().unwrap_or_default(), Vec::new());
     }
     let text = match read_list_text(path) {
         Ok(t) => t,
-        Err(d) => return vec![d],
+        Err(d) => return (vec![d], Vec::new()),
     };
     let (list, mut diags) = parse_list(path, &text);
+    let mut lists = Vec::new();
     if is_startup_list(&list) {
-        build(list, &mut diags);
+        build(list, &mut diags, &mut lists);
     } else if is_zero_offset_list(&list) {
-        interpret_zero_offsets(&list, &mut diags);
+        lists.push(interpret_zero_offsets(&list, &mut diags).1);
     } else if super::tools::is_tool_list(&list) {
-        super::tools::interpret_tools(&list, &mut diags);
+        lists.push(super::tools::interpret_tools(&list, &mut diags).1);
+    } else if is_axis_list(&list) {
+        lists.push(tally_axis_list(&list, &mut diags));
+        interpret_axis(None, &list, &mut diags);
     } else {
         // Cache values are not finished here: the start-up list may switch caching on.
-        interpret_channel(list, &mut diags);
+        let folder = list_folder(path);
+        lists.push(interpret_channel(list, &folder, &mut diags).summary);
     }
-    diags
+    (diags, lists)
+}
+
+/// The CNC's working directory: `cnc_dir` of runtime.toml (joined to runtime.toml's folder),
+/// else the start-up list's folder, or its parent when that folder is `listen`.
+pub fn cnc_dir(startup_list: &Path, runtime: Option<&RuntimeConfig>) -> PathBuf {
+    let folder = list_folder(startup_list);
+    if let Some(dir) = runtime.and_then(|r| r.cnc_dir.as_deref()) {
+        return super::search_path::resolve(&folder, &dir.to_string_lossy());
+    }
+    let is_listen = folder
+        .file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.eq_ignore_ascii_case(LIST_FOLDER));
+    match folder.parent() {
+        Some(p) if is_listen && !p.as_os_str().is_empty() => p.to_path_buf(),
+        Some(_) if is_listen => PathBuf::from("."),
+        _ => folder,
+    }
 }
 
 /// Interpret everything; `None` when an error made a channel impossible to set up.
-fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
+fn build(
+    list: ParamList,
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+) -> Option<Config> {
     let startup_path = list.file.clone();
-    let startup = interpret_startup(list, diags);
     let runtime_path = list_folder(&startup_path).join(RUNTIME_FILE);
     let (runtime_file, runtime) = if runtime_path.exists() {
         match read_runtime(&runtime_path) {
@@ -138,11 +197,17 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
     } else {
         (None, Some(RuntimeConfig::default()))
     };
+    let cnc_dir = cnc_dir(&startup_path, runtime.as_ref());
+    let startup = interpret_startup(list, &cnc_dir, diags);
+    lists.push(startup.summary.clone());
 
     let tools_path = list_folder(&startup_path).join(super::tools::TOOLS_FILE);
     let (tools_file, tools) = if tools_path.exists() {
         match super::tools::read_tools(&tools_path, diags) {
-            Ok(t) => (Some(tools_path), t),
+            Ok((t, summary)) => {
+                lists.push(summary);
+                (Some(tools_path), t)
+            }
             Err(e) => {
                 diags.push(e);
                 (Some(tools_path), Vec::new())
@@ -151,20 +216,151 @@ fn build(list: ParamList, diags: &mut Vec<Diagnostic>) -> Option<Config> {
     } else {
         (None, Vec::new())
     };
-    let channels = channels(&startup, diags);
+    let (error_text_file, error_texts) = match &startup.error_texts {
+        Some(r) => match read_error_texts(&r.path) {
+            Ok(t) => (Some(r.path.clone()), Some(Arc::new(t))),
+            Err(e) => {
+                diags.push(cannot_read(
+                    &startup.list,
+                    &r.entry,
+                    "error text file",
+                    &r.path,
+                    &e,
+                ));
+                (Some(r.path.clone()), None)
+            }
+        },
+        None => (None, None),
+    };
+    let axis_lists = axis_lists(&startup, diags, lists);
+    if let (false, Some(rt), Some(file)) = (axis_lists.is_empty(), &runtime, &runtime_file) {
+        if rt.axes != RuntimeConfig::default().axes {
+            diags.push(Diagnostic::warning(
+                file,
+                1,
+                1,
+                None,
+                "[[axes]] is not used: the start-up list names axis lists (achs_mds[i]), \
+                 and the axes come from them",
+            ));
+        }
+    }
+    let channels = match &runtime {
+        Some(rt) => channels(&startup, &axis_lists, rt, &cnc_dir, diags, lists),
+        None => None,
+    };
     Some(Config {
         startup_list: startup_path,
         startup: startup.list,
+        cnc_dir,
         runtime_file,
         runtime: runtime?,
         channels: channels?,
         tools_file,
         tools,
+        error_text_file,
+        error_texts,
+        lists: Vec::new(),
         warnings: Vec::new(),
     })
 }
 
-fn channels(startup: &StartupList, diags: &mut Vec<Diagnostic>) -> Option<Vec<ChannelConfig>> {
+/// A file named by `entry` could not be read: the error at the entry's value.
+fn cannot_read(
+    list: &ParamList,
+    entry: &Entry,
+    what: &str,
+    path: &Path,
+    e: &Diagnostic,
+) -> Diagnostic {
+    list.error_at(
+        entry,
+        entry.value_pos,
+        format!(
+            "{}: {what} {} cannot be read: {}",
+            entry.name.text,
+            path.display(),
+            e.message
+        ),
+    )
+}
+
+/// Step: the axis lists (`achs_mds[i]` over `default_achs_mds`), in index order, each read
+/// once; a logical axis number given twice is an error.
+fn axis_lists(
+    startup: &StartupList,
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+) -> Vec<AxisList> {
+    if startup.axis_lists.is_empty() {
+        return Vec::new();
+    }
+    let default = startup
+        .default_axis_list
+        .as_ref()
+        .and_then(|r| match read_list(&r.path) {
+            Ok((list, errs)) => {
+                diags.extend(errs);
+                lists.push(tally_axis_list(&list, diags));
+                Some(list)
+            }
+            Err(e) => {
+                diags.push(cannot_read(
+                    &startup.list,
+                    &r.entry,
+                    "default axis list",
+                    &r.path,
+                    &e,
+                ));
+                None
+            }
+        });
+    let mut out: Vec<AxisList> = Vec::new();
+    for r in startup.axis_lists.values() {
+        let list = match read_list(&r.path) {
+            Ok((list, errs)) => {
+                diags.extend(errs);
+                list
+            }
+            Err(e) => {
+                diags.push(cannot_read(
+                    &startup.list,
+                    &r.entry,
+                    "axis list",
+                    &r.path,
+                    &e,
+                ));
+                continue;
+            }
+        };
+        lists.push(tally_axis_list(&list, diags));
+        let axis = interpret_axis(default.as_ref(), &list, diags);
+        if let Some(first) = out.iter().find(|a| a.logical_number == axis.logical_number) {
+            diags.push(startup.list.error_at(
+                &r.entry,
+                r.entry.value_pos,
+                format!(
+                    "{}: kopf.achs_nr {} is also the logical number of {} (P-AXIS-00016: unique)",
+                    r.entry.name.text,
+                    axis.logical_number,
+                    first.file.display()
+                ),
+            ));
+            continue;
+        }
+        out.push(axis);
+    }
+    out
+}
+
+fn channels(
+    startup: &StartupList,
+    axis_lists: &[AxisList],
+    runtime: &RuntimeConfig,
+    cnc_dir: &Path,
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+) -> Option<Vec<ChannelConfig>> {
     let count = startup.channel_count?;
     let mut out = Vec::new();
     // Channels may share one list; read and report it once.
@@ -174,32 +370,30 @@ fn channels(startup: &StartupList, diags: &mut Vec<Diagnostic>) -> Option<Vec<Ch
         let Some(r) = startup.channel_lists.get(&i) else {
             continue;
         };
-        if let Some(chan) = seen.get(&r.path) {
-            out.push(combine(startup, i, chan.clone(), diags));
-            continue;
-        }
-        let chan = match read_list(&r.path) {
-            Ok((list, errs)) => {
-                diags.extend(errs);
-                let chan = interpret_channel(list, diags);
-                seen.insert(r.path.clone(), chan.clone());
-                chan
-            }
-            Err(e) => {
-                diags.push(startup.list.error_at(
-                    &r.entry,
-                    r.entry.value_pos,
-                    format!(
-                        "{}: channel list {} cannot be read: {}",
-                        r.entry.name.text,
-                        r.path.display(),
-                        e.message
-                    ),
-                ));
-                continue;
-            }
+        let chan = match seen.get(&r.path) {
+            Some(chan) => chan.clone(),
+            None => match read_list(&r.path) {
+                Ok((list, errs)) => {
+                    diags.extend(errs);
+                    let chan = interpret_channel(list, cnc_dir, diags);
+                    lists.push(chan.summary.clone());
+                    seen.insert(r.path.clone(), chan.clone());
+                    chan
+                }
+                Err(e) => {
+                    diags.push(cannot_read(
+                        &startup.list,
+                        &r.entry,
+                        "channel list",
+                        &r.path,
+                        &e,
+                    ));
+                    continue;
+                }
+            },
         };
-        out.push(combine(startup, i, chan, diags));
+        let axes = super::axes::channel_axes(&chan, axis_lists, runtime, diags)?;
+        out.push(combine(startup, i, chan, axes, diags));
     }
     // Zero-offset lists; channels may share one: read and report it once.
     let mut tables: HashMap<PathBuf, Option<ZeroOffsetTable>> = HashMap::new();
@@ -209,17 +403,17 @@ fn channels(startup: &StartupList, diags: &mut Vec<Diagnostic>) -> Option<Vec<Ch
         };
         let table = tables.entry(r.path.clone()).or_insert_with(|| {
             match read_zero_offsets(&r.path, diags) {
-                Ok(t) => Some(t),
+                Ok((t, summary)) => {
+                    lists.push(summary);
+                    Some(t)
+                }
                 Err(e) => {
-                    diags.push(startup.list.error_at(
+                    diags.push(cannot_read(
+                        &startup.list,
                         &r.entry,
-                        r.entry.value_pos,
-                        format!(
-                            "{}: zero-offset list {} cannot be read: {}",
-                            r.entry.name.text,
-                            r.path.display(),
-                            e.message
-                        ),
+                        "zero-offset list",
+                        &r.path,
+                        &e,
                     ));
                     None
                 }
@@ -237,6 +431,7 @@ fn combine(
     startup: &StartupList,
     i: u32,
     chan: ChannelList,
+    axes: Vec<AxisConfig>,
     diags: &mut Vec<Diagnostic>,
 ) -> ChannelConfig {
     let start_decoder = startup.decoder.get(&i).cloned().unwrap_or_default();
@@ -250,6 +445,8 @@ fn combine(
         index: i as usize,
         list_path: chan.list.file.clone(),
         streaming_prog_file: chan.streaming_prog_file,
+        implicit: chan.implicit,
+        axes,
         search_paths,
         paths_from_channel_list,
         decoder: decoder.finish(diags),

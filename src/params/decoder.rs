@@ -10,7 +10,11 @@ use crate::diag::Diagnostic;
 /// Switches file caching (`#CACHE LOAD`) on.
 pub const FCT_USE_CACHED_FILES: &str = "FCT_USE_CACHED_FILES";
 /// Function names the kernel documents. Only caching changes the emulator's behaviour.
-pub const KNOWN_FUNCTIONS: [&str; 2] = [FCT_USE_CACHED_FILES, "FCT_VOL_COMP_COMPUTATION"];
+pub const KNOWN_FUNCTIONS: [&str; 3] = [
+    "FCT_DEFAULT",
+    FCT_USE_CACHED_FILES,
+    "FCT_VOL_COMP_COMPUTATION",
+];
 
 /// Cache files when caching is on and `max_cache_number` is not given.
 pub const DEFAULT_CACHE_FILES: u32 = 4;

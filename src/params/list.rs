@@ -60,6 +60,20 @@ pub enum ValueKind {
     Word,
     /// `"…"` text; may contain blanks and `(`.
     Quoted,
+    /// The value of another parameter, named by its P number: `P-AXIS-00008.0` is
+    /// P-AXIS-00008 (of gear 0). Resolved by the typed view that reads the entry.
+    Ref(ParamRef),
+}
+
+/// A reference to another parameter by its P number, as ISG lists write it:
+/// `P-<GROUP>-<number>[.<index>]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParamRef {
+    /// `AXIS`, `CHAN`, `STUP` …
+    pub group: String,
+    pub number: u32,
+    /// The `.n` suffix: the index of the referenced table entry (the gear for axis data).
+    pub index: Option<u32>,
 }
 
 /// A value as read: its kind and its text (without quotes and without the comment).
@@ -173,9 +187,31 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
     let mut first_unlisted = 0usize;
     // A leading byte-order mark is an editor artefact, not part of the first name.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut ended_at: Option<usize> = None;
     for (idx, raw) in text.split('\n').enumerate() {
         let line_no = idx + 1;
         let line = raw.strip_suffix('\r').unwrap_or(raw);
+        if let Some(end_line) = ended_at {
+            // The kernel stops reading at `Ende`; entries after it would be silently lost.
+            if !matches!(parse_line(line), Ok(None)) {
+                errors.push(
+                    Diagnostic::warning(
+                        file,
+                        line_no,
+                        1,
+                        None,
+                        format!("after `{END_OF_LIST}` on line {end_line}: not read"),
+                    )
+                    .with_source(line),
+                );
+                break;
+            }
+            continue;
+        }
+        if is_end_of_list(line) {
+            ended_at = Some(line_no);
+            continue;
+        }
         match parse_line(line) {
             Ok(None) => {}
             Ok(Some(parsed)) => {
@@ -230,6 +266,16 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
         ));
     }
     (list, errors)
+}
+
+/// The word that ends a list (German "end"): the kernel reads no further.
+pub const END_OF_LIST: &str = "Ende";
+
+/// `Ende` alone on a line (blanks and a comment after a blank allowed).
+fn is_end_of_list(line: &str) -> bool {
+    let t = line.trim_start_matches(is_blank);
+    t.strip_prefix(END_OF_LIST)
+        .is_some_and(|rest| rest.is_empty() || rest.starts_with(is_blank))
 }
 
 /// Most malformed lines one list reports. A file of garbage has an error a line; the first
@@ -309,7 +355,7 @@ fn ends_token(c: char) -> bool {
 /// Parse one line (without line end). `Ok(None)` for blank and comment lines.
 fn parse_line(line: &str) -> Result<Option<ParsedLine>, LineError> {
     let (rest, _) = blanks(line).map_err(|_| line_error(line, line, "unreadable line".into()))?;
-    if is_comment(line, rest)? {
+    if is_comment(rest) {
         return Ok(None);
     }
     let name_off = line.len() - rest.len();
@@ -331,27 +377,12 @@ fn line_error(line: &str, rest: &str, message: String) -> LineError {
     }
 }
 
-/// Line step 1: whether the line (from its first non-blank, `rest`) is blank or a comment;
-/// a `#` glued to text is an error, not a comment.
-fn is_comment(line: &str, rest: &str) -> Result<bool, LineError> {
-    if rest.is_empty() {
-        return Ok(true);
-    }
-    // Comments: `#` followed by a blank or nothing (the ISG rule); also `#` runs and rulers
-    // such as `#####` or `#----`, and `;` lines as in the source documents' examples.
-    if let Some(after) = rest.strip_prefix('#') {
-        match after.chars().next() {
-            None | Some(' ' | '\t' | '#' | '-' | '=' | '*') => return Ok(true),
-            Some(_) => {
-                return Err(line_error(
-                    line,
-                    rest,
-                    "`#` starts a comment only when a blank follows it".into(),
-                ))
-            }
-        }
-    }
-    Ok(rest.starts_with(';'))
+/// Line step 1: whether the line (from its first non-blank, `rest`) is blank or a comment.
+/// Every line that starts with `#` is one: `#name value` is how installations comment an
+/// entry out (`#spindel[0].range_way 0`), `# text`, `#####` rulers; so are `;` lines as in
+/// the source documents' examples.
+fn is_comment(rest: &str) -> bool {
+    rest.is_empty() || rest.starts_with('#') || rest.starts_with(';')
 }
 
 /// Line step 2: the name, segments separated by dots, each with an optional `[index]`;
@@ -443,7 +474,8 @@ fn parse_value(line: &str, name_text: &str, cur: &str) -> Result<(Value, usize),
         };
         let text = &body[..end];
         let after = &body[end + 1..];
-        check_string_tail(after).map_err(|at| err(at, tail_message()))?;
+        check_tail(after)
+            .map_err(|at| err(at, "expected a blank after the closing `\"`".into()))?;
         let value = Value {
             kind: ValueKind::Quoted,
             text: text.to_string(),
@@ -476,33 +508,78 @@ fn parse_value(line: &str, name_text: &str, cur: &str) -> Result<(Value, usize),
         return Ok((value, value_off));
     }
 
-    // Unquoted word: only blanks or a `(` comment may follow.
-    check_string_tail(after_tok).map_err(|at| err(at, tail_message()))?;
+    if let Some(r) = param_ref(token) {
+        let value = Value {
+            kind: ValueKind::Ref(r),
+            text: token.to_string(),
+        };
+        return Ok((value, value_off));
+    }
+
+    // Unquoted word, or a `|` list of words with blanks around the bars
+    // (`FCT_DEFAULT | FCT_M_PRE_OUTPUT`); after it, text after a blank is a comment.
+    let mut end = value_off + token.len();
+    let mut rest = after_tok;
+    loop {
+        let trimmed = rest.trim_start_matches(is_blank);
+        let Some(after_bar) = trimmed.strip_prefix('|') else {
+            break;
+        };
+        let next = after_bar.trim_start_matches(is_blank);
+        let (after_next, _) =
+            take_while1::<_, _, nom::error::Error<&str>>(|c| !ends_token(c) && c != '|')
+                .parse(next)
+                .map_err(|_| err(next, "expected a name after `|`".into()))?;
+        end = line.len() - after_next.len();
+        rest = after_next;
+    }
+    let text = &line[value_off..end];
     let value = Value {
         kind: ValueKind::Word,
-        text: token.to_string(),
+        text: text.to_string(),
     };
     Ok((value, value_off))
+}
+
+/// `P-AXIS-00008` or `P-AXIS-00008.0`: another parameter's value by its P number.
+fn param_ref(token: &str) -> Option<ParamRef> {
+    let rest = token.strip_prefix("P-")?;
+    let (group, rest) = rest.split_once('-')?;
+    if group.is_empty() || !group.bytes().all(|b| b.is_ascii_uppercase()) {
+        return None;
+    }
+    let (number, index) = match rest.split_once('.') {
+        Some((n, i)) => (n, Some(i)),
+        None => (rest, None),
+    };
+    if number.len() != 5 || !number.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let index = match index {
+        Some(i) if !i.is_empty() && i.len() <= 5 && i.bytes().all(|b| b.is_ascii_digit()) => {
+            Some(i.parse().ok()?)
+        }
+        Some(_) => return None,
+        None => None,
+    };
+    Some(ParamRef {
+        group: group.to_string(),
+        number: number.parse().ok()?,
+        index,
+    })
 }
 
 fn first_char(s: &str) -> char {
     s.chars().next().unwrap_or(' ')
 }
 
-fn tail_message() -> String {
-    "unexpected text after a string value: quote strings that contain blanks or `(`, \
-     and start a comment after a string with `(`"
-        .to_string()
-}
-
-/// After a string value only blanks, or blanks and a `(` comment, may follow.
+/// After a quoted string: nothing, a blank (what follows a blank is a comment) or a `(`.
 /// On failure returns the rest starting at the offending character.
-fn check_string_tail(after: &str) -> Result<(), &str> {
-    let rest = after.trim_start_matches(is_blank);
-    if rest.is_empty() || rest.starts_with('(') {
+fn check_tail(after: &str) -> Result<(), &str> {
+    if after.is_empty() || after.starts_with(is_blank) || after.starts_with('(') {
         Ok(())
     } else {
-        Err(rest)
+        Err(after)
     }
 }
 
@@ -601,8 +678,6 @@ mod tests {
 
     #[test]
     fn malformed_lines_point_at_the_column() {
-        let d = bad("#comment");
-        assert_eq!((d.line, d.col), (1, 1));
         let d = bad("kanal_anzahl");
         assert_eq!((d.line, d.col), (1, 13));
         assert!(d.message.contains("no value"));
@@ -610,7 +685,9 @@ mod tests {
         assert_eq!(d.col, 5);
         let d = bad("s \"open");
         assert_eq!(d.col, 3);
-        let d = bad("s two words");
+        let d = bad("s \"x\"y");
+        assert_eq!(d.col, 6);
+        let d = bad("s A | ");
         assert_eq!(d.col, 7);
         let d = bad("a.b. 3");
         assert_eq!(d.col, 5);
@@ -637,8 +714,58 @@ mod tests {
     fn column_counts_characters_not_bytes() {
         let d = bad("ä");
         assert_eq!(d.col, 1);
-        let (_, errs) = parse_list(Path::new("t.lis"), "a \"ü\" x");
-        assert_eq!(errs[0].col, 7);
+        let (_, errs) = parse_list(Path::new("t.lis"), "a \"ü\"x");
+        assert_eq!(errs[0].col, 6);
+    }
+
+    #[test]
+    fn the_kernels_own_list_constructs() {
+        // `#` glued to a name comments the entry out.
+        let (list, errs) = parse_list(Path::new("t.lis"), "#spindel[0].range_way 0\n#comment\n");
+        assert!(errs.is_empty() && list.entries.is_empty(), "{errs:?}");
+        // Unquoted `|` lists with blanks, then a comment.
+        let e = one("configuration.decoder.function FCT_DEFAULT | FCT_M_PRE_OUTPUT |FCT_SURFACE ( P-CHAN-00087");
+        assert_eq!(e.value.kind, ValueKind::Word);
+        assert_eq!(
+            e.value.as_str(),
+            "FCT_DEFAULT | FCT_M_PRE_OUTPUT |FCT_SURFACE"
+        );
+        // Text after a word and a blank is a comment, as after a number.
+        assert_eq!(one("s two words").value.as_str(), "two");
+        // An unclosed `(` comment after a number.
+        let e =
+            one("kenngr.swe_pos 15000000 ( P-AXIS-00178 : [0.1um] Positive software limit switch");
+        assert_eq!(e.value.as_int(), Some(15_000_000));
+        // A reference to another parameter by its P number.
+        let e = one("getriebe[0].slope_profil.a_brems P-AXIS-00008.0");
+        assert_eq!(
+            e.value.kind,
+            ValueKind::Ref(ParamRef {
+                group: "AXIS".into(),
+                number: 8,
+                index: Some(0)
+            })
+        );
+        assert!(matches!(
+            one("a P-CHAN-00158").value.kind,
+            ValueKind::Ref(ParamRef {
+                number: 158,
+                index: None,
+                ..
+            })
+        ));
+        assert_eq!(one("a P-AXIS-8").value.kind, ValueKind::Word);
+        // `Ende` ends the list; an entry after it is not read, with a warning.
+        let (list, errs) = parse_list(Path::new("t.lis"), "a 1\nEnde\n\n# x\n");
+        assert!(errs.is_empty(), "{errs:?}");
+        assert_eq!(list.entries.len(), 1);
+        let (list, errs) = parse_list(Path::new("t.lis"), "a 1\nEnde\nb 2\n");
+        assert_eq!(list.entries.len(), 1);
+        assert_eq!(errs.len(), 1);
+        assert_eq!(errs[0].severity, crate::diag::Severity::Warning);
+        assert_eq!(errs[0].line, 3);
+        // `Ende` with a value is an ordinary entry.
+        assert_eq!(one("Endeffektor 3").value.as_int(), Some(3));
     }
 
     #[test]

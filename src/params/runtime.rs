@@ -19,6 +19,10 @@ use crate::queue::{AXIS_LETTERS, MAX_AXES};
 pub struct RuntimeConfig {
     /// Period of the fixed-cycle loop in µs (default 1000 = 1 ms, the usual CNC cycle).
     pub cycle_period_us: u64,
+    /// The CNC's working directory, which relative paths in the lists are joined to; relative
+    /// to runtime.toml's folder. Default: the start-up list's folder, or its parent when that
+    /// folder is called `listen` (an installation's layout).
+    pub cnc_dir: Option<std::path::PathBuf>,
     /// Simulated latency of every program file open in µs (default 0), so soak tests can
     /// show what the file cache saves.
     pub fs_latency_us: u64,
@@ -35,6 +39,7 @@ impl Default for RuntimeConfig {
     fn default() -> Self {
         RuntimeConfig {
             cycle_period_us: 1000,
+            cnc_dir: None,
             fs_latency_us: 0,
             fs_latency_us_per_kib: 0,
             axes: ["X", "Y", "Z"]
@@ -48,13 +53,27 @@ impl Default for RuntimeConfig {
     }
 }
 
-/// One axis's name and limits.
+/// Whether an axis moves along a line (mm) or turns (degrees: every `_mm` limit of a rotary
+/// axis is in °, every `_mm_per_…` in °/…). From an axis list's `kenngr.achs_typ`
+/// (P-AXIS-00018); axes written in runtime.toml are linear.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum AxisKind {
+    #[default]
+    Linear,
+    Rotary,
+}
+
+/// One axis's name and limits: the one axis table motion, the 21897 limit check and the
+/// ADS axis objects read, filled from the axis lists or from runtime.toml.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisConfig {
     /// Axis name as programmed: one of `X Y Z A B C` (the axes the interpolator drives).
     /// Required.
     pub name: String,
+    /// Linear or rotary (not a runtime.toml key: only axis lists say so).
+    #[serde(skip)]
+    pub kind: AxisKind,
     /// Largest programmed feed in mm/min (default 30000).
     #[serde(default = "default_velocity")]
     pub max_velocity_mm_per_min: f64,
@@ -93,6 +112,7 @@ impl AxisConfig {
     pub fn named(name: &str) -> Self {
         AxisConfig {
             name: name.to_string(),
+            kind: AxisKind::Linear,
             max_velocity_mm_per_min: default_velocity(),
             max_acceleration_mm_per_s2: default_acceleration(),
             max_jerk_mm_per_s3: None,
@@ -101,6 +121,15 @@ impl AxisConfig {
             soft_limit_max_mm: default_soft_max(),
         }
     }
+}
+
+/// The interpolator's index (`AXIS_LETTERS`) of an axis name such as `x` or `Z`: the one rule
+/// `setup` relies on, so `check` refuses exactly what `run` could not build.
+pub fn axis_index(name: &str) -> Option<usize> {
+    let n = name.trim();
+    (n.len() == 1)
+        .then(|| n.as_bytes()[0].to_ascii_uppercase())
+        .and_then(|b| AXIS_LETTERS.iter().position(|&l| l == b))
 }
 
 /// Decoder budgets.
@@ -407,13 +436,7 @@ fn validate_axis(
     fail: &mut impl FnMut(&str, Option<usize>, &str, String),
 ) {
     let at = Some(i);
-    // The one rule `setup` relies on: a name is one of the interpolator's axis letters,
-    // so `check` refuses exactly what `run` could not build.
-    let name_ok = a.name.trim().len() == 1
-        && AXIS_LETTERS
-            .iter()
-            .any(|&l| a.name.trim().eq_ignore_ascii_case(&(l as char).to_string()));
-    if !name_ok {
+    if axis_index(&a.name).is_none() {
         fail(
             "axes",
             at,

@@ -263,10 +263,21 @@ pub fn resolve(base: &Path, text: &str) -> PathBuf {
         text.replace('\\', "/").into()
     };
     let p = Path::new(text.as_ref());
-    if p.is_absolute() {
+    let joined = if p.is_absolute() {
         p.to_path_buf()
     } else {
         base.join(p)
+    };
+    // `./listen/x.lis` names `listen/x.lis`: the `.` parts say nothing, and messages read
+    // better without them.
+    let clean: PathBuf = joined
+        .components()
+        .filter(|c| !matches!(c, std::path::Component::CurDir))
+        .collect();
+    if clean.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        clean
     }
 }
 

@@ -1,24 +1,28 @@
 //! The start-up list (`startup.lis`, `hochlauf.lis` in German installations): channel count,
-//! each channel's list, program search paths and decoder settings per channel.
+//! each channel's list, the axis lists, program search paths and decoder settings per
+//! channel, and the kernel's error text file.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
+use super::catalog::{ListKind, ListSummary, Tally};
 use super::decoder::{DecoderField, DecoderParams};
 use super::list::{Entry, ParamList};
-use super::search_path::{list_folder, resolve, PathCollector, PathField, SearchPath};
+use super::search_path::{resolve, PathCollector, PathField, SearchPath};
 use super::value::{string_value, uint_value};
 use crate::diag::Diagnostic;
 
 /// Channels one kernel runs (ISG: `pfad[i]` with i = 0 ... 11, "maximum number of channels: 12").
 pub const MAX_CHANNELS: u32 = 12;
+/// Axis lists one kernel reads (P-STUP-00015: `achs_mds[i]`, i = 0 … 31).
+pub const MAX_AXIS_LISTS: u32 = 32;
 /// Longest list path we accept.
 const MAX_PATH_CHARS: usize = 256;
 
-/// Where a channel's list is and which line named it.
+/// Where a list (or other file) the start-up list names is and which line named it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ChannelListRef {
-    /// Absolute as written, or joined to the start-up list's folder.
+pub struct ListRef {
+    /// Absolute as written, or joined to the CNC's working directory.
     pub path: PathBuf,
     /// The `sda_mds[i]` line, so a missing file is reported there.
     pub entry: Entry,
@@ -30,15 +34,23 @@ pub struct StartupList {
     pub list: ParamList,
     /// `kanal_anzahl`; `None` when missing or bad (an error was reported).
     pub channel_count: Option<u32>,
-    pub channel_lists: BTreeMap<u32, ChannelListRef>,
+    pub channel_lists: BTreeMap<u32, ListRef>,
     /// `pfad[i].*` per channel, sorted by priority.
     pub search_paths: BTreeMap<u32, Vec<SearchPath>>,
     /// `configuration.channel[i].decoder.*` per channel.
     pub decoder: BTreeMap<u32, DecoderParams>,
     /// `zero_offset_list[i]`: channel i's zero-offset list.
-    pub zero_offset_lists: BTreeMap<u32, ChannelListRef>,
+    pub zero_offset_lists: BTreeMap<u32, ListRef>,
     /// `zero_offset_list`: the zero-offset list of every channel without its own.
-    pub zero_offset_default: Option<ChannelListRef>,
+    pub zero_offset_default: Option<ListRef>,
+    /// `achs_mds[i]` (P-STUP-00015): the axis lists, by index.
+    pub axis_lists: BTreeMap<u32, ListRef>,
+    /// `default_achs_mds` (P-STUP-00035): the list under every axis list.
+    pub default_axis_list: Option<ListRef>,
+    /// `error_text_of_id` (P-STUP-00168): the kernel's error text file.
+    pub error_texts: Option<ListRef>,
+    /// Entries used, inert and unknown.
+    pub summary: ListSummary,
 }
 
 /// Does this list look like a start-up list? (It names `kanal_anzahl` or `sda_mds[…]`.)
@@ -78,26 +90,23 @@ pub(crate) fn warn_duplicates(list: &ParamList, diags: &mut Vec<Diagnostic>) {
     }
 }
 
-pub(crate) fn warn_unknown(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) {
-    diags.push(list.warning_at(
-        e,
-        e.name_pos,
-        format!(
-            "unknown parameter {}: kept, but the emulator does not use it",
-            e.name.text
-        ),
-    ));
-}
-
-/// Check the start-up list's entries. Problems go to `diags`; the result holds what was good.
-pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> StartupList {
+/// Check the start-up list's entries; relative paths are joined to `cnc_dir`, the CNC's
+/// working directory. Problems go to `diags`; the result holds what was good.
+pub fn interpret_startup(
+    list: ParamList,
+    cnc_dir: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> StartupList {
     warn_duplicates(&list, diags);
-    let base = list_folder(&list.file);
+    let base = cnc_dir.to_path_buf();
     let channel_count = read_channel_count(&list, diags);
     // Without a valid count, indices are still checked against the kernel's maximum.
     let bound = channel_count.unwrap_or(MAX_CHANNELS);
 
-    let mut g = Gathered::default();
+    let mut g = Gathered {
+        tally: Some(Tally::new(ListKind::Startup)),
+        ..Gathered::default()
+    };
     for e in &list.entries {
         let s = shape(e);
         if channel_out_of_range(&list, e, &s, bound, channel_count, diags) {
@@ -109,9 +118,16 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
         channel_lists,
         zero_offset_lists,
         zero_offset_default,
+        axis_lists,
+        default_axis_list,
+        error_texts,
         decoder,
         collectors,
+        tally,
     } = g;
+    let summary = tally
+        .unwrap_or_else(|| Tally::new(ListKind::Startup))
+        .finish(&list);
 
     let search_paths = collectors
         .into_iter()
@@ -127,6 +143,10 @@ pub fn interpret_startup(list: ParamList, diags: &mut Vec<Diagnostic>) -> Startu
         decoder,
         zero_offset_lists,
         zero_offset_default,
+        axis_lists,
+        default_axis_list,
+        error_texts,
+        summary,
     }
 }
 
@@ -171,6 +191,19 @@ fn channel_out_of_range(
     channel_count: Option<u32>,
     diags: &mut Vec<Diagnostic>,
 ) -> bool {
+    if let [("achs_mds", Some(i))] = s {
+        if *i >= MAX_AXIS_LISTS {
+            diags.push(list.error_at(
+                e,
+                e.name_pos,
+                format!(
+                    "{}: axis list index {i} is not below the maximum of {MAX_AXIS_LISTS}",
+                    e.name.text
+                ),
+            ));
+            return true;
+        }
+    }
     let channel = match s {
         [("sda_mds" | "zero_offset_list", Some(i))]
         | [("pfad", Some(i)), (_, Some(_))]
@@ -200,11 +233,15 @@ fn channel_out_of_range(
 /// What the entries of a start-up list name, gathered entry by entry (step 2).
 #[derive(Default)]
 struct Gathered<'l> {
-    channel_lists: BTreeMap<u32, ChannelListRef>,
-    zero_offset_lists: BTreeMap<u32, ChannelListRef>,
-    zero_offset_default: Option<ChannelListRef>,
+    channel_lists: BTreeMap<u32, ListRef>,
+    zero_offset_lists: BTreeMap<u32, ListRef>,
+    zero_offset_default: Option<ListRef>,
+    axis_lists: BTreeMap<u32, ListRef>,
+    default_axis_list: Option<ListRef>,
+    error_texts: Option<ListRef>,
     decoder: BTreeMap<u32, DecoderParams>,
     collectors: BTreeMap<u32, PathCollector<'l>>,
+    tally: Option<Tally>,
 }
 
 impl<'l> Gathered<'l> {
@@ -220,38 +257,44 @@ impl<'l> Gathered<'l> {
     ) {
         match s {
             [("kanal_anzahl", None)] => {}
-            [("sda_mds", Some(i))] => match string_value(list, e, MAX_PATH_CHARS) {
-                Ok(p) if p.is_empty() => diags.push(list.error_at(
-                    e,
-                    e.value_pos,
-                    format!("{}: empty channel list path", e.name.text),
-                )),
-                Ok(p) => {
-                    self.channel_lists.insert(
-                        *i,
-                        ChannelListRef {
-                            path: resolve(base, &p),
-                            entry: e.clone(),
-                        },
-                    );
+            [("sda_mds", Some(i))] => {
+                if let Some(r) = file_ref(list, base, e, "channel list", diags) {
+                    self.channel_lists.insert(*i, r);
                 }
-                Err(d) => diags.push(d),
-            },
+            }
             [("zero_offset_list", index)] => self.zero_offset_list(list, base, e, *index, diags),
+            [("achs_mds", Some(i))] => {
+                if let Some(r) = file_ref(list, base, e, "axis list", diags) {
+                    self.axis_lists.insert(*i, r);
+                }
+            }
+            [("default_achs_mds", None)] => {
+                self.default_axis_list = file_ref(list, base, e, "default axis list", diags);
+            }
+            // P-STUP-00168; `error_message_texts` is the name some installations write.
+            [("error_text_of_id" | "error_message_texts", None)] => {
+                self.error_texts = file_ref(list, base, e, "error text file", diags);
+            }
             [("pfad", Some(i)), (field, Some(j))] => self.path(list, e, *i, field, *j, diags),
             [("configuration", None), ("channel", Some(i)), ("decoder", None), (field, None)] => {
                 let field = match *field {
                     "function" => DecoderField::Function,
                     "max_cache_number" => DecoderField::MaxCacheNumber,
                     "max_cache_size" => DecoderField::MaxCacheSize,
-                    _ => return warn_unknown(list, e, diags),
+                    _ => return self.not_read(list, e, diags),
                 };
                 self.decoder
                     .entry(*i)
                     .or_default()
                     .set(list, e, field, diags);
             }
-            _ => warn_unknown(list, e, diags),
+            _ => self.not_read(list, e, diags),
+        }
+    }
+
+    fn not_read(&mut self, list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) {
+        if let Some(t) = &mut self.tally {
+            t.not_read(list, e, diags);
         }
     }
 
@@ -264,25 +307,14 @@ impl<'l> Gathered<'l> {
         index: Option<u32>,
         diags: &mut Vec<Diagnostic>,
     ) {
-        match string_value(list, e, MAX_PATH_CHARS) {
-            Ok(p) if p.is_empty() => diags.push(list.error_at(
-                e,
-                e.value_pos,
-                format!("{}: empty zero-offset list path", e.name.text),
-            )),
-            Ok(p) => {
-                let r = ChannelListRef {
-                    path: resolve(base, &p),
-                    entry: e.clone(),
-                };
-                match index {
-                    Some(i) => {
-                        self.zero_offset_lists.insert(i, r);
-                    }
-                    None => self.zero_offset_default = Some(r),
-                }
+        let Some(r) = file_ref(list, base, e, "zero-offset list", diags) else {
+            return;
+        };
+        match index {
+            Some(i) => {
+                self.zero_offset_lists.insert(i, r);
             }
-            Err(d) => diags.push(d),
+            None => self.zero_offset_default = Some(r),
         }
     }
 
@@ -301,7 +333,7 @@ impl<'l> Gathered<'l> {
             "typ" => Some(PathField::Kinds),
             "prioritaet" => Some(PathField::Priority),
             "log_nr" => None,
-            _ => return warn_unknown(list, e, diags),
+            _ => return self.not_read(list, e, diags),
         };
         match field {
             Some(f) => self
@@ -319,11 +351,39 @@ impl<'l> Gathered<'l> {
     }
 }
 
+/// A file the start-up list names: a non-empty path, joined to the CNC's working directory.
+fn file_ref(
+    list: &ParamList,
+    base: &Path,
+    e: &Entry,
+    what: &str,
+    diags: &mut Vec<Diagnostic>,
+) -> Option<ListRef> {
+    match string_value(list, e, MAX_PATH_CHARS) {
+        Ok(p) if p.is_empty() => {
+            diags.push(list.error_at(
+                e,
+                e.value_pos,
+                format!("{}: empty {what} path", e.name.text),
+            ));
+            None
+        }
+        Ok(p) => Some(ListRef {
+            path: resolve(base, &p),
+            entry: e.clone(),
+        }),
+        Err(d) => {
+            diags.push(d);
+            None
+        }
+    }
+}
+
 /// Step 3: with a valid count, every channel below it needs its channel list.
 fn check_channel_lists(
     list: &ParamList,
     channel_count: Option<u32>,
-    channel_lists: &BTreeMap<u32, ChannelListRef>,
+    channel_lists: &BTreeMap<u32, ListRef>,
     diags: &mut Vec<Diagnostic>,
 ) {
     if let (Some(n), Some(count_entry)) = (channel_count, list.get("kanal_anzahl")) {
@@ -344,7 +404,7 @@ fn check_channel_lists(
 
 impl StartupList {
     /// The zero-offset list of channel `i` (0-based), if the start-up list names one.
-    pub fn zero_offset_list(&self, i: u32) -> Option<&ChannelListRef> {
+    pub fn zero_offset_list(&self, i: u32) -> Option<&ListRef> {
         self.zero_offset_lists
             .get(&i)
             .or(self.zero_offset_default.as_ref())
@@ -354,7 +414,7 @@ impl StartupList {
 fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
     matches!(
         s,
-        [("sda_mds" | "zero_offset_list", Some(_))]
+        [("sda_mds" | "zero_offset_list" | "achs_mds", Some(_))]
             | [
                 ("pfad", Some(_)),
                 ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))

@@ -13,8 +13,9 @@
 
 use std::path::Path;
 
+use super::catalog::{ListKind, ListSummary, Tally};
 use super::list::{read_list, ParamList};
-use super::startup::{shape, warn_duplicates, warn_unknown};
+use super::startup::{shape, warn_duplicates};
 use super::zero_offsets::{int_value, MM_PER_UNIT};
 use crate::diag::Diagnostic;
 
@@ -38,21 +39,25 @@ pub fn is_tool_list(list: &ParamList) -> bool {
 
 /// Read and check a tool list. `Err` when the file cannot be read; entry problems go to
 /// `diags`.
-pub fn read_tools(path: &Path, diags: &mut Vec<Diagnostic>) -> Result<ToolRadii, Diagnostic> {
+pub fn read_tools(
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> Result<(ToolRadii, ListSummary), Diagnostic> {
     let (list, errs) = read_list(path)?;
     diags.extend(errs);
     Ok(interpret_tools(&list, diags))
 }
 
 /// Check a parsed tool list.
-pub fn interpret_tools(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ToolRadii {
+pub fn interpret_tools(list: &ParamList, diags: &mut Vec<Diagnostic>) -> (ToolRadii, ListSummary) {
     warn_duplicates(list, diags);
+    let mut tally = Tally::new(ListKind::Tools);
     let mut out: ToolRadii = Vec::new();
     for e in &list.entries {
         let d = match shape(e).as_slice() {
             [("wz", Some(d)), ("radius", None)] => *d,
             _ => {
-                warn_unknown(list, e, diags);
+                tally.not_read(list, e, diags);
                 continue;
             }
         };
@@ -78,7 +83,7 @@ pub fn interpret_tools(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ToolRad
         }
     }
     out.sort_by_key(|(d, _)| *d);
-    out
+    (out, tally.finish(list))
 }
 
 #[cfg(test)]
@@ -94,7 +99,7 @@ mod tests {
         );
         assert!(errs.is_empty());
         let mut d = Vec::new();
-        let t = interpret_tools(&list, &mut d);
+        let (t, _) = interpret_tools(&list, &mut d);
         assert!(is_tool_list(&list));
         assert_eq!(t, vec![(1, 5.0), (2, 2.5)]);
         assert_eq!(d.len(), 2, "{d:?}");

@@ -24,6 +24,7 @@ pub fn uint_value(list: &ParamList, e: &Entry, max: u64) -> Result<u64, Diagnost
                 format!("{name}: must be a whole number (found {})", e.value.text),
             ))
         }
+        ValueKind::Ref(_) => return Err(unresolved(list, e)),
         ValueKind::Word | ValueKind::Quoted => {
             return Err(list.error_at(
                 e,
@@ -40,6 +41,46 @@ pub fn uint_value(list: &ParamList, e: &Entry, max: u64) -> Result<u64, Diagnost
         ));
     }
     Ok(v)
+}
+
+/// A finite number written as an integer, `0x…` or with a fraction (the kernel's later
+/// builds keep positions as REAL64), in `min ..= max`.
+pub fn number_value(list: &ParamList, e: &Entry, min: f64, max: f64) -> Result<f64, Diagnostic> {
+    let name = &e.name.text;
+    let v = match e.value.kind {
+        ValueKind::Int(v) => v as f64,
+        ValueKind::Hex(v) => v as f64,
+        ValueKind::Float(v) => v,
+        ValueKind::Ref(_) => return Err(unresolved(list, e)),
+        ValueKind::Word | ValueKind::Quoted => {
+            return Err(list.error_at(
+                e,
+                e.value_pos,
+                format!("{name}: expected a number, found `{}`", e.value.text),
+            ))
+        }
+    };
+    if !(min..=max).contains(&v) {
+        return Err(list.error_at(
+            e,
+            e.value_pos,
+            format!("{name}: {v} is not in the plausible range {min} … {max}"),
+        ));
+    }
+    Ok(v)
+}
+
+/// A reference (`P-AXIS-00008.0`) the list does not resolve: the parameter it names is not
+/// set in the lists read, or is not one ncchannel knows.
+pub fn unresolved(list: &ParamList, e: &Entry) -> Diagnostic {
+    list.error_at(
+        e,
+        e.value_pos,
+        format!(
+            "{}: refers to {}, which is not set in the lists read (or not a parameter ncchannel knows)",
+            e.name.text, e.value.text
+        ),
+    )
 }
 
 /// A string of at most `max_chars` characters.

@@ -8,8 +8,9 @@
 
 use std::path::Path;
 
+use super::catalog::{ListKind, ListSummary, Tally};
 use super::list::{read_list, Entry, ParamList, ValueKind};
-use super::startup::{shape, warn_duplicates, warn_unknown};
+use super::startup::{shape, warn_duplicates};
 use crate::diag::Diagnostic;
 use crate::queue::MAX_AXES;
 
@@ -40,15 +41,19 @@ pub fn is_zero_offset_list(list: &ParamList) -> bool {
 pub fn read_zero_offsets(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
-) -> Result<ZeroOffsetTable, Diagnostic> {
+) -> Result<(ZeroOffsetTable, ListSummary), Diagnostic> {
     let (list, errs) = read_list(path)?;
     diags.extend(errs);
     Ok(interpret_zero_offsets(&list, diags))
 }
 
 /// Check a parsed zero-offset list.
-pub fn interpret_zero_offsets(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ZeroOffsetTable {
+pub fn interpret_zero_offsets(
+    list: &ParamList,
+    diags: &mut Vec<Diagnostic>,
+) -> (ZeroOffsetTable, ListSummary) {
     warn_duplicates(list, diags);
+    let mut tally = Tally::new(ListKind::ZeroOffsets);
     let mut offsets = [[0.0; MAX_AXES]; GROUPS];
     let mut inactive = [[false; MAX_AXES]; GROUPS];
     for e in &list.entries {
@@ -57,7 +62,7 @@ pub fn interpret_zero_offsets(list: &ParamList, diags: &mut Vec<Diagnostic>) -> 
                 (*i, *j, *f)
             }
             _ => {
-                warn_unknown(list, e, diags);
+                tally.not_read(list, e, diags);
                 continue;
             }
         };
@@ -112,7 +117,7 @@ pub fn interpret_zero_offsets(list: &ParamList, diags: &mut Vec<Diagnostic>) -> 
             }
         }
     }
-    offsets
+    (offsets, tally.finish(list))
 }
 
 /// A signed 32-bit whole number (the kernel's SGN32), decimal or `0x…`.
@@ -130,6 +135,7 @@ pub(crate) fn int_value(list: &ParamList, e: &Entry) -> Result<i64, Diagnostic> 
                 ),
             ))
         }
+        ValueKind::Ref(_) => return Err(super::value::unresolved(list, e)),
         ValueKind::Word | ValueKind::Quoted => {
             return Err(list.error_at(
                 e,
@@ -160,7 +166,7 @@ mod tests {
         let (list, errs) = parse_list(Path::new("np.lis"), text);
         assert!(errs.is_empty(), "{errs:?}");
         let mut d = Vec::new();
-        let t = interpret_zero_offsets(&list, &mut d);
+        let (t, _) = interpret_zero_offsets(&list, &mut d);
         (t, d)
     }
 
