@@ -558,7 +558,9 @@ fn run_trace_writes_a_header_and_one_row_per_stride_ending_at_the_end_point() {
     let peak_jerk = rows.iter().map(|r| r[5].abs()).fold(0.0, f64::max);
     assert!(peak_jerk > 1000.0, "jerk is traced ({peak_jerk})");
     let last = rows.last().unwrap();
-    assert_eq!((last[1], last[2], last[3]), (20.0, 20.0, 0.0));
+    assert_eq!((last[1], last[2]), (20.0, 20.0));
+    // The filter's last step into the end point may be a rounding residue (nm per tick).
+    assert!(last[3].abs() < 1e-3, "{}", last[3]);
 }
 
 /// The seed's streaming-spline example (nc/streaming_spline.nc), with the feed the excerpt
