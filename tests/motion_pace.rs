@@ -95,6 +95,11 @@ fn run(q: &mut BlockQueue, start: Position) -> Run {
 
 /// The R50 circle at F6000 from (50, 0): one G03 (n = 0) or n chords.
 fn circle(n: usize) -> Run {
+    circle_with(n, PathMode::default())
+}
+
+/// The same, the chords programmed with `path` (contouring).
+fn circle_with(n: usize, path: PathMode) -> Run {
     let mut q = BlockQueue::new(1_000_000);
     let start = p(50.0, 0.0);
     if n == 0 {
@@ -115,7 +120,7 @@ fn circle(n: usize) -> Run {
             } else {
                 p(50.0 * phi.cos(), 50.0 * phi.sin())
             };
-            q.push(block(k as u32, line(at, to, 6000.0, PathMode::default())));
+            q.push(block(k as u32, line(at, to, 6000.0, path)));
             at = to;
         }
     }
@@ -201,4 +206,73 @@ fn the_square_stops_at_its_corners_without_contouring() {
     // A stop within one cycle: no axis changes its velocity by more than aᵢ·dt = 2 mm/s.
     assert!(speeds.iter().all(|v| *v <= 2.0), "{speeds:?}");
     r.check.verdict().unwrap();
+}
+
+/// The deviation from the programmed corners: per inner corner, how close the path comes to
+/// it, mm (the contour's middle lies this far from the corner).
+fn corner_deviations_mm(r: &Run) -> Vec<f64> {
+    [p(100.0, 0.0), p(100.0, 100.0), p(0.0, 100.0)]
+        .iter()
+        .map(|c| {
+            r.positions
+                .iter()
+                .map(|q| (q[0] - c[0]).hypot(q[1] - c[1]))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect()
+}
+
+#[test]
+fn the_contoured_square_rounds_its_corners_within_the_default_deviation_at_speed() {
+    let sharp = square(None);
+    let r = square(Some(DEFAULT_PATH_DEV_MM));
+    let speeds = corner_speeds(&r);
+    let devs = corner_deviations_mm(&r);
+    let dev = devs.iter().copied().fold(0.0, f64::max);
+    println!(
+        "square with G261 ({DEFAULT_PATH_DEV_MM} mm): {:.3} s (sharp {:.3} s), corners {speeds:.2?} mm/s, deviation {dev:.5} mm",
+        r.time_s, sharp.time_s
+    );
+    // Every corner rounded by the default deviation: the path passes δ from the corner
+    // (the ticks sample the curve every 14 µm, so the closest sample lies up to 1 µm further).
+    assert!(
+        devs.iter()
+            .all(|d| (DEFAULT_PATH_DEV_MM..DEFAULT_PATH_DEV_MM + 1e-3).contains(d)),
+        "{devs:?}"
+    );
+    // And nowhere farther than δ from the programmed sides.
+    let off = r
+        .positions
+        .iter()
+        .map(|q| q[0].min(100.0 - q[0]).min(q[1]).min(100.0 - q[1]).abs())
+        .fold(0.0, f64::max);
+    assert!(off <= DEFAULT_PATH_DEV_MM, "{off}");
+    // A tangent arc of radius 0.1207 mm passed at 80 % of a = 2000 mm/s² centripetal.
+    assert!(speeds.iter().all(|v| *v >= 13.0), "{speeds:?}");
+    assert!(r.time_s < sharp.time_s);
+    r.check.verdict().unwrap();
+}
+
+#[test]
+fn coarse_chords_need_contouring_to_keep_the_pace() {
+    // 36 chords turn 10° at each junction: at F6000 an axis' velocity would jump by 17 mm/s
+    // in one cycle, 8.7 × what a = 2000 mm/s² allows, so without contouring the junctions
+    // are slow. With G261 at its default deviation they are rounded and passed at speed.
+    let arc = circle(0);
+    let sharp = circle(36);
+    let path = PathMode {
+        contour_dev_mm: Some(DEFAULT_PATH_DEV_MM),
+        ..PathMode::default()
+    };
+    let round = circle_with(36, path);
+    println!(
+        "36 chords: {:.3} s sharp, {:.3} s with G261 ({:.3}×), arc {:.3} s",
+        sharp.time_s,
+        round.time_s,
+        round.time_s / arc.time_s,
+        arc.time_s
+    );
+    assert!(round.time_s <= 1.1 * arc.time_s, "{}", round.time_s);
+    sharp.check.verdict().unwrap();
+    round.check.verdict().unwrap();
 }

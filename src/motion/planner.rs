@@ -55,6 +55,9 @@ pub const JUMP_MARGIN: f64 = 0.95;
 /// Share of its acceleration a line keeps whatever its junctions claim: a junction that would
 /// leave less is not passed at feed but with the fixed reserve.
 pub const PROFILE_FLOOR: f64 = 0.2;
+/// Share of the axes' full acceleration a contour blend may use for its centripetal
+/// acceleration; its tangential ramp gets √(1 − share²) of it.
+pub const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
 /// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
 /// window when a program is mostly assignments or M functions.
 const NON_MOTION_PER_BLOCK: usize = 4;
@@ -547,7 +550,9 @@ impl Planner {
     /// A silent motion entry (a contour blend) at the back of the window; it does not count
     /// towards the lookahead.
     fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
-        let kind = EntryKind::Move(Box::new(self.segment(mv)));
+        let mut seg = self.segment(mv);
+        self.blend_dynamics(&mut seg);
+        let kind = EntryKind::Move(Box::new(seg));
         self.window.push_back(Entry {
             info,
             kind,
@@ -759,6 +764,32 @@ impl Planner {
                 }
             }
         }
+    }
+
+    /// A contour blend is passed at what the axes allow: [`BLEND_CENTRIPETAL_SHARE`] of the
+    /// smallest moving axis' full acceleration for the centripetal part, the rest of the
+    /// vector for the tangential ramp (a programmed arc keeps the junction reserve and the
+    /// even split: it may be long and start or end at a corner). A blend is tangent to both
+    /// lines, so it needs no reserve of its own.
+    fn blend_dynamics(&self, seg: &mut Segment) {
+        let Some(c) = seg.mv.arc() else { return };
+        let min_accel = [c.a, c.b]
+            .iter()
+            .filter_map(|&i| self.axes[i].as_ref())
+            .map(|ax| ax.max_accel_mm_per_s2.max(1e-6))
+            .fold(f64::INFINITY, f64::min);
+        if !(min_accel.is_finite() && c.radius_mm > 0.0) {
+            return;
+        }
+        let share = BLEND_CENTRIPETAL_SHARE;
+        let v = (share * min_accel * c.radius_mm).sqrt();
+        let vmax = [c.a, c.b]
+            .iter()
+            .filter_map(|&i| self.axes[i].as_ref())
+            .map(|ax| ax.max_velocity_mm_per_min.max(1e-6) / 60.0)
+            .fold(f64::INFINITY, f64::min);
+        seg.limit_mm_per_s = v.min(vmax);
+        seg.accel_mm_per_s2 = (1.0 - share * share).sqrt() * min_accel;
     }
 
     /// Contouring: if the last motion block in the window ends in a corner it should blend
