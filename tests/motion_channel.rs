@@ -499,6 +499,27 @@ fn contoured_square_stays_within_the_deviation_and_does_not_stop_at_corners() {
     assert!(slowest < 1.0, "{slowest}");
 }
 
+#[test]
+fn a_flush_while_contouring_keeps_its_corner_sharp_and_the_others_blended() {
+    // Kernels since V2.10.1503.08 accept #FLUSH with polynomial contouring on and suppress
+    // the blend at the motion blocks around it (TF5200 "Flushing NC channel").
+    for flush in ["#FLUSH WAIT", "#FLUSH", "#FLUSH CONTINUE"] {
+        let s = Setup::new("", "");
+        let program = format!("G261\nG1 X50 F3000\nY50\n{flush}\nX0\nY0\nG260\nM30\n");
+        let (pos, _) = run_file(&s, "flush.nc", &program, 20_000);
+        let closest = |cx: f64, cy: f64| {
+            pos.iter()
+                .map(|p| (p[0] - cx).hypot(p[1] - cy))
+                .fold(f64::INFINITY, f64::min)
+        };
+        // The corner at the flush (50, 50) stays sharp (passed at the speed of a sharp corner,
+        // sampled within 1 µm); (50, 0) and (0, 50) are blended.
+        assert!(closest(50.0, 50.0) < 1e-3, "{flush}");
+        assert!(closest(50.0, 0.0) > 0.04, "{flush}");
+        assert!(closest(0.0, 50.0) > 0.04, "{flush}");
+    }
+}
+
 fn contoured_square(s: &Setup) {
     let program = "#CONTOUR MODE [DEV PATH_DEV=0.05]\nG261\nG1 X50 F3000\nY50\nX0\nY0\n\
                    G260\nM30\n";

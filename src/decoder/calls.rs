@@ -43,7 +43,10 @@ impl Decoder {
         match c {
             Command::Flush(kind) => {
                 if self.modal.cross_block_active() {
-                    return Err(DecodeError::new(codes::FLUSH_CROSS_BLOCK, "#FLUSH while a cross-block function is active (TRC, contouring, spline, HSC)"));
+                    return Err(DecodeError::new(
+                        codes::FLUSH_CROSS_BLOCK,
+                        "#FLUSH while a cross-block function is active (TRC, spline, HSC)",
+                    ));
                 }
                 self.emit(info, Action::Flush(*kind), false, io);
                 if *kind == FlushKind::Wait && self.search.is_none() {

@@ -75,7 +75,7 @@ pub const CACHE_FULL: u32 = 21562;
 pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
 /// File larger than `max_cache_size`.
 pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
-/// `#FLUSH` while a cross-block function (TRC, contouring, spline, HSC) is active.
+/// `#FLUSH` while a cross-block function (TRC, spline, HSC) is active.
 pub const FLUSH_CROSS_BLOCK: u32 = 21909;
 /// An array index outside the declared array (TF5200 diagnosis 21928).
 pub const ARRAY_INDEX_RANGE: u32 = 21928;

@@ -803,7 +803,9 @@ impl Planner {
                     at = Some(i);
                     break;
                 }
-                k if k.is_barrier() => return None,
+                // A flush of any kind suppresses the blend at the motion blocks around it
+                // (TF5200 "Flushing NC channel"), `#FLUSH CONTINUE` included.
+                k if k.is_barrier() || matches!(k, EntryKind::Flush(_)) => return None,
                 _ => {}
             }
         }
