@@ -734,3 +734,84 @@ fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
         c.errors()
     );
 }
+
+/// Run `program` to its end or its first error: the channel's errors and the largest |X|
+/// the axes reached.
+fn run_to_error(runtime: &str, program: &str) -> (Vec<ncchannel::channel::ErrorRecord>, f64) {
+    let s = Setup::new("", runtime);
+    s.write("params/tools.lis", "wz[1].radius 50000\n");
+    s.write("nc/lim.nc", program);
+    let mut c = s.channel();
+    c.start(&tick(0), "lim.nc").unwrap();
+    let mut x_max: f64 = 0.0;
+    for k in 1..200_000u64 {
+        c.step(&tick(k));
+        x_max = x_max.max(c.position()[0].abs());
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.state() != State::Active {
+            break;
+        }
+    }
+    (c.errors().to_vec(), x_max)
+}
+
+#[test]
+fn a_compensated_path_beyond_a_software_limit_is_21897_before_the_axis_gets_there() {
+    // Soft limit X ≤ 1000 (the default) and a 5 mm tool: the programmed points lie on the
+    // limit, the compensated outer corner around (1000, 0) would take X to 1005.
+    let program = "N1 G17 G41 D1 G01 X0 Y0 F1000\nN2 G01 X1000 Y0\nN3 G01 X1000 Y-100\n\
+                   N4 G40 G01 X900 Y-100\nM30\n";
+    let (errors, x_max) = run_to_error("", program);
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    let e = &errors[0];
+    assert_eq!(e.code, 21897, "{e:?}");
+    assert!(
+        e.msg.contains("axis X compensated path reaches 1005"),
+        "{}",
+        e.msg
+    );
+    assert_eq!(
+        (e.prog.as_deref(), e.line),
+        (Some("lim.nc"), Some(2)),
+        "{e:?}"
+    );
+    assert!(x_max <= 1000.0, "the axis reached {x_max}");
+    // The same contour with the limit out of reach runs to its end.
+    let wide = "[[axes]]\nname = \"X\"\nsoft_limit_max_mm = 1010.0\n[[axes]]\nname = \"Y\"\n";
+    let (errors, x_max) = run_to_error(wide, program);
+    assert!(errors.is_empty(), "{errors:?}");
+    assert!((x_max - 1005.0).abs() < 1e-6, "{x_max}");
+}
+
+#[test]
+fn an_axis_outside_its_limits_may_move_back_inside_but_not_further_out() {
+    // X starts at 0, below its lower limit 10.
+    let rt = "[[axes]]\nname = \"X\"\nsoft_limit_min_mm = 10.0\n[[axes]]\nname = \"Y\"\n";
+    let (errors, x_max) = run_to_error(rt, "G1 X20 F3000\nM30\n");
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(x_max, 20.0);
+    let (errors, _) = run_to_error(rt, "G1 X-5 F3000\nM30\n");
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(errors[0].code, 21897);
+    // The message names the end point that lies further out, not the start.
+    assert!(
+        errors[0]
+            .msg
+            .contains("axis X end point -5 mm, below the lower"),
+        "{}",
+        errors[0].msg
+    );
+}
+
+#[test]
+fn a_negative_dwell_is_refused_with_the_kernels_range_error() {
+    for (program, code) in [("G04 X-1\nM30\n", 20752), ("#TIME -0.5\nM30\n", 20751)] {
+        let (errors, _) = run_to_error("", program);
+        assert_eq!(errors.len(), 1, "{program}: {errors:?}");
+        assert_eq!(errors[0].code, code, "{program}: {errors:?}");
+        assert!(errors[0].msg.contains("µs"), "{}", errors[0].msg);
+    }
+    // Zero is a dwell of no time.
+    let (errors, _) = run_to_error("", "G04 X0\nM30\n");
+    assert!(errors.is_empty(), "{errors:?}");
+}

@@ -92,14 +92,8 @@ impl Decoder {
                     Value::Num(n) => *n,
                     Value::Expr(e) => self.eval(e)?,
                 };
-                self.emit(
-                    info,
-                    Action::Dwell {
-                        seconds: seconds.max(0.0),
-                    },
-                    false,
-                    io,
-                );
+                let seconds = super::words::dwell_seconds(seconds, codes::DWELL_RANGE_TIME)?;
+                self.emit(info, Action::Dwell { seconds }, false, io);
             }
             // Accepted without effect (lang::dialect): a block like any other.
             Command::Inert { .. } => self.emit(info, Action::None, false, io),

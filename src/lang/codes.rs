@@ -47,6 +47,10 @@ pub const UNEXPECTED_PROGRAM_END: u32 = 20377;
 pub const VARIABLE_MEMORY_FULL: u32 = 20967;
 /// An array with more indices than variables have (TF5200 diagnosis 20974).
 pub const TOO_MANY_INDICES: u32 = 20974;
+/// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis 20751.
+pub const DWELL_RANGE_TIME: u32 = 20751;
+/// G04 with a dwell time out of range (negative): TF5200 diagnosis 20752.
+pub const DWELL_RANGE_G04: u32 = 20752;
 /// Label defined twice in one program level.
 pub const LABEL_TWICE: u32 = 20836;
 /// `$GOTO` target not found.

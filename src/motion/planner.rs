@@ -37,6 +37,10 @@ use crate::queue::{
     Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
 };
 
+use crate::decoder::arc::outside_limits;
+use crate::decoder::SoftLimits;
+use crate::lang::codes;
+
 use super::interpolator::tangent;
 use super::spline::Spline;
 use super::trc::{Comp, PlanError};
@@ -254,8 +258,15 @@ pub struct Planner {
     comp_out: Vec<Move>,
     /// Tool radii by D number, mm.
     tool_radii: Vec<(u32, f64)>,
-    /// An error found while planning (compensation impossible), for the channel.
+    /// An error found while planning (compensation impossible, a software limit on the path
+    /// the axes follow), for the channel.
     error: Option<PlanError>,
+    /// Software limits per axis (the decoder's check, on the path after compensation,
+    /// contouring and splines).
+    soft_limits: [SoftLimits; MAX_AXES],
+    soft_enabled: [bool; MAX_AXES],
+    /// Program and line of the last block that entered the window with its event.
+    last_block: Option<(std::sync::Arc<str>, u32)>,
 }
 
 impl Planner {
@@ -271,6 +282,15 @@ impl Planner {
                 JUNCTION_ACCEL_SHARE * a.max_accel_mm_per_s2.max(1e-6)
             })
         });
+        let soft_limits = std::array::from_fn(|i| {
+            by_index[i]
+                .as_ref()
+                .map_or(SoftLimits::default(), |a: &AxisLimits| SoftLimits {
+                    min_mm: a.min_mm,
+                    max_mm: a.max_mm,
+                })
+        });
+        let soft_enabled = std::array::from_fn(|i| by_index[i].is_some());
         let lookahead = settings.lookahead_blocks.max(1);
         let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
         Planner {
@@ -295,6 +315,9 @@ impl Planner {
             error: None,
             reserve,
             cycle_s: 0.001,
+            soft_limits,
+            soft_enabled,
+            last_block: None,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -517,6 +540,12 @@ impl Planner {
     fn push_entry(&mut self, info: Option<BlockInfo>, kind: EntryKind, counted: bool) {
         let is_move = matches!(kind, EntryKind::Move(_));
         let counted = counted && is_move;
+        if let Some(i) = &info {
+            self.last_block = Some((i.prog.clone(), i.line));
+        }
+        if let EntryKind::Move(seg) = &kind {
+            self.check_limits(&seg.mv);
+        }
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
@@ -552,6 +581,7 @@ impl Planner {
     fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
         let mut seg = self.segment(mv);
         self.blend_dynamics(&mut seg);
+        self.check_limits(&seg.mv);
         let kind = EntryKind::Move(Box::new(seg));
         self.window.push_back(Entry {
             info,
@@ -693,6 +723,39 @@ impl Planner {
         while let Some(i) = self.comp_waiting.pop_front() {
             self.push_entry(i, EntryKind::Plain, false);
         }
+    }
+
+    /// Software limits on the path the axes follow (21897): a move entering the window —
+    /// compensated, a contour blend, a spline piece — that takes an axis beyond a limit
+    /// stops the channel before the axes get there (the window runs ahead of them). The
+    /// decoder checks the programmed end points; this catches what compensation, contouring
+    /// and splines add to them.
+    fn check_limits(&mut self, mv: &Move) {
+        if self.error.is_some() {
+            return;
+        }
+        let Some(b) = outside_limits(mv, &self.soft_limits, &self.soft_enabled) else {
+            return;
+        };
+        let path = if mv.path.comp != CompSide::Off {
+            "compensated path reaches"
+        } else if mv.path.spline.is_some() {
+            "spline reaches"
+        } else if mv.path.contour_dev_mm.is_some() && !b.at_end {
+            "contour reaches"
+        } else if b.at_end {
+            "end point"
+        } else {
+            "arc reaches"
+        };
+        self.error = Some(PlanError {
+            code: codes::SOFT_LIMIT,
+            msg: b.message(path),
+            block: self
+                .last_block
+                .as_ref()
+                .map(|(p, l)| (p.to_string(), u64::from(*l))),
+        });
     }
 
     /// The error compensation ran into, once.
