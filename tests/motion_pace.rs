@@ -276,3 +276,223 @@ fn coarse_chords_need_contouring_to_keep_the_pace() {
     sharp.check.verdict().unwrap();
     round.check.verdict().unwrap();
 }
+
+/// The slowest path velocity of two 40 mm lines at F6000 meeting at a kink of `deg`°, mm/s.
+fn kink_speed(deg: f64) -> f64 {
+    let mut q = BlockQueue::new(16);
+    let th = deg.to_radians();
+    let (a, b) = (p(0.0, 0.0), p(40.0, 0.0));
+    let c = p(40.0 + 40.0 * th.cos(), 40.0 * th.sin());
+    q.push(block(1, line(a, b, 6000.0, PathMode::default())));
+    q.push(block(2, line(b, c, 6000.0, PathMode::default())));
+    q.push(block(3, Action::End { m: 30 }));
+    let r = run(&mut q, a);
+    r.check.verdict().unwrap();
+    // Between leaving the start and arriving at the end: the slowest moment is the kink.
+    let first = r.velocities.iter().position(|v| *v > 99.0).unwrap();
+    let last = r.velocities.iter().rposition(|v| *v > 99.0).unwrap();
+    r.velocities[first..=last]
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn the_corner_speed_falls_with_the_kink_as_the_axes_allow() {
+    // a = 2000 mm/s², dt = 1 ms: a 1° kink near feed, 5° and more by the jump rule, 90° a
+    // stop. The rule's speed is monotone in the angle.
+    let speeds: Vec<f64> = [0.5, 1.0, 2.0, 5.0, 10.0, 45.0, 90.0]
+        .iter()
+        .map(|&d| kink_speed(d))
+        .collect();
+    println!("kink 0.5/1/2/5/10/45/90°: {speeds:.2?} mm/s");
+    assert!(speeds[0] >= 99.0 && speeds[1] >= 95.0, "{speeds:?}");
+    assert!(speeds.windows(2).all(|w| w[1] <= w[0] + 1e-9), "{speeds:?}");
+    assert!(speeds[6] <= 2.0, "{speeds:?}");
+}
+
+/// Regenerates the plots of docs/motion.md from runs on the shipped settings:
+/// `cargo test --release --test motion_pace -- --ignored docs_plots`.
+#[test]
+#[ignore = "writes docs/*.svg"]
+fn docs_plots() {
+    corner_speed_plot(Path::new("docs/corner_speed.svg"));
+    contour_corner_plot(Path::new("docs/contour_corner.svg"));
+}
+
+fn corner_speed_plot(out: &Path) {
+    use plotters::prelude::*;
+    let angles: Vec<f64> = (0..=40)
+        .map(|k| 0.1 * 900f64.powf(k as f64 / 40.0))
+        .collect();
+    let measured: Vec<(f64, f64)> = angles.iter().map(|&d| (d, kink_speed(d))).collect();
+    // The fixed-reserve rule this replaced: v·|Δtᵢ| ≤ 0.25·a·dt on the worse axis.
+    let reserve: Vec<(f64, f64)> = angles
+        .iter()
+        .map(|&d| {
+            let th: f64 = d.to_radians();
+            let jump = (1.0 - th.cos()).max(th.sin());
+            (d, (0.25 * 2000.0 * DT / jump).min(100.0))
+        })
+        .collect();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 500)).into_drawing_area();
+        root.fill(&WHITE).unwrap();
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Corner speed of two lines at F6000, shipped axes (a = 2000 mm/s², 1 ms cycle)",
+                ("sans-serif", 18),
+            )
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d((0.1f64..90f64).log_scale(), 0f64..110f64)
+            .unwrap();
+        chart
+            .configure_mesh()
+            .x_desc("direction change at the junction (°)")
+            .y_desc("slowest path velocity (mm/s)")
+            .draw()
+            .unwrap();
+        let blue = RGBColor(31, 95, 191);
+        chart
+            .draw_series(LineSeries::new(
+                measured.iter().copied(),
+                blue.stroke_width(2),
+            ))
+            .unwrap()
+            .label("each axis' acceleration over the cycle (measured)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue));
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(LineSeries::new(
+                reserve.iter().copied(),
+                grey.stroke_width(2),
+            ))
+            .unwrap()
+            .label("the fixed 25 % reserve it replaced")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .unwrap();
+        root.present().unwrap();
+    }
+    std::fs::write(out, svg).unwrap();
+}
+
+fn contour_corner_plot(out: &Path) {
+    use plotters::prelude::*;
+    let sharp = square(None);
+    let round = square(Some(DEFAULT_PATH_DEV_MM));
+    // Around the corner (100, 0), 1:1: a square window in mm on a square drawing area.
+    let (x0, x1, y0, y1) = (99.55, 100.15, -0.15, 0.45);
+    let near = |r: &Run| -> Vec<(f64, f64)> {
+        r.positions
+            .iter()
+            .filter(|q| q[0] >= x0 && q[0] <= x1 && q[1] >= y0 && q[1] <= y1)
+            .map(|q| (q[0], q[1]))
+            .collect()
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1100, 560)).into_drawing_area();
+        root.fill(&WHITE).unwrap();
+        let (left, right) = root.split_horizontally(560);
+        let build = |y1: f64| {
+            ChartBuilder::on(&left)
+                .caption("corner (100, 0) of the square, 1:1", ("sans-serif", 16))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .unwrap()
+        };
+        // 1:1: the Y range stretched to the plotting area's aspect (the same caption is
+        // drawn twice, in the same place).
+        let (w, h) = build(y1).plotting_area().dim_in_pixel();
+        let mut chart = build(y0 + (x1 - x0) * f64::from(h) / f64::from(w));
+        chart
+            .configure_mesh()
+            .x_desc("X (mm)")
+            .y_desc("Y (mm)")
+            .draw()
+            .unwrap();
+        let grey = RGBColor(150, 150, 150);
+        chart
+            .draw_series(LineSeries::new(near(&sharp), grey.stroke_width(2)))
+            .unwrap()
+            .label("programmed (G260: stops)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        let blue = RGBColor(31, 95, 191);
+        chart
+            .draw_series(
+                near(&round)
+                    .into_iter()
+                    .map(|q| Circle::new(q, 2, blue.filled())),
+            )
+            .unwrap()
+            .label("G261, one dot per 1 ms cycle")
+            .legend(move |(x, y)| Circle::new((x + 10, y), 3, blue.filled()));
+        let red = RGBColor(214, 39, 40);
+        let ring: Vec<(f64, f64)> = (0..=100)
+            .map(|k| {
+                let a = std::f64::consts::FRAC_PI_2 * (1.0 + k as f64 / 100.0);
+                (
+                    100.0 + DEFAULT_PATH_DEV_MM * a.cos(),
+                    DEFAULT_PATH_DEV_MM * a.sin().abs(),
+                )
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(ring, red.stroke_width(1)))
+            .unwrap()
+            .label("0.05 mm from the corner")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .unwrap();
+        // The path velocity over the first two sides.
+        let t_end = 4.5;
+        let mut v = ChartBuilder::on(&right)
+            .caption("path velocity, F3000", ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(50)
+            .build_cartesian_2d(0f64..t_end, 0f64..55f64)
+            .unwrap();
+        v.configure_mesh()
+            .x_desc("time (s)")
+            .y_desc("v (mm/s)")
+            .draw()
+            .unwrap();
+        for (r, colour, name) in [(&sharp, grey, "G260"), (&round, blue, "G261")] {
+            let pts: Vec<(f64, f64)> = r
+                .velocities
+                .iter()
+                .enumerate()
+                .map(|(k, v)| ((k + 1) as f64 * DT, *v))
+                .take_while(|(t, _)| *t <= t_end)
+                .collect();
+            v.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+                .unwrap()
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        }
+        v.configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .unwrap();
+        root.present().unwrap();
+    }
+    std::fs::write(out, svg).unwrap();
+}
