@@ -4,16 +4,13 @@
 //! acceleration on every tick within its limit.
 
 use std::path::Path;
-use std::sync::Arc;
 
 mod common;
 use common::limit_check::{LimitCheck, DEFAULT_EPS};
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
+use common::queued::{block, r50_circle};
 use ncchannel::motion::contour::DEFAULT_PATH_DEV_MM;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
-};
+use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Position};
 
 const DT: f64 = 0.001;
 
@@ -22,22 +19,6 @@ fn shipped() -> (Vec<AxisLimits>, PlannerSettings) {
     let config = ncchannel::params::load(Path::new("params/startup.lis")).unwrap();
     let s = ncchannel::setup::channel_settings(&config, &config.channels[0]).unwrap();
     (s.axes, s.planner)
-}
-
-fn block(line: u32, action: Action) -> QueuedBlock {
-    QueuedBlock {
-        info: BlockInfo {
-            prog: Arc::from("t.nc"),
-            line,
-            offset: 0,
-            counter: line as u64,
-            n: None,
-            text: None,
-            stream: false,
-        },
-        action,
-        silent: false,
-    }
 }
 
 fn p(x: f64, y: f64) -> Position {
@@ -101,30 +82,7 @@ fn circle(n: usize) -> Run {
 /// The same, the chords programmed with `path` (contouring).
 fn circle_with(n: usize, path: PathMode) -> Run {
     let mut q = BlockQueue::new(1_000_000);
-    let start = p(50.0, 0.0);
-    if n == 0 {
-        let spec = ArcSpec {
-            plane: Plane::Xy,
-            ijk: [Some(-50.0), Some(0.0), None],
-            radius: None,
-            cw: false,
-        };
-        let mv = arc_move(&spec, start, start, 6000.0, 1e-6).unwrap();
-        q.push(block(1, Action::Move(mv)));
-    } else {
-        let mut at = start;
-        for k in 1..=n {
-            let phi = std::f64::consts::TAU * k as f64 / n as f64;
-            let to = if k == n {
-                start
-            } else {
-                p(50.0 * phi.cos(), 50.0 * phi.sin())
-            };
-            q.push(block(k as u32, line(at, to, 6000.0, path)));
-            at = to;
-        }
-    }
-    q.push(block(n as u32 + 1, Action::End { m: 30 }));
+    let start = r50_circle(&mut q, n, path);
     let r = run(&mut q, start);
     assert_eq!(r.positions.last().copied(), Some(start));
     r
@@ -459,40 +417,51 @@ fn contour_corner_plot(out: &Path) {
             .border_style(BLACK)
             .draw()
             .unwrap();
-        // The path velocity over the first two sides.
-        let t_end = 4.5;
-        let mut v = ChartBuilder::on(&right)
-            .caption("path velocity, F3000", ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0f64..t_end, 0f64..55f64)
-            .unwrap();
-        v.configure_mesh()
-            .x_desc("time (s)")
-            .y_desc("v (mm/s)")
-            .draw()
-            .unwrap();
-        for (r, colour, name) in [(&sharp, grey, "G260"), (&round, blue, "G261")] {
-            let pts: Vec<(f64, f64)> = r
-                .velocities
-                .iter()
-                .enumerate()
-                .map(|(k, v)| ((k + 1) as f64 * DT, *v))
-                .take_while(|(t, _)| *t <= t_end)
-                .collect();
-            v.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
-                .unwrap()
-                .label(name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-        }
-        v.configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .unwrap();
+        velocity_panel(&right, &[(&sharp, grey, "G260"), (&round, blue, "G261")]);
         root.present().unwrap();
     }
     std::fs::write(out, svg).unwrap();
+}
+
+/// The path velocity of `runs` over the square's first two sides.
+fn velocity_panel(
+    area: &plotters::drawing::DrawingArea<
+        plotters::prelude::SVGBackend<'_>,
+        plotters::coord::Shift,
+    >,
+    runs: &[(&Run, plotters::style::RGBColor, &str)],
+) {
+    use plotters::prelude::*;
+    let t_end = 4.5;
+    let mut v = ChartBuilder::on(area)
+        .caption("path velocity, F3000", ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0f64..t_end, 0f64..55f64)
+        .unwrap();
+    v.configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("v (mm/s)")
+        .draw()
+        .unwrap();
+    for &(r, colour, name) in runs {
+        let pts: Vec<(f64, f64)> = r
+            .velocities
+            .iter()
+            .enumerate()
+            .map(|(k, v)| ((k + 1) as f64 * DT, *v))
+            .take_while(|(t, _)| *t <= t_end)
+            .collect();
+        v.draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+            .unwrap()
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+    }
+    v.configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .unwrap();
 }

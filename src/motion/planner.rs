@@ -1167,7 +1167,7 @@ impl Planner {
             let floor = PROFILE_FLOOR
                 * (prev.full_accel_mm_per_s2 * t_prev[k].abs())
                     .max(next.full_accel_mm_per_s2 * t_next[k].abs());
-            if !(need[k] + floor <= a) {
+            if !need[k].is_finite() || need[k] + floor > a {
                 return self.reserve;
             }
         }
