@@ -22,12 +22,15 @@
 //! lifts the plan without a stop.
 //!
 //! Junction rule. At a corner the direction jumps from t1 to t2 and each axis' velocity jumps
-//! by v·|t2ᵢ − t1ᵢ| within one tick. The planner reserves [`JUNCTION_ACCEL_SHARE`] of every
-//! axis' acceleration for these jumps and plans path acceleration with the rest, so
-//! v ≤ share·aᵢ·dt / |Δtᵢ| keeps the per-tick velocity change of every axis within aᵢ; when
+//! by v·|t2ᵢ − t1ᵢ| within one tick, on top of the tangential acceleration of the blocks on
+//! both sides. Each axis' budget for the jump is what those blocks leave of aᵢ, so
+//! v ≤ budgetᵢ·dt / |Δtᵢ| keeps the per-tick velocity change of every axis within aᵢ; when
 //! blocks are shorter than one tick's travel several corners fall into one tick, so also
-//! v² ≤ share·aᵢ·L / |Δtᵢ| (L the shorter of the two blocks), the polygon's own centripetal
-//! limit. Non-motion blocks between two moves do not break the junction; a dwell, the program
+//! v² ≤ budgetᵢ·L / |Δtᵢ| (L the shorter of the two blocks), the polygon's own centripetal
+//! limit. Between two lines the junction claims the budget passing it at feed takes, and the
+//! lines accelerate with the rest (`Planner::link`); next to an arc, for a corner that cannot
+//! be passed at feed, and with a corner filter, the budget is [`JUNCTION_ACCEL_SHARE`] of aᵢ.
+//! Non-motion blocks between two moves do not break the junction; a dwell, the program
 //! end, `#FLUSH` and `#FLUSH WAIT` do (the motion stops there).
 
 use std::collections::VecDeque;
@@ -94,7 +97,7 @@ pub struct Segment {
     /// Highest path velocity the axes allow on this block, whatever the override, mm/s.
     pub limit_mm_per_s: f64,
     /// Path acceleration limit the profile uses, mm/s²: on a line the axis limits less what
-    /// the junctions at its two ends claim ([`Planner::link`]).
+    /// the junctions at its two ends claim (`Planner::link`).
     pub accel_mm_per_s2: f64,
     /// Path acceleration with every axis' full limit projected on the block, mm/s².
     pub full_accel_mm_per_s2: f64,
