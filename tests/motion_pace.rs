@@ -205,7 +205,8 @@ fn the_contoured_square_rounds_its_corners_within_the_default_deviation_at_speed
         .map(|q| q[0].min(100.0 - q[0]).min(q[1]).min(100.0 - q[1]).abs())
         .fold(0.0, f64::max);
     assert!(off <= DEFAULT_PATH_DEV_MM, "{off}");
-    // A tangent arc of radius 0.1207 mm passed at 80 % of a = 2000 mm/s² centripetal.
+    // A tangent arc of radius 0.1207 mm passed at 80 % of 95 % of a = 2000 mm/s²
+    // centripetal: 13.5 mm/s.
     assert!(speeds.iter().all(|v| *v >= 13.0), "{speeds:?}");
     assert!(r.time_s < sharp.time_s);
     r.check.verdict().unwrap();
