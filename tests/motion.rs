@@ -2,9 +2,8 @@
 //! notes observed — planner release rules, the trapezoid timing, exact end points, hold,
 //! override, and the axis limits on every tick of a long random program.
 
-use std::sync::Arc;
-
 mod common;
+use common::queued::block;
 use common::random_path::{self, Rng};
 
 use common::limit_check::{LimitCheck, DEFAULT_EPS};
@@ -12,9 +11,7 @@ use ncchannel::decoder::arc::{ArcError, ArcSpec};
 use ncchannel::lang::block::FlushKind;
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
-};
+use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane, Position};
 
 /// The positional form reads best in these tables of cases.
 #[allow(clippy::too_many_arguments)]
@@ -56,26 +53,6 @@ fn axes(vmax_mm_per_min: f64, accel: f64) -> Vec<AxisLimits> {
             max_mm: 1000.0,
         })
         .collect()
-}
-
-fn info(line: u32) -> BlockInfo {
-    BlockInfo {
-        prog: Arc::from("t.nc"),
-        line,
-        offset: 0,
-        counter: line as u64,
-        n: None,
-        text: None,
-        stream: false,
-    }
-}
-
-fn block(line: u32, action: Action) -> QueuedBlock {
-    QueuedBlock {
-        info: info(line),
-        action,
-        silent: false,
-    }
 }
 
 fn line(start: Position, end: Position, feed: f64) -> Action {

@@ -3,17 +3,14 @@
 //! velocity, acceleration and jerk on every tick of random programs, the rest-to-rest time,
 //! polylines against the true arc, the memory effect's non-motion blocks.
 
-use std::sync::Arc;
-
 mod common;
+use common::queued::{block, r50_circle};
 use common::random_path::{self, Rng};
 
 use common::limit_check::{LimitCheck, FILTERED_EPS};
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Plane, Position,
-    QueuedBlock, SplineKind,
+    Action, BlockQueue, CompSide, Move, MoveKind, PathMode, Position, SplineKind,
 };
 
 const DT: f64 = 0.001;
@@ -36,22 +33,6 @@ fn settings(lookahead: usize, corner_ms: f64) -> PlannerSettings {
     PlannerSettings {
         lookahead_blocks: lookahead,
         corner_smoothing_s: corner_ms / 1000.0,
-    }
-}
-
-fn block(line: u32, action: Action) -> QueuedBlock {
-    QueuedBlock {
-        info: BlockInfo {
-            prog: Arc::from("t.nc"),
-            line,
-            offset: 0,
-            counter: line as u64,
-            n: None,
-            text: None,
-            stream: false,
-        },
-        action,
-        silent: false,
     }
 }
 
@@ -105,37 +86,8 @@ fn run_to_end(
 fn circle_time_s(n: usize, axes: &[AxisLimits], s: PlannerSettings) -> f64 {
     let mut m = Motion::with_planner(axes.to_vec(), s);
     let mut q = BlockQueue::new(1_000_000);
-    let start = p(50.0, 0.0, 0.0);
+    let start = r50_circle(&mut q, n, PathMode::default());
     m.set_position(start);
-    if n == 0 {
-        let mv = arc_move(
-            &ArcSpec {
-                plane: Plane::Xy,
-                ijk: [Some(-50.0), Some(0.0), None],
-                radius: None,
-                cw: false,
-            },
-            start,
-            start,
-            6000.0,
-            1e-6,
-        )
-        .unwrap();
-        q.push(block(1, Action::Move(mv)));
-    } else {
-        let mut at = start;
-        for k in 1..=n {
-            let phi = std::f64::consts::TAU * k as f64 / n as f64;
-            let to = if k == n {
-                start
-            } else {
-                p(50.0 * phi.cos(), 50.0 * phi.sin(), 0.0)
-            };
-            q.push(block(k as u32, line(at, to, 6000.0)));
-            at = to;
-        }
-    }
-    q.push(block(n as u32 + 1, Action::End { m: 30 }));
     let (ticks, positions) = run_to_end(&mut m, &mut q, None, 200_000);
     assert_eq!(positions.last().copied(), Some(start));
     ticks as f64 * DT

@@ -134,7 +134,9 @@ fn stream_resets_checksum_is_pinned() {
 }
 
 const PINNED_CHECKSUM: &str = "896073f112bf4710";
-const PINNED_TICKS: u64 = 185_498;
+/// 183,187 since the corner-speed rule takes each axis' acceleration over the cycle (small
+/// kinks passed near feed): the same blocks in the same order, 1.2 % fewer ticks.
+const PINNED_TICKS: u64 = 183_187;
 
 #[test]
 fn four_channels_stream_independently_in_one_cycle() {

@@ -217,6 +217,79 @@ pub fn extent(mv: &Move) -> (Position, Position) {
     (lo, hi)
 }
 
+/// How far a computed position may pass a software limit by rounding alone, mm: an arc's
+/// quadrant point computed as centre + radius may lie 1e-13 mm beyond an end point exactly
+/// on the limit, which is allowed (moving *to* a limit is). Far below the 0.1 µm resolution.
+const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
+
+/// The first axis `mv` takes outside its software limits (21897), if any.
+///
+/// An axis that starts outside its limits (after a reset there, or with limits changed) may
+/// move back inside: the bound on that side is its start, so it may not go further out but
+/// may return — otherwise such an axis could never move again.
+pub fn outside_limits(
+    mv: &Move,
+    limits: &[super::SoftLimits; MAX_AXES],
+    enabled: &[bool; MAX_AXES],
+) -> Option<LimitBreach> {
+    let (lo, hi) = extent(mv);
+    for (i, l) in limits.iter().enumerate() {
+        if !enabled[i] {
+            continue;
+        }
+        let min_mm = l.min_mm.min(mv.start[i]);
+        let max_mm = l.max_mm.max(mv.start[i]);
+        let (value_mm, below) = if lo[i] < min_mm - SOFT_LIMIT_SLACK_MM {
+            (lo[i], true)
+        } else if hi[i] > max_mm + SOFT_LIMIT_SLACK_MM {
+            (hi[i], false)
+        } else {
+            continue;
+        };
+        return Some(LimitBreach {
+            axis: i,
+            value_mm,
+            below,
+            at_end: value_mm == mv.end[i],
+            limits: *l,
+        });
+    }
+    None
+}
+
+/// Where a move leaves an axis' software limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LimitBreach {
+    /// Index into `AXIS_LETTERS`.
+    pub axis: usize,
+    /// The farthest value outside, mm.
+    pub value_mm: f64,
+    /// Below the lower limit (else above the upper).
+    pub below: bool,
+    /// The value is the move's end point (else a point on the way: an arc's extent).
+    pub at_end: bool,
+    pub limits: super::SoftLimits,
+}
+
+impl LimitBreach {
+    /// The 21897 text: `path` names what reaches the value ("end point", "arc reaches",
+    /// "compensated path reaches").
+    pub fn message(&self, path: &str) -> String {
+        format!(
+            "axis {} {path} {} mm, {} software limit (limits {} to {} mm)",
+            char::from(crate::queue::AXIS_LETTERS[self.axis]),
+            self.value_mm,
+            if self.below {
+                "below the lower"
+            } else {
+                "above the upper"
+            },
+            self.limits.min_mm,
+            self.limits.max_mm
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -172,7 +172,10 @@ impl Decoder {
         match c {
             Command::Flush(kind) => {
                 if self.modal.cross_block_active() {
-                    return Err(DecodeError::new(codes::FLUSH_CROSS_BLOCK, "#FLUSH while a cross-block function is active (TRC, contouring, spline, HSC)"));
+                    return Err(DecodeError::new(
+                        codes::FLUSH_CROSS_BLOCK,
+                        "#FLUSH while a cross-block function is active (TRC, spline, HSC)",
+                    ));
                 }
                 self.emit(info, Action::Flush(*kind), false, io);
                 if *kind == FlushKind::Wait && self.search.is_none() {
@@ -218,14 +221,8 @@ impl Decoder {
                     Value::Num(n) => *n,
                     Value::Expr(e) => self.eval(e)?,
                 };
-                self.emit(
-                    info,
-                    Action::Dwell {
-                        seconds: seconds.max(0.0),
-                    },
-                    false,
-                    io,
-                );
+                let seconds = super::words::dwell_seconds(seconds, codes::DWELL_RANGE_TIME)?;
+                self.emit(info, Action::Dwell { seconds }, false, io);
             }
             // Accepted without effect (lang::dialect): a block like any other.
             Command::Inert { .. } => self.emit(info, Action::None, false, io),

@@ -162,9 +162,11 @@ impl Modal {
         }
     }
 
-    /// A cross-block function that forbids `#FLUSH` (21909) is active.
+    /// A cross-block function that forbids `#FLUSH` (21909) is active: TRC, spline or HSC.
+    /// Polynomial contouring does not (kernels since V2.10.1503.08, TF5200 "Flushing NC
+    /// channel"): the motion suppresses the blend at the motion blocks around the flush.
     pub fn cross_block_active(&self) -> bool {
-        self.radius_comp != RadiusComp::Off || self.contouring || self.spline || self.hsc
+        self.radius_comp != RadiusComp::Off || self.spline || self.hsc
     }
 }
 

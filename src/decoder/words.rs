@@ -11,11 +11,6 @@
 use super::modal::FeedMode;
 use super::*;
 
-/// How far a computed position may pass a software limit by rounding alone, mm: an arc's
-/// quadrant point computed as centre + radius may lie 1e-13 mm beyond an end point exactly
-/// on the limit, which is allowed (moving *to* a limit is). Far below the 0.1 µm resolution.
-const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
-
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
 /// G functions one block may hold (a CAM header writes six or seven).
@@ -131,7 +126,7 @@ impl Decoder {
         let info = self.info(block, text, meta, io);
         let mut queued = false;
         if gs.dwell {
-            let seconds = w.dwell_s.unwrap_or(0.0).max(0.0);
+            let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
             self.emit(info.clone(), Action::Dwell { seconds }, false, io);
             queued = true;
         } else if gs.set_reference {
@@ -381,36 +376,19 @@ impl Decoder {
 
     /// Software limits: every axis's end point, and for an arc every point of the arc in
     /// its plane, inside `[min, max]` of runtime.toml, or the block is refused before any
-    /// of it moves — as a real kernel checks set positions in path preparation.
+    /// of it moves — as a real kernel checks set positions in path preparation. An axis that
+    /// starts outside may move back inside ([`arc::outside_limits`]).
     fn within_soft_limits(&self, mv: &Move) -> Res {
-        let (lo, hi) = arc::extent(mv);
-        for (i, limits) in self.settings.soft_limits_mm.iter().enumerate() {
-            if !self.settings.axes[i] {
-                continue;
-            }
-            let (value, bound) = if lo[i] < limits.min_mm - SOFT_LIMIT_SLACK_MM {
-                (lo[i], "below the lower")
-            } else if hi[i] > limits.max_mm + SOFT_LIMIT_SLACK_MM {
-                (hi[i], "above the upper")
-            } else {
-                continue;
-            };
-            let reach = if matches!(mv.kind, MoveKind::Arc { .. }) && value != mv.end[i] {
-                "arc reaches"
-            } else {
-                "end point"
-            };
-            return Err(DecodeError::new(
-                codes::SOFT_LIMIT,
-                format!(
-                    "axis {} {reach} {value} mm, {bound} software limit (limits {} to {} mm)",
-                    char::from(AXIS_LETTERS[i]),
-                    limits.min_mm,
-                    limits.max_mm
-                ),
-            ));
-        }
-        Ok(())
+        let Some(b) = arc::outside_limits(mv, &self.settings.soft_limits_mm, &self.settings.axes)
+        else {
+            return Ok(());
+        };
+        let reach = if matches!(mv.kind, MoveKind::Arc { .. }) && !b.at_end {
+            "arc reaches"
+        } else {
+            "end point"
+        };
+        Err(DecodeError::new(codes::SOFT_LIMIT, b.message(reach)))
     }
 
     /// Step 5: H functions are reported; M17/M29 return, M2/M30 end the program; a block
@@ -517,4 +495,18 @@ fn push_function(list: &mut [u32; MAX_FUNCTIONS], n: &mut usize, v: f64, letter:
     list[*n] = whole(v).unwrap_or(0);
     *n += 1;
     Ok(())
+}
+
+/// A programmed dwell time, s: refused when negative (`code`: 20752 after G04, 20751 after
+/// `#TIME`; TF5200 diagnosis "Dwell time is out of range of permissible values", whose
+/// parameters are the value and the limits in µs).
+pub(super) fn dwell_seconds(seconds: f64, code: u32) -> Result<f64, DecodeError> {
+    if seconds >= 0.0 {
+        return Ok(seconds);
+    }
+    let us = (seconds * 1e6).round();
+    Err(DecodeError::new(
+        code,
+        format!("dwell time {us} µs out of the permissible range (lower limit 0 µs)"),
+    ))
 }

@@ -47,6 +47,10 @@ pub const UNEXPECTED_PROGRAM_END: u32 = 20377;
 pub const VARIABLE_MEMORY_FULL: u32 = 20967;
 /// An array with more indices than variables have (TF5200 diagnosis 20974).
 pub const TOO_MANY_INDICES: u32 = 20974;
+/// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis 20751.
+pub const DWELL_RANGE_TIME: u32 = 20751;
+/// G04 with a dwell time out of range (negative): TF5200 diagnosis 20752.
+pub const DWELL_RANGE_G04: u32 = 20752;
 /// Label defined twice in one program level.
 pub const LABEL_TWICE: u32 = 20836;
 /// `$GOTO` target not found.
@@ -75,7 +79,7 @@ pub const CACHE_FULL: u32 = 21562;
 pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
 /// File larger than `max_cache_size`.
 pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
-/// `#FLUSH` while a cross-block function (TRC, contouring, spline, HSC) is active.
+/// `#FLUSH` while a cross-block function (TRC, spline, HSC) is active.
 pub const FLUSH_CROSS_BLOCK: u32 = 21909;
 /// An array index outside the declared array (TF5200 diagnosis 21928).
 pub const ARRAY_INDEX_RANGE: u32 = 21928;

@@ -362,6 +362,7 @@ impl Motion {
         self.filter.configure(self.dt_s);
         if !self.ended {
             self.planner.front_busy = self.front_started;
+            self.planner.set_cycle_s(self.dt_s);
             self.planner.take_from(queue);
             if let Some(e) = self.planner.take_error() {
                 notes.push(MotionNote::Error {
@@ -369,9 +370,13 @@ impl Motion {
                     msg: e.msg,
                     block: e.block,
                 });
+                // Nothing more moves: the channel stops on the error (a software limit is
+                // found before the axes reach it, and must stay so).
+                self.v_mm_per_s = 0.0;
+            } else {
+                self.planner.plan_if_needed(self.override_pct, self.dt_s);
+                self.execute(dt_s, notes);
             }
-            self.planner.plan_if_needed(self.override_pct, self.dt_s);
-            self.execute(dt_s, notes);
         } else {
             self.v_mm_per_s = 0.0;
         }

@@ -22,12 +22,15 @@
 //! lifts the plan without a stop.
 //!
 //! Junction rule. At a corner the direction jumps from t1 to t2 and each axis' velocity jumps
-//! by v·|t2ᵢ − t1ᵢ| within one tick. The planner reserves [`JUNCTION_ACCEL_SHARE`] of every
-//! axis' acceleration for these jumps and plans path acceleration with the rest, so
-//! v ≤ share·aᵢ·dt / |Δtᵢ| keeps the per-tick velocity change of every axis within aᵢ; when
+//! by v·|t2ᵢ − t1ᵢ| within one tick, on top of the tangential acceleration of the blocks on
+//! both sides. Each axis' budget for the jump is what those blocks leave of aᵢ, so
+//! v ≤ budgetᵢ·dt / |Δtᵢ| keeps the per-tick velocity change of every axis within aᵢ; when
 //! blocks are shorter than one tick's travel several corners fall into one tick, so also
-//! v² ≤ share·aᵢ·L / |Δtᵢ| (L the shorter of the two blocks), the polygon's own centripetal
-//! limit. Non-motion blocks between two moves do not break the junction; a dwell, the program
+//! v² ≤ budgetᵢ·L / |Δtᵢ| (L the shorter of the two blocks), the polygon's own centripetal
+//! limit. Between two lines the junction claims the budget passing it at feed takes, and the
+//! lines accelerate with the rest (`Planner::link`); next to an arc, for a corner that cannot
+//! be passed at feed, and with a corner filter, the budget is [`JUNCTION_ACCEL_SHARE`] of aᵢ.
+//! Non-motion blocks between two moves do not break the junction; a dwell, the program
 //! end, `#FLUSH` and `#FLUSH WAIT` do (the motion stops there).
 
 use std::collections::VecDeque;
@@ -36,6 +39,10 @@ use crate::lang::block::FlushKind;
 use crate::queue::{
     Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
 };
+
+use crate::decoder::arc::outside_limits;
+use crate::decoder::SoftLimits;
+use crate::lang::codes;
 
 use super::interpolator::tangent;
 use super::spline::Spline;
@@ -48,6 +55,20 @@ pub const JUNCTION_ACCEL_SHARE: f64 = 0.25;
 /// Share of the profile acceleration an arc may use for its centripetal acceleration; the
 /// tangential ramp gets √(1 − share²) of it, so both together stay within the limit.
 pub const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
+/// Share of a junction's budget its velocity jumps may use: the rest covers the neighbouring
+/// junctions when several fall into one cycle with unequal corners (the rule looks at the two
+/// blocks on each side of a junction only).
+pub const JUMP_MARGIN: f64 = 0.95;
+/// Share of its acceleration a line keeps whatever its junctions claim: a junction that would
+/// leave less is not passed at feed but with the fixed reserve.
+pub const PROFILE_FLOOR: f64 = 0.2;
+/// Share of the axes' full acceleration a contour blend may use for its centripetal
+/// acceleration; its tangential ramp gets √(1 − share²) of it.
+pub const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
+/// Share of the smallest moving axis' acceleration a contour blend uses in all: sampled once
+/// per cycle, a curve under centripetal and tangential acceleration at once shows slightly
+/// more than the vector's length (0.07 % measured at the full length).
+pub const BLEND_ACCEL_SHARE: f64 = 0.95;
 /// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
 /// window when a program is mostly assignments or M functions.
 const NON_MOTION_PER_BLOCK: usize = 4;
@@ -79,8 +100,14 @@ pub struct Segment {
     pub programmed_mm_per_s: f64,
     /// Highest path velocity the axes allow on this block, whatever the override, mm/s.
     pub limit_mm_per_s: f64,
-    /// Path acceleration limit, mm/s².
+    /// Path acceleration limit the profile uses, mm/s²: on a line the axis limits less what
+    /// the junctions at its two ends claim (`Planner::link`).
     pub accel_mm_per_s2: f64,
+    /// Path acceleration with every axis' full limit projected on the block, mm/s².
+    pub full_accel_mm_per_s2: f64,
+    /// Per axis, the acceleration the junction at this block's end claims for its velocity
+    /// jump, mm/s² (the default reserve until the next block is known).
+    pub end_claim_mm_per_s2: [f64; MAX_AXES],
     /// Junction with the previous motion block: `None` = the motion stops before this block.
     pub junction: Option<Junction>,
     /// Planned velocity at the block end, mm/s.
@@ -90,8 +117,16 @@ pub struct Segment {
 /// What limits the velocity at the start of a block coming from the previous one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Junction {
-    /// maxᵢ |Δtᵢ| / (share·aᵢ), s²/mm: velocity ≤ dt / k and ≤ √(L / k).
+    /// maxᵢ |Δtᵢ| / budgetᵢ, s²/mm: velocity ≤ dt / k and ≤ √(L / k).
     pub k_s2_per_mm: f64,
+    /// Per axis, the change of the unit tangent |t2ᵢ − t1ᵢ| (the velocity jump per mm/s).
+    pub jump: [f64; MAX_AXES],
+    /// Per axis, the previous block's tangential acceleration at the junction, mm/s².
+    pub prev_load_mm_per_s2: [f64; MAX_AXES],
+    /// Per axis, the acceleration this junction claims from the blocks on both sides, mm/s².
+    pub claim_mm_per_s2: [f64; MAX_AXES],
+    /// Both blocks are straight: the budget rule applies (else the fixed reserve).
+    pub straight: bool,
     /// The shorter of the two blocks, mm.
     pub short_mm: f64,
     /// The previous block's length, mm.
@@ -206,6 +241,10 @@ pub struct Planner {
     dirty: bool,
     /// Corner smoothing window, s (0 = off).
     corner_s: f64,
+    /// Per axis, the fixed junction reserve [`JUNCTION_ACCEL_SHARE`]·aᵢ, mm/s².
+    reserve: [f64; MAX_AXES],
+    /// Cycle time the junction claims are sized for, s.
+    cycle_s: f64,
     /// The front entry is executing (its geometry is fixed).
     pub front_busy: bool,
     /// The spline being built (G151), if any.
@@ -226,8 +265,15 @@ pub struct Planner {
     comp_out: Vec<Move>,
     /// Tool radii by D number, mm.
     tool_radii: Vec<(u32, f64)>,
-    /// An error found while planning (compensation impossible), for the channel.
+    /// An error found while planning (compensation impossible, a software limit on the path
+    /// the axes follow), for the channel.
     error: Option<PlanError>,
+    /// Software limits per axis (the decoder's check, on the path after compensation,
+    /// contouring and splines).
+    soft_limits: [SoftLimits; MAX_AXES],
+    soft_enabled: [bool; MAX_AXES],
+    /// Program and line of the last block that entered the window with its event.
+    last_block: Option<(std::sync::Arc<str>, u32)>,
 }
 
 impl Planner {
@@ -238,6 +284,20 @@ impl Planner {
                 by_index[a.index] = Some(a.clone());
             }
         }
+        let reserve = std::array::from_fn(|i| {
+            by_index[i].as_ref().map_or(0.0, |a: &AxisLimits| {
+                JUNCTION_ACCEL_SHARE * a.max_accel_mm_per_s2.max(1e-6)
+            })
+        });
+        let soft_limits = std::array::from_fn(|i| {
+            by_index[i]
+                .as_ref()
+                .map_or(SoftLimits::default(), |a: &AxisLimits| SoftLimits {
+                    min_mm: a.min_mm,
+                    max_mm: a.max_mm,
+                })
+        });
+        let soft_enabled = std::array::from_fn(|i| by_index[i].is_some());
         let lookahead = settings.lookahead_blocks.max(1);
         let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
         Planner {
@@ -260,6 +320,11 @@ impl Planner {
             comp_out: Vec::new(),
             tool_radii: Vec::new(),
             error: None,
+            reserve,
+            cycle_s: 0.001,
+            soft_limits,
+            soft_enabled,
+            last_block: None,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -277,7 +342,35 @@ impl Planner {
     pub fn set_corner_window_s(&mut self, corner_s: f64) {
         if corner_s != self.corner_s {
             self.corner_s = corner_s;
+            self.relink();
             self.dirty = true;
+        }
+    }
+
+    /// The cycle time junction claims are sized for, s.
+    pub fn set_cycle_s(&mut self, dt_s: f64) {
+        if dt_s > 0.0 && dt_s.is_finite() {
+            self.cycle_s = dt_s;
+        }
+    }
+
+    /// Every junction in the window afresh (the corner window changed: claims are made only
+    /// without one). The executing front keeps its acceleration.
+    fn relink(&mut self) {
+        let reserve = self.reserve;
+        for i in 0..self.window.len() {
+            if i == 0 && self.front_busy {
+                continue;
+            }
+            if let EntryKind::Move(seg) = &mut self.window[i].kind {
+                seg.end_claim_mm_per_s2 = reserve;
+                if is_straight(&seg.mv) {
+                    seg.accel_mm_per_s2 = seg.full_accel_mm_per_s2 * (1.0 - JUNCTION_ACCEL_SHARE);
+                }
+            }
+        }
+        for i in 0..self.window.len() {
+            self.link(i);
         }
     }
     pub fn len(&self) -> usize {
@@ -339,14 +432,7 @@ impl Planner {
     /// acceleration (no junction reserve: a lone line has no junction), mm/s², mm/s³
     /// (infinite: no jerk limit on any moving axis).
     pub fn line_limits(&self, seg: &Segment) -> (f64, f64) {
-        // A line's planned acceleration is the projected axis limits less the reserve
-        // (`segment`): the reserve given back.
-        let full = seg.accel_mm_per_s2 / (1.0 - JUNCTION_ACCEL_SHARE);
-        let accel = if full.is_finite() {
-            full
-        } else {
-            seg.accel_mm_per_s2
-        };
+        let accel = seg.full_accel_mm_per_s2;
         let t = tangent(&seg.mv, seg.length_mm, false);
         let mut jerk = f64::INFINITY;
         for (i, ti) in t.iter().enumerate() {
@@ -461,6 +547,12 @@ impl Planner {
     fn push_entry(&mut self, info: Option<BlockInfo>, kind: EntryKind, counted: bool) {
         let is_move = matches!(kind, EntryKind::Move(_));
         let counted = counted && is_move;
+        if let Some(i) = &info {
+            self.last_block = Some((i.prog.clone(), i.line));
+        }
+        if let EntryKind::Move(seg) = &kind {
+            self.check_limits(&seg.mv);
+        }
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
             EntryKind::Move(_) => self.release_next_move,
@@ -474,6 +566,9 @@ impl Planner {
             kind,
             counted,
         });
+        if is_move {
+            self.link(self.window.len() - 1);
+        }
         if counted {
             self.moves += 1;
         }
@@ -491,12 +586,16 @@ impl Planner {
     /// A silent motion entry (a contour blend) at the back of the window; it does not count
     /// towards the lookahead.
     fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
-        let kind = EntryKind::Move(Box::new(self.segment(mv)));
+        let mut seg = self.segment(mv);
+        self.blend_dynamics(&mut seg);
+        self.check_limits(&seg.mv);
+        let kind = EntryKind::Move(Box::new(seg));
         self.window.push_back(Entry {
             info,
             kind,
             counted: false,
         });
+        self.link(self.window.len() - 1);
     }
 
     /// A G1 point in spline mode: into the spline (a new one if the type changed), and the
@@ -633,6 +732,39 @@ impl Planner {
         }
     }
 
+    /// Software limits on the path the axes follow (21897): a move entering the window —
+    /// compensated, a contour blend, a spline piece — that takes an axis beyond a limit
+    /// stops the channel before the axes get there (the window runs ahead of them). The
+    /// decoder checks the programmed end points; this catches what compensation, contouring
+    /// and splines add to them.
+    fn check_limits(&mut self, mv: &Move) {
+        if self.error.is_some() {
+            return;
+        }
+        let Some(b) = outside_limits(mv, &self.soft_limits, &self.soft_enabled) else {
+            return;
+        };
+        let path = if mv.path.comp != CompSide::Off {
+            "compensated path reaches"
+        } else if mv.path.spline.is_some() {
+            "spline reaches"
+        } else if mv.path.contour_dev_mm.is_some() && !b.at_end {
+            "contour reaches"
+        } else if b.at_end {
+            "end point"
+        } else {
+            "arc reaches"
+        };
+        self.error = Some(PlanError {
+            code: codes::SOFT_LIMIT,
+            msg: b.message(path),
+            block: self
+                .last_block
+                .as_ref()
+                .map(|(p, l)| (p.to_string(), u64::from(*l))),
+        });
+    }
+
     /// The error compensation ran into, once.
     pub fn take_error(&mut self) -> Option<PlanError> {
         self.error.take()
@@ -704,6 +836,35 @@ impl Planner {
         }
     }
 
+    /// A contour blend is passed at what the axes allow: of the smallest moving axis' full
+    /// acceleration, what passing at feed takes for the centripetal part (at most
+    /// [`BLEND_CENTRIPETAL_SHARE`]), the rest of the vector for the tangential ramp (a programmed arc keeps the junction reserve and the
+    /// even split: it may be long and start or end at a corner). A blend is tangent to both
+    /// lines, so it needs no reserve of its own.
+    fn blend_dynamics(&self, seg: &mut Segment) {
+        let Some(c) = seg.mv.arc() else { return };
+        let min_accel = [c.a, c.b]
+            .iter()
+            .filter_map(|&i| self.axes[i].as_ref())
+            .map(|ax| BLEND_ACCEL_SHARE * ax.max_accel_mm_per_s2.max(1e-6))
+            .fold(f64::INFINITY, f64::min);
+        if !(min_accel.is_finite() && c.radius_mm > 0.0) {
+            return;
+        }
+        let vmax = [c.a, c.b]
+            .iter()
+            .filter_map(|&i| self.axes[i].as_ref())
+            .map(|ax| ax.max_velocity_mm_per_min.max(1e-6) / 60.0)
+            .fold(f64::INFINITY, f64::min);
+        // The centripetal share passing at feed takes (a blend of a nearly straight corner
+        // needs almost none and leaves the ramp nearly all), at most the constant.
+        let feed = seg.programmed_mm_per_s.min(vmax);
+        let share = (feed * feed / (c.radius_mm * min_accel)).min(BLEND_CENTRIPETAL_SHARE);
+        let v = (share * min_accel * c.radius_mm).sqrt();
+        seg.limit_mm_per_s = v.min(vmax);
+        seg.accel_mm_per_s2 = (1.0 - share * share).sqrt() * min_accel;
+    }
+
     /// Contouring: if the last motion block in the window ends in a corner it should blend
     /// (G261 / G61), shorten it and `next` and return the blend arc (see [`super::contour`]).
     /// The window's front is not changed once it executes.
@@ -715,7 +876,9 @@ impl Planner {
                     at = Some(i);
                     break;
                 }
-                k if k.is_barrier() => return None,
+                // A flush of any kind suppresses the blend at the motion blocks around it
+                // (TF5200 "Flushing NC channel"), `#FLUSH CONTINUE` included.
+                k if k.is_barrier() || matches!(k, EntryKind::Flush(_)) => return None,
                 _ => {}
             }
         }
@@ -843,7 +1006,7 @@ impl Planner {
             }
         }
         let mut limit = f64::INFINITY;
-        let mut accel = f64::INFINITY;
+        let mut full = f64::INFINITY;
         let mut rapid = f64::INFINITY;
         let mut min_accel = f64::INFINITY;
         for (i, s) in share.iter().enumerate() {
@@ -852,17 +1015,19 @@ impl Planner {
             }
             let Some(ax) = &self.axes[i] else { continue };
             let vmax = ax.max_velocity_mm_per_min.max(1e-6) / 60.0;
-            let amax = ax.max_accel_mm_per_s2.max(1e-6) * (1.0 - JUNCTION_ACCEL_SHARE);
+            let amax = ax.max_accel_mm_per_s2.max(1e-6);
             limit = limit.min(vmax / s);
             rapid = rapid.min(ax.rapid_mm_per_min.max(1e-6) / 60.0 / s);
-            accel = accel.min(amax / s);
+            full = full.min(amax / s);
             min_accel = min_accel.min(amax);
         }
+        let mut accel = full * (1.0 - JUNCTION_ACCEL_SHARE);
         if curvature > 0.0 && min_accel.is_finite() {
             // Centripetal v²·κ ≤ share·a; the tangential ramp gets the rest of the vector.
-            limit = limit.min((ARC_CENTRIPETAL_SHARE * min_accel / curvature).sqrt());
+            let reserve_accel = min_accel * (1.0 - JUNCTION_ACCEL_SHARE);
+            limit = limit.min((ARC_CENTRIPETAL_SHARE * reserve_accel / curvature).sqrt());
             let tangential = (1.0 - ARC_CENTRIPETAL_SHARE * ARC_CENTRIPETAL_SHARE).sqrt();
-            accel = accel.min(tangential * min_accel);
+            accel = accel.min(tangential * reserve_accel);
         }
         if !limit.is_finite() {
             // No configured axis moves (zero length, or an axis without limits): nothing to
@@ -872,54 +1037,207 @@ impl Planner {
         if !accel.is_finite() {
             accel = f64::MAX;
         }
+        if !full.is_finite() {
+            full = f64::MAX;
+        }
         let programmed = match mv.kind {
             MoveKind::Rapid => rapid.min(limit),
             _ => mv.feed_mm_per_min.max(0.0) / 60.0,
         };
-        let junction = self.junction_to(length_mm, &t0);
         Segment {
             mv,
             length_mm,
             programmed_mm_per_s: programmed,
             limit_mm_per_s: limit,
             accel_mm_per_s2: accel,
-            junction,
+            full_accel_mm_per_s2: full,
+            end_claim_mm_per_s2: self.reserve,
+            junction: None,
             exit_mm_per_s: 0.0,
         }
     }
 
-    /// The junction with the last motion block in the window, unless a barrier lies between.
-    fn junction_to(&self, length_mm: f64, t_next: &[f64; MAX_AXES]) -> Option<Junction> {
-        for e in self.window.iter().rev() {
-            match &e.kind {
-                EntryKind::Move(prev) => {
-                    if length_mm <= 0.0 || prev.length_mm <= 0.0 {
-                        return None;
-                    }
-                    let t_prev = tangent(&prev.mv, prev.length_mm, true);
-                    let mut k: f64 = 0.0;
-                    for i in 0..MAX_AXES {
-                        let d = (t_next[i] - t_prev[i]).abs();
-                        if d <= 1e-12 {
-                            continue;
-                        }
-                        let a = self.axes[i]
-                            .as_ref()
-                            .map_or(f64::INFINITY, |ax| ax.max_accel_mm_per_s2.max(1e-6));
-                        k = k.max(d / (JUNCTION_ACCEL_SHARE * a));
-                    }
-                    return Some(Junction {
-                        k_s2_per_mm: k,
-                        short_mm: length_mm.min(prev.length_mm),
-                        prev_length_mm: prev.length_mm,
-                        prev_programmed_mm_per_s: prev.programmed_mm_per_s,
-                        prev_limit_mm_per_s: prev.limit_mm_per_s,
-                    });
-                }
+    /// The last motion entry before window index `i`, unless a barrier lies between.
+    fn move_before(&self, i: usize) -> Option<usize> {
+        for j in (0..i).rev() {
+            match &self.window[j].kind {
+                EntryKind::Move(_) => return Some(j),
                 k if k.is_barrier() => return None,
                 _ => {}
             }
         }
         None
     }
+
+    /// Join the motion entry at window index `i` to the one before it (the corner-speed rule,
+    /// docs/motion.md "Corners").
+    ///
+    /// At the junction each axis' velocity jumps by v·|Δtᵢ| within one cycle, an acceleration
+    /// of v·|Δtᵢ| / dt on top of the tangential acceleration of the blocks on both sides. Each
+    /// axis' budget for the jump is what those blocks leave of aᵢ. Between two lines the
+    /// junction *claims* what it needs to be passed at the slower block's feed — v·|Δtᵢ| /
+    /// dt, or v²·|Δtᵢ| / L when several junctions fall into one cycle — if both blocks keep
+    /// at least [`PROFILE_FLOOR`] of their acceleration; the lines then accelerate with the
+    /// rest. A corner that cannot be passed at feed (a square's 90°) claims the fixed reserve
+    /// [`JUNCTION_ACCEL_SHARE`] and is passed at what it allows (nearly a stop). Next to an
+    /// arc, or with a corner filter, every junction uses the fixed reserve.
+    fn link(&mut self, i: usize) {
+        let Some(EntryKind::Move(next)) = self.window.get(i).map(|e| &e.kind) else {
+            return;
+        };
+        let Some(p) = self.move_before(i) else {
+            if let Some(EntryKind::Move(next)) = self.window.get_mut(i).map(|e| &mut e.kind) {
+                next.junction = None;
+            }
+            return;
+        };
+        let EntryKind::Move(prev) = &self.window[p].kind else {
+            return;
+        };
+        if next.length_mm <= 0.0 || prev.length_mm <= 0.0 {
+            if let EntryKind::Move(next) = &mut self.window[i].kind {
+                next.junction = None;
+            }
+            return;
+        }
+        let t_prev = tangent(&prev.mv, prev.length_mm, true);
+        let t_next = tangent(&next.mv, next.length_mm, false);
+        // The budget rule needs the jump to land within the cycle: with a corner filter the
+        // jumps are spread and bounded by the fixed reserve ([`Junction::smoothed_limit_mm_per_s`]).
+        let straight = is_straight(&prev.mv) && is_straight(&next.mv) && self.corner_s <= 0.0;
+        let short_mm = next.length_mm.min(prev.length_mm);
+        let mut jump = [0.0; MAX_AXES];
+        for (k, j) in jump.iter_mut().enumerate() {
+            let d = (t_next[k] - t_prev[k]).abs();
+            *j = if d <= 1e-12 { 0.0 } else { d };
+        }
+        let claim = if straight {
+            let v = prev.cruise_mm_per_s(100.0).min(next.cruise_mm_per_s(100.0));
+            self.claim(&jump, v, short_mm, (prev, &t_prev), (next, &t_next))
+        } else {
+            self.reserve
+        };
+        let prev_busy = p == 0 && self.front_busy;
+        let prev_start = tangent(&prev.mv, prev.length_mm, false);
+        let junction = Junction {
+            k_s2_per_mm: 0.0,
+            jump,
+            prev_load_mm_per_s2: [0.0; MAX_AXES],
+            claim_mm_per_s2: claim,
+            straight,
+            short_mm,
+            prev_length_mm: prev.length_mm,
+            prev_programmed_mm_per_s: prev.programmed_mm_per_s,
+            prev_limit_mm_per_s: prev.limit_mm_per_s,
+        };
+        // The previous block gives what this junction claims (unless it already runs).
+        let prev_accel = if let EntryKind::Move(prev) = &mut self.window[p].kind {
+            if !prev_busy && straight {
+                prev.end_claim_mm_per_s2 = claim;
+                let start = prev.junction.map_or([0.0; MAX_AXES], |j| j.claim_mm_per_s2);
+                prev.accel_mm_per_s2 = line_accel(&self.axes, prev, &prev_start, &start);
+                let a = prev.accel_mm_per_s2;
+                if let Some(j) = prev.junction.as_mut() {
+                    j.k_s2_per_mm = junction_k(&self.axes, j, a, &prev_start);
+                }
+            }
+            prev.accel_mm_per_s2
+        } else {
+            return;
+        };
+        let mut junction = junction;
+        for (k, l) in junction.prev_load_mm_per_s2.iter_mut().enumerate() {
+            *l = prev_accel * t_prev[k].abs();
+        }
+        if let EntryKind::Move(next) = &mut self.window[i].kind {
+            if straight {
+                next.accel_mm_per_s2 = line_accel(&self.axes, next, &t_next, &claim);
+            }
+            junction.k_s2_per_mm = junction_k(&self.axes, &junction, next.accel_mm_per_s2, &t_next);
+            next.junction = Some(junction);
+        }
+    }
+
+    /// What a junction between two lines claims per axis, mm/s²: what passing it at `v`
+    /// takes, if both lines keep [`PROFILE_FLOOR`] of their acceleration; else the reserve.
+    fn claim(
+        &self,
+        jump: &[f64; MAX_AXES],
+        v: f64,
+        short_mm: f64,
+        (prev, t_prev): (&Segment, &[f64; MAX_AXES]),
+        (next, t_next): (&Segment, &[f64; MAX_AXES]),
+    ) -> [f64; MAX_AXES] {
+        let per_s = (1.0 / self.cycle_s).max(v / short_mm);
+        let mut need = [0.0; MAX_AXES];
+        for k in 0..MAX_AXES {
+            let Some(ax) = &self.axes[k] else { continue };
+            let a = ax.max_accel_mm_per_s2.max(1e-6);
+            need[k] = v * jump[k] * per_s / JUMP_MARGIN;
+            let floor = PROFILE_FLOOR
+                * (prev.full_accel_mm_per_s2 * t_prev[k].abs())
+                    .max(next.full_accel_mm_per_s2 * t_next[k].abs());
+            if !need[k].is_finite() || need[k] + floor > a {
+                return self.reserve;
+            }
+        }
+        need
+    }
+}
+
+/// A line's path acceleration: every axis' limit less the larger claim of its two junctions,
+/// projected on the line, mm/s².
+fn line_accel(
+    axes: &[Option<AxisLimits>; MAX_AXES],
+    seg: &Segment,
+    t: &[f64; MAX_AXES],
+    start_claim: &[f64; MAX_AXES],
+) -> f64 {
+    let mut accel = f64::INFINITY;
+    for (k, tk) in t.iter().enumerate() {
+        let s = tk.abs();
+        if s <= 1e-12 {
+            continue;
+        }
+        let Some(ax) = &axes[k] else { continue };
+        let a = ax.max_accel_mm_per_s2.max(1e-6);
+        let left = a - start_claim[k].max(seg.end_claim_mm_per_s2[k]);
+        accel = accel.min(left.max(1e-6) / s);
+    }
+    if accel.is_finite() {
+        accel
+    } else {
+        seg.accel_mm_per_s2
+    }
+}
+
+/// A block whose tangent is the same along it (the budget rule's tangential load is exact).
+fn is_straight(mv: &Move) -> bool {
+    matches!(mv.kind, MoveKind::Line | MoveKind::Rapid)
+}
+
+/// k of a junction, s²/mm: maxᵢ |Δtᵢ| / budgetᵢ, the budget being what the blocks on both
+/// sides leave of aᵢ (`next_accel` along `t_next`), or the fixed reserve next to an arc.
+fn junction_k(
+    axes: &[Option<AxisLimits>; MAX_AXES],
+    j: &Junction,
+    next_accel: f64,
+    t_next: &[f64; MAX_AXES],
+) -> f64 {
+    let mut k: f64 = 0.0;
+    for i in 0..MAX_AXES {
+        if j.jump[i] <= 0.0 {
+            continue;
+        }
+        let a = axes[i]
+            .as_ref()
+            .map_or(f64::INFINITY, |ax| ax.max_accel_mm_per_s2.max(1e-6));
+        let budget = if j.straight {
+            JUMP_MARGIN * (a - j.prev_load_mm_per_s2[i].max(next_accel * t_next[i].abs()))
+        } else {
+            JUNCTION_ACCEL_SHARE * a
+        };
+        k = k.max(j.jump[i] / budget.max(1e-9 * a));
+    }
+    k
 }

@@ -316,4 +316,5 @@ pub fn run_client(
 }
 
 pub mod limit_check;
+pub mod queued;
 pub mod random_path;
