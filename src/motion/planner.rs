@@ -550,8 +550,12 @@ impl Planner {
         if let Some(i) = &info {
             self.last_block = Some((i.prog.clone(), i.line));
         }
+        // A programmed move was checked by the decoder with the same rule, and a contour
+        // trims it to a piece of itself; what compensation and splines make of it is new.
         if let EntryKind::Move(seg) = &kind {
-            self.check_limits(&seg.mv);
+            if seg.mv.path.comp != CompSide::Off || seg.mv.path.spline.is_some() {
+                self.check_limits(&seg.mv);
+            }
         }
         let release = match &kind {
             EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
