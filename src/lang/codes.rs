@@ -143,17 +143,19 @@ pub const ARRAY_INDEX_RANGE: u32 = 21928;
 /// `#FLUSH` while a spline (G151) is active (TF5200 diagnosis ID 120102 "Flushing buffers not
 /// allowed while spline interpolation is active.").
 pub const FLUSH_UNDER_SPLINE: u32 = 120102;
-/// `#FLUSH` while `#HSC` is on (TF5200 diagnosis ID 120434, HSC in its spline mode 2; ncchannel
-/// has no other HSC mode).
+/// `#FLUSH` while `#HSC` is on (TF5200 diagnosis ID 120434, for HSC in its spline mode 2;
+/// ncchannel does not tell the HSC modes apart).
 pub const FLUSH_UNDER_HSC: u32 = 120434;
 
-// ---- Error ids: ours, 900000–999999 (no kernel id with this meaning) ---------------------
+// ---- Error ids: ours, 900000–999999 (no kernel id with this meaning read) ----------------
 
-/// Expression: square root of a negative number.
+/// Expression: square root of a negative number. (The kernel's 20398 may mean this; its page
+/// was not in the index searched, so the id stays ours until it is read.)
 pub const EVAL_SQRT_NEGATIVE: u32 = 900002;
 /// Expression: ASIN/ACOS outside -1..1.
 pub const EVAL_OUT_OF_DOMAIN: u32 = 900003;
-/// Expression: undefined variable or parameter.
+/// Expression: undefined variable or parameter. (Candidates to read: the kernel's 20196; its
+/// 20925 "Unknown parameter." covers P parameters only.)
 pub const EVAL_UNDEFINED: u32 = 900005;
 /// Expression: invalid index (P[0.5], P[-1]).
 pub const EVAL_BAD_INDEX: u32 = 900006;
@@ -161,7 +163,7 @@ pub const EVAL_BAD_INDEX: u32 = 900006;
 pub const EVAL_NOT_FINITE: u32 = 900007;
 /// The streaming program is already running (called a second time).
 pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
-/// End of the main program's file without M30/M02.
+/// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
 pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
 pub const SUB_END_MISSING: u32 = 900104;
