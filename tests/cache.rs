@@ -235,7 +235,7 @@ fn cache_without_fct_use_cached_files_is_90160_naming_the_parameter() {
         "#CACHE CLEAR ALL",
     ] {
         let (code, msg, _) = failing(&rig, &format!("{cmd}\nG1 X10 F1000\nM30\n"));
-        assert_eq!(code, 90160, "{cmd}");
+        assert_eq!(code, 900160, "{cmd}");
         assert!(msg.contains("FCT_USE_CACHED_FILES"), "{msg}");
     }
     // Calls work as ever, from the file system.

@@ -88,29 +88,29 @@ fn streaming_program_is_virtual() {
 #[test]
 fn stray_control_statements_have_their_own_numbers() {
     let cases = [
-        ("$ELSE", 20211),
-        ("$ELSEIF P1", 20212),
-        ("$ENDIF", 20213),
-        ("$CASE 1", 20214),
-        ("$DEFAULT", 20215),
-        ("$BREAK", 20216),
-        ("$ENDSWITCH", 20217),
-        ("$ENDFOR", 20218),
-        ("$ENDWHILE", 20219),
-        ("$ENDDO P1", 20220),
-        ("$UNTIL P1", 20221),
-        ("$CONTINUE", 20222),
+        ("$ELSE", 20214),
+        ("$ELSEIF P1", 20216),
+        ("$ENDIF", 20218),
+        ("$CASE 1", 20221),
+        ("$DEFAULT", 20223),
+        ("$BREAK", 20243),
+        ("$ENDSWITCH", 20225),
+        ("$ENDFOR", 20232),
+        ("$ENDWHILE", 20237),
+        ("$ENDDO P1", 20240),
+        ("$UNTIL P1", 21469),
+        ("$CONTINUE", 20244),
     ];
     for (stmt, code) in cases {
         let text = format!("N10 G1 X1\nN20 {stmt}\nM30\n");
         assert_eq!(codes(&text), vec![(2, 5, code)], "{stmt}");
     }
     // Mismatched closers are stray too, and the opener stays open.
-    assert_eq!(codes("$IF P1\n$ENDFOR\n$ENDIF\n"), vec![(2, 1, 20218)]);
-    assert_eq!(codes("$IF P1\n$ELSE\n$ELSE\n$ENDIF\n"), vec![(3, 1, 20211)]);
+    assert_eq!(codes("$IF P1\n$ENDFOR\n$ENDIF\n"), vec![(2, 1, 20232)]);
+    assert_eq!(codes("$IF P1\n$ELSE\n$ELSE\n$ENDIF\n"), vec![(3, 1, 20214)]);
     assert_eq!(
         codes("$IF P1\n$ELSE\n$ELSEIF P2\n$ENDIF\n"),
-        vec![(3, 1, 20212)]
+        vec![(3, 1, 20216)]
     );
 }
 
@@ -165,7 +165,7 @@ fn open_blocks_at_program_end() {
     // Each program level closes its own blocks.
     assert_eq!(
         codes("%L SUB\n$SWITCH P1\nM17\n%main\n$ENDSWITCH\nM30\n"),
-        vec![(2, 1, 20375), (5, 1, 20217)]
+        vec![(2, 1, 20375), (5, 1, 20225)]
     );
     assert_eq!(codes("#VAR\nV.L.X = 1\n"), vec![(1, 1, 20375)]);
     assert_eq!(codes("G1 X1\n#COMMENT BEGIN\nM30\n"), vec![(2, 1, 20375)]);

@@ -140,6 +140,20 @@ fn file_errors(rig: &Rig, text: &str) -> Vec<u64> {
     r.error_codes()
 }
 
+/// `#FLUSH` is refused under each cross-block function with the kernel's id for it (TF5200
+/// diagnosis IDs 20651, 120102, 120434).
+#[test]
+fn flush_refusals_name_the_function() {
+    let rig = rig();
+    for (text, code) in [
+        ("G41 D1\nX1 F100\n#FLUSH\nM30\n", 20651),
+        ("G151\n#FLUSH\nM30\n", 120102),
+        ("#HSC ON [OPMODE 2]\n#FLUSH\nM30\n", 120434),
+    ] {
+        assert_eq!(stream_errors(&rig, text), [code], "{text:?}");
+    }
+}
+
 #[test]
 fn streaming_rules_have_their_error_numbers() {
     let rig = rig();
@@ -152,7 +166,7 @@ fn streaming_rules_have_their_error_numbers() {
         ("LL sub\nM30\n", 21479),
         ("N10 $GOTO N99\nN20 X1 F100\nM30\n", 20840),
         ("N10: X1 F100\nN10: X2\nM30\n", 20836),
-        ("N10 #FLUSH CONTINUE\nG41 D1\nX1 F100\n#FLUSH\nM30\n", 21909),
+        ("N10 #FLUSH CONTINUE\nG41 D1\nX1 F100\n#FLUSH\nM30\n", 20651),
     ] {
         assert_eq!(stream_errors(&rig, text), [code], "{text:?}");
     }
@@ -178,10 +192,10 @@ fn file_programs_may_loop_and_jump_back() {
 fn structure_errors_in_files() {
     let rig = rig();
     for (text, code) in [
-        ("$ENDIF\nM30\n", 20213),
-        ("$ELSE\nM30\n", 20211),
-        ("$CASE 1\nM30\n", 20214),
-        ("$ENDFOR\nM30\n", 20218),
+        ("$ENDIF\nM30\n", 20218),
+        ("$ELSE\nM30\n", 20214),
+        ("$CASE 1\nM30\n", 20221),
+        ("$ENDFOR\nM30\n", 20232),
         ("$IF 1\nX1 F100\nM30\n", 20375),
         ("M17\n", 20376),
         ("$GOTO [NOWHERE]\nM30\n", 20840),

@@ -257,8 +257,8 @@ fn each_dwell_form_dwells_its_time() {
 const REFUSED_BLOCKS: &[(&str, u32, u32)] = &[
     ("N10 G1 X1 X2 F100", codes::AXIS_TWICE, 11),
     ("G1 X1 Y2 Z3 Y4 F100", codes::AXIS_TWICE, 13),
-    ("S1000 M3 S1500", codes::WORD_TWICE, 10),
-    ("G1 X1 F100 F200", codes::WORD_TWICE, 12),
+    ("S1000 M3 S1500", codes::S_TWICE, 10),
+    ("G1 X1 F100 F200", codes::F_TWICE, 12),
     ("T1 D1 T2", codes::WORD_TWICE, 7),
     ("G2 X1 Y1 I1 I2 F100", codes::WORD_TWICE, 13),
     ("G04 Y2", codes::DWELL_NOT_ALONE, 5),

@@ -218,10 +218,10 @@ fn values_that_cannot_be_real_are_refused_in_check_and_run() {
         (format!("P1 = {nines}"), 20200),
         ("G02 X10 Y0 I1000000000000000000 F100".to_string(), 20020),
         ("G02 X1 Y0 R1000000 F100".to_string(), 20054),
-        ("T1.5".to_string(), 90132),
-        ("D-2".to_string(), 90132),
-        ("S-100".to_string(), 90132),
-        ("F-1".to_string(), 90132),
+        ("T1.5".to_string(), 900132),
+        ("D-2".to_string(), 900132),
+        ("S-100".to_string(), 900132),
+        ("F-1".to_string(), 900132),
     ] {
         let text = format!("{block}\nM30\n");
         assert_eq!(check_codes(&text), [code], "check {block:.40}");
@@ -235,8 +235,8 @@ fn values_that_cannot_be_real_are_refused_in_check_and_run() {
     for (block, code) in [
         ("P1 = 10 ** 300\nG02 X10 Y0 R[P1] F100", 20054),
         ("P1 = 10 ** 18\nG02 X10 Y0 I[P1] F100", 20020),
-        ("S[-5]", 90132),
-        ("T[1 / 3]", 90132),
+        ("S[-5]", 900132),
+        ("T[1 / 3]", 900132),
     ] {
         let text = format!("{block}\nM30\n");
         assert_eq!(

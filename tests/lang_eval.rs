@@ -123,17 +123,17 @@ fn function_syntax_errors() {
 
 #[test]
 fn evaluation_errors_have_numbers() {
-    assert_eq!(ev_err("1 / 0"), 90001);
-    assert_eq!(ev_err("1 MOD 0"), 90001);
-    assert_eq!(ev_err("SQRT[-1]"), 90002);
-    assert_eq!(ev_err("ACOS[1.5]"), 90003);
-    assert_eq!(ev_err("ASIN[-2]"), 90003);
-    assert_eq!(ev_err("LN[0]"), 90004);
-    assert_eq!(ev_err("P7 + 1"), 90005);
-    assert_eq!(ev_err("P[0.5]"), 90006);
-    assert_eq!(ev_err("P[-1]"), 90006);
-    assert_eq!(ev_err("EXP[1000]"), 90007);
-    assert_eq!(ev_err("TAN[90]"), 90007);
+    assert_eq!(ev_err("1 / 0"), 20396);
+    assert_eq!(ev_err("1 MOD 0"), 20396);
+    assert_eq!(ev_err("SQRT[-1]"), 900002);
+    assert_eq!(ev_err("ACOS[1.5]"), 900003);
+    assert_eq!(ev_err("ASIN[-2]"), 900003);
+    assert_eq!(ev_err("LN[0]"), 20399);
+    assert_eq!(ev_err("P7 + 1"), 900005);
+    assert_eq!(ev_err("P[0.5]"), 900006);
+    assert_eq!(ev_err("P[-1]"), 900006);
+    assert_eq!(ev_err("EXP[1000]"), 900007);
+    assert_eq!(ev_err("TAN[90]"), 900007);
     let e = parse_expr("V.L.MISSING").unwrap();
     let err = eval(&e, &Store::default()).unwrap_err();
     assert_eq!(err.to_string(), "undefined variable V.L.MISSING");

@@ -186,9 +186,9 @@ fn every_word_letter() {
         let b = p(&line);
         assert_eq!(words(&b).len(), 1, "{line}");
     }
-    // Tool and tool offset numbers are whole numbers (90132, value out of range).
-    assert_eq!(err("T2.5"), (90132, 1));
-    assert_eq!(err("X1 D-1"), (90132, 4));
+    // Tool and tool offset numbers are whole numbers (900132, value out of range).
+    assert_eq!(err("T2.5"), (900132, 1));
+    assert_eq!(err("X1 D-1"), (900132, 4));
     assert_eq!(err("Q5"), (20200, 1));
     assert_eq!(err("X10 O5"), (20200, 5));
     assert_eq!(err("X"), (20200, 2));
@@ -206,7 +206,7 @@ fn known_and_unknown_g_and_m() {
     assert_eq!(err("N10 G999 X1"), (20131, 5));
     assert_eq!(err("G1 G7"), (20131, 4));
     // ISG knows G5 (tangential TRC); ncchannel refuses it by name (lang::dialect).
-    assert_eq!(err("G1 G5"), (90133, 4));
+    assert_eq!(err("G1 G5"), (900133, 4));
     assert_eq!(err("G1.5"), (20131, 1));
     assert_eq!(err("G[P1]"), (20131, 1));
     for m in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 17, 29, 30, 10, 99] {
@@ -315,7 +315,9 @@ fn control_statements() {
     assert_eq!(err("$FOOBAR"), (20209, 1));
     assert_eq!(err("N10 $IF P1 G1"), (20200, 12));
     assert_eq!(err("N10 $ENDIF X1"), (20200, 12));
-    assert_eq!(err("X1 $ENDIF"), (20200, 4));
+    // A $ statement after other words: TF5200 diagnosis ID 20206.
+    assert_eq!(err("X1 $ENDIF"), (20206, 4));
+    assert_eq!(err("G1 X10 $IF P1 == 1"), (20206, 8));
     assert_eq!(err("$GOTO 40"), (20200, 7));
 }
 
@@ -376,7 +378,11 @@ fn hash_commands() {
     assert_eq!(err("#FOO"), (20209, 1));
     assert_eq!(err("N10 #NOSUCH [\"x\"]"), (20209, 5));
     assert_eq!(err("#FLUSH X1"), (20200, 8));
-    assert_eq!(err("G1 #FLUSH"), (20200, 4));
+    // A # command after other words: TF5200 diagnosis ID 20207, whose example this is.
+    assert_eq!(err("G1 #FLUSH"), (20207, 4));
+    assert_eq!(err("G1 X10 F100 #TIME 8.15"), (20207, 13));
+    // A call after other words stays the general syntax error.
+    assert_eq!(err("X1 L sub.nc"), (20200, 4));
 }
 
 #[test]

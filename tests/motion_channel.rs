@@ -247,7 +247,7 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
         c.step(&tick(k));
     }
     assert_eq!(c.state(), State::Error);
-    assert_eq!(c.last_error().unwrap().code, 90130);
+    assert_eq!(c.last_error().unwrap().code, 900130);
 }
 
 #[test]
@@ -623,14 +623,14 @@ fn streaming_spline_example_in_packets_passes_its_points_without_stopping() {
 }
 
 #[test]
-fn flush_inside_the_streaming_spline_is_21909() {
+fn flush_inside_the_streaming_spline_is_120102() {
     let s = Setup::new("", "");
     let text = streaming_spline_text().replace("N36345", "#FLUSH\r\nN36345");
     let (head, tail) = text.split_at(text.find("N36340").unwrap());
     let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
     assert_eq!(
         c.last_error().map(|e| e.code),
-        Some(21909),
+        Some(120102),
         "{:?}",
         c.errors()
     );
@@ -729,7 +729,7 @@ fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
     assert_eq!(c.state(), State::Error);
     assert_eq!(
         c.last_error().map(|e| e.code),
-        Some(90140),
+        Some(900140),
         "{:?}",
         c.errors()
     );

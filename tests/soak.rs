@@ -245,7 +245,7 @@ fn an_unexpected_error_is_a_violation_and_exit_1_an_expected_one_is_not() {
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(json["all_held"], false);
     assert_eq!(
-        json["channels"][0]["errors"]["90005"]
+        json["channels"][0]["errors"]["900005"]
             .as_u64()
             .map(|n| n > 0),
         Some(true)
@@ -253,7 +253,7 @@ fn an_unexpected_error_is_a_violation_and_exit_1_an_expected_one_is_not() {
     let ok = write_scenario(
         dir.path(),
         "ok.toml",
-        &format!("{body}[invariants]\nexpected_errors = [90005]\n"),
+        &format!("{body}[invariants]\nexpected_errors = [900005]\n"),
     );
     let (code, out) = soak_cli(&[ok.to_str().unwrap(), "-q"]);
     assert_eq!(code, 0, "{out}");

@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+use super::out::Stdout;
 use crate::report::stats::Histogram;
 use crate::runtime::{bare_loop, Clock, Runtime};
 use crate::soak::load::streaming_channels;
@@ -39,15 +40,15 @@ pub struct BenchArgs {
     pub plot: Option<PathBuf>,
 }
 
-fn print_hist(name: &str, h: &Histogram) {
-    println!(
+fn print_hist(out: &mut Stdout, name: &str, h: &Histogram) {
+    out.line(format_args!(
         "{name:<20} p50 {:>8.2}  p99 {:>8.2}  p99.9 {:>8.2}  max {:>9.2}  (n = {})",
         h.quantile_us(0.5),
         h.quantile_us(0.99),
         h.quantile_us(0.999),
         h.max_us(),
         h.count()
-    );
+    ));
 }
 
 pub fn execute(args: BenchArgs) -> ExitCode {
@@ -68,10 +69,11 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         .ceil()
         .max(1.0) as u64;
     let slices = (ticks / (1_000_000 / args.period_us).max(1)).clamp(1, 3600);
-    println!(
+    let mut out = Stdout::new();
+    out.line(format_args!(
         "bench: period {} µs, {} channels streaming, {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop, alternating in {slices} slices",
         args.period_us, args.channels
-    );
+    ));
     // Runtime and bare loop alternate in slices of about a second, so a change of load on a
     // shared machine (another build starting) hits both alike.
     let mut bare = Histogram::new();
@@ -86,18 +88,20 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     }
     let (cycle, stats) = rt.into_inner();
 
-    println!("all figures in µs");
-    print_hist("tick work", &stats.work);
-    print_hist("tick lateness", &stats.lateness);
-    print_hist("bare loop lateness", &bare);
+    out.line("all figures in µs");
+    print_hist(&mut out, "tick work", &stats.work);
+    print_hist(&mut out, "tick lateness", &stats.lateness);
+    print_hist(&mut out, "bare loop lateness", &bare);
     let bare_p99 = bare.quantile_us(0.99);
     let ratio = if bare_p99 > 0.0 {
         stats.lateness.quantile_us(0.99) / bare_p99
     } else {
         f64::NAN
     };
-    println!("overruns             {}", stats.overruns);
-    println!("lateness p99 ratio runtime / bare loop: {ratio:.2} (target ≤ 1.2)");
+    out.line(format_args!("overruns             {}", stats.overruns));
+    out.line(format_args!(
+        "lateness p99 ratio runtime / bare loop: {ratio:.2} (target ≤ 1.2)"
+    ));
     let blocks = cycle.total_blocks;
     let (mut ok, mut rejected, mut bytes) = (0, 0, 0);
     for s in &cycle.slots {
@@ -107,22 +111,27 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         bytes += c.bytes;
     }
     let wall = wall.as_secs_f64();
-    println!(
+    out.line(format_args!(
         "load: {blocks} blocks executed ({:.0}/s), {ok} writes ok, {rejected} rejected (buffer full), {:.1} MB streamed in {wall:.2} s",
         blocks as f64 / wall.max(1e-9),
         bytes as f64 / 1e6,
-    );
+    ));
     let t = &cycle.tallies;
     let violations = t.order.violations + t.errors.violations + t.limits.violations;
     if violations > 0 {
-        println!("invariant violations during the bench: {violations}");
+        out.line(format_args!(
+            "invariant violations during the bench: {violations}"
+        ));
     }
     if let Some(p) = &args.plot {
         let svg = crate::soak::plot::lateness_svg(&stats.lateness, &bare, period);
         if let Err(e) = std::fs::write(p, svg) {
             return usage(format!("--plot {}: {e}", p.display()));
         }
-        println!("histogram written to {}", p.display());
+        out.line(format_args!("histogram written to {}", p.display()));
+    }
+    if let Err(e) = out.finish() {
+        super::serve::report(format_args!("ncchannel bench: standard output: {e}"));
     }
     ExitCode::from(super::exit::OK)
 }

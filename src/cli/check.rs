@@ -47,8 +47,13 @@ pub fn execute(args: CheckArgs) -> ExitCode {
         .iter()
         .filter(|d| d.severity == Severity::Error)
         .count();
+    // A reader that stops early (`| head`) ends the findings, not the run (`super::out`).
+    let mut out = super::out::Stdout::new();
     for d in &diags {
-        println!("{}", d.render());
+        out.line(d.render());
+    }
+    if let Err(e) = out.finish() {
+        super::serve::report(format_args!("ncchannel check: standard output: {e}"));
     }
     for l in &summaries {
         eprintln!("ncchannel check: {l}");

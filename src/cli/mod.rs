@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod check;
 mod logger;
+pub mod out;
 pub mod receive;
 pub mod run;
 pub mod serve;

@@ -413,8 +413,11 @@ fn build_report(
 
 /// The event log written out, the report file and the human summary.
 fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) {
-    if let Err(e) = machine.finish_log() {
-        eprintln!("ncchannel run: event log: {e}");
+    // A reader of `--events -` or of the summary that went away (`| head`) is no error of
+    // the run (`super::out`).
+    match machine.finish_log() {
+        Err(e) if !super::out::reader_gone(&e) => eprintln!("ncchannel run: event log: {e}"),
+        _ => {}
     }
     if let Some(p) = &args.report {
         if let Err(e) = report.write_file(p) {
@@ -428,8 +431,9 @@ fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) {
     } else {
         report.print_human(&mut std::io::stdout())
     };
-    if let Err(e) = printed {
-        eprintln!("ncchannel run: summary: {e}");
+    match printed {
+        Err(e) if !super::out::reader_gone(&e) => eprintln!("ncchannel run: summary: {e}"),
+        _ => {}
     }
 }
 

@@ -34,7 +34,7 @@ pub enum ArcError {
 }
 
 impl ArcError {
-    /// The number reported: 20020 / 20054 / 20034 (TF5200 diagnosis list), 90130 (ours)
+    /// The number reported: 20020 / 20054 / 20034 (TF5200 diagnosis list), 900130 (ours)
     /// for an inconsistent circle.
     pub fn code(&self) -> u32 {
         match self {

@@ -171,10 +171,10 @@ impl Decoder {
         let info = self.info(block, text, meta, io);
         match c {
             Command::Flush(kind) => {
-                if self.modal.cross_block_active() {
+                if let Some((code, what)) = self.modal.flush_refusal() {
                     return Err(DecodeError::new(
-                        codes::FLUSH_CROSS_BLOCK,
-                        "#FLUSH while a cross-block function is active (TRC, spline, HSC)",
+                        code,
+                        format!("#FLUSH while {what} is active"),
                     ));
                 }
                 self.emit(info, Action::Flush(*kind), false, io);

@@ -696,7 +696,7 @@ impl Decoder {
 /// A whole number written as a float (`G01` parses as 1.0).
 pub(crate) use crate::lang::range::whole_u32 as whole;
 
-/// The variable store's refusal with its number (20967, 21928, 20974, 90005).
+/// The variable store's refusal with its number (20967, 21928, 20974, `codes::EVAL_UNDEFINED`).
 fn var_error(e: vars::VarError) -> DecodeError {
     DecodeError::new(e.code(), e.to_string())
 }

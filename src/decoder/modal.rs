@@ -162,11 +162,21 @@ impl Modal {
         }
     }
 
-    /// A cross-block function that forbids `#FLUSH` (21909) is active: TRC, spline or HSC.
-    /// Polynomial contouring does not (kernels since V2.10.1503.08, TF5200 "Flushing NC
-    /// channel"): the motion suppresses the blend at the motion blocks around the flush.
-    pub fn cross_block_active(&self) -> bool {
-        self.radius_comp != RadiusComp::Off || self.spline || self.hsc
+    /// The cross-block function that forbids `#FLUSH`, if one is active: its error id and
+    /// name. TRC, spline and HSC do (TF5200 diagnosis IDs 20651, 120102, 120434); polynomial
+    /// contouring does not (kernels since V2.10.1503.08, TF5200 "Flushing NC channel"): the
+    /// motion suppresses the blend at the motion blocks around the flush.
+    pub fn flush_refusal(&self) -> Option<(u32, &'static str)> {
+        use crate::lang::codes;
+        if self.radius_comp != RadiusComp::Off {
+            Some((codes::FLUSH_UNDER_TRC, "tool radius compensation"))
+        } else if self.spline {
+            Some((codes::FLUSH_UNDER_SPLINE, "spline interpolation"))
+        } else if self.hsc {
+            Some((codes::FLUSH_UNDER_HSC, "#HSC"))
+        } else {
+            None
+        }
     }
 }
 

@@ -106,7 +106,7 @@ pub enum VarError {
 
 impl VarError {
     /// 20967 memory used up, 21928 index outside the array, 20974 too many indices (TF5200
-    /// diagnosis list); an element of an undeclared array is undefined (90005).
+    /// diagnosis list); an element of an undeclared array is undefined (`codes::EVAL_UNDEFINED`).
     pub fn code(&self) -> u32 {
         match self {
             VarError::Full { .. } => VARIABLE_MEMORY_FULL,

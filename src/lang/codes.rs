@@ -1,138 +1,420 @@
-//! The NC language's fixed tables in one place: every error number the channel raises (ISG's
-//! and ours), known G and M functions, address letters and our assignment of the "unexpected
-//! control statement" numbers.
+//! The NC language's fixed tables in one place: every error id the channel raises, known G
+//! and M functions, address letters.
 //!
-//! The ISG numbers are those of the TF5200 diagnosis list (README, "Error numbers"). Where
-//! ISG gives only a range (20211–20245) or no number we know of, the numbers below are *our*
-//! assignment from the 9xxxx range, documented in the README, so that a client can still tell
-//! errors apart. No other file spells an error number: it names one of these.
+//! An id either means here what it means in the kernel's own error list (the TF5200
+//! diagnosis pages, "ID nnnnn", at infosys.beckhoff.com/content/1033/tf5200_diagnosis/) or it
+//! lies in 900000–999999, a range the kernel does not use (it uses 0–159999, 220000–319999,
+//! 400000–409999, 500000 and 1000000–1001851; 9xxxx holds its tool radius compensation
+//! errors). Our own ids are 900000 plus the last digits they had before they left 9xxxx
+//! (README "Error numbers"). [`EMITTED`] lists every id ncchannel can emit, [`KERNEL_TITLES`]
+//! the published title of each kernel id among them whose page was read and [`KERNEL_UNREAD`]
+//! the few whose page is still to be read; the test `every_emitted_id_is_the_kernels_or_ours`
+//! holds them together. No other file spells an error number: it names one of these.
 
-// ---- ISG numbers -----------------------------------------------------------------------
+// ---- Error ids: the kernel's (TF5200 diagnosis ID page cited) ---------------------------
 
-/// Warning: error writing the object (stream buffer full, write rejected).
+/// Warning: error writing the object (stream buffer full, write rejected): TF5200 diagnosis
+/// ID 11012.
 pub const WRITE_REJECTED: u32 = 11012;
-/// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis 20020).
+/// G1/G2/G3 with path feed 0: no F programmed, or G95 without a spindle speed (TF5200
+/// diagnosis ID 20008 "Feed rate in motion block is 0.").
+pub const NO_FEED: u32 = 20008;
+/// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
-/// centre undetermined (TF5200 diagnosis 20034).
+/// centre undetermined (TF5200 diagnosis ID 20034).
 pub const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
-/// The centre computed from R lies outside the data format (TF5200 diagnosis 20054, whose
+/// The centre computed from R lies outside the data format (TF5200 diagnosis ID 20054, whose
 /// example is `G02 X1 R1000000`).
 pub const ARC_RADIUS_RANGE: u32 = 20054;
-/// Unknown G function.
+/// Unknown G function (TF5200 diagnosis ID 20131).
 pub const UNKNOWN_G: u32 = 20131;
-/// Unknown M function.
+/// Unknown M function (TF5200 diagnosis ID 20157).
 pub const UNKNOWN_M: u32 = 20157;
-/// NC command or axis name expected: the general syntax error. Also used for a block
-/// longer than [`MAX_BLOCK_CHARS`] and for expressions nested deeper than the parser allows.
+/// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
+pub const F_TWICE: u32 = 20175;
+/// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",
+/// whose example is `S1000 M03 … S1500`).
+pub const S_TWICE: u32 = 20181;
+/// NC command or axis name expected: the general syntax error (TF5200 diagnosis ID 20200).
+/// Also used for a block longer than [`MAX_BLOCK_CHARS`] and for expressions nested deeper
+/// than the parser allows.
 pub const SYNTAX: u32 = 20200;
-/// An axis programmed twice in one block.
+/// An axis programmed twice in one block (TF5200 diagnosis ID 20203 "Double-programmed
+/// axis.").
 pub const AXIS_TWICE: u32 = 20203;
-/// Unknown `#` command.
+/// Unknown `#` command (TF5200 diagnosis ID 20209).
+/// A `$` statement with other words in its block (TF5200 diagnosis ID 20206 "$ command must
+/// be programmed exclusively in NC block.").
+pub const CONTROL_NOT_ALONE: u32 = 20206;
+/// A `#` command with other words before it in its block (TF5200 diagnosis ID 20207 "#
+/// command must be programmed exclusively in NC block.").
+pub const COMMAND_NOT_ALONE: u32 = 20207;
 pub const UNKNOWN_COMMAND: u32 = 20209;
-/// Main program not found.
+/// `$ELSE` without its `$IF` (TF5200 diagnosis ID 20214).
+pub const UNEXPECTED_ELSE: u32 = 20214;
+/// `$ELSEIF` without its `$IF` (TF5200 diagnosis ID 20216).
+pub const UNEXPECTED_ELSEIF: u32 = 20216;
+/// `$ENDIF` without its `$IF` (TF5200 diagnosis ID 20218).
+pub const UNEXPECTED_ENDIF: u32 = 20218;
+/// `$CASE` outside `$SWITCH` (TF5200 diagnosis ID 20221).
+pub const UNEXPECTED_CASE: u32 = 20221;
+/// `$DEFAULT` outside `$SWITCH` (TF5200 diagnosis ID 20223).
+pub const UNEXPECTED_DEFAULT: u32 = 20223;
+/// `$ENDSWITCH` without its `$SWITCH` (TF5200 diagnosis ID 20225).
+pub const UNEXPECTED_ENDSWITCH: u32 = 20225;
+/// `$ENDFOR` without its `$FOR` (TF5200 diagnosis ID 20232).
+pub const UNEXPECTED_ENDFOR: u32 = 20232;
+/// `$ENDWHILE` without its `$WHILE` (TF5200 diagnosis ID 20237).
+pub const UNEXPECTED_ENDWHILE: u32 = 20237;
+/// `$ENDDO` without its `$DO` (TF5200 diagnosis ID 20240; page not yet read, see
+/// [`KERNEL_UNREAD`]).
+pub const UNEXPECTED_ENDDO: u32 = 20240;
+/// `$BREAK` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20243).
+pub const UNEXPECTED_BREAK: u32 = 20243;
+/// `$CONTINUE` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20244).
+pub const UNEXPECTED_CONTINUE: u32 = 20244;
+/// `$UNTIL` without its `$REPEAT` (TF5200 diagnosis ID 21469; page not yet read, see
+/// [`KERNEL_UNREAD`]).
+pub const UNEXPECTED_UNTIL: u32 = 21469;
+/// Subroutine calls nested deeper than `decoder.max_subroutine_depth` (TF5200 diagnosis ID
+/// 20360 "Stack overflow for global sub-routines."; ncchannel counts local calls too).
+pub const NESTING_TOO_DEEP: u32 = 20360;
+/// Main program not found (TF5200 diagnosis ID 20368).
 pub const MAIN_NOT_FOUND: u32 = 20368;
-/// Global subroutine not found.
+/// Global subroutine not found (TF5200 diagnosis ID 20369).
 pub const SUBROUTINE_NOT_FOUND: u32 = 20369;
-/// Local subroutine not found.
+/// Local subroutine not found (TF5200 diagnosis ID 20373).
 pub const LOCAL_SUB_NOT_FOUND: u32 = 20373;
-/// Control blocks still open at program end.
+/// Control blocks still open at program end (TF5200 diagnosis ID 20375).
 pub const OPEN_CONTROL_BLOCK: u32 = 20375;
-/// M17/M29 where no subroutine runs.
+/// M17/M29 where no subroutine runs (TF5200 diagnosis ID 20376).
 pub const UNEXPECTED_SUB_END: u32 = 20376;
-/// M30/M02 inside a subroutine (a warning: the program ends).
+/// M30/M02 inside a subroutine, a warning: the program ends (TF5200 diagnosis ID 20377).
 pub const UNEXPECTED_PROGRAM_END: u32 = 20377;
-/// Memory for variables of one class (V.P., V.L., V.S., V.E.; ours adds P) used up: a
-/// declaration or a new variable does not fit (TF5200 diagnosis 20967).
-pub const VARIABLE_MEMORY_FULL: u32 = 20967;
-/// An array with more indices than variables have (TF5200 diagnosis 20974).
-pub const TOO_MANY_INDICES: u32 = 20974;
-/// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis 20751.
+/// Expression: division by zero, also `MOD 0` (TF5200 diagnosis ID 20396 "Division by 0.").
+pub const EVAL_DIVISION_BY_ZERO: u32 = 20396;
+/// Expression: LN/LOG of a number <= 0 (TF5200 diagnosis ID 20399 "Logarithm less
+/// than/equal 0.").
+pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
+/// `#FLUSH` while tool radius compensation G41/G42 is active (TF5200 diagnosis ID 20651 "NC
+/// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
+/// the flush right after G40 before a motion block, a state ncchannel does not have).
+pub const FLUSH_UNDER_TRC: u32 = 20651;
+/// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis ID 20751.
 pub const DWELL_RANGE_TIME: u32 = 20751;
-/// G04 with a dwell time out of range (negative): TF5200 diagnosis 20752.
+/// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
 pub const DWELL_RANGE_G04: u32 = 20752;
-/// Label defined twice in one program level.
+/// Label defined twice in one program level (TF5200 diagnosis ID 20836).
 pub const LABEL_TWICE: u32 = 20836;
-/// `$GOTO` target not found.
+/// `$GOTO` target not found (TF5200 diagnosis ID 20840).
 pub const LABEL_NOT_FOUND: u32 = 20840;
-/// Streaming data without a correct CR LF line end.
+/// Memory for variables of one class (V.P., V.L., V.S., V.E.; ours adds P) used up: a
+/// declaration or a new variable does not fit (TF5200 diagnosis ID 20967).
+pub const VARIABLE_MEMORY_FULL: u32 = 20967;
+/// An array with more indices than variables have (TF5200 diagnosis ID 20974).
+pub const TOO_MANY_INDICES: u32 = 20974;
+/// Streaming data without a correct CR LF line end (TF5200 diagnosis ID 21476).
 pub const NO_LINE_END: u32 = 21476;
-/// Backward jump in a streaming program.
+/// Backward jump in a streaming program (TF5200 diagnosis ID 21477).
 pub const STREAM_BACKWARD_JUMP: u32 = 21477;
-/// Loop statement in a streaming program.
+/// Loop statement in a streaming program (TF5200 diagnosis ID 21478).
 pub const STREAM_LOOP: u32 = 21478;
-/// Local subroutine call (LL) in a streaming program.
+/// Local subroutine call (LL) in a streaming program (TF5200 diagnosis ID 21479).
 pub const STREAM_LOCAL_CALL: u32 = 21479;
+/// Block search target not found (TF5200 diagnosis ID 21532).
+pub const SEARCH_NOT_FOUND: u32 = 21532;
+/// Invalid `#CACHE` programming (TF5200 diagnosis ID 21560).
+pub const CACHE_SYNTAX: u32 = 21560;
+/// Double programming inside one `#CACHE` command (TF5200 diagnosis ID 21561).
+pub const CACHE_DOUBLE: u32 = 21561;
+/// File cache full (TF5200 diagnosis ID 21562).
+pub const CACHE_FULL: u32 = 21562;
+/// File for the cache not found, or unreadable (TF5200 diagnosis ID 21563).
+pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
+/// File larger than `max_cache_size` (TF5200 diagnosis ID 21564).
+pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
 /// An axis end point (or an arc's extent) outside the axis's software limits: the block is
-/// refused before it moves (TF5200 diagnosis 21897 "Axis position is out of permissible
+/// refused before it moves (TF5200 diagnosis ID 21897 "Axis position is out of permissible
 /// value range", with the axis, the value and both limits).
 pub const SOFT_LIMIT: u32 = 21897;
-/// Block search target not found.
-pub const SEARCH_NOT_FOUND: u32 = 21532;
-/// Invalid `#CACHE` programming.
-pub const CACHE_SYNTAX: u32 = 21560;
-/// Double programming inside one `#CACHE` command.
-pub const CACHE_DOUBLE: u32 = 21561;
-/// File cache full.
-pub const CACHE_FULL: u32 = 21562;
-/// File for the cache not found (or unreadable).
-pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
-/// File larger than `max_cache_size`.
-pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
-/// `#FLUSH` while a cross-block function (TRC, spline, HSC) is active.
-pub const FLUSH_CROSS_BLOCK: u32 = 21909;
-/// An array index outside the declared array (TF5200 diagnosis 21928).
+/// An array index outside the declared array (TF5200 diagnosis ID 21928).
 pub const ARRAY_INDEX_RANGE: u32 = 21928;
+/// `#FLUSH` while a spline (G151) is active (TF5200 diagnosis ID 120102 "Flushing buffers not
+/// allowed while spline interpolation is active.").
+pub const FLUSH_UNDER_SPLINE: u32 = 120102;
+/// `#FLUSH` while `#HSC` is on (TF5200 diagnosis ID 120434, for HSC in its spline mode 2;
+/// ncchannel does not tell the HSC modes apart).
+pub const FLUSH_UNDER_HSC: u32 = 120434;
 
-// ---- Our numbers (no ISG number known) ---------------------------------------------------
+// ---- Error ids: ours, 900000–999999 (no kernel id with this meaning read) ----------------
 
-/// Expression: division by zero.
-pub const EVAL_DIVISION_BY_ZERO: u32 = 90001;
-/// Expression: square root of a negative number.
-pub const EVAL_SQRT_NEGATIVE: u32 = 90002;
+/// Expression: square root of a negative number. (The kernel's 20398 may mean this; its page
+/// was not in the index searched, so the id stays ours until it is read.)
+pub const EVAL_SQRT_NEGATIVE: u32 = 900002;
 /// Expression: ASIN/ACOS outside -1..1.
-pub const EVAL_OUT_OF_DOMAIN: u32 = 90003;
-/// Expression: LN/LOG of a non-positive number.
-pub const EVAL_LOG_NON_POSITIVE: u32 = 90004;
-/// Expression: undefined variable or parameter.
-pub const EVAL_UNDEFINED: u32 = 90005;
-/// Expression: invalid index.
-pub const EVAL_BAD_INDEX: u32 = 90006;
-/// Expression: result not finite.
-pub const EVAL_NOT_FINITE: u32 = 90007;
-/// Subroutine nesting deeper than the channel allows.
-pub const NESTING_TOO_DEEP: u32 = 90101;
+pub const EVAL_OUT_OF_DOMAIN: u32 = 900003;
+/// Expression: undefined variable or parameter. (Candidates to read: the kernel's 20196; its
+/// 20925 "Unknown parameter." covers P parameters only.)
+pub const EVAL_UNDEFINED: u32 = 900005;
+/// Expression: invalid index (P[0.5], P[-1]).
+pub const EVAL_BAD_INDEX: u32 = 900006;
+/// Expression: result not finite (`EXP[1000]`, `TAN[90]`).
+pub const EVAL_NOT_FINITE: u32 = 900007;
 /// The streaming program is already running (called a second time).
-pub const STREAM_ALREADY_ACTIVE: u32 = 90102;
-/// End of the main program's file without M30/M02.
-pub const MAIN_END_MISSING: u32 = 90103;
+pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
+/// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
+pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
-pub const SUB_END_MISSING: u32 = 90104;
+pub const SUB_END_MISSING: u32 = 900104;
 /// Program file larger than the store reads.
-pub const PROGRAM_TOO_LARGE: u32 = 90110;
+pub const PROGRAM_TOO_LARGE: u32 = 900110;
 /// Program file could not be read.
-pub const PROGRAM_UNREADABLE: u32 = 90111;
+pub const PROGRAM_UNREADABLE: u32 = 900111;
 /// Program name not allowed (absolute or leaving the search path).
-pub const PROGRAM_BAD_NAME: u32 = 90112;
+pub const PROGRAM_BAD_NAME: u32 = 900112;
 /// Circle end point, centre and radius do not agree.
-pub const ARC_INCONSISTENT: u32 = 90130;
-/// G1/G2/G3 without a programmed feed (or G95 without a spindle speed).
-pub const NO_FEED: u32 = 90131;
-/// A value out of range (negative feed, non-finite axis value, `$FOR` step 0, …).
-pub const BAD_VALUE: u32 = 90132;
+pub const ARC_INCONSISTENT: u32 = 900130;
+/// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
+/// whole number, …).
+pub const BAD_VALUE: u32 = 900132;
 /// A G function or `#` command of the ISG dialect that ncchannel does not model: refused
 /// by name rather than given a wrong meaning (docs/nc-language.md lists them).
-pub const UNSUPPORTED: u32 = 90133;
-/// A dwell (G04, `#TIME`) with other words in its block: it must stand alone.
-pub const DWELL_NOT_ALONE: u32 = 90134;
-/// A word other than an axis programmed twice in one block (F, S, T, D, I, J, K, R, E, or
-/// two G functions of one group): 20203's siblings, which ISG numbers we do not know.
-pub const WORD_TWICE: u32 = 90135;
+pub const UNSUPPORTED: u32 = 900133;
+/// A dwell (G04) with any other word in its block: refused. The kernel's TF5200 diagnosis ID
+/// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
+/// which the kernel goes on; ours refuses every word, so it keeps its own id.
+pub const DWELL_NOT_ALONE: u32 = 900134;
+/// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
+/// axis [`AXIS_TWICE`]).
+pub const WORD_TWICE: u32 = 900135;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
 /// elements do not meet, no tool data for the D word, or compensation outside G17.
-pub const TRC_IMPOSSIBLE: u32 = 90140;
+pub const TRC_IMPOSSIBLE: u32 = 900140;
 /// `#CACHE` while the file cache is disabled.
-pub const CACHE_NOT_ENABLED: u32 = 90160;
+pub const CACHE_NOT_ENABLED: u32 = 900160;
+
+// ---- End of the error ids ----------------------------------------------------------------
+
+/// The id for a word other than an axis programmed twice in one block.
+pub fn word_twice(letter: u8) -> u32 {
+    match letter.to_ascii_uppercase() {
+        b'F' => F_TWICE,
+        b'S' => S_TWICE,
+        _ => WORD_TWICE,
+    }
+}
+
+/// Every error id ncchannel can emit, with a short meaning: the constants above, once each.
+pub const EMITTED: &[(u32, &str)] = &[
+    (WRITE_REJECTED, "stream write rejected"),
+    (NO_FEED, "feed 0 in a motion block"),
+    (ARC_CENTER_RANGE, "circle centre outside the data format"),
+    (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
+    (ARC_RADIUS_RANGE, "centre from R outside the data format"),
+    (UNKNOWN_G, "unknown G function"),
+    (UNKNOWN_M, "unknown M function"),
+    (F_TWICE, "F twice in a block"),
+    (S_TWICE, "S twice in a block"),
+    (SYNTAX, "syntax"),
+    (AXIS_TWICE, "axis twice in a block"),
+    (CONTROL_NOT_ALONE, "$ statement not alone in its block"),
+    (COMMAND_NOT_ALONE, "# command not alone in its block"),
+    (UNKNOWN_COMMAND, "unknown # command"),
+    (UNEXPECTED_ELSE, "unexpected $ELSE"),
+    (UNEXPECTED_ELSEIF, "unexpected $ELSEIF"),
+    (UNEXPECTED_ENDIF, "unexpected $ENDIF"),
+    (UNEXPECTED_CASE, "unexpected $CASE"),
+    (UNEXPECTED_DEFAULT, "unexpected $DEFAULT"),
+    (UNEXPECTED_ENDSWITCH, "unexpected $ENDSWITCH"),
+    (UNEXPECTED_ENDFOR, "unexpected $ENDFOR"),
+    (UNEXPECTED_ENDWHILE, "unexpected $ENDWHILE"),
+    (UNEXPECTED_ENDDO, "unexpected $ENDDO"),
+    (UNEXPECTED_BREAK, "unexpected $BREAK"),
+    (UNEXPECTED_CONTINUE, "unexpected $CONTINUE"),
+    (UNEXPECTED_UNTIL, "unexpected $UNTIL"),
+    (NESTING_TOO_DEEP, "subroutine nesting too deep"),
+    (MAIN_NOT_FOUND, "main program not found"),
+    (SUBROUTINE_NOT_FOUND, "global subroutine not found"),
+    (LOCAL_SUB_NOT_FOUND, "local subroutine not found"),
+    (OPEN_CONTROL_BLOCK, "open control blocks at program end"),
+    (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
+    (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
+    (EVAL_DIVISION_BY_ZERO, "division by zero"),
+    (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
+    (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
+    (DWELL_RANGE_TIME, "#TIME out of range"),
+    (DWELL_RANGE_G04, "G04 time out of range"),
+    (LABEL_TWICE, "label defined twice"),
+    (LABEL_NOT_FOUND, "label not found"),
+    (VARIABLE_MEMORY_FULL, "variable memory full"),
+    (TOO_MANY_INDICES, "too many array indices"),
+    (NO_LINE_END, "stream: no CR LF"),
+    (STREAM_BACKWARD_JUMP, "stream: backward jump"),
+    (STREAM_LOOP, "stream: loop"),
+    (STREAM_LOCAL_CALL, "stream: LL call"),
+    (SEARCH_NOT_FOUND, "block search target not found"),
+    (CACHE_SYNTAX, "#CACHE invalid"),
+    (CACHE_DOUBLE, "#CACHE double programming"),
+    (CACHE_FULL, "file cache full"),
+    (CACHE_FILE_NOT_FOUND, "cache file not found"),
+    (CACHE_FILE_TOO_LARGE, "cache file too large"),
+    (SOFT_LIMIT, "beyond a software limit"),
+    (ARRAY_INDEX_RANGE, "array index outside the array"),
+    (FLUSH_UNDER_SPLINE, "#FLUSH under spline"),
+    (FLUSH_UNDER_HSC, "#FLUSH under #HSC"),
+    (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
+    (EVAL_OUT_OF_DOMAIN, "ASIN/ACOS outside -1..1"),
+    (EVAL_UNDEFINED, "undefined variable"),
+    (EVAL_BAD_INDEX, "invalid index"),
+    (EVAL_NOT_FINITE, "result not finite"),
+    (STREAM_ALREADY_ACTIVE, "streaming program already running"),
+    (MAIN_END_MISSING, "main program without M30/M02"),
+    (SUB_END_MISSING, "subroutine without M17/M29"),
+    (PROGRAM_TOO_LARGE, "program file too large"),
+    (PROGRAM_UNREADABLE, "program file unreadable"),
+    (PROGRAM_BAD_NAME, "program name leaves the search path"),
+    (ARC_INCONSISTENT, "circle inconsistent"),
+    (BAD_VALUE, "value out of range"),
+    (UNSUPPORTED, "dialect function refused by name"),
+    (DWELL_NOT_ALONE, "dwell not alone in its block"),
+    (WORD_TWICE, "T, D, I, J, K, R or E twice in a block"),
+    (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
+    (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
+];
+
+/// Our own ids: a range the kernel's list does not use.
+pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
+
+/// Kernel ids ncchannel emits whose diagnosis page was read, each with the title the page
+/// publishes and, in the comment, the page (infosys.beckhoff.com/content/1033/ +
+/// `tf5200_diagnosis/<n>.html` unless another manual is named). English titles; 20054's
+/// English page is not in the index searched, so its German title (content/1031/) stands.
+pub const KERNEL_TITLES: &[(u32, &str)] = &[
+    (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
+    (20008, "Feed rate in motion block is 0."), // 250515083
+    (
+        20020,
+        "Circle centre point parameter outside permissible data format.",
+    ), // 250558603
+    (
+        20034,
+        "Programming of a full circle with radius specification not possible.",
+    ), // 250602123
+    (
+        20054,
+        "Korrigierter Mittelpunkt außerhalb erlaubtem Datenformat.",
+    ), // 1031: 250663051
+    (20131, "Unknown G function"),       // named so on the page of ID 20107, 250784907
+    (20175, "Double-programmed F-word."), // 250998155
+    (20181, "Double-programmed spindle."), // 251019915
+    (20203, "Double-programmed axis."),  // 251085195
+    (
+        20206,
+        "$ command must be programmed exclusively in NC block.",
+    ), // 251093899
+    (
+        20207,
+        "# command must be programmed exclusively in NC block.",
+    ), // 251098251
+    (
+        20214,
+        "Unexpected ELSE. Does not match the current control block.",
+    ), // 251124363
+    (
+        20216,
+        "Unexpected ELSEIF. Does not match the current control block.",
+    ), // 251133067
+    (
+        20218,
+        "Unexpected ENDIF. Does not match the current control block.",
+    ), // 251141771
+    (
+        20221,
+        "Unexpected CASE. Does not match the current control block.",
+    ), // 251154827
+    (
+        20223,
+        "Unexpected DEFAULT. Does not match the current control block.",
+    ), // 251163531
+    (
+        20225,
+        "Unexpected ENDSWITCH. Does not match the current control block.",
+    ), // 251172235
+    (
+        20232,
+        "Unexpected ENDFOR. Does not match the current control block.",
+    ), // 251202699
+    (
+        20237,
+        "Unexpected ENDWHILE. Does not match the current control block.",
+    ), // 251224459
+    (20243, "Unexpected 'BREAK'. No valid/open control blocks."), // 251250571
+    (
+        20244,
+        "Unexpected 'CONTINUE'. No valid/open control blocks.",
+    ), // 251254923
+    (20360, "Stack overflow for global sub-routines."), // 251402891
+    (20375, "There are valid open control blocks at program end."), // 251459467
+    (20396, "Division by 0."),           // 251507339
+    (20399, "Logarithm less than/equal 0."), // 251520395
+    (20651, "NC command is not allowed during active TRC."), // 252112267
+    (20751, "Dwell time is out of range of permissible values."), // 252425611
+    (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (
+        20967,
+        "Memory for variables limited, allocation of new variable impossible.",
+    ), // 253126283
+    (20974, "Too many indices in variable array programmed."), // 253143691
+    (
+        21476,
+        "Streaming data does not contain a correct line end marker",
+    ), // tf5200_data_streaming/222589963
+    (21477, "Backward jump during streaming not allowed."), // 254836619
+    (21478, "Loop during streaming not allowed."), // 254840971
+    (
+        21479,
+        "Call of local subroutine during streaming not allowed.",
+    ), // 254845323
+    (21928, "Array index is out of data range."), // 256586123
+    (
+        120102,
+        "Flushing buffers not allowed while spline interpolation is active.",
+    ), // 264284811
+    (
+        120434,
+        "While HSC function is active with mode 2 flushing NC channel is not permitted.",
+    ), // 264720011
+];
+
+/// Kernel ids ncchannel emits whose diagnosis page the searched index did not return, with the
+/// meaning ncchannel gives them. All but two were assigned before the id table existed;
+/// 20240 and 21469 sit between pages that were read (20239 "'DO' must be programmed
+/// exclusively", 20241 "After 'ENDDO' only the condition is permissible"; 21470 "After
+/// 'UNTIL' only the condition is permissible"), in the kernel's pattern of "Unexpected X"
+/// before "X must be programmed exclusively". Each stays here until its page is read and it
+/// moves to [`KERNEL_TITLES`] (or, if it means something else, to our range).
+pub const KERNEL_UNREAD: &[(u32, &str)] = &[
+    (20157, "unknown M function"),
+    (20200, "NC command or axis name expected"),
+    (20209, "unknown # command or $ statement"),
+    (20240, "unexpected $ENDDO"),
+    (20368, "main program not found"),
+    (20369, "global subroutine not found"),
+    (20373, "local subroutine not found"),
+    (20376, "M17/M29 where no subroutine runs"),
+    (20377, "M30/M02 inside a subroutine"),
+    (20836, "label defined twice"),
+    (20840, "label not found"),
+    (21469, "unexpected $UNTIL"),
+    (21532, "block search target not found"),
+    (21560, "invalid #CACHE programming"),
+    (21561, "double programming in #CACHE"),
+    (21562, "file cache full"),
+    (21563, "cache file not found"),
+    (21564, "cache file too large"),
+    (21897, "axis position out of the permissible range"),
+];
 
 /// Longest block the parser accepts, in characters without the line end (TF5200 programming manual).
 pub const MAX_BLOCK_CHARS: usize = 4000;
@@ -231,22 +513,22 @@ pub enum StrayKind {
 }
 
 impl StrayKind {
-    /// Our assignment inside ISG's "unexpected control statement" range 20211–20245: one
-    /// number per statement so a log line says which statement was out of place.
+    /// The kernel's "unexpected control statement" id of this statement (TF5200 diagnosis
+    /// IDs 20214–20244 and 21469, one per statement).
     pub fn code(self) -> u32 {
         match self {
-            StrayKind::Else => 20211,
-            StrayKind::ElseIf => 20212,
-            StrayKind::EndIf => 20213,
-            StrayKind::Case => 20214,
-            StrayKind::Default => 20215,
-            StrayKind::Break => 20216,
-            StrayKind::EndSwitch => 20217,
-            StrayKind::EndFor => 20218,
-            StrayKind::EndWhile => 20219,
-            StrayKind::EndDo => 20220,
-            StrayKind::Until => 20221,
-            StrayKind::Continue => 20222,
+            StrayKind::Else => UNEXPECTED_ELSE,
+            StrayKind::ElseIf => UNEXPECTED_ELSEIF,
+            StrayKind::EndIf => UNEXPECTED_ENDIF,
+            StrayKind::Case => UNEXPECTED_CASE,
+            StrayKind::Default => UNEXPECTED_DEFAULT,
+            StrayKind::Break => UNEXPECTED_BREAK,
+            StrayKind::EndSwitch => UNEXPECTED_ENDSWITCH,
+            StrayKind::EndFor => UNEXPECTED_ENDFOR,
+            StrayKind::EndWhile => UNEXPECTED_ENDWHILE,
+            StrayKind::EndDo => UNEXPECTED_ENDDO,
+            StrayKind::Until => UNEXPECTED_UNTIL,
+            StrayKind::Continue => UNEXPECTED_CONTINUE,
         }
     }
 
@@ -295,16 +577,103 @@ mod tests {
     }
 
     #[test]
-    fn stray_codes_are_distinct_and_in_isg_range() {
+    fn stray_codes_are_distinct_and_the_kernels() {
         use StrayKind::*;
         let all = [
             Else, ElseIf, EndIf, Case, Default, Break, EndSwitch, EndFor, EndWhile, EndDo, Until,
             Continue,
         ];
         let mut codes: Vec<u32> = all.iter().map(|k| k.code()).collect();
-        assert!(codes.iter().all(|c| (20211..=20245).contains(c)));
-        codes.sort();
+        for (k, c) in all.iter().zip(&codes) {
+            let word = k.keyword().trim_start_matches('$');
+            let title = KERNEL_TITLES
+                .iter()
+                .chain(KERNEL_UNREAD)
+                .find(|(id, _)| id == c)
+                .map(|(_, t)| t.to_ascii_uppercase());
+            assert!(
+                title.as_deref().is_some_and(|t| t.contains(word)),
+                "{} is {c}, whose kernel meaning is {title:?}",
+                k.keyword()
+            );
+        }
+        codes.sort_unstable();
         codes.dedup();
         assert_eq!(codes.len(), all.len());
+    }
+
+    /// Every id ncchannel emits is a kernel id whose meaning is recorded (with its published
+    /// title where the page was read), or lies in our range; no id is listed twice.
+    #[test]
+    fn every_emitted_id_is_the_kernels_or_ours() {
+        let mut ids: Vec<u32> = EMITTED.iter().map(|(id, _)| *id).collect();
+        for (id, meaning) in EMITTED {
+            let read = KERNEL_TITLES.iter().any(|(k, _)| k == id);
+            let unread = KERNEL_UNREAD.iter().any(|(k, _)| k == id);
+            let ours = OURS.contains(id);
+            assert_eq!(
+                u8::from(read) + u8::from(unread) + u8::from(ours),
+                1,
+                "{id} ({meaning}): read {read}, unread {unread}, ours {ours}"
+            );
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        assert_eq!(ids.len(), EMITTED.len(), "an id is listed twice");
+        for (k, title) in KERNEL_TITLES.iter().chain(KERNEL_UNREAD) {
+            assert!(!title.is_empty(), "{k}");
+            assert!(
+                ids.binary_search(k).is_ok(),
+                "{k} is recorded but never emitted"
+            );
+        }
+    }
+
+    /// The ids whose page is still to be read: a new one is a deliberate change of this list.
+    #[test]
+    fn unread_kernel_ids_are_the_known_few() {
+        let unread: Vec<u32> = KERNEL_UNREAD.iter().map(|(id, _)| *id).collect();
+        assert_eq!(
+            unread,
+            [
+                20157, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20836, 20840, 21469,
+                21532, 21560, 21561, 21562, 21563, 21564, 21897
+            ]
+        );
+    }
+
+    /// [`EMITTED`] holds every error id constant this file declares, read from its text.
+    #[test]
+    fn every_error_constant_is_in_the_table() {
+        let text = include_str!("codes.rs");
+        let start = text.find("// ---- Error ids").expect("start marker");
+        let end = text
+            .find("// ---- End of the error ids")
+            .expect("end marker");
+        let mut seen = 0;
+        for line in text[start..end].lines() {
+            let Some(rest) = line.strip_prefix("pub const ") else {
+                continue;
+            };
+            let (name, value) = rest.split_once(": u32 = ").expect("a u32 constant");
+            let value: u32 = value.trim_end_matches(';').parse().expect("a number");
+            assert!(
+                EMITTED.iter().any(|(id, _)| *id == value),
+                "{name} = {value} missing from EMITTED"
+            );
+            seen += 1;
+        }
+        assert_eq!(
+            seen,
+            EMITTED.len(),
+            "EMITTED lists an id no constant declares"
+        );
+    }
+
+    #[test]
+    fn word_twice_names_f_and_s_by_the_kernels_ids() {
+        assert_eq!(word_twice(b'F'), F_TWICE);
+        assert_eq!(word_twice(b's'), S_TWICE);
+        assert_eq!(word_twice(b'T'), WORD_TWICE);
     }
 }

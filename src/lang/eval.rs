@@ -6,8 +6,9 @@
 //! is 45. Logical operators take any value with |v| ≥ 0.5 as true and give 1 or 0; bitwise
 //! operators work on the values rounded to 64-bit integers (`INV 0` is -1).
 //!
-//! ISG's own numbers for evaluation errors are not in our sources, so they come from our
-//! documented range 90001–90099 (README "NC language").
+//! Evaluation errors carry the kernel's id where its list has one with the same meaning
+//! (division by 0, square root of a negative number, logarithm <= 0), ours from 900000–999999
+//! otherwise; both are in `super::codes`.
 
 use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
 
@@ -77,9 +78,7 @@ pub enum EvalError {
 }
 
 impl EvalError {
-    /// Our numbers (ISG's are unknown to us): 90001 division by zero, 90002 square root of a
-    /// negative number, 90003 ASIN/ACOS outside -1..1, 90004 LN/LOG of a non-positive number,
-    /// 90005 undefined variable, 90006 invalid index, 90007 result not finite.
+    /// The error id (`super::codes`, README "Error numbers").
     pub fn code(&self) -> u32 {
         use super::codes;
         match self {

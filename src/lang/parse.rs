@@ -13,10 +13,10 @@ use super::block::{
     Value, VarDecl, VarRef, Word,
 };
 use super::codes::{
-    is_known_g, is_known_m, is_word_letter, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
-    DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, SYNTAX,
-    TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
-    WORD_TWICE,
+    is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
+    COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, SYNTAX, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G,
+    UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -333,15 +333,21 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             });
             i = r;
         } else {
-            let msg = match b {
-                b'#' => "a # command must stand alone in its block",
-                b'$' => "a $ statement must stand alone in its block",
-                b'%' => "a program head must stand alone in its block",
-                b'N' | b'n' => "the block number must come first in the block",
-                b'L' | b'l' => "a call must stand alone in its block",
-                _ => "NC command or axis name expected",
+            let (code, msg) = match b {
+                b'#' => (
+                    COMMAND_NOT_ALONE,
+                    "a # command must stand alone in its block",
+                ),
+                b'$' => (
+                    CONTROL_NOT_ALONE,
+                    "a $ statement must stand alone in its block",
+                ),
+                b'%' => (SYNTAX, "a program head must stand alone in its block"),
+                b'N' | b'n' => (SYNTAX, "the block number must come first in the block"),
+                b'L' | b'l' => (SYNTAX, "a call must stand alone in its block"),
+                _ => (SYNTAX, "NC command or axis name expected"),
             };
-            return Err(perr(i, SYNTAX, msg));
+            return Err(perr(i, code, msg));
         }
     }
 }
@@ -355,7 +361,8 @@ fn is_dwell(it: &Item) -> bool {
     }
 }
 
-/// A letter programmed a second time in its block: 20203 for an axis, ours for the rest.
+/// A letter programmed a second time in its block: [`AXIS_TWICE`] for an axis, [`word_twice`]
+/// for the rest.
 fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
     let l = letter as char;
     if crate::queue::AXIS_LETTERS.contains(&letter) {
@@ -365,7 +372,11 @@ fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
             format!("axis {l} programmed twice in the block"),
         )
     } else {
-        perr(at, WORD_TWICE, format!("{l} programmed twice in the block"))
+        perr(
+            at,
+            word_twice(letter),
+            format!("{l} programmed twice in the block"),
+        )
     }
 }
 

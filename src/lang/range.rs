@@ -7,8 +7,8 @@
 //!
 //! | word | range | refused with |
 //! |---|---|---|
-//! | F, S | not negative | 90132 |
-//! | T, D | a whole number 0 to 4294967295 | 90132 |
+//! | F, S | not negative | 900132 |
+//! | T, D | a whole number 0 to 4294967295 | 900132 |
 //! | I, J, K | within ±214,748.3647 | 20020 (TF5200: circle centre parameter outside the data format) |
 //! | R | within ±214,748.3647 | 20054 (TF5200: centre outside the data format, example `R1000000`) |
 //!

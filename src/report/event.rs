@@ -361,7 +361,7 @@ impl EventLog {
                     };
                     note_dropped(&mut out, &mut lines)?;
                     for ev in batch.drain(..) {
-                        serde_json::to_writer(&mut out, &ev).map_err(io::Error::other)?;
+                        serde_json::to_writer(&mut out, &ev).map_err(io::Error::from)?;
                         out.write_all(b"\n")?;
                         lines += 1;
                     }

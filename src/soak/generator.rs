@@ -123,7 +123,7 @@ pub struct Generator {
     /// next motion is an absolute line, never an arc whose centre depends on the start.
     position_unknown: bool,
     /// Bit k: P<k> was assigned this epoch (a reset forgets parameters; reading an unset one
-    /// is error 90005).
+    /// is error `codes::EVAL_UNDEFINED`).
     params_set: u16,
     /// Indices into `cache_files` loaded this epoch (a reset clears the cache).
     cached: Vec<usize>,

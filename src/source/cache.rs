@@ -32,7 +32,8 @@ pub enum CacheError {
 }
 
 impl CacheError {
-    /// ISG error number (TF5200 File Caching, diagnosis list); 90160 is ours (no ISG number known).
+    /// The error id: the kernel's (TF5200 File Caching, diagnosis list), or ours for
+    /// [`CacheError::NotEnabled`] (no kernel id known); see `crate::lang::codes`.
     pub fn code(&self) -> u32 {
         use crate::lang::codes;
         match self {
@@ -270,9 +271,18 @@ mod tests {
             max_files: 0,
             max_file_bytes: 0,
         });
-        assert_eq!(c.load("x", &mut s).unwrap_err().code(), 90160);
-        assert_eq!(c.clear("x").unwrap_err().code(), 90160);
-        assert_eq!(c.clear_all().unwrap_err().code(), 90160);
+        assert_eq!(
+            c.load("x", &mut s).unwrap_err().code(),
+            crate::lang::codes::CACHE_NOT_ENABLED
+        );
+        assert_eq!(
+            c.clear("x").unwrap_err().code(),
+            crate::lang::codes::CACHE_NOT_ENABLED
+        );
+        assert_eq!(
+            c.clear_all().unwrap_err().code(),
+            crate::lang::codes::CACHE_NOT_ENABLED
+        );
         c.reset();
     }
 }

@@ -440,7 +440,7 @@ mod tests {
         for bad in ["../etc/passwd", "/etc/passwd", "", "a\0b"] {
             assert_eq!(
                 s.open(bad, ProgramKind::Main).unwrap_err().code(),
-                90112,
+                crate::lang::codes::PROGRAM_BAD_NAME,
                 "{bad:?}"
             );
         }

@@ -1,0 +1,69 @@
+//! Standard output for the commands' results.
+//!
+//! `println!` panics when the reader of standard output has gone (`ncchannel check FILE |
+//! head`: a panic message and exit 101). [`Stdout`] writes through one locked handle and
+//! takes a reader that went away as the end of the output: nothing more is written and the
+//! command finishes as a normal run would, with its own exit code. Any other write error is
+//! kept and handed back by [`Stdout::finish`] for the command to report. Why this rather than
+//! the default SIGPIPE action: docs/design-choices.md ("cli").
+
+use std::fmt::Display;
+use std::io::{self, Write};
+
+/// Is this the error of a write whose reader went away (a closed pipe)?
+pub fn reader_gone(e: &io::Error) -> bool {
+    e.kind() == io::ErrorKind::BrokenPipe
+}
+
+/// A command's standard output; see the module documentation.
+pub struct Stdout {
+    lock: io::StdoutLock<'static>,
+    /// The reader has gone: the output ended there.
+    gone: bool,
+    /// The first write error other than the reader going away; nothing is written after it.
+    failed: Option<io::Error>,
+}
+
+impl Stdout {
+    pub fn new() -> Self {
+        Self {
+            lock: io::stdout().lock(),
+            gone: false,
+            failed: None,
+        }
+    }
+
+    /// Write one line (unless the output has ended).
+    pub fn line(&mut self, text: impl Display) {
+        if self.gone || self.failed.is_some() {
+            return;
+        }
+        if let Err(e) = writeln!(self.lock, "{text}") {
+            self.end(e);
+        }
+    }
+
+    /// Flush, and return the first write error other than the reader going away.
+    pub fn finish(mut self) -> io::Result<()> {
+        if !self.gone && self.failed.is_none() {
+            if let Err(e) = self.lock.flush() {
+                self.end(e);
+            }
+        }
+        self.failed.map_or(Ok(()), Err)
+    }
+
+    fn end(&mut self, e: io::Error) {
+        if reader_gone(&e) {
+            self.gone = true;
+        } else {
+            self.failed = Some(e);
+        }
+    }
+}
+
+impl Default for Stdout {
+    fn default() -> Self {
+        Self::new()
+    }
+}
