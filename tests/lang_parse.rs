@@ -423,14 +423,16 @@ fn calls_and_heads() {
         p("%streaming-spline").body,
         Body::ProgramHead {
             name: "streaming-spline".into(),
-            local: false
+            local: false,
+            title: String::new()
         }
     );
     assert_eq!(
         p("%L sub1").body,
         Body::ProgramHead {
             name: "SUB1".into(),
-            local: true
+            local: true,
+            title: String::new()
         }
     );
     canon("%L SUB1");

@@ -244,14 +244,19 @@ fn call() -> impl Strategy<Value = Call> {
     ]
 }
 
+/// A program title: words after the head's name (`% 100 Drilling plate 4`).
+fn title() -> impl Strategy<Value = String> {
+    prop::collection::vec("[A-Za-z0-9_.-]{1,6}", 0..3).prop_map(|w| w.join(" "))
+}
+
 fn body() -> impl Strategy<Value = Body> {
     prop_oneof![
         4 => prop::collection::vec(item(), 0..6).prop_map(|items| Body::Items(once_per_letter(items))),
         2 => control().prop_map(Body::Control),
         1 => command().prop_map(Body::Command),
         1 => call().prop_map(Body::Call),
-        1 => "[A-Za-z0-9_.-]{0,10}".prop_map(|name| Body::ProgramHead { name, local: false }),
-        1 => ident().prop_map(|name| Body::ProgramHead { name, local: true }),
+        1 => ("[A-Za-z0-9_.-]{0,10}", title()).prop_map(|(name, title)| Body::ProgramHead { name, local: false, title }),
+        1 => (ident(), title()).prop_map(|(name, title)| Body::ProgramHead { name, local: true, title }),
     ]
 }
 

@@ -625,7 +625,9 @@ pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
         }
         match &block.body {
             Body::Command(Command::CommentBegin) => comment = true,
-            Body::ProgramHead { name, local: true } => {
+            Body::ProgramHead {
+                name, local: true, ..
+            } => {
                 index
                     .local_subs
                     .insert(name.to_ascii_uppercase(), LinePos { pos, line_no });

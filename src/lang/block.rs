@@ -39,8 +39,14 @@ pub enum Body {
     Command(Command),
     /// `L file`, `LL name`, `L CYCLE [...]`.
     Call(Call),
-    /// `%name` (main program head) or `%L name` (local subroutine head).
-    ProgramHead { name: String, local: bool },
+    /// `%name` (main program head) or `%L name` (local subroutine head). A blank may stand
+    /// between `%` and the name (`% 100`); text after the name up to a comment is the
+    /// program's `title` (`% TestProgram for streaming mode`), empty when there is none.
+    ProgramHead {
+        name: String,
+        local: bool,
+        title: String,
+    },
 }
 
 /// One element of an ordinary block.

@@ -59,11 +59,19 @@ impl Display for Block {
             Body::Control(c) => write!(f, "{sep}{c}"),
             Body::Command(c) => write!(f, "{sep}{c}"),
             Body::Call(c) => write!(f, "{sep}{c}"),
-            Body::ProgramHead { name, local } => {
+            Body::ProgramHead { name, local, title } => {
                 if *local {
-                    write!(f, "{sep}%L {}", FileName(name))
+                    write!(f, "{sep}%L {}", FileName(name))?;
+                } else if name.eq_ignore_ascii_case("L") && !title.is_empty() {
+                    // `%L title` would be a local subroutine head.
+                    write!(f, "{sep}%\"{name}\"")?;
                 } else {
-                    write!(f, "{sep}%{}", FileName(name))
+                    write!(f, "{sep}%{}", FileName(name))?;
+                }
+                if title.is_empty() {
+                    Ok(())
+                } else {
+                    write!(f, " {title}")
                 }
             }
         }

@@ -238,8 +238,9 @@ fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> 
         }
         Some(b'%') => {
             let (r, (name, local)) = program_head(i)?;
+            let (r, title) = program_title(r);
             end_of_block(r, "nothing may follow a program head in its block")?;
-            Body::ProgramHead { name, local }
+            Body::ProgramHead { name, local, title }
         }
         Some(b'L' | b'l') if starts_call(i) => {
             let (r, c) = call(ctx, i)?;
@@ -1010,9 +1011,9 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     }
 }
 
-/// `%name` or `%L name`.
+/// `%name`, `% name` or `%L name` (TF5200 programming manual, "NC block structure": `% 100`).
 fn program_head(i: &str) -> PResult<'_, (String, bool)> {
-    let after = &i[1..];
+    let after = ws(&i[1..]);
     let ab = after.as_bytes();
     if matches!(ab.first(), Some(b'L' | b'l')) && matches!(ab.get(1), Some(b' ' | b'\t')) {
         let r = ws(&after[1..]);
@@ -1024,6 +1025,14 @@ fn program_head(i: &str) -> PResult<'_, (String, bool)> {
     }
     let (rest, name) = file_name(after, false);
     Ok((rest, (name.to_string(), false)))
+}
+
+/// The text after a program head's name up to a comment, trimmed: the program's title
+/// (`% TestProgram for streaming mode`, `%Test - Achsen`). Kept, never interpreted.
+fn program_title(i: &str) -> (&str, String) {
+    let t = ws(i);
+    let end = t.find([';', '(']).unwrap_or(t.len());
+    (&t[end..], t[..end].trim_end().to_string())
 }
 
 // ---------------------------------------------------------------------------------------
