@@ -109,3 +109,50 @@ fn program_heads_with_a_blank_or_a_title() {
         assert_eq!(r.position('X'), 10.0, "{head}");
     }
 }
+
+#[test]
+fn a_backslash_continues_the_block_in_the_next_line() {
+    let rig = Rig::new();
+    // A DIN block; the continuation line may bring a block number of its own.
+    let r = runs_clean(&rig, "N10 G01 F1000 \\\nN20 X10 Y20\nM30\n");
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 20.0));
+    assert_eq!(r.block_texts().len(), 2, "{:?}", r.block_texts());
+    // Comments after the `\`, and blank or comment lines between the lines of a block.
+    let r = runs_clean(
+        &rig,
+        "G01 X1 \\ (more follows)\n\n; a note\n  Y2 \\\n  F500\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (1.0, 2.0));
+    // A `\` inside a comment continues nothing.
+    let r = runs_clean(&rig, "G01 X3 F100 ; not continued \\\nY4\nM30\n");
+    assert_eq!(r.block_texts().len(), 3);
+    // L CYCLE [...] over several lines.
+    rig.program("c.cyc", "G01 X[@P1] Y[@P2] F1000\nM17\n");
+    let r = runs_clean(&rig, "L CYCLE [NAME=c.cyc \\\n  @P1=5 \\\n  @P2=7 ]\nM30\n");
+    assert_eq!((r.position('X'), r.position('Y')), (5.0, 7.0));
+    // A #VAR initialiser over two lines.
+    let r = runs_clean(
+        &rig,
+        "#VAR\n  V.L.N = 1 + \\\n    2\n#ENDVAR\nG01 X[V.L.N] F100\nM30\n",
+    );
+    assert_eq!(r.position('X'), 3.0);
+}
+
+#[test]
+fn an_error_in_a_continued_block_names_the_line_it_stands_in() {
+    let rig = Rig::new();
+    fails_at(
+        &rig,
+        "G01 X1 F100\nN10 G01 F1000 \\\nN20 X10 Q5\nM30\n",
+        20200,
+        3,
+        9,
+        true,
+    );
+    fails_at(&rig, "G01 X1 F100 \\\n\n  Y2 X3\nM30\n", 20203, 3, 6, true);
+    // The block limit holds for the joined block: 4000 characters, the 4001st is refused
+    // in the line it stands in.
+    let line = format!("{}\\\n", "X1 ".repeat(300).replace("X1", "G1"));
+    let text = format!("{}M30\n", line.repeat(6));
+    fails_at(&rig, &text, 20200, 5, 4001 - 4 * 901, true);
+}
