@@ -20,7 +20,9 @@ fn run_everywhere(rig: &Rig, text: &str) -> RunResult {
     ] {
         let s = rig.run("streaming.nc", Some(feeder(&input, 992, 1)), 1_000_000);
         assert_eq!(s.finish, file.finish, "{how}: {}\n{}", text, s.log);
-        assert_eq!(s.block_texts(), file.block_texts(), "{how}: {text}");
+        if file.finish == Some(Finish::Ended) {
+            assert_eq!(s.block_texts(), file.block_texts(), "{how}: {text}");
+        }
         assert_eq!(error_places(&s), error_places(&file), "{how}: {text}");
     }
     file
@@ -155,4 +157,36 @@ fn an_error_in_a_continued_block_names_the_line_it_stands_in() {
     let line = format!("{}\\\n", "X1 ".repeat(300).replace("X1", "G1"));
     let text = format!("{}M30\n", line.repeat(6));
     fails_at(&rig, &text, 20200, 5, 4001 - 4 * 901, true);
+}
+
+#[test]
+fn an_address_takes_a_parameter_expression_without_brackets() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "P1=10 P2=1 P10=1 P20=2\nG01 XP1*SIN[P2 * 30]*2 YP10+P20 F1000\nM30\n",
+    );
+    assert!((r.position('X') - 10.0).abs() < 1e-9, "{}", r.position('X'));
+    assert_eq!((r.position('Y'), r.position('Z')), (3.0, 0.0));
+    let r = runs_clean(
+        &rig,
+        "#VAR\n  V.P.TOOLNR = 7\n  V.L.x = 4\n#ENDVAR\nM6 TV.P.TOOLNR\nG01 XV.L.x Y-V.L.X F100\nM30\n",
+    );
+    assert_eq!(r.machine.channels()[0].decoder().modal().tool, 7);
+    assert_eq!((r.position('X'), r.position('Y')), (4.0, -4.0));
+    // The value ends at the blank: what follows is the next word.
+    let b = parse_block("XP1 +2").unwrap_err();
+    assert_eq!((b.code, b.col), (20200, 5), "{}", b.message);
+    fails_at(&rig, "P1=1\nG01 XP1*[P1 Y2 F100\nM30\n", 20200, 2, 13, true);
+    // An undefined variable is the run's error, at the word.
+    fails_at(
+        &rig,
+        "G01 X1 F100\nG01 YV.L.NOPE\nM30\n",
+        90005,
+        2,
+        5,
+        false,
+    );
+    // G, M and H still take literal numbers only.
+    assert_eq!(parse_block("MP1").unwrap_err().code, 20157);
 }

@@ -415,6 +415,12 @@ fn word<'a>(
     let ab = after.as_bytes();
     let (neg, skip) = match ab.first() {
         Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
+        Some(b'P' | b'p' | b'V' | b'v' | b'@') if starts_variable(ab) => {
+            return word_unbracketed(ctx, i, up, col, after, items)
+        }
+        Some(b'-' | b'+') if starts_variable(&ab[1..]) => {
+            return word_unbracketed(ctx, i, up, col, after, items)
+        }
         Some(b'-') if ab.get(1) == Some(&b'[') => {
             return word_expr(ctx, i, up, col, &after[1..], true, items)
         }
@@ -473,6 +479,75 @@ fn word<'a>(
     Ok(rest)
 }
 
+/// G, M and H take literal numbers only.
+fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
+    match up {
+        b'G' => Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
+        b'M' => Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
+        b'H' => Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
+        _ => Ok(()),
+    }
+}
+
+/// Does a parameter or variable start here (`P1`, `P[..]`, `V.L.X`, `@P1`)?
+fn starts_variable(b: &[u8]) -> bool {
+    match b {
+        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[',
+        [b'V' | b'v', b'.', ..] => true,
+        [b'@', b'P' | b'p', ..] => true,
+        _ => false,
+    }
+}
+
+/// A word whose value is an expression starting with a parameter or variable, written
+/// without brackets: `XP1*SIN[P2*30]`, `TV.P.TOOLNR`, `BP10+P20`. The expression runs to
+/// the next blank or comment outside brackets (TF5200 programming manual, "Arithmetic
+/// expressions" and "Parameters").
+fn word_unbracketed<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    after: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    literal_only(i, up)?;
+    let mut depth = 0usize;
+    let end = after
+        .bytes()
+        .position(|b| match b {
+            b'[' => {
+                depth += 1;
+                false
+            }
+            b']' => {
+                depth = depth.saturating_sub(1);
+                false
+            }
+            b' ' | b'\t' | b'(' | b';' => depth == 0,
+            _ => false,
+        })
+        .unwrap_or(after.len());
+    let cut = ctx.cut(ctx.line.len() - after.len() + end);
+    let text = &cut.line[cut.line.len() - end..];
+    let e = match cut.expr(text) {
+        Ok(("", e)) => e,
+        Ok((rest, _)) => {
+            return Err(ctx.err_at(cut.col(rest), SYNTAX, "operator or blank expected"));
+        }
+        Err(e) => {
+            let e = cut.to_error(e);
+            return Err(ctx.err_at(e.col, e.code, e.message));
+        }
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
+        col,
+    }));
+    Ok(&after[end..])
+}
+
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
 fn word_expr<'a>(
     ctx: &Ctx<'a>,
@@ -483,12 +558,7 @@ fn word_expr<'a>(
     negate: bool,
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
-    match up {
-        b'G' => return Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
-        b'M' => return Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
-        b'H' => return Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
-        _ => {}
-    }
+    literal_only(i, up)?;
     let (rest, e) = ctx.bracketed(bracket)?;
     let e = if negate {
         super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
