@@ -190,3 +190,30 @@ fn an_address_takes_a_parameter_expression_without_brackets() {
     // G, M and H still take literal numbers only.
     assert_eq!(parse_block("MP1").unwrap_err().code, 20157);
 }
+
+#[test]
+fn an_m_function_takes_a_value_carried_with_its_event() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "P1=3\nG01 X1 F100 M200=1200\nM201 = P1*2 H20=5 H21\nM30\n",
+    );
+    let ms: Vec<(u64, f64)> = r
+        .of("m_function")
+        .iter()
+        .map(|e| (e["m"].as_u64().unwrap(), e["value"].as_f64().unwrap()))
+        .collect();
+    assert_eq!(ms, [(200, 1200.0), (201, 6.0)]);
+    let hs: Vec<(u64, Option<f64>)> = r
+        .of("h_function")
+        .iter()
+        .map(|e| (e["h"].as_u64().unwrap(), e["value"].as_f64()))
+        .collect();
+    assert_eq!(hs, [(20, Some(5.0)), (21, None)]);
+    // An M function without a value has no event of its own, as before.
+    let r = runs_clean(&rig, "M3 S1000\nM30\n");
+    assert_eq!(r.of("m_function").len(), 0);
+    // The number is still checked; an undefined value is the run's error at the M.
+    fails_at(&rig, "G01 X1 F100\nM70000=1\nM30\n", 20157, 2, 1, true);
+    fails_at(&rig, "G01 X1 F100\nX2 M200=P9\nM30\n", 90005, 2, 4, false);
+}

@@ -158,6 +158,12 @@ fn item() -> impl Strategy<Value = Item> {
             value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
             col: 0,
         }),
+        1 => (prop::sample::select(vec![b'M', b'H']), 0u32..=65_535, expr()).prop_map(|(letter, number, e)| Item::FunctionValue {
+            letter,
+            number,
+            value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
+            col: 0,
+        }),
     ]
 }
 
@@ -280,7 +286,9 @@ fn without_cols(mut b: Block) -> Block {
         for item in items {
             match item {
                 Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+                Item::Assign { col, .. }
+                | Item::GValue { col, .. }
+                | Item::FunctionValue { col, .. } => *col = 0,
             }
         }
     }

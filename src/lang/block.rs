@@ -68,6 +68,14 @@ pub enum Item {
         value: Value,
         col: u32,
     },
+    /// An M or H function with a value for the PLC side: `M200=1200`, `H20=[P1*2]`
+    /// (`letter` b'M' or b'H', `number` 0..=65535). `col` is the letter's column.
+    FunctionValue {
+        letter: u8,
+        number: u32,
+        value: Value,
+        col: u32,
+    },
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.

@@ -96,6 +96,18 @@ impl Display for Item {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
                 Value::Expr(e) => write!(f, "G{g}={e}"),
             },
+            Item::FunctionValue {
+                letter,
+                number,
+                value,
+                ..
+            } => {
+                let l = char::from(*letter);
+                match value {
+                    Value::Num(v) => write!(f, "{l}{number}={}", Num(*v)),
+                    Value::Expr(e) => write!(f, "{l}{number}={e}"),
+                }
+            }
         }
     }
 }

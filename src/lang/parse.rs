@@ -352,7 +352,7 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } => false,
+        Item::Assign { .. } | Item::FunctionValue { .. } => false,
     }
 }
 
@@ -389,6 +389,12 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
             Item::GValue { g, col, .. } => (*col, format!("G{g}")),
+            Item::FunctionValue {
+                letter,
+                number,
+                col,
+                ..
+            } => (*col, format!("{}{number}", char::from(*letter))),
         };
         return Err(ctx.err_at(
             col,
@@ -464,6 +470,20 @@ fn word<'a>(
                 UNKNOWN_M,
                 format!("H function H{v} outside 0 to 65535"),
             ));
+        }
+        b'M' | b'H' => {
+            if let Some(r) = ws(rest).strip_prefix('=') {
+                // `M200=1200`: a technology function with a value (TF5200 programming
+                // manual, "User-specific technology functions").
+                let (r, e) = ctx.expr(ws(r))?;
+                items.push(Item::FunctionValue {
+                    letter: up,
+                    number: integer_code(v).unwrap_or(0),
+                    value: expr_value(e),
+                    col,
+                });
+                return Ok(r);
+            }
         }
         _ => {
             if let Err(e) = word_value(up, v) {
