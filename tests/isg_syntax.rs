@@ -217,3 +217,17 @@ fn an_m_function_takes_a_value_carried_with_its_event() {
     fails_at(&rig, "G01 X1 F100\nM70000=1\nM30\n", 20157, 2, 1, true);
     fails_at(&rig, "G01 X1 F100\nX2 M200=P9\nM30\n", 90005, 2, 4, false);
 }
+
+#[test]
+fn an_axis_takes_an_expression_after_an_equals_sign() {
+    let rig = Rig::new();
+    let r = runs_clean(&rig, "P1=3\nG01 X=10 Y = P1+2 F100\nZ =-P1 * 2\nM30\n");
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (10.0, 5.0, -6.0)
+    );
+    // Axis names are X Y Z A B C (src/params/axes.rs): no axis is called A1.
+    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 4, true);
+    // F, S and the other addresses keep their plain form.
+    assert_eq!(parse_block("F=100").unwrap_err().col, 2);
+}

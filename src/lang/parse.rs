@@ -427,6 +427,16 @@ fn word<'a>(
         Some(b'-' | b'+') if starts_variable(&ab[1..]) => {
             return word_unbracketed(ctx, i, up, col, after, items)
         }
+        Some(b'=' | b' ' | b'\t') if is_axis_letter(up) && ws(after).starts_with('=') => {
+            // `X=10`, `X = P1+2`: an axis assigned an expression.
+            let (r, e) = ctx.expr(ws(&ws(after)[1..]))?;
+            items.push(Item::Word(Word {
+                letter: up,
+                value: expr_value(e),
+                col,
+            }));
+            return Ok(r);
+        }
         Some(b'-') if ab.get(1) == Some(&b'[') => {
             return word_expr(ctx, i, up, col, &after[1..], true, items)
         }
@@ -507,6 +517,15 @@ fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
         b'H' => Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
         _ => Ok(()),
     }
+}
+
+/// An axis name: X Y Z A B C and the further axis names U V W. Axis names with digits
+/// (`A1`) are not configurable (`src/params/axes.rs`), so `A1 = 0` stays refused.
+fn is_axis_letter(up: u8) -> bool {
+    matches!(
+        up,
+        b'X' | b'Y' | b'Z' | b'A' | b'B' | b'C' | b'U' | b'V' | b'W'
+    )
 }
 
 /// Does a parameter or variable start here (`P1`, `P[..]`, `V.L.X`, `@P1`)?
