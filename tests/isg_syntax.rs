@@ -231,3 +231,67 @@ fn an_axis_takes_an_expression_after_an_equals_sign() {
     // F, S and the other addresses keep their plain form.
     assert_eq!(parse_block("F=100").unwrap_err().col, 2);
 }
+
+#[test]
+fn var_declarations_take_types_lists_and_block_numbers() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "#VAR\n\
+         \x20 V.P.VAR_1\n\
+         \x20 V.P.VAR_3 : UNS32 = 10\n\
+         \x20 V.L.NAME_1 : STRING[20] = \"GRUNDPLATTE\"\n\
+         \x20 V.L.VAR_1 : REAL = 23.45\n\
+         \x20 V.L.VAR_2 : SGN08\n\
+         \x20 V.L.B : BOOLEAN = TRUE\n\
+         \x20 V.P.ARRAY_1[3][6] = [10,11,12,13,14,15, \\\n\
+         \x20                      20,21,22,23,24,25, \\\n\
+         \x20                      30,31,32,33,34,35 ]\n\
+         \x20 V.L.ROW[3] = [10, 11, 12]\n\
+         #ENDVAR\n\
+         N10 #VAR\n\
+         N20   V.S.EXAMPLE[5] = [1,2,3,4,5 ]\n\
+         N30 #ENDVAR\n\
+         G01 X[V.P.VAR_3] Y[V.P.ARRAY_1[1][2] + V.L.B] Z[V.L.ROW[2] + V.S.EXAMPLE[4] + V.L.VAR_1] F100\n\
+         M30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 23.0));
+    assert!(
+        (r.position('Z') - 40.45).abs() < 1e-9,
+        "{}",
+        r.position('Z')
+    );
+    let d = parse_var_declaration("N5 V.L.N : UNS32 = 10").unwrap();
+    assert_eq!(
+        (d.ty, d.to_string().as_str()),
+        (Some(VarType::Uns32), "V.L.N : UNS32=10")
+    );
+    let d = parse_var_declaration("V.P.T[2][2] = [1, 2, P1]").unwrap();
+    assert_eq!(d.to_string(), "V.P.T[2][2]=[1, 2, P1]");
+    // Refused where the fault stands, in check and in a run alike.
+    for (decl, col) in [
+        ("V.L.ROW[3] = [1, 2, 3, 4]", 24),
+        ("V.L.S : STRING[5] = \"TOO LONG\"", 21),
+        ("V.L.S : STRING[127]", 15),
+        ("V.L.X : FLOAT", 9),
+        ("V.L.X = [1, 2]", 11),
+    ] {
+        fails_at(
+            &rig,
+            &format!("G01 X1 F100\n#VAR\n{decl}\n#ENDVAR\nM30\n"),
+            20200,
+            3,
+            col,
+            true,
+        );
+    }
+    // A string variable is not kept: using it is undefined.
+    fails_at(
+        &rig,
+        "#VAR\nV.L.S : STRING[5] = \"AB\"\n#ENDVAR\nG01 X[V.L.S] F100\nM30\n",
+        90005,
+        4,
+        5,
+        false,
+    );
+}

@@ -488,7 +488,9 @@ fn var_declarations() {
             scope: VScope::Local,
             name: "COUNT".into(),
             dims: vec![],
-            init: Some(Expr::Num(5.0))
+            ty: None,
+            init: Some(Expr::Num(5.0)),
+            values: vec![]
         }
     );
     let d = parse_var_declaration("  v.p.table[10][3] ; grid").unwrap();

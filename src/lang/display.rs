@@ -16,7 +16,7 @@ use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
     BinOp, Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Index, Item, Label,
-    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, Word,
+    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 
 impl Display for Block {
@@ -424,9 +424,24 @@ impl Display for VarDecl {
         for d in &self.dims {
             write!(f, "[{d}]")?;
         }
-        match &self.init {
-            Some(e) => write!(f, "={e}"),
-            None => Ok(()),
+        match self.ty {
+            Some(VarType::String(n)) => write!(f, " : STRING[{n}]")?,
+            Some(t) => write!(f, " : {}", t.name())?,
+            None => {}
         }
+        if let Some(e) = &self.init {
+            return write!(f, "={e}");
+        }
+        if !self.values.is_empty() {
+            f.write_str("=[")?;
+            for (k, e) in self.values.iter().enumerate() {
+                if k > 0 {
+                    f.write_str(", ")?;
+                }
+                write!(f, "{e}")?;
+            }
+            f.write_char(']')?;
+        }
+        Ok(())
     }
 }

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, VScope,
-    Value, VarDecl, VarRef, Word,
+    Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Item, Label, SplineCommand,
+    VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -1149,7 +1149,9 @@ fn program_title(i: &str) -> (&str, String) {
 // ---------------------------------------------------------------------------------------
 
 fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'a>>> {
-    let i = gap(line);
+    // A line of a #VAR block may carry a block number (`N50 V.S.EXAMPLE[5] = [1,2,3,4,5]`).
+    let (i, _) = prefix(ws(line))?;
+    let i = gap(i);
     let b = i.as_bytes();
     if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
         return Err(perr(
@@ -1214,19 +1216,151 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             ),
         ));
     }
+    let (r, ty) = var_type(ws(r), r)?;
     let j = ws(r);
-    let (r, init) = match j.strip_prefix('=') {
+    let (r, init, values) = match j.strip_prefix('=') {
+        Some(k) if matches!(ty, Some(VarType::String(_))) => {
+            (string_init(ws(k), ty)?, None, Vec::new())
+        }
+        Some(k) if !dims.is_empty() && is_list(ws(k)) => {
+            let (r, values) = init_list(ctx, ws(k), elements)?;
+            (r, None, values)
+        }
         Some(k) => {
             let (r, e) = ctx.expr(ws(k))?;
-            (r, Some(e))
+            (r, Some(e), Vec::new())
         }
-        None => (r, None),
+        None => (r, None, Vec::new()),
     };
     end_of_block(r, "nothing may follow a declaration")?;
     Ok(VarDecl {
         scope,
         name,
         dims,
+        ty,
         init,
+        values,
     })
+}
+
+/// `: <type>` after a declared name (`: UNS32`, `: STRING[20]`), if there is one; `none` is
+/// the input to go on from when there is not.
+fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
+    let Some(t) = i.strip_prefix(':') else {
+        return Ok((none, None));
+    };
+    let t = ws(t);
+    let len = t
+        .bytes()
+        .take_while(u8::is_ascii_alphanumeric)
+        .count()
+        .min(16);
+    let ty = match t[..len].to_ascii_uppercase().as_str() {
+        "BOOLEAN" => VarType::Boolean,
+        "SGN08" => VarType::Sgn08,
+        "UNS08" => VarType::Uns08,
+        "SGN16" => VarType::Sgn16,
+        "UNS16" => VarType::Uns16,
+        "SGN32" => VarType::Sgn32,
+        "UNS32" => VarType::Uns32,
+        "REAL" | "REAL64" => VarType::Real,
+        "STRING" => {
+            let s = &t[len..];
+            let size = s.strip_prefix('[').and_then(|n| {
+                let (rest, n) = uint(n).ok()?;
+                let rest = rest.strip_prefix(']')?;
+                (1..=126).contains(&n).then_some((rest, n as u8))
+            });
+            return match size {
+                Some((rest, n)) => Ok((rest, Some(VarType::String(n)))),
+                None => fail(s, SYNTAX, "STRING[<length 1 to 126>] expected"),
+            };
+        }
+        _ => {
+            return fail(
+                t,
+                SYNTAX,
+                "data type BOOLEAN, SGN08, UNS08, SGN16, UNS16, SGN32, UNS32, REAL64 or STRING[n] expected",
+            )
+        }
+    };
+    Ok((&t[len..], Some(ty)))
+}
+
+/// The quoted start value of a `STRING[n]` variable, at most n characters.
+fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>> {
+    let Some(q) = i.strip_prefix('"') else {
+        return Err(perr(
+            i,
+            SYNTAX,
+            "a STRING variable starts with a \"quoted\" text",
+        ));
+    };
+    let Some(end) = q.find('"') else {
+        return Err(perr(i, SYNTAX, "closing `\"` missing"));
+    };
+    let max = match ty {
+        Some(VarType::String(n)) => usize::from(n),
+        _ => 0,
+    };
+    if q[..end].chars().count() > max {
+        return Err(perr(
+            i,
+            SYNTAX,
+            format!("text longer than the STRING[{max}] declared"),
+        ));
+    }
+    Ok(&q[end + 1..])
+}
+
+/// Does `[` open a list (`[10, 11, 12]`: a comma outside inner brackets) rather than a
+/// bracketed expression (`[P1*2]`, the value of every element)?
+fn is_list(i: &str) -> bool {
+    if !i.starts_with('[') {
+        return false;
+    }
+    let mut depth = 0usize;
+    for b in i.bytes() {
+        match b {
+            b'[' => depth += 1,
+            b']' => {
+                depth -= 1;
+                if depth == 0 {
+                    return false;
+                }
+            }
+            b',' if depth == 1 => return true,
+            _ => {}
+        }
+    }
+    false
+}
+
+/// `[e1, e2, …]`: an array's first `elements` values at most.
+fn init_list<'a>(ctx: &Ctx<'a>, i: &'a str, elements: u64) -> PResult<'a, Vec<Expr>> {
+    let open = i;
+    let mut values = Vec::new();
+    let mut j = &i[1..];
+    loop {
+        j = ws(j);
+        let (r, e) = ctx.expr(j)?;
+        if values.len() as u64 == elements {
+            return fail(
+                j,
+                SYNTAX,
+                format!("more values than the {elements} elements declared"),
+            );
+        }
+        values.push(e);
+        let r = ws(r);
+        if let Some(r) = r.strip_prefix(',') {
+            j = r;
+        } else if let Some(r) = r.strip_prefix(']') {
+            return Ok((r, values));
+        } else if r.is_empty() {
+            return fail(open, SYNTAX, "`]` missing after the values");
+        } else {
+            return fail(r, SYNTAX, "`,` or `]` expected");
+        }
+    }
 }
