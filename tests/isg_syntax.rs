@@ -295,3 +295,24 @@ fn var_declarations_take_types_lists_and_block_numbers() {
         false,
     );
 }
+
+#[test]
+fn ncchannel_check_names_the_line_of_an_error_in_a_continued_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.nc");
+    std::fs::write(
+        &bad,
+        "% 100 (title)\r\nN10 G01 F1000 \\\r\nN20 X10 Q5\r\nM30\r\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("check")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    let want = format!("{}:3:9: error 20200: ", bad.display());
+    assert!(text.contains(&want), "{text}");
+    assert!(text.contains("  N20 X10 Q5\n          ^"), "{text}");
+}
