@@ -428,14 +428,7 @@ fn word<'a>(
             return word_unbracketed(ctx, i, up, col, after, items)
         }
         Some(b'=' | b' ' | b'\t') if is_axis_letter(up) && ws(after).starts_with('=') => {
-            // `X=10`, `X = P1+2`: an axis assigned an expression.
-            let (r, e) = ctx.expr(ws(&ws(after)[1..]))?;
-            items.push(Item::Word(Word {
-                letter: up,
-                value: expr_value(e),
-                col,
-            }));
-            return Ok(r);
+            return axis_assigned(ctx, up, col, after, items)
         }
         Some(b'-') if ab.get(1) == Some(&b'[') => {
             return word_expr(ctx, i, up, col, &after[1..], true, items)
@@ -483,16 +476,7 @@ fn word<'a>(
         }
         b'M' | b'H' => {
             if let Some(r) = ws(rest).strip_prefix('=') {
-                // `M200=1200`: a technology function with a value (TF5200 programming
-                // manual, "User-specific technology functions").
-                let (r, e) = ctx.expr(ws(r))?;
-                items.push(Item::FunctionValue {
-                    letter: up,
-                    number: integer_code(v).unwrap_or(0),
-                    value: expr_value(e),
-                    col,
-                });
-                return Ok(r);
+                return function_value(ctx, (up, v), col, r, items);
             }
         }
         _ => {
@@ -519,6 +503,44 @@ fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
     }
 }
 
+/// `M200=1200`: an M or H function with a value (TF5200 programming manual, "User-specific
+/// technology functions"); `i` is the text after the `=`.
+#[cold]
+fn function_value<'a>(
+    ctx: &Ctx<'a>,
+    (up, number): (u8, f64),
+    col: u32,
+    i: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let (r, e) = ctx.expr(ws(i))?;
+    items.push(Item::FunctionValue {
+        letter: up,
+        number: integer_code(number).unwrap_or(0),
+        value: expr_value(e),
+        col,
+    });
+    Ok(r)
+}
+
+/// `X=10`, `X = P1+2`: an axis given an expression after an equals sign.
+#[cold]
+fn axis_assigned<'a>(
+    ctx: &Ctx<'a>,
+    up: u8,
+    col: u32,
+    after: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let (r, e) = ctx.expr(ws(&ws(after)[1..]))?;
+    items.push(Item::Word(Word {
+        letter: up,
+        value: expr_value(e),
+        col,
+    }));
+    Ok(r)
+}
+
 /// An axis name: X Y Z A B C and the further axis names U V W. Axis names with digits
 /// (`A1`) are not configurable (`src/params/axes.rs`), so `A1 = 0` stays refused.
 fn is_axis_letter(up: u8) -> bool {
@@ -542,6 +564,7 @@ fn starts_variable(b: &[u8]) -> bool {
 /// without brackets: `XP1*SIN[P2*30]`, `TV.P.TOOLNR`, `BP10+P20`. The expression runs to
 /// the next blank or comment outside brackets (TF5200 programming manual, "Arithmetic
 /// expressions" and "Parameters").
+#[cold]
 fn word_unbracketed<'a>(
     ctx: &Ctx<'a>,
     i: &'a str,
