@@ -548,7 +548,7 @@ impl Decoder {
             let mut at = meta;
             if let Some(col) = e.col {
                 let (line, col) = joiner.position(col);
-                at.line += line;
+                at.line = at.line.saturating_add(line);
                 e.col = Some(col);
             }
             self.fail(e, at);
