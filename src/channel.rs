@@ -795,7 +795,14 @@ impl Channel {
                     );
                     self.message = Some(text);
                 }
-                Note::HFunction { h } => self.emit(tick, EventKind::HFunction { h }),
+                Note::HFunction { h, value } => self.emit(tick, EventKind::HFunction { h, value }),
+                Note::MFunction { m, value } => self.emit(
+                    tick,
+                    EventKind::MFunction {
+                        m,
+                        value: Some(value),
+                    },
+                ),
                 Note::Cache { op, file } => self.emit(
                     tick,
                     EventKind::Cache {

@@ -226,7 +226,7 @@ fn file_larger_than_max_cache_size_is_21564_and_is_not_read() {
 }
 
 #[test]
-fn cache_without_fct_use_cached_files_is_90160_naming_the_parameter() {
+fn cache_without_fct_use_cached_files_is_900160_naming_the_parameter() {
     let rig = Rig::with_cache(None, "");
     rig.program("a.cyc", "M17\n");
     for cmd in [

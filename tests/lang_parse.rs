@@ -19,7 +19,9 @@ fn without_cols(mut b: Block) -> Block {
         for item in items {
             match item {
                 Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+                Item::Assign { col, .. }
+                | Item::GValue { col, .. }
+                | Item::FunctionValue { col, .. } => *col = 0,
             }
         }
     }
@@ -429,14 +431,16 @@ fn calls_and_heads() {
         p("%streaming-spline").body,
         Body::ProgramHead {
             name: "streaming-spline".into(),
-            local: false
+            local: false,
+            title: String::new()
         }
     );
     assert_eq!(
         p("%L sub1").body,
         Body::ProgramHead {
             name: "SUB1".into(),
-            local: true
+            local: true,
+            title: String::new()
         }
     );
     canon("%L SUB1");
@@ -490,7 +494,9 @@ fn var_declarations() {
             scope: VScope::Local,
             name: "COUNT".into(),
             dims: vec![],
-            init: Some(Expr::Num(5.0))
+            ty: None,
+            init: Some(Expr::Num(5.0)),
+            values: vec![]
         }
     );
     let d = parse_var_declaration("  v.p.table[10][3] ; grid").unwrap();

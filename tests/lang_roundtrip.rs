@@ -158,6 +158,12 @@ fn item() -> impl Strategy<Value = Item> {
             value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
             col: 0,
         }),
+        1 => (prop::sample::select(vec![b'M', b'H']), 0u32..=65_535, expr()).prop_map(|(letter, number, e)| Item::FunctionValue {
+            letter,
+            number,
+            value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
+            col: 0,
+        }),
     ]
 }
 
@@ -244,14 +250,19 @@ fn call() -> impl Strategy<Value = Call> {
     ]
 }
 
+/// A program title: words after the head's name (`% 100 Drilling plate 4`).
+fn title() -> impl Strategy<Value = String> {
+    prop::collection::vec("[A-Za-z0-9_.-]{1,6}", 0..3).prop_map(|w| w.join(" "))
+}
+
 fn body() -> impl Strategy<Value = Body> {
     prop_oneof![
         4 => prop::collection::vec(item(), 0..6).prop_map(|items| Body::Items(once_per_letter(items))),
         2 => control().prop_map(Body::Control),
         1 => command().prop_map(Body::Command),
         1 => call().prop_map(Body::Call),
-        1 => "[A-Za-z0-9_.-]{0,10}".prop_map(|name| Body::ProgramHead { name, local: false }),
-        1 => ident().prop_map(|name| Body::ProgramHead { name, local: true }),
+        1 => ("[A-Za-z0-9_.-]{0,10}", title()).prop_map(|(name, title)| Body::ProgramHead { name, local: false, title }),
+        1 => (ident(), title()).prop_map(|(name, title)| Body::ProgramHead { name, local: true, title }),
     ]
 }
 
@@ -275,7 +286,9 @@ fn without_cols(mut b: Block) -> Block {
         for item in items {
             match item {
                 Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+                Item::Assign { col, .. }
+                | Item::GValue { col, .. }
+                | Item::FunctionValue { col, .. } => *col = 0,
             }
         }
     }
@@ -294,6 +307,50 @@ proptest! {
         prop_assert_eq!(parsed.to_string(), text.clone());
         let crlf = parse_block(&format!("{text}\r\n")).map_err(|e| TestCaseError::fail(e.to_string()))?;
         prop_assert_eq!(crlf, parsed);
+    }
+
+    /// A block of words split at its blanks over lines ending in `\\` reads as the block,
+    /// and every column of the joined text maps back to the line and column it came from.
+    #[test]
+    fn a_block_split_over_continued_lines_reads_as_the_block(
+        mut b in block(),
+        items in prop::collection::vec(item(), 0..8),
+    ) {
+        b.body = Body::Items(once_per_letter(items));
+        let text = b.to_string();
+        prop_assume!(text.chars().count() <= 3000);
+        // The block skip, number and label stay in the first line: a block number at the
+        // start of a continuation line is the line's own, not part of the block.
+        let mut parts: Vec<String> = Vec::new();
+        let mut in_prefix = true;
+        for p in text.split(' ') {
+            let b = p.as_bytes();
+            in_prefix &= b.first() == Some(&b'/')
+                || b.first() == Some(&b'[')
+                || (b.first() == Some(&b'N') && b.get(1).is_some_and(u8::is_ascii_digit));
+            match parts.last_mut() {
+                Some(first) if in_prefix => {
+                    first.push(' ');
+                    first.push_str(p);
+                }
+                _ => parts.push(p.to_string()),
+            }
+        }
+        let mut joiner = Joiner::default();
+        let mut lines = Vec::new();
+        for (k, part) in parts.iter().enumerate() {
+            let line = if k + 1 < parts.len() { format!("{part} \\") } else { part.to_string() };
+            let done = joiner.push(&line);
+            prop_assert_eq!(done, k + 1 == parts.len(), "{:?}", line);
+            lines.push(line);
+        }
+        let joined = parse_block(joiner.text()).map_err(|e| TestCaseError::fail(format!("{text:?}: {e}")))?;
+        prop_assert_eq!(without_cols(joined), without_cols(parse_block(&text).unwrap()));
+        for (col, c) in joiner.text().chars().enumerate() {
+            let (line, at) = joiner.position(col as u32 + 1);
+            let written = lines[line as usize].chars().nth(at as usize - 1);
+            prop_assert!(written == Some(c) || (c == ' ' && written == Some('\\')), "{:?} col {}", joiner.text(), col + 1);
+        }
     }
 
     #[test]

@@ -712,7 +712,7 @@ fn trc_square_and_circle_stay_equidistant_to_the_programmed_path() {
 }
 
 #[test]
-fn trc_radius_larger_than_an_inner_arc_is_error_90140() {
+fn trc_radius_larger_than_an_inner_arc_is_error_900140() {
     let s = Setup::new("", "");
     s.write("params/tools.lis", "wz[1].radius 50000\n");
     let program = "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F3000\nG3 X6 Y0 I3 J0\nG1 X20\nG40 X30\nM30\n";

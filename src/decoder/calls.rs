@@ -40,14 +40,24 @@ impl Decoder {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
     /// values it made count against this tick's declaration budget.
     pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
+        if let Some(crate::lang::block::VarType::String(_)) = d.ty {
+            // Values are numbers here: a string variable is accepted and not kept
+            // (docs/nc-language.md, "Variables"); a use of it is undefined (900005).
+            return Ok(());
+        }
         let init = match &d.init {
             Some(e) => self.eval(e)?,
             None => 0.0,
         };
+        let mut values = Vec::with_capacity(d.values.len());
+        for e in &d.values {
+            values.push(self.eval(e)?);
+        }
         let made = self
             .vars
             .declare(d.scope, &d.name, &d.dims, init)
             .map_err(var_error)?;
+        self.vars.fill(d.scope, &d.name, &values);
         self.declared_this_tick += made;
         Ok(())
     }

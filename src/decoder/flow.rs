@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use crate::lang::block::{Block, Body, Command, Control, GotoTarget, Item, Label, Value};
-use crate::lang::{is_comment_end, parse_block, Expr, VarRef};
+use crate::lang::{continuation, is_comment_end, parse_block, Expr, Joiner, VarRef};
 
 use super::frame::{self, LabelIndex, LineMeta, LinePos, Source, MAX_SEEN_LABELS};
 use super::vars::VarSlot;
@@ -599,8 +599,12 @@ pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
     let mut depth = 0usize;
     let mut comment = false;
     let mut line = String::new();
+    let mut joiner = Joiner::default();
+    let mut at = LinePos { pos, line_no };
     loop {
-        let at = LinePos { pos, line_no };
+        if !joiner.is_open() {
+            at = LinePos { pos, line_no };
+        }
         let Some(next) = frame::cut_line(text, pos, &mut line, true) else {
             break;
         };
@@ -612,7 +616,12 @@ pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
             }
             continue;
         }
-        let Ok(block) = parse_block(&line) else {
+        // A block written over several lines (`\`) is read as the decoder reads it.
+        let joined = joiner.is_open() || continuation(&line).is_some();
+        if joined && !joiner.push(&line) && next < text.len() {
+            continue;
+        }
+        let Ok(block) = parse_block(if joined { joiner.text() } else { &line }) else {
             continue;
         };
         if let Some(l) = &block.label {
@@ -625,7 +634,9 @@ pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
         }
         match &block.body {
             Body::Command(Command::CommentBegin) => comment = true,
-            Body::ProgramHead { name, local: true } => {
+            Body::ProgramHead {
+                name, local: true, ..
+            } => {
                 index
                     .local_subs
                     .insert(name.to_ascii_uppercase(), LinePos { pos, line_no });

@@ -21,7 +21,7 @@ use std::time::Duration;
 
 use crate::lang::block::{Block, Body, Call, Command, FlushKind, Item, SplineCommand, Value};
 use crate::lang::codes;
-use crate::lang::{is_comment_end, parse_block, parse_var_line, VarLine};
+use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
 use crate::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
 };
@@ -187,9 +187,16 @@ pub enum Note {
         text: String,
         save: bool,
     },
-    /// An H function (0..=65535) decoded: handed to the PLC side.
+    /// An H function (0..=65535) decoded: handed to the PLC side, with its value when
+    /// programmed with one (`H20=5`).
     HFunction {
         h: u32,
+        value: Option<f64>,
+    },
+    /// An M function programmed with a value (`M200=1200`): handed to the PLC side.
+    MFunction {
+        m: u32,
+        value: f64,
     },
 }
 
@@ -255,6 +262,10 @@ pub struct Decoder {
     /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
     declared_this_tick: usize,
     line: String,
+    /// A block written over several lines (`\` at the end of a line) being collected, and
+    /// where its first line stands.
+    joiner: Joiner,
+    join_meta: LineMeta,
     notes: Vec<Note>,
     stats: DecoderStats,
     /// The word collection of the block being executed, kept between blocks.
@@ -283,6 +294,8 @@ impl Decoder {
             ready_at: Duration::ZERO,
             declared_this_tick: 0,
             line: String::new(),
+            joiner: Joiner::default(),
+            join_meta: LineMeta { line: 0, offset: 0 },
             notes: Vec::new(),
             stats: DecoderStats::default(),
             words: None,
@@ -360,6 +373,7 @@ impl Decoder {
         search: Option<SearchTarget>,
     ) -> Res {
         self.frames.clear();
+        self.joiner = Joiner::default();
         self.modal = Modal::defaults(machine_pos);
         self.vars.start_program();
         self.counter = 0;
@@ -402,6 +416,7 @@ impl Decoder {
     /// Channel reset: frames, stream position, parameters and modal state go; V.S. stays.
     pub fn reset(&mut self, machine_pos: Position) {
         self.frames.clear();
+        self.joiner = Joiner::default();
         self.stream.restart();
         self.stream_active = false;
         self.vars.reset();
@@ -478,6 +493,12 @@ impl Decoder {
                     self.line = line;
                     break;
                 }
+                LineRead::Eof if self.joiner.is_open() => {
+                    // The file ends in a continued line: the block is what there is.
+                    self.line = line;
+                    budget -= 1;
+                    self.run_joined(io);
+                }
                 LineRead::Eof => {
                     self.line = line;
                     budget -= 1;
@@ -492,8 +513,20 @@ impl Decoder {
                 LineRead::Line(meta) => {
                     self.starved = false;
                     budget -= 1;
-                    self.counter += 1;
                     self.stats.lines += 1;
+                    if self.joiner.is_open()
+                        || (continuation(&line).is_some() && !self.top().comment_block)
+                    {
+                        if !self.joiner.is_open() {
+                            self.join_meta = meta;
+                        }
+                        if self.joiner.push(&line) {
+                            self.run_joined(io);
+                        }
+                        self.line = line;
+                        continue;
+                    }
+                    self.counter += 1;
                     let r = self.process_line(&line, meta, io);
                     self.line = line;
                     if let Err(e) = r {
@@ -502,6 +535,26 @@ impl Decoder {
                 }
             }
         }
+    }
+
+    /// Run the block collected from several lines; an error's column names the line it
+    /// was written in.
+    fn run_joined(&mut self, io: &mut DecoderIo<'_>) {
+        let joiner = std::mem::take(&mut self.joiner);
+        let meta = self.join_meta;
+        self.counter += 1;
+        let r = self.process_line(joiner.text(), meta, io);
+        if let Err(mut e) = r {
+            let mut at = meta;
+            if let Some(col) = e.col {
+                let (line, col) = joiner.position(col);
+                at.line = at.line.saturating_add(line);
+                e.col = Some(col);
+            }
+            self.fail(e, at);
+        }
+        self.joiner = joiner;
+        self.joiner.close();
     }
 
     fn fail(&mut self, e: DecodeError, meta: LineMeta) {

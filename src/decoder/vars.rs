@@ -438,6 +438,16 @@ impl VarStore {
         Ok(elements)
     }
 
+    /// Write `values` into the first elements of `name`, just declared (an array
+    /// initialiser, row-major); the parser refuses more values than elements.
+    pub fn fill(&mut self, scope: VScope, name: &str, values: &[f64]) {
+        if let Some(var) = self.scope_mut(scope).vars.get_mut(name) {
+            for (d, v) in var.values.iter_mut().zip(values) {
+                *d = *v;
+            }
+        }
+    }
+
     /// V.E. written from outside the channel.
     pub fn set_external(&mut self, name: &str, v: f64) -> Result<(), VarError> {
         self.set(

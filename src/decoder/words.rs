@@ -43,8 +43,11 @@ pub(super) struct Words {
     /// `G04 <t>` / `G04 P<t>`: the dwell time in seconds.
     dwell_s: Option<f64>,
     ms: [u32; MAX_FUNCTIONS],
+    /// The value of each M programmed with one (`M200=1200`), by its place in `ms`.
+    m_values: [Option<f64>; MAX_FUNCTIONS],
     n_ms: usize,
     hs: [u32; MAX_FUNCTIONS],
+    h_values: [Option<f64>; MAX_FUNCTIONS],
     n_hs: usize,
 }
 
@@ -162,6 +165,24 @@ impl Decoder {
                 }
                 w.push_g(*g, *col).map_err(|e| e.at(*col))
             }
+            Item::FunctionValue {
+                letter,
+                number,
+                value,
+                col,
+            } => {
+                let v = match value {
+                    Value::Num(n) => *n,
+                    Value::Expr(e) => self.eval(e).map_err(|e| e.at(*col))?,
+                };
+                let n = f64::from(*number);
+                if *letter == b'H' {
+                    push_function(&mut w.hs, &mut w.h_values, &mut w.n_hs, (n, Some(v)), 'H')
+                } else {
+                    push_function(&mut w.ms, &mut w.m_values, &mut w.n_ms, (n, Some(v)), 'M')
+                }
+                .map_err(|e| e.at(*col))
+            }
             Item::Word(word) => {
                 let v = match &word.value {
                     Value::Num(n) => *n,
@@ -182,8 +203,8 @@ impl Decoder {
         match letter {
             // The parser takes G, M and H as literal whole numbers only.
             b'G' => w.push_g(whole(v).unwrap_or(u32::MAX), col)?,
-            b'M' => push_function(&mut w.ms, &mut w.n_ms, v, 'M')?,
-            b'H' => push_function(&mut w.hs, &mut w.n_hs, v, 'H')?,
+            b'M' => push_function(&mut w.ms, &mut w.m_values, &mut w.n_ms, (v, None), 'M')?,
+            b'H' => push_function(&mut w.hs, &mut w.h_values, &mut w.n_hs, (v, None), 'H')?,
             b'F' => w.feed = Some((v, col)),
             b'S' => w.spindle_rpm = Some(v),
             // Whole numbers: the range check above refused anything else.
@@ -400,8 +421,13 @@ impl Decoder {
         queued: bool,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        for &h in w.hs() {
-            self.notes.push(Note::HFunction { h });
+        for (&h, &value) in w.hs().iter().zip(&w.h_values) {
+            self.notes.push(Note::HFunction { h, value });
+        }
+        for (&m, &value) in w.ms().iter().zip(&w.m_values) {
+            if let Some(value) = value {
+                self.notes.push(Note::MFunction { m, value });
+            }
         }
         let stop = w.ms().iter().copied().find(|m| matches!(m, 0 | 1));
         let queued = match stop {
@@ -483,8 +509,15 @@ fn unconfigured(letter: u8) -> DecodeError {
     )
 }
 
-/// Add an M or H number to the block's list (at most [`MAX_FUNCTIONS`]).
-fn push_function(list: &mut [u32; MAX_FUNCTIONS], n: &mut usize, v: f64, letter: char) -> Res {
+/// Add an M or H number, and its value if programmed with one, to the block's list (at most
+/// [`MAX_FUNCTIONS`]).
+fn push_function(
+    list: &mut [u32; MAX_FUNCTIONS],
+    values: &mut [Option<f64>; MAX_FUNCTIONS],
+    n: &mut usize,
+    (v, value): (f64, Option<f64>),
+    letter: char,
+) -> Res {
     if *n == list.len() {
         return Err(DecodeError::new(
             codes::SYNTAX,
@@ -493,6 +526,7 @@ fn push_function(list: &mut [u32; MAX_FUNCTIONS], n: &mut usize, v: f64, letter:
     }
     // The parser admits only whole numbers 0..=65535 for M and H.
     list[*n] = whole(v).unwrap_or(0);
+    values[*n] = value;
     *n += 1;
     Ok(())
 }

@@ -39,8 +39,14 @@ pub enum Body {
     Command(Command),
     /// `L file`, `LL name`, `L CYCLE [...]`.
     Call(Call),
-    /// `%name` (main program head) or `%L name` (local subroutine head).
-    ProgramHead { name: String, local: bool },
+    /// `%name` (main program head) or `%L name` (local subroutine head). A blank may stand
+    /// between `%` and the name (`% 100`); text after the name up to a comment is the
+    /// program's `title` (`% TestProgram for streaming mode`), empty when there is none.
+    ProgramHead {
+        name: String,
+        local: bool,
+        title: String,
+    },
 }
 
 /// One element of an ordinary block.
@@ -59,6 +65,14 @@ pub enum Item {
     /// parse to this item. `col` is the G's column.
     GValue {
         g: u32,
+        value: Value,
+        col: u32,
+    },
+    /// An M or H function with a value for the PLC side: `M200=1200`, `H20=[P1*2]`
+    /// (`letter` b'M' or b'H', `number` 0..=65535). `col` is the letter's column.
+    FunctionValue {
+        letter: u8,
+        number: u32,
         value: Value,
         col: u32,
     },
@@ -299,7 +313,8 @@ pub enum Call {
     },
 }
 
-/// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`.
+/// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,
+/// `V.L.N : UNS32 = 10`, `V.P.ROW[3] = [10, 11, 12]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VarDecl {
     pub scope: VScope,
@@ -307,5 +322,46 @@ pub struct VarDecl {
     pub name: String,
     /// Array dimensions as declared (`[10]` → `[10]`); empty for a scalar.
     pub dims: Vec<u32>,
+    /// The type named after `:`, if one is (`V.L.N : UNS32`).
+    pub ty: Option<VarType>,
+    /// The value every element starts with (`= 5`); none for a list or a string.
     pub init: Option<Expr>,
+    /// An array initialiser `= [10, 11, 12]`: the first elements in row-major order (the
+    /// rest stay 0). Empty when there is none.
+    pub values: Vec<Expr>,
+}
+
+/// The data types a declaration may name (TF5200 programming manual, "Variables": the
+/// elementary types of V.E. variables, as ISG's editor grammar lists them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarType {
+    Boolean,
+    Sgn08,
+    Uns08,
+    Sgn16,
+    Uns16,
+    Sgn32,
+    Uns32,
+    /// `REAL` or `REAL64`.
+    Real,
+    /// `STRING[n]`, n characters at most (1 to 126). ncchannel's values are numbers: a
+    /// string variable is accepted and not kept (docs/nc-language.md, "Variables").
+    String(u8),
+}
+
+impl VarType {
+    /// The type's name as written in a declaration (`REAL` as `REAL64`).
+    pub fn name(self) -> &'static str {
+        match self {
+            VarType::Boolean => "BOOLEAN",
+            VarType::Sgn08 => "SGN08",
+            VarType::Uns08 => "UNS08",
+            VarType::Sgn16 => "SGN16",
+            VarType::Uns16 => "UNS16",
+            VarType::Sgn32 => "SGN32",
+            VarType::Uns32 => "UNS32",
+            VarType::Real => "REAL64",
+            VarType::String(_) => "STRING",
+        }
+    }
 }

@@ -10,6 +10,7 @@ use std::collections::{HashMap, HashSet};
 
 use super::block::{Body, Command, Control, GotoTarget, Label};
 use super::codes::{StrayKind, LABEL_NOT_FOUND, LABEL_TWICE, OPEN_CONTROL_BLOCK, SYNTAX};
+use super::join::{continuation, Joiner};
 use super::parse::{is_comment_end, parse_block, parse_var_line, VarLine};
 
 /// Most findings one check lists. A file of garbage (a binary, a log passed by mistake) has
@@ -239,93 +240,138 @@ pub fn check_program(text: &str) -> Vec<ProgramDiag> {
 /// [`check_program`], and the number of findings in all (more than the list holds when the
 /// list was cut at [`MAX_PROGRAM_DIAGS`]).
 pub fn check_program_counted(text: &str) -> (Vec<ProgramDiag>, usize) {
-    let mut diags = Diags::default();
-    let mut level = Level::default();
-    let mut comment_from: Option<usize> = None;
-    let mut var_from: Option<(usize, usize)> = None;
+    let mut c = Checker::default();
+    let mut joiner = Joiner::default();
+    let mut first = 0;
     for (idx, raw) in text.lines().enumerate() {
         let line = idx + 1;
-        if comment_from.is_some() {
+        if c.comment_from.is_some() {
+            // Comment text is not NC: no line of it continues another.
             if is_comment_end(raw) {
-                comment_from = None;
+                c.comment_from = None;
             }
             continue;
         }
-        if var_from.is_some() {
-            // The decoder reads these lines with the same function.
-            match parse_var_line(raw) {
-                Ok(VarLine::End) => var_from = None,
-                Ok(VarLine::Blank | VarLine::Decl(_)) => {}
-                Err(e) => diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message)),
+        if joiner.is_open() || continuation(raw).is_some() {
+            // A block written over several lines (`\`): checked once it is complete.
+            if !joiner.is_open() {
+                first = line;
+            }
+            if joiner.push(raw) {
+                c.block(joiner.text(), first, Some(&joiner));
             }
             continue;
+        }
+        c.block(raw, line, None);
+    }
+    if joiner.is_open() {
+        // The text ends in a continued line: the block is what there is, as in a run.
+        c.block(joiner.text(), first, Some(&joiner));
+    }
+    c.finish()
+}
+
+/// The state of one check between lines.
+#[derive(Default)]
+struct Checker {
+    diags: Diags,
+    level: Level,
+    comment_from: Option<usize>,
+    var_from: Option<(usize, usize)>,
+}
+
+/// The line and column of column `col` of a block that starts in `line`, written over
+/// several lines when `joined`.
+fn place(line: usize, col: usize, joined: Option<&Joiner>) -> (usize, usize) {
+    match joined {
+        Some(j) => {
+            let (d, c) = j.position(col as u32);
+            (line + d as usize, c as usize)
+        }
+        None => (line, col),
+    }
+}
+
+impl Checker {
+    fn push(&mut self, line: usize, col: usize, joined: Option<&Joiner>, code: u32, msg: String) {
+        let (line, col) = place(line, col, joined);
+        self.diags.push(ProgramDiag::new(line, col, code, msg));
+    }
+
+    /// One block (one line, or the lines of a block joined by `\`) starting in `line`.
+    fn block(&mut self, raw: &str, line: usize, joined: Option<&Joiner>) {
+        if self.var_from.is_some() {
+            // The decoder reads these lines with the same function.
+            match parse_var_line(raw) {
+                Ok(VarLine::End) => self.var_from = None,
+                Ok(VarLine::Blank | VarLine::Decl(_)) => {}
+                Err(e) => self.push(line, e.col as usize, joined, e.code, e.message),
+            }
+            return;
         }
         let block = match parse_block(raw) {
             Ok(b) => b,
-            Err(e) => {
-                diags.push(ProgramDiag::new(line, e.col as usize, e.code, e.message));
-                continue;
-            }
+            Err(e) => return self.push(line, e.col as usize, joined, e.code, e.message),
         };
         if let Some(n) = block.n {
-            level.block_numbers.insert(n);
+            self.level.block_numbers.insert(n);
         }
         if let Some(label) = &block.label {
             let col = match label {
                 Label::Number(_) => col_of(raw, "N"),
                 Label::Name(_) => col_of(raw, "["),
             };
-            if let Some(first) = level.labels.get(label) {
-                diags.push(ProgramDiag::new(
-                    line,
-                    col,
-                    LABEL_TWICE,
-                    format!("label {label} already defined in line {first}"),
-                ));
+            if let Some(first) = self.level.labels.get(label) {
+                let msg = format!("label {label} already defined in line {first}");
+                self.push(line, col, joined, LABEL_TWICE, msg);
             } else {
-                level.labels.insert(label.clone(), line);
+                self.level.labels.insert(label.clone(), line);
             }
         }
         match &block.body {
-            Body::Command(Command::CommentBegin) => comment_from = Some(line),
-            Body::Command(Command::Var) => var_from = Some((line, col_of(raw, "#"))),
-            Body::Command(Command::EndVar) => diags.push(ProgramDiag::new(
-                line,
-                col_of(raw, "#"),
-                SYNTAX,
-                "#ENDVAR without #VAR",
-            )),
+            Body::Command(Command::CommentBegin) => self.comment_from = Some(line),
+            Body::Command(Command::Var) => {
+                self.var_from = Some(place(line, col_of(raw, "#"), joined));
+            }
+            Body::Command(Command::EndVar) => {
+                let msg = "#ENDVAR without #VAR".to_string();
+                self.push(line, col_of(raw, "#"), joined, SYNTAX, msg);
+            }
             Body::ProgramHead { .. } => {
-                std::mem::take(&mut level).finish(&mut diags);
+                std::mem::take(&mut self.level).finish(&mut self.diags);
             }
             Body::Control(c) => {
                 let col = match c {
                     Control::IfGoto(..) => col_of(raw, "$GOTO"),
                     _ => col_of(raw, "$"),
                 };
-                level.control(c, line, col, &mut diags);
+                let (line, col) = place(line, col, joined);
+                self.level.control(c, line, col, &mut self.diags);
             }
             _ => {}
         }
     }
-    level.finish(&mut diags);
-    if let Some(line) = comment_from {
-        diags.push(ProgramDiag::new(
-            line,
-            1,
-            OPEN_CONTROL_BLOCK,
-            "#COMMENT BEGIN not closed by #COMMENT END before the program ends",
-        ));
+
+    fn finish(mut self) -> (Vec<ProgramDiag>, usize) {
+        self.level.finish(&mut self.diags);
+        if let Some(line) = self.comment_from {
+            self.diags.push(ProgramDiag::new(
+                line,
+                1,
+                OPEN_CONTROL_BLOCK,
+                "#COMMENT BEGIN not closed by #COMMENT END before the program ends",
+            ));
+        }
+        if let Some((line, col)) = self.var_from {
+            self.diags.push(ProgramDiag::new(
+                line,
+                col,
+                OPEN_CONTROL_BLOCK,
+                "#VAR not closed by #ENDVAR before the program ends",
+            ));
+        }
+        let Diags { mut kept, found } = self.diags;
+        kept.sort_by_key(|d| (d.line, d.col));
+        (kept, found)
     }
-    if let Some((line, col)) = var_from {
-        diags.push(ProgramDiag::new(
-            line,
-            col,
-            OPEN_CONTROL_BLOCK,
-            "#VAR not closed by #ENDVAR before the program ends",
-        ));
-    }
-    let Diags { mut kept, found } = diags;
-    kept.sort_by_key(|d| (d.line, d.col));
-    (kept, found)
 }

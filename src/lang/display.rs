@@ -16,7 +16,7 @@ use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
     BinOp, Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Index, Item, Label,
-    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, Word,
+    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 
 impl Display for Block {
@@ -59,11 +59,19 @@ impl Display for Block {
             Body::Control(c) => write!(f, "{sep}{c}"),
             Body::Command(c) => write!(f, "{sep}{c}"),
             Body::Call(c) => write!(f, "{sep}{c}"),
-            Body::ProgramHead { name, local } => {
+            Body::ProgramHead { name, local, title } => {
                 if *local {
-                    write!(f, "{sep}%L {}", FileName(name))
+                    write!(f, "{sep}%L {}", FileName(name))?;
+                } else if name.eq_ignore_ascii_case("L") && !title.is_empty() {
+                    // `%L title` would be a local subroutine head.
+                    write!(f, "{sep}%\"{name}\"")?;
                 } else {
-                    write!(f, "{sep}%{}", FileName(name))
+                    write!(f, "{sep}%{}", FileName(name))?;
+                }
+                if title.is_empty() {
+                    Ok(())
+                } else {
+                    write!(f, " {title}")
                 }
             }
         }
@@ -88,6 +96,18 @@ impl Display for Item {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
                 Value::Expr(e) => write!(f, "G{g}={e}"),
             },
+            Item::FunctionValue {
+                letter,
+                number,
+                value,
+                ..
+            } => {
+                let l = char::from(*letter);
+                match value {
+                    Value::Num(v) => write!(f, "{l}{number}={}", Num(*v)),
+                    Value::Expr(e) => write!(f, "{l}{number}={e}"),
+                }
+            }
         }
     }
 }
@@ -404,9 +424,24 @@ impl Display for VarDecl {
         for d in &self.dims {
             write!(f, "[{d}]")?;
         }
-        match &self.init {
-            Some(e) => write!(f, "={e}"),
-            None => Ok(()),
+        match self.ty {
+            Some(VarType::String(n)) => write!(f, " : STRING[{n}]")?,
+            Some(t) => write!(f, " : {}", t.name())?,
+            None => {}
         }
+        if let Some(e) = &self.init {
+            return write!(f, "={e}");
+        }
+        if !self.values.is_empty() {
+            f.write_str("=[")?;
+            for (k, e) in self.values.iter().enumerate() {
+                if k > 0 {
+                    f.write_str(", ")?;
+                }
+                write!(f, "{e}")?;
+            }
+            f.write_char(']')?;
+        }
+        Ok(())
     }
 }

@@ -189,6 +189,13 @@ impl<'a> Ctx<'a> {
         Ok(())
     }
 
+    /// The same line cut after its first `len` bytes (a char boundary): a parser that must
+    /// stop there (`XP1*2 Y3`: an unbracketed word value ends at the blank) and still
+    /// reports the columns of the whole line.
+    pub(crate) fn cut(&self, len: usize) -> Ctx<'a> {
+        Ctx::with_ascii(&self.line[..len.min(self.line.len())], self.ascii)
+    }
+
     /// 1-based character column of the position where `rest` starts.
     pub fn col(&self, rest: &str) -> u32 {
         let off = self.line.len().saturating_sub(rest.len());

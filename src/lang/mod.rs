@@ -13,6 +13,7 @@ mod display;
 pub mod error;
 pub mod eval;
 pub mod expr;
+pub mod join;
 mod number;
 pub mod parse;
 pub mod range;
@@ -22,6 +23,7 @@ pub use check::{check_program, check_program_counted, ProgramDiag, MAX_PROGRAM_D
 pub use error::SyntaxError;
 pub use eval::{case_matches, eval, is_true, resolve, EvalError, VarKey, Vars};
 pub use expr::parse_expr;
+pub use join::{continuation, Joiner};
 pub use parse::{
     is_blank_line, is_comment_end, parse_block, parse_var_declaration, parse_var_line, VarLine,
 };

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, FlushKind, GotoTarget, Item, Label, SplineCommand, VScope,
-    Value, VarDecl, VarRef, Word,
+    Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Item, Label, SplineCommand,
+    VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -238,8 +238,9 @@ fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> 
         }
         Some(b'%') => {
             let (r, (name, local)) = program_head(i)?;
+            let (r, title) = program_title(r);
             end_of_block(r, "nothing may follow a program head in its block")?;
-            Body::ProgramHead { name, local }
+            Body::ProgramHead { name, local, title }
         }
         Some(b'L' | b'l') if starts_call(i) => {
             let (r, c) = call(ctx, i)?;
@@ -357,7 +358,7 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } => false,
+        Item::Assign { .. } | Item::FunctionValue { .. } => false,
     }
 }
 
@@ -399,6 +400,12 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
             Item::GValue { g, col, .. } => (*col, format!("G{g}")),
+            Item::FunctionValue {
+                letter,
+                number,
+                col,
+                ..
+            } => (*col, format!("{}{number}", char::from(*letter))),
         };
         return Err(ctx.err_at(
             col,
@@ -425,6 +432,15 @@ fn word<'a>(
     let ab = after.as_bytes();
     let (neg, skip) = match ab.first() {
         Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
+        Some(b'P' | b'p' | b'V' | b'v' | b'@') if starts_variable(ab) => {
+            return word_unbracketed(ctx, i, up, col, after, items)
+        }
+        Some(b'-' | b'+') if starts_variable(&ab[1..]) => {
+            return word_unbracketed(ctx, i, up, col, after, items)
+        }
+        Some(b'=' | b' ' | b'\t') if is_axis_letter(up) && ws(after).starts_with('=') => {
+            return axis_assigned(ctx, up, col, after, items)
+        }
         Some(b'-') if ab.get(1) == Some(&b'[') => {
             return word_expr(ctx, i, up, col, &after[1..], true, items)
         }
@@ -469,6 +485,11 @@ fn word<'a>(
                 format!("H function H{v} outside 0 to 65535"),
             ));
         }
+        b'M' | b'H' => {
+            if let Some(r) = ws(rest).strip_prefix('=') {
+                return function_value(ctx, (up, v), col, r, items);
+            }
+        }
         _ => {
             if let Err(e) = word_value(up, v) {
                 return Err(perr(i, e.code, e.message));
@@ -483,6 +504,123 @@ fn word<'a>(
     Ok(rest)
 }
 
+/// G, M and H take literal numbers only.
+fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
+    match up {
+        b'G' => Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
+        b'M' => Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
+        b'H' => Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
+        _ => Ok(()),
+    }
+}
+
+/// `M200=1200`: an M or H function with a value (TF5200 programming manual, "User-specific
+/// technology functions"); `i` is the text after the `=`.
+#[cold]
+fn function_value<'a>(
+    ctx: &Ctx<'a>,
+    (up, number): (u8, f64),
+    col: u32,
+    i: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let (r, e) = ctx.expr(ws(i))?;
+    items.push(Item::FunctionValue {
+        letter: up,
+        number: integer_code(number).unwrap_or(0),
+        value: expr_value(e),
+        col,
+    });
+    Ok(r)
+}
+
+/// `X=10`, `X = P1+2`: an axis given an expression after an equals sign.
+#[cold]
+fn axis_assigned<'a>(
+    ctx: &Ctx<'a>,
+    up: u8,
+    col: u32,
+    after: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let (r, e) = ctx.expr(ws(&ws(after)[1..]))?;
+    items.push(Item::Word(Word {
+        letter: up,
+        value: expr_value(e),
+        col,
+    }));
+    Ok(r)
+}
+
+/// An axis name: X Y Z A B C and the further axis names U V W. Axis names with digits
+/// (`A1`) are not configurable (`src/params/axes.rs`), so `A1 = 0` stays refused.
+fn is_axis_letter(up: u8) -> bool {
+    matches!(
+        up,
+        b'X' | b'Y' | b'Z' | b'A' | b'B' | b'C' | b'U' | b'V' | b'W'
+    )
+}
+
+/// Does a parameter or variable start here (`P1`, `P[..]`, `V.L.X`, `@P1`)?
+fn starts_variable(b: &[u8]) -> bool {
+    match b {
+        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[',
+        [b'V' | b'v', b'.', ..] => true,
+        [b'@', b'P' | b'p', ..] => true,
+        _ => false,
+    }
+}
+
+/// A word whose value is an expression starting with a parameter or variable, written
+/// without brackets: `XP1*SIN[P2*30]`, `TV.P.TOOLNR`, `BP10+P20`. The expression runs to
+/// the next blank or comment outside brackets (TF5200 programming manual, "Arithmetic
+/// expressions" and "Parameters").
+#[cold]
+fn word_unbracketed<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    after: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    literal_only(i, up)?;
+    let mut depth = 0usize;
+    let end = after
+        .bytes()
+        .position(|b| match b {
+            b'[' => {
+                depth += 1;
+                false
+            }
+            b']' => {
+                depth = depth.saturating_sub(1);
+                false
+            }
+            b' ' | b'\t' | b'(' | b';' => depth == 0,
+            _ => false,
+        })
+        .unwrap_or(after.len());
+    let cut = ctx.cut(ctx.line.len() - after.len() + end);
+    let text = &cut.line[cut.line.len() - end..];
+    let e = match cut.expr(text) {
+        Ok(("", e)) => e,
+        Ok((rest, _)) => {
+            return Err(ctx.err_at(cut.col(rest), SYNTAX, "operator or blank expected"));
+        }
+        Err(e) => {
+            let e = cut.to_error(e);
+            return Err(ctx.err_at(e.col, e.code, e.message));
+        }
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
+        col,
+    }));
+    Ok(&after[end..])
+}
+
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
 fn word_expr<'a>(
     ctx: &Ctx<'a>,
@@ -493,12 +631,7 @@ fn word_expr<'a>(
     negate: bool,
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
-    match up {
-        b'G' => return Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
-        b'M' => return Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
-        b'H' => return Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
-        _ => {}
-    }
+    literal_only(i, up)?;
     let (rest, e) = ctx.bracketed(bracket)?;
     let e = if negate {
         super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
@@ -1021,9 +1154,9 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     }
 }
 
-/// `%name` or `%L name`.
+/// `%name`, `% name` or `%L name` (TF5200 programming manual, "NC block structure": `% 100`).
 fn program_head(i: &str) -> PResult<'_, (String, bool)> {
-    let after = &i[1..];
+    let after = ws(&i[1..]);
     let ab = after.as_bytes();
     if matches!(ab.first(), Some(b'L' | b'l')) && matches!(ab.get(1), Some(b' ' | b'\t')) {
         let r = ws(&after[1..]);
@@ -1037,12 +1170,22 @@ fn program_head(i: &str) -> PResult<'_, (String, bool)> {
     Ok((rest, (name.to_string(), false)))
 }
 
+/// The text after a program head's name up to a comment, trimmed: the program's title
+/// (`% TestProgram for streaming mode`, `%Test - Achsen`). Kept, never interpreted.
+fn program_title(i: &str) -> (&str, String) {
+    let t = ws(i);
+    let end = t.find([';', '(']).unwrap_or(t.len());
+    (&t[end..], t[..end].trim_end().to_string())
+}
+
 // ---------------------------------------------------------------------------------------
 // #VAR declarations
 // ---------------------------------------------------------------------------------------
 
 fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'a>>> {
-    let i = gap(line);
+    // A line of a #VAR block may carry a block number (`N50 V.S.EXAMPLE[5] = [1,2,3,4,5]`).
+    let (i, _) = prefix(ws(line))?;
+    let i = gap(i);
     let b = i.as_bytes();
     if !(matches!(b.first(), Some(b'V' | b'v')) && b.get(1) == Some(&b'.')) {
         return Err(perr(
@@ -1107,19 +1250,151 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
             ),
         ));
     }
+    let (r, ty) = var_type(ws(r), r)?;
     let j = ws(r);
-    let (r, init) = match j.strip_prefix('=') {
+    let (r, init, values) = match j.strip_prefix('=') {
+        Some(k) if matches!(ty, Some(VarType::String(_))) => {
+            (string_init(ws(k), ty)?, None, Vec::new())
+        }
+        Some(k) if !dims.is_empty() && is_list(ws(k)) => {
+            let (r, values) = init_list(ctx, ws(k), elements)?;
+            (r, None, values)
+        }
         Some(k) => {
             let (r, e) = ctx.expr(ws(k))?;
-            (r, Some(e))
+            (r, Some(e), Vec::new())
         }
-        None => (r, None),
+        None => (r, None, Vec::new()),
     };
     end_of_block(r, "nothing may follow a declaration")?;
     Ok(VarDecl {
         scope,
         name,
         dims,
+        ty,
         init,
+        values,
     })
+}
+
+/// `: <type>` after a declared name (`: UNS32`, `: STRING[20]`), if there is one; `none` is
+/// the input to go on from when there is not.
+fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
+    let Some(t) = i.strip_prefix(':') else {
+        return Ok((none, None));
+    };
+    let t = ws(t);
+    let len = t
+        .bytes()
+        .take_while(u8::is_ascii_alphanumeric)
+        .count()
+        .min(16);
+    let ty = match t[..len].to_ascii_uppercase().as_str() {
+        "BOOLEAN" => VarType::Boolean,
+        "SGN08" => VarType::Sgn08,
+        "UNS08" => VarType::Uns08,
+        "SGN16" => VarType::Sgn16,
+        "UNS16" => VarType::Uns16,
+        "SGN32" => VarType::Sgn32,
+        "UNS32" => VarType::Uns32,
+        "REAL" | "REAL64" => VarType::Real,
+        "STRING" => {
+            let s = &t[len..];
+            let size = s.strip_prefix('[').and_then(|n| {
+                let (rest, n) = uint(n).ok()?;
+                let rest = rest.strip_prefix(']')?;
+                (1..=126).contains(&n).then_some((rest, n as u8))
+            });
+            return match size {
+                Some((rest, n)) => Ok((rest, Some(VarType::String(n)))),
+                None => fail(s, SYNTAX, "STRING[<length 1 to 126>] expected"),
+            };
+        }
+        _ => {
+            return fail(
+                t,
+                SYNTAX,
+                "data type BOOLEAN, SGN08, UNS08, SGN16, UNS16, SGN32, UNS32, REAL64 or STRING[n] expected",
+            )
+        }
+    };
+    Ok((&t[len..], Some(ty)))
+}
+
+/// The quoted start value of a `STRING[n]` variable, at most n characters.
+fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>> {
+    let Some(q) = i.strip_prefix('"') else {
+        return Err(perr(
+            i,
+            SYNTAX,
+            "a STRING variable starts with a \"quoted\" text",
+        ));
+    };
+    let Some(end) = q.find('"') else {
+        return Err(perr(i, SYNTAX, "closing `\"` missing"));
+    };
+    let max = match ty {
+        Some(VarType::String(n)) => usize::from(n),
+        _ => 0,
+    };
+    if q[..end].chars().count() > max {
+        return Err(perr(
+            i,
+            SYNTAX,
+            format!("text longer than the STRING[{max}] declared"),
+        ));
+    }
+    Ok(&q[end + 1..])
+}
+
+/// Does `[` open a list (`[10, 11, 12]`: a comma outside inner brackets) rather than a
+/// bracketed expression (`[P1*2]`, the value of every element)?
+fn is_list(i: &str) -> bool {
+    if !i.starts_with('[') {
+        return false;
+    }
+    let mut depth = 0usize;
+    for b in i.bytes() {
+        match b {
+            b'[' => depth += 1,
+            b']' => {
+                depth -= 1;
+                if depth == 0 {
+                    return false;
+                }
+            }
+            b',' if depth == 1 => return true,
+            _ => {}
+        }
+    }
+    false
+}
+
+/// `[e1, e2, …]`: an array's first `elements` values at most.
+fn init_list<'a>(ctx: &Ctx<'a>, i: &'a str, elements: u64) -> PResult<'a, Vec<Expr>> {
+    let open = i;
+    let mut values = Vec::new();
+    let mut j = &i[1..];
+    loop {
+        j = ws(j);
+        let (r, e) = ctx.expr(j)?;
+        if values.len() as u64 == elements {
+            return fail(
+                j,
+                SYNTAX,
+                format!("more values than the {elements} elements declared"),
+            );
+        }
+        values.push(e);
+        let r = ws(r);
+        if let Some(r) = r.strip_prefix(',') {
+            j = r;
+        } else if let Some(r) = r.strip_prefix(']') {
+            return Ok((r, values));
+        } else if r.is_empty() {
+            return fail(open, SYNTAX, "`]` missing after the values");
+        } else {
+            return fail(r, SYNTAX, "`,` or `]` expected");
+        }
+    }
 }

@@ -117,9 +117,20 @@ pub enum EventKind {
         text: String,
         save: bool,
     },
-    /// An H function decoded (0..=65535), for the PLC side.
+    /// An H function decoded (0..=65535), for the PLC side; `value` only when programmed
+    /// with one (`H20=5`).
     HFunction {
         h: u32,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        value: Option<f64>,
+    },
+    /// An M function programmed with a value (`M200=1200`, TF5200 "User-specific technology
+    /// functions"), for the PLC side. M functions without a value have no event of their own
+    /// (their block's `block` event shows them); `value` is optional so that they may.
+    MFunction {
+        m: u32,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        value: Option<f64>,
     },
     /// M00 (`m` 0) or M01 (`m` 1, M01 switch on) reached: the channel holds until the next
     /// start.

@@ -1,0 +1,318 @@
+//! Constructs of real ISG programs (TF5200 programming manual; the test programs of ISG's
+//! editor support `isg-stuttgart/vscode-isg-cnc`, `src/test/res/*.nc`): each one run from a
+//! file and streamed — whole and one line per packet — with `check` agreeing with the run.
+
+mod common;
+
+use common::{feeder, Rig, RunResult};
+use ncchannel::channel::Finish;
+use ncchannel::lang::*;
+
+/// `text` run from a file, streamed in large packets and streamed one line per packet. Every
+/// run must finish the same way with the same blocks; returns the file run.
+fn run_everywhere(rig: &Rig, text: &str) -> RunResult {
+    rig.program("t.nc", text);
+    let file = rig.run("t.nc", None, 1_000_000);
+    let one_per_packet: String = text.lines().map(|l| format!("{l}\n\x0c 2\n")).collect();
+    for (how, input) in [
+        ("large packets", text.to_string()),
+        ("line per packet", one_per_packet),
+    ] {
+        let s = rig.run("streaming.nc", Some(feeder(&input, 992, 1)), 1_000_000);
+        assert_eq!(s.finish, file.finish, "{how}: {}\n{}", text, s.log);
+        if file.finish == Some(Finish::Ended) {
+            assert_eq!(s.block_texts(), file.block_texts(), "{how}: {text}");
+        }
+        assert_eq!(error_places(&s), error_places(&file), "{how}: {text}");
+    }
+    file
+}
+
+/// (code, line, column) of each error event; the column is the message's "(column N)".
+fn error_places(r: &RunResult) -> Vec<(u64, u64, u64)> {
+    r.of("error")
+        .iter()
+        .map(|e| {
+            let msg = e["msg"].as_str().unwrap_or("");
+            let col = msg
+                .rsplit_once("(column ")
+                .and_then(|(_, c)| c.trim_end_matches(')').parse().ok())
+                .unwrap_or(0);
+            (
+                e["code"].as_u64().unwrap_or(0),
+                e["line"].as_u64().unwrap_or(0),
+                col,
+            )
+        })
+        .collect()
+}
+
+/// (line, column, code) of each finding of `check`.
+fn check_places(text: &str) -> Vec<(usize, usize, u32)> {
+    check_program(text)
+        .into_iter()
+        .map(|d| (d.line, d.col, d.code))
+        .collect()
+}
+
+/// A program that must run to its end everywhere and check clean.
+fn runs_clean(rig: &Rig, text: &str) -> RunResult {
+    assert_eq!(check_places(text), [], "check: {text}");
+    let r = run_everywhere(rig, text);
+    assert_eq!(r.finish, Some(Finish::Ended), "{text}\n{}", r.log);
+    r
+}
+
+/// A program that fails with one error, the same in check (when `check_sees`) and every run.
+fn fails_at(rig: &Rig, text: &str, code: u32, line: usize, col: usize, check_sees: bool) {
+    let r = run_everywhere(rig, text);
+    assert_eq!(r.finish, Some(Finish::Error), "{text}\n{}", r.log);
+    assert_eq!(
+        error_places(&r),
+        [(u64::from(code), line as u64, col as u64)],
+        "{text}"
+    );
+    if check_sees {
+        assert_eq!(check_places(text), [(line, col, code)], "check: {text}");
+    }
+}
+
+#[test]
+fn program_heads_with_a_blank_or_a_title() {
+    for (line, name, title) in [
+        ("% 100", "100", ""),
+        (
+            "% TestProgram for streaming mode",
+            "TestProgram",
+            "for streaming mode",
+        ),
+        ("%Test - Achsen", "Test", "- Achsen"),
+        ("% 100 (comment)", "100", ""),
+        ("%L UP1   title words ; comment", "UP1", "title words"),
+    ] {
+        let b = parse_block(line).unwrap_or_else(|e| panic!("{line}: {e}"));
+        let Body::ProgramHead {
+            name: n, title: t, ..
+        } = &b.body
+        else {
+            panic!("{line}: {b:?}")
+        };
+        assert_eq!((n.as_str(), t.as_str()), (name, title), "{line}");
+        assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
+    }
+    let rig = Rig::new();
+    for head in [
+        "% 100",
+        "% TestProgram for streaming mode",
+        "%Test - Achsen",
+        "% 100 (comment)",
+    ] {
+        let r = runs_clean(&rig, &format!("{head}\nN10 G01 X10 F1000\nM30\n"));
+        assert_eq!(r.position('X'), 10.0, "{head}");
+    }
+}
+
+#[test]
+fn a_backslash_continues_the_block_in_the_next_line() {
+    let rig = Rig::new();
+    // A DIN block; the continuation line may bring a block number of its own.
+    let r = runs_clean(&rig, "N10 G01 F1000 \\\nN20 X10 Y20\nM30\n");
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 20.0));
+    assert_eq!(r.block_texts().len(), 2, "{:?}", r.block_texts());
+    // Comments after the `\`, and blank or comment lines between the lines of a block.
+    let r = runs_clean(
+        &rig,
+        "G01 X1 \\ (more follows)\n\n; a note\n  Y2 \\\n  F500\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (1.0, 2.0));
+    // A `\` inside a comment continues nothing.
+    let r = runs_clean(&rig, "G01 X3 F100 ; not continued \\\nY4\nM30\n");
+    assert_eq!(r.block_texts().len(), 3);
+    // L CYCLE [...] over several lines.
+    rig.program("c.cyc", "G01 X[@P1] Y[@P2] F1000\nM17\n");
+    let r = runs_clean(&rig, "L CYCLE [NAME=c.cyc \\\n  @P1=5 \\\n  @P2=7 ]\nM30\n");
+    assert_eq!((r.position('X'), r.position('Y')), (5.0, 7.0));
+    // A #VAR initialiser over two lines.
+    let r = runs_clean(
+        &rig,
+        "#VAR\n  V.L.N = 1 + \\\n    2\n#ENDVAR\nG01 X[V.L.N] F100\nM30\n",
+    );
+    assert_eq!(r.position('X'), 3.0);
+}
+
+#[test]
+fn an_error_in_a_continued_block_names_the_line_it_stands_in() {
+    let rig = Rig::new();
+    fails_at(
+        &rig,
+        "G01 X1 F100\nN10 G01 F1000 \\\nN20 X10 Q5\nM30\n",
+        20200,
+        3,
+        9,
+        true,
+    );
+    fails_at(&rig, "G01 X1 F100 \\\n\n  Y2 X3\nM30\n", 20203, 3, 6, true);
+    // The block limit holds for the joined block: 4000 characters, the 4001st is refused
+    // in the line it stands in.
+    let line = format!("{}\\\n", "X1 ".repeat(300).replace("X1", "G1"));
+    let text = format!("{}M30\n", line.repeat(6));
+    fails_at(&rig, &text, 20200, 5, 4001 - 4 * 901, true);
+}
+
+#[test]
+fn an_address_takes_a_parameter_expression_without_brackets() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "P1=10 P2=1 P10=1 P20=2\nG01 XP1*SIN[P2 * 30]*2 YP10+P20 F1000\nM30\n",
+    );
+    assert!((r.position('X') - 10.0).abs() < 1e-9, "{}", r.position('X'));
+    assert_eq!((r.position('Y'), r.position('Z')), (3.0, 0.0));
+    let r = runs_clean(
+        &rig,
+        "#VAR\n  V.P.TOOLNR = 7\n  V.L.x = 4\n#ENDVAR\nM6 TV.P.TOOLNR\nG01 XV.L.x Y-V.L.X F100\nM30\n",
+    );
+    assert_eq!(r.machine.channels()[0].decoder().modal().tool, 7);
+    assert_eq!((r.position('X'), r.position('Y')), (4.0, -4.0));
+    // The value ends at the blank: what follows is the next word.
+    let b = parse_block("XP1 +2").unwrap_err();
+    assert_eq!((b.code, b.col), (20200, 5), "{}", b.message);
+    fails_at(&rig, "P1=1\nG01 XP1*[P1 Y2 F100\nM30\n", 20200, 2, 13, true);
+    // An undefined variable is the run's error, at the word.
+    fails_at(
+        &rig,
+        "G01 X1 F100\nG01 YV.L.NOPE\nM30\n",
+        900005,
+        2,
+        5,
+        false,
+    );
+    // G, M and H still take literal numbers only.
+    assert_eq!(parse_block("MP1").unwrap_err().code, 20157);
+}
+
+#[test]
+fn an_m_function_takes_a_value_carried_with_its_event() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "P1=3\nG01 X1 F100 M200=1200\nM201 = P1*2 H20=5 H21\nM30\n",
+    );
+    let ms: Vec<(u64, f64)> = r
+        .of("m_function")
+        .iter()
+        .map(|e| (e["m"].as_u64().unwrap(), e["value"].as_f64().unwrap()))
+        .collect();
+    assert_eq!(ms, [(200, 1200.0), (201, 6.0)]);
+    let hs: Vec<(u64, Option<f64>)> = r
+        .of("h_function")
+        .iter()
+        .map(|e| (e["h"].as_u64().unwrap(), e["value"].as_f64()))
+        .collect();
+    assert_eq!(hs, [(20, Some(5.0)), (21, None)]);
+    // An M function without a value has no event of its own, as before.
+    let r = runs_clean(&rig, "M3 S1000\nM30\n");
+    assert_eq!(r.of("m_function").len(), 0);
+    // The number is still checked; an undefined value is the run's error at the M.
+    fails_at(&rig, "G01 X1 F100\nM70000=1\nM30\n", 20157, 2, 1, true);
+    fails_at(&rig, "G01 X1 F100\nX2 M200=P9\nM30\n", 900005, 2, 4, false);
+}
+
+#[test]
+fn an_axis_takes_an_expression_after_an_equals_sign() {
+    let rig = Rig::new();
+    let r = runs_clean(&rig, "P1=3\nG01 X=10 Y = P1+2 F100\nZ =-P1 * 2\nM30\n");
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (10.0, 5.0, -6.0)
+    );
+    // Axis names are X Y Z A B C (src/params/axes.rs): no axis is called A1.
+    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 4, true);
+    // F, S and the other addresses keep their plain form.
+    assert_eq!(parse_block("F=100").unwrap_err().col, 2);
+}
+
+#[test]
+fn var_declarations_take_types_lists_and_block_numbers() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "#VAR\n\
+         \x20 V.P.VAR_1\n\
+         \x20 V.P.VAR_3 : UNS32 = 10\n\
+         \x20 V.L.NAME_1 : STRING[20] = \"GRUNDPLATTE\"\n\
+         \x20 V.L.VAR_1 : REAL = 23.45\n\
+         \x20 V.L.VAR_2 : SGN08\n\
+         \x20 V.L.B : BOOLEAN = TRUE\n\
+         \x20 V.P.ARRAY_1[3][6] = [10,11,12,13,14,15, \\\n\
+         \x20                      20,21,22,23,24,25, \\\n\
+         \x20                      30,31,32,33,34,35 ]\n\
+         \x20 V.L.ROW[3] = [10, 11, 12]\n\
+         #ENDVAR\n\
+         N10 #VAR\n\
+         N20   V.S.EXAMPLE[5] = [1,2,3,4,5 ]\n\
+         N30 #ENDVAR\n\
+         G01 X[V.P.VAR_3] Y[V.P.ARRAY_1[1][2] + V.L.B] Z[V.L.ROW[2] + V.S.EXAMPLE[4] + V.L.VAR_1] F100\n\
+         M30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 23.0));
+    assert!(
+        (r.position('Z') - 40.45).abs() < 1e-9,
+        "{}",
+        r.position('Z')
+    );
+    let d = parse_var_declaration("N5 V.L.N : UNS32 = 10").unwrap();
+    assert_eq!(
+        (d.ty, d.to_string().as_str()),
+        (Some(VarType::Uns32), "V.L.N : UNS32=10")
+    );
+    let d = parse_var_declaration("V.P.T[2][2] = [1, 2, P1]").unwrap();
+    assert_eq!(d.to_string(), "V.P.T[2][2]=[1, 2, P1]");
+    // Refused where the fault stands, in check and in a run alike.
+    for (decl, col) in [
+        ("V.L.ROW[3] = [1, 2, 3, 4]", 24),
+        ("V.L.S : STRING[5] = \"TOO LONG\"", 21),
+        ("V.L.S : STRING[127]", 15),
+        ("V.L.X : FLOAT", 9),
+        ("V.L.X = [1, 2]", 11),
+    ] {
+        fails_at(
+            &rig,
+            &format!("G01 X1 F100\n#VAR\n{decl}\n#ENDVAR\nM30\n"),
+            20200,
+            3,
+            col,
+            true,
+        );
+    }
+    // A string variable is not kept: using it is undefined.
+    fails_at(
+        &rig,
+        "#VAR\nV.L.S : STRING[5] = \"AB\"\n#ENDVAR\nG01 X[V.L.S] F100\nM30\n",
+        900005,
+        4,
+        5,
+        false,
+    );
+}
+
+#[test]
+fn ncchannel_check_names_the_line_of_an_error_in_a_continued_block() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.nc");
+    std::fs::write(
+        &bad,
+        "% 100 (title)\r\nN10 G01 F1000 \\\r\nN20 X10 Q5\r\nM30\r\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("check")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    let want = format!("{}:3:9: error 20200: ", bad.display());
+    assert!(text.contains(&want), "{text}");
+    assert!(text.contains("  N20 X10 Q5\n          ^"), "{text}");
+}
