@@ -151,6 +151,14 @@ fn blocks(events: &[(u64, EventKind)]) -> Vec<(String, Option<u64>)> {
         .collect()
 }
 
+/// [`blocks`] with a missing block number as 0, to compare with a literal list.
+fn numbered_blocks(events: &[(u64, EventKind)]) -> Vec<(String, u64)> {
+    blocks(events)
+        .into_iter()
+        .map(|(p, n)| (p, n.unwrap_or(0)))
+        .collect()
+}
+
 fn end_tick(events: &[(u64, EventKind)]) -> u64 {
     events
         .iter()
@@ -296,10 +304,7 @@ fn implicit_subroutines_run_in_a_stream_started_under_the_channel_lists_name() {
         ],
         20_000,
     );
-    let got: Vec<(String, u64)> = blocks(&ev)
-        .into_iter()
-        .map(|(p, n)| (p, n.unwrap_or(0)))
-        .collect();
+    let got = numbered_blocks(&ev);
     let want: Vec<(String, u64)> = [
         ("init.nc", 1),
         ("init.nc", 2),
@@ -395,10 +400,7 @@ fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
     let mut c = i.channel();
     c.start(&tick(0), "part.nc").unwrap();
     let ev = run(&mut c, &[], 20_000);
-    let got: Vec<(String, u64)> = blocks(&ev)
-        .into_iter()
-        .map(|(p, n)| (p, n.unwrap_or(0)))
-        .collect();
+    let got = numbered_blocks(&ev);
     let want: Vec<(String, u64)> = [
         ("init.nc", 1),
         ("init.nc", 2),
