@@ -222,7 +222,23 @@ fn command() -> impl Strategy<Value = Command> {
         file().prop_map(|file| CacheClear { file }),
         (any::<bool>(), options()).prop_map(|(on, options)| Hsc { on, options }),
         options().prop_map(|options| ContourMode { options }),
-        (any::<bool>(), "[A-Za-z0-9_ .,:]{0,20}").prop_map(|(save, text)| Msg { save, text }),
+        (
+            any::<bool>(),
+            "[A-Za-z0-9_ .,:]{0,20}",
+            prop::collection::vec(expr(), 0..3)
+        )
+            .prop_map(|(save, text, args)| Msg(Box::new(ncchannel::lang::Message {
+                options: if save { vec!["SAVE"] } else { Vec::new() },
+                text: text + &"%d".repeat(args.len()),
+                quoted: true,
+                args,
+            }))),
+        "[A-Za-z0-9_.,:]{1,20}".prop_map(|text| Msg(Box::new(ncchannel::lang::Message {
+            options: vec!["INFO", "SYN", "HMI"],
+            text,
+            quoted: false,
+            args: Vec::new(),
+        }))),
         // `#TIME` reads an expression: a literal comes back as a number, `-3` as a negation.
         expr().prop_map(|e| Time(match e {
             Expr::Num(v) => Value::Num(v.abs()),

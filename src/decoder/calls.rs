@@ -209,10 +209,11 @@ impl Decoder {
             }
             Command::Var => self.top().var_block = true,
             Command::EndVar => {}
-            Command::Msg { save, text } => {
+            Command::Msg(m) => {
+                let text = self.format_message(m)?;
                 self.notes.push(Note::Message {
-                    text: text.clone(),
-                    save: *save,
+                    text,
+                    save: m.save(),
                 });
                 self.emit(info, Action::None, false, io);
             }
@@ -228,6 +229,17 @@ impl Decoder {
             Command::Inert { .. } => self.emit(info, Action::None, false, io),
         }
         Ok(())
+    }
+
+    /// `#MSG`: its values evaluated, in written order, and put into its text
+    /// (`lang::msg::format_message`, bounded by `MAX_MSG_CHARS`).
+    fn format_message(&mut self, m: &crate::lang::Message) -> Res<String> {
+        let mut values = Vec::with_capacity(m.args.len());
+        for e in &m.args {
+            values.push(self.eval(e)?);
+        }
+        crate::lang::msg::format_message(m, &values)
+            .map_err(|e| DecodeError::new(codes::MSG_TOO_LONG, e.to_string()))
     }
 
     /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).

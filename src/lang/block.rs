@@ -249,12 +249,9 @@ pub enum Command {
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,
-    /// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]`: an operator message;
-    /// the bracket text is kept verbatim (quotes removed when it is one quoted string).
-    Msg {
-        save: bool,
-        text: String,
-    },
+    /// `#MSG ["text", values…]`, `#MSG SAVE …`, `#MSG INFO …`: an operator message
+    /// (`super::msg`). Boxed: messages are rare and `Block` stays small.
+    Msg(Box<Message>),
     /// `#TIME <seconds>`: a dwell (TF5200 "Dwell time").
     Time(Value),
     /// A `#` command of ISG's list that ncchannel accepts without effect
@@ -262,6 +259,27 @@ pub enum Command {
     Inert {
         text: String,
     },
+}
+
+/// An operator message (TF5200 programming manual, "Messages from the NC program").
+#[derive(Debug, Clone, PartialEq)]
+pub struct Message {
+    /// The keywords between `#MSG` and the bracket, upper-case, as written: `SAVE EXCLUSIVE`,
+    /// `INFO`, `SYN HMI`.
+    pub options: Vec<&'static str>,
+    /// The format text without its quotes, or the bracket text verbatim when it is not one
+    /// quoted string (then `quoted` is false and nothing is formatted).
+    pub text: String,
+    pub quoted: bool,
+    /// The values for the text's format elements, as many as it has.
+    pub args: Vec<Expr>,
+}
+
+impl Message {
+    /// `#MSG SAVE …`: the kernel writes it to its report file as well.
+    pub fn save(&self) -> bool {
+        self.options.first() == Some(&"SAVE")
+    }
 }
 
 /// `#FLUSH` variants; in the event log `plain`, `continue`, `wait`.

@@ -359,14 +359,19 @@ impl Display for Command {
             }
             Command::Var => f.write_str("#VAR"),
             Command::EndVar => f.write_str("#ENDVAR"),
-            Command::Msg { save, text } => {
-                f.write_str(if *save { "#MSG SAVE" } else { "#MSG" })?;
-                // A text with a quote inside was kept as written between the brackets.
-                if text.contains('"') {
-                    write!(f, " [{text}]")
-                } else {
-                    write!(f, " [\"{text}\"]")
+            Command::Msg(m) => {
+                f.write_str("#MSG")?;
+                for o in &m.options {
+                    write!(f, " {o}")?;
                 }
+                if !m.quoted {
+                    return write!(f, " [{}]", m.text);
+                }
+                write!(f, " [\"{}\"", m.text)?;
+                for a in &m.args {
+                    write!(f, ", {a}")?;
+                }
+                f.write_char(']')
             }
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),

@@ -770,7 +770,7 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
         }
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
-        b"MSG" => msg(r),
+        b"MSG" => super::msg::parse_msg(ctx, r),
         b"TIME" => {
             let (r, v) = ctx.expr(r)?;
             Ok((r, Command::Time(expr_value(v))))
@@ -801,26 +801,6 @@ fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command
         ),
         None => fail(i, UNKNOWN_COMMAND, format!("unknown NC command #{word}")),
     }
-}
-
-/// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]` (TF5200 "#MSG").
-fn msg(i: &str) -> PResult<'_, Command> {
-    let (r, save) = if let Some(r) = keyword(i, "SAVE") {
-        (ws(r), true)
-    } else if let Some(r) = keyword(i, "INFO") {
-        (ws(r), false)
-    } else {
-        (i, false)
-    };
-    if !r.starts_with('[') {
-        return fail(r, SYNTAX, "#MSG takes [\"text\"]");
-    }
-    let (rest, text) = verbatim_options(r, r)?;
-    let text = match text.strip_prefix('"').and_then(|t| t.strip_suffix('"')) {
-        Some(t) if !t.contains('"') => t.to_string(),
-        _ => text,
-    };
-    Ok((rest, Command::Msg { save, text }))
 }
 
 /// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to

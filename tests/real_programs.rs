@@ -1,0 +1,136 @@
+//! Constructs of real programs (ISG's SDK examples, CAM and printer post-processor output,
+//! ISG's editor test programs) that the kernel runs: `#MSG` with formatted values, implicit
+//! subroutine calls G800–G819 with parameters, and the inert tool and channel commands. Each
+//! is run from a file and from the stream, and `ncchannel check` (`check_program`) finds what
+//! a run finds, at the same line and column.
+
+mod common;
+
+use common::{feeder, Rig, RunResult};
+use ncchannel::channel::Finish;
+use ncchannel::lang::codes;
+use ncchannel::lang::msg::{MAX_MSG_CHARS, MAX_MSG_VALUES};
+use ncchannel::lang::{check_program, parse_block};
+
+/// Run `text` as `t.nc` from a file and as the streaming program; both results.
+fn both(rig: &Rig, text: &str) -> [RunResult; 2] {
+    rig.program("t.nc", text);
+    let file = rig.run("t.nc", None, 2_000_000);
+    let stream = rig.run(
+        "streaming.nc",
+        Some(feeder(&text.replace('\n', "\r\n"), 4096, 1)),
+        2_000_000,
+    );
+    [file, stream]
+}
+
+fn messages(r: &RunResult) -> Vec<(String, bool)> {
+    r.of("message")
+        .iter()
+        .map(|e| {
+            (
+                e["text"].as_str().unwrap().to_string(),
+                e["save"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// The run's one error: its code and the column its message names.
+fn error_at(r: &RunResult) -> (u64, Option<u32>) {
+    let e = r.of("error");
+    assert_eq!(e.len(), 1, "{}", r.log);
+    let msg = e[0]["msg"].as_str().unwrap();
+    let col = msg
+        .rsplit_once("(column ")
+        .and_then(|(_, c)| c.trim_end_matches(')').parse().ok());
+    (e[0]["code"].as_u64().unwrap(), col)
+}
+
+#[test]
+fn msg_formats_its_values_as_printf_does_in_file_and_stream() {
+    let rig = Rig::new();
+    let text = "P1 = 2.5\nP2 = 7\nP3 = -0.125\n\
+        #MSG [\"P1= %f\", P1]\n\
+        #MSG [\"tool %d of %d: %5.2f mm\", P2, P2 + 1, P3 * 10]\n\
+        #MSG SAVE EXCLUSIVE [\"%s%%\", P1 * 4]\n\
+        #MSG INFO SYN HMI [\"RED,%D,BOLD\", 20]\n\
+        #MSG SAVE CONTINUE [\"plain\"]\n\
+        #MSG ACK PLC [no quotes %d]\n\
+        M30\n";
+    for r in both(&rig, text) {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        assert_eq!(
+            messages(&r),
+            [
+                ("P1= 2.500000".to_string(), false),
+                ("tool 7 of 8: -1.25 mm".to_string(), false),
+                ("10%".to_string(), true),
+                ("RED,20,BOLD".to_string(), false),
+                ("plain".to_string(), true),
+                ("no quotes %d".to_string(), false),
+            ]
+        );
+        assert_eq!(r.machine.channels()[0].message(), Some("no quotes %d"));
+    }
+    assert_eq!(check_program(text), []);
+}
+
+#[test]
+fn msg_with_the_wrong_number_of_values_is_the_kernels_error_at_its_column() {
+    let cases: [(&str, u32, usize); 6] = [
+        // Fewer values than elements: 20721 at the closing bracket.
+        ("#MSG [\"%d and %d\", 1]", codes::MSG_ARG_COUNT, 21),
+        // More values than elements: 20721 at the first value too many.
+        ("#MSG [\"%d\", 1, 2]", codes::MSG_ARG_COUNT, 16),
+        ("#MSG [\"x=%d\", ]", codes::MSG_NO_VALUE, 15),
+        ("#MSG [\"x=%q\", 1]", codes::MSG_UNKNOWN_FORMAT, 10),
+        ("#MSG [\"x=%123f\", 1]", codes::MSG_UNKNOWN_FORMAT, 10),
+        ("#MSG SAVE HMI [\"x\"]", codes::SYNTAX, 11),
+    ];
+    let rig = Rig::new();
+    for (line, code, col) in cases {
+        let text = format!("G1 X1 F1000\n{line}\nM30\n");
+        let d = check_program(&text);
+        assert_eq!(d.len(), 1, "{line}: {d:?}");
+        assert_eq!((d[0].line, d[0].col, d[0].code), (2, col, code), "{line}");
+        for r in both(&rig, &text) {
+            assert_eq!(r.finish, Some(Finish::Error), "{line}");
+            assert_eq!(error_at(&r), (u64::from(code), Some(col as u32)), "{line}");
+            assert!(r.of("message").is_empty());
+        }
+    }
+    let many = format!("#MSG [\"{}\"]", "%d".repeat(MAX_MSG_VALUES + 1));
+    let e = parse_block(&many).unwrap_err();
+    assert_eq!(e.code, codes::MSG_TOO_MANY_VALUES);
+    assert!(e.message.contains(&MAX_MSG_VALUES.to_string()), "{e}");
+}
+
+#[test]
+fn a_formatted_message_longer_than_the_bound_is_refused_not_allocated() {
+    let rig = Rig::new();
+    let elements = "%99.99f".repeat(MAX_MSG_VALUES);
+    let values = ", P1".repeat(MAX_MSG_VALUES);
+    let text = format!("P1 = 1000000\n#MSG [\"{elements}\"{values}]\nM30\n");
+    assert_eq!(check_program(&text), [], "a run-time bound");
+    for r in both(&rig, &text) {
+        assert_eq!(r.finish, Some(Finish::Error));
+        assert_eq!(error_at(&r).0, u64::from(codes::MSG_TOO_LONG));
+        assert!(r.log.contains(&MAX_MSG_CHARS.to_string()), "{}", r.log);
+    }
+}
+
+#[test]
+fn msg_prints_back_as_text_that_parses_to_the_same_block() {
+    for line in [
+        "#MSG [\"P1= %f\", P1]",
+        "#MSG SAVE EXCLUSIVE [\"a %d b %s\", [P1 + 2] * 3, V.L.X]",
+        "#MSG INFO SYN_ACK EVENT_LOGGER [\"x\"]",
+        "#MSG [free text]",
+        "#MSG [\"a \"b\" c\"]",
+    ] {
+        let b = parse_block(line).unwrap();
+        let printed = b.to_string();
+        assert_eq!(parse_block(&printed).unwrap(), b, "{line} → {printed}");
+    }
+}
