@@ -134,3 +134,115 @@ fn msg_prints_back_as_text_that_parses_to_the_same_block() {
         assert_eq!(parse_block(&printed).unwrap(), b, "{line} → {printed}");
     }
 }
+
+/// A rig whose channel list configures G800 and G805 (P-CHAN-00187) and their programs.
+fn g800_rig() -> Rig {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "streaming_prog_file streaming.nc\n\
+         g800_prog_file[0] g800.nc ( P-CHAN-00187\n\
+         g800_prog_file[5] g805.nc\n",
+    )
+    .unwrap();
+    rig.program("g800.nc", "N5 G01 Z4 F6000\nN6 M17\n");
+    rig.program("g805.nc", "N1 G01 X[@P1] Z[@P3] F6000\nN2 M17\n");
+    rig
+}
+
+fn numbered_blocks(r: &RunResult) -> Vec<(String, u64)> {
+    r.of("block")
+        .iter()
+        .map(|e| {
+            (
+                e["prog"].as_str().unwrap().to_string(),
+                e["n"].as_u64().unwrap_or(0),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn g800_to_g819_call_their_configured_subroutine_with_its_parameters() {
+    let rig = g800_rig();
+    let text = "N10 G01 Y1 F6000\nN20 G805[-2.5, 3, 1.5]\nN30 G800\nN40 G805 [1, , 2] M30\n";
+    assert_eq!(check_program(text), []);
+    for (k, r) in both(&rig, text).iter().enumerate() {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        let main = if k == 0 { "t.nc" } else { "streaming.nc" };
+        let want: Vec<(String, u64)> = [
+            (main, 10),
+            (main, 20),
+            ("g805.nc", 1),
+            ("g805.nc", 2),
+            (main, 30),
+            ("g800.nc", 5),
+            ("g800.nc", 6),
+            (main, 40),
+            ("g805.nc", 1),
+            ("g805.nc", 2),
+        ]
+        .iter()
+        .map(|(p, n)| (p.to_string(), *n))
+        .collect();
+        assert_eq!(numbered_blocks(r), want, "{}", r.log);
+        // The last call's @P1 and @P3 (the gap is @P2); Z of G800's program before it.
+        assert_eq!(
+            (r.position('X'), r.position('Y'), r.position('Z')),
+            (1.0, 1.0, 2.0)
+        );
+        let end = r
+            .events
+            .iter()
+            .position(|e| e["ev"] == "program_end")
+            .unwrap();
+        let last_block = r.events.iter().rposition(|e| e["ev"] == "block").unwrap();
+        assert!(last_block < end, "the end waits for the subroutine");
+    }
+}
+
+#[test]
+fn an_unconfigured_g800_call_is_the_kernels_unknown_g_function_at_its_column() {
+    let rig = g800_rig();
+    for line in ["N20 G801", "N20 G801[1, 2]"] {
+        let text = format!("N10 G01 X1 F6000\n{line}\nM30\n");
+        // The channel list decides: the static check cannot know it.
+        assert_eq!(check_program(&text), []);
+        for r in both(&rig, &text) {
+            assert_eq!(r.finish, Some(Finish::Error), "{line}");
+            assert_eq!(
+                error_at(&r),
+                (u64::from(codes::UNKNOWN_G), Some(5)),
+                "{line}"
+            );
+            assert!(r.log.contains("g800_prog_file[1]"), "{}", r.log);
+        }
+    }
+}
+
+#[test]
+fn g800_parameters_are_checked_by_the_parser_in_check_and_run() {
+    let rig = g800_rig();
+    let many = format!("G805[{}]", vec!["1"; 51].join(", "));
+    for (line, col) in [
+        ("G805[1, 2", 10usize),
+        ("G805[1 2]", 8),
+        (many.as_str(), 156),
+    ] {
+        let text = format!("{line}\nM30\n");
+        let d = check_program(&text);
+        assert_eq!(d.len(), 1, "{line}: {d:?}");
+        assert_eq!(
+            (d[0].line, d[0].col, d[0].code),
+            (1, col, codes::SYNTAX),
+            "{line}"
+        );
+        for r in both(&rig, &text) {
+            assert_eq!(error_at(&r), (u64::from(codes::SYNTAX), Some(col as u32)));
+        }
+    }
+    for line in ["G805[-27.12, 28.955, 2.87]", "G800[, 2, ]", "G819[]"] {
+        let b = parse_block(line).unwrap();
+        assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
+    }
+}

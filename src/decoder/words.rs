@@ -46,6 +46,10 @@ pub(super) struct Words {
     n_ms: usize,
     hs: [u32; MAX_FUNCTIONS],
     n_hs: usize,
+    /// G800–G819 (number, column): an implicit subroutine call at the end of the block.
+    call: Option<(u32, u32)>,
+    /// Its transfer parameters as `@P` number and value (gaps left out).
+    call_params: Vec<(u32, f64)>,
 }
 
 impl Words {
@@ -64,6 +68,9 @@ impl Words {
         self.dwell_s = None;
         self.n_ms = 0;
         self.n_hs = 0;
+        if self.call.take().is_some() {
+            self.call_params.clear();
+        }
     }
 
     fn push_g(&mut self, g: u32, col: u32) -> Res {
@@ -76,9 +83,6 @@ impl Words {
         self.gs[self.n_gs] = (g, col);
         self.n_gs += 1;
         Ok(())
-    }
-    fn gs(&self) -> &[(u32, u32)] {
-        &self.gs[..self.n_gs]
     }
     fn ms(&self) -> &[u32] {
         &self.ms[..self.n_ms]
@@ -162,6 +166,16 @@ impl Decoder {
                 }
                 w.push_g(*g, *col).map_err(|e| e.at(*col))
             }
+            Item::GCall { g, args, col } => {
+                self.implicit_call(*g, *col, w)?;
+                for (k, a) in args.iter().enumerate() {
+                    if let Some(e) = a {
+                        let v = self.eval(e).map_err(|e| e.at(*col))?;
+                        w.call_params.push((k as u32 + 1, v));
+                    }
+                }
+                Ok(())
+            }
             Item::Word(word) => {
                 let v = match &word.value {
                     Value::Num(n) => *n,
@@ -214,8 +228,13 @@ impl Decoder {
     /// modal part (spindle, coolant).
     fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
         let mut gs = BlockGs::default();
-        for &(g, col) in w.gs() {
+        for k in 0..w.n_gs {
+            let (g, col) = w.gs[k];
             if !apply_g(&mut self.modal, g, &mut gs) {
+                if crate::lang::gcall::G_CALLS.contains(&g) {
+                    self.implicit_call(g, col, w)?;
+                    continue;
+                }
                 return Err(
                     DecodeError::new(codes::UNKNOWN_G, format!("unknown G function G{g}")).at(col),
                 );
@@ -428,6 +447,19 @@ impl Decoder {
                 ));
             }
         }
+        if let Some((g, col)) = w.call {
+            if self.m6_subroutine(w).is_some() {
+                return Err(DecodeError::new(
+                    codes::UNSUPPORTED,
+                    "G800–G819 and M6 with its subroutine in one block",
+                )
+                .at(col));
+            }
+            if !queued {
+                self.emit(info.clone(), Action::None, false, io);
+            }
+            return self.call_g800(g, &w.call_params, end_m, info, io);
+        }
         if let Some(name) = self.m6_subroutine(w) {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
@@ -453,6 +485,30 @@ impl Decoder {
             self.emit(info.clone(), Action::None, false, io);
         }
         self.program_end(m, info, io)
+    }
+
+    /// G800–G819 in this block (`col` its column): its subroutine must be configured
+    /// (20131 otherwise, as the kernel's P-CHAN-00187 says), one call per block.
+    fn implicit_call(&self, g: u32, col: u32, w: &mut Words) -> Res {
+        if self.g800_subroutine(g).is_none() {
+            return Err(DecodeError::new(
+                codes::UNKNOWN_G,
+                format!(
+                    "unknown G function G{g}: no g800_prog_file[{}] in the channel list",
+                    g - 800
+                ),
+            )
+            .at(col));
+        }
+        if w.call.is_some() {
+            return Err(DecodeError::new(
+                codes::UNSUPPORTED,
+                "two implicit subroutine calls (G800–G819) in one block",
+            )
+            .at(col));
+        }
+        w.call = Some((g, col));
+        Ok(())
     }
 
     /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in

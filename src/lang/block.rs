@@ -62,6 +62,15 @@ pub enum Item {
         value: Value,
         col: u32,
     },
+    /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
+    /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
+    /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None`. `G800` without a bracket is
+    /// an ordinary G word. `col` is the G's column.
+    GCall {
+        g: u32,
+        args: Vec<Option<Expr>>,
+        col: u32,
+    },
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.

@@ -121,7 +121,12 @@ const G_TABLE: &[(u32, u32, &str, Support)] = &[
     (333, 339, "weighting with feedhold", R),
     (351, 351, "mirroring with axis specification", R),
     (359, 360, "exact stop off / on", N),
-    (800, 819, "implicit subroutine calls", R),
+    (
+        800,
+        819,
+        "implicit subroutine calls (g800_prog_file[i], P-CHAN-00187)",
+        I,
+    ),
     (900, 901, "deceleration at / after block end", N),
 ];
 

@@ -88,6 +88,18 @@ impl Display for Item {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
                 Value::Expr(e) => write!(f, "G{g}={e}"),
             },
+            Item::GCall { g, args, .. } => {
+                write!(f, "G{g}[")?;
+                for (k, a) in args.iter().enumerate() {
+                    if k > 0 {
+                        f.write_str(", ")?;
+                    }
+                    if let Some(e) = a {
+                        e.fmt(f)?;
+                    }
+                }
+                f.write_char(']')
+            }
         }
     }
 }

@@ -13,6 +13,7 @@ mod display;
 pub mod error;
 pub mod eval;
 pub mod expr;
+pub mod gcall;
 pub mod msg;
 mod number;
 pub mod parse;

@@ -357,7 +357,7 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } => false,
+        Item::Assign { .. } | Item::GCall { .. } => false,
     }
 }
 
@@ -398,7 +398,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             }
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
-            Item::GValue { g, col, .. } => (*col, format!("G{g}")),
+            Item::GValue { g, col, .. } | Item::GCall { g, col, .. } => (*col, format!("G{g}")),
         };
         return Err(ctx.err_at(
             col,
@@ -451,6 +451,9 @@ fn word<'a>(
             };
             if !is_known_g(g) {
                 dialect_g(i, g)?;
+                if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
+                    return Ok(r);
+                }
             }
             if G_WITH_VALUE.contains(&g) {
                 if let Some((r, value)) = g_value(ctx, rest, g == 4)? {
