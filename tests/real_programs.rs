@@ -246,3 +246,35 @@ fn g800_parameters_are_checked_by_the_parser_in_check_and_run() {
         assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
     }
 }
+
+#[test]
+fn tool_and_channel_commands_and_weightings_are_inert_blocks_that_change_no_path() {
+    let rig = Rig::new();
+    let text = "N10 G01 X1 F6000\n\
+        N20 #TOOL PREP [2]\n\
+        N30 #TOOL DATA [V.G.T_AKT]\n\
+        N40 #TOOL LIFE READ [2, 1]\n\
+        N50 #CHANNEL INIT [CMDPOS]\n\
+        N60 G129=70\n\
+        N70 G131 = 50\n\
+        N80 G130 X70 Y75\n\
+        N90 G231=80\n\
+        N100 G233=60\n\
+        N110 G129=70 Y2\n\
+        N120 M30\n";
+    assert_eq!(check_program(text), []);
+    for r in both(&rig, text) {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        let texts = r.block_texts();
+        assert_eq!(texts.len(), 12, "{texts:?}");
+        assert!(texts[1].contains("#TOOL PREP [2]"), "{texts:?}");
+        assert!(texts[4].contains("#CHANNEL INIT [CMDPOS]"), "{texts:?}");
+        // G130's axis words are weights: X stays at 1, Y is moved only by N110.
+        assert_eq!((r.position('X'), r.position('Y')), (1.0, 2.0));
+    }
+    // The other forms of the keywords stay refused by name, the axis-specific G00 ones too.
+    for line in ["#TOOL ORI [1]", "#CHANNEL SET [X]", "G230 X50", "G232 X50"] {
+        let e = parse_block(line).unwrap_err();
+        assert_eq!((e.code, e.col), (codes::UNSUPPORTED, 1), "{line}");
+    }
+}

@@ -240,6 +240,10 @@ impl Decoder {
                 );
             }
         }
+        if gs.axis_weights {
+            // G130 X70: weightings, no move (the weighting itself is not modelled).
+            w.axes_set = 0;
+        }
         if gs.dwell {
             // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
             if w.axes_set & 1 != 0 {

@@ -505,8 +505,10 @@ pub const KNOWN_G: &[u32] = &[
 ];
 
 /// G functions that take a value: `G133=<expr>`, `G134=<expr>` (TF5200 "Weighting the ramp
-/// times", also written `G134 50`) and the dwell `G04 <seconds>`.
-pub const G_WITH_VALUE: &[u32] = &[4, 133, 134];
+/// times", also written `G134 50`), `G129=<expr>` (weighting of rapid traverse velocity),
+/// `G131=<expr>` / `G231=<expr>` (acceleration weighting, TF5200 "Acceleration weighting"),
+/// `G233=<expr>` (weighting for G00) and the dwell `G04 <seconds>`.
+pub const G_WITH_VALUE: &[u32] = &[4, 129, 131, 133, 134, 231, 233];
 
 /// Is `g` one of the implemented G functions ([`KNOWN_G`])?
 #[inline]

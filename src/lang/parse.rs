@@ -786,7 +786,8 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
 /// ncchannel treats it as a no-op, refused by name when it does not support it, 20209 when
 /// ISG's list does not have it either.
 fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command> {
-    match command_support(kw) {
+    let rest = &i[1 + word.len()..];
+    match command_support(kw).map(|s| super::dialect::form_support(s, kw, rest)) {
         Some(Support::Inert) => {
             // The whole command to the comment: options in brackets may hold anything.
             let text = i[1..].split([';', '(']).next().unwrap_or("").trim_end();
