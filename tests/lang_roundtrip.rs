@@ -222,6 +222,7 @@ fn command() -> impl Strategy<Value = Command> {
         file().prop_map(|file| CacheClear { file }),
         (any::<bool>(), options()).prop_map(|(on, options)| Hsc { on, options }),
         options().prop_map(|options| ContourMode { options }),
+        (any::<bool>(), options()).prop_map(|(on, options)| ContourSwitch { on, options }),
         (
             any::<bool>(),
             "[A-Za-z0-9_ .,:]{0,20}",

@@ -278,3 +278,43 @@ fn tool_and_channel_commands_and_weightings_are_inert_blocks_that_change_no_path
         assert_eq!((e.code, e.col), (codes::UNSUPPORTED, 1), "{line}");
     }
 }
+
+#[test]
+fn contour_mode_on_and_off_are_g261_and_g260_with_the_deviation() {
+    let rig = Rig::new();
+    let square = "G01 X20 F3000\nY20\nX0\nY0\n";
+    let switched =
+        format!("#CONTOUR MODE ON [DEV PATH_DEV=0.08]\n{square}#CONTOUR MODE OFF\n{square}M30\n");
+    let by_g = format!("#CONTOUR MODE [DEV PATH_DEV=0.08]\nG261\n{square}G260\n{square}M30\n");
+    let sharp = format!("{square}{square}M30\n");
+    assert_eq!(check_program(&switched), []);
+    let [a, a_stream] = both(&rig, &switched);
+    let [b, _] = both(&rig, &by_g);
+    let [c, _] = both(&rig, &sharp);
+    for r in [&a, &a_stream, &b, &c] {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    }
+    assert_eq!(a.ticks, b.ticks, "ON/OFF contour as G261/G260 do");
+    assert_eq!(a_stream.ticks, a.ticks);
+    assert!(
+        a.ticks < c.ticks,
+        "{} contoured, {} sharp",
+        a.ticks,
+        c.ticks
+    );
+    // Only the first square is blended: with the second one contoured too it would be shorter.
+    let [d, _] = both(
+        &rig,
+        &format!("#CONTOUR MODE ON [DEV PATH_DEV=0.08]\n{square}{square}M30\n"),
+    );
+    assert!(
+        d.ticks < a.ticks,
+        "{} both contoured, {} first only",
+        d.ticks,
+        a.ticks
+    );
+    for line in ["#CONTOUR MODE ON [DEV PATH_DEV=0.08]", "#CONTOUR MODE OFF"] {
+        let b = parse_block(line).unwrap();
+        assert_eq!(b.to_string(), line);
+    }
+}

@@ -255,6 +255,13 @@ pub enum Command {
     ContourMode {
         options: String,
     },
+    /// `#CONTOUR MODE ON [...]` (parameters as `ContourMode`, then contouring on as G261) and
+    /// `#CONTOUR MODE OFF` (as G260) (TF5200 programming manual, "Activating contouring modes
+    /// in the NC program").
+    ContourSwitch {
+        on: bool,
+        options: String,
+    },
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,

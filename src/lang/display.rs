@@ -369,6 +369,14 @@ impl Display for Command {
                 f.write_str("#CONTOUR MODE")?;
                 options_fmt(f, options)
             }
+            Command::ContourSwitch { on, options } => {
+                f.write_str(if *on {
+                    "#CONTOUR MODE ON"
+                } else {
+                    "#CONTOUR MODE OFF"
+                })?;
+                options_fmt(f, options)
+            }
             Command::Var => f.write_str("#VAR"),
             Command::EndVar => f.write_str("#ENDVAR"),
             Command::Msg(m) => {

@@ -768,6 +768,12 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let Some(m) = keyword(r, "MODE") else {
                 return fail(r, SYNTAX, "#CONTOUR takes MODE");
             };
+            for (kw, on) in [("ON", true), ("OFF", false)] {
+                if let Some(r) = keyword(ws(m), kw) {
+                    let (r, options) = verbatim_options(ws(r), r)?;
+                    return Ok((r, Command::ContourSwitch { on, options }));
+                }
+            }
             let (r, options) = verbatim_options(ws(m), m)?;
             Ok((r, Command::ContourMode { options }))
         }
