@@ -318,3 +318,25 @@ fn contour_mode_on_and_off_are_g261_and_g260_with_the_deviation() {
         assert_eq!(b.to_string(), line);
     }
 }
+
+#[test]
+fn a_local_subroutine_without_m17_ends_at_the_next_program_head() {
+    let rig = Rig::new();
+    let subs = "%L SUB1\nN1 G01 X5 F6000\n%L SUB2\nN2 G01 Y5 F6000\n";
+    let called = format!("{subs}%main\nN10 LL SUB1\nN20 LL SUB2\nN30 M30\n");
+    assert_eq!(check_program(&called), []);
+    rig.program("t.nc", &called);
+    let r = rig.run("t.nc", None, 2_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    let n: Vec<u64> = numbered_blocks(&r).iter().map(|(_, n)| *n).collect();
+    assert_eq!(n, [10, 1, 20, 2, 30]);
+    assert_eq!((r.position('X'), r.position('Y')), (5.0, 5.0));
+    // Not called, the sections are passed over up to the main program, in a file and streamed.
+    let passed = format!("{subs}%main\nN10 G01 Z1 F6000\nN20 M30\n");
+    for r in both(&rig, &passed) {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        let n: Vec<u64> = numbered_blocks(&r).iter().map(|(_, n)| *n).collect();
+        assert_eq!(n, [10, 20]);
+        assert_eq!((r.position('X'), r.position('Z')), (0.0, 1.0));
+    }
+}
