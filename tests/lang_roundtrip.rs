@@ -153,7 +153,15 @@ fn item() -> impl Strategy<Value = Item> {
         1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
         1 => (0u32..=65_535).prop_map(|h| Item::Word(Word { letter: b'H', value: Value::Num(f64::from(h)), col: 0 })),
         1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::Assign { target: Box::new(target), value, col: 0 }),
-        1 => (prop::sample::select(vec![133u32, 134]), expr()).prop_map(|(g, e)| Item::GValue {
+        1 => (800u32..=819, prop::collection::vec(prop::option::of(expr()), 0..4))
+            .prop_map(|(g, mut args)| {
+                // The parser drops trailing gaps: they define nothing.
+                while args.last().is_some_and(Option::is_none) {
+                    args.pop();
+                }
+                Item::GCall { g, args, col: 0 }
+            }),
+        1 => (prop::sample::select(vec![129u32, 131, 133, 134, 231, 233]), expr()).prop_map(|(g, e)| Item::GValue {
             g,
             value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
             col: 0,

@@ -241,7 +241,12 @@ fn g800_parameters_are_checked_by_the_parser_in_check_and_run() {
             assert_eq!(error_at(&r), (u64::from(codes::SYNTAX), Some(col as u32)));
         }
     }
-    for line in ["G805[-27.12, 28.955, 2.87]", "G800[, 2, ]", "G819[]"] {
+    for line in [
+        "G805[-27.12, 28.955, 2.87]",
+        "G800[, 2, ]",
+        "G819[]",
+        "G801[1, , ]",
+    ] {
         let b = parse_block(line).unwrap();
         assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
     }

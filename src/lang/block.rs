@@ -64,7 +64,8 @@ pub enum Item {
     },
     /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
     /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
-    /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None`. `G800` without a bracket is
+    /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None` (trailing gaps are dropped).
+    /// `G800` without a bracket is
     /// an ordinary G word. `col` is the G's column.
     GCall {
         g: u32,

@@ -52,6 +52,10 @@ pub(crate) fn g_call<'a>(
             r = ws(after);
         }
         if let Some(after) = r.strip_prefix(']') {
+            // Trailing gaps define nothing: `[1, ]` is `[1]`, one canonical form.
+            while args.last().is_some_and(Option::is_none) {
+                args.pop();
+            }
             items.push(Item::GCall { g, args, col });
             return Ok(Some(after));
         }
