@@ -19,9 +19,8 @@ fn without_cols(mut b: Block) -> Block {
         for item in items {
             match item {
                 Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. } | Item::GValue { col, .. } | Item::GCall { col, .. } => {
-                    *col = 0
-                }
+                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+                Item::GCall(c) => c.col = 0,
             }
         }
     }

@@ -159,7 +159,7 @@ fn item() -> impl Strategy<Value = Item> {
                 while args.last().is_some_and(Option::is_none) {
                     args.pop();
                 }
-                Item::GCall { g, args, col: 0 }
+                Item::GCall(Box::new(ncchannel::lang::GCall { g, args, col: 0 }))
             }),
         1 => (prop::sample::select(vec![129u32, 131, 133, 134, 231, 233]), expr()).prop_map(|(g, e)| Item::GValue {
             g,
@@ -300,9 +300,8 @@ fn without_cols(mut b: Block) -> Block {
         for item in items {
             match item {
                 Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. } | Item::GValue { col, .. } | Item::GCall { col, .. } => {
-                    *col = 0
-                }
+                Item::Assign { col, .. } | Item::GValue { col, .. } => *col = 0,
+                Item::GCall(c) => c.col = 0,
             }
         }
     }

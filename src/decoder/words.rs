@@ -68,9 +68,12 @@ impl Words {
         self.dwell_s = None;
         self.n_ms = 0;
         self.n_hs = 0;
-        if self.call.take().is_some() {
-            self.call_params.clear();
-        }
+        // `call_params` count only with `call`, and are cleared when it is set.
+        self.call = None;
+    }
+
+    fn gs(&self) -> &[(u32, u32)] {
+        &self.gs[..self.n_gs]
     }
 
     fn push_g(&mut self, g: u32, col: u32) -> Res {
@@ -166,11 +169,11 @@ impl Decoder {
                 }
                 w.push_g(*g, *col).map_err(|e| e.at(*col))
             }
-            Item::GCall { g, args, col } => {
-                self.implicit_call(*g, *col, w)?;
-                for (k, a) in args.iter().enumerate() {
+            Item::GCall(c) => {
+                self.implicit_call(c.g, c.col, w)?;
+                for (k, a) in c.args.iter().enumerate() {
                     if let Some(e) = a {
-                        let v = self.eval(e).map_err(|e| e.at(*col))?;
+                        let v = self.eval(e).map_err(|e| e.at(c.col))?;
                         w.call_params.push((k as u32 + 1, v));
                     }
                 }
@@ -228,17 +231,22 @@ impl Decoder {
     /// modal part (spindle, coolant).
     fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
         let mut gs = BlockGs::default();
-        for k in 0..w.n_gs {
-            let (g, col) = w.gs[k];
+        let mut call = None;
+        for &(g, col) in w.gs() {
             if !apply_g(&mut self.modal, g, &mut gs) {
                 if crate::lang::gcall::G_CALLS.contains(&g) {
-                    self.implicit_call(g, col, w)?;
+                    if call.replace((g, col)).is_some() {
+                        return Err(two_calls().at(col));
+                    }
                     continue;
                 }
                 return Err(
                     DecodeError::new(codes::UNKNOWN_G, format!("unknown G function G{g}")).at(col),
                 );
             }
+        }
+        if let Some((g, col)) = call {
+            self.implicit_call(g, col, w)?;
         }
         if gs.axis_weights {
             // G130 X70: weightings, no move (the weighting itself is not modelled).
@@ -505,13 +513,10 @@ impl Decoder {
             .at(col));
         }
         if w.call.is_some() {
-            return Err(DecodeError::new(
-                codes::UNSUPPORTED,
-                "two implicit subroutine calls (G800–G819) in one block",
-            )
-            .at(col));
+            return Err(two_calls().at(col));
         }
         w.call = Some((g, col));
+        w.call_params.clear();
         Ok(())
     }
 
@@ -534,6 +539,13 @@ impl Decoder {
             self.check_open_flow()
         }
     }
+}
+
+fn two_calls() -> DecodeError {
+    DecodeError::new(
+        codes::UNSUPPORTED,
+        "two implicit subroutine calls (G800–G819) in one block",
+    )
 }
 
 fn unconfigured(letter: u8) -> DecodeError {

@@ -65,13 +65,17 @@ pub enum Item {
     /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
     /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
     /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None` (trailing gaps are dropped).
-    /// `G800` without a bracket is
-    /// an ordinary G word. `col` is the G's column.
-    GCall {
-        g: u32,
-        args: Vec<Option<Expr>>,
-        col: u32,
-    },
+    /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
+    /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
+    GCall(Box<GCall>),
+}
+
+/// An implicit subroutine call's G number, transfer parameters and column ([`Item::GCall`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GCall {
+    pub g: u32,
+    pub args: Vec<Option<Expr>>,
+    pub col: u32,
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.

@@ -88,9 +88,9 @@ impl Display for Item {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
                 Value::Expr(e) => write!(f, "G{g}={e}"),
             },
-            Item::GCall { g, args, .. } => {
-                write!(f, "G{g}[")?;
-                for (k, a) in args.iter().enumerate() {
+            Item::GCall(c) => {
+                write!(f, "G{}[", c.g)?;
+                for (k, a) in c.args.iter().enumerate() {
                     if k > 0 {
                         f.write_str(", ")?;
                     }

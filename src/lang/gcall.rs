@@ -5,7 +5,7 @@
 //! `@P1`, `@P2`, …). Which subroutine G800 + i calls is the channel list's
 //! `g800_prog_file[i]` (P-CHAN-00187); the decoder looks it up.
 
-use super::block::{Expr, Item};
+use super::block::{Expr, GCall, Item};
 use super::codes::SYNTAX;
 use super::expr::{perr, ws, Ctx, PErr};
 
@@ -33,7 +33,7 @@ pub(crate) fn g_call<'a>(
     let mut args: Vec<Option<Expr>> = Vec::new();
     r = ws(r);
     if let Some(after) = r.strip_prefix(']') {
-        items.push(Item::GCall { g, args, col });
+        items.push(Item::GCall(Box::new(GCall { g, args, col })));
         return Ok(Some(after));
     }
     loop {
@@ -56,7 +56,7 @@ pub(crate) fn g_call<'a>(
             while args.last().is_some_and(Option::is_none) {
                 args.pop();
             }
-            items.push(Item::GCall { g, args, col });
+            items.push(Item::GCall(Box::new(GCall { g, args, col })));
             return Ok(Some(after));
         }
         let Some(after) = r.strip_prefix(',') else {

@@ -357,7 +357,7 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::GCall { .. } => false,
+        Item::Assign { .. } | Item::GCall(_) => false,
     }
 }
 
@@ -398,7 +398,8 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             }
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
-            Item::GValue { g, col, .. } | Item::GCall { g, col, .. } => (*col, format!("G{g}")),
+            Item::GValue { g, col, .. } => (*col, format!("G{g}")),
+            Item::GCall(c) => (c.col, format!("G{}", c.g)),
         };
         return Err(ctx.err_at(
             col,
@@ -455,7 +456,8 @@ fn word<'a>(
                     return Ok(r);
                 }
             }
-            if G_WITH_VALUE.contains(&g) {
+            // The implemented G functions take no value but G04: G01 skips the list search.
+            if (g == 4 || !is_known_g(g)) && G_WITH_VALUE.contains(&g) {
                 if let Some((r, value)) = g_value(ctx, rest, g == 4)? {
                     items.push(Item::GValue { g, value, col });
                     return Ok(r);
