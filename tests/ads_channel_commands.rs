@@ -198,7 +198,8 @@ fn the_last_msg_text_is_read_at_mc_message_r() {
     let rig = common::Rig::new();
     rig.program(
         "msg.nc",
-        "N10 #MSG [\"Insert the clamp\"]\nN20 G04 0.5\nN30 #MSG [\"Clamp closed\"]\nN40 M30\n",
+        "N10 #MSG [\"Insert the clamp\"]\nN20 G04 0.5\nN25 P1 = 3.26\n\
+         N30 #MSG [\"Clamp %d closed at %.1f mm\", 2, P1]\nN40 M30\n",
     );
     let served = common::Served::start(&rig);
     let c = client(&served);
@@ -210,14 +211,15 @@ fn the_last_msg_text_is_read_at_mc_message_r() {
     );
     com.start("msg.nc");
     com.wait_state(3);
-    assert_eq!(com.string(0x1F, 120), "Clamp closed");
+    // The formatted text (TF5200 "Messages from the NC program": printf-style values).
+    assert_eq!(com.string(0x1F, 120), "Clamp 2 closed at 3.3 mm");
     drop(c);
     let (_, events) = served.finish();
     let texts: Vec<&str> = common::of(&events, "message")
         .iter()
         .filter_map(|e| e["text"].as_str())
         .collect();
-    assert_eq!(texts, ["Insert the clamp", "Clamp closed"]);
+    assert_eq!(texts, ["Insert the clamp", "Clamp 2 closed at 3.3 mm"]);
 }
 
 #[test]

@@ -130,7 +130,9 @@ fn every_reference_g_function_is_implemented_inert_or_refused_as_documented() {
         }
     }
     assert!(seen > 150, "{seen} G numbers read from the reference");
-    // Every accepted G runs in a channel (alone in its block; G04 with its time).
+    // Every accepted G runs in a channel (alone in its block; G04 with its time). G800–G819
+    // call the subroutines a channel list configures: tests/real_programs.rs runs them.
+    accepted.retain(|g| !ncchannel::lang::gcall::G_CALLS.contains(g));
     let rig = Rig::new();
     let mut prog: String = accepted
         .iter()

@@ -22,6 +22,7 @@ fn without_cols(mut b: Block) -> Block {
                 Item::Assign { col, .. }
                 | Item::GValue { col, .. }
                 | Item::FunctionValue { col, .. } => *col = 0,
+                Item::GCall(c) => c.col = 0,
             }
         }
     }

@@ -153,7 +153,15 @@ fn item() -> impl Strategy<Value = Item> {
         1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
         1 => (0u32..=65_535).prop_map(|h| Item::Word(Word { letter: b'H', value: Value::Num(f64::from(h)), col: 0 })),
         1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::Assign { target: Box::new(target), value, col: 0 }),
-        1 => (prop::sample::select(vec![133u32, 134]), expr()).prop_map(|(g, e)| Item::GValue {
+        1 => (800u32..=819, prop::collection::vec(prop::option::of(expr()), 0..4))
+            .prop_map(|(g, mut args)| {
+                // The parser drops trailing gaps: they define nothing.
+                while args.last().is_some_and(Option::is_none) {
+                    args.pop();
+                }
+                Item::GCall(Box::new(ncchannel::lang::GCall { g, args, col: 0 }))
+            }),
+        1 => (prop::sample::select(vec![129u32, 131, 133, 134, 231, 233]), expr()).prop_map(|(g, e)| Item::GValue {
             g,
             value: match e { Expr::Num(v) => Value::Num(v), e => Value::Expr(e) },
             col: 0,
@@ -228,7 +236,24 @@ fn command() -> impl Strategy<Value = Command> {
         file().prop_map(|file| CacheClear { file }),
         (any::<bool>(), options()).prop_map(|(on, options)| Hsc { on, options }),
         options().prop_map(|options| ContourMode { options }),
-        (any::<bool>(), "[A-Za-z0-9_ .,:]{0,20}").prop_map(|(save, text)| Msg { save, text }),
+        (any::<bool>(), options()).prop_map(|(on, options)| ContourSwitch { on, options }),
+        (
+            any::<bool>(),
+            "[A-Za-z0-9_ .,:]{0,20}",
+            prop::collection::vec(expr(), 0..3)
+        )
+            .prop_map(|(save, text, args)| Msg(Box::new(ncchannel::lang::Message {
+                options: if save { vec!["SAVE"] } else { Vec::new() },
+                text: text + &"%d".repeat(args.len()),
+                quoted: true,
+                args,
+            }))),
+        "[A-Za-z0-9_.,:]{1,20}".prop_map(|text| Msg(Box::new(ncchannel::lang::Message {
+            options: vec!["INFO", "SYN", "HMI"],
+            text,
+            quoted: false,
+            args: Vec::new(),
+        }))),
         // `#TIME` reads an expression: a literal comes back as a number, `-3` as a negation.
         expr().prop_map(|e| Time(match e {
             Expr::Num(v) => Value::Num(v.abs()),
@@ -289,6 +314,7 @@ fn without_cols(mut b: Block) -> Block {
                 Item::Assign { col, .. }
                 | Item::GValue { col, .. }
                 | Item::FunctionValue { col, .. } => *col = 0,
+                Item::GCall(c) => c.col = 0,
             }
         }
     }

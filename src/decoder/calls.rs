@@ -83,15 +83,62 @@ impl Decoder {
     /// A global subroutine call without a call line (an implicit call): the frame is pushed,
     /// its blocks run as those of `L name` would.
     pub(super) fn call_global(&mut self, name: &str, io: &mut DecoderIo<'_>) -> Res {
+        self.call_implicit(name, FrameKind::Global, Vec::new(), io)
+    }
+
+    /// An implicit call of `name` as `kind`, with `params` as its `@P` values.
+    fn call_implicit(
+        &mut self,
+        name: &str,
+        kind: FrameKind,
+        params: Vec<(u32, f64)>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         if self.frames.len() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
             ));
         }
-        let frame = self.open_subroutine(name, FrameKind::Global, io)?;
-        self.vars.push_level(Vec::new());
+        let frame = self.open_subroutine(name, kind, io)?;
+        self.vars.push_level(params);
         self.frames.push(frame);
+        Ok(())
+    }
+
+    /// The subroutine `g800_prog_file[g - 800]` names (P-CHAN-00187), if configured.
+    pub(super) fn g800_subroutine(&self, g: u32) -> Option<&str> {
+        let i = usize::try_from(g.checked_sub(800)?).ok()?;
+        self.settings.implicit.g800.get(i)?.as_deref()
+    }
+
+    /// G800–G819 as the last action of its block (TF5200 programming manual, "Implicit
+    /// subroutine calls"): its subroutine runs, as a cycle when parameters were given (read
+    /// as `@P1`, `@P2`, …); an end in the same block waits for its return.
+    pub(super) fn call_g800(
+        &mut self,
+        g: u32,
+        params: &[(u32, f64)],
+        end_m: Option<u32>,
+        info: BlockInfo,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let Some(name) = self.g800_subroutine(g).map(str::to_string) else {
+            return Err(DecodeError::new(
+                codes::UNKNOWN_G,
+                format!("unknown G function G{g}"),
+            ));
+        };
+        let depth = self.frames.len();
+        let kind = if params.is_empty() {
+            FrameKind::Global
+        } else {
+            FrameKind::Cycle
+        };
+        self.call_implicit(&name, kind, params.to_vec(), io)?;
+        if let Some(m) = end_m {
+            self.implicit.held.push(HeldEnd { m, info, depth });
+        }
         Ok(())
     }
 
@@ -217,12 +264,21 @@ impl Decoder {
                 }
                 self.emit(info, Action::None, false, io)
             }
+            // `ON [...]`: the parameters, then G261; `OFF`: G260.
+            Command::ContourSwitch { on, options } => {
+                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                    self.modal.contour_dev_mm = dev;
+                }
+                self.modal.contouring = *on;
+                self.emit(info, Action::None, false, io)
+            }
             Command::Var => self.top().var_block = true,
             Command::EndVar => {}
-            Command::Msg { save, text } => {
+            Command::Msg(m) => {
+                let text = self.format_message(m)?;
                 self.notes.push(Note::Message {
-                    text: text.clone(),
-                    save: *save,
+                    text,
+                    save: m.save(),
                 });
                 self.emit(info, Action::None, false, io);
             }
@@ -238,6 +294,17 @@ impl Decoder {
             Command::Inert { .. } => self.emit(info, Action::None, false, io),
         }
         Ok(())
+    }
+
+    /// `#MSG`: its values evaluated, in written order, and put into its text
+    /// (`lang::msg::format_message`, bounded by `MAX_MSG_CHARS`).
+    fn format_message(&mut self, m: &crate::lang::Message) -> Res<String> {
+        let mut values = Vec::with_capacity(m.args.len());
+        for e in &m.args {
+            values.push(self.eval(e)?);
+        }
+        crate::lang::msg::format_message(m, &values)
+            .map_err(|e| DecodeError::new(codes::MSG_TOO_LONG, e.to_string()))
     }
 
     /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).

@@ -66,7 +66,8 @@ pub enum SkipUntil {
     LoopContinue,
     /// A forward `$GOTO` (streams): the line with this label.
     Label(GotoTarget),
-    /// A `%L name` section met while running the main program: up to its M17/M29.
+    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
+    /// next `%name` head when it has none.
     LocalSubroutine,
 }
 
@@ -166,10 +167,14 @@ impl Decoder {
             return self.skip_to_label(block, t);
         }
         if skip.until == SkipUntil::LocalSubroutine {
-            if let Body::Items(items) = &block.body {
-                if items_have_m(items, &[17, 29]) {
+            match &block.body {
+                Body::Items(items) if items_have_m(items, &[17, 29]) => self.top().skip = None,
+                // A section without M17/M29 ends at the next main program head, which runs.
+                Body::ProgramHead { local: false, .. } => {
                     self.top().skip = None;
+                    return Ok(true);
                 }
+                _ => {}
             }
             return Ok(false);
         }

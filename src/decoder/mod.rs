@@ -645,6 +645,12 @@ impl Decoder {
             Body::Control(c) => self.exec_control(c, meta),
             Body::Command(c) => self.exec_command(c, &block, text, meta, io),
             Body::Call(c) => self.exec_call(c, &block, text, meta, io),
+            Body::ProgramHead { .. } if self.top().kind == FrameKind::Local => {
+                // A local subroutine without M17/M29 ends where the next program begins.
+                self.check_open_flow()?;
+                self.return_from_subroutine();
+                self.resume_held_end(io)
+            }
             Body::ProgramHead { local: true, .. } => {
                 // A local subroutine section met while running: it runs only when called.
                 let top = self.top();

@@ -193,6 +193,9 @@ pub struct BlockGs {
     pub set_reference: bool,
     /// G60 / G09 / G900 / G901: stop at this block's end (state only, as `BlockEnd`).
     pub stop_this_block: bool,
+    /// G130: the block's axis words are acceleration weightings in percent, not positions
+    /// (TF5200 programming manual, "Acceleration weighting"); no motion.
+    pub axis_weights: bool,
 }
 
 /// Apply one G code. `false` for a G code the channel does not know or refuses (the parser
@@ -218,6 +221,7 @@ pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
         54..=59 => m.zero_offset = (g - 53) as usize,
         61 => b.contour_this_block = true,
         60 | 9 | 900 | 901 => b.stop_this_block = true,
+        130 => b.axis_weights = true,
         70 => m.units = Units::Inch,
         71 => m.units = Units::Metric,
         90 => m.absolute = true,

@@ -49,6 +49,10 @@ pub(super) struct Words {
     hs: [u32; MAX_FUNCTIONS],
     h_values: [Option<f64>; MAX_FUNCTIONS],
     n_hs: usize,
+    /// G800–G819 (number, column): an implicit subroutine call at the end of the block.
+    call: Option<(u32, u32)>,
+    /// Its transfer parameters as `@P` number and value (gaps left out).
+    call_params: Vec<(u32, f64)>,
 }
 
 impl Words {
@@ -67,6 +71,12 @@ impl Words {
         self.dwell_s = None;
         self.n_ms = 0;
         self.n_hs = 0;
+        // `call_params` count only with `call`, and are cleared when it is set.
+        self.call = None;
+    }
+
+    fn gs(&self) -> &[(u32, u32)] {
+        &self.gs[..self.n_gs]
     }
 
     fn push_g(&mut self, g: u32, col: u32) -> Res {
@@ -79,9 +89,6 @@ impl Words {
         self.gs[self.n_gs] = (g, col);
         self.n_gs += 1;
         Ok(())
-    }
-    fn gs(&self) -> &[(u32, u32)] {
-        &self.gs[..self.n_gs]
     }
     fn ms(&self) -> &[u32] {
         &self.ms[..self.n_ms]
@@ -183,6 +190,16 @@ impl Decoder {
                 }
                 .map_err(|e| e.at(*col))
             }
+            Item::GCall(c) => {
+                self.implicit_call(c.g, c.col, w)?;
+                for (k, a) in c.args.iter().enumerate() {
+                    if let Some(e) = a {
+                        let v = self.eval(e).map_err(|e| e.at(c.col))?;
+                        w.call_params.push((k as u32 + 1, v));
+                    }
+                }
+                Ok(())
+            }
             Item::Word(word) => {
                 let v = match &word.value {
                     Value::Num(n) => *n,
@@ -235,12 +252,26 @@ impl Decoder {
     /// modal part (spindle, coolant).
     fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
         let mut gs = BlockGs::default();
+        let mut call = None;
         for &(g, col) in w.gs() {
             if !apply_g(&mut self.modal, g, &mut gs) {
+                if crate::lang::gcall::G_CALLS.contains(&g) {
+                    if call.replace((g, col)).is_some() {
+                        return Err(two_calls().at(col));
+                    }
+                    continue;
+                }
                 return Err(
                     DecodeError::new(codes::UNKNOWN_G, format!("unknown G function G{g}")).at(col),
                 );
             }
+        }
+        if let Some((g, col)) = call {
+            self.implicit_call(g, col, w)?;
+        }
+        if gs.axis_weights {
+            // G130 X70: weightings, no move (the weighting itself is not modelled).
+            w.axes_set = 0;
         }
         if gs.dwell {
             // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
@@ -454,6 +485,19 @@ impl Decoder {
                 ));
             }
         }
+        if let Some((g, col)) = w.call {
+            if self.m6_subroutine(w).is_some() {
+                return Err(DecodeError::new(
+                    codes::UNSUPPORTED,
+                    "G800–G819 and M6 with its subroutine in one block",
+                )
+                .at(col));
+            }
+            if !queued {
+                self.emit(info.clone(), Action::None, false, io);
+            }
+            return self.call_g800(g, &w.call_params, end_m, info, io);
+        }
         if let Some(name) = self.m6_subroutine(w) {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
@@ -481,6 +525,27 @@ impl Decoder {
         self.program_end(m, info, io)
     }
 
+    /// G800–G819 in this block (`col` its column): its subroutine must be configured
+    /// (20131 otherwise, as the kernel's P-CHAN-00187 says), one call per block.
+    fn implicit_call(&self, g: u32, col: u32, w: &mut Words) -> Res {
+        if self.g800_subroutine(g).is_none() {
+            return Err(DecodeError::new(
+                codes::UNKNOWN_G,
+                format!(
+                    "unknown G function G{g}: no g800_prog_file[{}] in the channel list",
+                    g - 800
+                ),
+            )
+            .at(col));
+        }
+        if w.call.is_some() {
+            return Err(two_calls().at(col));
+        }
+        w.call = Some((g, col));
+        w.call_params.clear();
+        Ok(())
+    }
+
     /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in
     /// the main program every control block must be closed.
     pub(super) fn program_end_checks(&mut self, m: u32) -> Res {
@@ -500,6 +565,13 @@ impl Decoder {
             self.check_open_flow()
         }
     }
+}
+
+fn two_calls() -> DecodeError {
+    DecodeError::new(
+        codes::UNSUPPORTED,
+        "two implicit subroutine calls (G800–G819) in one block",
+    )
 }
 
 fn unconfigured(letter: u8) -> DecodeError {

@@ -76,6 +76,20 @@ pub enum Item {
         value: Value,
         col: u32,
     },
+    /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
+    /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
+    /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None` (trailing gaps are dropped).
+    /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
+    /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
+    GCall(Box<GCall>),
+}
+
+/// An implicit subroutine call's G number, transfer parameters and column ([`Item::GCall`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GCall {
+    pub g: u32,
+    pub args: Vec<Option<Expr>>,
+    pub col: u32,
 }
 
 /// An address letter with its value: `G01`, `X12.5`, `F[P1*2]`.
@@ -260,15 +274,19 @@ pub enum Command {
     ContourMode {
         options: String,
     },
+    /// `#CONTOUR MODE ON [...]` (parameters as `ContourMode`, then contouring on as G261) and
+    /// `#CONTOUR MODE OFF` (as G260) (TF5200 programming manual, "Activating contouring modes
+    /// in the NC program").
+    ContourSwitch {
+        on: bool,
+        options: String,
+    },
     /// `#VAR` … `#ENDVAR`: declarations of V.P./V.L./V.S. variables in between.
     Var,
     EndVar,
-    /// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]`: an operator message;
-    /// the bracket text is kept verbatim (quotes removed when it is one quoted string).
-    Msg {
-        save: bool,
-        text: String,
-    },
+    /// `#MSG ["text", values…]`, `#MSG SAVE …`, `#MSG INFO …`: an operator message
+    /// (`super::msg`). Boxed: messages are rare and `Block` stays small.
+    Msg(Box<Message>),
     /// `#TIME <seconds>`: a dwell (TF5200 "Dwell time").
     Time(Value),
     /// A `#` command of ISG's list that ncchannel accepts without effect
@@ -276,6 +294,27 @@ pub enum Command {
     Inert {
         text: String,
     },
+}
+
+/// An operator message (TF5200 programming manual, "Messages from the NC program").
+#[derive(Debug, Clone, PartialEq)]
+pub struct Message {
+    /// The keywords between `#MSG` and the bracket, upper-case, as written: `SAVE EXCLUSIVE`,
+    /// `INFO`, `SYN HMI`.
+    pub options: Vec<&'static str>,
+    /// The format text without its quotes, or the bracket text verbatim when it is not one
+    /// quoted string (then `quoted` is false and nothing is formatted).
+    pub text: String,
+    pub quoted: bool,
+    /// The values for the text's format elements, as many as it has.
+    pub args: Vec<Expr>,
+}
+
+impl Message {
+    /// `#MSG SAVE …`: the kernel writes it to its report file as well.
+    pub fn save(&self) -> bool {
+        self.options.first() == Some(&"SAVE")
+    }
 }
 
 /// `#FLUSH` variants; in the event log `plain`, `continue`, `wait`.

@@ -101,6 +101,18 @@ pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
 pub const FLUSH_UNDER_TRC: u32 = 20651;
+/// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
+/// ID 20721 "Number of parameters and the number of format specifiers do not match.").
+pub const MSG_ARG_COUNT: u32 = 20721;
+/// `#MSG`: more format elements than values can be given (TF5200 diagnosis ID 20724 "Too many
+/// parameters in the message string."; the limit is `lang::msg::MAX_MSG_VALUES`).
+pub const MSG_TOO_MANY_VALUES: u32 = 20724;
+/// `#MSG`: a comma not followed by a value (TF5200 diagnosis ID 20726 "After a comma a
+/// mathematical expression is expected.").
+pub const MSG_NO_VALUE: u32 = 20726;
+/// `#MSG`: a format element other than `%s %S %d %D %f %F` (TF5200 diagnosis ID 21232,
+/// "Unbekannter Formatstring.", unknown format string).
+pub const MSG_UNKNOWN_FORMAT: u32 = 21232;
 /// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis ID 20751.
 pub const DWELL_RANGE_TIME: u32 = 20751;
 /// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
@@ -188,6 +200,8 @@ pub const DWELL_NOT_ALONE: u32 = 900134;
 /// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
 /// axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
+/// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
+pub const MSG_TOO_LONG: u32 = 900136;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
 /// elements do not meet, no tool data for the D word, or compensation outside G17.
 pub const TRC_IMPOSSIBLE: u32 = 900140;
@@ -243,6 +257,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
+    (MSG_ARG_COUNT, "#MSG values do not match the format"),
+    (MSG_TOO_MANY_VALUES, "#MSG with too many format elements"),
+    (MSG_NO_VALUE, "#MSG comma without a value"),
+    (MSG_UNKNOWN_FORMAT, "#MSG unknown format element"),
     (DWELL_RANGE_TIME, "#TIME out of range"),
     (DWELL_RANGE_G04, "G04 time out of range"),
     (LABEL_TWICE, "label defined twice"),
@@ -279,6 +297,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
     (WORD_TWICE, "T, D, I, J, K, R or E twice in a block"),
+    (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
 ];
@@ -289,7 +308,8 @@ pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
 /// Kernel ids ncchannel emits whose diagnosis page was read, each with the title the page
 /// publishes and, in the comment, the page (infosys.beckhoff.com/content/1033/ +
 /// `tf5200_diagnosis/<n>.html` unless another manual is named). English titles; 20054's
-/// English page is not in the index searched, so its German title (content/1031/) stands.
+/// and 21232's English pages are not in the index searched, so their German titles
+/// (content/1031/) stand.
 pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
     (20008, "Feed rate in motion block is 0."), // 250515083
@@ -359,6 +379,15 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20396, "Division by 0."),           // 251507339
     (20399, "Logarithm less than/equal 0."), // 251520395
     (20651, "NC command is not allowed during active TRC."), // 252112267
+    (
+        20721,
+        "Number of parameters and the number of format specifiers do not match.",
+    ), // 252329867
+    (20724, "Too many parameters in the message string."), // 252342923
+    (
+        20726,
+        "After a comma a mathematical expression is expected.",
+    ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
     (
@@ -376,6 +405,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         21479,
         "Call of local subroutine during streaming not allowed.",
     ), // 254845323
+    (21232, "Unbekannter Formatstring."), // content/1031/tf5200_diagnosis/253866123
     (21928, "Array index is out of data range."), // 256586123
     (
         120102,
@@ -475,8 +505,10 @@ pub const KNOWN_G: &[u32] = &[
 ];
 
 /// G functions that take a value: `G133=<expr>`, `G134=<expr>` (TF5200 "Weighting the ramp
-/// times", also written `G134 50`) and the dwell `G04 <seconds>`.
-pub const G_WITH_VALUE: &[u32] = &[4, 133, 134];
+/// times", also written `G134 50`), `G129=<expr>` (weighting of rapid traverse velocity),
+/// `G131=<expr>` / `G231=<expr>` (acceleration weighting, TF5200 "Acceleration weighting"),
+/// `G233=<expr>` (weighting for G00) and the dwell `G04 <seconds>`.
+pub const G_WITH_VALUE: &[u32] = &[4, 129, 131, 133, 134, 231, 233];
 
 /// Is `g` one of the implemented G functions ([`KNOWN_G`])?
 #[inline]

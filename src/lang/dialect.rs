@@ -76,7 +76,14 @@ const G_TABLE: &[(u32, u32, &str, Support)] = &[
     (108, 108, "edge banding", R),
     (112, 112, "gear changing", R),
     (115, 117, "look-ahead functions", N),
-    (127, 131, "weighting of velocity and acceleration", R),
+    (127, 128, "weighting of velocity and acceleration", R),
+    (129, 129, "weighting of rapid traverse velocity", N),
+    (
+        130,
+        131,
+        "acceleration weighting (G130's axis words are weights, no move)",
+        N,
+    ),
     (132, 134, "weighting of ramp times", N),
     (135, 135, "selecting feedforward control", N),
     (136, 136, "weighting of feedforward control", R),
@@ -105,7 +112,10 @@ const G_TABLE: &[(u32, u32, &str, Support)] = &[
     (194, 194, "F word as weighting of maximum feed rate", R),
     (196, 196, "maximum spindle speed for G96", R),
     (200, 202, "manual mode", R),
-    (230, 233, "weighting for G00", R),
+    (230, 230, "axis-specific acceleration weighting for G00", R),
+    (231, 231, "acceleration weighting for G00", N),
+    (232, 232, "axis-specific weighting for G00", R),
+    (233, 233, "weighting for G00", N),
     (236, 239, "TRC selection variants", R),
     (
         260,
@@ -121,7 +131,12 @@ const G_TABLE: &[(u32, u32, &str, Support)] = &[
     (333, 339, "weighting with feedhold", R),
     (351, 351, "mirroring with axis specification", R),
     (359, 360, "exact stop off / on", N),
-    (800, 819, "implicit subroutine calls", R),
+    (
+        800,
+        819,
+        "implicit subroutine calls (g800_prog_file[i], P-CHAN-00187)",
+        I,
+    ),
     (900, 901, "deceleration at / after block end", N),
 ];
 
@@ -250,6 +265,37 @@ const COMMAND_TABLE: &[(&str, Support)] = &[
     ("WAIT", R),
     ("WCS", R),
 ];
+
+/// `#` commands refused by their first keyword whose forms named here are accepted without
+/// effect, because the kernel does something behind them that changes no path:
+/// `#CHANNEL INIT [CMDPOS]` / `[ACTPOS]` (TF5200 programming manual, "Request current command
+/// positions … (#CHANNEL INIT)": command and actual positions are one in ncchannel),
+/// `#TOOL PREP`, `#TOOL DATA` (requests to the tool management, "Programming commands and
+/// variables"), `#TOOL LIFE READ` ("Reading/removing tool life values": tool life data to the
+/// tool management).
+const INERT_FORMS: &[(&str, &[&str])] = &[
+    ("CHANNEL", &["INIT"]),
+    ("TOOL", &["DATA"]),
+    ("TOOL", &["LIFE", "READ"]),
+    ("TOOL", &["PREP"]),
+];
+
+/// `s` for the command `kw` (upper-case) whose text after the keyword is `rest`, made
+/// [`Support::Inert`] when it is one of the [`INERT_FORMS`].
+pub fn form_support(s: Support, kw: &[u8], rest: &str) -> Support {
+    let inert = INERT_FORMS.iter().any(|(k, words)| {
+        k.as_bytes() == kw
+            && words
+                .iter()
+                .try_fold(rest, |r, w| super::expr::keyword(super::expr::ws(r), w))
+                .is_some()
+    });
+    if s == Support::Refused && inert {
+        Support::Inert
+    } else {
+        s
+    }
+}
 
 /// What ncchannel does with the `#` command whose first keyword is `kw` (upper-case);
 /// `None` for a keyword ISG's list does not have (20209).

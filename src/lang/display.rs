@@ -108,6 +108,18 @@ impl Display for Item {
                     Value::Expr(e) => write!(f, "{l}{number}={e}"),
                 }
             }
+            Item::GCall(c) => {
+                write!(f, "G{}[", c.g)?;
+                for (k, a) in c.args.iter().enumerate() {
+                    if k > 0 {
+                        f.write_str(", ")?;
+                    }
+                    if let Some(e) = a {
+                        e.fmt(f)?;
+                    }
+                }
+                f.write_char(']')
+            }
         }
     }
 }
@@ -377,16 +389,29 @@ impl Display for Command {
                 f.write_str("#CONTOUR MODE")?;
                 options_fmt(f, options)
             }
+            Command::ContourSwitch { on, options } => {
+                f.write_str(if *on {
+                    "#CONTOUR MODE ON"
+                } else {
+                    "#CONTOUR MODE OFF"
+                })?;
+                options_fmt(f, options)
+            }
             Command::Var => f.write_str("#VAR"),
             Command::EndVar => f.write_str("#ENDVAR"),
-            Command::Msg { save, text } => {
-                f.write_str(if *save { "#MSG SAVE" } else { "#MSG" })?;
-                // A text with a quote inside was kept as written between the brackets.
-                if text.contains('"') {
-                    write!(f, " [{text}]")
-                } else {
-                    write!(f, " [\"{text}\"]")
+            Command::Msg(m) => {
+                f.write_str("#MSG")?;
+                for o in &m.options {
+                    write!(f, " {o}")?;
                 }
+                if !m.quoted {
+                    return write!(f, " [{}]", m.text);
+                }
+                write!(f, " [\"{}\"", m.text)?;
+                for a in &m.args {
+                    write!(f, ", {a}")?;
+                }
+                f.write_char(']')
             }
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),

@@ -358,7 +358,7 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::FunctionValue { .. } => false,
+        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) => false,
     }
 }
 
@@ -406,6 +406,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 col,
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
+            Item::GCall(c) => (c.col, format!("G{}", c.g)),
         };
         return Err(ctx.err_at(
             col,
@@ -467,8 +468,12 @@ fn word<'a>(
             };
             if !is_known_g(g) {
                 dialect_g(i, g)?;
+                if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
+                    return Ok(r);
+                }
             }
-            if G_WITH_VALUE.contains(&g) {
+            // The implemented G functions take no value but G04: G01 skips the list search.
+            if (g == 4 || !is_known_g(g)) && G_WITH_VALUE.contains(&g) {
                 if let Some((r, value)) = g_value(ctx, rest, g == 4)? {
                     items.push(Item::GValue { g, value, col });
                     return Ok(r);
@@ -898,12 +903,18 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let Some(m) = keyword(r, "MODE") else {
                 return fail(r, SYNTAX, "#CONTOUR takes MODE");
             };
+            for (kw, on) in [("ON", true), ("OFF", false)] {
+                if let Some(r) = keyword(ws(m), kw) {
+                    let (r, options) = verbatim_options(ws(r), r)?;
+                    return Ok((r, Command::ContourSwitch { on, options }));
+                }
+            }
             let (r, options) = verbatim_options(ws(m), m)?;
             Ok((r, Command::ContourMode { options }))
         }
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
-        b"MSG" => msg(r),
+        b"MSG" => super::msg::parse_msg(ctx, r),
         b"TIME" => {
             let (r, v) = ctx.expr(r)?;
             Ok((r, Command::Time(expr_value(v))))
@@ -916,7 +927,8 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
 /// ncchannel treats it as a no-op, refused by name when it does not support it, 20209 when
 /// ISG's list does not have it either.
 fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command> {
-    match command_support(kw) {
+    let rest = &i[1 + word.len()..];
+    match command_support(kw).map(|s| super::dialect::form_support(s, kw, rest)) {
         Some(Support::Inert) => {
             // The whole command to the comment: options in brackets may hold anything.
             let text = i[1..].split([';', '(']).next().unwrap_or("").trim_end();
@@ -934,26 +946,6 @@ fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command
         ),
         None => fail(i, UNKNOWN_COMMAND, format!("unknown NC command #{word}")),
     }
-}
-
-/// `#MSG ["text"]`, `#MSG SAVE ["text"]`, `#MSG INFO ["text"]` (TF5200 "#MSG").
-fn msg(i: &str) -> PResult<'_, Command> {
-    let (r, save) = if let Some(r) = keyword(i, "SAVE") {
-        (ws(r), true)
-    } else if let Some(r) = keyword(i, "INFO") {
-        (ws(r), false)
-    } else {
-        (i, false)
-    };
-    if !r.starts_with('[') {
-        return fail(r, SYNTAX, "#MSG takes [\"text\"]");
-    }
-    let (rest, text) = verbatim_options(r, r)?;
-    let text = match text.strip_prefix('"').and_then(|t| t.strip_suffix('"')) {
-        Some(t) if !t.contains('"') => t.to_string(),
-        _ => text,
-    };
-    Ok((rest, Command::Msg { save, text }))
 }
 
 /// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to

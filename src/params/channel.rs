@@ -1,6 +1,6 @@
 //! A channel list: the streaming program name (P-CHAN-00158), the implicitly called
 //! subroutines (at program start P-CHAN-00119, at program end P-CHAN-00252, at M6
-//! P-CHAN-00118), the channel's axes (`gruppe[0].achse[j].*`, P-CHAN-00006 / -00035), the
+//! P-CHAN-00118, for G800–G819 P-CHAN-00187), the channel's axes (`gruppe[0].achse[j].*`, P-CHAN-00006 / -00035), the
 //! channel's own program search paths (`path[j].*`, replacing the start-up list's) and
 //! decoder overrides.
 
@@ -31,7 +31,13 @@ pub struct ImplicitSubroutines {
     pub at_end: Option<String>,
     /// `m6_prog_file` (P-CHAN-00118): called for M6, as the last action of its block.
     pub at_m6: Option<String>,
+    /// `g800_prog_file[i]` (P-CHAN-00187, TF5200 channel parameter "Additional implicit
+    /// calls with G8xx"): called for G800 + i, i = 0…19, as the last action of its block.
+    pub g800: [Option<String>; G800_CALLS],
 }
+
+/// G800–G819: the implicit calls `g800_prog_file[0…19]` configures (P-CHAN-00187).
+pub const G800_CALLS: usize = 20;
 
 /// One axis of the channel's axis group, as the channel list names it.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,6 +100,9 @@ pub fn interpret_channel(
             [("start_init_prog_file", None)] => implicit.at_start = program_name(&list, e, diags),
             [("final_prog_file", None)] => implicit.at_end = program_name(&list, e, diags),
             [("m6_prog_file", None)] => implicit.at_m6 = program_name(&list, e, diags),
+            [("g800_prog_file", Some(i))] if (*i as usize) < G800_CALLS => {
+                implicit.g800[*i as usize] = program_name(&list, e, diags);
+            }
             [("start_init_prog_file_mode", None)] => start_mode = call_mode(&list, e, diags),
             [("final_prog_file_mode", None)] => final_mode = call_mode(&list, e, diags),
             [("gruppe", Some(0)), ("achse", Some(j)), ("bezeichnung", None)] => {
