@@ -345,3 +345,59 @@ fn a_local_subroutine_without_m17_ends_at_the_next_program_head() {
         assert_eq!((r.position('X'), r.position('Z')), (0.0, 1.0));
     }
 }
+
+#[test]
+fn a_printer_post_processor_program_runs_to_m30_with_its_own_g80x_subroutines() {
+    // In the style of a bioprinter's post-processor for a TwinCAT CNC: a head with blanks
+    // and a comment, M functions with values (pressure on and off), a layer start as a G805
+    // call continued over two lines, contouring switched on with its deviation, a message
+    // with a value, a flush before the pressure goes off, and a park call G800.
+    let rig = g800_rig();
+    let text = "% Bioprinter job 42 (generated)\n\
+        N10 G17 G90 G71\n\
+        N20 #CONTOUR MODE ON [DEV PATH_DEV=0.08]\n\
+        N30 M200=1200\n\
+        N40 G805[0, \\\n     0, 1.5]\n\
+        N50 #MSG [\"layer %d of %d\", 1, 1]\n\
+        N60 G01 X20 Y0 F3000\n\
+        N70 X20 Y20\n\
+        N80 X0 Y20\n\
+        N90 X0 Y0\n\
+        N100 #FLUSH WAIT\n\
+        N110 M201=0\n\
+        N120 G800\n\
+        N130 #CONTOUR MODE OFF\n\
+        N140 M30\n";
+    assert_eq!(check_program(text), []);
+    for (k, r) in both(&rig, text).iter().enumerate() {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        assert!(r.error_codes().is_empty(), "{}", r.log);
+        let main = if k == 0 { "t.nc" } else { "streaming.nc" };
+        let calls: Vec<(String, u64)> = numbered_blocks(r)
+            .into_iter()
+            .filter(|(p, _)| p != main)
+            .collect();
+        let want: Vec<(String, u64)> = [
+            ("g805.nc", 1),
+            ("g805.nc", 2),
+            ("g800.nc", 5),
+            ("g800.nc", 6),
+        ]
+        .iter()
+        .map(|(p, n)| (p.to_string(), *n))
+        .collect();
+        assert_eq!(calls, want, "{}", r.log);
+        let m_values: Vec<(u64, f64)> = r
+            .of("m_function")
+            .iter()
+            .map(|e| (e["m"].as_u64().unwrap(), e["value"].as_f64().unwrap()))
+            .collect();
+        assert_eq!(m_values, [(200, 1200.0), (201, 0.0)], "{}", r.log);
+        assert_eq!(messages(r), [("layer 1 of 1".to_string(), false)]);
+        // The square closed at the origin at the layer height, then G800 lifted Z to 4.
+        assert_eq!(
+            (r.position('X'), r.position('Y'), r.position('Z')),
+            (0.0, 0.0, 4.0)
+        );
+    }
+}
