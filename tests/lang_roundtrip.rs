@@ -100,7 +100,12 @@ fn expr() -> BoxedStrategy<Expr> {
                     };
                     Expr::Func(f, args)
                 }),
-            var_ref(inner).prop_map(|v| Expr::Var(Box::new(v))),
+            var_ref(inner.clone()).prop_map(|v| Expr::Var(Box::new(v))),
+            (
+                prop::sample::select(vec![VarTest::Exist, VarTest::IsNumber, VarTest::IsString]),
+                var_ref(inner)
+            )
+                .prop_map(|(t, v)| Expr::Test(t, Box::new(v))),
         ]
     })
     .boxed()
@@ -237,16 +242,28 @@ fn command() -> impl Strategy<Value = Command> {
     ]
 }
 
+/// A cycle parameter's value: an expression or a quoted string (no `"` inside).
+fn cycle_arg() -> impl Strategy<Value = CycleArg> {
+    prop_oneof![
+        3 => expr().prop_map(CycleArg::Expr),
+        1 => "[A-Za-z0-9_ .,:-]{0,12}".prop_map(CycleArg::Str),
+    ]
+}
+
 fn call() -> impl Strategy<Value = Call> {
     prop_oneof![
         file().prop_map(|file| Call::Global { file }),
         ident().prop_map(|name| Call::Local { name }),
-        (file(), prop::collection::btree_map(0u32..20, expr(), 0..4)).prop_map(|(name, params)| {
-            Call::Cycle {
+        (
+            file(),
+            any::<bool>(),
+            prop::collection::btree_map(0u32..20, cycle_arg(), 0..4)
+        )
+            .prop_map(|(name, local, params)| Call::Cycle {
                 name,
+                local,
                 params: params.into_iter().collect(),
-            }
-        }),
+            }),
     ]
 }
 

@@ -49,6 +49,10 @@ impl Vars for VarStore {
     fn get(&self, key: &VarKey<'_>) -> Option<f64> {
         VarStore::get(self, &slot(key)?)
     }
+
+    fn is_string(&self, key: &VarKey<'_>) -> bool {
+        slot(key).is_some_and(|s| VarStore::is_string(self, &s))
+    }
 }
 
 pub(super) fn err(e: eval::EvalError) -> DecodeError {

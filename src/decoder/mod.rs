@@ -7,6 +7,7 @@
 
 pub mod arc;
 mod calls;
+mod cycles;
 mod expr;
 pub mod flow;
 pub mod frame;
@@ -761,7 +762,7 @@ fn stream_allows(block: &Block) -> Res {
             codes::STREAM_LOOP,
             "loop statement in streaming program; streaming aborted",
         )),
-        Body::Call(Call::Local { .. }) => Err(DecodeError::new(
+        Body::Call(Call::Local { .. } | Call::Cycle { local: true, .. }) => Err(DecodeError::new(
             codes::STREAM_LOCAL_CALL,
             "local subroutine call (LL) in streaming program",
         )),

@@ -138,6 +138,31 @@ pub enum Expr {
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),
     Func(Func, Vec<Expr>),
+    /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]`: a question about a variable rather than
+    /// its value (1 or 0), so an undefined `v` is no error here.
+    Test(VarTest, Box<VarRef>),
+}
+
+/// What `Expr::Test` asks about its variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarTest {
+    /// `EXIST[v]`: `v` has a value, a number or a string.
+    Exist,
+    /// `IS_NUMBER[v]`: `v` holds a number.
+    IsNumber,
+    /// `IS_STRING[v]`: `v` holds a string (a cycle parameter `@P1="text"`).
+    IsString,
+}
+
+impl VarTest {
+    /// The function's name as written in NC text.
+    pub fn name(self) -> &'static str {
+        match self {
+            VarTest::Exist => "EXIST",
+            VarTest::IsNumber => "IS_NUMBER",
+            VarTest::IsString => "IS_STRING",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -306,11 +331,22 @@ pub enum Call {
     Global { file: String },
     /// `LL name`: local subroutine defined by `%L name` in the same file.
     Local { name: String },
-    /// `L CYCLE [NAME=file.cyc @P1=0 @P2=0]`.
+    /// `L CYCLE [NAME=file.cyc @P1=0 @P2="text"]` (a cycle file), or with `local`
+    /// `LL CYCLE [NAME=sub @P1=0]` (a `%L sub` section of the calling file).
     Cycle {
         name: String,
-        params: Vec<(u32, Expr)>,
+        local: bool,
+        params: Vec<(u32, CycleArg)>,
     },
+}
+
+/// The value of a cycle parameter `@P<n>=…`: an expression, evaluated at the call, or a
+/// quoted string (`@P1="String1"`), carried as written (docs/nc-language.md, "Constructs of
+/// real programs").
+#[derive(Debug, Clone, PartialEq)]
+pub enum CycleArg {
+    Expr(Expr),
+    Str(String),
 }
 
 /// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,

@@ -28,7 +28,7 @@ use nom::character::complete::char as ch;
 use nom::error::{ErrorKind, ParseError};
 use nom::IResult;
 
-use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
+use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
 use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX};
 use super::error::SyntaxError;
 use super::number::{scan_unsigned, TOO_LARGE};
@@ -371,7 +371,8 @@ impl<'a> Ctx<'a> {
             b'P' | b'p'
                 if i.as_bytes()
                     .get(1)
-                    .is_some_and(|&c| c.is_ascii_digit() || c == b'[') =>
+                    .is_some_and(|&c| c.is_ascii_digit() || c == b'[')
+                    || is_pp(i.as_bytes()) =>
             {
                 let (rest, v) = self.var_ref(i)?;
                 Ok((rest, Expr::Var(Box::new(v))))
@@ -396,6 +397,9 @@ impl<'a> Ctx<'a> {
             _ => {}
         }
         let Some(func) = func_by_name(&name) else {
+            if let Some(test) = var_test_by_name(&name) {
+                return self.var_test(test, i, rest);
+            }
             return fail(i, SYNTAX, format!("unknown function or operand `{name}`"));
         };
         let j = ws(rest);
@@ -435,6 +439,42 @@ impl<'a> Ctx<'a> {
         Ok((j, Expr::Func(func, args)))
     }
 
+    /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]` after the name (`at` is where the name
+    /// starts, `rest` after it): the argument is one variable, not an expression.
+    #[cold]
+    fn var_test(&self, test: VarTest, at: &'a str, rest: &'a str) -> PResult<'a, Expr> {
+        let name = test.name();
+        let j = ws(rest);
+        let Some(j) = j.strip_prefix('[') else {
+            return fail(j, SYNTAX, format!("`[` expected after {name}"));
+        };
+        let _g = self.enter(j)?;
+        let j = ws(j);
+        let (k, v) = match self.var_ref(j) {
+            Ok(ok) => ok,
+            Err(nom::Err::Failure(p)) if p.input.len() < j.len() => {
+                return Err(nom::Err::Failure(p))
+            }
+            Err(_) => {
+                return fail(
+                    j,
+                    SYNTAX,
+                    format!("{name} takes a variable (P, V., @P), not an expression"),
+                )
+            }
+        };
+        let k = ws(k);
+        let Some(k) = k.strip_prefix(']') else {
+            return fail(
+                k,
+                SYNTAX,
+                format!("`]` expected after the variable of {name}"),
+            );
+        };
+        self.set_height(self.height.get() + 1, at)?;
+        Ok((k, Expr::Test(test, Box::new(v))))
+    }
+
     /// `P<n>`, `P[expr]`, each with optional adjacent `[i]` indices; `V.x.name[..]`; `@P<n>`.
     pub fn var_ref(&self, i: &'a str) -> PResult<'a, VarRef> {
         let bytes = i.as_bytes();
@@ -461,6 +501,10 @@ impl<'a> Ctx<'a> {
                     let (r, e) = self.bracketed(rest)?;
                     h = self.height.get();
                     (r, Index::Expr(Box::new(e)))
+                } else if is_pp(i.as_bytes()) {
+                    let (r, n) = self.indirect_p(rest)?;
+                    h = self.height.get();
+                    (r, n)
                 } else {
                     match uint(rest) {
                         Ok((r, n)) => (r, Index::Const(n)),
@@ -689,6 +733,42 @@ pub const FUNCS: [Func; 18] = [
     Func::Floor,
     Func::Ceil,
 ];
+
+/// `PP<n>` (or `PPP<n>`, …) at the start of `b`: the parameter whose number is P<n>'s
+/// value (TF5200 programming manual, "Indirect parameters": `PPnn` points to the parameter
+/// whose number `Pnn` holds; `PPP…` is allowed too).
+pub(crate) fn is_pp(b: &[u8]) -> bool {
+    let ps = b.iter().take_while(|c| matches!(c, b'P' | b'p')).count();
+    ps >= 2 && b.get(ps).is_some_and(u8::is_ascii_digit)
+}
+
+impl<'a> Ctx<'a> {
+    /// The number of `PP…P<n>` from the second `P` on (`i`): `P[P…[P<n>]]`, one level a `P`,
+    /// within the tree height limit.
+    #[cold]
+    fn indirect_p(&self, i: &'a str) -> PResult<'a, Index> {
+        let ps = i.bytes().take_while(|c| matches!(c, b'P' | b'p')).count();
+        let (r, n) = uint(&i[ps..])?;
+        let depth = u32::try_from(ps).unwrap_or(u32::MAX).saturating_mul(2);
+        self.set_height(depth, i)?;
+        let mut number = Index::Const(n);
+        for _ in 0..ps {
+            let inner = VarRef::P {
+                number,
+                indices: Vec::new(),
+            };
+            number = Index::Expr(Box::new(Expr::Var(Box::new(inner))));
+        }
+        Ok((r, number))
+    }
+}
+
+/// `EXIST`, `IS_NUMBER`, `IS_STRING` (upper-case `name`).
+fn var_test_by_name(upper: &str) -> Option<VarTest> {
+    [VarTest::Exist, VarTest::IsNumber, VarTest::IsString]
+        .into_iter()
+        .find(|t| t.name() == upper)
+}
 
 fn func_by_name(upper: &str) -> Option<Func> {
     FUNCS.into_iter().find(|f| f.name() == upper)

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Item, Label, SplineCommand,
-    VScope, Value, VarDecl, VarRef, VarType, Word,
+    Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Item, Label,
+    SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -564,7 +564,7 @@ fn is_axis_letter(up: u8) -> bool {
 /// Does a parameter or variable start here (`P1`, `P[..]`, `V.L.X`, `@P1`)?
 fn starts_variable(b: &[u8]) -> bool {
     match b {
-        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[',
+        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[' || super::expr::is_pp(b),
         [b'V' | b'v', b'.', ..] => true,
         [b'@', b'P' | b'p', ..] => true,
         _ => false,
@@ -1069,6 +1069,9 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     let local = matches!(i.as_bytes().get(1), Some(b'L' | b'l'));
     let r = ws(&i[if local { 2 } else { 1 }..]);
     if local {
+        if let Some(c) = keyword(r, "CYCLE").map(ws).filter(|c| c.starts_with('[')) {
+            return cycle(ctx, c, true);
+        }
         let (rest, name) = file_name(r, false);
         if name.is_empty() {
             return fail(r, SYNTAX, "subroutine name expected after LL");
@@ -1083,7 +1086,7 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     if let Some(c) = keyword(r, "CYCLE") {
         let c = ws(c);
         if c.starts_with('[') {
-            return cycle(ctx, c);
+            return cycle(ctx, c, false);
         }
         return fail(
             c,
@@ -1103,19 +1106,27 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     ))
 }
 
-/// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
-fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
+/// `[NAME=file.cyc @P1=0 @P2=[P5*2] @P3="text"]`: blanks or commas between the entries
+/// (TF5200 programming manual, "Calling cycles"; `local` for `LL CYCLE`).
+fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str, local: bool) -> PResult<'a, Call> {
     let open = i;
     let mut j = &i[1..];
     let mut name: Option<String> = None;
-    let mut params: Vec<(u32, super::block::Expr)> = Vec::new();
+    let mut params: Vec<(u32, CycleArg)> = Vec::new();
     loop {
         j = j.trim_start_matches([' ', '\t', ',']);
         if let Some(rest) = j.strip_prefix(']') {
             let Some(name) = name else {
                 return fail(open, SYNTAX, "NAME=<file> missing in L CYCLE");
             };
-            return Ok((rest, Call::Cycle { name, params }));
+            return Ok((
+                rest,
+                Call::Cycle {
+                    name,
+                    local,
+                    params,
+                },
+            ));
         }
         if let Some(n) = keyword(j, "NAME") {
             let n = ws(n);
@@ -1143,8 +1154,14 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
             let Some(r) = r.strip_prefix('=') else {
                 return fail(r, SYNTAX, "`=` expected after the cycle parameter");
             };
-            let (r, e) = ctx.expr(ws(r))?;
-            params.push((p, e));
+            let r = ws(r);
+            let (r, a) = if r.starts_with('"') {
+                cycle_string(r)?
+            } else {
+                let (r, e) = ctx.expr(r)?;
+                (r, CycleArg::Expr(e))
+            };
+            params.push((p, a));
             j = r;
         } else if j.is_empty() {
             return fail(j, SYNTAX, "`]` missing after L CYCLE [");
@@ -1152,6 +1169,21 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
             return fail(j, SYNTAX, "NAME=<file> or @P<n>=<value> expected");
         }
     }
+}
+
+/// `"text"` as a cycle parameter's value: everything up to the next `"` (a block holds no
+/// line break, so the text is bounded by the block).
+#[cold]
+fn cycle_string(i: &str) -> PResult<'_, CycleArg> {
+    let body = &i[1..];
+    let Some(end) = body.find('"') else {
+        return fail(
+            i,
+            SYNTAX,
+            "closing `\"` missing in the cycle parameter's string",
+        );
+    };
+    Ok((&body[end + 1..], CycleArg::Str(body[..end].to_string())))
 }
 
 /// `%name`, `% name` or `%L name` (TF5200 programming manual, "NC block structure": `% 100`).
