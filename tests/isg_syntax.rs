@@ -400,6 +400,15 @@ fn ll_cycle_calls_a_local_subroutine_with_parameters() {
         (r.position('X'), r.position('Y'), r.position('Z')),
         (7.0, 5.0, 2.0)
     );
+    // A modal call is refused by name (900133) at MODAL.
+    fails_at(
+        &rig,
+        "L CYCLE [NAME=c.cyc MODAL_MOVE @P1=1]\nM30\n",
+        900133,
+        1,
+        21,
+        true,
+    );
     let b = parse_block("LL CYCLE [NAME=UP1 @P1=7]").unwrap();
     assert_eq!(b.to_string(), "LL CYCLE [NAME=UP1 @P1=7]");
     // Streamed, a local call is refused as `LL name` is (21479).

@@ -1,6 +1,6 @@
 //! Cycle calls: `L CYCLE [NAME=file @P1=… @P2="text"]` runs a cycle file, `LL CYCLE
-//! [NAME=sub …]` a `%L sub` section of the calling file (TF5200 programming manual, "Calling
-//! cycles"). The parameters are evaluated at the call and visible as `@P<n>` in the new
+//! [NAME=sub …]` a `%L sub` section of the calling file (TF5200 programming manual, "Cycles as
+//! global or local subroutines (Call L | LL CYCLE)"). The parameters are evaluated at the call and visible as `@P<n>` in the new
 //! level; a string parameter is kept as written, so `IS_STRING[@P1]` and `EXIST[@P1]` see
 //! it, and using it as a number is 900008 (docs/nc-language.md, "Constructs of real
 //! programs").

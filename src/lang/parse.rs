@@ -1107,7 +1107,9 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
 }
 
 /// `[NAME=file.cyc @P1=0 @P2=[P5*2] @P3="text"]`: blanks or commas between the entries
-/// (TF5200 programming manual, "Calling cycles"; `local` for `LL CYCLE`).
+/// (TF5200 programming manual, "Cycles as global or local subroutines (Call L | LL CYCLE)";
+/// `local` for `LL CYCLE`). A modal call (`MODAL`, `MODAL_MOVE`, `MODAL_BLOCK`) is refused
+/// by name: ncchannel does not repeat a cycle after later blocks.
 fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str, local: bool) -> PResult<'a, Call> {
     let open = i;
     let mut j = &i[1..];
@@ -1163,6 +1165,15 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str, local: bool) -> PResult<'a, Call> {
             };
             params.push((p, a));
             j = r;
+        } else if ["MODAL_MOVE", "MODAL_BLOCK", "MODAL"]
+            .into_iter()
+            .any(|kw| keyword(j, kw).is_some())
+        {
+            return fail(
+                j,
+                UNSUPPORTED,
+                "a modal cycle call (MODAL, MODAL_MOVE, MODAL_BLOCK) is not supported by ncchannel",
+            );
         } else if j.is_empty() {
             return fail(j, SYNTAX, "`]` missing after L CYCLE [");
         } else {
