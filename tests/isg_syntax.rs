@@ -443,3 +443,26 @@ fn pp_is_the_parameter_whose_number_a_parameter_holds() {
     // P1 undefined: PP1 has no number.
     fails_at(&rig, "G01 X[PP1] F100\nM30\n", 900005, 1, 5, false);
 }
+
+#[test]
+fn v_a_abs_is_the_axis_position_after_the_previous_block() {
+    let rig = Rig::new();
+    // TF5200 programming manual, "Axis-specific variables (V.A.)": V.A.ABS.X or V.A.ABS[0].
+    let r = runs_clean(
+        &rig,
+        "G01 X10 Y20 F1000\nG01 X[V.A.ABS.X + 1] YV.A.ABS[1]+2\n\
+         G92 X0\nG01 Z[V.A.ABS.X + 3]\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (11.0, 22.0, 3.0)
+    );
+    let b = parse_block("X[v.a.abs.x] Y[V.A.ABS[P1 + 1]]").unwrap();
+    assert_eq!(b.to_string(), "X[V.A.ABS.X] Y[V.A.ABS[P1 + 1]]");
+    // The other V.A. fields are refused by name; V.A. is read-only.
+    fails_at(&rig, "G01 X[V.A.PROG.X] F100\nM30\n", 900133, 1, 11, true);
+    fails_at(&rig, "V.A.ABS.X = 5\nM30\n", 20200, 1, 1, true);
+    // An axis the channel does not have has no position.
+    fails_at(&rig, "G01 X[V.A.ABS.U] F100\nM30\n", 900005, 1, 5, false);
+    fails_at(&rig, "G01 X[V.A.ABS[3]] F100\nM30\n", 900005, 1, 5, false);
+}

@@ -6,6 +6,7 @@
 //! the channel's back-pressure.
 
 pub mod arc;
+mod axis_vars;
 mod calls;
 mod cycles;
 mod expr;
@@ -739,11 +740,11 @@ impl Decoder {
     }
 
     fn eval(&self, e: &crate::lang::block::Expr) -> Res<f64> {
-        expr::eval(e, &self.vars)
+        expr::eval(e, &expr::Env(self))
     }
 
     fn resolve(&self, v: &crate::lang::block::VarRef) -> Res<VarSlot> {
-        expr::resolve(v, &self.vars)
+        expr::resolve(v, &expr::Env(self))
     }
 }
 

@@ -108,6 +108,18 @@ pub enum VarRef {
     },
     /// `@P<n>`: a cycle parameter, visible inside a cycle called by `L CYCLE [... @Pn=..]`.
     CycleParam(u32),
+    /// `V.A.ABS.X` / `V.A.ABS[0]`: the axis' absolute coordinate at the end of the previous
+    /// block, in the active coordinate system (TF5200 programming manual, "Axis-specific
+    /// variables (V.A.)"). Read-only.
+    AxisAbs(AxisSel),
+}
+
+/// The axis of a `V.A.` variable: by name (`.X`) or by index in the channel's axis list.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AxisSel {
+    /// Upper-case axis letter.
+    Name(u8),
+    Index(Box<Expr>),
 }
 
 /// The number of a P parameter: written out, or computed (`P[P1+5]`).

@@ -15,8 +15,8 @@
 use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
-    BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Index, Item,
-    Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget,
+    Index, Item, Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 
 impl Display for Block {
@@ -272,6 +272,8 @@ impl Display for VarRef {
                 indices
             }
             VarRef::CycleParam(n) => return write!(f, "@P{n}"),
+            VarRef::AxisAbs(AxisSel::Name(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
+            VarRef::AxisAbs(AxisSel::Index(e)) => return write!(f, "V.A.ABS{}", Bracketed(e)),
         };
         for e in indices {
             Bracketed(e).fmt(f)?;

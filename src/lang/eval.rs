@@ -10,7 +10,7 @@
 //! (division by 0, square root of a negative number, logarithm <= 0), ours from 900000–999999
 //! otherwise; both are in `super::codes`.
 
-use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
+use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
 
 /// A variable with every index evaluated: what the decoder stores values under.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -25,6 +25,16 @@ pub enum VarKey<'e> {
     },
     /// `@P<n>`, a cycle parameter.
     CycleParam(u32),
+    /// `V.A.ABS.<axis>`: the axis' absolute coordinate after the previous block.
+    AxisAbs(AxisId),
+}
+
+/// The axis of a `V.A.` variable, its index evaluated: which axis a letter or index names
+/// is the decoder's to say.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AxisId {
+    Letter(u8),
+    Index(u32),
 }
 
 impl std::fmt::Display for VarKey<'_> {
@@ -43,6 +53,8 @@ impl std::fmt::Display for VarKey<'_> {
                 indices
             }
             VarKey::CycleParam(n) => return write!(f, "@P{n}"),
+            VarKey::AxisAbs(AxisId::Letter(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
+            VarKey::AxisAbs(AxisId::Index(i)) => return write!(f, "V.A.ABS[{i}]"),
         };
         for i in indices {
             write!(f, "[{i}]")?;
@@ -182,6 +194,10 @@ pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalE
             indices: indices_of(indices, vars)?,
         },
         VarRef::CycleParam(n) => VarKey::CycleParam(*n),
+        VarRef::AxisAbs(AxisSel::Name(l)) => VarKey::AxisAbs(AxisId::Letter(*l)),
+        VarRef::AxisAbs(AxisSel::Index(e)) => {
+            VarKey::AxisAbs(AxisId::Index(index(eval(e, vars)?)?))
+        }
     })
 }
 

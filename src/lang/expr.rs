@@ -28,8 +28,8 @@ use nom::character::complete::char as ch;
 use nom::error::{ErrorKind, ParseError};
 use nom::IResult;
 
-use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
-use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX};
+use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
+use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX, UNSUPPORTED};
 use super::error::SyntaxError;
 use super::number::{scan_unsigned, TOO_LARGE};
 
@@ -520,6 +520,7 @@ impl<'a> Ctx<'a> {
             }
             Some(b'V' | b'v') if bytes.get(1) == Some(&b'.') => {
                 let scope = match bytes.get(2).map(u8::to_ascii_uppercase) {
+                    Some(b'A') if bytes.get(3) == Some(&b'.') => return self.axis_var(i),
                     Some(b'P') => VScope::Program,
                     Some(b'L') => VScope::Local,
                     Some(b'S') => VScope::SelfRetaining,
@@ -558,6 +559,51 @@ impl<'a> Ctx<'a> {
             }
             _ => fail(i, SYNTAX, "parameter or variable expected"),
         }
+    }
+
+    /// `V.A.<field>.<axis>` or `V.A.<field>[<index>]` (`i` at the `V`): `ABS` is modelled,
+    /// every other field of the manual's list is refused by name (900133).
+    #[cold]
+    fn axis_var(&self, i: &'a str) -> PResult<'a, VarRef> {
+        let f = &i[4..];
+        let (rest, field) = match name_upper(f) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "axis variable name expected"),
+            Err(e) => return Err(e),
+        };
+        if field != "ABS" {
+            return fail(
+                f,
+                UNSUPPORTED,
+                format!("V.A.{field} is an ISG axis variable ncchannel does not model"),
+            );
+        }
+        let axis = if let Some(r) = rest.strip_prefix('.') {
+            match r.as_bytes().first() {
+                Some(&b)
+                    if b.is_ascii_alphabetic()
+                        && !r.as_bytes().get(1).is_some_and(|&c| is_ident_byte(c)) =>
+                {
+                    self.height.set(1);
+                    return Ok((
+                        &r[1..],
+                        VarRef::AxisAbs(AxisSel::Name(b.to_ascii_uppercase())),
+                    ));
+                }
+                _ => return fail(r, SYNTAX, "axis name expected after V.A.ABS."),
+            }
+        } else if rest.starts_with('[') {
+            let (r, e) = self.bracketed(rest)?;
+            self.set_height(self.height.get() + 1, i)?;
+            (r, e)
+        } else {
+            return fail(
+                rest,
+                SYNTAX,
+                "`.<axis>` or `[<index>]` expected after V.A.ABS",
+            );
+        };
+        Ok((axis.0, VarRef::AxisAbs(AxisSel::Index(Box::new(axis.1)))))
     }
 
     /// Array indices written directly after a variable: `[i]`, `[i][j]`.

@@ -322,6 +322,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
             let (r, target) = ctx.var_ref(i)?;
+            writable(&target, i)?;
             let r = ws(r);
             let Some(r) = r.strip_prefix('=') else {
                 return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
@@ -788,9 +789,19 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     Ok((rest, c))
 }
 
+/// A variable a program may assign: not a `V.A.` axis variable, which the kernel only lets
+/// programs read (TF5200 programming manual, "Axis-specific variables (V.A.)").
+fn writable<'a>(v: &VarRef, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
+    if matches!(v, VarRef::AxisAbs(_)) {
+        return Err(perr(at, SYNTAX, "V.A. axis variables are read-only"));
+    }
+    Ok(())
+}
+
 /// `$FOR P1 = start, end[, step]`.
 fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     let (r, var) = ctx.var_ref(i)?;
+    writable(&var, i)?;
     let r = ws(r);
     let Some(r) = r.strip_prefix('=') else {
         return fail(r, SYNTAX, "`=` expected after the $FOR variable");
