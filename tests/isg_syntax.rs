@@ -466,3 +466,41 @@ fn v_a_abs_is_the_axis_position_after_the_previous_block() {
     fails_at(&rig, "G01 X[V.A.ABS.U] F100\nM30\n", 900005, 1, 5, false);
     fails_at(&rig, "G01 X[V.A.ABS[3]] F100\nM30\n", 900005, 1, 5, false);
 }
+
+#[test]
+fn hsc_options_and_file_names() {
+    let rig = Rig::new();
+    // TF5200 programming manual, "Trim a contour (#HSC ON/OFF)": options after ON, or
+    // parameters alone.
+    let r = runs_clean(
+        &rig,
+        "#HSC ON [BSPLINE PATH_DEV 0.2 TRACK_DEV 5 MERGE 1]\nG01 X10 F1000\n#HSC OFF\n\
+         #HSC [OPMODE 1 CONTERROR 0.01]\nG01 Y5\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 5.0));
+    let b = parse_block("#HSC [BSPLINE PATH_DEV=0.2]").unwrap();
+    assert_eq!(b.to_string(), "#HSC [BSPLINE PATH_DEV=0.2]");
+    // "Definition of file names (#FILE NAME)": MSG names the #MSG SAVE file, inert here.
+    let r = runs_clean(
+        &rig,
+        "#FILENAME[ MSG=\"prog_flow.txt\" ]\n#FILE NAME [MSG \"x.txt\"]\nG01 X2 F1000\nM30\n",
+    );
+    assert_eq!(r.position('X'), 2.0);
+    assert_eq!(
+        parse_block("#FILENAME [MSG=\"a.txt\"] (c)")
+            .unwrap()
+            .to_string(),
+        "#FILENAME [MSG=\"a.txt\"] (c)".split(" (").next().unwrap()
+    );
+    // Renaming an implicit subroutine is refused by name at its id.
+    fails_at(
+        &rig,
+        "#FILENAME [M6=\"tool.nc\"]\nM30\n",
+        900133,
+        1,
+        12,
+        true,
+    );
+    fails_at(&rig, "#FILENAME [XY=\"a\"]\nM30\n", 20200, 1, 12, true);
+    fails_at(&rig, "#FILENAME [MSG=\"a]\nM30\n", 20200, 1, 16, true);
+}

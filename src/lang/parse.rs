@@ -899,8 +899,10 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
                 (r, true)
             } else if let Some(r) = keyword(r, "OFF") {
                 (r, false)
+            } else if r.starts_with('[') {
+                return hsc_parameters(i, r);
             } else {
-                return fail(r, SYNTAX, "#HSC takes ON or OFF");
+                return fail(r, SYNTAX, "#HSC takes ON, OFF or [parameters]");
             };
             let (r, options) = verbatim_options(ws(r), r)?;
             Ok((r, Command::Hsc { on, options }))
@@ -912,6 +914,8 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let (r, options) = verbatim_options(ws(m), m)?;
             Ok((r, Command::ContourMode { options }))
         }
+        b"FILENAME" => file_names(i, r),
+        b"FILE" if keyword(r, "NAME").is_some() => file_names(i, ws(&r[4..])),
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
         b"MSG" => msg(r),
@@ -944,6 +948,69 @@ fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command
             format!("#{word} is an ISG command ncchannel does not support"),
         ),
         None => fail(i, UNKNOWN_COMMAND, format!("unknown NC command #{word}")),
+    }
+}
+
+/// The command from its `#` (`i`) up to `rest` as an inert command, verbatim.
+fn inert_to<'a>(i: &'a str, rest: &'a str) -> PResult<'a, Command> {
+    let text = i[1..i.len() - rest.len()].trim_end().to_string();
+    Ok((rest, Command::Inert { text }))
+}
+
+/// `#HSC [BSPLINE PATH_DEV 0.2 …]` / `#HSC [OPMODE 1 CONTERROR 0.01]` (TF5200 programming
+/// manual, "Trim a contour (#HSC ON/OFF)": ON and OFF are optional): parameters of the HSC
+/// smoothing without switching it, which ncchannel does not model: inert.
+#[cold]
+fn hsc_parameters<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
+    let (rest, _) = verbatim_options(r, r)?;
+    inert_to(i, rest)
+}
+
+/// `#FILENAME [MSG="prog_flow.txt"]` and `#FILE NAME [...]` (TF5200 programming manual,
+/// "Definition of file names (#FILE NAME)"): `MSG` names the file `#MSG SAVE` writes to, and
+/// ncchannel writes none, so it is inert. The other file ids (`M6`, `D`, `G80`–`G89`,
+/// `G800`–`G839`) rename implicit subroutines, which is refused by name (900133).
+#[cold]
+fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
+    let Some(mut j) = r.strip_prefix('[') else {
+        return fail(r, SYNTAX, "#FILENAME takes [<id>=\"<file name>\" …]");
+    };
+    loop {
+        j = ws(j);
+        if let Some(rest) = j.strip_prefix(']') {
+            return inert_to(i, rest);
+        }
+        let (k, id) = match name_upper(j) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => {
+                return fail(j, SYNTAX, "file id (MSG, M6, D, G80…) or `]` expected")
+            }
+            Err(e) => return Err(e),
+        };
+        if id != "MSG" {
+            let known = matches!(id.as_str(), "M6" | "D")
+                || id
+                    .strip_prefix('G')
+                    .and_then(|n| n.parse::<u32>().ok())
+                    .is_some_and(|g| (80..=89).contains(&g) || (800..=839).contains(&g));
+            if known {
+                return fail(
+                    j,
+                    UNSUPPORTED,
+                    format!("#FILENAME {id}=… renames an implicit subroutine, which ncchannel does not support"),
+                );
+            }
+            return fail(j, SYNTAX, format!("unknown file id {id} in #FILENAME"));
+        }
+        let k = ws(k);
+        let k = ws(k.strip_prefix('=').unwrap_or(k));
+        let Some(body) = k.strip_prefix('"') else {
+            return fail(k, SYNTAX, "quoted file name expected in #FILENAME");
+        };
+        let Some(end) = body.find('"') else {
+            return fail(k, SYNTAX, "closing `\"` missing in #FILENAME");
+        };
+        j = &body[end + 1..];
     }
 }
 
