@@ -504,3 +504,31 @@ fn hsc_options_and_file_names() {
     fails_at(&rig, "#FILENAME [XY=\"a\"]\nM30\n", 20200, 1, 12, true);
     fails_at(&rig, "#FILENAME [MSG=\"a]\nM30\n", 20200, 1, 16, true);
 }
+
+#[test]
+fn v_g_tool_radii_come_from_the_tool_list() {
+    let rig = Rig::new();
+    let params = rig.startup().parent().unwrap().to_path_buf();
+    std::fs::write(
+        params.join("tools.lis"),
+        "wz[1].radius 50000\nwz[2].radius 25000\n",
+    )
+    .unwrap();
+    // TF5200 programming manual, "Global variables (V.G.)": WZ_AKT the active tool, WZ[j]
+    // any tool data set; D0 (none selected) has radius 0.
+    let r = runs_clean(
+        &rig,
+        "G01 X[V.G.WZ[2].R] Y[V.G.WZ_AKT.R + 1] F1000\nD1\nG01 Z[V.G.WZ_AKT.R]\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (2.5, 1.0, 5.0)
+    );
+    let b = parse_block("X[v.g.wz_akt.r] Y[V.G.WZ[P1].R]").unwrap();
+    assert_eq!(b.to_string(), "X[V.G.WZ_AKT.R] Y[V.G.WZ[P1].R]");
+    // A D the tool list does not have; variables and fields not modelled; read-only.
+    fails_at(&rig, "G01 X[V.G.WZ[3].R] F100\nM30\n", 900005, 1, 5, false);
+    fails_at(&rig, "G01 X[V.G.FEEDRATE] F100\nM30\n", 900133, 1, 11, true);
+    fails_at(&rig, "G01 X[V.G.WZ_AKT.L] F100\nM30\n", 900133, 1, 18, true);
+    fails_at(&rig, "V.G.WZ[1].R = 2\nM30\n", 20200, 1, 1, true);
+}

@@ -1,7 +1,9 @@
-//! Axis variables a program reads (TF5200 programming manual, "Axis-specific variables
-//! (V.A.)"): `V.A.ABS.<axis>` / `V.A.ABS[<index>]`, the axis' coordinate at the end of the
-//! previous block in the active coordinate system. The parser refuses the manual's other
-//! V.A. fields by name (docs/nc-language.md, "Constructs of real programs").
+//! Machine data a program reads: `V.A.ABS.<axis>` / `V.A.ABS[<index>]`, the axis'
+//! coordinate at the end of the previous block in the active coordinate system (TF5200
+//! programming manual, "Axis-specific variables (V.A.)"), and `V.G.WZ_AKT.R` /
+//! `V.G.WZ[j].R`, tool radii from the tool list ("Global variables (V.G.)"). The parser
+//! refuses the manual's other V.A. and V.G. variables by name (docs/nc-language.md,
+//! "Constructs of real programs").
 
 use super::*;
 
@@ -20,5 +22,25 @@ impl Decoder {
         }
         let off = self.program_offset(modal::BlockGs::default());
         Some((self.modal.pos[i] - off[i]) / self.length_scale(i))
+    }
+}
+
+impl Decoder {
+    /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
+    pub fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
+        self.tool_radii = radii;
+    }
+
+    /// Radius of tool data set `d` (`None`: the active D), mm; D0 is radius 0; `None` for a
+    /// D the tool list does not have.
+    pub(super) fn tool_radius(&self, d: Option<u32>) -> Option<f64> {
+        let d = d.unwrap_or(self.modal.tool_offset);
+        if d == 0 {
+            return Some(0.0);
+        }
+        self.tool_radii
+            .iter()
+            .find(|(n, _)| *n == d)
+            .map(|(_, r)| *r)
     }
 }

@@ -43,7 +43,7 @@ pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
         }
         VarKey::CycleParam(n) => VarSlot::CycleParam(*n),
         // Read from the decoder's position, never stored (`Env`).
-        VarKey::AxisAbs(_) => return None,
+        VarKey::AxisAbs(_) | VarKey::ToolRadius(_) => return None,
     })
 }
 
@@ -55,6 +55,7 @@ impl Vars for Env<'_> {
     fn get(&self, key: &VarKey<'_>) -> Option<f64> {
         match key {
             VarKey::AxisAbs(id) => self.0.axis_abs(*id),
+            VarKey::ToolRadius(d) => self.0.tool_radius(*d),
             _ => VarStore::get(&self.0.vars, &slot(key)?),
         }
     }

@@ -248,6 +248,8 @@ pub struct Decoder {
     stream_active: bool,
     vars: VarStore,
     modal: Modal,
+    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
+    tool_radii: Vec<(u32, f64)>,
     /// ISG block counter of the current program.
     counter: u64,
     state: DecoderState,
@@ -287,6 +289,7 @@ impl Decoder {
             stream_active: false,
             vars: VarStore::new(),
             modal: Modal::defaults([0.0; MAX_AXES]),
+            tool_radii: Vec::new(),
             counter: 0,
             state: DecoderState::Idle,
             search: None,

@@ -112,6 +112,10 @@ pub enum VarRef {
     /// block, in the active coordinate system (TF5200 programming manual, "Axis-specific
     /// variables (V.A.)"). Read-only.
     AxisAbs(AxisSel),
+    /// `V.G.WZ_AKT.R` (the active tool's radius; `None`) or `V.G.WZ[j].R` (tool data set
+    /// j's), mm, from the tool list (TF5200 programming manual, "Global variables (V.G.)").
+    /// Read-only.
+    ToolRadius(Option<Box<Expr>>),
 }
 
 /// The axis of a `V.A.` variable: by name (`.X`) or by index in the channel's axis list.

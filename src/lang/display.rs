@@ -274,6 +274,8 @@ impl Display for VarRef {
             VarRef::CycleParam(n) => return write!(f, "@P{n}"),
             VarRef::AxisAbs(AxisSel::Name(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
             VarRef::AxisAbs(AxisSel::Index(e)) => return write!(f, "V.A.ABS{}", Bracketed(e)),
+            VarRef::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
+            VarRef::ToolRadius(Some(e)) => return write!(f, "V.G.WZ{}.R", Bracketed(e)),
         };
         for e in indices {
             Bracketed(e).fmt(f)?;

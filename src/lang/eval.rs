@@ -27,6 +27,8 @@ pub enum VarKey<'e> {
     CycleParam(u32),
     /// `V.A.ABS.<axis>`: the axis' absolute coordinate after the previous block.
     AxisAbs(AxisId),
+    /// `V.G.WZ_AKT.R` (`None`: the active tool) or `V.G.WZ[j].R`: a tool radius.
+    ToolRadius(Option<u32>),
 }
 
 /// The axis of a `V.A.` variable, its index evaluated: which axis a letter or index names
@@ -55,6 +57,8 @@ impl std::fmt::Display for VarKey<'_> {
             VarKey::CycleParam(n) => return write!(f, "@P{n}"),
             VarKey::AxisAbs(AxisId::Letter(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
             VarKey::AxisAbs(AxisId::Index(i)) => return write!(f, "V.A.ABS[{i}]"),
+            VarKey::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
+            VarKey::ToolRadius(Some(j)) => return write!(f, "V.G.WZ[{j}].R"),
         };
         for i in indices {
             write!(f, "[{i}]")?;
@@ -198,6 +202,8 @@ pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalE
         VarRef::AxisAbs(AxisSel::Index(e)) => {
             VarKey::AxisAbs(AxisId::Index(index(eval(e, vars)?)?))
         }
+        VarRef::ToolRadius(None) => VarKey::ToolRadius(None),
+        VarRef::ToolRadius(Some(e)) => VarKey::ToolRadius(Some(index(eval(e, vars)?)?)),
     })
 }
 

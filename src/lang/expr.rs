@@ -521,6 +521,7 @@ impl<'a> Ctx<'a> {
             Some(b'V' | b'v') if bytes.get(1) == Some(&b'.') => {
                 let scope = match bytes.get(2).map(u8::to_ascii_uppercase) {
                     Some(b'A') if bytes.get(3) == Some(&b'.') => return self.axis_var(i),
+                    Some(b'G') if bytes.get(3) == Some(&b'.') => return self.global_var(i),
                     Some(b'P') => VScope::Program,
                     Some(b'L') => VScope::Local,
                     Some(b'S') => VScope::SelfRetaining,
@@ -604,6 +605,55 @@ impl<'a> Ctx<'a> {
             );
         };
         Ok((axis.0, VarRef::AxisAbs(AxisSel::Index(Box::new(axis.1)))))
+    }
+
+    /// `V.G.WZ_AKT.R` or `V.G.WZ[<j>].R` (`i` at the `V`): the tool radii of the tool list;
+    /// every other V.G. variable or tool field is refused by name (900133).
+    #[cold]
+    fn global_var(&self, i: &'a str) -> PResult<'a, VarRef> {
+        self.height.set(0);
+        let f = &i[4..];
+        let (rest, name) = match name_upper(f) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "global variable name expected"),
+            Err(e) => return Err(e),
+        };
+        let (rest, tool) = match name.as_str() {
+            "WZ_AKT" => (rest, None),
+            "WZ" if rest.starts_with('[') => {
+                let (r, e) = self.bracketed(rest)?;
+                (r, Some(Box::new(e)))
+            }
+            "WZ" => return fail(rest, SYNTAX, "`[<tool>]` expected after V.G.WZ"),
+            _ => {
+                return fail(
+                    f,
+                    UNSUPPORTED,
+                    format!("V.G.{name} is an ISG global variable ncchannel does not model"),
+                )
+            }
+        };
+        let Some(r) = rest.strip_prefix('.') else {
+            return fail(
+                rest,
+                SYNTAX,
+                format!("`.<field>` expected after V.G.{name}"),
+            );
+        };
+        let (rest, field) = match name_upper(r) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(r, SYNTAX, "tool data field expected"),
+            Err(e) => return Err(e),
+        };
+        if field != "R" {
+            return fail(
+                r,
+                UNSUPPORTED,
+                format!("V.G.{name}.{field}: ncchannel's tool list has radii (R) only"),
+            );
+        }
+        self.set_height(self.height.get() + 1, i)?;
+        Ok((rest, VarRef::ToolRadius(tool)))
     }
 
     /// Array indices written directly after a variable: `[i]`, `[i][j]`.

@@ -792,8 +792,8 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
 /// A variable a program may assign: not a `V.A.` axis variable, which the kernel only lets
 /// programs read (TF5200 programming manual, "Axis-specific variables (V.A.)").
 fn writable<'a>(v: &VarRef, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
-    if matches!(v, VarRef::AxisAbs(_)) {
-        return Err(perr(at, SYNTAX, "V.A. axis variables are read-only"));
+    if matches!(v, VarRef::AxisAbs(_) | VarRef::ToolRadius(_)) {
+        return Err(perr(at, SYNTAX, "V.A. and V.G. variables are read-only"));
     }
     Ok(())
 }
