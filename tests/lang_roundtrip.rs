@@ -53,6 +53,17 @@ fn var_ref(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
     ]
 }
 
+/// Variables a program only reads: `V.A.ABS.X`, `V.A.ABS[i]`, `V.G.WZ_AKT.R`, `V.G.WZ[j].R`.
+fn read_only_var(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
+    prop_oneof![
+        prop::sample::select(b"XYZABCUVW".to_vec()).prop_map(|l| VarRef::AxisAbs(AxisSel::Name(l))),
+        e.clone()
+            .prop_map(|x| VarRef::AxisAbs(AxisSel::Index(Box::new(x)))),
+        Just(VarRef::ToolRadius(None)),
+        e.prop_map(|x| VarRef::ToolRadius(Some(Box::new(x)))),
+    ]
+}
+
 fn expr() -> BoxedStrategy<Expr> {
     let leaf = prop_oneof![
         3 => num().prop_map(Expr::Num),
@@ -101,6 +112,7 @@ fn expr() -> BoxedStrategy<Expr> {
                     Expr::Func(f, args)
                 }),
             var_ref(inner.clone()).prop_map(|v| Expr::Var(Box::new(v))),
+            read_only_var(inner.clone()).prop_map(|v| Expr::Var(Box::new(v))),
             (
                 prop::sample::select(vec![VarTest::Exist, VarTest::IsNumber, VarTest::IsString]),
                 var_ref(inner)
