@@ -181,8 +181,9 @@ pub const ARC_INCONSISTENT: u32 = 900130;
 /// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
 /// whole number, …).
 pub const BAD_VALUE: u32 = 900132;
-/// A G function or `#` command of the ISG dialect that ncchannel does not model: refused
-/// by name rather than given a wrong meaning (docs/nc-language.md lists them).
+/// A G function, `#` command, V.A./V.G. variable, `#FILENAME` file id or modal cycle call
+/// of the ISG dialect that ncchannel does not model: refused by name rather than given a
+/// wrong meaning (docs/nc-language.md lists them).
 pub const UNSUPPORTED: u32 = 900133;
 /// A dwell (G04) with any other word in its block: refused. The kernel's TF5200 diagnosis ID
 /// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
