@@ -480,7 +480,7 @@ fn hsc_options_and_file_names() {
     assert_eq!((r.position('X'), r.position('Y')), (10.0, 5.0));
     let b = parse_block("#HSC [BSPLINE PATH_DEV=0.2]").unwrap();
     assert_eq!(b.to_string(), "#HSC [BSPLINE PATH_DEV=0.2]");
-    // "Definition of file names (#FILE NAME)": MSG names the #MSG SAVE file, inert here.
+    // "Definition von Dateinamen (#FILE NAME)": MSG names the #MSG SAVE file, inert here.
     let r = runs_clean(
         &rig,
         "#FILENAME[ MSG=\"prog_flow.txt\" ]\n#FILE NAME [MSG \"x.txt\"]\nG01 X2 F1000\nM30\n",

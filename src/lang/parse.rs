@@ -967,7 +967,8 @@ fn hsc_parameters<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
 }
 
 /// `#FILENAME [MSG="prog_flow.txt"]` and `#FILE NAME [...]` (TF5200 programming manual,
-/// "Definition of file names (#FILE NAME)"): `MSG` names the file `#MSG SAVE` writes to, and
+/// German edition, "Definition von Dateinamen (#FILE NAME)"; the older TwinCAT CNC
+/// programming manual's "Definition of file names" writes `#FILENAME`): `MSG` names the file `#MSG SAVE` writes to, and
 /// ncchannel writes none, so it is inert. The other file ids (`M6`, `D`, `G80`–`G89`,
 /// `G800`–`G839`) rename implicit subroutines, which is refused by name (900133).
 #[cold]
