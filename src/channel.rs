@@ -215,7 +215,11 @@ impl Channel {
                 .with_latency(s.fs_latency),
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
-            decoder: Decoder::new(s.decoder),
+            decoder: {
+                let mut d = Decoder::new(s.decoder);
+                d.set_tool_radii(s.tools.clone());
+                d
+            },
             motion: {
                 let mut m = Motion::with_planner(s.axes, s.planner);
                 m.set_tool_radii(s.tools);

@@ -316,3 +316,219 @@ fn ncchannel_check_names_the_line_of_an_error_in_a_continued_block() {
     assert!(text.contains(&want), "{text}");
     assert!(text.contains("  N20 X10 Q5\n          ^"), "{text}");
 }
+
+#[test]
+fn exist_is_number_and_is_string_ask_about_a_variable() {
+    let rig = Rig::new();
+    // EXIST: defined or not, without an error for the undefined one.
+    let r = runs_clean(
+        &rig,
+        "P1 = 5\nV.L.A = 2\n\
+         G01 X[EXIST[P1]] Y[EXIST[P2] + 2] Z[EXIST[V.L.A] + EXIST[V.P.NONE] * 10] F1000\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (1.0, 2.0, 1.0)
+    );
+    // IS_NUMBER / IS_STRING of numbers, in conditions as ISG's editor test programs write them.
+    let r = runs_clean(
+        &rig,
+        "P1 = 5\n$IF IS_NUMBER[P1] == TRUE\nG01 X3 F1000\n$ENDIF\n\
+         $IF is_string[P1] == TRUE\nG01 Y3 F1000\n$ENDIF\nG01 Z[IS_NUMBER[P7]] F1000\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (3.0, 0.0, 0.0)
+    );
+    // The argument is one variable, not an expression (20200 at the argument).
+    fails_at(&rig, "G01 X[EXIST[3]] F100\nM30\n", 20200, 1, 13, true);
+    fails_at(&rig, "G01 X[IS_NUMBER P1] F100\nM30\n", 20200, 1, 17, true);
+    // An index of the variable is still evaluated: an undefined one is an error.
+    fails_at(&rig, "G01 X[EXIST[P[P9]]] F100\nM30\n", 900005, 1, 5, false);
+}
+
+#[test]
+fn cycle_parameters_may_be_strings() {
+    let rig = Rig::new();
+    rig.program(
+        "c.cyc",
+        "$IF IS_STRING[@P1] == TRUE\nG01 X1 F1000\n$ENDIF\n\
+         $IF IS_NUMBER[@P2] == TRUE\nG01 Y[@P2] F1000\n$ENDIF\n\
+         G01 Z[EXIST[@P1] + EXIST[@P3] * 10 + IS_NUMBER[@P1] * 100] F1000\nM17\n",
+    );
+    // The form of ISG's editor test programs: a blank before `=`, a quoted string.
+    let r = runs_clean(
+        &rig,
+        "L CYCLE [NAME=c.cyc @P1 =\"String1\" @P2=12.34]\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (1.0, 12.34, 1.0)
+    );
+    // A string with blanks and a semicolon inside its quotes.
+    let r = runs_clean(&rig, "L CYCLE [NAME=c.cyc @P1=\"a b; c\" @P2=1]\nM30\n");
+    assert_eq!(r.position('X'), 1.0);
+    // Used as a number, a string parameter is 900008 where it is used.
+    rig.program("s.cyc", "G01 X[@P1] F100\nM17\n");
+    rig.program("main.nc", "L CYCLE [NAME=s.cyc @P1=\"abc\"]\nM30\n");
+    let r = rig.run("main.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Error), "{}", r.log);
+    assert_eq!(r.error_codes(), [900008], "{}", r.log);
+    // A string without its closing quote is 20200 at the quote.
+    fails_at(
+        &rig,
+        "L CYCLE [NAME=c.cyc @P1=\"abc]\nM30\n",
+        20200,
+        1,
+        25,
+        true,
+    );
+    let b = parse_block("L CYCLE [NAME=c.cyc @P1 = \"x y\" @P2=2]").unwrap();
+    assert_eq!(b.to_string(), "L CYCLE [NAME=c.cyc @P1=\"x y\" @P2=2]");
+}
+
+#[test]
+fn ll_cycle_calls_a_local_subroutine_with_parameters() {
+    let rig = Rig::new();
+    let text = "%L UP1\nG01 X[@P1] F1000\n$IF IS_STRING[@P2] == TRUE\nG01 Y5\n$ENDIF\nM17\n\
+                %main\nLL CYCLE [NAME=UP1 @P1=7 @P2=\"text\"]\nG01 Z2\nM30\n";
+    assert_eq!(check_places(text), [], "check");
+    rig.program("t.nc", text);
+    let r = rig.run("t.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (7.0, 5.0, 2.0)
+    );
+    // A modal call is refused by name (900133) at MODAL.
+    fails_at(
+        &rig,
+        "L CYCLE [NAME=c.cyc MODAL_MOVE @P1=1]\nM30\n",
+        900133,
+        1,
+        21,
+        true,
+    );
+    let b = parse_block("LL CYCLE [NAME=UP1 @P1=7]").unwrap();
+    assert_eq!(b.to_string(), "LL CYCLE [NAME=UP1 @P1=7]");
+    // Streamed, a local call is refused as `LL name` is (21479).
+    let s = rig.run(
+        "streaming.nc",
+        Some(feeder("LL CYCLE [NAME=UP1 @P1=7]\nM30\n", 992, 1)),
+        1_000_000,
+    );
+    assert_eq!(s.finish, Some(Finish::Error), "{}", s.log);
+    assert_eq!(s.error_codes(), [21479], "{}", s.log);
+    // A name without its %L section is 20373, as for LL.
+    rig.program("n.nc", "LL CYCLE [NAME=NOPE]\nM30\n");
+    let r = rig.run("n.nc", None, 1_000_000);
+    assert_eq!(r.error_codes(), [20373], "{}", r.log);
+}
+
+#[test]
+fn pp_is_the_parameter_whose_number_a_parameter_holds() {
+    let rig = Rig::new();
+    // TF5200 programming manual, "Indirect parameters": P1 = 20, PP1 = 5 sets P20.
+    let r = runs_clean(
+        &rig,
+        "P1 = 20  P2 = 40\nPP1 = 5\nPP2 = PP1 + 1\nP3 = 1\n\
+         G01 X[P20] YP40 ZPPP3+2 F1000\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (5.0, 6.0, 7.0)
+    );
+    let b = parse_block("PP1 = PPP2").unwrap();
+    assert_eq!(b.to_string(), "P[P1]=P[P[P2]]");
+    // P1 undefined: PP1 has no number.
+    fails_at(&rig, "G01 X[PP1] F100\nM30\n", 900005, 1, 5, false);
+}
+
+#[test]
+fn v_a_abs_is_the_axis_position_after_the_previous_block() {
+    let rig = Rig::new();
+    // TF5200 programming manual, "Axis-specific variables (V.A.)": V.A.ABS.X or V.A.ABS[0].
+    let r = runs_clean(
+        &rig,
+        "G01 X10 Y20 F1000\nG01 X[V.A.ABS.X + 1] YV.A.ABS[1]+2\n\
+         G92 X0\nG01 Z[V.A.ABS.X + 3]\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (11.0, 22.0, 3.0)
+    );
+    let b = parse_block("X[v.a.abs.x] Y[V.A.ABS[P1 + 1]]").unwrap();
+    assert_eq!(b.to_string(), "X[V.A.ABS.X] Y[V.A.ABS[P1 + 1]]");
+    // The other V.A. fields are refused by name; V.A. is read-only.
+    fails_at(&rig, "G01 X[V.A.PROG.X] F100\nM30\n", 900133, 1, 11, true);
+    fails_at(&rig, "V.A.ABS.X = 5\nM30\n", 20200, 1, 1, true);
+    // An axis the channel does not have has no position.
+    fails_at(&rig, "G01 X[V.A.ABS.U] F100\nM30\n", 900005, 1, 5, false);
+    fails_at(&rig, "G01 X[V.A.ABS[3]] F100\nM30\n", 900005, 1, 5, false);
+}
+
+#[test]
+fn hsc_options_and_file_names() {
+    let rig = Rig::new();
+    // TF5200 programming manual, "Trim a contour (#HSC ON/OFF)": options after ON, or
+    // parameters alone.
+    let r = runs_clean(
+        &rig,
+        "#HSC ON [BSPLINE PATH_DEV 0.2 TRACK_DEV 5 MERGE 1]\nG01 X10 F1000\n#HSC OFF\n\
+         #HSC [OPMODE 1 CONTERROR 0.01]\nG01 Y5\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (10.0, 5.0));
+    let b = parse_block("#HSC [BSPLINE PATH_DEV=0.2]").unwrap();
+    assert_eq!(b.to_string(), "#HSC [BSPLINE PATH_DEV=0.2]");
+    // "Definition von Dateinamen (#FILE NAME)": MSG names the #MSG SAVE file, inert here.
+    let r = runs_clean(
+        &rig,
+        "#FILENAME[ MSG=\"prog_flow.txt\" ]\n#FILE NAME [MSG \"x.txt\"]\nG01 X2 F1000\nM30\n",
+    );
+    assert_eq!(r.position('X'), 2.0);
+    assert_eq!(
+        parse_block("#FILENAME [MSG=\"a.txt\"] (c)")
+            .unwrap()
+            .to_string(),
+        "#FILENAME [MSG=\"a.txt\"] (c)".split(" (").next().unwrap()
+    );
+    // Renaming an implicit subroutine is refused by name at its id.
+    fails_at(
+        &rig,
+        "#FILENAME [M6=\"tool.nc\"]\nM30\n",
+        900133,
+        1,
+        12,
+        true,
+    );
+    fails_at(&rig, "#FILENAME [XY=\"a\"]\nM30\n", 20200, 1, 12, true);
+    fails_at(&rig, "#FILENAME [MSG=\"a]\nM30\n", 20200, 1, 16, true);
+}
+
+#[test]
+fn v_g_tool_radii_come_from_the_tool_list() {
+    let rig = Rig::new();
+    let params = rig.startup().parent().unwrap().to_path_buf();
+    std::fs::write(
+        params.join("tools.lis"),
+        "wz[1].radius 50000\nwz[2].radius 25000\n",
+    )
+    .unwrap();
+    // TF5200 programming manual, "Global variables (V.G.)": WZ_AKT the active tool, WZ[j]
+    // any tool data set; D0 (none selected) has radius 0.
+    let r = runs_clean(
+        &rig,
+        "G01 X[V.G.WZ[2].R] Y[V.G.WZ_AKT.R + 1] F1000\nD1\nG01 Z[V.G.WZ_AKT.R]\nM30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (2.5, 1.0, 5.0)
+    );
+    let b = parse_block("X[v.g.wz_akt.r] Y[V.G.WZ[P1].R]").unwrap();
+    assert_eq!(b.to_string(), "X[V.G.WZ_AKT.R] Y[V.G.WZ[P1].R]");
+    // A D the tool list does not have; variables and fields not modelled; read-only.
+    fails_at(&rig, "G01 X[V.G.WZ[3].R] F100\nM30\n", 900005, 1, 5, false);
+    fails_at(&rig, "G01 X[V.G.FEEDRATE] F100\nM30\n", 900133, 1, 11, true);
+    fails_at(&rig, "G01 X[V.G.WZ_AKT.L] F100\nM30\n", 900133, 1, 18, true);
+    fails_at(&rig, "V.G.WZ[1].R = 2\nM30\n", 20200, 1, 1, true);
+}

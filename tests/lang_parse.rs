@@ -418,12 +418,17 @@ fn calls_and_heads() {
         })
     );
     let b = p("N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5*2]]");
-    let Body::Call(Call::Cycle { name, params }) = &b.body else {
+    let Body::Call(Call::Cycle {
+        name,
+        local: false,
+        params,
+    }) = &b.body
+    else {
         panic!("{b:?}")
     };
     assert_eq!(name, "Laser_on.cyc");
     assert_eq!(params.len(), 2);
-    assert_eq!(params[0], (1, Expr::Num(0.0)));
+    assert_eq!(params[0], (1, CycleArg::Expr(Expr::Num(0.0))));
     assert_eq!(
         b.to_string(),
         "N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=P5 * 2]"

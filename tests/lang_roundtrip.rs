@@ -53,6 +53,17 @@ fn var_ref(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
     ]
 }
 
+/// Variables a program only reads: `V.A.ABS.X`, `V.A.ABS[i]`, `V.G.WZ_AKT.R`, `V.G.WZ[j].R`.
+fn read_only_var(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
+    prop_oneof![
+        prop::sample::select(b"XYZABCUVW".to_vec()).prop_map(|l| VarRef::AxisAbs(AxisSel::Name(l))),
+        e.clone()
+            .prop_map(|x| VarRef::AxisAbs(AxisSel::Index(Box::new(x)))),
+        Just(VarRef::ToolRadius(None)),
+        e.prop_map(|x| VarRef::ToolRadius(Some(Box::new(x)))),
+    ]
+}
+
 fn expr() -> BoxedStrategy<Expr> {
     let leaf = prop_oneof![
         3 => num().prop_map(Expr::Num),
@@ -100,7 +111,13 @@ fn expr() -> BoxedStrategy<Expr> {
                     };
                     Expr::Func(f, args)
                 }),
-            var_ref(inner).prop_map(|v| Expr::Var(Box::new(v))),
+            var_ref(inner.clone()).prop_map(|v| Expr::Var(Box::new(v))),
+            read_only_var(inner.clone()).prop_map(|v| Expr::Var(Box::new(v))),
+            (
+                prop::sample::select(vec![VarTest::Exist, VarTest::IsNumber, VarTest::IsString]),
+                var_ref(inner)
+            )
+                .prop_map(|(t, v)| Expr::Test(t, Box::new(v))),
         ]
     })
     .boxed()
@@ -262,16 +279,28 @@ fn command() -> impl Strategy<Value = Command> {
     ]
 }
 
+/// A cycle parameter's value: an expression or a quoted string (no `"` inside).
+fn cycle_arg() -> impl Strategy<Value = CycleArg> {
+    prop_oneof![
+        3 => expr().prop_map(CycleArg::Expr),
+        1 => "[A-Za-z0-9_ .,:-]{0,12}".prop_map(CycleArg::Str),
+    ]
+}
+
 fn call() -> impl Strategy<Value = Call> {
     prop_oneof![
         file().prop_map(|file| Call::Global { file }),
         ident().prop_map(|name| Call::Local { name }),
-        (file(), prop::collection::btree_map(0u32..20, expr(), 0..4)).prop_map(|(name, params)| {
-            Call::Cycle {
+        (
+            file(),
+            any::<bool>(),
+            prop::collection::btree_map(0u32..20, cycle_arg(), 0..4)
+        )
+            .prop_map(|(name, local, params)| Call::Cycle {
                 name,
+                local,
                 params: params.into_iter().collect(),
-            }
-        }),
+            }),
     ]
 }
 

@@ -356,16 +356,11 @@ impl Decoder {
                 self.call_global(file, io)?;
                 self.emit(info, Action::None, false, io);
             }
-            Call::Cycle { name, params } => {
-                let mut values = Vec::with_capacity(params.len());
-                for (n, e) in params {
-                    values.push((*n, self.eval(e)?));
-                }
-                let frame = self.open_subroutine(name, FrameKind::Cycle, io)?;
-                self.emit(info, Action::None, false, io);
-                self.vars.push_level(values);
-                self.frames.push(frame);
-            }
+            Call::Cycle {
+                name,
+                local,
+                params,
+            } => self.call_cycle(name, *local, params, info, io)?,
             Call::Local { name } => {
                 let index = self.label_index()?;
                 let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {

@@ -42,12 +42,36 @@ pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
             }
         }
         VarKey::CycleParam(n) => VarSlot::CycleParam(*n),
+        // Read from the decoder's position, never stored (`Env`).
+        VarKey::AxisAbs(_) | VarKey::ToolRadius(_) => return None,
     })
+}
+
+/// What an expression in a running program sees: the variable store and, for `V.A.ABS`,
+/// the decoder's position.
+pub(super) struct Env<'d>(pub &'d super::Decoder);
+
+impl Vars for Env<'_> {
+    fn get(&self, key: &VarKey<'_>) -> Option<f64> {
+        match key {
+            VarKey::AxisAbs(id) => self.0.axis_abs(*id),
+            VarKey::ToolRadius(d) => self.0.tool_radius(*d),
+            _ => VarStore::get(&self.0.vars, &slot(key)?),
+        }
+    }
+
+    fn is_string(&self, key: &VarKey<'_>) -> bool {
+        Vars::is_string(&self.0.vars, key)
+    }
 }
 
 impl Vars for VarStore {
     fn get(&self, key: &VarKey<'_>) -> Option<f64> {
         VarStore::get(self, &slot(key)?)
+    }
+
+    fn is_string(&self, key: &VarKey<'_>) -> bool {
+        slot(key).is_some_and(|s| VarStore::is_string(self, &s))
     }
 }
 
@@ -55,11 +79,11 @@ pub(super) fn err(e: eval::EvalError) -> DecodeError {
     e.into()
 }
 
-pub fn eval(e: &Expr, vars: &VarStore) -> Result<f64, DecodeError> {
+pub fn eval(e: &Expr, vars: &dyn Vars) -> Result<f64, DecodeError> {
     eval::eval(e, vars).map_err(err)
 }
 
-pub fn resolve(v: &VarRef, vars: &VarStore) -> Result<VarSlot, DecodeError> {
+pub fn resolve(v: &VarRef, vars: &dyn Vars) -> Result<VarSlot, DecodeError> {
     let k = eval::resolve(v, vars).map_err(err)?;
     slot(&k)
         .ok_or_else(|| DecodeError::new(codes::BAD_VALUE, format!("{k}: more than three indices")))

@@ -6,7 +6,9 @@
 //! the channel's back-pressure.
 
 pub mod arc;
+mod axis_vars;
 mod calls;
+mod cycles;
 mod expr;
 pub mod flow;
 pub mod frame;
@@ -246,6 +248,8 @@ pub struct Decoder {
     stream_active: bool,
     vars: VarStore,
     modal: Modal,
+    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
+    tool_radii: Vec<(u32, f64)>,
     /// ISG block counter of the current program.
     counter: u64,
     state: DecoderState,
@@ -285,6 +289,7 @@ impl Decoder {
             stream_active: false,
             vars: VarStore::new(),
             modal: Modal::defaults([0.0; MAX_AXES]),
+            tool_radii: Vec::new(),
             counter: 0,
             state: DecoderState::Idle,
             search: None,
@@ -744,11 +749,11 @@ impl Decoder {
     }
 
     fn eval(&self, e: &crate::lang::block::Expr) -> Res<f64> {
-        expr::eval(e, &self.vars)
+        expr::eval(e, &expr::Env(self))
     }
 
     fn resolve(&self, v: &crate::lang::block::VarRef) -> Res<VarSlot> {
-        expr::resolve(v, &self.vars)
+        expr::resolve(v, &expr::Env(self))
     }
 }
 
@@ -767,7 +772,7 @@ fn stream_allows(block: &Block) -> Res {
             codes::STREAM_LOOP,
             "loop statement in streaming program; streaming aborted",
         )),
-        Body::Call(Call::Local { .. }) => Err(DecodeError::new(
+        Body::Call(Call::Local { .. } | Call::Cycle { local: true, .. }) => Err(DecodeError::new(
             codes::STREAM_LOCAL_CALL,
             "local subroutine call (LL) in streaming program",
         )),

@@ -196,6 +196,8 @@ pub struct VarStore {
     external: Scope,
     /// Cycle parameters per level (`@P`), innermost last.
     cycle: Vec<Vec<(u32, f64)>>,
+    /// String cycle parameters (`@P1="text"`) per level, beside `cycle`: one entry per level.
+    cycle_text: Vec<Vec<(u32, Box<str>)>>,
 }
 
 impl VarStore {
@@ -204,6 +206,7 @@ impl VarStore {
             p_flat: vec![f64::NAN; FLAT_P],
             local: vec![Scope::default()],
             cycle: vec![Vec::new()],
+            cycle_text: vec![Vec::new()],
             ..Default::default()
         }
     }
@@ -217,6 +220,8 @@ impl VarStore {
         self.local.push(Scope::default());
         self.cycle.clear();
         self.cycle.push(Vec::new());
+        self.cycle_text.clear();
+        self.cycle_text.push(Vec::new());
     }
 
     /// Channel reset: everything but V.S. and V.E. goes.
@@ -226,15 +231,39 @@ impl VarStore {
 
     /// A subroutine or cycle level begins.
     pub fn push_level(&mut self, cycle_params: Vec<(u32, f64)>) {
+        self.push_cycle_level(cycle_params, Vec::new());
+    }
+
+    /// A cycle level begins with numeric and string parameters (`@P1=5 @P2="text"`).
+    pub fn push_cycle_level(&mut self, numbers: Vec<(u32, f64)>, texts: Vec<(u32, Box<str>)>) {
         self.local.push(Scope::default());
-        self.cycle.push(cycle_params);
+        self.cycle.push(numbers);
+        self.cycle_text.push(texts);
     }
 
     pub fn pop_level(&mut self) {
         if self.local.len() > 1 {
             self.local.pop();
             self.cycle.pop();
+            self.cycle_text.pop();
         }
+    }
+
+    /// The innermost level that has cycle parameters, numbers or strings.
+    fn cycle_level(&self) -> Option<usize> {
+        (0..self.cycle.len()).rev().find(|&k| {
+            !self.cycle[k].is_empty() || self.cycle_text.get(k).is_some_and(|t| !t.is_empty())
+        })
+    }
+
+    /// Whether `k` is a cycle parameter holding a string (`@P1="text"`).
+    pub fn is_string(&self, k: &VarSlot) -> bool {
+        let VarSlot::CycleParam(n) = k else {
+            return false;
+        };
+        self.cycle_level()
+            .and_then(|l| self.cycle_text.get(l))
+            .is_some_and(|t| t.iter().any(|(m, _)| m == n))
     }
 
     /// Bytes the variables of `class` are charged now.
@@ -307,11 +336,8 @@ impl VarStore {
             VarSlot::P { .. } => self.p_other.get(k).copied(),
             VarSlot::CycleParam(n) => {
                 // @P of the innermost cycle level that has them.
-                self.cycle
-                    .iter()
-                    .rev()
-                    .find(|l| !l.is_empty())
-                    .and_then(|l| l.iter().find(|(m, _)| m == n).map(|(_, v)| *v))
+                self.cycle_level()
+                    .and_then(|l| self.cycle[l].iter().find(|(m, _)| m == n).map(|(_, v)| *v))
             }
             VarSlot::V {
                 scope,
@@ -342,6 +368,9 @@ impl VarStore {
                     self.cycle.push(Vec::new());
                 }
                 let last = self.cycle.len() - 1;
+                if let Some(t) = self.cycle_text.get_mut(last) {
+                    t.retain(|(m, _)| *m != n);
+                }
                 let level = &mut self.cycle[last];
                 match level.iter_mut().find(|(m, _)| *m == n) {
                     Some(slot) => slot.1 = v,

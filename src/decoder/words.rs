@@ -309,7 +309,7 @@ impl Decoder {
 
     /// The offset from program to machine coordinates of axis `i` (zero offset and G92;
     /// none under G53 in this block).
-    fn program_offset(&self, gs: BlockGs) -> [f64; MAX_AXES] {
+    pub(super) fn program_offset(&self, gs: BlockGs) -> [f64; MAX_AXES] {
         if gs.machine_coords {
             return [0.0; MAX_AXES];
         }
@@ -345,7 +345,7 @@ impl Decoder {
     }
 
     /// mm per programmed unit on axis `i`: inch scales the linear axes, not A, B, C.
-    fn length_scale(&self, i: usize) -> f64 {
+    pub(super) fn length_scale(&self, i: usize) -> f64 {
         match AXIS_LETTERS[i] {
             b'A' | b'B' | b'C' => 1.0,
             _ => self.modal.units.mm_per_unit(),

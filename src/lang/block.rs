@@ -122,6 +122,22 @@ pub enum VarRef {
     },
     /// `@P<n>`: a cycle parameter, visible inside a cycle called by `L CYCLE [... @Pn=..]`.
     CycleParam(u32),
+    /// `V.A.ABS.X` / `V.A.ABS[0]`: the axis' absolute coordinate at the end of the previous
+    /// block, in the active coordinate system (TF5200 programming manual, "Axis-specific
+    /// variables (V.A.)"). Read-only.
+    AxisAbs(AxisSel),
+    /// `V.G.WZ_AKT.R` (the active tool's radius; `None`) or `V.G.WZ[j].R` (tool data set
+    /// j's), mm, from the tool list (TF5200 programming manual, "Global variables (V.G.)").
+    /// Read-only.
+    ToolRadius(Option<Box<Expr>>),
+}
+
+/// The axis of a `V.A.` variable: by name (`.X`) or by index in the channel's axis list.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AxisSel {
+    /// Upper-case axis letter.
+    Name(u8),
+    Index(Box<Expr>),
 }
 
 /// The number of a P parameter: written out, or computed (`P[P1+5]`).
@@ -152,6 +168,31 @@ pub enum Expr {
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),
     Func(Func, Vec<Expr>),
+    /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]`: a question about a variable rather than
+    /// its value (1 or 0), so an undefined `v` is no error here.
+    Test(VarTest, Box<VarRef>),
+}
+
+/// What `Expr::Test` asks about its variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarTest {
+    /// `EXIST[v]`: `v` has a value, a number or a string.
+    Exist,
+    /// `IS_NUMBER[v]`: `v` holds a number.
+    IsNumber,
+    /// `IS_STRING[v]`: `v` holds a string (a cycle parameter `@P1="text"`).
+    IsString,
+}
+
+impl VarTest {
+    /// The function's name as written in NC text.
+    pub fn name(self) -> &'static str {
+        match self {
+            VarTest::Exist => "EXIST",
+            VarTest::IsNumber => "IS_NUMBER",
+            VarTest::IsString => "IS_STRING",
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -345,11 +386,22 @@ pub enum Call {
     Global { file: String },
     /// `LL name`: local subroutine defined by `%L name` in the same file.
     Local { name: String },
-    /// `L CYCLE [NAME=file.cyc @P1=0 @P2=0]`.
+    /// `L CYCLE [NAME=file.cyc @P1=0 @P2="text"]` (a cycle file), or with `local`
+    /// `LL CYCLE [NAME=sub @P1=0]` (a `%L sub` section of the calling file).
     Cycle {
         name: String,
-        params: Vec<(u32, Expr)>,
+        local: bool,
+        params: Vec<(u32, CycleArg)>,
     },
+}
+
+/// The value of a cycle parameter `@P<n>=…`: an expression, evaluated at the call, or a
+/// quoted string (`@P1="String1"`), carried as written (docs/nc-language.md, "Constructs of
+/// real programs").
+#[derive(Debug, Clone, PartialEq)]
+pub enum CycleArg {
+    Expr(Expr),
+    Str(String),
 }
 
 /// One declaration inside `#VAR` … `#ENDVAR`: `V.L.COUNT = 5`, `V.P.TABLE[10]`,

@@ -173,6 +173,9 @@ pub const EVAL_UNDEFINED: u32 = 900005;
 pub const EVAL_BAD_INDEX: u32 = 900006;
 /// Expression: result not finite (`EXP[1000]`, `TAN[90]`).
 pub const EVAL_NOT_FINITE: u32 = 900007;
+/// Expression: a variable holding a string (a cycle parameter `@P1="text"`) used as a
+/// number.
+pub const EVAL_STRING_AS_NUMBER: u32 = 900008;
 /// The streaming program is already running (called a second time).
 pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
 /// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
@@ -190,8 +193,9 @@ pub const ARC_INCONSISTENT: u32 = 900130;
 /// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
 /// whole number, …).
 pub const BAD_VALUE: u32 = 900132;
-/// A G function or `#` command of the ISG dialect that ncchannel does not model: refused
-/// by name rather than given a wrong meaning (docs/nc-language.md lists them).
+/// A G function, `#` command, V.A./V.G. variable, `#FILENAME` file id or modal cycle call
+/// of the ISG dialect that ncchannel does not model: refused by name rather than given a
+/// wrong meaning (docs/nc-language.md lists them).
 pub const UNSUPPORTED: u32 = 900133;
 /// A dwell (G04) with any other word in its block: refused. The kernel's TF5200 diagnosis ID
 /// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
@@ -286,6 +290,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (EVAL_UNDEFINED, "undefined variable"),
     (EVAL_BAD_INDEX, "invalid index"),
     (EVAL_NOT_FINITE, "result not finite"),
+    (EVAL_STRING_AS_NUMBER, "string used as a number"),
     (STREAM_ALREADY_ACTIVE, "streaming program already running"),
     (MAIN_END_MISSING, "main program without M30/M02"),
     (SUB_END_MISSING, "subroutine without M17/M29"),

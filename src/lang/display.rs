@@ -15,8 +15,8 @@
 use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
-    BinOp, Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Index, Item, Label,
-    SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget,
+    Index, Item, Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 
 impl Display for Block {
@@ -165,7 +165,7 @@ impl Display for Bracketed<'_> {
 fn strength(e: &Expr) -> u8 {
     match e {
         Expr::Num(v) if v.is_sign_negative() => UNARY,
-        Expr::Num(_) | Expr::Var(_) | Expr::Func(..) => OPERAND,
+        Expr::Num(_) | Expr::Var(_) | Expr::Func(..) | Expr::Test(..) => OPERAND,
         Expr::Unary(..) => UNARY,
         Expr::Binary(BinOp::Pow, ..) => POWER,
         Expr::Binary(op, ..) => op.level(),
@@ -234,6 +234,7 @@ impl Display for Expr {
                 }
                 f.write_char(']')
             }
+            Expr::Test(test, v) => write!(f, "{}[{v}]", test.name()),
         }
     }
 }
@@ -283,6 +284,10 @@ impl Display for VarRef {
                 indices
             }
             VarRef::CycleParam(n) => return write!(f, "@P{n}"),
+            VarRef::AxisAbs(AxisSel::Name(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
+            VarRef::AxisAbs(AxisSel::Index(e)) => return write!(f, "V.A.ABS{}", Bracketed(e)),
+            VarRef::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
+            VarRef::ToolRadius(Some(e)) => return write!(f, "V.G.WZ{}.R", Bracketed(e)),
         };
         for e in indices {
             Bracketed(e).fmt(f)?;
@@ -432,10 +437,18 @@ impl Display for Call {
         match self {
             Call::Global { file } => write!(f, "L {}", FileName(file)),
             Call::Local { name } => write!(f, "LL {}", FileName(name)),
-            Call::Cycle { name, params } => {
-                write!(f, "L CYCLE [NAME={}", FileName(name))?;
-                for (p, e) in params {
-                    write!(f, " @P{p}={e}")?;
+            Call::Cycle {
+                name,
+                local,
+                params,
+            } => {
+                let l = if *local { "LL" } else { "L" };
+                write!(f, "{l} CYCLE [NAME={}", FileName(name))?;
+                for (p, a) in params {
+                    match a {
+                        CycleArg::Expr(e) => write!(f, " @P{p}={e}")?,
+                        CycleArg::Str(s) => write!(f, " @P{p}=\"{s}\"")?,
+                    }
                 }
                 f.write_char(']')
             }

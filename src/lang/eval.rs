@@ -10,7 +10,7 @@
 //! (division by 0, square root of a negative number, logarithm <= 0), ours from 900000–999999
 //! otherwise; both are in `super::codes`.
 
-use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
+use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
 
 /// A variable with every index evaluated: what the decoder stores values under.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -25,6 +25,18 @@ pub enum VarKey<'e> {
     },
     /// `@P<n>`, a cycle parameter.
     CycleParam(u32),
+    /// `V.A.ABS.<axis>`: the axis' absolute coordinate after the previous block.
+    AxisAbs(AxisId),
+    /// `V.G.WZ_AKT.R` (`None`: the active tool) or `V.G.WZ[j].R`: a tool radius.
+    ToolRadius(Option<u32>),
+}
+
+/// The axis of a `V.A.` variable, its index evaluated: which axis a letter or index names
+/// is the decoder's to say.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AxisId {
+    Letter(u8),
+    Index(u32),
 }
 
 impl std::fmt::Display for VarKey<'_> {
@@ -43,6 +55,10 @@ impl std::fmt::Display for VarKey<'_> {
                 indices
             }
             VarKey::CycleParam(n) => return write!(f, "@P{n}"),
+            VarKey::AxisAbs(AxisId::Letter(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
+            VarKey::AxisAbs(AxisId::Index(i)) => return write!(f, "V.A.ABS[{i}]"),
+            VarKey::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
+            VarKey::ToolRadius(Some(j)) => return write!(f, "V.G.WZ[{j}].R"),
         };
         for i in indices {
             write!(f, "[{i}]")?;
@@ -56,6 +72,12 @@ pub trait Vars {
     /// The value stored under `key`, or `None` if it is not defined (or the index is outside
     /// the declared array).
     fn get(&self, key: &VarKey<'_>) -> Option<f64>;
+
+    /// Whether `key` holds a string (a cycle parameter `@P1="text"`): it exists, but has no
+    /// number for [`Vars::get`] to give.
+    fn is_string(&self, _key: &VarKey<'_>) -> bool {
+        false
+    }
 }
 
 /// Why an expression has no value. `code()` gives the number reported to the operator.
@@ -75,6 +97,8 @@ pub enum EvalError {
     BadIndex(f64),
     #[error("result is not a finite number")]
     NotFinite,
+    #[error("{0} holds a string, not a number")]
+    StringAsNumber(String),
 }
 
 impl EvalError {
@@ -89,6 +113,7 @@ impl EvalError {
             EvalError::Undefined(_) => codes::EVAL_UNDEFINED,
             EvalError::BadIndex(_) => codes::EVAL_BAD_INDEX,
             EvalError::NotFinite => codes::EVAL_NOT_FINITE,
+            EvalError::StringAsNumber(_) => codes::EVAL_STRING_AS_NUMBER,
         }
     }
 }
@@ -109,9 +134,16 @@ pub fn eval(expr: &Expr, vars: &dyn Vars) -> Result<f64, EvalError> {
         Expr::Num(v) => *v,
         Expr::Var(r) => {
             let key = resolve(r, vars)?;
-            return vars
-                .get(&key)
-                .ok_or_else(|| EvalError::Undefined(key.to_string()));
+            return vars.get(&key).ok_or_else(|| no_number(&key, vars));
+        }
+        Expr::Test(test, r) => {
+            let key = resolve(r, vars)?;
+            let number = vars.get(&key).is_some();
+            bool_num(match test {
+                VarTest::Exist => number || vars.is_string(&key),
+                VarTest::IsNumber => number,
+                VarTest::IsString => !number && vars.is_string(&key),
+            })
         }
         Expr::Unary(op, e) => {
             let x = eval(e, vars)?;
@@ -166,7 +198,23 @@ pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalE
             indices: indices_of(indices, vars)?,
         },
         VarRef::CycleParam(n) => VarKey::CycleParam(*n),
+        VarRef::AxisAbs(AxisSel::Name(l)) => VarKey::AxisAbs(AxisId::Letter(*l)),
+        VarRef::AxisAbs(AxisSel::Index(e)) => {
+            VarKey::AxisAbs(AxisId::Index(index(eval(e, vars)?)?))
+        }
+        VarRef::ToolRadius(None) => VarKey::ToolRadius(None),
+        VarRef::ToolRadius(Some(e)) => VarKey::ToolRadius(Some(index(eval(e, vars)?)?)),
     })
+}
+
+/// Why `key` gave no number: it holds a string, or nothing.
+#[cold]
+fn no_number(key: &VarKey<'_>, vars: &dyn Vars) -> EvalError {
+    if vars.is_string(key) {
+        EvalError::StringAsNumber(key.to_string())
+    } else {
+        EvalError::Undefined(key.to_string())
+    }
 }
 
 fn indices_of(indices: &[Expr], vars: &dyn Vars) -> Result<Vec<u32>, EvalError> {

@@ -28,8 +28,8 @@ use nom::character::complete::char as ch;
 use nom::error::{ErrorKind, ParseError};
 use nom::IResult;
 
-use super::block::{BinOp, Expr, Func, Index, UnOp, VScope, VarRef};
-use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX};
+use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
+use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX, UNSUPPORTED};
 use super::error::SyntaxError;
 use super::number::{scan_unsigned, TOO_LARGE};
 
@@ -371,7 +371,8 @@ impl<'a> Ctx<'a> {
             b'P' | b'p'
                 if i.as_bytes()
                     .get(1)
-                    .is_some_and(|&c| c.is_ascii_digit() || c == b'[') =>
+                    .is_some_and(|&c| c.is_ascii_digit() || c == b'[')
+                    || is_pp(i.as_bytes()) =>
             {
                 let (rest, v) = self.var_ref(i)?;
                 Ok((rest, Expr::Var(Box::new(v))))
@@ -396,6 +397,9 @@ impl<'a> Ctx<'a> {
             _ => {}
         }
         let Some(func) = func_by_name(&name) else {
+            if let Some(test) = var_test_by_name(&name) {
+                return self.var_test(test, i, rest);
+            }
             return fail(i, SYNTAX, format!("unknown function or operand `{name}`"));
         };
         let j = ws(rest);
@@ -435,6 +439,42 @@ impl<'a> Ctx<'a> {
         Ok((j, Expr::Func(func, args)))
     }
 
+    /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]` after the name (`at` is where the name
+    /// starts, `rest` after it): the argument is one variable, not an expression.
+    #[cold]
+    fn var_test(&self, test: VarTest, at: &'a str, rest: &'a str) -> PResult<'a, Expr> {
+        let name = test.name();
+        let j = ws(rest);
+        let Some(j) = j.strip_prefix('[') else {
+            return fail(j, SYNTAX, format!("`[` expected after {name}"));
+        };
+        let _g = self.enter(j)?;
+        let j = ws(j);
+        let (k, v) = match self.var_ref(j) {
+            Ok(ok) => ok,
+            Err(nom::Err::Failure(p)) if p.input.len() < j.len() => {
+                return Err(nom::Err::Failure(p))
+            }
+            Err(_) => {
+                return fail(
+                    j,
+                    SYNTAX,
+                    format!("{name} takes a variable (P, V., @P), not an expression"),
+                )
+            }
+        };
+        let k = ws(k);
+        let Some(k) = k.strip_prefix(']') else {
+            return fail(
+                k,
+                SYNTAX,
+                format!("`]` expected after the variable of {name}"),
+            );
+        };
+        self.set_height(self.height.get() + 1, at)?;
+        Ok((k, Expr::Test(test, Box::new(v))))
+    }
+
     /// `P<n>`, `P[expr]`, each with optional adjacent `[i]` indices; `V.x.name[..]`; `@P<n>`.
     pub fn var_ref(&self, i: &'a str) -> PResult<'a, VarRef> {
         let bytes = i.as_bytes();
@@ -461,6 +501,10 @@ impl<'a> Ctx<'a> {
                     let (r, e) = self.bracketed(rest)?;
                     h = self.height.get();
                     (r, Index::Expr(Box::new(e)))
+                } else if is_pp(i.as_bytes()) {
+                    let (r, n) = self.indirect_p(rest)?;
+                    h = self.height.get();
+                    (r, n)
                 } else {
                     match uint(rest) {
                         Ok((r, n)) => (r, Index::Const(n)),
@@ -476,6 +520,8 @@ impl<'a> Ctx<'a> {
             }
             Some(b'V' | b'v') if bytes.get(1) == Some(&b'.') => {
                 let scope = match bytes.get(2).map(u8::to_ascii_uppercase) {
+                    Some(b'A') if bytes.get(3) == Some(&b'.') => return self.axis_var(i),
+                    Some(b'G') if bytes.get(3) == Some(&b'.') => return self.global_var(i),
                     Some(b'P') => VScope::Program,
                     Some(b'L') => VScope::Local,
                     Some(b'S') => VScope::SelfRetaining,
@@ -514,6 +560,100 @@ impl<'a> Ctx<'a> {
             }
             _ => fail(i, SYNTAX, "parameter or variable expected"),
         }
+    }
+
+    /// `V.A.<field>.<axis>` or `V.A.<field>[<index>]` (`i` at the `V`): `ABS` is modelled,
+    /// every other field of the manual's list is refused by name (900133).
+    #[cold]
+    fn axis_var(&self, i: &'a str) -> PResult<'a, VarRef> {
+        let f = &i[4..];
+        let (rest, field) = match name_upper(f) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "axis variable name expected"),
+            Err(e) => return Err(e),
+        };
+        if field != "ABS" {
+            return fail(
+                f,
+                UNSUPPORTED,
+                format!("V.A.{field} is an ISG axis variable ncchannel does not model"),
+            );
+        }
+        let axis = if let Some(r) = rest.strip_prefix('.') {
+            match r.as_bytes().first() {
+                Some(&b)
+                    if b.is_ascii_alphabetic()
+                        && !r.as_bytes().get(1).is_some_and(|&c| is_ident_byte(c)) =>
+                {
+                    self.height.set(1);
+                    return Ok((
+                        &r[1..],
+                        VarRef::AxisAbs(AxisSel::Name(b.to_ascii_uppercase())),
+                    ));
+                }
+                _ => return fail(r, SYNTAX, "axis name expected after V.A.ABS."),
+            }
+        } else if rest.starts_with('[') {
+            let (r, e) = self.bracketed(rest)?;
+            self.set_height(self.height.get() + 1, i)?;
+            (r, e)
+        } else {
+            return fail(
+                rest,
+                SYNTAX,
+                "`.<axis>` or `[<index>]` expected after V.A.ABS",
+            );
+        };
+        Ok((axis.0, VarRef::AxisAbs(AxisSel::Index(Box::new(axis.1)))))
+    }
+
+    /// `V.G.WZ_AKT.R` or `V.G.WZ[<j>].R` (`i` at the `V`): the tool radii of the tool list;
+    /// every other V.G. variable or tool field is refused by name (900133).
+    #[cold]
+    fn global_var(&self, i: &'a str) -> PResult<'a, VarRef> {
+        self.height.set(0);
+        let f = &i[4..];
+        let (rest, name) = match name_upper(f) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "global variable name expected"),
+            Err(e) => return Err(e),
+        };
+        let (rest, tool) = match name.as_str() {
+            "WZ_AKT" => (rest, None),
+            "WZ" if rest.starts_with('[') => {
+                let (r, e) = self.bracketed(rest)?;
+                (r, Some(Box::new(e)))
+            }
+            "WZ" => return fail(rest, SYNTAX, "`[<tool>]` expected after V.G.WZ"),
+            _ => {
+                return fail(
+                    f,
+                    UNSUPPORTED,
+                    format!("V.G.{name} is an ISG global variable ncchannel does not model"),
+                )
+            }
+        };
+        let Some(r) = rest.strip_prefix('.') else {
+            return fail(
+                rest,
+                SYNTAX,
+                format!("`.<field>` expected after V.G.{name}"),
+            );
+        };
+        let (rest, field) = match name_upper(r) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => return fail(r, SYNTAX, "tool data field expected"),
+            Err(e) => return Err(e),
+        };
+        if field != "R" {
+            return fail(
+                r,
+                UNSUPPORTED,
+                format!("V.G.{name}.{field}: ncchannel's tool list has radii (R) only"),
+            );
+        }
+        self.set_height(self.height.get() + 1, i)?;
+        Ok((rest, VarRef::ToolRadius(tool)))
     }
 
     /// Array indices written directly after a variable: `[i]`, `[i][j]`.
@@ -689,6 +829,42 @@ pub const FUNCS: [Func; 18] = [
     Func::Floor,
     Func::Ceil,
 ];
+
+/// `PP<n>` (or `PPP<n>`, …) at the start of `b`: the parameter whose number is P<n>'s
+/// value (TF5200 programming manual, "Indirect parameters": `PPnn` points to the parameter
+/// whose number `Pnn` holds; `PPP…` is allowed too).
+pub(crate) fn is_pp(b: &[u8]) -> bool {
+    let ps = b.iter().take_while(|c| matches!(c, b'P' | b'p')).count();
+    ps >= 2 && b.get(ps).is_some_and(u8::is_ascii_digit)
+}
+
+impl<'a> Ctx<'a> {
+    /// The number of `PP…P<n>` from the second `P` on (`i`): `P[P…[P<n>]]`, one level a `P`,
+    /// within the tree height limit.
+    #[cold]
+    fn indirect_p(&self, i: &'a str) -> PResult<'a, Index> {
+        let ps = i.bytes().take_while(|c| matches!(c, b'P' | b'p')).count();
+        let (r, n) = uint(&i[ps..])?;
+        let depth = u32::try_from(ps).unwrap_or(u32::MAX).saturating_mul(2);
+        self.set_height(depth, i)?;
+        let mut number = Index::Const(n);
+        for _ in 0..ps {
+            let inner = VarRef::P {
+                number,
+                indices: Vec::new(),
+            };
+            number = Index::Expr(Box::new(Expr::Var(Box::new(inner))));
+        }
+        Ok((r, number))
+    }
+}
+
+/// `EXIST`, `IS_NUMBER`, `IS_STRING` (upper-case `name`).
+fn var_test_by_name(upper: &str) -> Option<VarTest> {
+    [VarTest::Exist, VarTest::IsNumber, VarTest::IsString]
+        .into_iter()
+        .find(|t| t.name() == upper)
+}
 
 fn func_by_name(upper: &str) -> Option<Func> {
     FUNCS.into_iter().find(|f| f.name() == upper)

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, Expr, FlushKind, GotoTarget, Item, Label, SplineCommand,
-    VScope, Value, VarDecl, VarRef, VarType, Word,
+    Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Item, Label,
+    SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -322,6 +322,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
             let (r, target) = ctx.var_ref(i)?;
+            writable(&target, i)?;
             let r = ws(r);
             let Some(r) = r.strip_prefix('=') else {
                 return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
@@ -569,7 +570,7 @@ fn is_axis_letter(up: u8) -> bool {
 /// Does a parameter or variable start here (`P1`, `P[..]`, `V.L.X`, `@P1`)?
 fn starts_variable(b: &[u8]) -> bool {
     match b {
-        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[',
+        [b'P' | b'p', c, ..] => c.is_ascii_digit() || *c == b'[' || super::expr::is_pp(b),
         [b'V' | b'v', b'.', ..] => true,
         [b'@', b'P' | b'p', ..] => true,
         _ => false,
@@ -793,9 +794,19 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     Ok((rest, c))
 }
 
+/// A variable a program may assign: not a `V.A.` axis variable, which the kernel only lets
+/// programs read (TF5200 programming manual, "Axis-specific variables (V.A.)").
+fn writable<'a>(v: &VarRef, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
+    if matches!(v, VarRef::AxisAbs(_) | VarRef::ToolRadius(_)) {
+        return Err(perr(at, SYNTAX, "V.A. and V.G. variables are read-only"));
+    }
+    Ok(())
+}
+
 /// `$FOR P1 = start, end[, step]`.
 fn for_head<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     let (r, var) = ctx.var_ref(i)?;
+    writable(&var, i)?;
     let r = ws(r);
     let Some(r) = r.strip_prefix('=') else {
         return fail(r, SYNTAX, "`=` expected after the $FOR variable");
@@ -893,8 +904,10 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
                 (r, true)
             } else if let Some(r) = keyword(r, "OFF") {
                 (r, false)
+            } else if r.starts_with('[') {
+                return hsc_parameters(i, r);
             } else {
-                return fail(r, SYNTAX, "#HSC takes ON or OFF");
+                return fail(r, SYNTAX, "#HSC takes ON, OFF or [parameters]");
             };
             let (r, options) = verbatim_options(ws(r), r)?;
             Ok((r, Command::Hsc { on, options }))
@@ -912,6 +925,8 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let (r, options) = verbatim_options(ws(m), m)?;
             Ok((r, Command::ContourMode { options }))
         }
+        b"FILENAME" => file_names(i, r),
+        b"FILE" if keyword(r, "NAME").is_some() => file_names(i, ws(&r[4..])),
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
         b"MSG" => super::msg::parse_msg(ctx, r),
@@ -948,6 +963,69 @@ fn dialect_command<'a>(i: &'a str, kw: &[u8], word: &str) -> PResult<'a, Command
     }
 }
 
+/// The command from its `#` (`i`) up to `rest` as an inert command, verbatim.
+fn inert_to<'a>(i: &'a str, rest: &'a str) -> PResult<'a, Command> {
+    let text = i[1..i.len() - rest.len()].trim_end().to_string();
+    Ok((rest, Command::Inert { text }))
+}
+
+/// `#HSC [BSPLINE PATH_DEV 0.2 …]` / `#HSC [OPMODE 1 CONTERROR 0.01]` (TF5200 programming
+/// manual, "Trim a contour (#HSC ON/OFF)": ON and OFF are optional): parameters of the HSC
+/// smoothing without switching it, which ncchannel does not model: inert.
+#[cold]
+fn hsc_parameters<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
+    let (rest, _) = verbatim_options(r, r)?;
+    inert_to(i, rest)
+}
+
+/// `#FILENAME [MSG="prog_flow.txt"]` and `#FILE NAME [...]` (TF5200 programming manual,
+/// German edition, "Definition von Dateinamen (#FILE NAME)"; the older TwinCAT CNC
+/// programming manual's "Definition of file names" writes `#FILENAME`): `MSG` names the file `#MSG SAVE` writes to, and
+/// ncchannel writes none, so it is inert. The other file ids (`M6`, `D`, `G80`–`G89`,
+/// `G800`–`G839`) rename implicit subroutines, which is refused by name (900133).
+#[cold]
+fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
+    let Some(mut j) = r.strip_prefix('[') else {
+        return fail(r, SYNTAX, "#FILENAME takes [<id>=\"<file name>\" …]");
+    };
+    loop {
+        j = ws(j);
+        if let Some(rest) = j.strip_prefix(']') {
+            return inert_to(i, rest);
+        }
+        let (k, id) = match name_upper(j) {
+            Ok(ok) => ok,
+            Err(nom::Err::Error(_)) => {
+                return fail(j, SYNTAX, "file id (MSG, M6, D, G80…) or `]` expected")
+            }
+            Err(e) => return Err(e),
+        };
+        if id != "MSG" {
+            let known = matches!(id.as_str(), "M6" | "D")
+                || id
+                    .strip_prefix('G')
+                    .and_then(|n| n.parse::<u32>().ok())
+                    .is_some_and(|g| (80..=89).contains(&g) || (800..=839).contains(&g));
+            if known {
+                return fail(
+                    j,
+                    UNSUPPORTED,
+                    format!("#FILENAME {id}=… renames an implicit subroutine, which ncchannel does not support"),
+                );
+            }
+            return fail(j, SYNTAX, format!("unknown file id {id} in #FILENAME"));
+        }
+        let k = ws(k);
+        let k = ws(k.strip_prefix('=').unwrap_or(k));
+        let Some(body) = k.strip_prefix('"') else {
+            return fail(k, SYNTAX, "quoted file name expected in #FILENAME");
+        };
+        let Some(end) = body.find('"') else {
+            return fail(k, SYNTAX, "closing `\"` missing in #FILENAME");
+        };
+        j = &body[end + 1..];
+    }
+}
 /// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
 /// return when there is no bracket.
 fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
@@ -1061,6 +1139,9 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     let local = matches!(i.as_bytes().get(1), Some(b'L' | b'l'));
     let r = ws(&i[if local { 2 } else { 1 }..]);
     if local {
+        if let Some(c) = keyword(r, "CYCLE").map(ws).filter(|c| c.starts_with('[')) {
+            return cycle(ctx, c, true);
+        }
         let (rest, name) = file_name(r, false);
         if name.is_empty() {
             return fail(r, SYNTAX, "subroutine name expected after LL");
@@ -1075,7 +1156,7 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     if let Some(c) = keyword(r, "CYCLE") {
         let c = ws(c);
         if c.starts_with('[') {
-            return cycle(ctx, c);
+            return cycle(ctx, c, false);
         }
         return fail(
             c,
@@ -1095,19 +1176,29 @@ fn call<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
     ))
 }
 
-/// `[NAME=file.cyc @P1=0 @P2=[P5*2]]`: blanks or commas between the entries.
-fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
+/// `[NAME=file.cyc @P1=0 @P2=[P5*2] @P3="text"]`: blanks or commas between the entries
+/// (TF5200 programming manual, "Cycles as global or local subroutines (Call L | LL CYCLE)";
+/// `local` for `LL CYCLE`). A modal call (`MODAL`, `MODAL_MOVE`, `MODAL_BLOCK`) is refused
+/// by name: ncchannel does not repeat a cycle after later blocks.
+fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str, local: bool) -> PResult<'a, Call> {
     let open = i;
     let mut j = &i[1..];
     let mut name: Option<String> = None;
-    let mut params: Vec<(u32, super::block::Expr)> = Vec::new();
+    let mut params: Vec<(u32, CycleArg)> = Vec::new();
     loop {
         j = j.trim_start_matches([' ', '\t', ',']);
         if let Some(rest) = j.strip_prefix(']') {
             let Some(name) = name else {
                 return fail(open, SYNTAX, "NAME=<file> missing in L CYCLE");
             };
-            return Ok((rest, Call::Cycle { name, params }));
+            return Ok((
+                rest,
+                Call::Cycle {
+                    name,
+                    local,
+                    params,
+                },
+            ));
         }
         if let Some(n) = keyword(j, "NAME") {
             let n = ws(n);
@@ -1135,15 +1226,45 @@ fn cycle<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Call> {
             let Some(r) = r.strip_prefix('=') else {
                 return fail(r, SYNTAX, "`=` expected after the cycle parameter");
             };
-            let (r, e) = ctx.expr(ws(r))?;
-            params.push((p, e));
+            let r = ws(r);
+            let (r, a) = if r.starts_with('"') {
+                cycle_string(r)?
+            } else {
+                let (r, e) = ctx.expr(r)?;
+                (r, CycleArg::Expr(e))
+            };
+            params.push((p, a));
             j = r;
+        } else if ["MODAL_MOVE", "MODAL_BLOCK", "MODAL"]
+            .into_iter()
+            .any(|kw| keyword(j, kw).is_some())
+        {
+            return fail(
+                j,
+                UNSUPPORTED,
+                "a modal cycle call (MODAL, MODAL_MOVE, MODAL_BLOCK) is not supported by ncchannel",
+            );
         } else if j.is_empty() {
             return fail(j, SYNTAX, "`]` missing after L CYCLE [");
         } else {
             return fail(j, SYNTAX, "NAME=<file> or @P<n>=<value> expected");
         }
     }
+}
+
+/// `"text"` as a cycle parameter's value: everything up to the next `"` (a block holds no
+/// line break, so the text is bounded by the block).
+#[cold]
+fn cycle_string(i: &str) -> PResult<'_, CycleArg> {
+    let body = &i[1..];
+    let Some(end) = body.find('"') else {
+        return fail(
+            i,
+            SYNTAX,
+            "closing `\"` missing in the cycle parameter's string",
+        );
+    };
+    Ok((&body[end + 1..], CycleArg::Str(body[..end].to_string())))
 }
 
 /// `%name`, `% name` or `%L name` (TF5200 programming manual, "NC block structure": `% 100`).

@@ -1,0 +1,46 @@
+//! Machine data a program reads: `V.A.ABS.<axis>` / `V.A.ABS[<index>]`, the axis'
+//! coordinate at the end of the previous block in the active coordinate system (TF5200
+//! programming manual, "Axis-specific variables (V.A.)"), and `V.G.WZ_AKT.R` /
+//! `V.G.WZ[j].R`, tool radii from the tool list ("Global variables (V.G.)"). The parser
+//! refuses the manual's other V.A. and V.G. variables by name (docs/nc-language.md,
+//! "Constructs of real programs").
+
+use super::*;
+
+impl Decoder {
+    /// `V.A.ABS.<axis>`: the axis' end point of the previous block in program coordinates
+    /// (zero offset and G92 taken off, in inch under G70); `None` for an axis the channel
+    /// does not have.
+    pub(super) fn axis_abs(&self, id: crate::lang::AxisId) -> Option<f64> {
+        use crate::lang::AxisId;
+        let i = match id {
+            AxisId::Letter(l) => crate::queue::AXIS_LETTERS.iter().position(|&a| a == l)?,
+            AxisId::Index(n) => usize::try_from(n).ok()?,
+        };
+        if !*self.settings.axes.get(i)? {
+            return None;
+        }
+        let off = self.program_offset(modal::BlockGs::default());
+        Some((self.modal.pos[i] - off[i]) / self.length_scale(i))
+    }
+}
+
+impl Decoder {
+    /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
+    pub fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
+        self.tool_radii = radii;
+    }
+
+    /// Radius of tool data set `d` (`None`: the active D), mm; D0 is radius 0; `None` for a
+    /// D the tool list does not have.
+    pub(super) fn tool_radius(&self, d: Option<u32>) -> Option<f64> {
+        let d = d.unwrap_or(self.modal.tool_offset);
+        if d == 0 {
+            return Some(0.0);
+        }
+        self.tool_radii
+            .iter()
+            .find(|(n, _)| *n == d)
+            .map(|(_, r)| *r)
+    }
+}

@@ -1,0 +1,60 @@
+//! Cycle calls: `L CYCLE [NAME=file @P1=… @P2="text"]` runs a cycle file, `LL CYCLE
+//! [NAME=sub …]` a `%L sub` section of the calling file (TF5200 programming manual, "Cycles as
+//! global or local subroutines (Call L | LL CYCLE)"). The parameters are evaluated at the call and visible as `@P<n>` in the new
+//! level; a string parameter is kept as written, so `IS_STRING[@P1]` and `EXIST[@P1]` see
+//! it, and using it as a number is 900008 (docs/nc-language.md, "Constructs of real
+//! programs").
+
+use super::*;
+use crate::lang::block::CycleArg;
+
+impl Decoder {
+    pub(super) fn call_cycle(
+        &mut self,
+        name: &str,
+        local: bool,
+        params: &[(u32, CycleArg)],
+        info: BlockInfo,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let mut numbers = Vec::with_capacity(params.len());
+        let mut texts = Vec::new();
+        for (n, a) in params {
+            match a {
+                CycleArg::Expr(e) => numbers.push((*n, self.eval(e)?)),
+                CycleArg::Str(s) => texts.push((*n, Box::from(s.as_str()))),
+            }
+        }
+        let frame = if local {
+            self.local_cycle_frame(name)?
+        } else {
+            self.open_subroutine(name, FrameKind::Cycle, io)?
+        };
+        self.emit(info, Action::None, false, io);
+        self.vars.push_cycle_level(numbers, texts);
+        self.frames.push(frame);
+        Ok(())
+    }
+
+    /// The frame of `%L name` in the running file, as `LL name` finds it.
+    fn local_cycle_frame(&mut self, name: &str) -> Res<Frame> {
+        let index = self.label_index()?;
+        let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
+            return Err(DecodeError::new(
+                codes::LOCAL_SUB_NOT_FOUND,
+                format!("local subroutine {name} of LL CYCLE not found"),
+            ));
+        };
+        let top = self.top();
+        let Source::File(p) = &top.source else {
+            return Err(DecodeError::new(
+                codes::STREAM_LOCAL_CALL,
+                "local cycle call (LL CYCLE) in streaming program",
+            ));
+        };
+        let mut frame = Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
+        frame.label_index = Some(index);
+        frame.seek(at);
+        Ok(frame)
+    }
+}
