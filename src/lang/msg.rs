@@ -13,6 +13,7 @@
 use super::block::{Command, Expr, Message};
 use super::codes::{MSG_ARG_COUNT, MSG_NO_VALUE, MSG_TOO_MANY_VALUES, MSG_UNKNOWN_FORMAT, SYNTAX};
 use super::expr::{fail, keyword, perr, ws, Ctx, PErr};
+use super::parse::verbatim_options;
 
 /// Most values (format elements) one message may carry: ncchannel's limit, which 20724
 /// reports as its limit value (the kernel's own limit is not published on the page).
@@ -42,7 +43,7 @@ pub(crate) fn parse_msg<'a>(ctx: &Ctx<'a>, i: &'a str) -> Res<'a, Command> {
     let (rest, (text, quoted, args)) = match quoted_body(ctx, r)? {
         Some(b) => b,
         None => {
-            let (rest, text) = verbatim(r)?;
+            let (rest, text) = verbatim_options(r, r)?;
             (rest, (text, false, Vec::new()))
         }
     };
@@ -143,24 +144,6 @@ fn quoted_body<'a>(
 
 fn count_msg(elements: usize, values: usize) -> String {
     format!("#MSG text has {elements} format element(s) but {values} value(s) are programmed")
-}
-
-/// `[ … ]` kept verbatim (brackets may nest), trimmed.
-fn verbatim(i: &str) -> Res<'_, String> {
-    let mut depth = 0usize;
-    for (k, b) in i.bytes().enumerate() {
-        match b {
-            b'[' => depth += 1,
-            b']' => {
-                depth -= 1;
-                if depth == 0 {
-                    return Ok((&i[k + 1..], i[1..k].trim().to_string()));
-                }
-            }
-            _ => {}
-        }
-    }
-    fail(i, SYNTAX, "`]` missing")
 }
 
 /// One format element of a text: `%[flags][width][.precision]conversion`.

@@ -1026,9 +1026,10 @@ fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
         j = &body[end + 1..];
     }
 }
+
 /// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
 /// return when there is no bracket.
-fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
+pub(super) fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
     if !i.starts_with('[') {
         return Ok((none, String::new()));
     }
@@ -1049,7 +1050,7 @@ fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
 }
 
 /// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (TF5200 File Caching;
-/// the seed writes no blank before the bracket). Bad form 21560, a second target 21561.
+/// its examples write no blank before the bracket). Bad form 21560, a second target 21561.
 fn cache(i: &str) -> PResult<'_, Command> {
     let (r, load) = if let Some(r) = keyword(i, "LOAD") {
         (r, true)

@@ -667,7 +667,8 @@ mod tests {
 
     #[test]
     fn comments_blank_lines_crlf_tabs() {
-        let text = "# comment\r\n#\r\n\r\n\t \r\n##########\r\n; seed style\r\nname\tvalue\r\n";
+        let text =
+            "# comment\r\n#\r\n\r\n\t \r\n##########\r\n; semicolon style\r\nname\tvalue\r\n";
         let (list, errs) = parse_list(Path::new("t.lis"), text);
         assert!(errs.is_empty(), "{errs:?}");
         assert_eq!(list.entries.len(), 1);
