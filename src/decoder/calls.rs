@@ -362,24 +362,7 @@ impl Decoder {
                 params,
             } => self.call_cycle(name, *local, params, info, io)?,
             Call::Local { name } => {
-                let index = self.label_index()?;
-                let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
-                    return Err(DecodeError::new(
-                        codes::LOCAL_SUB_NOT_FOUND,
-                        format!("local subroutine {name} not found"),
-                    ));
-                };
-                let top = self.top();
-                let Source::File(p) = &top.source else {
-                    return Err(DecodeError::new(
-                        codes::STREAM_LOCAL_CALL,
-                        "local subroutine call (LL) in streaming program",
-                    ));
-                };
-                let mut frame =
-                    Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
-                frame.label_index = Some(index);
-                frame.seek(at);
+                let frame = self.local_frame(name, "local subroutine call (LL)")?;
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
                 self.frames.push(frame);

@@ -26,7 +26,7 @@ impl Decoder {
             }
         }
         let frame = if local {
-            self.local_cycle_frame(name)?
+            self.local_frame(name, "local cycle call (LL CYCLE)")?
         } else {
             self.open_subroutine(name, FrameKind::Cycle, io)?
         };
@@ -36,20 +36,21 @@ impl Decoder {
         Ok(())
     }
 
-    /// The frame of `%L name` in the running file, as `LL name` finds it.
-    fn local_cycle_frame(&mut self, name: &str) -> Res<Frame> {
+    /// The frame of `%L name` in the running file, for `LL name` and `LL CYCLE` (`what`
+    /// names the call in the streaming error): not in a streaming program, where it is 21479.
+    pub(super) fn local_frame(&mut self, name: &str, what: &str) -> Res<Frame> {
         let index = self.label_index()?;
         let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
             return Err(DecodeError::new(
                 codes::LOCAL_SUB_NOT_FOUND,
-                format!("local subroutine {name} of LL CYCLE not found"),
+                format!("local subroutine {name} not found"),
             ));
         };
         let top = self.top();
         let Source::File(p) = &top.source else {
             return Err(DecodeError::new(
                 codes::STREAM_LOCAL_CALL,
-                "local cycle call (LL CYCLE) in streaming program",
+                format!("{what} in streaming program"),
             ));
         };
         let mut frame = Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
