@@ -143,6 +143,14 @@ pub(crate) fn name_upper(i: &str) -> PResult<'_, String> {
     Ok((rest, s))
 }
 
+/// [`name_upper`], or 20200 with `expected` (what the grammar wanted there) at `i`.
+pub(crate) fn name_or<'a>(i: &'a str, expected: &'static str) -> PResult<'a, String> {
+    match name_upper(i) {
+        Err(nom::Err::Error(_)) => fail(i, SYNTAX, expected),
+        r => r,
+    }
+}
+
 /// Parse state for one line: the line itself (for columns) and the expression nesting depth.
 pub(crate) struct Ctx<'a> {
     pub line: &'a str,
@@ -542,11 +550,7 @@ impl<'a> Ctx<'a> {
                     );
                 };
                 let rest = &rest[1..];
-                let (rest, name) = match name_upper(rest) {
-                    Ok(ok) => ok,
-                    Err(nom::Err::Error(_)) => return fail(rest, SYNTAX, "variable name expected"),
-                    Err(e) => return Err(e),
-                };
+                let (rest, name) = name_or(rest, "variable name expected")?;
                 let (rest, indices) = self.indices(rest)?;
                 self.set_height(self.height.get() + 1, i)?;
                 Ok((
@@ -567,11 +571,7 @@ impl<'a> Ctx<'a> {
     #[cold]
     fn axis_var(&self, i: &'a str) -> PResult<'a, VarRef> {
         let f = &i[4..];
-        let (rest, field) = match name_upper(f) {
-            Ok(ok) => ok,
-            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "axis variable name expected"),
-            Err(e) => return Err(e),
-        };
+        let (rest, field) = name_or(f, "axis variable name expected")?;
         if field != "ABS" {
             return fail(
                 f,
@@ -613,11 +613,7 @@ impl<'a> Ctx<'a> {
     fn global_var(&self, i: &'a str) -> PResult<'a, VarRef> {
         self.height.set(0);
         let f = &i[4..];
-        let (rest, name) = match name_upper(f) {
-            Ok(ok) => ok,
-            Err(nom::Err::Error(_)) => return fail(f, SYNTAX, "global variable name expected"),
-            Err(e) => return Err(e),
-        };
+        let (rest, name) = name_or(f, "global variable name expected")?;
         let (rest, tool) = match name.as_str() {
             "WZ_AKT" => (rest, None),
             "WZ" if rest.starts_with('[') => {
@@ -640,11 +636,7 @@ impl<'a> Ctx<'a> {
                 format!("`.<field>` expected after V.G.{name}"),
             );
         };
-        let (rest, field) = match name_upper(r) {
-            Ok(ok) => ok,
-            Err(nom::Err::Error(_)) => return fail(r, SYNTAX, "tool data field expected"),
-            Err(e) => return Err(e),
-        };
+        let (rest, field) = name_or(r, "tool data field expected")?;
         if field != "R" {
             return fail(
                 r,

@@ -20,7 +20,7 @@ use super::codes::{
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
-use super::expr::{fail, keyword, name_upper, perr, uint, ws, Ctx, PErr, PResult};
+use super::expr::{fail, keyword, name_or, name_upper, perr, uint, ws, Ctx, PErr, PResult};
 use super::number::{scan_unsigned, TOO_LARGE};
 use super::range::word_value;
 
@@ -993,13 +993,7 @@ fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
         if let Some(rest) = j.strip_prefix(']') {
             return inert_to(i, rest);
         }
-        let (k, id) = match name_upper(j) {
-            Ok(ok) => ok,
-            Err(nom::Err::Error(_)) => {
-                return fail(j, SYNTAX, "file id (MSG, M6, D, G80…) or `]` expected")
-            }
-            Err(e) => return Err(e),
-        };
+        let (k, id) = name_or(j, "file id (MSG, M6, D, G80…) or `]` expected")?;
         if id != "MSG" {
             let known = matches!(id.as_str(), "M6" | "D")
                 || id
