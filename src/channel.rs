@@ -35,6 +35,7 @@ pub struct ErrorRecord {
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
+use crate::machine::{HmiOp, Op, Reply};
 pub use crate::mode::{Mode, State};
 
 /// Why a command was refused.
@@ -204,6 +205,68 @@ pub struct Channel {
 }
 
 impl Channel {
+    /// The one door into a channel: every command and read a client, a feeder, the soak or
+    /// the CLI makes is an [`Op`] applied here, in the tick that serves it.
+    pub fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
+        match op {
+            Op::WriteStream(_) if self.state() == State::Error || !self.streaming_enabled() => {
+                Reply::StreamNotReady
+            }
+            Op::WriteStream(data) => Reply::Stream(self.write_stream(tick, &data)),
+            Op::CommandMode(v) => Reply::Command(self.command_mode(tick, v)),
+            Op::CommandState(v) => Reply::Command(self.command_state(tick, v)),
+            Op::SetProgram(name) => {
+                self.set_program(&name);
+                Reply::Done
+            }
+            Op::Hold => {
+                self.hold(tick);
+                Reply::Done
+            }
+            Op::Resume => {
+                self.resume(tick);
+                Reply::Done
+            }
+            Op::Reset => {
+                self.reset(tick);
+                Reply::Done
+            }
+            Op::SetOverride(p) => Reply::Command(self.set_override(p)),
+            Op::WriteExternal(name, v) => Reply::Value(self.write_external(&name, v).then_some(v)),
+            Op::ReadExternal(name) => Reply::Value(self.read_external(&name)),
+            Op::Status => {
+                let mut s = crate::machine::status_of(self);
+                s.tick = tick.index;
+                s.period = tick.period;
+                Reply::Status(Box::new(s))
+            }
+            Op::Hmi(h) => Reply::Command(match h {
+                HmiOp::SingleBlock(on) => {
+                    self.set_single_block(on);
+                    Ok(())
+                }
+                HmiOp::OptionalStop(on) => {
+                    self.set_optional_stop(on);
+                    Ok(())
+                }
+                HmiOp::SkipLevels(mask) => {
+                    self.set_skip_levels(mask);
+                    Ok(())
+                }
+                HmiOp::ExecutionMode(m) => self.set_execution_mode(m),
+                HmiOp::Search(s) => {
+                    self.set_search_command(s);
+                    Ok(())
+                }
+                HmiOp::ResetCycleTimes => Ok(()),
+            }),
+            Op::ErrorRecord(i) => Reply::ErrorRecord {
+                total: self.stats().errors,
+                record: crate::machine::error_record(self, i),
+            },
+        }
+    }
+
     pub fn new(s: ChannelSettings, events_enabled: bool) -> Self {
         let zero_offsets = s.decoder.zero_offsets;
         Channel {

@@ -269,7 +269,9 @@ impl Machine {
         }
     }
 
-    /// Apply one request to its channel (the runtime serves requests through this).
+    /// Route one request to its channel (the runtime serves requests through this). The
+    /// cycle-time statistics are the machine's, so their reset and the times in a status are
+    /// filled in here.
     pub fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
         if op == Op::Hmi(HmiOp::ResetCycleTimes) {
             self.cycle_times = CycleTimes::default();
@@ -279,63 +281,12 @@ impl Machine {
         let Some(c) = self.channel_mut(channel) else {
             return Reply::NoChannel;
         };
-        match op {
-            Op::WriteStream(_) if c.state() == State::Error || !c.streaming_enabled() => {
-                Reply::StreamNotReady
-            }
-            Op::WriteStream(data) => Reply::Stream(c.write_stream(tick, &data)),
-            Op::CommandMode(v) => Reply::Command(c.command_mode(tick, v)),
-            Op::CommandState(v) => Reply::Command(c.command_state(tick, v)),
-            Op::SetProgram(name) => {
-                c.set_program(&name);
-                Reply::Done
-            }
-            Op::Hold => {
-                c.hold(tick);
-                Reply::Done
-            }
-            Op::Resume => {
-                c.resume(tick);
-                Reply::Done
-            }
-            Op::Reset => {
-                c.reset(tick);
-                Reply::Done
-            }
-            Op::SetOverride(p) => Reply::Command(c.set_override(p)),
-            Op::WriteExternal(name, v) => Reply::Value(c.write_external(&name, v).then_some(v)),
-            Op::ReadExternal(name) => Reply::Value(c.read_external(&name)),
-            Op::Status => {
-                let mut s = status_of(c);
-                s.tick = tick.index;
-                s.period = tick.period;
+        match c.apply(tick, op) {
+            Reply::Status(mut s) => {
                 s.cycle_times = times;
-                Reply::Status(Box::new(s))
+                Reply::Status(s)
             }
-            Op::Hmi(h) => Reply::Command(match h {
-                HmiOp::SingleBlock(on) => {
-                    c.set_single_block(on);
-                    Ok(())
-                }
-                HmiOp::OptionalStop(on) => {
-                    c.set_optional_stop(on);
-                    Ok(())
-                }
-                HmiOp::SkipLevels(mask) => {
-                    c.set_skip_levels(mask);
-                    Ok(())
-                }
-                HmiOp::ExecutionMode(m) => c.set_execution_mode(m),
-                HmiOp::Search(s) => {
-                    c.set_search_command(s);
-                    Ok(())
-                }
-                HmiOp::ResetCycleTimes => Ok(()),
-            }),
-            Op::ErrorRecord(i) => Reply::ErrorRecord {
-                total: c.stats().errors,
-                record: error_record(c, i),
-            },
+            r => r,
         }
     }
 }
@@ -347,7 +298,7 @@ fn wire(e: &ErrorRecord) -> (u32, String) {
 
 /// The `index`-th error of the channel (0 = first): kept in the channel's error list, or the
 /// last error when it is the newest one.
-fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
+pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     let i = usize::try_from(index).ok()?;
     if let Some(e) = c.errors().get(i) {
         return Some(wire(e));
