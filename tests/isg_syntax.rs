@@ -532,3 +532,27 @@ fn v_g_tool_radii_come_from_the_tool_list() {
     fails_at(&rig, "G01 X[V.G.WZ_AKT.L] F100\nM30\n", 900133, 1, 18, true);
     fails_at(&rig, "V.G.WZ[1].R = 2\nM30\n", 20200, 1, 1, true);
 }
+
+#[test]
+fn a_comment_block_may_stand_among_var_declarations() {
+    // ISG's editor documents a variable with a comment block inside `#VAR`
+    // (`isg-stuttgart/vscode-isg-cnc`, `src/test/res/docHover1.nc`).
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "#VAR\n\
+         #COMMENT BEGIN\n\
+         \x20 First doc for V.P.VAR_1, not NC: X = = ]\n\
+         #COMMENT END\n\
+         \x20 V.P.VAR_1 = 10 ; doc\n\
+         #ENDVAR\n\
+         G01 XV.P.VAR_1 F100\n\
+         M30\n",
+    );
+    assert_eq!(r.position('X'), 10.0);
+    // Inside the comment `#ENDVAR` is comment text: both blocks stay open to the end (20375).
+    assert_eq!(
+        check_places("#VAR\n#COMMENT BEGIN\n#ENDVAR\nM30\n"),
+        [(1, 1, 20375), (2, 1, 20375)],
+    );
+}

@@ -614,6 +614,8 @@ impl Decoder {
             match parse_var_line(text)? {
                 VarLine::Blank => {}
                 VarLine::End => top.var_block = false,
+                // The comment block ends inside the `#VAR` block: both flags hold.
+                VarLine::CommentBegin => top.comment_block = true,
                 VarLine::Decl(d) => self.declare(&d)?,
             }
             return Ok(());

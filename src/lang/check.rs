@@ -304,6 +304,7 @@ impl Checker {
             // The decoder reads these lines with the same function.
             match parse_var_line(raw) {
                 Ok(VarLine::End) => self.var_from = None,
+                Ok(VarLine::CommentBegin) => self.comment_from = Some(line),
                 Ok(VarLine::Blank | VarLine::Decl(_)) => {}
                 Err(e) => self.push(line, e.col as usize, joined, e.code, e.message),
             }

@@ -36,6 +36,11 @@ pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
 /// number, optionally followed by a comment)? The decoder asks this for every line inside a
 /// `#COMMENT BEGIN` block without parsing the line: comment text need not be valid NC.
 pub fn is_comment_end(line: &str) -> bool {
+    is_comment_command(line, "END")
+}
+
+/// Is this line `#COMMENT <word>` and nothing else (but a comment)?
+fn is_comment_command(line: &str, word: &'static str) -> bool {
     let line = strip_line_end(line);
     let Ok((i, _)) = prefix(ws(line)) else {
         return false;
@@ -49,7 +54,7 @@ pub fn is_comment_end(line: &str) -> bool {
     if !i.starts_with([' ', '\t']) {
         return false;
     }
-    let Some(i) = keyword(ws(i), "END") else {
+    let Some(i) = keyword(ws(i), word) else {
         return false;
     };
     gap(i).is_empty()
@@ -79,6 +84,10 @@ pub enum VarLine {
     End,
     /// A declaration, validated (at most three sizes, at most `MAX_ARRAY_ELEMENTS` elements).
     Decl(VarDecl),
+    /// `#COMMENT BEGIN`: a comment block inside the declarations (ISG's editor documents a
+    /// variable this way, `isg-stuttgart/vscode-isg-cnc` `src/test/res/docHover1.nc`); the
+    /// lines up to `#COMMENT END` are comment text, then declarations go on.
+    CommentBegin,
 }
 
 /// Read one line inside a `#VAR` block.
@@ -88,6 +97,9 @@ pub fn parse_var_line(line: &str) -> Result<VarLine, SyntaxError> {
     }
     if is_var_end(line) {
         return Ok(VarLine::End);
+    }
+    if is_comment_command(line, "BEGIN") {
+        return Ok(VarLine::CommentBegin);
     }
     parse_var_declaration(line).map(VarLine::Decl)
 }
