@@ -346,7 +346,7 @@ fn block_search_by_number_counter_and_offset_restores_the_state_of_a_full_run() 
 }
 
 #[test]
-fn block_search_target_not_found_is_21532() {
+fn block_search_target_not_found_is_20704() {
     let rig = rig();
     rig.program("search.nc", SEARCH_PROGRAM);
     let r = rig.run_with("search.nc", None, 1_000_000, |m| {
@@ -354,5 +354,5 @@ fn block_search_target_not_found_is_21532() {
             .unwrap()
             .set_search(Some(SearchTarget::BlockNumber(999)))
     });
-    assert_eq!(r.error_codes(), [21532]);
+    assert_eq!(r.error_codes(), [20704]);
 }

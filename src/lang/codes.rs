@@ -43,13 +43,14 @@ pub const SYNTAX: u32 = 20200;
 /// An axis programmed twice in one block (TF5200 diagnosis ID 20203 "Double-programmed
 /// axis.").
 pub const AXIS_TWICE: u32 = 20203;
-/// Unknown `#` command (TF5200 diagnosis ID 20209).
 /// A `$` statement with other words in its block (TF5200 diagnosis ID 20206 "$ command must
 /// be programmed exclusively in NC block.").
 pub const CONTROL_NOT_ALONE: u32 = 20206;
 /// A `#` command with other words before it in its block (TF5200 diagnosis ID 20207 "#
 /// command must be programmed exclusively in NC block.").
 pub const COMMAND_NOT_ALONE: u32 = 20207;
+/// Unknown `#` command or `$` statement (TF5200 diagnosis ID 20209; page not yet read, see
+/// [`KERNEL_UNREAD`]).
 pub const UNKNOWN_COMMAND: u32 = 20209;
 /// `$ELSE` without its `$IF` (TF5200 diagnosis ID 20214).
 pub const UNEXPECTED_ELSE: u32 = 20214;
@@ -97,6 +98,12 @@ pub const EVAL_DIVISION_BY_ZERO: u32 = 20396;
 /// Expression: LN/LOG of a number <= 0 (TF5200 diagnosis ID 20399 "Logarithm less
 /// than/equal 0.").
 pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
+/// Block search: M30/M02 or the end of the file reached before the continuation position
+/// (the search target) was found. The TF5200 block search manual ("Exceptions and errors",
+/// tf5200_blocksearch/348601995) names P-ERR-20704 for a continuation position not found;
+/// its TwinCAT 2 edition quotes the message, "program end reached without restart mark
+/// found". The diagnosis page of ID 20704 itself was not in the index searched.
+pub const SEARCH_NOT_FOUND: u32 = 20704;
 /// `#FLUSH` while tool radius compensation G41/G42 is active (TF5200 diagnosis ID 20651 "NC
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
@@ -117,7 +124,8 @@ pub const MSG_UNKNOWN_FORMAT: u32 = 21232;
 pub const DWELL_RANGE_TIME: u32 = 20751;
 /// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
 pub const DWELL_RANGE_G04: u32 = 20752;
-/// Label defined twice in one program level (TF5200 diagnosis ID 20836).
+/// Label defined twice in one program level (TF5200 diagnosis ID 20836 "Multiple defined
+/// label").
 pub const LABEL_TWICE: u32 = 20836;
 /// `$GOTO` target not found (TF5200 diagnosis ID 20840).
 pub const LABEL_NOT_FOUND: u32 = 20840;
@@ -134,8 +142,6 @@ pub const STREAM_BACKWARD_JUMP: u32 = 21477;
 pub const STREAM_LOOP: u32 = 21478;
 /// Local subroutine call (LL) in a streaming program (TF5200 diagnosis ID 21479).
 pub const STREAM_LOCAL_CALL: u32 = 21479;
-/// Block search target not found (TF5200 diagnosis ID 21532).
-pub const SEARCH_NOT_FOUND: u32 = 21532;
 /// Invalid `#CACHE` programming (TF5200 diagnosis ID 21560).
 pub const CACHE_SYNTAX: u32 = 21560;
 /// Double programming inside one `#CACHE` command (TF5200 diagnosis ID 21561).
@@ -314,7 +320,9 @@ pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
 /// publishes and, in the comment, the page (infosys.beckhoff.com/content/1033/ +
 /// `tf5200_diagnosis/<n>.html` unless another manual is named). English titles; 20054's
 /// and 21232's English pages are not in the index searched, so their German titles
-/// (content/1031/) stand.
+/// (content/1031/) stand. 20704's diagnosis page was not in the index either: its message
+/// is the one the TwinCAT 2 block search manual quotes (content/1033/blocksearch/
+/// 15328482315, "Exceptions / Errors"), whose TF5200 edition names the same id.
 pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
     (20008, "Feed rate in motion block is 0."), // 250515083
@@ -384,6 +392,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20396, "Division by 0."),           // 251507339
     (20399, "Logarithm less than/equal 0."), // 251520395
     (20651, "NC command is not allowed during active TRC."), // 252112267
+    (20704, "program end reached without restart mark found"), // blocksearch/15328482315
     (
         20721,
         "Number of parameters and the number of format specifiers do not match.",
@@ -395,6 +404,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (20836, "Multiple defined label"),   // 252721547
     (
         20967,
         "Memory for variables limited, allocation of new variable impossible.",
@@ -427,8 +437,14 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
 /// 20240 and 21469 sit between pages that were read (20239 "'DO' must be programmed
 /// exclusively", 20241 "After 'ENDDO' only the condition is permissible"; 21470 "After
 /// 'UNTIL' only the condition is permissible"), in the kernel's pattern of "Unexpected X"
-/// before "X must be programmed exclusively". Each stays here until its page is read and it
-/// moves to [`KERNEL_TITLES`] (or, if it means something else, to our range).
+/// before "X must be programmed exclusively". What the neighbours say of two of them: the
+/// page after 20157 that was read, 20160 "Unknown internal M-function." (250945931), is an
+/// M number above the user range that is no internal M function either; and the TwinCAT 2
+/// CNC diagnosis list (content/1033/tccncdiagnosis/15651576715, "ID-range 20500-20749")
+/// gives 20509 "Unknown NC-command after #.", while the TF5200 pages of neither 20209 nor
+/// 20509 were in the index, so which of the two the current kernel raises for an unknown
+/// `#` command is open. Each stays here until its page is read and it moves to
+/// [`KERNEL_TITLES`] (or, if it means something else, to our range).
 pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     (20157, "unknown M function"),
     (20200, "NC command or axis name expected"),
@@ -439,10 +455,8 @@ pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     (20373, "local subroutine not found"),
     (20376, "M17/M29 where no subroutine runs"),
     (20377, "M30/M02 inside a subroutine"),
-    (20836, "label defined twice"),
     (20840, "label not found"),
     (21469, "unexpected $UNTIL"),
-    (21532, "block search target not found"),
     (21560, "invalid #CACHE programming"),
     (21561, "double programming in #CACHE"),
     (21562, "file cache full"),
@@ -673,8 +687,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20836, 20840, 21469,
-                21532, 21560, 21561, 21562, 21563, 21564, 21897
+                20157, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840, 21469, 21560,
+                21561, 21562, 21563, 21564, 21897
             ]
         );
     }
