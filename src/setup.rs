@@ -8,9 +8,9 @@ use crate::decoder::{DecoderSettings, SoftLimits};
 use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::runtime::axis_index;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
-use crate::queue::MAX_AXES;
 use crate::source::cache::CacheLimits;
 use crate::source::store::{FsLatency, SearchDir, PATH_MAIN, PATH_SUB};
+use crate::vocab::axis::MAX_AXES;
 
 #[derive(Debug, Error)]
 pub enum SetupError {

@@ -8,10 +8,11 @@ use common::random_path::{self, Rng};
 
 use common::limit_check::{LimitCheck, DEFAULT_EPS};
 use ncchannel::decoder::arc::{ArcError, ArcSpec};
-use ncchannel::lang::block::FlushKind;
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane, Position};
+use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane};
+use ncchannel::vocab::axis::Position;
+use ncchannel::vocab::flush::FlushKind;
 
 /// The positional form reads best in these tables of cases.
 #[allow(clippy::too_many_arguments)]

@@ -12,7 +12,8 @@ use std::f64::consts::{PI, TAU};
 use crate::lang::codes::{
     ARC_CENTER_RANGE, ARC_FULL_CIRCLE_BY_RADIUS, ARC_INCONSISTENT, ARC_RADIUS_RANGE, MAX_COORD_MM,
 };
-use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
+use crate::queue::{Move, MoveKind, Plane};
+use crate::vocab::axis::{Position, MAX_AXES};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ArcError {
@@ -277,7 +278,7 @@ impl LimitBreach {
     pub fn message(&self, path: &str) -> String {
         format!(
             "axis {} {path} {} mm, {} software limit (limits {} to {} mm)",
-            char::from(crate::queue::AXIS_LETTERS[self.axis]),
+            char::from(crate::vocab::axis::AXIS_LETTERS[self.axis]),
             self.value_mm,
             if self.below {
                 "below the lower"

@@ -2,7 +2,7 @@
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
 use super::*;
-use crate::report::event::CacheOp;
+use crate::vocab::event::CacheOp;
 
 /// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
 /// before it: applied when the frame stack is back at `depth`.

@@ -21,15 +21,15 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::lang::block::{Block, Body, Call, Command, FlushKind, Item, SplineCommand, Value};
+use crate::lang::block::{Block, Body, Call, Command, Item, SplineCommand, Value};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
-use crate::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
-};
+use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, QueuedBlock};
 use crate::source::cache::Cache;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::source::stream::StreamBuffer;
+use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
+use crate::vocab::flush::FlushKind;
 
 use flow::{goto_text, is_loop_statement, Skip, SkipUntil};
 use frame::{
@@ -181,7 +181,7 @@ pub enum Note {
         found: bool,
     },
     Cache {
-        op: crate::report::event::CacheOp,
+        op: crate::vocab::event::CacheOp,
         file: String,
     },
     /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).

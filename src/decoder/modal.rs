@@ -3,7 +3,8 @@
 
 use crate::lang::block::SplineCommand;
 use crate::lang::dialect::{g_support, Support};
-use crate::queue::{Plane, Position, MAX_AXES};
+use crate::queue::Plane;
+use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Motion G group.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,7 +12,8 @@
 //! the previous block has left, so blends never overlap and no line shrinks to nothing (the
 //! radius, and with it the deviation, shrinks instead).
 
-use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
+use crate::queue::{Move, MoveKind, Plane};
+use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Deviation for G261/G61 before any `#CONTOUR MODE` sets one, mm.
 pub const DEFAULT_PATH_DEV_MM: f64 = 0.05;

@@ -13,7 +13,8 @@
 //! An impossible compensation — the tool radius is not below an arc's radius on the inside,
 //! or two elements too short for their offsets to meet — is error [`TRC_IMPOSSIBLE`].
 
-use crate::queue::{CompSide, Move, MoveKind, Plane, Position};
+use crate::queue::{CompSide, Move, MoveKind, Plane};
+use crate::vocab::axis::Position;
 
 pub use crate::lang::codes::TRC_IMPOSSIBLE;
 /// Below this two points are one, mm.

@@ -1,7 +1,7 @@
 //! The channel's file cache (`#CACHE`, TF5200 File Caching): global subroutines and cycles
 //! held in memory so that calling them no longer touches the file system.
 
-use crate::report::event::CacheOp;
+use crate::vocab::event::CacheOp;
 use thiserror::Error;
 
 use super::store::{ProgramKind, ProgramStore, ProgramText, StoreError};
