@@ -12,6 +12,7 @@ pub mod decoder;
 pub mod diag;
 pub mod dnc;
 pub mod feeder;
+pub mod geometry;
 pub mod lang;
 pub mod machine;
 pub mod motion;

@@ -4,7 +4,8 @@
 use thiserror::Error;
 
 use crate::channel::{Channel, ChannelSettings};
-use crate::decoder::{DecoderSettings, SoftLimits};
+use crate::decoder::DecoderSettings;
+use crate::geometry::SoftLimits;
 use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::runtime::axis_index;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};

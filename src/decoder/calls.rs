@@ -259,14 +259,14 @@ impl Decoder {
                 self.emit(info, Action::None, false, io);
             }
             Command::ContourMode { options } => {
-                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                if let Some(dev) = super::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.emit(info, Action::None, false, io)
             }
             // `ON [...]`: the parameters, then G261; `OFF`: G260.
             Command::ContourSwitch { on, options } => {
-                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                if let Some(dev) = super::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.modal.contouring = *on;

@@ -39,8 +39,8 @@ use crate::queue::{Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, Spl
 use crate::vocab::axis::MAX_AXES;
 use crate::vocab::flush::FlushKind;
 
-use crate::decoder::arc::outside_limits;
-use crate::decoder::SoftLimits;
+use crate::geometry::arc::outside_limits;
+use crate::geometry::SoftLimits;
 use crate::lang::codes;
 
 use super::interpolator::tangent;

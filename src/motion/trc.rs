@@ -462,7 +462,7 @@ fn trim(mut m: Move, start: Option<[f64; 2]>, end: Option<[f64; 2]>) -> Move {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::decoder::arc::{arc_move, ArcSpec};
+    use crate::geometry::arc::{arc_move, ArcSpec};
     use crate::queue::PathMode;
 
     fn p(x: f64, y: f64) -> Position {

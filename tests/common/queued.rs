@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
+use ncchannel::geometry::arc::{arc_move, ArcSpec};
 use ncchannel::queue::{
     Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, QueuedBlock,
 };

@@ -1,7 +1,7 @@
 //! Random motion blocks for the tick-by-tick limit tests: a deterministic generator and
 //! rapids, lines (short and long, in 3-D) and arcs / helices in every plane.
 
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
+use ncchannel::geometry::arc::{arc_move, ArcSpec};
 use ncchannel::queue::{Move, MoveKind, PathMode, Plane};
 use ncchannel::vocab::axis::Position;
 
