@@ -31,9 +31,10 @@ use crate::source::stream::StreamBuffer;
 use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 use crate::vocab::flush::FlushKind;
 
-use flow::{goto_text, is_loop_statement, Skip, SkipUntil};
+use flow::{goto_text, is_loop_statement};
 use frame::{
-    read_file_line, Frame, FrameKind, LineMeta, LineRead, Source, StreamNote, StreamReader,
+    read_file_line, Frame, FrameKind, LineMeta, LineRead, Skip, SkipUntil, Source, StreamNote,
+    StreamReader,
 };
 use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
 use vars::{VarSlot, VarStore};
