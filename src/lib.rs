@@ -1,8 +1,8 @@
 //! ncchannel: an emulated CNC channel of a TwinCAT 3 CNC / ISG kernel.
 //!
 //! Data flows one way through a tick: requests → stream → decoder → planner →
-//! interpolator → events. Each room below owns one machine part; see the
-//! README's architecture section for who may talk to whom.
+//! interpolator → events. Each room below owns one machine part; `vocab` is the floor of
+//! words they share. See the README's architecture section for who may import whom.
 
 pub mod ads;
 pub mod bounded;
