@@ -16,9 +16,9 @@ use std::time::Instant;
 use criterion::{criterion_group, criterion_main, Criterion};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, Position, QueuedBlock,
-    SplineKind,
+    Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, QueuedBlock, SplineKind,
 };
+use ncchannel::vocab::axis::Position;
 
 const DT: f64 = 0.001;
 const WINDOW: usize = 32;

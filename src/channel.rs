@@ -12,12 +12,13 @@ use thiserror::Error;
 use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note, SearchTarget};
 use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use crate::queue::{Action, BlockQueue, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES};
+use crate::queue::{Action, BlockQueue, QueuedBlock};
 use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
 use crate::source::store::{FsLatency, ProgramStore, SearchDir, StoreStats};
 use crate::source::stream::{StreamBuffer, StreamWriteError};
+use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 
 /// Errors kept for the report (`ChannelStats::errors` counts all of them).
 pub const MAX_LISTED_ERRORS: usize = 256;
@@ -36,7 +37,7 @@ pub struct ErrorRecord {
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
 use crate::machine::{HmiOp, Op, Reply};
-pub use crate::mode::{Mode, State};
+pub use crate::vocab::mode::{Mode, State};
 
 /// Why a command was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -762,7 +763,7 @@ impl Channel {
         if !matches!(last.action, Action::Flush(_) | Action::End { .. }) {
             self.single_gate.push(QueuedBlock {
                 info: last.info,
-                action: Action::Flush(crate::lang::block::FlushKind::Stop),
+                action: Action::Flush(crate::vocab::flush::FlushKind::Stop),
                 silent: true,
             });
             self.single_flushes += 1;
@@ -916,7 +917,7 @@ impl Channel {
                         );
                     }
                 }
-                MotionNote::Flush(crate::lang::block::FlushKind::Stop)
+                MotionNote::Flush(crate::vocab::flush::FlushKind::Stop)
                     if self.single_flushes > 0 =>
                 {
                     // The flush feed_single_block added: no program event.

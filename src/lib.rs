@@ -1,8 +1,8 @@
 //! ncchannel: an emulated CNC channel of a TwinCAT 3 CNC / ISG kernel.
 //!
 //! Data flows one way through a tick: requests → stream → decoder → planner →
-//! interpolator → events. Each room below owns one machine part; see the
-//! README's architecture section for who may talk to whom.
+//! interpolator → events. Each room below owns one machine part; `vocab` is the floor of
+//! words they share. See the README's architecture section for who may import whom.
 
 pub mod ads;
 pub mod bounded;
@@ -12,9 +12,9 @@ pub mod decoder;
 pub mod diag;
 pub mod dnc;
 pub mod feeder;
+pub mod geometry;
 pub mod lang;
 pub mod machine;
-pub mod mode;
 pub mod motion;
 pub mod params;
 pub mod queue;
@@ -23,4 +23,4 @@ pub mod runtime;
 pub mod setup;
 pub mod soak;
 pub mod source;
-pub mod tick;
+pub mod vocab;

@@ -7,14 +7,8 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use crate::lang::block::FlushKind;
-
-/// Axes the emulator knows, in this order. Configured axes are a subset.
-pub const AXIS_LETTERS: [u8; MAX_AXES] = *b"XYZABC";
-pub const MAX_AXES: usize = 6;
-
-/// Axis positions: mm for linear axes X Y Z, degrees for rotary axes A B C.
-pub type Position = [f64; MAX_AXES];
+use crate::vocab::axis::{Position, MAX_AXES};
+use crate::vocab::flush::FlushKind;
 
 /// Where a block came from, carried to the `block` event emitted when it takes effect.
 #[derive(Debug, Clone, PartialEq)]

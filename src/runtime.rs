@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
-use crate::report::stats::{CycleStats, Histogram};
-pub use crate::tick::Tick;
+use crate::vocab::stats::{CycleStats, Histogram};
+pub use crate::vocab::tick::Tick;
 
 /// Requests served per tick at most. A flood of requests (say a client hammering the stream
 /// object from many connections) then delays its own answers, never the tick: the rest wait

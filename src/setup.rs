@@ -4,13 +4,14 @@
 use thiserror::Error;
 
 use crate::channel::{Channel, ChannelSettings};
-use crate::decoder::{DecoderSettings, SoftLimits};
+use crate::decoder::DecoderSettings;
+use crate::geometry::SoftLimits;
 use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::runtime::axis_index;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
-use crate::queue::MAX_AXES;
 use crate::source::cache::CacheLimits;
 use crate::source::store::{FsLatency, SearchDir, PATH_MAIN, PATH_SUB};
+use crate::vocab::axis::MAX_AXES;
 
 #[derive(Debug, Error)]
 pub enum SetupError {

@@ -13,7 +13,8 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame};
+use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, CommandId, Frame};
+use ncchannel::vocab::ams::AmsNetId;
 
 mod abuse_common;
 mod ads_common;
@@ -264,7 +265,7 @@ fn served_again(srv: &Serve, within: Duration) -> bool {
 fn connections_beyond_the_limit_are_refused_and_the_served_ones_are_undisturbed() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();
-    let limit = ncchannel::ads::server::DEFAULT_MAX_CONNECTIONS;
+    let limit = ncchannel::vocab::ams::DEFAULT_MAX_CONNECTIONS;
     let mut held: Vec<Conn> = (0..limit).map(|_| srv.connect()).collect();
     for (i, c) in held.iter_mut().enumerate() {
         assert!(
@@ -464,7 +465,7 @@ fn thousands_of_notification_requests_meet_the_whole_server_budget() {
     });
     let ok: usize = results.iter().map(|r| r.0).sum();
     let full: usize = results.iter().map(|r| r.1).sum();
-    let budget = ncchannel::ads::server::DEFAULT_NOTIFICATION_SAMPLES_PER_S as usize / 100;
+    let budget = ncchannel::vocab::ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S as usize / 100;
     println!(
         "ABUSE notification flood: {} requests over {connections} connections: {ok} handles granted, {full} answered 0x716",
         connections * per_connection
@@ -506,7 +507,7 @@ fn thousands_of_notification_requests_meet_the_whole_server_budget() {
 fn idle_connections_are_closed_after_the_idle_timeout() {
     let srv = Serve::start(&["--ads-idle-timeout", "2"]);
     let rss = srv.rss_kib();
-    let limit = ncchannel::ads::server::DEFAULT_MAX_CONNECTIONS;
+    let limit = ncchannel::vocab::ams::DEFAULT_MAX_CONNECTIONS;
     let started = Instant::now();
     let mut silent: Vec<Conn> = (0..limit).map(|_| srv.connect()).collect();
     // All slots held: a newcomer is refused ...

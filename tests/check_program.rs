@@ -5,6 +5,7 @@ use std::path::Path;
 use std::process::Command as Process;
 
 use ncchannel::lang::*;
+use ncchannel::vocab::flush::FlushKind;
 
 fn codes(text: &str) -> Vec<(usize, usize, u32)> {
     check_program(text)

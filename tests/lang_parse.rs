@@ -1,6 +1,7 @@
 //! The block parser against the TF5200 programming manual's syntax: every construct, its canonical text and its errors.
 
 use ncchannel::lang::*;
+use ncchannel::vocab::flush::FlushKind;
 
 fn p(line: &str) -> Block {
     parse_block(line).unwrap_or_else(|e| panic!("{line:?}: {e}"))

@@ -4,6 +4,7 @@
 use ncchannel::lang::codes::{KNOWN_G, WORD_LETTERS};
 use ncchannel::lang::expr::FUNCS;
 use ncchannel::lang::*;
+use ncchannel::vocab::flush::FlushKind;
 use proptest::prelude::*;
 
 fn num() -> impl Strategy<Value = f64> {

@@ -7,11 +7,12 @@ use common::queued::block;
 use common::random_path::{self, Rng};
 
 use common::limit_check::{LimitCheck, DEFAULT_EPS};
-use ncchannel::decoder::arc::{ArcError, ArcSpec};
-use ncchannel::lang::block::FlushKind;
+use ncchannel::geometry::arc::{ArcError, ArcSpec};
 use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane, Position};
+use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane};
+use ncchannel::vocab::axis::Position;
+use ncchannel::vocab::flush::FlushKind;
 
 /// The positional form reads best in these tables of cases.
 #[allow(clippy::too_many_arguments)]
@@ -25,7 +26,7 @@ fn arc_move(
     feed: f64,
     tol: f64,
 ) -> Result<Move, ArcError> {
-    ncchannel::decoder::arc::arc_move(
+    ncchannel::geometry::arc::arc_move(
         &ArcSpec {
             plane,
             ijk,

@@ -9,9 +9,8 @@ use common::random_path::{self, Rng};
 
 use common::limit_check::{LimitCheck, FILTERED_EPS};
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{
-    Action, BlockQueue, CompSide, Move, MoveKind, PathMode, Position, SplineKind,
-};
+use ncchannel::queue::{Action, BlockQueue, CompSide, Move, MoveKind, PathMode, SplineKind};
+use ncchannel::vocab::axis::Position;
 
 const DT: f64 = 0.001;
 

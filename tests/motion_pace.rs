@@ -8,9 +8,10 @@ use std::path::Path;
 mod common;
 use common::limit_check::{LimitCheck, DEFAULT_EPS};
 use common::queued::{block, r50_circle};
-use ncchannel::motion::contour::DEFAULT_PATH_DEV_MM;
+use ncchannel::decoder::modal::DEFAULT_PATH_DEV_MM;
 use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Position};
+use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode};
+use ncchannel::vocab::axis::Position;
 
 const DT: f64 = 0.001;
 

@@ -4,14 +4,15 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use ncchannel::lang::block::FlushKind;
-use ncchannel::mode::{Mode, State};
-use ncchannel::report::event::{CacheOp, Event, EventKind, EventLog, ProgramEndKind};
-use ncchannel::report::stats::CycleStats;
+use ncchannel::report::event::{Event, EventKind, EventLog, ProgramEndKind};
 use ncchannel::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
 };
 use ncchannel::runtime::{Clock, RunEnd, Runtime, Tick};
+use ncchannel::vocab::event::CacheOp;
+use ncchannel::vocab::flush::FlushKind;
+use ncchannel::vocab::mode::{Mode, State};
+use ncchannel::vocab::stats::CycleStats;
 use serde_json::Value;
 
 #[path = "common/streaming_load.rs"]

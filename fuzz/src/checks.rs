@@ -9,12 +9,13 @@ use std::path::Path;
 
 use arbitrary::{Arbitrary, Unstructured};
 
-use ncchannel::ads::frame::{self, Frame, DEFAULT_MAX_FRAME_BYTES};
+use ncchannel::ads::frame::{self, Frame};
 use ncchannel::ads::payload;
 use ncchannel::dnc::markers::{Anchor, Markers};
 use ncchannel::dnc::splitter::{ProgramEnd, ProgramSink, ProgramStart, Splitter};
 use ncchannel::lang::{self, VarKey, Vars};
 use ncchannel::source::stream::{StreamBuffer, MAX_PROGRAM_STREAM_SIZE};
+use ncchannel::vocab::ams::DEFAULT_MAX_FRAME_BYTES;
 
 /// Longest NC line the fuzzers hand to the parser: ISG lines are at most 4000 characters, and
 /// a longer one only slows the fuzzer without reaching new code.

@@ -10,10 +10,11 @@ use std::net::{IpAddr, SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
 
 use super::backend::{mode, state};
-use super::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame, FLAGS_REQUEST};
+use super::frame::{self, AmsAddr, AmsHeader, CommandId, Frame, FLAGS_REQUEST};
 use super::objects::{offset, GROUP_CHANNEL, PORT_CNC_COM};
 use super::payload::{self, request};
 use super::result::AdsResult;
+use crate::vocab::ams::{AmsNetId, DEFAULT_MAX_FRAME_BYTES};
 
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
@@ -120,7 +121,7 @@ impl AdsClient {
         self.stream.write_all(&frame::encode(&header, data))?;
         let deadline = Instant::now() + self.timeout;
         loop {
-            if let Some((f, n)) = frame::decode(&self.buf, frame::DEFAULT_MAX_FRAME_BYTES)? {
+            if let Some((f, n)) = frame::decode(&self.buf, DEFAULT_MAX_FRAME_BYTES)? {
                 self.buf.drain(..n);
                 if let Frame::Ams { header: h, data } = f {
                     if h.command == command
@@ -359,7 +360,7 @@ pub fn stream_text(
     };
     let mut last_report = start;
     let mut last_accept = start;
-    let mut rtt = crate::report::stats::Histogram::new();
+    let mut rtt = crate::vocab::stats::Histogram::new();
     for (i, packet) in packets.iter().enumerate() {
         loop {
             let sent = Instant::now();

@@ -43,8 +43,8 @@ pub const MAX_PARAMETER_BYTES: usize = 300;
 const TENTH_UM_PER_MM: f64 = 10_000.0;
 /// µm/s per mm/min: feeds on the wire.
 const UM_PER_S_PER_MM_PER_MIN: f64 = 1000.0 / 60.0;
-/// Axes per channel ncchannel can configure (`queue::MAX_AXES`).
-const MAX_AXES_PER_CHANNEL: u32 = crate::queue::MAX_AXES as u32;
+/// Axes per channel ncchannel can configure (`vocab::axis::MAX_AXES`).
+const MAX_AXES_PER_CHANNEL: u32 = crate::vocab::axis::MAX_AXES as u32;
 
 const SRC_DUMP: &str = "ISG object dump";
 const SRC_TS: &str = "ISG object dump; TwinSharp";

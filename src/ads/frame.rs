@@ -7,14 +7,13 @@
 //! bytes, so a hostile length can never make the server reserve memory.
 
 use std::fmt;
-use std::str::FromStr;
+
+use crate::vocab::ams::AmsNetId;
 
 /// Size of the AMS/TCP header: u16 reserved + u32 length.
 pub const TCP_HEADER_LEN: usize = 6;
 /// Size of the AMS header that follows it.
 pub const AMS_HEADER_LEN: usize = 32;
-/// Default upper bound for the AMS/TCP length field (runtime config `ads.max_frame_bytes`).
-pub const DEFAULT_MAX_FRAME_BYTES: usize = 65_536;
 
 /// State flags of a request (ADS command, TCP transport).
 pub const FLAGS_REQUEST: u16 = 0x0004;
@@ -25,60 +24,6 @@ pub const FLAGS_RESPONSE: u16 = 0x0005;
 pub const AMS_ERR_PORT_NOT_FOUND: u32 = 6;
 /// AMS router-level error in the header: the target machine (NetId) is not this one.
 pub const AMS_ERR_MACHINE_NOT_FOUND: u32 = 7;
-
-/// A six-byte AMS network id, written `a.b.c.d.e.f`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord, serde::Deserialize)]
-#[serde(try_from = "String")]
-pub struct AmsNetId(pub [u8; 6]);
-
-impl TryFrom<String> for AmsNetId {
-    type Error = NetIdParseError;
-    fn try_from(s: String) -> Result<Self, Self::Error> {
-        s.parse()
-    }
-}
-
-impl AmsNetId {
-    /// The local NetId clients use when they talk to "this machine".
-    pub const LOCAL: AmsNetId = AmsNetId([127, 0, 0, 1, 1, 1]);
-}
-
-impl fmt::Display for AmsNetId {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let [a, b, c, d, e, g] = self.0;
-        write!(f, "{a}.{b}.{c}.{d}.{e}.{g}")
-    }
-}
-
-/// Why a NetId string did not parse.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("invalid AMS NetId {text:?}: expected six numbers 0-255 separated by dots (a.b.c.d.e.f)")]
-pub struct NetIdParseError {
-    pub text: String,
-}
-
-impl FromStr for AmsNetId {
-    type Err = NetIdParseError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let err = || NetIdParseError {
-            text: s.to_string(),
-        };
-        let mut out = [0u8; 6];
-        let mut parts = s.split('.');
-        for byte in out.iter_mut() {
-            let part = parts.next().ok_or_else(err)?;
-            if part.is_empty() || part.len() > 3 || !part.bytes().all(|b| b.is_ascii_digit()) {
-                return Err(err());
-            }
-            *byte = part.parse().map_err(|_| err())?;
-        }
-        if parts.next().is_some() {
-            return Err(err());
-        }
-        Ok(AmsNetId(out))
-    }
-}
 
 /// An AMS address: NetId plus AMS port (553 is the CNC's COM task).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -297,24 +242,6 @@ mod tests {
             state_flags: FLAGS_REQUEST,
             error: 0,
             invoke_id: 0xDEAD_BEEF,
-        }
-    }
-
-    #[test]
-    fn net_id_round_trips_and_rejects_garbage() {
-        let id: AmsNetId = "192.168.0.10.1.1".parse().unwrap();
-        assert_eq!(id.0, [192, 168, 0, 10, 1, 1]);
-        assert_eq!(id.to_string(), "192.168.0.10.1.1");
-        for bad in [
-            "1.2.3.4.5",
-            "1.2.3.4.5.6.7",
-            "1.2.3.4.5.256",
-            "1..3.4.5.6",
-            "a.b.c.d.e.f",
-            "",
-            "1.2.3.4.5.+6",
-        ] {
-            assert!(bad.parse::<AmsNetId>().is_err(), "{bad:?} parsed");
         }
     }
 

@@ -17,12 +17,11 @@ pub mod memory;
 pub mod objects;
 pub mod payload;
 pub mod result;
-pub mod route;
 pub mod sda;
 pub mod server;
 
+pub use crate::vocab::ams::{AmsNetId, RouteEntry};
 pub use backend::{CncBackend, DeviceError, StreamFill, StreamWriteOutcome};
-pub use frame::{AmsAddr, AmsNetId};
+pub use frame::AmsAddr;
 pub use result::AdsResult;
-pub use route::RouteEntry;
 pub use server::{spawn, ServerConfig, ServerHandle};

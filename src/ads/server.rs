@@ -18,28 +18,18 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use super::backend::CncBackend;
 use super::frame::{
-    self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame, AMS_ERR_MACHINE_NOT_FOUND,
-    AMS_ERR_PORT_NOT_FOUND, FLAGS_REQUEST,
+    self, AmsAddr, AmsHeader, CommandId, Frame, AMS_ERR_MACHINE_NOT_FOUND, AMS_ERR_PORT_NOT_FOUND,
+    FLAGS_REQUEST,
 };
 use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
-use super::route::RouteEntry;
+use crate::vocab::ams::{
+    AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
+    DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
+    DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+};
 
-/// Default bind address: loopback only, the standard ADS/TCP port.
-pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), 48898);
-/// Default bound on simultaneous connections.
-pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
-/// Default bound on notification handles per connection.
-pub const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
-/// Default bound on notification handles over the whole server.
-pub const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
-/// Default budget of notification samples per second over the whole server. Each sample is a
-/// read served by the runtime; 10 000/s is 10 reads a tick at 1 ms, well inside
-/// `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never cost the cycle its period.
-pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 = 10_000;
-/// Default idle timeout (see [`ServerConfig::idle_timeout`]).
-pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
 /// Default bound on the bytes waiting in one connection's send queue.
 pub const DEFAULT_MAX_SEND_QUEUE_BYTES: usize = 1 << 20;
 /// A write to a client that takes longer than this (its receive window stays shut) ends
@@ -92,7 +82,7 @@ impl Default for ServerConfig {
             bind: DEFAULT_BIND,
             allow_non_loopback: false,
             net_id: None,
-            max_frame_bytes: frame::DEFAULT_MAX_FRAME_BYTES,
+            max_frame_bytes: DEFAULT_MAX_FRAME_BYTES,
             max_connections: DEFAULT_MAX_CONNECTIONS,
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
             max_notifications_total: DEFAULT_MAX_NOTIFICATIONS_TOTAL,

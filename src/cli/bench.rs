@@ -11,9 +11,9 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use super::out::Stdout;
-use crate::report::stats::Histogram;
 use crate::runtime::{bare_loop, Clock, Runtime};
 use crate::soak::load::streaming_channels;
+use crate::vocab::stats::Histogram;
 
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {

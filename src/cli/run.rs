@@ -374,7 +374,7 @@ fn build_report(
     outcome: Outcome,
     (ticks, time_s): (u64, f64),
     summary: Option<&crate::runtime::RunSummary>,
-    stats: &crate::report::stats::CycleStats,
+    stats: &crate::vocab::stats::CycleStats,
     period: Duration,
 ) -> Report {
     let c = &machine.channels()[args.channel as usize - 1];

@@ -9,8 +9,9 @@ use crate::ads::client::{self, AdsClient, StreamOptions, StreamProgress};
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 use indicatif::ProgressBar;
 
-use crate::ads::frame::{AmsAddr, AmsNetId};
+use crate::ads::frame::AmsAddr;
 use crate::ads::objects::PORT_CNC_COM;
+use crate::vocab::ams::AmsNetId;
 
 #[derive(Debug, clap::Args)]
 pub struct StreamArgs {

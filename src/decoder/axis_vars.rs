@@ -14,7 +14,7 @@ impl Decoder {
     pub(super) fn axis_abs(&self, id: crate::lang::AxisId) -> Option<f64> {
         use crate::lang::AxisId;
         let i = match id {
-            AxisId::Letter(l) => crate::queue::AXIS_LETTERS.iter().position(|&a| a == l)?,
+            AxisId::Letter(l) => AXIS_LETTERS.iter().position(|&a| a == l)?,
             AxisId::Index(n) => usize::try_from(n).ok()?,
         };
         if !*self.settings.axes.get(i)? {

@@ -2,7 +2,7 @@
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
 use super::*;
-use crate::report::event::CacheOp;
+use crate::vocab::event::CacheOp;
 
 /// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
 /// before it: applied when the frame stack is back at `depth`.
@@ -259,14 +259,14 @@ impl Decoder {
                 self.emit(info, Action::None, false, io);
             }
             Command::ContourMode { options } => {
-                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                if let Some(dev) = super::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.emit(info, Action::None, false, io)
             }
             // `ON [...]`: the parameters, then G261; `OFF`: G260.
             Command::ContourSwitch { on, options } => {
-                if let Some(dev) = crate::motion::contour::path_dev_mm(options) {
+                if let Some(dev) = super::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.modal.contouring = *on;

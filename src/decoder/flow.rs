@@ -9,81 +9,12 @@ use std::sync::Arc;
 use crate::lang::block::{Block, Body, Command, Control, GotoTarget, Item, Label, Value};
 use crate::lang::{continuation, is_comment_end, parse_block, Expr, Joiner, VarRef};
 
-use super::frame::{self, LabelIndex, LineMeta, LinePos, Source, MAX_SEEN_LABELS};
-use super::vars::VarSlot;
+use super::frame::{
+    self, FlowEntry, LabelIndex, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS,
+};
 use super::{whole, DecodeError, Decoder, Res};
 use crate::lang::codes;
 use crate::lang::eval::is_true;
-
-/// One open control structure of a frame.
-#[derive(Debug, Clone, PartialEq)]
-pub enum FlowEntry {
-    /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
-    If { taken: bool },
-    /// `$SWITCH`: the value cases compare against.
-    Switch { value: f64 },
-    /// `$FOR var = start, end, step`: the body starts at `body`.
-    For {
-        var: VarSlot,
-        end: f64,
-        step: f64,
-        body: LinePos,
-    },
-    /// `$WHILE`: `head` is the `$WHILE` line itself (the condition is evaluated there).
-    While { head: LinePos },
-    /// `$DO` … `$ENDDO cond`.
-    Do { body: LinePos },
-    /// `$REPEAT` … `$UNTIL cond`.
-    Repeat { body: LinePos },
-}
-
-impl FlowEntry {
-    pub fn is_loop(&self) -> bool {
-        matches!(
-            self,
-            FlowEntry::For { .. }
-                | FlowEntry::While { .. }
-                | FlowEntry::Do { .. }
-                | FlowEntry::Repeat { .. }
-        )
-    }
-}
-
-/// What the skip machine is looking for.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SkipUntil {
-    /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
-    IfBranch,
-    /// A branch has run: the `$ENDIF`.
-    IfEnd,
-    /// `$SWITCH` looking for its case: a matching `$CASE`, `$DEFAULT` or `$ENDSWITCH`.
-    Case,
-    /// After `$BREAK` in a switch: the `$ENDSWITCH`.
-    SwitchEnd,
-    /// A false `$WHILE` or a `$BREAK` in a loop: past the loop's end statement.
-    LoopExit,
-    /// `$CONTINUE`: the loop's end statement, which is then evaluated.
-    LoopContinue,
-    /// A forward `$GOTO` (streams): the line with this label.
-    Label(GotoTarget),
-    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
-    /// next `%name` head when it has none.
-    LocalSubroutine,
-}
-
-/// Skip state: what we look for and how deep inside skipped structures we are.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Skip {
-    pub until: SkipUntil,
-    /// Structures opened inside the skipped region and not yet closed.
-    pub depth: u32,
-}
-
-impl Skip {
-    pub fn new(until: SkipUntil) -> Self {
-        Skip { until, depth: 0 }
-    }
-}
 
 /// How a `$` statement changes nesting, for skipping and for the label index.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

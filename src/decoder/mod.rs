@@ -5,7 +5,6 @@
 //! pulls a new stream segment only when it has decoded the previous one: that is the whole of
 //! the channel's back-pressure.
 
-pub mod arc;
 mod axis_vars;
 mod calls;
 mod cycles;
@@ -21,19 +20,21 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::lang::block::{Block, Body, Call, Command, FlushKind, Item, SplineCommand, Value};
+use crate::geometry::{arc, SoftLimits};
+use crate::lang::block::{Block, Body, Call, Command, Item, SplineCommand, Value};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
-use crate::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, Position, QueuedBlock, AXIS_LETTERS, MAX_AXES,
-};
+use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, QueuedBlock};
 use crate::source::cache::Cache;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::source::stream::StreamBuffer;
+use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
+use crate::vocab::flush::FlushKind;
 
-use flow::{goto_text, is_loop_statement, Skip, SkipUntil};
+use flow::{goto_text, is_loop_statement};
 use frame::{
-    read_file_line, Frame, FrameKind, LineMeta, LineRead, Source, StreamNote, StreamReader,
+    read_file_line, Frame, FrameKind, LineMeta, LineRead, Skip, SkipUntil, Source, StreamNote,
+    StreamReader,
 };
 use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
 use vars::{VarSlot, VarStore};
@@ -63,22 +64,6 @@ pub struct DecoderSettings {
     /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
     /// is reported with it, ncchannel's detail after it in parentheses.
     pub error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
-}
-
-/// One axis's software limits, mm (machine coordinates); unbounded by default.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SoftLimits {
-    pub min_mm: f64,
-    pub max_mm: f64,
-}
-
-impl Default for SoftLimits {
-    fn default() -> Self {
-        SoftLimits {
-            min_mm: f64::NEG_INFINITY,
-            max_mm: f64::INFINITY,
-        }
-    }
 }
 
 /// Values `#VAR` declarations may make in one tick before decoding waits for the next: a
@@ -181,7 +166,7 @@ pub enum Note {
         found: bool,
     },
     Cache {
-        op: crate::report::event::CacheOp,
+        op: crate::vocab::event::CacheOp,
         file: String,
     },
     /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).

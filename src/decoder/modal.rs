@@ -3,7 +3,25 @@
 
 use crate::lang::block::SplineCommand;
 use crate::lang::dialect::{g_support, Support};
-use crate::queue::{Plane, Position, MAX_AXES};
+use crate::queue::Plane;
+use crate::vocab::axis::{Position, MAX_AXES};
+
+/// Deviation for G261/G61 before any `#CONTOUR MODE` sets one, mm.
+pub const DEFAULT_PATH_DEV_MM: f64 = 0.05;
+
+/// `PATH_DEV=<mm>` from the bracket text of `#CONTOUR MODE [...]`, if it has a valid one.
+pub fn path_dev_mm(options: &str) -> Option<f64> {
+    options
+        .split(|c: char| c.is_whitespace() || c == '[' || c == ']' || c == ',')
+        .filter_map(|w| {
+            let (k, v) = w.split_once('=')?;
+            k.trim()
+                .eq_ignore_ascii_case("PATH_DEV")
+                .then(|| v.trim().parse::<f64>().ok())
+                .flatten()
+        })
+        .find(|v| v.is_finite() && *v >= 0.0)
+}
 
 /// Motion G group.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,7 +153,7 @@ impl Modal {
             zero_offset: 0,
             radius_comp: RadiusComp::Off,
             contouring: false,
-            contour_dev_mm: crate::motion::contour::DEFAULT_PATH_DEV_MM,
+            contour_dev_mm: DEFAULT_PATH_DEV_MM,
             spline: false,
             spline_type: SplineCommand::TypeAkima,
             hsc: false,
@@ -262,3 +280,15 @@ pub fn apply_m(m: &mut Modal, code: u32) {
 
 /// Zero-offset table: G54..G59 → offset per axis (mm / degrees).
 pub type ZeroOffsets = [[f64; MAX_AXES]; 6];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn path_dev_comes_from_the_bracket() {
+        assert_eq!(path_dev_mm("[DEV PATH_DEV=0.02 CONST_VEL=1]"), Some(0.02));
+        assert_eq!(path_dev_mm("[DIST RELEASE_DIST=1]"), None);
+        assert_eq!(path_dev_mm("[DEV PATH_DEV=x]"), None);
+    }
+}

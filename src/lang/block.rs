@@ -5,6 +5,8 @@
 //! character columns into the line, kept so that errors found later (an unknown label,
 //! an undefined parameter) can still point at the right place.
 
+use crate::vocab::flush::FlushKind;
+
 /// A parsed NC line.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Block {
@@ -356,19 +358,6 @@ impl Message {
     pub fn save(&self) -> bool {
         self.options.first() == Some(&"SAVE")
     }
-}
-
-/// `#FLUSH` variants; in the event log `plain`, `continue`, `wait`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FlushKind {
-    /// `#FLUSH`: release all held blocks, stop at the end of the last.
-    #[serde(rename = "plain")]
-    Stop,
-    /// `#FLUSH CONTINUE`: release all, no stop if the next block comes in time.
-    Continue,
-    /// `#FLUSH WAIT`: decoding waits until interpolation has emptied the channel.
-    Wait,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

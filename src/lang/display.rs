@@ -15,9 +15,10 @@
 use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
-    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget,
-    Index, Item, Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Index, Item,
+    Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
+use crate::vocab::flush::FlushKind;
 
 impl Display for Block {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Item, Label,
-    SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
+    Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Item, Label, SplineCommand,
+    VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -23,6 +23,7 @@ use super::error::SyntaxError;
 use super::expr::{fail, keyword, name_or, name_upper, perr, uint, ws, Ctx, PErr, PResult};
 use super::number::{scan_unsigned, TOO_LARGE};
 use super::range::word_value;
+use crate::vocab::flush::FlushKind;
 
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
 /// line, or more than 4000 characters, is error 20200.
@@ -379,7 +380,7 @@ fn is_dwell(it: &Item) -> bool {
 /// for the rest.
 fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
     let l = letter as char;
-    if crate::queue::AXIS_LETTERS.contains(&letter) {
+    if crate::vocab::axis::AXIS_LETTERS.contains(&letter) {
         perr(
             at,
             AXIS_TWICE,

@@ -12,28 +12,13 @@
 //! the previous block has left, so blends never overlap and no line shrinks to nothing (the
 //! radius, and with it the deviation, shrinks instead).
 
-use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
+use crate::queue::{Move, MoveKind, Plane};
+use crate::vocab::axis::{Position, MAX_AXES};
 
-/// Deviation for G261/G61 before any `#CONTOUR MODE` sets one, mm.
-pub const DEFAULT_PATH_DEV_MM: f64 = 0.05;
 /// Corners turning less than this are left alone (collinear within rounding), rad.
 const MIN_TURN_RAD: f64 = 1e-7;
 /// Corners turning more than π minus this (a reversal) are left sharp, rad.
 const MAX_TURN_MARGIN_RAD: f64 = 1e-3;
-
-/// `PATH_DEV=<mm>` from the bracket text of `#CONTOUR MODE [...]`, if it has a valid one.
-pub fn path_dev_mm(options: &str) -> Option<f64> {
-    options
-        .split(|c: char| c.is_whitespace() || c == '[' || c == ']' || c == ',')
-        .filter_map(|w| {
-            let (k, v) = w.split_once('=')?;
-            k.trim()
-                .eq_ignore_ascii_case("PATH_DEV")
-                .then(|| v.trim().parse::<f64>().ok())
-                .flatten()
-        })
-        .find(|v| v.is_finite() && *v >= 0.0)
-}
 
 /// The blend of the corner between lines `prev` (ending at the corner) and `next` (starting
 /// there), or `None` when the corner stays sharp (not two lines, not in one of the planes
@@ -149,12 +134,5 @@ mod tests {
         };
         assert!(!cw);
         assert!((radius_mm - 0.05 / (2f64.sqrt() - 1.0)).abs() < 1e-12);
-    }
-
-    #[test]
-    fn path_dev_comes_from_the_bracket() {
-        assert_eq!(path_dev_mm("[DEV PATH_DEV=0.02 CONST_VEL=1]"), Some(0.02));
-        assert_eq!(path_dev_mm("[DIST RELEASE_DIST=1]"), None);
-        assert_eq!(path_dev_mm("[DEV PATH_DEV=x]"), None);
     }
 }

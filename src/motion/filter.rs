@@ -16,7 +16,7 @@
 //! per turn of the window, so nothing drifts; once the window holds one position only, the
 //! output is that position exactly, so programmed end points are reached exactly.
 
-use crate::queue::{Position, MAX_AXES};
+use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Longest window, ticks (bounds memory and tick work whatever the limits say).
 pub const MAX_WINDOW_TICKS: usize = 4096;

@@ -7,7 +7,8 @@
 //! to the next block, so block end times are exact and a square at F1000 reaches its corners
 //! when the trapezoid says. Time is whatever the caller passes; no clock is read here.
 
-use crate::queue::{Move, Position, MAX_AXES};
+use crate::queue::Move;
+use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Below this a remaining length counts as the block end, mm.
 pub const END_EPS_MM: f64 = 1e-9;

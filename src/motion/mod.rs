@@ -18,8 +18,9 @@ pub mod trc;
 
 use std::sync::Arc;
 
-use crate::lang::block::FlushKind;
-use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind, Position, MAX_AXES};
+use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind};
+use crate::vocab::axis::{Position, MAX_AXES};
+use crate::vocab::flush::FlushKind;
 
 use filter::{jerk_window_s, AxisFilter};
 use interpolator::{advance, advance_swing, point_at, Profile, Swing};
@@ -30,7 +31,7 @@ use trace::{CsvTrace, Sample, Trace};
 /// Limits of one axis (runtime.toml `[[axes]]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AxisLimits {
-    /// Index into `queue::AXIS_LETTERS`.
+    /// Index into `vocab::axis::AXIS_LETTERS`.
     pub index: usize,
     /// Maximum velocity, mm/min.
     pub max_velocity_mm_per_min: f64,

@@ -35,13 +35,12 @@
 
 use std::collections::VecDeque;
 
-use crate::lang::block::FlushKind;
-use crate::queue::{
-    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, MAX_AXES,
-};
+use crate::queue::{Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind};
+use crate::vocab::axis::MAX_AXES;
+use crate::vocab::flush::FlushKind;
 
-use crate::decoder::arc::outside_limits;
-use crate::decoder::SoftLimits;
+use crate::geometry::arc::outside_limits;
+use crate::geometry::SoftLimits;
 use crate::lang::codes;
 
 use super::interpolator::tangent;

@@ -18,7 +18,8 @@
 
 use std::collections::VecDeque;
 
-use crate::queue::{Move, MoveKind, PathMode, Position, SplineKind, MAX_AXES};
+use crate::queue::{Move, MoveKind, PathMode, SplineKind};
+use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Longest piece a curve segment is cut into, mm.
 pub const MAX_PIECE_MM: f64 = 0.02;

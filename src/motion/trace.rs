@@ -1,7 +1,8 @@
 //! Trace: per-tick samples of position and path velocity kept for `--plot`, decimated so a long
 //! run never holds more than a fixed number of points.
 
-use crate::queue::{Plane, Position};
+use crate::queue::Plane;
+use crate::vocab::axis::Position;
 
 /// One recorded tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -135,7 +136,7 @@ impl CsvTrace {
             let unit = if i < 3 { "mm" } else { "deg" };
             header.push_str(&format!(
                 ",{}_{unit}",
-                crate::queue::AXIS_LETTERS[i] as char
+                crate::vocab::axis::AXIS_LETTERS[i] as char
             ));
         }
         header.push_str(",velocity_mm_per_s,acceleration_mm_per_s2,jerk_mm_per_s3");

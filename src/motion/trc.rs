@@ -13,7 +13,8 @@
 //! An impossible compensation — the tool radius is not below an arc's radius on the inside,
 //! or two elements too short for their offsets to meet — is error [`TRC_IMPOSSIBLE`].
 
-use crate::queue::{CompSide, Move, MoveKind, Plane, Position};
+use crate::queue::{CompSide, Move, MoveKind, Plane};
+use crate::vocab::axis::Position;
 
 pub use crate::lang::codes::TRC_IMPOSSIBLE;
 /// Below this two points are one, mm.
@@ -461,7 +462,7 @@ fn trim(mut m: Move, start: Option<[f64; 2]>, end: Option<[f64; 2]>) -> Move {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::decoder::arc::{arc_move, ArcSpec};
+    use crate::geometry::arc::{arc_move, ArcSpec};
     use crate::queue::PathMode;
 
     fn p(x: f64, y: f64) -> Position {

@@ -28,7 +28,7 @@ use super::list::{Entry, ParamList, ValueKind};
 use super::runtime::{axis_index, AxisConfig, AxisKind, RuntimeConfig};
 use super::value::{number_value, unresolved};
 use crate::diag::{Diagnostic, Severity};
-use crate::queue::MAX_AXES;
+use crate::vocab::axis::MAX_AXES;
 
 /// mm (or °) per kernel position unit: 0.1 µm (P-AXIS-00178: 0.1 µm, 0.0001 °).
 pub const MM_PER_POSITION_UNIT: f64 = 1e-4;

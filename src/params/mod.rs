@@ -22,5 +22,5 @@ pub use config::{check_list_file, load, ChannelConfig, Config, RUNTIME_FILE};
 pub use decoder::{CacheSettings, DecoderSettings, FCT_USE_CACHED_FILES};
 pub use error::ParamError;
 pub use list::{Entry, ParamList, Value, ValueKind};
-pub use runtime::{AdsConfig, AmsNetId, AxisConfig, AxisKind, RouteEntry, RuntimeConfig};
+pub use runtime::{AdsConfig, AxisConfig, AxisKind, RuntimeConfig};
 pub use search_path::{SearchPath, MAIN_PROGRAMS, SUBROUTINES};

@@ -8,10 +8,12 @@ use std::path::Path;
 use serde::Deserialize;
 
 use crate::diag::Diagnostic;
+// NetIds and route entries are the floor's, shared with the ADS server: one parser, one meaning.
+use crate::vocab::ams::{AmsNetId, RouteEntry};
+use crate::vocab::axis::{AXIS_LETTERS, MAX_AXES};
 
 /// Largest runtime.toml we read; the real one is a few KiB.
 pub const MAX_RUNTIME_BYTES: u64 = 1024 * 1024;
-use crate::queue::{AXIS_LETTERS, MAX_AXES};
 
 /// The emulator's own settings.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -201,19 +203,20 @@ pub struct AdsConfig {
 }
 
 impl Default for AdsConfig {
-    /// The ADS server's own defaults (`ads::server`), so each limit has one number.
+    /// The ADS server's own defaults (`vocab::ams`, which `ads::server` uses too), so each
+    /// limit has one number.
     fn default() -> Self {
-        use crate::ads::server as srv;
+        use crate::vocab::ams;
         AdsConfig {
-            bind: SocketAddrText(srv::DEFAULT_BIND),
+            bind: SocketAddrText(ams::DEFAULT_BIND),
             net_id: AmsNetId([127, 0, 0, 1, 1, 1]),
-            max_frame_bytes: crate::ads::frame::DEFAULT_MAX_FRAME_BYTES as u32,
+            max_frame_bytes: ams::DEFAULT_MAX_FRAME_BYTES as u32,
             allowed_clients: Vec::new(),
-            max_connections: srv::DEFAULT_MAX_CONNECTIONS as u32,
-            max_notifications_per_connection: srv::DEFAULT_MAX_NOTIFICATIONS as u32,
-            max_notifications_total: srv::DEFAULT_MAX_NOTIFICATIONS_TOTAL as u32,
-            notification_samples_per_s: srv::DEFAULT_NOTIFICATION_SAMPLES_PER_S as u32,
-            idle_timeout_s: srv::DEFAULT_IDLE_TIMEOUT.as_secs() as u32,
+            max_connections: ams::DEFAULT_MAX_CONNECTIONS as u32,
+            max_notifications_per_connection: ams::DEFAULT_MAX_NOTIFICATIONS as u32,
+            max_notifications_total: ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL as u32,
+            notification_samples_per_s: ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S as u32,
+            idle_timeout_s: ams::DEFAULT_IDLE_TIMEOUT.as_secs() as u32,
         }
     }
 }
@@ -231,10 +234,6 @@ impl TryFrom<String> for SocketAddrText {
             .map_err(|_| format!("`{s}` is not an address:port such as 127.0.0.1:48898"))
     }
 }
-
-/// NetIds and route entries are the ADS room's types: one parser, one meaning.
-pub use crate::ads::frame::AmsNetId;
-pub use crate::ads::route::RouteEntry;
 
 /// Parse and check runtime.toml text. Errors name the key (`ads.net_id`, `axes[1].name`).
 pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {

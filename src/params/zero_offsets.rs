@@ -12,7 +12,7 @@ use super::catalog::{ListKind, ListSummary, Tally};
 use super::list::{read_list, Entry, ParamList, ValueKind};
 use super::startup::{shape, warn_duplicates};
 use crate::diag::Diagnostic;
-use crate::queue::MAX_AXES;
+use crate::vocab::axis::MAX_AXES;
 
 /// Zero-offset groups the emulator selects: G54 … G59.
 pub const GROUPS: usize = 6;

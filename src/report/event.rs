@@ -22,9 +22,10 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
-use crate::lang::block::FlushKind;
-use crate::mode::{Mode, State};
-use crate::tick::Tick;
+use crate::vocab::event::CacheOp;
+use crate::vocab::flush::FlushKind;
+use crate::vocab::mode::{Mode, State};
+use crate::vocab::tick::Tick;
 
 /// One event: when, where, what. Serialises as `{"tick":…,"t":…,"ch":…,"ev":"…",…fields}`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -160,22 +161,6 @@ impl ProgramEndKind {
             ProgramEndKind::M30
         }
     }
-}
-
-/// A file cache operation (TF5200 File Caching; `op` of `cache`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CacheOp {
-    /// `#CACHE LOAD` of a file not yet cached.
-    Load,
-    /// `#CACHE LOAD` of a cached file that changed on disk.
-    Refresh,
-    /// `#CACHE CLEAR`.
-    Clear,
-    /// `#CACHE CLEAR ALL`.
-    ClearAll,
-    /// A subroutine call served from the cache.
-    Hit,
 }
 
 impl Event {

@@ -3,5 +3,4 @@
 pub mod event;
 pub mod plot;
 pub mod progress;
-pub mod stats;
 pub mod summary;

@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::motion::trace::{Sample, Trace};
-use crate::queue::AXIS_LETTERS;
+use crate::vocab::axis::AXIS_LETTERS;
 
 const WIDTH: u32 = 1400;
 const HEIGHT: u32 = 900;

@@ -7,8 +7,8 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 
-use crate::report::stats::CycleStats;
 use crate::source::stream::StreamCounters;
+use crate::vocab::stats::CycleStats;
 
 /// How the run ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

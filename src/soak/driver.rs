@@ -247,7 +247,7 @@ impl Cycle for SoakCycle {
             let p = slot.channel.position();
             for &(i, lo, hi) in &slot.limits {
                 if !(lo - 1e-9..=hi + 1e-9).contains(&p[i]) {
-                    let (v, axis) = (p[i], crate::queue::AXIS_LETTERS[i] as char);
+                    let (v, axis) = (p[i], crate::vocab::axis::AXIS_LETTERS[i] as char);
                     self.tallies.limits.violate(|| {
                         format!(
                             "channel {number}, tick {t}: {axis} = {v:.4} mm outside [{lo}, {hi}]"

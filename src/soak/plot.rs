@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use plotters::prelude::*;
 
-use crate::report::stats::Histogram;
+use crate::vocab::stats::Histogram;
 
 const WIDTH: u32 = 900;
 const HEIGHT: u32 = 480;

@@ -6,7 +6,7 @@ use std::io::{self, Write};
 use serde::Serialize;
 
 use super::invariants::Verdict;
-use crate::report::stats::{CycleStats, Histogram};
+use crate::vocab::stats::{CycleStats, Histogram};
 
 /// Percentiles of one histogram, µs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]

@@ -1,10 +1,10 @@
 //! The channel's file cache (`#CACHE`, TF5200 File Caching): global subroutines and cycles
 //! held in memory so that calling them no longer touches the file system.
 
-use crate::report::event::CacheOp;
 use thiserror::Error;
 
 use super::store::{ProgramKind, ProgramStore, ProgramText, StoreError};
+use crate::vocab::event::CacheOp;
 
 /// Cache limits from the lists (P-STUP-00050..52 / P-CHAN-00500..504).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,9 +7,10 @@ use std::net::{SocketAddr, TcpStream};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, AmsNetId, CommandId, Frame};
+use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, CommandId, Frame};
 use ncchannel::ads::memory::{DrainRate, MemoryBackend};
 use ncchannel::ads::{spawn, ServerConfig, ServerHandle};
+use ncchannel::vocab::ams::AmsNetId;
 
 pub const CH1: u32 = 0x20101;
 

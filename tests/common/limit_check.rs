@@ -10,7 +10,7 @@
 //! junction rule bounds only approximately (several corners inside one tick with unequal block
 //! lengths); with it the bounds are exact and ε is rounding.
 
-use ncchannel::queue::{Position, MAX_AXES};
+use ncchannel::vocab::axis::{Position, MAX_AXES};
 
 use ncchannel::motion::AxisLimits;
 
@@ -130,7 +130,7 @@ impl LimitCheck {
                 self.worst_accel[i],
                 self.worst_jerk[i],
             );
-            let letter = ncchannel::queue::AXIS_LETTERS[i] as char;
+            let letter = ncchannel::vocab::axis::AXIS_LETTERS[i] as char;
             if wv.ratio > 1.0 + self.eps {
                 bad.push(format!(
                     "{letter}: velocity {:.6} × limit at tick {}",

@@ -3,10 +3,11 @@
 
 use std::sync::Arc;
 
-use ncchannel::decoder::arc::{arc_move, ArcSpec};
+use ncchannel::geometry::arc::{arc_move, ArcSpec};
 use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, Position, QueuedBlock,
+    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, QueuedBlock,
 };
+use ncchannel::vocab::axis::Position;
 
 /// The event of line `line` of `t.nc`.
 pub fn info(line: u32) -> BlockInfo {

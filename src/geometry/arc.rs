@@ -9,10 +9,12 @@
 
 use std::f64::consts::{PI, TAU};
 
+use super::SoftLimits;
 use crate::lang::codes::{
     ARC_CENTER_RANGE, ARC_FULL_CIRCLE_BY_RADIUS, ARC_INCONSISTENT, ARC_RADIUS_RANGE, MAX_COORD_MM,
 };
-use crate::queue::{Move, MoveKind, Plane, Position, MAX_AXES};
+use crate::queue::{Move, MoveKind, Plane};
+use crate::vocab::axis::{Position, MAX_AXES};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ArcError {
@@ -229,7 +231,7 @@ const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
 /// may return — otherwise such an axis could never move again.
 pub fn outside_limits(
     mv: &Move,
-    limits: &[super::SoftLimits; MAX_AXES],
+    limits: &[SoftLimits; MAX_AXES],
     enabled: &[bool; MAX_AXES],
 ) -> Option<LimitBreach> {
     let (lo, hi) = extent(mv);
@@ -268,7 +270,7 @@ pub struct LimitBreach {
     pub below: bool,
     /// The value is the move's end point (else a point on the way: an arc's extent).
     pub at_end: bool,
-    pub limits: super::SoftLimits,
+    pub limits: SoftLimits,
 }
 
 impl LimitBreach {
@@ -277,7 +279,7 @@ impl LimitBreach {
     pub fn message(&self, path: &str) -> String {
         format!(
             "axis {} {path} {} mm, {} software limit (limits {} to {} mm)",
-            char::from(crate::queue::AXIS_LETTERS[self.axis]),
+            char::from(crate::vocab::axis::AXIS_LETTERS[self.axis]),
             self.value_mm,
             if self.below {
                 "below the lower"

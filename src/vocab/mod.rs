@@ -1,0 +1,11 @@
+//! The ground floor: the words every layer shares — time, modes and states, axes, `#FLUSH`,
+//! cache operations, the ADS endpoint's ids and defaults, cycle statistics. It imports nothing
+//! from the crate but itself; every other room may import it.
+
+pub mod ams;
+pub mod axis;
+pub mod event;
+pub mod flush;
+pub mod mode;
+pub mod stats;
+pub mod tick;
