@@ -92,10 +92,10 @@ fn response_swaps_addresses_byte_for_byte_and_echoes_command_and_invoke_id() {
     );
     assert_eq!(resp.len(), 38 + data_len);
     assert_eq!(u32_at(&resp, 30), 0, "no header error");
-    // result 0, length 8, mode STANDBY (1), state READY (3)
+    // result 0, length 8, mode AUTOMATIC (2), state READY (3)
     assert_eq!(
         &resp[38..],
-        &[0, 0, 0, 0, 8, 0, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0]
+        &[0, 0, 0, 0, 8, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0]
     );
 }
 
@@ -362,10 +362,19 @@ fn stream_object_results_follow_the_buffer() {
         u32_at(&result_of_read(&mut raw, CH1, offset::STREAM_FILL, 8).1, 0),
         0
     );
-    // A line without CR LF: 0x706, channel error 21476, state ERROR.
+    // A line without CR LF: 0x706, channel error 21476, state ERROR; what the buffer held
+    // stays (the channel refuses the packet, it does not empty the buffer).
+    assert_eq!(
+        result_of_write(&mut raw, CH1, offset::STREAM, b"N5\r\n"),
+        0
+    );
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::STREAM, b"N10 X1\n"),
         0x706
+    );
+    assert_eq!(
+        u32_at(&result_of_read(&mut raw, CH1, offset::STREAM_FILL, 8).1, 0),
+        4
     );
     let (_, ms) = result_of_read(&mut raw, CH1, offset::MODE_STATE, 8);
     assert_eq!(u32_at(&ms, 4), 6);
@@ -531,9 +540,15 @@ fn program_start_hold_resume_and_ve_variables() {
     assert_eq!(u32_at(&d, 0), 0x705);
 
     // Streamed lines are executed while ACTIVE: block counter and positions move (12.8 mm
-    // at F6000 take about 0.2 s).
+    // at F6000 take about 0.2 s). `#FLUSH` releases the move from the lookahead window, which
+    // would otherwise wait for more blocks (README, Motion).
     assert_eq!(
-        result_of_write(&mut raw, CH1, offset::STREAM, b"N10 G1 X12.5 Y-3 F6000\r\n"),
+        result_of_write(
+            &mut raw,
+            CH1,
+            offset::STREAM,
+            b"N10 G1 X12.5 Y-3 F6000\r\n#FLUSH\r\n"
+        ),
         0
     );
     let deadline = Instant::now() + Duration::from_secs(10);
@@ -542,8 +557,11 @@ fn program_start_hold_resume_and_ve_variables() {
         let (_, p) = result_of_read(&mut raw, CH1, offset::POSITIONS, 24);
         let x = f64::from_le_bytes(p[0..8].try_into().unwrap());
         let y = f64::from_le_bytes(p[8..16].try_into().unwrap());
-        if (x - 12.5).abs() < 1e-9 && (y + 3.0).abs() < 1e-9 {
-            assert_eq!(u64::from_le_bytes(c[..8].try_into().unwrap()), 1);
+        let blocks = u64::from_le_bytes(c[..8].try_into().unwrap());
+        // The counter is read before the positions: once it counts both blocks (the move and
+        // #FLUSH) and the axes stand at the target, the line was executed exactly once.
+        if blocks >= 2 && (x - 12.5).abs() < 1e-9 && (y + 3.0).abs() < 1e-9 {
+            assert_eq!(blocks, 2);
             break;
         }
         assert!(Instant::now() < deadline, "line never executed: ({x}, {y})");
