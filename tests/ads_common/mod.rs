@@ -5,6 +5,7 @@
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -32,18 +33,15 @@ impl Write for LogBytes {
     }
 }
 
-/// Real channels running behind a backend: each has the streaming program `streaming.nc`,
-/// the default axes X Y Z and programs in `nc/` of a temporary folder; they start in
-/// AUTOMATIC / READY, as the controller does.
-pub struct Channels {
-    pub backend: Arc<dyn CncBackend>,
-    ticking: Option<Ticking>,
-    log: LogBytes,
+/// Parameter lists of `n` channels and their programs in a temporary folder: each channel has
+/// the streaming program `streaming.nc`, the default axes X Y Z, and programs in `nc/`.
+/// Tests may add programs and change the lists before the channels start.
+pub struct Params {
     pub dir: tempfile::TempDir,
 }
 
-impl Channels {
-    pub fn start(n: u16) -> Channels {
+impl Params {
+    pub fn new(n: u16) -> Params {
         let dir = tempfile::tempdir().unwrap();
         let params = dir.path().join("params");
         std::fs::create_dir_all(&params).unwrap();
@@ -62,7 +60,40 @@ impl Channels {
             .unwrap();
         }
         std::fs::write(params.join("startup.lis"), startup).unwrap();
-        let config = ncchannel::params::load(&params.join("startup.lis")).unwrap();
+        Params { dir }
+    }
+
+    /// The start-up list (`params/startup.lis`).
+    pub fn startup(&self) -> PathBuf {
+        self.dir.path().join("params/startup.lis")
+    }
+
+    /// Write program `name` into `nc/`.
+    pub fn program(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.dir.path().join("nc").join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+}
+
+/// Real channels running behind a backend: a `Machine` from [`Params`], ticking in real time
+/// (1 ms, the lists' default) on its own thread; they start in AUTOMATIC / READY, as the
+/// controller does.
+pub struct Channels {
+    pub backend: Arc<dyn CncBackend>,
+    ticking: Option<Ticking>,
+    log: LogBytes,
+    pub params: Params,
+}
+
+impl Channels {
+    /// `n` channels with the lists of [`Params::new`].
+    pub fn start(n: u16) -> Channels {
+        Channels::from_params(Params::new(n))
+    }
+
+    pub fn from_params(params: Params) -> Channels {
+        let config = ncchannel::params::load(&params.startup()).unwrap();
         let channels = ncchannel::setup::channels(&config, true).unwrap();
         let log = LogBytes::default();
         let machine = Machine::new(
@@ -76,7 +107,7 @@ impl Channels {
             backend: Arc::new(backend),
             ticking: Some(ticking),
             log,
-            dir,
+            params,
         }
     }
 
@@ -135,13 +166,36 @@ pub fn block_texts(events: &[Value]) -> Vec<String> {
 
 /// A server on a loopback port over two real channels, with `config` otherwise.
 pub fn server_with(config: ServerConfig) -> (ServerHandle, Channels) {
-    let channels = Channels::start(2);
+    serve(Channels::start(2), config)
+}
+
+/// A server on a loopback port over `channels`, with `config` otherwise.
+pub fn serve(channels: Channels, config: ServerConfig) -> (ServerHandle, Channels) {
     let config = ServerConfig {
         bind: "127.0.0.1:0".parse().unwrap(),
         ..config
     };
     let handle = spawn(config, Arc::clone(&channels.backend)).expect("server starts");
     (handle, channels)
+}
+
+/// The channels of `params` behind a server on a loopback port, as `ncchannel serve` runs them.
+pub struct Served {
+    pub server: ServerHandle,
+    pub channels: Channels,
+}
+
+impl Served {
+    pub fn start(params: Params) -> Served {
+        let (server, channels) = serve(Channels::from_params(params), ServerConfig::default());
+        Served { server, channels }
+    }
+
+    /// Shut the server down, stop the channels and return their event log.
+    pub fn finish(self) -> Vec<Value> {
+        self.server.shutdown();
+        self.channels.events()
+    }
 }
 
 pub fn server() -> (ServerHandle, Channels) {
