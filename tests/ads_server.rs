@@ -364,10 +364,7 @@ fn stream_object_results_follow_the_buffer() {
     );
     // A line without CR LF: 0x706, channel error 21476, state ERROR; what the buffer held
     // stays (the channel refuses the packet, it does not empty the buffer).
-    assert_eq!(
-        result_of_write(&mut raw, CH1, offset::STREAM, b"N5\r\n"),
-        0
-    );
+    assert_eq!(result_of_write(&mut raw, CH1, offset::STREAM, b"N5\r\n"), 0);
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::STREAM, b"N10 X1\n"),
         0x706
@@ -589,7 +586,11 @@ fn notifications_arrive_on_change_and_stop_after_delete() {
     let samples = payload::decode_notification(&nd).unwrap();
     assert_eq!(samples.len(), 1);
     assert_eq!(samples[0].handle, handle);
-    assert_eq!(samples[0].data, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
+    assert_eq!(
+        samples[0].data,
+        [2, 0, 0, 0, 3, 0, 0, 0],
+        "AUTOMATIC / READY"
+    );
 
     // No change, no sample.
     assert!(raw.frame_bytes(Duration::from_millis(50)).is_none());

@@ -20,9 +20,20 @@ fn program(lines: usize) -> String {
     let mut s = String::new();
     for i in 1..lines {
         if i % 50 == 0 {
-            s.push_str(&format!("N{} G01 X{}.{:03} F6000\n", i * 10, i % 3, i % 1000));
+            s.push_str(&format!(
+                "N{} G01 X{}.{:03} F6000\n",
+                i * 10,
+                i % 3,
+                i % 1000
+            ));
         } else {
-            s.push_str(&format!("N{} P{} = {}.{:03}\n", i * 10, 1 + i % 3, i % 97, i % 1000));
+            s.push_str(&format!(
+                "N{} P{} = {}.{:03}\n",
+                i * 10,
+                1 + i % 3,
+                i % 97,
+                i % 1000
+            ));
         }
     }
     s.push_str("M30");
@@ -76,7 +87,11 @@ fn client_streams_a_large_program_through_a_full_buffer() {
     assert!(reports >= 1);
     assert_eq!(channels.status(1).program.as_deref(), Some("streaming.nc"));
     let (blocks, warnings_11012) = executed(channels);
-    assert_eq!(blocks, lines_of(&text), "every line executed once, in order");
+    assert_eq!(
+        blocks,
+        lines_of(&text),
+        "every line executed once, in order"
+    );
     assert!(warnings_11012 as u64 >= p.rejections);
 }
 

@@ -306,9 +306,17 @@ fn group(channel: u16) -> u32 {
 /// (0x105), as a PLC or HMI does.
 pub fn start_program(client: &mut AdsClient, channel: u16, name: &str) -> Result<(), ClientError> {
     let g = group(channel);
-    client.write(g, offset::COMMAND_MODE, &(Mode::Automatic as i32).to_le_bytes())?;
+    client.write(
+        g,
+        offset::COMMAND_MODE,
+        &(Mode::Automatic as i32).to_le_bytes(),
+    )?;
     client.write(g, offset::COMMAND_PROGRAM, name.as_bytes())?;
-    client.write(g, offset::COMMAND_STATE, &(State::Active as i32).to_le_bytes())
+    client.write(
+        g,
+        offset::COMMAND_STATE,
+        &(State::Active as i32).to_le_bytes(),
+    )
 }
 
 /// Whether the channel runs a program (ACTIVE or HOLD), which will drain the stream buffer.

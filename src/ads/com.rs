@@ -735,8 +735,12 @@ fn write_switch(
     data: &[u8],
 ) -> Result<(), AdsResult> {
     match field {
-        Field::SingleBlockCommand => unit(backend.command(ch, Op::Hmi(HmiOp::SingleBlock(bool_arg(data)?)))),
-        Field::OptionalStop => unit(backend.command(ch, Op::Hmi(HmiOp::OptionalStop(bool_arg(data)?)))),
+        Field::SingleBlockCommand => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::SingleBlock(bool_arg(data)?))))
+        }
+        Field::OptionalStop => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::OptionalStop(bool_arg(data)?))))
+        }
         Field::SkipCommand => {
             let mask = uint_arg(data)?;
             if mask & !0x3FF != 0 {
@@ -751,7 +755,9 @@ fn write_switch(
             }
             unit(backend.command(ch, Op::SetOverride(f64::from(tenths) / 10.0)))
         }
-        Field::ExecutionModeCommand => unit(backend.command(ch, Op::Hmi(HmiOp::ExecutionMode(i32_arg(data)?)))),
+        Field::ExecutionModeCommand => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::ExecutionMode(i32_arg(data)?))))
+        }
         _ => Err(AdsResult::ACCESS_DENIED),
     }
 }

@@ -939,7 +939,10 @@ mod tests {
         let sem = handle_of(&hli, &format!("{ms}.command_semaphor_rw"));
         hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1]).unwrap();
         assert_eq!(mode_state(b), (Mode::Automatic, State::Active));
-        assert_eq!(b.status(1).unwrap().program.as_deref(), Some("streaming.nc"));
+        assert_eq!(
+            b.status(1).unwrap().program.as_deref(),
+            Some("streaming.nc")
+        );
         assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [0]);
         let state = handle_of(&hli, &format!("{ms}.state_r.state"));
         assert_eq!(

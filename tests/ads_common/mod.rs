@@ -129,7 +129,10 @@ impl Channels {
             if done(&s) {
                 return s;
             }
-            assert!(Instant::now() < deadline, "not reached within {within:?}: {s:?}");
+            assert!(
+                Instant::now() < deadline,
+                "not reached within {within:?}: {s:?}"
+            );
             std::thread::sleep(Duration::from_millis(1));
         }
     }
@@ -139,7 +142,9 @@ impl Channels {
         let mut m: Machine = self.ticking.take().unwrap().stop().unwrap();
         m.finish_log().unwrap();
         let text = String::from_utf8(self.log.0.lock().unwrap().clone()).unwrap();
-        text.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+        text.lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
     }
 }
 
