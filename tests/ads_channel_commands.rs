@@ -3,7 +3,7 @@
 //! decoder's block-skip mask, block search by N number through `mc_cmd_bs_*` and the execution
 //! mode, and the `mc_active_*` objects following execution.
 
-mod common;
+mod ads_common;
 
 use std::time::{Duration, Instant};
 
@@ -49,7 +49,7 @@ impl Com<'_> {
     }
 }
 
-fn client(served: &common::Served) -> Client {
+fn client(served: &ads_common::Served) -> Client {
     Client::new(
         served.server.local_addr(),
         Timeouts::new(Duration::from_secs(5)),
@@ -63,7 +63,7 @@ fn com_device(c: &Client) -> Com<'_> {
 }
 
 fn block_ns(events: &[Value]) -> Vec<u64> {
-    common::of(events, "block")
+    ads_common::of(events, "block")
         .iter()
         .filter_map(|e| e["n"].as_u64())
         .collect()
@@ -73,9 +73,9 @@ const PROGRAM: &str = "N10 G01 X1 F6000\nN20 X2\n/N30 X3\n/2 N40 X4\nN50 X5\nN60
 
 #[test]
 fn single_block_runs_one_block_per_start() {
-    let rig = common::Rig::new();
-    rig.program("sb.nc", PROGRAM);
-    let served = common::Served::start(&rig);
+    let params = ads_common::Params::new(1);
+    params.program("sb.nc", PROGRAM);
+    let served = ads_common::Served::start(params);
     let c = client(&served);
     let com = com_device(&c);
     com.write(0x01, &[1]);
@@ -95,15 +95,15 @@ fn single_block_runs_one_block_per_start() {
     }
     com.wait_state(3);
     drop(c);
-    let (_, events) = served.finish();
+    let events = served.finish();
     assert_eq!(block_ns(&events), [10, 20, 30, 40, 50, 60]);
 }
 
 #[test]
 fn skip_levels_skip_their_blocks_and_single_block_can_be_left() {
-    let rig = common::Rig::new();
-    rig.program("skip.nc", PROGRAM);
-    let served = common::Served::start(&rig);
+    let params = ads_common::Params::new(1);
+    params.program("skip.nc", PROGRAM);
+    let served = ads_common::Served::start(params);
     let c = client(&served);
     let com = com_device(&c);
     com.write(0x04, &0x1u32.to_le_bytes()); // skip level 1
@@ -121,15 +121,15 @@ fn skip_levels_skip_their_blocks_and_single_block_can_be_left() {
     com.write(0x137, &[1]);
     com.wait_state(3);
     drop(c);
-    let (_, events) = served.finish();
+    let events = served.finish();
     assert_eq!(block_ns(&events), [10, 20, 40, 50, 60]);
 }
 
 #[test]
 fn block_search_by_number_through_the_com_objects() {
-    let rig = common::Rig::new();
-    rig.program("bs.nc", PROGRAM);
-    let served = common::Served::start(&rig);
+    let params = ads_common::Params::new(1);
+    params.program("bs.nc", PROGRAM);
+    let served = ads_common::Served::start(params);
     let c = client(&served);
     let com = com_device(&c);
     com.write(0x49, &4u16.to_le_bytes()); // mc_cmd_bs_type_w: block number
@@ -149,8 +149,8 @@ fn block_search_by_number_through_the_com_objects() {
     com.wait_state(3);
     assert_eq!(com.u32(0x40), 0, "the start took the block search");
     drop(c);
-    let (_, events) = served.finish();
-    let search = common::of(&events, "search");
+    let events = served.finish();
+    let search = ads_common::of(&events, "search");
     assert_eq!(search.len(), 1, "{search:?}");
     assert_eq!(search[0]["found"], true);
     assert_eq!(block_ns(&events).first(), Some(&50));
@@ -158,17 +158,17 @@ fn block_search_by_number_through_the_com_objects() {
 
 #[test]
 fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
-    let rig = common::Rig::new();
-    let startup = std::fs::read_to_string(rig.startup()).unwrap();
-    std::fs::write(rig.startup(), startup + "zero_offset_list zero.lis\n").unwrap();
+    let params = ads_common::Params::new(1);
+    let startup = std::fs::read_to_string(params.startup()).unwrap();
+    std::fs::write(params.startup(), startup + "zero_offset_list zero.lis\n").unwrap();
     // G54 shifts X by 10 mm (list unit 0.1 µm).
     std::fs::write(
-        rig.dir.path().join("params/zero.lis"),
+        params.dir.path().join("params/zero.lis"),
         "np_grp[0].achse[0].versch 100000\n",
     )
     .unwrap();
-    rig.program("g54.nc", "N10 G54 G01 X5 F6000\nN20 X6\nN30 M30\n");
-    let served = common::Served::start(&rig);
+    params.program("g54.nc", "N10 G54 G01 X5 F6000\nN20 X6\nN30 M30\n");
+    let served = ads_common::Served::start(params);
     let c = client(&served);
     let com = com_device(&c);
     com.write(0x01, &[1]);
@@ -195,13 +195,13 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
 
 #[test]
 fn the_last_msg_text_is_read_at_mc_message_r() {
-    let rig = common::Rig::new();
-    rig.program(
+    let params = ads_common::Params::new(1);
+    params.program(
         "msg.nc",
         "N10 #MSG [\"Insert the clamp\"]\nN20 G04 0.5\nN25 P1 = 3.26\n\
          N30 #MSG [\"Clamp %d closed at %.1f mm\", 2, P1]\nN40 M30\n",
     );
-    let served = common::Served::start(&rig);
+    let served = ads_common::Served::start(params);
     let c = client(&served);
     let com = com_device(&c);
     assert_eq!(
@@ -214,8 +214,8 @@ fn the_last_msg_text_is_read_at_mc_message_r() {
     // The formatted text (TF5200 "Messages from the NC program": printf-style values).
     assert_eq!(com.string(0x1F, 120), "Clamp 2 closed at 3.3 mm");
     drop(c);
-    let (_, events) = served.finish();
-    let texts: Vec<&str> = common::of(&events, "message")
+    let events = served.finish();
+    let texts: Vec<&str> = ads_common::of(&events, "message")
         .iter()
         .filter_map(|e| e["text"].as_str())
         .collect();
@@ -226,9 +226,9 @@ fn the_last_msg_text_is_read_at_mc_message_r() {
 fn m00_always_holds_and_m01_only_with_the_m01_switch() {
     let program = "N10 G01 X1 F6000\nN20 M00\nN30 X2\nN40 M01\nN50 X3\nN60 M30\n";
     for switch in [false, true] {
-        let rig = common::Rig::new();
-        rig.program("stops.nc", program);
-        let served = common::Served::start(&rig);
+        let params = ads_common::Params::new(1);
+        params.program("stops.nc", program);
+        let served = ads_common::Served::start(params);
         let c = client(&served);
         let com = com_device(&c);
         com.write(0x07, &[u8::from(switch)]);
@@ -247,9 +247,9 @@ fn m00_always_holds_and_m01_only_with_the_m01_switch() {
         }
         com.wait_state(3);
         drop(c);
-        let (_, events) = served.finish();
+        let events = served.finish();
         assert_eq!(block_ns(&events), [10, 20, 30, 40, 50, 60]);
-        let stop_ms: Vec<u64> = common::of(&events, "program_stop")
+        let stop_ms: Vec<u64> = ads_common::of(&events, "program_stop")
             .iter()
             .filter_map(|e| e["m"].as_u64())
             .collect();

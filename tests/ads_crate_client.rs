@@ -44,7 +44,7 @@ fn device_info_state_and_mode_state() {
     assert_eq!(dev.get_state().unwrap(), (AdsState::Run, 0));
     let mut ms = [0u8; 8];
     dev.read_exact(CH1, offset::MODE_STATE, &mut ms).unwrap();
-    assert_eq!(ms, [1, 0, 0, 0, 3, 0, 0, 0]);
+    assert_eq!(ms, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
     dev.write_control(AdsState::Run, 0).unwrap();
 }
 
@@ -59,7 +59,6 @@ fn stream_writes_until_busy_then_0x708() {
     }
     let err = dev.write(CH1, offset::STREAM, &packet).unwrap_err();
     assert_eq!(ads_code(err), 0x708);
-    assert_eq!(b.warnings_11012(1), 1);
     let err = dev.write(CH1, offset::STREAM, b"N10 no crlf").unwrap_err();
     assert_eq!(ads_code(err), 0x706);
     let mut text = [0u8; 128];
@@ -68,6 +67,13 @@ fn stream_writes_until_busy_then_0x708() {
     // Wrong port: the crate reports the AMS header error.
     let none = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 800));
     assert_eq!(ads_code(none.get_info().unwrap_err()), 6);
+    drop(client);
+    srv.shutdown();
+    assert_eq!(
+        warnings(&b.events(), 11012),
+        1,
+        "the refused write is the channel's warning 11012"
+    );
 }
 
 /// V.E. variables in the SDA task (port 552) as TwinSharp `ZeroOffsets.cs` reaches variables:
@@ -75,8 +81,7 @@ fn stream_writes_until_busy_then_0x708() {
 #[test]
 fn ve_variables_through_an_sda_handle() {
     let (srv, b) = server();
-    use ncchannel::ads::CncBackend;
-    b.write_ve(1, "DEPTH", 0.0).unwrap();
+    b.backend.write_ve(1, "DEPTH", 0.0).unwrap();
     let client = connect(&srv, 40003);
     let sda = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 552));
     let mut h = [0u8; 4];
@@ -113,14 +118,14 @@ fn notifications_reach_the_crate_on_mode_change() {
         .expect("initial sample");
     let s: Vec<_> = first.samples().collect();
     assert_eq!(s[0].handle, handle);
-    assert_eq!(s[0].data, [1, 0, 0, 0, 3, 0, 0, 0]);
-    dev.write(CH1, offset::COMMAND_MODE, &2i32.to_le_bytes())
+    assert_eq!(s[0].data, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
+    dev.write(CH1, offset::COMMAND_MODE, &1i32.to_le_bytes())
         .unwrap();
     let next = rx
         .recv_timeout(Duration::from_secs(5))
         .expect("sample after change");
     let s: Vec<_> = next.samples().collect();
-    assert_eq!(s[0].data, [2, 0, 0, 0, 3, 0, 0, 0]);
+    assert_eq!(s[0].data, [1, 0, 0, 0, 3, 0, 0, 0], "STANDBY / READY");
     dev.delete_notification(handle).unwrap();
 }
 

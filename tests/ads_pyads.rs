@@ -1,5 +1,5 @@
-//! Runs tests/python/test_pyads.py (unmodified pyads 3.6 + adslib) against the server over the
-//! in-memory backend. Needs a Python with pyads, so it is ignored by default:
+//! Runs tests/python/test_pyads.py (unmodified pyads 3.6 + adslib) against the server over
+//! real channels (tests/ads_common). Needs a Python with pyads, so it is ignored by default:
 //!
 //! `NCCHANNEL_PYTHON=/path/to/venv/bin/python cargo test --test ads_pyads -- --ignored`
 

@@ -1,13 +1,14 @@
 //! End to end: the real channels in real time at 1 ms behind the ADS server, driven by
 //! the independent `ads` crate client exactly as a streaming client drives a real controller.
 
+mod ads_common;
 mod common;
 
 use std::time::{Duration, Instant};
 
 use ads::notif::{Attributes, TransmissionMode};
 use ads::{AmsAddr, AmsNetId, Client, Source, Timeouts};
-use common::{Rig, Served};
+use ads_common::{Params, Served};
 use ncchannel::ads::objects::offset;
 
 const CH1: u32 = 0x20101;
@@ -52,8 +53,7 @@ fn packets(lines: &[String]) -> Vec<Vec<u8>> {
 
 #[test]
 fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() {
-    let rig = Rig::new();
-    let served = Served::start(&rig);
+    let served = Served::start(Params::new(1));
     let client = connect(&served.server);
     let dev = client.device(target());
 
@@ -112,8 +112,8 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
     dev.delete_notification(handle).unwrap();
     drop(client);
 
-    let (_, events) = served.finish();
-    assert_eq!(common::block_texts(&events), lines);
+    let events = served.finish();
+    assert_eq!(ads_common::block_texts(&events), lines);
     let warnings = events
         .iter()
         .filter(|e| e["ev"] == "warning" && e["code"] == 11012)
@@ -126,8 +126,7 @@ fn ads_client_streams_5000_lines_into_a_running_channel_exactly_once_in_order() 
 
 #[test]
 fn reset_over_ads_empties_the_stream_and_reads_back_ready() {
-    let rig = Rig::new();
-    let served = Served::start(&rig);
+    let served = Served::start(Params::new(1));
     let client = connect(&served.server);
     let dev = client.device(target());
     dev.write(CH1, offset::STREAM, b"N1 G01 X1000 F100\r\n")

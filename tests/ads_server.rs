@@ -1,5 +1,6 @@
 //! The ADS server on the wire: framing, address swap, echo, exact sizes, bad frames, limits,
-//! notifications and the route allow-list (docs/ads-wire.md), against the in-memory backend.
+//! notifications and the route allow-list (docs/ads-wire.md), against real channels ticking
+//! at 1 ms behind the server (tests/ads_common).
 
 mod ads_common;
 
@@ -7,7 +8,6 @@ use std::time::{Duration, Instant};
 
 use ads_common::*;
 use ncchannel::ads::frame::AmsAddr;
-use ncchannel::ads::memory::DrainRate;
 use ncchannel::ads::objects::offset;
 use ncchannel::ads::payload::{self, request};
 use ncchannel::ads::{RouteEntry, ServerConfig};
@@ -92,10 +92,10 @@ fn response_swaps_addresses_byte_for_byte_and_echoes_command_and_invoke_id() {
     );
     assert_eq!(resp.len(), 38 + data_len);
     assert_eq!(u32_at(&resp, 30), 0, "no header error");
-    // result 0, length 8, mode STANDBY (1), state READY (3)
+    // result 0, length 8, mode AUTOMATIC (2), state READY (3)
     assert_eq!(
         &resp[38..],
-        &[0, 0, 0, 0, 8, 0, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0]
+        &[0, 0, 0, 0, 8, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0]
     );
 }
 
@@ -191,7 +191,7 @@ fn connections_beyond_the_limit_are_closed_and_the_others_keep_working() {
         max_connections: 2,
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut a = Raw::connect(srv.local_addr());
     let mut b = Raw::connect(srv.local_addr());
     a.call(READ_STATE, 1, &[]);
@@ -303,7 +303,7 @@ fn configured_net_id_answers_other_machines_with_error_7() {
         net_id: Some(device().net_id),
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     assert_eq!(raw.call(READ_STATE, 1, &[]).0.error, 0);
     let other = AmsAddr {
@@ -325,7 +325,7 @@ fn result_of_read(raw: &mut Raw, group: u32, off: u32, len: u32) -> (u32, Vec<u8
 
 #[test]
 fn stream_object_results_follow_the_buffer() {
-    let (srv, b) = server();
+    let (srv, channels) = server();
     let mut raw = Raw::connect(srv.local_addr());
     let packet = [vec![b'X'; 990], b"\r\n".to_vec()].concat();
     // The channel is not running, so nothing drains: 4 × 992 fit in 4094, the 5th does not.
@@ -336,7 +336,6 @@ fn stream_object_results_follow_the_buffer() {
         result_of_write(&mut raw, CH1, offset::STREAM, &packet),
         0x708
     );
-    assert_eq!(b.warnings_11012(1), 1, "the channel raised warning 11012");
     let (r, fill) = result_of_read(&mut raw, CH1, offset::STREAM_FILL, 8);
     assert_eq!(r, 0);
     assert_eq!(u32_at(&fill, 0), 3968);
@@ -363,15 +362,35 @@ fn stream_object_results_follow_the_buffer() {
         u32_at(&result_of_read(&mut raw, CH1, offset::STREAM_FILL, 8).1, 0),
         0
     );
-    // A line without CR LF: 0x706, channel error 21476, state ERROR.
+    // A line without CR LF: 0x706, channel error 21476, state ERROR; what the buffer held
+    // stays (the channel refuses the packet, it does not empty the buffer).
+    assert_eq!(result_of_write(&mut raw, CH1, offset::STREAM, b"N5\r\n"), 0);
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::STREAM, b"N10 X1\n"),
         0x706
+    );
+    assert_eq!(
+        u32_at(&result_of_read(&mut raw, CH1, offset::STREAM_FILL, 8).1, 0),
+        4
     );
     let (_, ms) = result_of_read(&mut raw, CH1, offset::MODE_STATE, 8);
     assert_eq!(u32_at(&ms, 4), 6);
     let (_, msg) = result_of_read(&mut raw, CH1, offset::ERROR_MESSAGE, 200);
     assert!(String::from_utf8_lossy(&msg).contains("21476"));
+    // In ERROR nothing drains the buffer before a reset: a write is refused outright, 0x707,
+    // not "busy" (retrying cannot succeed; docs/exactly-once.md).
+    assert_eq!(
+        result_of_write(&mut raw, CH1, offset::STREAM, b"N20 X2\r\n"),
+        0x707
+    );
+    drop(raw);
+    srv.shutdown();
+    let events = channels.events();
+    assert_eq!(
+        warnings(&events, 11012),
+        2,
+        "each full write (0x708) is one warning 11012 of the channel"
+    );
 }
 
 #[test]
@@ -420,8 +439,13 @@ fn groups_offsets_and_sizes_are_checked() {
     );
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::HOLD, &[]),
-        0x707,
-        "hold while not active"
+        0,
+        "hold while not active: accepted, nothing to hold"
+    );
+    assert_eq!(
+        u32_at(&result_of_read(&mut raw, CH1, offset::MODE_STATE, 8).1, 4),
+        3,
+        "still READY"
     );
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::FEED_OVERRIDE, &1500u16.to_le_bytes()),
@@ -444,7 +468,7 @@ fn groups_offsets_and_sizes_are_checked() {
 
 #[test]
 fn program_start_hold_resume_and_ve_variables() {
-    let (srv, b) = server();
+    let (srv, channels) = server();
     let mut raw = Raw::connect(srv.local_addr());
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::COMMAND_MODE, &2i32.to_le_bytes()),
@@ -459,13 +483,13 @@ fn program_start_hold_resume_and_ve_variables() {
         ),
         0
     );
-    assert_eq!(b.program(1), "streaming.nc");
     assert_eq!(
         result_of_write(&mut raw, CH1, offset::COMMAND_STATE, &4i16.to_le_bytes()),
         0
     );
     let (_, ms) = result_of_read(&mut raw, CH1, offset::MODE_STATE, 8);
     assert_eq!((u32_at(&ms, 0), u32_at(&ms, 4)), (2, 4));
+    assert_eq!(channels.status(1).program.as_deref(), Some("streaming.nc"));
     assert_eq!(result_of_write(&mut raw, CH1, offset::HOLD, &[1]), 0);
     assert_eq!(
         u32_at(&result_of_read(&mut raw, CH1, offset::MODE_STATE, 8).1, 4),
@@ -512,24 +536,34 @@ fn program_start_hold_resume_and_ve_variables() {
     let d = sda_call(WRITE, 4, &write_req(0x122301, 0x4A, b"V.E.speed\0abc"));
     assert_eq!(u32_at(&d, 0), 0x705);
 
-    // Streamed lines are consumed while ACTIVE: block counter and positions move.
+    // Streamed lines are executed while ACTIVE: block counter and positions move (12.8 mm
+    // at F6000 take about 0.2 s). `#FLUSH` releases the move from the lookahead window, which
+    // would otherwise wait for more blocks (README, Motion).
     assert_eq!(
-        result_of_write(&mut raw, CH1, offset::STREAM, b"N10 G1 X12.5 Y-3 F1000\r\n"),
+        result_of_write(
+            &mut raw,
+            CH1,
+            offset::STREAM,
+            b"N10 G1 X12.5 Y-3 F6000\r\n#FLUSH\r\n"
+        ),
         0
     );
-    let deadline = Instant::now() + Duration::from_secs(2);
+    let deadline = Instant::now() + Duration::from_secs(10);
     loop {
         let (_, c) = result_of_read(&mut raw, CH1, offset::BLOCK_COUNTER, 8);
-        if u64::from_le_bytes(c[..8].try_into().unwrap()) == 1 {
+        let (_, p) = result_of_read(&mut raw, CH1, offset::POSITIONS, 24);
+        let x = f64::from_le_bytes(p[0..8].try_into().unwrap());
+        let y = f64::from_le_bytes(p[8..16].try_into().unwrap());
+        let blocks = u64::from_le_bytes(c[..8].try_into().unwrap());
+        // The counter is read before the positions: once it counts both blocks (the move and
+        // #FLUSH) and the axes stand at the target, the line was executed exactly once.
+        if blocks >= 2 && (x - 12.5).abs() < 1e-9 && (y + 3.0).abs() < 1e-9 {
+            assert_eq!(blocks, 2);
             break;
         }
-        assert!(Instant::now() < deadline, "line never consumed");
+        assert!(Instant::now() < deadline, "line never executed: ({x}, {y})");
         std::thread::sleep(Duration::from_millis(2));
     }
-    let (_, p) = result_of_read(&mut raw, CH1, offset::POSITIONS, 24);
-    let x = f64::from_le_bytes(p[0..8].try_into().unwrap());
-    let y = f64::from_le_bytes(p[8..16].try_into().unwrap());
-    assert_eq!((x, y), (12.5, -3.0));
 }
 
 #[test]
@@ -552,7 +586,11 @@ fn notifications_arrive_on_change_and_stop_after_delete() {
     let samples = payload::decode_notification(&nd).unwrap();
     assert_eq!(samples.len(), 1);
     assert_eq!(samples[0].handle, handle);
-    assert_eq!(samples[0].data, [1, 0, 0, 0, 3, 0, 0, 0]);
+    assert_eq!(
+        samples[0].data,
+        [2, 0, 0, 0, 3, 0, 0, 0],
+        "AUTOMATIC / READY"
+    );
 
     // No change, no sample.
     assert!(raw.frame_bytes(Duration::from_millis(50)).is_none());
@@ -563,7 +601,7 @@ fn notifications_arrive_on_change_and_stop_after_delete() {
         device(),
         client_addr(40000),
         2,
-        &write_req(CH1, offset::COMMAND_MODE, &2i32.to_le_bytes()),
+        &write_req(CH1, offset::COMMAND_MODE, &1i32.to_le_bytes()),
     ));
     let mut got_response = false;
     let mut got_sample = false;
@@ -573,7 +611,7 @@ fn notifications_arrive_on_change_and_stop_after_delete() {
             3 => got_response = true,
             8 => {
                 let s = payload::decode_notification(&d).unwrap();
-                assert_eq!(s[0].data, [2, 0, 0, 0, 3, 0, 0, 0]);
+                assert_eq!(s[0].data, [1, 0, 0, 0, 3, 0, 0, 0], "STANDBY / READY");
                 got_sample = true;
             }
             c => panic!("unexpected command {c}"),
@@ -588,7 +626,7 @@ fn notifications_arrive_on_change_and_stop_after_delete() {
     raw.call(
         WRITE,
         5,
-        &write_req(CH1, offset::COMMAND_MODE, &1i32.to_le_bytes()),
+        &write_req(CH1, offset::COMMAND_MODE, &2i32.to_le_bytes()),
     );
     assert!(
         raw.frame_bytes(Duration::from_millis(50)).is_none(),
@@ -602,7 +640,7 @@ fn notifications_on_unreadable_objects_are_refused_and_handles_are_bounded() {
         max_notifications: 2,
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     let bad = request::add_notification(CH1, offset::STREAM, 8, 4, 0, 10_000);
     assert_eq!(
@@ -652,7 +690,7 @@ fn unlisted_net_ids_get_no_service_and_listed_ones_do() {
         allow: vec!["10.1.2.3.1.1".parse::<RouteEntry>().unwrap()],
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     let stranger = AmsAddr {
         net_id: "9.9.9.9.1.1".parse().unwrap(),
@@ -676,7 +714,7 @@ fn unlisted_ip_addresses_are_disconnected() {
         allow: vec!["10.9.9.9".parse::<RouteEntry>().unwrap()],
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     raw.send(&request_bytes(READ_STATE, device(), client_addr(1), 1, &[]));
     assert!(raw.closed_within(Duration::from_secs(2)));
@@ -685,14 +723,15 @@ fn unlisted_ip_addresses_are_disconnected() {
         allow: vec!["127.0.0.1".parse::<RouteEntry>().unwrap()],
         ..ServerConfig::default()
     };
-    let (srv, _b) = server_with(cfg, DrainRate::default());
+    let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     assert_eq!(raw.call(READ_STATE, 3, &[]).0.invoke_id, 3);
 }
 
 #[test]
 fn non_loopback_bind_needs_the_opt_in() {
-    let backend = ncchannel::ads::memory::MemoryBackend::new(1, DrainRate::default());
+    let channels = Channels::start(1);
+    let backend = std::sync::Arc::clone(&channels.backend);
     let cfg = ServerConfig {
         bind: "0.0.0.0:0".parse().unwrap(),
         ..ServerConfig::default()

@@ -1,5 +1,7 @@
-//! `ncchannel stream` and the client library behind it, against a server over the in-memory
-//! channel: everything sent arrives once, in order, as CR LF lines, through a full buffer.
+//! `ncchannel stream` and the client library behind it, against a server over real channels
+//! (tests/ads_common): everything sent is executed once, in order, through a full buffer.
+
+use ncchannel::vocab::mode::State;
 
 mod ads_common;
 
@@ -9,23 +11,48 @@ use std::time::Duration;
 use ads_common::*;
 use ncchannel::ads::client::{self, AdsClient, StreamError, StreamOptions};
 use ncchannel::ads::frame::AmsAddr;
-use ncchannel::ads::memory::DrainRate;
 use ncchannel::ads::ServerConfig;
 
-/// A program several times the 4094-byte buffer, with LF line ends and no final line end.
+/// A program several times the 4094-byte buffer, with LF line ends and no final line end:
+/// parameter blocks with a short move every 50 lines, so the channel executes it in a
+/// fraction of a second of real time yet still lags a client that writes as fast as it can.
 fn program(lines: usize) -> String {
-    let mut s = String::from("%stream_test\n");
+    let mut s = String::new();
     for i in 1..lines {
-        s.push_str(&format!(
-            "N{} G01 X{}.{:03} Y{} F2000\n",
-            i * 10,
-            i % 97,
-            i % 1000,
-            i % 13
-        ));
+        if i % 50 == 0 {
+            s.push_str(&format!(
+                "N{} G01 X{}.{:03} F6000\n",
+                i * 10,
+                i % 3,
+                i % 1000
+            ));
+        } else {
+            s.push_str(&format!(
+                "N{} P{} = {}.{:03}\n",
+                i * 10,
+                1 + i % 3,
+                i % 97,
+                i % 1000
+            ));
+        }
     }
     s.push_str("M30");
     s
+}
+
+/// Wait until the program has ended (READY again), then stop the channels and return the
+/// lines channel 1 executed and its 11012 warnings.
+fn executed(channels: Channels) -> (Vec<String>, usize) {
+    channels.wait_for(1, Duration::from_secs(60), |s| {
+        s.state == State::Ready && s.program.is_none()
+    });
+    let events = channels.events();
+    (block_texts(&events), warnings(&events, 11012))
+}
+
+/// The lines of `text`, as the channel's block events name them.
+fn lines_of(text: &str) -> Vec<String> {
+    text.lines().map(str::to_string).collect()
 }
 
 fn crlf(text: &str) -> Vec<u8> {
@@ -44,11 +71,7 @@ fn connect(srv: &ncchannel::ads::ServerHandle) -> AdsClient {
 
 #[test]
 fn client_streams_a_large_program_through_a_full_buffer() {
-    let slow = DrainRate {
-        lines_per_tick: 1,
-        period: Duration::from_millis(1),
-    };
-    let (srv, backend) = server_with(ServerConfig::default(), slow);
+    let (srv, channels) = server_with(ServerConfig::default());
     let mut c = connect(&srv);
     assert!(c.read_device_info().unwrap().name.starts_with("ncchannel"));
     let text = program(800);
@@ -62,18 +85,19 @@ fn client_streams_a_large_program_through_a_full_buffer() {
     assert_eq!(p.bytes_sent, expected.len() as u64);
     assert!(p.rejections > 0, "a slow channel must have pushed back");
     assert!(reports >= 1);
+    assert_eq!(channels.status(1).program.as_deref(), Some("streaming.nc"));
+    let (blocks, warnings_11012) = executed(channels);
     assert_eq!(
-        backend.consumed(1),
-        expected,
-        "every byte arrives once, in order"
+        blocks,
+        lines_of(&text),
+        "every line executed once, in order"
     );
-    assert_eq!(backend.program(1), "streaming.nc");
-    assert!(backend.warnings_11012(1) >= p.rejections);
+    assert!(warnings_11012 as u64 >= p.rejections);
 }
 
 #[test]
 fn packets_respect_the_packet_size() {
-    let (srv, backend) = server();
+    let (srv, channels) = server();
     let mut c = connect(&srv);
     let text = program(50);
     let opts = StreamOptions {
@@ -83,7 +107,7 @@ fn packets_respect_the_packet_size() {
     };
     let p = client::stream_text(&mut c, text.as_bytes(), &opts, &mut |_| {}).unwrap();
     assert!(p.packets_sent >= (text.len() as u64) / 64);
-    assert_eq!(backend.consumed(1), crlf(&text));
+    assert_eq!(executed(channels).0, lines_of(&text));
 }
 
 #[test]
@@ -104,7 +128,7 @@ fn bin() -> Command {
 
 #[test]
 fn the_binary_streams_a_file_and_starts_the_program() {
-    let (srv, backend) = server();
+    let (srv, channels) = server();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("part.nc");
     let text = program(400);
@@ -132,7 +156,7 @@ fn the_binary_streams_a_file_and_starts_the_program() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert!(stderr.contains("stream: done"), "{stderr}");
-    assert_eq!(backend.consumed(1), crlf(&text));
+    assert_eq!(executed(channels).0, lines_of(&text));
 }
 
 #[test]

@@ -8,7 +8,7 @@
 //! Also: every record of the description table is read back and its object read at its
 //! address with its size, and the type text agrees with the size.
 
-mod common;
+mod ads_common;
 
 use std::collections::HashMap;
 use std::time::Duration;
@@ -88,8 +88,8 @@ fn handle(plc: &ads::Device<'_>, symbol: &str) -> u32 {
 
 #[test]
 fn new_cnc_sequence_of_twinsharp_succeeds_on_the_wire() {
-    let rig = common::Rig::new();
-    let served = common::Served::start(&rig);
+    let params = ads_common::Params::new(1);
+    let served = ads_common::Served::start(params);
     let source = AmsAddr::new(AmsNetId::new(10, 1, 2, 3, 1, 1), 40100);
     let client = Client::new(
         served.server.local_addr(),

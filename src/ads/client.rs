@@ -9,7 +9,6 @@ use std::io::{self, Read, Write};
 use std::net::{IpAddr, SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
 
-use super::backend::{mode, state};
 use super::frame::{self, AmsAddr, AmsHeader, CommandId, Frame, FLAGS_REQUEST};
 use super::objects::{offset, GROUP_CHANNEL, PORT_CNC_COM};
 use super::payload::{self, request};
@@ -17,6 +16,7 @@ use super::result::AdsResult;
 use crate::vocab::ams::{AmsNetId, DEFAULT_MAX_FRAME_BYTES};
 
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
+use crate::vocab::mode::{Mode, State};
 
 /// What went wrong talking to the device.
 #[derive(Debug, thiserror::Error)]
@@ -307,9 +307,17 @@ fn group(channel: u16) -> u32 {
 /// (0x105), as a PLC or HMI does.
 pub fn start_program(client: &mut AdsClient, channel: u16, name: &str) -> Result<(), ClientError> {
     let g = group(channel);
-    client.write(g, offset::COMMAND_MODE, &mode::AUTOMATIC.to_le_bytes())?;
+    client.write(
+        g,
+        offset::COMMAND_MODE,
+        &(Mode::Automatic as i32).to_le_bytes(),
+    )?;
     client.write(g, offset::COMMAND_PROGRAM, name.as_bytes())?;
-    client.write(g, offset::COMMAND_STATE, &state::ACTIVE.to_le_bytes())
+    client.write(
+        g,
+        offset::COMMAND_STATE,
+        &(State::Active as i32).to_le_bytes(),
+    )
 }
 
 /// Whether the channel runs a program (ACTIVE or HOLD), which will drain the stream buffer.
@@ -318,8 +326,8 @@ fn program_running(client: &mut AdsClient, channel: u16) -> Result<bool, ClientE
     let [_, _, _, _, a, b, c, d] = ms[..] else {
         return Ok(false);
     };
-    let s = i32::from_le_bytes([a, b, c, d]);
-    Ok(s == state::ACTIVE || s == state::HOLD)
+    let s = State::from_i32(i32::from_le_bytes([a, b, c, d]));
+    Ok(matches!(s, Some(State::Active | State::Hold)))
 }
 
 /// The channel's error text when it is in state ERROR.
@@ -329,7 +337,7 @@ fn channel_error(client: &mut AdsClient, channel: u16) -> Result<Option<String>,
     let [_, _, _, _, a, b, c, d] = ms[..] else {
         return Ok(None);
     };
-    if i32::from_le_bytes([a, b, c, d]) == state::ERROR {
+    if State::from_i32(i32::from_le_bytes([a, b, c, d])) == Some(State::Error) {
         let text = client.read(g, offset::ERROR_MESSAGE, 256)?;
         let end = text.iter().position(|&b| b == 0).unwrap_or(text.len());
         return Ok(Some(String::from_utf8_lossy(&text[..end]).into_owned()));

@@ -13,7 +13,7 @@
 //! kernel: "the first channel drives platform data"). What ncchannel does not model is
 //! absent (0x703), never a made-up value.
 
-use super::backend::{CncBackend, DeviceError, HmiOp, Status};
+use super::backend::{CncBackend, DeviceError, HmiOp, Op, Status};
 use super::description::{self, Access, AdsType, ObjectInfo};
 use super::hli::{Hli, HmiRequest};
 use super::result::AdsResult;
@@ -272,7 +272,7 @@ fn platform_axes(backend: &dyn CncBackend) -> Result<Vec<PlatformAxis>, AdsResul
     let mut out = Vec::new();
     for ch in 1..=backend.channel_count() {
         let n = backend
-            .view(ch)
+            .status(ch)
             .map_err(DeviceError::result)?
             .positions
             .len();
@@ -354,7 +354,7 @@ fn resolve(
 /// platform axes), names unique. `ch` 0 lists channel 1.
 pub fn objects(backend: &dyn CncBackend, ch: u16) -> Result<Vec<ObjectInfo>, AdsResult> {
     let ch = ch.max(1);
-    let view = backend.view(ch).map_err(DeviceError::result)?;
+    let view = backend.status(ch).map_err(DeviceError::result)?;
     let group = GROUP_CHANNEL + u32::from(ch);
     let axes = platform_axes(backend)?;
     let mut out = Vec::with_capacity(TABLE.len() + 16 * axes.len());
@@ -471,11 +471,11 @@ pub fn read(
     match t.def.scope {
         Scope::Platform => read_platform(backend, t.def, length),
         Scope::Channel => {
-            let v = backend.view(t.ch).map_err(dev)?;
+            let v = backend.status(t.ch).map_err(dev)?;
             read_channel(&v, t.ch, t.def, length)
         }
         Scope::ChannelAxis => {
-            let v = backend.view(t.ch).map_err(dev)?;
+            let v = backend.status(t.ch).map_err(dev)?;
             let i = (t.axis as usize)
                 .checked_sub(1)
                 .filter(|&i| i < v.positions.len())
@@ -493,7 +493,7 @@ pub fn read(
                 .checked_sub(1)
                 .and_then(|i| axes.get(i))
                 .ok_or(AdsResult::INVALID_OFFSET)?;
-            let v = backend.view(a.ch).map_err(dev)?;
+            let v = backend.status(a.ch).map_err(dev)?;
             read_axis(&v, a.ch, a.index, t.axis as u16, t.def, length)
         }
     }
@@ -501,7 +501,7 @@ pub fn read(
 
 fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec<u8>, AdsResult> {
     let channels = backend.channel_count();
-    let v = backend.view(1).map_err(dev)?;
+    let v = backend.status(1).map_err(dev)?;
     let t = v.cycle_times;
     let bytes = match def.field {
         Field::TickCounter => (v.tick as u32).to_le_bytes().to_vec(),
@@ -688,7 +688,7 @@ pub fn write(
     }
     let ch = t.ch;
     match t.def.field {
-        Field::TimeReset => unit(backend.hmi(1, HmiOp::ResetCycleTimes)),
+        Field::TimeReset => unit(backend.command(1, Op::Hmi(HmiOp::ResetCycleTimes))),
         Field::Stream => write_stream(backend, ch, data),
         Field::SingleBlockCommand
         | Field::OptionalStop
@@ -718,7 +718,7 @@ fn unit(r: Result<(), DeviceError>) -> Result<(), AdsResult> {
 
 /// Write step: stream bytes go to the channel's stream; its refusal is the answer.
 fn write_stream(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
-    let r = backend.stream_write(ch, data).result();
+    let r = backend.write_stream(ch, data);
     if r.is_ok() {
         Ok(())
     } else {
@@ -735,23 +735,29 @@ fn write_switch(
     data: &[u8],
 ) -> Result<(), AdsResult> {
     match field {
-        Field::SingleBlockCommand => unit(backend.hmi(ch, HmiOp::SingleBlock(bool_arg(data)?))),
-        Field::OptionalStop => unit(backend.hmi(ch, HmiOp::OptionalStop(bool_arg(data)?))),
+        Field::SingleBlockCommand => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::SingleBlock(bool_arg(data)?))))
+        }
+        Field::OptionalStop => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::OptionalStop(bool_arg(data)?))))
+        }
         Field::SkipCommand => {
             let mask = uint_arg(data)?;
             if mask & !0x3FF != 0 {
                 return Err(AdsResult::INVALID_DATA);
             }
-            unit(backend.hmi(ch, HmiOp::SkipLevels(mask)))
+            unit(backend.command(ch, Op::Hmi(HmiOp::SkipLevels(mask))))
         }
         Field::OverrideCommand => {
             let tenths = uint_arg(data)?;
             if tenths > 2000 {
                 return Err(AdsResult::INVALID_DATA);
             }
-            unit(backend.set_override(ch, f64::from(tenths) / 10.0))
+            unit(backend.command(ch, Op::SetOverride(f64::from(tenths) / 10.0)))
         }
-        Field::ExecutionModeCommand => unit(backend.hmi(ch, HmiOp::ExecutionMode(i32_arg(data)?))),
+        Field::ExecutionModeCommand => {
+            unit(backend.command(ch, Op::Hmi(HmiOp::ExecutionMode(i32_arg(data)?))))
+        }
         _ => Err(AdsResult::ACCESS_DENIED),
     }
 }
@@ -765,9 +771,9 @@ fn write_search(
     data: &[u8],
 ) -> Result<(), AdsResult> {
     let search = |f: &dyn Fn(&mut crate::channel::SearchCommand)| -> Result<(), AdsResult> {
-        let mut s = backend.view(ch).map_err(dev)?.hmi.search;
+        let mut s = backend.status(ch).map_err(dev)?.hmi.search;
         f(&mut s);
-        unit(backend.hmi(ch, HmiOp::Search(s)))
+        unit(backend.command(ch, Op::Hmi(HmiOp::Search(s))))
     };
     match field {
         Field::SearchType => {
@@ -808,14 +814,14 @@ fn write_mcm(
             let m = i32_arg(data)?;
             match hli.redirect(ch, HmiRequest::ToMode(m)) {
                 Some(r) => r,
-                None => unit(backend.command_mode(ch, m)),
+                None => unit(backend.command(ch, Op::CommandMode(m))),
             }
         }
         Field::McmToState => {
             let s = i32_arg(data)?;
             match hli.redirect(ch, HmiRequest::ToState(s)) {
                 Some(r) => r,
-                None => unit(backend.command_state(ch, s)),
+                None => unit(backend.command(ch, Op::CommandState(s))),
             }
         }
         Field::McmFromMode | Field::McmFromState => {
@@ -834,7 +840,7 @@ fn write_mcm(
             }
             match hli.redirect(ch, HmiRequest::Parameter(name)) {
                 Some(r) => r,
-                None => unit(backend.command_program(ch, name)),
+                None => unit(backend.command(ch, Op::SetProgram(name.to_string()))),
             }
         }
         _ => Err(AdsResult::ACCESS_DENIED),
@@ -852,9 +858,9 @@ fn write_hold_resume_reset(
         return Err(AdsResult::INVALID_SIZE);
     }
     unit(match field {
-        Field::Hold => backend.hold(ch),
-        Field::Resume => backend.resume(ch),
-        _ => backend.reset(ch),
+        Field::Hold => backend.command(ch, Op::Hold),
+        Field::Resume => backend.command(ch, Op::Resume),
+        _ => backend.command(ch, Op::Reset),
     })
 }
 
@@ -862,11 +868,12 @@ fn write_hold_resume_reset(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use crate::ads::testing;
 
     #[test]
     fn every_listed_readable_object_reads_its_size() {
-        let b = MemoryBackend::new(1, DrainRate::default());
+        let t = testing::channels(1);
+        let b = &t.backend;
         let list = objects(b.as_ref(), 0).unwrap();
         let mut names: Vec<_> = list.iter().map(|o| o.name.clone()).collect();
         names.sort();
@@ -884,7 +891,8 @@ mod tests {
 
     #[test]
     fn twinsharp_platform_axis_form_and_index_groups() {
-        let b = MemoryBackend::new(1, DrainRate::default());
+        let t = testing::channels(1);
+        let b = &t.backend;
         let a = read(b.as_ref(), 0x120200, 0x1000F, 2).unwrap();
         let c = read(b.as_ref(), 0x120201, 0x0F, 2).unwrap();
         assert_eq!(a, c);

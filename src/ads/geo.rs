@@ -220,12 +220,12 @@ pub fn read(
         let bytes = hli.unit_bytes(ch, unit, at as usize, def.size as usize)?;
         return fixed(bytes, length);
     }
-    let v = backend.view(ch).map_err(DeviceError::result)?;
+    let v = backend.status(ch).map_err(DeviceError::result)?;
     if def.field == Field::PlatformAxes {
         let mut n = 0usize;
         for c in 1..=backend.channel_count() {
             n += backend
-                .view(c)
+                .status(c)
                 .map_err(DeviceError::result)?
                 .positions
                 .len();
@@ -317,7 +317,7 @@ pub fn read_write(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use crate::ads::testing;
     use std::sync::Arc;
 
     fn query(b: &dyn CncBackend, group: u32, ch: i32, axis: i32) -> (u32, u32) {
@@ -331,7 +331,8 @@ mod tests {
 
     #[test]
     fn address_query_names_existing_instances_only() {
-        let b = MemoryBackend::new(1, DrainRate::default());
+        let t = testing::channels(1);
+        let b = &t.backend;
         assert_eq!(query(b.as_ref(), 0x121900, 1, 0), (0x121301, 0));
         assert_eq!(query(b.as_ref(), 0x123900, 1, 0), (0x123301, 0));
         assert_eq!(
@@ -349,15 +350,17 @@ mod tests {
 
     #[test]
     fn hld_shows_mode_state_and_the_hli_unit() {
-        let b = MemoryBackend::new(1, DrainRate::default());
-        let hli = Hli::new(Arc::clone(&b) as Arc<dyn CncBackend>);
+        let t = testing::channels(1);
+        let b = &t.backend;
+        let hli = Hli::new(Arc::clone(b));
         assert_eq!(
             read(b.as_ref(), &hli, 0x123301, 0x1F, 4).unwrap(),
             [3, 0, 0, 0]
         );
         assert_eq!(
             read(b.as_ref(), &hli, 0x123301, 0x20, 4).unwrap(),
-            [1, 0, 0, 0]
+            [2, 0, 0, 0],
+            "AUTOMATIC, as a channel starts"
         );
         assert_eq!(
             read(b.as_ref(), &hli, 0x123301, 0x2F, 300).unwrap().len(),

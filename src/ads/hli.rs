@@ -24,7 +24,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
-use super::backend::{CncBackend, DeviceError};
+use super::backend::{CncBackend, DeviceError, Op};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
 
@@ -533,7 +533,7 @@ impl Hli {
         for ch in 1..=self.backend.channel_count() {
             axes.push(
                 self.backend
-                    .view(ch)
+                    .status(ch)
                     .map_err(DeviceError::result)?
                     .positions
                     .len(),
@@ -593,10 +593,10 @@ impl Hli {
         let s = &img.symbols[i];
         match img.roles[s.root] {
             Role::ModeState(ch) => {
-                let (m, st) = self.backend.mode_state(ch).map_err(DeviceError::result)?;
+                let st = self.backend.status(ch).map_err(DeviceError::result)?;
                 let mut mem = img.memory();
-                mem[s.root][0..4].copy_from_slice(&(m as u32).to_le_bytes());
-                mem[s.root][4..8].copy_from_slice(&(st as u32).to_le_bytes());
+                mem[s.root][0..4].copy_from_slice(&(st.mode as u32).to_le_bytes());
+                mem[s.root][4..8].copy_from_slice(&(st.state as u32).to_le_bytes());
             }
             Role::ErrorRecord(ch) | Role::ErrorSemaphore(ch) => self.post_error(img, ch)?,
             _ => {}
@@ -636,18 +636,18 @@ impl Hli {
         let program = String::from_utf8_lossy(&param[..end]).trim().to_string();
         let b = &self.backend;
         let r = (|| {
-            let (mode, _) = b.mode_state(ch)?;
-            if to_mode != 0 && to_mode as i32 != mode {
-                b.command_mode(ch, to_mode as i32)?;
+            let mode = b.status(ch)?.mode;
+            if to_mode != 0 && to_mode != mode as u32 {
+                b.command(ch, Op::CommandMode(to_mode as i32))?;
             }
             if !program.is_empty() {
-                b.command_program(ch, &program)?;
+                b.command(ch, Op::SetProgram(program))?;
             }
             match to_state {
                 0 => Ok(()),
                 // "Resetting" as a target state (diagnosis 270061).
-                15 => b.reset(ch),
-                s => b.command_state(ch, s as i32),
+                15 => b.command(ch, Op::Reset),
+                s => b.command(ch, Op::CommandState(s as i32)),
             }
         })();
         if let Err(e) = r {
@@ -680,7 +680,7 @@ impl Hli {
                 .error_record(ch, index)
                 .map_err(DeviceError::result)?;
         }
-        let tick = self.backend.view(ch).map_err(DeviceError::result)?.tick;
+        let tick = self.backend.status(ch).map_err(DeviceError::result)?.tick;
         let code = rec.error.as_ref().map_or(0, |(c, _)| *c);
         let record = error_record(code, ch, tick);
         let mut mem = img.memory();
@@ -716,17 +716,17 @@ impl Hli {
                 if img.memory()[areas.request_semaphore][0] != 0 {
                     return Some(Err(AdsResult::BUSY));
                 }
-                let (mode, state) = match self.backend.mode_state(ch) {
-                    Ok(ms) => ms,
+                let (mode, state) = match self.backend.status(ch) {
+                    Ok(st) => (st.mode as u32, st.state as u32),
                     Err(e) => return Some(Err(e.result())),
                 };
                 let mut mem = img.memory();
                 let r = &mut mem[areas.request];
                 r.fill(0);
                 let words = [
-                    mode as u32,
-                    state as u32,
-                    p.to_mode.unwrap_or(mode as u32),
+                    mode,
+                    state,
+                    p.to_mode.unwrap_or(mode),
                     s as u32,
                     u32::from(ch),
                 ];
@@ -883,12 +883,20 @@ fn put(field: &mut [u8], text: &str) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ads::backend::CncBackend;
-    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use crate::ads::testing;
+    use crate::vocab::mode::{Mode, State};
+    use std::sync::Arc;
+
+    /// Mode and state of channel 1.
+    fn mode_state(b: &dyn CncBackend) -> (Mode, State) {
+        let s = b.status(1).unwrap();
+        (s.mode, s.state)
+    }
 
     #[test]
     fn names_resolve_case_insensitively_to_stable_handles() {
-        let hli = Hli::new(MemoryBackend::new(1, DrainRate::default()));
+        let t = testing::channels(1);
+        let hli = Hli::new(Arc::clone(&t.backend));
         let name = b"HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r\0";
         let h = hli.read_write(GROUP_HANDLE_BY_NAME, 0, 4, name).unwrap();
         let lower = name.to_ascii_lowercase();
@@ -898,7 +906,7 @@ mod tests {
         );
         let h = u32::from_le_bytes([h[0], h[1], h[2], h[3]]);
         let v = hli.read(GROUP_VALUE_BY_HANDLE, h, 8).unwrap();
-        assert_eq!(v, [1, 0, 0, 0, 3, 0, 0, 0], "STANDBY / READY");
+        assert_eq!(v, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
         assert_eq!(
             hli.read_write(GROUP_HANDLE_BY_NAME, 0, 4, b"HLI_Global_Variables.nope"),
             Err(SYMBOL_NOT_FOUND)
@@ -915,8 +923,10 @@ mod tests {
 
     #[test]
     fn command_unit_is_taken_when_the_semaphore_is_set_and_cleared() {
-        let b = MemoryBackend::new(1, DrainRate::default());
-        let hli = Hli::new(b.clone());
+        let t = testing::channels(1);
+        let b = t.backend.as_ref();
+        b.command(1, Op::CommandMode(Mode::Standby as i32)).unwrap();
+        let hli = Hli::new(Arc::clone(&t.backend));
         let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
         let mut cmd = vec![0u8; MODE_TRANSITION_BYTES];
         cmd[8..12].copy_from_slice(&2u32.to_le_bytes());
@@ -925,11 +935,14 @@ mod tests {
         let command = handle_of(&hli, &format!("{ms}.command_w"));
         hli.write(GROUP_VALUE_BY_HANDLE, command, &cmd).unwrap();
         // Written but not handed over: nothing happens.
-        assert_eq!(b.mode_state(1), Ok((1, 3)));
+        assert_eq!(mode_state(b), (Mode::Standby, State::Ready));
         let sem = handle_of(&hli, &format!("{ms}.command_semaphor_rw"));
         hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1]).unwrap();
-        assert_eq!(b.mode_state(1), Ok((2, 4)));
-        assert_eq!(b.program(1), "streaming.nc");
+        assert_eq!(mode_state(b), (Mode::Automatic, State::Active));
+        assert_eq!(
+            b.status(1).unwrap().program.as_deref(),
+            Some("streaming.nc")
+        );
         assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [0]);
         let state = handle_of(&hli, &format!("{ms}.state_r.state"));
         assert_eq!(
@@ -949,8 +962,10 @@ mod tests {
 
     #[test]
     fn with_enable_w_hmi_commands_become_requests_for_the_plc() {
-        let b = MemoryBackend::new(1, DrainRate::default());
-        let hli = Hli::new(b.clone());
+        let t = testing::channels(1);
+        let b = t.backend.as_ref();
+        b.command(1, Op::CommandMode(Mode::Standby as i32)).unwrap();
+        let hli = Hli::new(Arc::clone(&t.backend));
         assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), None, "no PLC yet");
         let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
         let enable = handle_of(&hli, &format!("{ms}.enable_w"));
@@ -958,7 +973,7 @@ mod tests {
         assert_eq!(hli.redirect(1, HmiRequest::ToMode(2)), Some(Ok(())));
         assert_eq!(hli.redirect(1, HmiRequest::Parameter("a.nc")), Some(Ok(())));
         assert_eq!(hli.redirect(1, HmiRequest::ToState(4)), Some(Ok(())));
-        assert_eq!(b.mode_state(1), Ok((1, 3)), "not executed");
+        assert_eq!(mode_state(b), (Mode::Standby, State::Ready), "not executed");
         let req = handle_of(&hli, &format!("{ms}.request_r"));
         let r = hli.read(GROUP_VALUE_BY_HANDLE, req, 327).unwrap();
         let word =
@@ -981,8 +996,9 @@ mod tests {
 
     #[test]
     fn errors_are_posted_one_at_a_time() {
-        let b = MemoryBackend::new(1, DrainRate::default());
-        let hli = Hli::new(b.clone());
+        let t = testing::channels(1);
+        let b = t.backend.as_ref();
+        let hli = Hli::new(Arc::clone(&t.backend));
         let sem = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.semaphor_rw");
         let rec = handle_of(&hli, "HLI_Global_Variables.gpCh[0]^.mc_error.satz_r");
         assert_eq!(
@@ -990,7 +1006,8 @@ mod tests {
             [0],
             "no error yet"
         );
-        let _ = b.stream_write(1, b"N10 X1\n");
+        // A line without CR LF while no program runs: the channel raises error 21476.
+        assert_eq!(b.write_stream(1, b"N10 X1\n"), AdsResult::INVALID_DATA);
         assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
         let r = hli.read(GROUP_VALUE_BY_HANDLE, rec, 942).unwrap();
         assert_eq!(r.len(), ERROR_RECORD_BYTES);

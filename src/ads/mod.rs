@@ -2,8 +2,10 @@
 //! 553, GEO 551, SDA 552, the PLC's HLI 851), a server that serves them to real clients
 //! (pyads, the `ads` crate, Node ads-client, TwinSharp), and a client for `ncchannel stream`.
 //!
-//! The object table reaches the channels only through [`backend::CncBackend`]; the runtime
-//! implements it, and [`memory::MemoryBackend`] is an in-memory stand-in for tests.
+//! The object table reaches the channels only through [`backend::CncBackend`], one door:
+//! `call(channel, Op) → Reply`, the channel's own vocabulary (`crate::machine`). The runtime
+//! implements it ([`channel_backend::ChannelBackend`]); the tests drive real channels through
+//! it too, so there is no stand-in channel to drift from the real one.
 
 pub mod backend;
 pub mod channel_backend;
@@ -13,15 +15,16 @@ pub mod description;
 pub mod frame;
 pub mod geo;
 pub mod hli;
-pub mod memory;
 pub mod objects;
 pub mod payload;
 pub mod result;
 pub mod sda;
 pub mod server;
+#[cfg(test)]
+pub(crate) mod testing;
 
 pub use crate::vocab::ams::{AmsNetId, RouteEntry};
-pub use backend::{CncBackend, DeviceError, StreamFill, StreamWriteOutcome};
+pub use backend::{CncBackend, DeviceError};
 pub use frame::AmsAddr;
 pub use result::AdsResult;
 pub use server::{spawn, ServerConfig, ServerHandle};

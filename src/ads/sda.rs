@@ -264,13 +264,14 @@ impl Sda {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ads::memory::{DrainRate, MemoryBackend};
+    use crate::ads::testing;
+    use std::sync::Arc;
 
     #[test]
     fn handle_then_plain_read_and_write_as_twinsharp_does() {
-        let b = MemoryBackend::new(1, DrainRate::default());
-        b.write_ve(1, "DEPTH", 1.5).unwrap();
-        let sda = Sda::new(b);
+        let t = testing::channels(1);
+        t.backend.write_ve(1, "DEPTH", 1.5).unwrap();
+        let sda = Sda::new(Arc::clone(&t.backend));
         let h = sda
             .read_write(0x122301, HANDLE_BY_NAME, 4, b"V.E.depth")
             .unwrap();

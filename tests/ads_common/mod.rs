@@ -1,31 +1,211 @@
-//! Shared helpers for the ADS integration tests: a server over the in-memory backend and a
-//! raw frame-level client, so tests can check bytes on the wire.
+//! Shared helpers for the ADS integration tests: a server over real channels (a `Machine`
+//! ticking in real time at 1 ms on its own thread, as `ncchannel serve` runs it) and a raw
+//! frame-level client, so tests can check bytes on the wire.
 #![allow(dead_code)]
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::sync::Arc;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use ncchannel::ads::backend::{CncBackend, Op, Status};
+use ncchannel::ads::channel_backend::Ticking;
 use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, CommandId, Frame};
-use ncchannel::ads::memory::{DrainRate, MemoryBackend};
 use ncchannel::ads::{spawn, ServerConfig, ServerHandle};
+use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::report::event::EventLog;
 use ncchannel::vocab::ams::AmsNetId;
+use serde_json::Value;
 
 pub const CH1: u32 = 0x20101;
 
-pub fn server_with(config: ServerConfig, rate: DrainRate) -> (ServerHandle, Arc<MemoryBackend>) {
-    let backend = MemoryBackend::new(2, rate);
+/// The event log's bytes, shared with the log writer thread.
+#[derive(Clone, Default)]
+struct LogBytes(Arc<Mutex<Vec<u8>>>);
+
+impl Write for LogBytes {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().unwrap().extend_from_slice(b);
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Parameter lists of `n` channels and their programs in a temporary folder: each channel has
+/// the streaming program `streaming.nc`, the default axes X Y Z, and programs in `nc/`.
+/// Tests may add programs and change the lists before the channels start.
+pub struct Params {
+    pub dir: tempfile::TempDir,
+}
+
+impl Params {
+    pub fn new(n: u16) -> Params {
+        let dir = tempfile::tempdir().unwrap();
+        let params = dir.path().join("params");
+        std::fs::create_dir_all(&params).unwrap();
+        std::fs::create_dir_all(dir.path().join("nc")).unwrap();
+        let mut startup = format!("kanal_anzahl {n}\n");
+        for i in 0..n {
+            startup.push_str(&format!(
+                "sda_mds[{i}] channel{ch}.lis\npfad[{i}].prg[0] ../nc\npfad[{i}].typ[0] 0x03\n\
+                 pfad[{i}].prioritaet[0] 0\n",
+                ch = i + 1
+            ));
+            std::fs::write(
+                params.join(format!("channel{}.lis", i + 1)),
+                "streaming_prog_file streaming.nc\n",
+            )
+            .unwrap();
+        }
+        std::fs::write(params.join("startup.lis"), startup).unwrap();
+        Params { dir }
+    }
+
+    /// The start-up list (`params/startup.lis`).
+    pub fn startup(&self) -> PathBuf {
+        self.dir.path().join("params/startup.lis")
+    }
+
+    /// Write program `name` into `nc/`.
+    pub fn program(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.dir.path().join("nc").join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+}
+
+/// Real channels running behind a backend: a `Machine` from [`Params`], ticking in real time
+/// (1 ms, the lists' default) on its own thread; they start in AUTOMATIC / READY, as the
+/// controller does.
+pub struct Channels {
+    pub backend: Arc<dyn CncBackend>,
+    ticking: Option<Ticking>,
+    log: LogBytes,
+    pub params: Params,
+}
+
+impl Channels {
+    /// `n` channels with the lists of [`Params::new`].
+    pub fn start(n: u16) -> Channels {
+        Channels::from_params(Params::new(n))
+    }
+
+    pub fn from_params(params: Params) -> Channels {
+        let config = ncchannel::params::load(&params.startup()).unwrap();
+        let channels = ncchannel::setup::channels(&config, true).unwrap();
+        let log = LogBytes::default();
+        let machine = Machine::new(
+            channels,
+            EventLog::to_writer(Box::new(log.clone())),
+            StopWhen::Never,
+        );
+        let period = Duration::from_micros(config.runtime.cycle_period_us);
+        let (backend, ticking) = Ticking::start(machine, period).unwrap();
+        Channels {
+            backend: Arc::new(backend),
+            ticking: Some(ticking),
+            log,
+            params,
+        }
+    }
+
+    /// Channel `ch`'s status, asked through the backend as the objects ask.
+    pub fn status(&self, ch: u16) -> Status {
+        self.backend.status(ch).unwrap()
+    }
+
+    /// Apply `op` to channel `ch` directly (test set-up, not the object under test).
+    pub fn command(&self, ch: u16, op: Op) {
+        self.backend.command(ch, op).unwrap();
+    }
+
+    /// Wait (bounded) until channel `ch`'s status satisfies `done`; the last status.
+    pub fn wait_for(&self, ch: u16, within: Duration, done: impl Fn(&Status) -> bool) -> Status {
+        let deadline = Instant::now() + within;
+        loop {
+            let s = self.status(ch);
+            if done(&s) {
+                return s;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "not reached within {within:?}: {s:?}"
+            );
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    /// Stop the runtime and return the machine's event log as JSON values.
+    pub fn events(mut self) -> Vec<Value> {
+        let mut m: Machine = self.ticking.take().unwrap().stop().unwrap();
+        m.finish_log().unwrap();
+        let text = String::from_utf8(self.log.0.lock().unwrap().clone()).unwrap();
+        text.lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    }
+}
+
+/// Events of one kind (`ev`), in order.
+pub fn of<'a>(events: &'a [Value], ev: &str) -> Vec<&'a Value> {
+    events.iter().filter(|e| e["ev"] == ev).collect()
+}
+
+/// How many warnings with ISG number `code` the channels raised.
+pub fn warnings(events: &[Value], code: u64) -> usize {
+    of(events, "warning")
+        .iter()
+        .filter(|e| e["code"] == code)
+        .count()
+}
+
+/// Texts of the `block` events, in order: the lines the channel executed.
+pub fn block_texts(events: &[Value]) -> Vec<String> {
+    of(events, "block")
+        .iter()
+        .map(|e| e["text"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// A server on a loopback port over two real channels, with `config` otherwise.
+pub fn server_with(config: ServerConfig) -> (ServerHandle, Channels) {
+    serve(Channels::start(2), config)
+}
+
+/// A server on a loopback port over `channels`, with `config` otherwise.
+pub fn serve(channels: Channels, config: ServerConfig) -> (ServerHandle, Channels) {
     let config = ServerConfig {
         bind: "127.0.0.1:0".parse().unwrap(),
         ..config
     };
-    let handle = spawn(config, backend.clone()).expect("server starts");
-    (handle, backend)
+    let handle = spawn(config, Arc::clone(&channels.backend)).expect("server starts");
+    (handle, channels)
 }
 
-pub fn server() -> (ServerHandle, Arc<MemoryBackend>) {
-    server_with(ServerConfig::default(), DrainRate::default())
+/// The channels of `params` behind a server on a loopback port, as `ncchannel serve` runs them.
+pub struct Served {
+    pub server: ServerHandle,
+    pub channels: Channels,
+}
+
+impl Served {
+    pub fn start(params: Params) -> Served {
+        let (server, channels) = serve(Channels::from_params(params), ServerConfig::default());
+        Served { server, channels }
+    }
+
+    /// Shut the server down, stop the channels and return their event log.
+    pub fn finish(self) -> Vec<Value> {
+        self.server.shutdown();
+        self.channels.events()
+    }
+}
+
+pub fn server() -> (ServerHandle, Channels) {
+    server_with(ServerConfig::default())
 }
 
 pub fn device() -> AmsAddr {
