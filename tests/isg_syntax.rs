@@ -271,7 +271,6 @@ fn var_declarations_take_types_lists_and_block_numbers() {
     // Refused where the fault stands, in check and in a run alike.
     for (decl, col) in [
         ("V.L.ROW[3] = [1, 2, 3, 4]", 24),
-        ("V.L.S : STRING[5] = \"TOO LONG\"", 21),
         ("V.L.S : STRING[127]", 15),
         ("V.L.X : FLOAT", 9),
         ("V.L.X = [1, 2]", 11),
@@ -285,13 +284,170 @@ fn var_declarations_take_types_lists_and_block_numbers() {
             true,
         );
     }
-    // A string variable is not kept: using it is undefined.
+    // A start value longer than the STRING[n] declared: the kernel's 21462 at its quote.
+    fails_at(
+        &rig,
+        "G01 X1 F100\n#VAR\nV.L.S : STRING[5] = \"TOO LONG\"\n#ENDVAR\nM30\n",
+        21462,
+        3,
+        21,
+        true,
+    );
+    // A string variable keeps its string: used as a number it is 900008 at the word.
     fails_at(
         &rig,
         "#VAR\nV.L.S : STRING[5] = \"AB\"\n#ENDVAR\nG01 X[V.L.S] F100\nM30\n",
-        900005,
+        900008,
         4,
         5,
+        false,
+    );
+}
+
+#[test]
+fn string_variables_hold_compare_and_join_strings() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "#VAR\n\
+         \x20 V.L.NAME : STRING[20] = \"GRUNDPLATTE\"\n\
+         \x20 V.L.EMPTY : STRING[5]\n\
+         \x20 V.P.T : STRING[10] = \"abc\"\n\
+         \x20 V.S.K : STRING[8]\n\
+         \x20 V.L.ROW[2] : STRING[3] = \"x\"\n\
+         #ENDVAR\n\
+         $IF V.L.NAME == \"GRUNDPLATTE\"\n\
+         G01 X1 F1000\n\
+         $ENDIF\n\
+         $IF V.L.NAME != \"grundplatte\" && LEN[V.L.EMPTY] == 0\n\
+         G01 Y1 F1000\n\
+         $ENDIF\n\
+         V.L.EMPTY = \"ab\"\n\
+         V.S.K = V.P.T + V.L.EMPTY\n\
+         V.L.ROW[1] = LEFT[V.S.K, 2] + \"!\"\n\
+         G01 X[LEN[V.S.K]] Y[IS_STRING[V.S.K] + 2 * EXIST[V.S.K] + 4 * IS_NUMBER[V.S.K]] \
+         Z[FIND[V.L.NAME, \"PLATTE\"] + 10 * [V.L.ROW[1] == \"ab!\"] + 20 * [V.L.ROW[0] == \"x\"]]\n\
+         M30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (5.0, 3.0, 36.0)
+    );
+    // An undeclared V. variable assigned a string becomes a string variable.
+    let r = runs_clean(
+        &rig,
+        "V.L.NEW = \"abc\"\nG01 X[IS_STRING[V.L.NEW] + LEN[V.L.NEW]] F1000\nM30\n",
+    );
+    assert_eq!(r.position('X'), 4.0);
+    // A string variable passed as a cycle parameter is a string parameter.
+    rig.program(
+        "c.cyc",
+        "G01 X[IS_STRING[@P1] + 2 * [@P1 == \"abc\"]] Y[@P2] F1000\nM17\n",
+    );
+    let r = runs_clean(
+        &rig,
+        "#VAR\nV.L.S : STRING[5] = \"abc\"\n#ENDVAR\nL CYCLE [NAME=c.cyc @P1=V.L.S @P2=LEN[V.L.S]]\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (3.0, 3.0));
+    // Printed back, a declaration and a string expression parse to the same.
+    let d = parse_var_declaration("V.L.S : STRING[5] = \"ab c\"").unwrap();
+    assert_eq!(d.to_string(), "V.L.S : STRING[5]=\"ab c\"");
+    assert_eq!(parse_var_declaration(&d.to_string()).unwrap(), d);
+    let b = parse_block("V.L.S = MID[V.L.T + \"x\", 2, 1]").unwrap();
+    assert_eq!(b.to_string(), "V.L.S=MID[V.L.T + \"x\", 2, 1]");
+    assert_eq!(parse_block(&b.to_string()).unwrap(), b);
+}
+
+#[test]
+fn string_errors_are_the_kernels_at_their_place() {
+    let rig = Rig::new();
+    let decl = "#VAR\nV.L.S : STRING[3] = \"ab\"\nV.L.N = 1\n#ENDVAR\n";
+    // Longer than the variable holds: 21462 at the assignment.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = \"abcd\"\nM30\n"),
+        21462,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X1 F100 V.L.S = V.L.S + \"cd\"\nM30\n"),
+        21462,
+        5,
+        13,
+        false,
+    );
+    // A number into a STRING variable, a string into a number.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = 5\nM30\n"),
+        900009,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.N = V.L.S\nM30\n"),
+        900008,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}P1 = V.L.S\nM30\n"),
+        900008,
+        5,
+        1,
+        false,
+    );
+    // An operator strings do not take: 21458.
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X[V.L.S * 2] F100\nM30\n"),
+        21458,
+        5,
+        5,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X[V.L.S + 1] F100\nM30\n"),
+        21458,
+        5,
+        5,
+        false,
+    );
+    // A position outside the string: 21545.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = DELETE[\"Hello world!\", 7, 100]\nM30\n"),
+        21545,
+        5,
+        1,
+        false,
+    );
+    // A literal longer than 126 characters: 21870 at its quote, in check too.
+    let long = "y".repeat(127);
+    fails_at(
+        &rig,
+        &format!("G01 X1 F100\nV.L.S = \"{long}\"\nM30\n"),
+        21870,
+        2,
+        9,
+        true,
+    );
+    // Joined beyond 126 characters: 21870 where it is joined.
+    let half = "z".repeat(100);
+    fails_at(
+        &rig,
+        &format!("V.L.A = \"{half}\"\nV.L.B = V.L.A + V.L.A\nM30\n"),
+        21870,
+        2,
+        1,
         false,
     );
 }

@@ -502,6 +502,7 @@ fn var_declarations() {
             dims: vec![],
             ty: None,
             init: Some(Expr::Num(5.0)),
+            text: None,
             values: vec![]
         }
     );

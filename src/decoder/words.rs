@@ -10,6 +10,8 @@
 
 use super::modal::FeedMode;
 use super::*;
+use crate::lang::block::VarRef;
+use crate::lang::eval::Val;
 
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
@@ -158,8 +160,37 @@ impl Decoder {
         match it {
             Item::Assign { target, value, col } => {
                 let key = self.resolve(target).map_err(|e| e.at(*col))?;
-                let v = self.eval(value).map_err(|e| e.at(*col))?;
-                self.set_var(key, v)
+                if matches!(**target, VarRef::P { .. }) {
+                    // P parameters hold numbers: the plain numeric path.
+                    let v = self.eval(value).map_err(|e| e.at(*col))?;
+                    return self.set_var(key, v);
+                }
+                // A V. variable or @P may hold a string (docs/nc-language.md, "Strings").
+                let v = expr::eval_value(value, &expr::Env(self)).map_err(|e| e.at(*col))?;
+                // A string where numbers are kept, or a number in a STRING variable, is
+                // refused at the assignment's column; the store's other refusals as for P.
+                match v {
+                    Val::Num(v) => self.set_var(key, v).map_err(|e| {
+                        if e.code == codes::EVAL_NUMBER_AS_STRING {
+                            e.at(*col)
+                        } else {
+                            e
+                        }
+                    }),
+                    Val::Str(s) => self.vars.set_str(key, &s).map_err(|e| {
+                        let string_fault = matches!(
+                            e,
+                            vars::VarError::StringTooLong { .. }
+                                | vars::VarError::StringToNumber(_)
+                        );
+                        let e = var_error(e);
+                        if string_fault {
+                            e.at(*col)
+                        } else {
+                            e
+                        }
+                    }),
+                }
             }
             Item::GValue { g, value, col } => {
                 // G132..G134 weight ramps (no effect here); G04's value is its time.

@@ -171,6 +171,37 @@ pub enum Expr {
     /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]`: a question about a variable rather than
     /// its value (1 or 0), so an undefined `v` is no error here.
     Test(VarTest, Box<VarRef>),
+    /// A quoted string `"text"` (at most [`MAX_STRING`] characters, no quote inside).
+    Str(Box<str>),
+    /// A string function (TF5200 programming manual, "Operations for character strings"):
+    /// `LEN["abc"]`, `MID[V.L.S, 3, 5]`.
+    StrFunc(StrFunc, Vec<Expr>),
+}
+
+/// Most characters a string value holds: a `STRING[n]` declares n of 1 to 126 (TF5200
+/// programming manual, "Variables"; ISG's editor grammar), and no string value is longer.
+pub const MAX_STRING: usize = 126;
+
+/// The string functions of TF5200 "Operations for character strings" ncchannel evaluates.
+/// Positions count characters from 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrFunc {
+    /// `LEN[str]`: the number of characters.
+    Len,
+    /// `LEFT[str, anz]`: the first anz characters.
+    Left,
+    /// `RIGHT[str, anz]`: the last anz characters.
+    Right,
+    /// `MID[str, anz, pos]`: anz characters from position pos.
+    Mid,
+    /// `FIND[str1, str2]`: the position of str2's first occurrence in str1 (case-sensitive),
+    /// 0 when there is none.
+    Find,
+    /// `ORD[str]`, `ORD[str, pos]`: the character value at pos (1 when not given).
+    Ord,
+    /// `DELETE[str, anz, pos]`: str without the anz characters from position pos (TF5200
+    /// diagnosis 21545's example).
+    Delete,
 }
 
 /// What `Expr::Test` asks about its variable.
@@ -180,7 +211,8 @@ pub enum VarTest {
     Exist,
     /// `IS_NUMBER[v]`: `v` holds a number.
     IsNumber,
-    /// `IS_STRING[v]`: `v` holds a string (a cycle parameter `@P1="text"`).
+    /// `IS_STRING[v]`: `v` holds a string (a `STRING[n]` variable, a cycle parameter
+    /// `@P1="text"`).
     IsString,
 }
 
@@ -417,6 +449,8 @@ pub struct VarDecl {
     pub ty: Option<VarType>,
     /// The value every element starts with (`= 5`); none for a list or a string.
     pub init: Option<Expr>,
+    /// The start value of a `STRING[n]` variable (`= "GRUNDPLATTE"`), without its quotes.
+    pub text: Option<String>,
     /// An array initialiser `= [10, 11, 12]`: the first elements in row-major order (the
     /// rest stay 0). Empty when there is none.
     pub values: Vec<Expr>,
@@ -435,8 +469,8 @@ pub enum VarType {
     Uns32,
     /// `REAL` or `REAL64`.
     Real,
-    /// `STRING[n]`, n characters at most (1 to 126). ncchannel's values are numbers: a
-    /// string variable is accepted and not kept (docs/nc-language.md, "Variables").
+    /// `STRING[n]`, n characters at most (1 to [`MAX_STRING`]): the variable holds a
+    /// string (docs/nc-language.md, "Strings").
     String(u8),
 }
 

@@ -15,8 +15,8 @@ use super::block::{
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, SYNTAX, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G,
-    UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, TOO_MANY_INDICES,
+    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -1360,9 +1360,12 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
     }
     let (r, ty) = var_type(ws(r), r)?;
     let j = ws(r);
+    let mut text = None;
     let (r, init, values) = match j.strip_prefix('=') {
         Some(k) if matches!(ty, Some(VarType::String(_))) => {
-            (string_init(ws(k), ty)?, None, Vec::new())
+            let (r, t) = string_init(ws(k), ty)?;
+            text = Some(t.to_string());
+            (r, None, Vec::new())
         }
         Some(k) if !dims.is_empty() && is_list(ws(k)) => {
             let (r, values) = init_list(ctx, ws(k), elements)?;
@@ -1381,6 +1384,7 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
         dims,
         ty,
         init,
+        text,
         values,
     })
 }
@@ -1429,8 +1433,9 @@ fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
     Ok((&t[len..], Some(ty)))
 }
 
-/// The quoted start value of a `STRING[n]` variable, at most n characters.
-fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>> {
+/// The quoted start value of a `STRING[n]` variable, at most n characters (longer: the
+/// kernel's 21462 at the quote); the rest of the line and the text without its quotes.
+fn string_init(i: &str, ty: Option<VarType>) -> Result<(&str, &str), nom::Err<PErr<'_>>> {
     let Some(q) = i.strip_prefix('"') else {
         return Err(perr(
             i,
@@ -1445,14 +1450,15 @@ fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>>
         Some(VarType::String(n)) => usize::from(n),
         _ => 0,
     };
-    if q[..end].chars().count() > max {
+    let len = q[..end].chars().count();
+    if len > max {
         return Err(perr(
             i,
-            SYNTAX,
-            format!("text longer than the STRING[{max}] declared"),
+            STRING_TOO_LONG_FOR_VARIABLE,
+            format!("text of {len} characters longer than the STRING[{max}] declared"),
         ));
     }
-    Ok(&q[end + 1..])
+    Ok((&q[end + 1..], &q[..end]))
 }
 
 /// Does `[` open a list (`[10, 11, 12]`: a comma outside inner brackets) rather than a
