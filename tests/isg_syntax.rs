@@ -226,8 +226,10 @@ fn an_axis_takes_an_expression_after_an_equals_sign() {
         (r.position('X'), r.position('Y'), r.position('Z')),
         (10.0, 5.0, -6.0)
     );
-    // Axis names are X Y Z A B C (src/params/axes.rs): no axis is called A1.
-    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 4, true);
+    // `A1 = 0` names the axis A1 (a name of more than one character takes `=`), which this
+    // channel does not have: 20200 at the name in a run; `check` has no channel to ask.
+    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 1, false);
+    assert_eq!(check_places("G01 X1 F100\nA1 = 0\nM30\n"), []);
     // F, S and the other addresses keep their plain form.
     assert_eq!(parse_block("F=100").unwrap_err().col, 2);
 }
@@ -687,4 +689,59 @@ fn v_g_tool_radii_come_from_the_tool_list() {
     fails_at(&rig, "G01 X[V.G.FEEDRATE] F100\nM30\n", 900133, 1, 11, true);
     fails_at(&rig, "G01 X[V.G.WZ_AKT.L] F100\nM30\n", 900133, 1, 18, true);
     fails_at(&rig, "V.G.WZ[1].R = 2\nM30\n", 20200, 1, 1, true);
+}
+
+/// A runtime.toml whose axes are named `X1`, `Y` and `A1`.
+fn named_axes_rig() -> Rig {
+    let axis = |name: &str| {
+        format!(
+            "[[axes]]\nname = \"{name}\"\nmax_velocity_mm_per_min = 30000.0\n\
+             max_acceleration_mm_per_s2 = 2000.0\nrapid_mm_per_min = 30000.0\n"
+        )
+    };
+    Rig::with_runtime(&format!("{}{}{}", axis("X1"), axis("Y"), axis("A1")))
+}
+
+#[test]
+fn axes_named_with_digits_take_an_equals_sign() {
+    let rig = named_axes_rig();
+    let r = runs_clean(
+        &rig,
+        "P1 = 2\nG01 X1=10 Y5 F1000\nX1 = P1 + 12 A1=90\nG01 X1=P1*3 F1000\nM30\n",
+    );
+    assert_eq!(
+        r.machine.channels()[0]
+            .named_positions()
+            .into_iter()
+            .map(|(n, v)| (n.to_string(), v))
+            .collect::<Vec<_>>(),
+        [
+            ("X1".to_string(), 6.0),
+            ("Y".to_string(), 5.0),
+            ("A1".to_string(), 90.0)
+        ]
+    );
+    // Printed back, a named axis parses to the same block.
+    let b = parse_block("G01 X1 = P1 + 2 Y5").unwrap();
+    assert_eq!(b.to_string(), "G1 X1=P1 + 2 Y5");
+    assert_eq!(
+        parse_block(&b.to_string()).unwrap().to_string(),
+        b.to_string()
+    );
+    // Without `=`, X10 is X with 10 — and this channel's X axis is X1: X alone is no axis.
+    fails_at(&rig, "G01 X10 F1000\nM30\n", 20200, 1, 5, false);
+    // A name the channel does not have, and one named twice.
+    fails_at(&rig, "G01 Z1=5 F1000\nM30\n", 20200, 1, 5, false);
+    fails_at(&rig, "G01 X1=5 X1=6 F1000\nM30\n", 20203, 1, 10, false);
+    // Too long a name is 20200 at the name, in check too.
+    fails_at(
+        &rig,
+        "G01 X123456789012345678=5 F1000\nM30\n",
+        20200,
+        1,
+        5,
+        true,
+    );
+    // An ordinary channel: `X1=5` names an axis it does not have.
+    fails_at(&Rig::new(), "G01 X1=5 F1000\nM30\n", 20200, 1, 5, false);
 }

@@ -76,12 +76,82 @@ pub enum Item {
         value: Value,
         col: u32,
     },
+    /// An axis named by more than its letter, `X1=10`, `Z_ACHSE = P1` (TF5200 programming
+    /// manual, "Axis commands": such a name takes `=` before its value). Boxed: rare, and
+    /// `Item` keeps its size. `col` is the name's column.
+    NamedAxis(Box<NamedAxis>),
     /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
     /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
     /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None` (trailing gaps are dropped).
     /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
     /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
     GCall(Box<GCall>),
+}
+
+/// An axis named by more than its letter with its value ([`Item::NamedAxis`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedAxis {
+    pub name: AxisName,
+    pub value: Value,
+    pub col: u32,
+}
+
+/// Most characters of an axis name (P-CHAN-00006 `bezeichnung`: "maximum 16 characters").
+pub const AXIS_NAME_MAX: usize = 16;
+
+/// An axis name: a letter X Y Z A B C, then letters, digits and `_` (`X1`, `A1`, `Z_ACHSE`),
+/// at most [`AXIS_NAME_MAX`] characters, upper-case. Fixed size, no allocation: the decoder
+/// compares it with the channel's table, resolved once at set-up.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct AxisName {
+    bytes: [u8; AXIS_NAME_MAX],
+    len: u8,
+}
+
+impl AxisName {
+    /// `name` as an axis name, or `None` if it is not one ncchannel can drive.
+    pub fn new(name: &str) -> Option<Self> {
+        let b = name.as_bytes();
+        let first = b.first()?.to_ascii_uppercase();
+        if b.len() > AXIS_NAME_MAX
+            || !b"XYZABC".contains(&first)
+            || !b[1..]
+                .iter()
+                .all(|c| c.is_ascii_alphanumeric() || *c == b'_')
+        {
+            return None;
+        }
+        let mut bytes = [0u8; AXIS_NAME_MAX];
+        for (d, s) in bytes.iter_mut().zip(b) {
+            *d = s.to_ascii_uppercase();
+        }
+        Some(AxisName {
+            bytes,
+            len: b.len() as u8,
+        })
+    }
+
+    /// The axis letter the name starts with: the interpolator slot the axis takes.
+    pub fn letter(&self) -> u8 {
+        self.bytes[0]
+    }
+
+    pub fn as_str(&self) -> &str {
+        // Built from ASCII only.
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
+    }
+}
+
+impl std::fmt::Display for AxisName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for AxisName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "AxisName({})", self.as_str())
+    }
 }
 
 /// An implicit subroutine call's G number, transfer parameters and column ([`Item::GCall`]).

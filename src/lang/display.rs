@@ -108,6 +108,10 @@ impl Display for Item {
                     Value::Expr(e) => write!(f, "{l}{number}={e}"),
                 }
             }
+            Item::NamedAxis(a) => match &a.value {
+                Value::Num(v) => write!(f, "{}={}", a.name, Num(*v)),
+                Value::Expr(e) => write!(f, "{}={e}", a.name),
+            },
             Item::GCall(c) => {
                 write!(f, "G{}[", c.g)?;
                 for (k, a) in c.args.iter().enumerate() {

@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Item, Label,
-    SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, FlushKind, GotoTarget, Item,
+    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -359,7 +359,9 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) => false,
+        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) | Item::NamedAxis(_) => {
+            false
+        }
     }
 }
 
@@ -408,6 +410,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
+            Item::NamedAxis(a) => (a.col, a.name.to_string()),
         };
         return Err(ctx.err_at(
             col,
@@ -432,6 +435,15 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
+    if crate::queue::AXIS_LETTERS.contains(&up)
+        && ab
+            .first()
+            .is_some_and(|&c| c.is_ascii_alphanumeric() || c == b'_')
+    {
+        if let Some(r) = named_axis(ctx, i, col, items)? {
+            return Ok(r);
+        }
+    }
     let (neg, skip) = match ab.first() {
         Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
         Some(b'P' | b'p' | b'V' | b'v' | b'@') if starts_variable(ab) => {
@@ -540,6 +552,41 @@ fn function_value<'a>(
     Ok(r)
 }
 
+/// `X1=10`, `Z_ACHSE = P1*2` (`i` at the name): an axis name of more than one character,
+/// which takes `=` before its value (TF5200 programming manual, "Axis commands"). `None`
+/// when no `=` follows the name (`X10 Y5` is X with 10). A name longer than
+/// [`AXIS_NAME_MAX`] is 20200 at the name.
+#[cold]
+fn named_axis<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    col: u32,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let len = i
+        .bytes()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == b'_')
+        .count();
+    let after = ws(&i[len..]);
+    if !after.starts_with('=') || after.starts_with("==") {
+        return Ok(None);
+    }
+    let Some(name) = AxisName::new(&i[..len]) else {
+        return Err(perr(
+            i,
+            SYNTAX,
+            format!("axis name longer than {AXIS_NAME_MAX} characters"),
+        ));
+    };
+    let (r, e) = ctx.expr(ws(&after[1..]))?;
+    items.push(Item::NamedAxis(Box::new(NamedAxis {
+        name,
+        value: expr_value(e),
+        col,
+    })));
+    Ok(Some(r))
+}
+
 /// `X=10`, `X = P1+2`: an axis given an expression after an equals sign.
 #[cold]
 fn axis_assigned<'a>(
@@ -558,8 +605,8 @@ fn axis_assigned<'a>(
     Ok(r)
 }
 
-/// An axis name: X Y Z A B C and the further axis names U V W. Axis names with digits
-/// (`A1`) are not configurable (`src/params/axes.rs`), so `A1 = 0` stays refused.
+/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`) are
+/// [`named_axis`]'s.
 fn is_axis_letter(up: u8) -> bool {
     matches!(
         up,
