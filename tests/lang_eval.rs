@@ -296,3 +296,17 @@ fn string_errors_are_the_kernels() {
     }
     assert_eq!(ev("LEN[\"abc\"] * 2"), 6.0);
 }
+
+/// A string holds what a comment would start (`;`, `(`): the quotes come first.
+#[test]
+fn quoted_text_is_not_a_comment() {
+    for (t, printed) in [
+        ("V.L.S = \"a;b\"", "V.L.S=\"a;b\""),
+        ("V.L.S = \"a (b) c\" ; comment", "V.L.S=\"a (b) c\""),
+        ("$IF V.L.S == \"x(y)\"", "$IF V.L.S == \"x(y)\""),
+        ("V.L.S = \"\"", "V.L.S=\"\""),
+    ] {
+        let b = parse_block(t).unwrap_or_else(|e| panic!("{t}: {e}"));
+        assert_eq!(b.to_string(), printed, "{t}");
+    }
+}
