@@ -405,6 +405,18 @@ impl Channel {
         self.positions_less(&[0.0; MAX_AXES])
     }
 
+    /// The position of each configured axis under its configured name (`X`, `X1`), in
+    /// `AXIS_LETTERS` order. [`Channel::axis_positions`] names each by its slot's letter.
+    pub fn named_positions(&self) -> Vec<(crate::lang::block::AxisName, f64)> {
+        let p = self.motion.position();
+        let configured = self.decoder.axes();
+        let names = self.decoder.axis_names();
+        (0..MAX_AXES)
+            .filter(|&i| configured[i])
+            .map(|i| (names[i], p[i]))
+            .collect()
+    }
+
     /// The configured axes' positions minus `offset`, in `AXIS_LETTERS` order.
     fn positions_less(&self, offset: &Position) -> Vec<(char, f64)> {
         let p = self.motion.position();

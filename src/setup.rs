@@ -15,7 +15,9 @@ use crate::vocab::axis::MAX_AXES;
 
 #[derive(Debug, Error)]
 pub enum SetupError {
-    #[error("axis '{0}': ncchannel knows the axes X Y Z A B C")]
+    #[error(
+        "axis '{0}': ncchannel knows the axes X Y Z A B C (or a name starting with one, as X1)"
+    )]
     UnknownAxis(String),
     #[error("channel {0} does not exist (the start-up list has {1})")]
     NoSuchChannel(u32, usize),
@@ -59,6 +61,12 @@ pub fn channel_settings(
     let axes = channel_axes(ch)?;
     let mut enabled = [false; MAX_AXES];
     let mut soft_limits_mm = [SoftLimits::default(); MAX_AXES];
+    let mut axis_names = crate::decoder::letter_names();
+    for (a, c) in axes.iter().zip(&ch.axes) {
+        if let Some(n) = crate::lang::block::AxisName::new(c.name.trim()) {
+            axis_names[a.index] = n;
+        }
+    }
     for a in &axes {
         enabled[a.index] = true;
         soft_limits_mm[a.index] = SoftLimits {
@@ -71,6 +79,7 @@ pub fn channel_settings(
         blocks_per_tick: rt.decoder.blocks_per_tick.max(1) as usize,
         max_depth: rt.decoder.max_subroutine_depth as usize,
         axes: enabled,
+        axis_names,
         zero_offsets: ch.zero_offsets,
         soft_limits_mm,
         implicit: ch.implicit.clone(),

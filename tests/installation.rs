@@ -429,3 +429,49 @@ fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
             end: ncchannel::report::event::ProgramEndKind::M30
         }));
 }
+
+/// P-CHAN-00006 names an axis `X1` (a name of more than one character): the program writes
+/// `X1=…`, and the axis takes X's slot (TF5200 programming manual, "Axis commands").
+#[test]
+fn an_axis_named_x1_in_the_channel_list_is_programmed_as_x1_equals() {
+    let i = Installation::new(
+        "gruppe[0].achse[0].bezeichnung X1\ngruppe[0].achse[2].bezeichnung Z_ACHSE\n",
+    );
+    i.write(
+        "prg/named.nc",
+        "N10 G01 X1=20 Y5 F6000\nN20 Z_ACHSE = 2 * 3\nN30 M30\n",
+    );
+    let mut c = i.channel();
+    c.start(&tick(0), "named.nc").unwrap();
+    let ev = run(&mut c, &[], 20_000);
+    end_tick(&ev);
+    let named: Vec<(String, f64)> = c
+        .named_positions()
+        .into_iter()
+        .map(|(n, v)| (n.to_string(), v))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            ("X1".to_string(), 20.0),
+            ("Y".to_string(), 5.0),
+            ("Z_ACHSE".to_string(), 6.0)
+        ]
+    );
+    // X alone is no axis of this channel.
+    i.write("prg/bare.nc", "N10 G01 X20 F6000\nN20 M30\n");
+    let mut c = i.channel();
+    c.start(&tick(0), "bare.nc").unwrap();
+    let ev = run(&mut c, &[], 20_000);
+    assert!(
+        ev.iter()
+            .any(|(_, e)| matches!(e, EventKind::Error { code: 20200, .. })),
+        "{ev:#?}"
+    );
+    // Two axes in X's slot are refused by the parameter check.
+    let i = Installation::new("gruppe[0].achse[1].bezeichnung X2\n");
+    let e = ncchannel::params::load(&i.startup())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("takes the slot of axis `X`"), "{e}");
+}

@@ -226,8 +226,10 @@ fn an_axis_takes_an_expression_after_an_equals_sign() {
         (r.position('X'), r.position('Y'), r.position('Z')),
         (10.0, 5.0, -6.0)
     );
-    // Axis names are X Y Z A B C (src/params/axes.rs): no axis is called A1.
-    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 4, true);
+    // `A1 = 0` names the axis A1 (a name of more than one character takes `=`), which this
+    // channel does not have: 20200 at the name in a run; `check` has no channel to ask.
+    fails_at(&rig, "G01 X1 F100\nA1 = 0\nM30\n", 20200, 2, 1, false);
+    assert_eq!(check_places("G01 X1 F100\nA1 = 0\nM30\n"), []);
     // F, S and the other addresses keep their plain form.
     assert_eq!(parse_block("F=100").unwrap_err().col, 2);
 }
@@ -271,7 +273,6 @@ fn var_declarations_take_types_lists_and_block_numbers() {
     // Refused where the fault stands, in check and in a run alike.
     for (decl, col) in [
         ("V.L.ROW[3] = [1, 2, 3, 4]", 24),
-        ("V.L.S : STRING[5] = \"TOO LONG\"", 21),
         ("V.L.S : STRING[127]", 15),
         ("V.L.X : FLOAT", 9),
         ("V.L.X = [1, 2]", 11),
@@ -285,13 +286,170 @@ fn var_declarations_take_types_lists_and_block_numbers() {
             true,
         );
     }
-    // A string variable is not kept: using it is undefined.
+    // A start value longer than the STRING[n] declared: the kernel's 21462 at its quote.
+    fails_at(
+        &rig,
+        "G01 X1 F100\n#VAR\nV.L.S : STRING[5] = \"TOO LONG\"\n#ENDVAR\nM30\n",
+        21462,
+        3,
+        21,
+        true,
+    );
+    // A string variable keeps its string: used as a number it is 900008 at the word.
     fails_at(
         &rig,
         "#VAR\nV.L.S : STRING[5] = \"AB\"\n#ENDVAR\nG01 X[V.L.S] F100\nM30\n",
-        900005,
+        900008,
         4,
         5,
+        false,
+    );
+}
+
+#[test]
+fn string_variables_hold_compare_and_join_strings() {
+    let rig = Rig::new();
+    let r = runs_clean(
+        &rig,
+        "#VAR\n\
+         \x20 V.L.NAME : STRING[20] = \"GRUNDPLATTE\"\n\
+         \x20 V.L.EMPTY : STRING[5]\n\
+         \x20 V.P.T : STRING[10] = \"abc\"\n\
+         \x20 V.S.K : STRING[8]\n\
+         \x20 V.L.ROW[2] : STRING[3] = \"x\"\n\
+         #ENDVAR\n\
+         $IF V.L.NAME == \"GRUNDPLATTE\"\n\
+         G01 X1 F1000\n\
+         $ENDIF\n\
+         $IF V.L.NAME != \"grundplatte\" && LEN[V.L.EMPTY] == 0\n\
+         G01 Y1 F1000\n\
+         $ENDIF\n\
+         V.L.EMPTY = \"ab\"\n\
+         V.S.K = V.P.T + V.L.EMPTY\n\
+         V.L.ROW[1] = LEFT[V.S.K, 2] + \"!\"\n\
+         G01 X[LEN[V.S.K]] Y[IS_STRING[V.S.K] + 2 * EXIST[V.S.K] + 4 * IS_NUMBER[V.S.K]] \
+         Z[FIND[V.L.NAME, \"PLATTE\"] + 10 * [V.L.ROW[1] == \"ab!\"] + 20 * [V.L.ROW[0] == \"x\"]]\n\
+         M30\n",
+    );
+    assert_eq!(
+        (r.position('X'), r.position('Y'), r.position('Z')),
+        (5.0, 3.0, 36.0)
+    );
+    // An undeclared V. variable assigned a string becomes a string variable.
+    let r = runs_clean(
+        &rig,
+        "V.L.NEW = \"abc\"\nG01 X[IS_STRING[V.L.NEW] + LEN[V.L.NEW]] F1000\nM30\n",
+    );
+    assert_eq!(r.position('X'), 4.0);
+    // A string variable passed as a cycle parameter is a string parameter.
+    rig.program(
+        "c.cyc",
+        "G01 X[IS_STRING[@P1] + 2 * [@P1 == \"abc\"]] Y[@P2] F1000\nM17\n",
+    );
+    let r = runs_clean(
+        &rig,
+        "#VAR\nV.L.S : STRING[5] = \"abc\"\n#ENDVAR\nL CYCLE [NAME=c.cyc @P1=V.L.S @P2=LEN[V.L.S]]\nM30\n",
+    );
+    assert_eq!((r.position('X'), r.position('Y')), (3.0, 3.0));
+    // Printed back, a declaration and a string expression parse to the same.
+    let d = parse_var_declaration("V.L.S : STRING[5] = \"ab c\"").unwrap();
+    assert_eq!(d.to_string(), "V.L.S : STRING[5]=\"ab c\"");
+    assert_eq!(parse_var_declaration(&d.to_string()).unwrap(), d);
+    let b = parse_block("V.L.S = MID[V.L.T + \"x\", 2, 1]").unwrap();
+    assert_eq!(b.to_string(), "V.L.S=MID[V.L.T + \"x\", 2, 1]");
+    assert_eq!(parse_block(&b.to_string()).unwrap(), b);
+}
+
+#[test]
+fn string_errors_are_the_kernels_at_their_place() {
+    let rig = Rig::new();
+    let decl = "#VAR\nV.L.S : STRING[3] = \"ab\"\nV.L.N = 1\n#ENDVAR\n";
+    // Longer than the variable holds: 21462 at the assignment.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = \"abcd\"\nM30\n"),
+        21462,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X1 F100 V.L.S = V.L.S + \"cd\"\nM30\n"),
+        21462,
+        5,
+        13,
+        false,
+    );
+    // A number into a STRING variable, a string into a number.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = 5\nM30\n"),
+        900009,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.N = V.L.S\nM30\n"),
+        900008,
+        5,
+        1,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}P1 = V.L.S\nM30\n"),
+        900008,
+        5,
+        1,
+        false,
+    );
+    // An operator strings do not take: 21458.
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X[V.L.S * 2] F100\nM30\n"),
+        21458,
+        5,
+        5,
+        false,
+    );
+    fails_at(
+        &rig,
+        &format!("{decl}G01 X[V.L.S + 1] F100\nM30\n"),
+        21458,
+        5,
+        5,
+        false,
+    );
+    // A position outside the string: 21545.
+    fails_at(
+        &rig,
+        &format!("{decl}V.L.S = DELETE[\"Hello world!\", 7, 100]\nM30\n"),
+        21545,
+        5,
+        1,
+        false,
+    );
+    // A literal longer than 126 characters: 21870 at its quote, in check too.
+    let long = "y".repeat(127);
+    fails_at(
+        &rig,
+        &format!("G01 X1 F100\nV.L.S = \"{long}\"\nM30\n"),
+        21870,
+        2,
+        9,
+        true,
+    );
+    // Joined beyond 126 characters: 21870 where it is joined.
+    let half = "z".repeat(100);
+    fails_at(
+        &rig,
+        &format!("V.L.A = \"{half}\"\nV.L.B = V.L.A + V.L.A\nM30\n"),
+        21870,
+        2,
+        1,
         false,
     );
 }
@@ -555,4 +713,59 @@ fn a_comment_block_may_stand_among_var_declarations() {
         check_places("#VAR\n#COMMENT BEGIN\n#ENDVAR\nM30\n"),
         [(1, 1, 20375), (2, 1, 20375)],
     );
+}
+
+/// A runtime.toml whose axes are named `X1`, `Y` and `A1`.
+fn named_axes_rig() -> Rig {
+    let axis = |name: &str| {
+        format!(
+            "[[axes]]\nname = \"{name}\"\nmax_velocity_mm_per_min = 30000.0\n\
+             max_acceleration_mm_per_s2 = 2000.0\nrapid_mm_per_min = 30000.0\n"
+        )
+    };
+    Rig::with_runtime(&format!("{}{}{}", axis("X1"), axis("Y"), axis("A1")))
+}
+
+#[test]
+fn axes_named_with_digits_take_an_equals_sign() {
+    let rig = named_axes_rig();
+    let r = runs_clean(
+        &rig,
+        "P1 = 2\nG01 X1=10 Y5 F1000\nX1 = P1 + 12 A1=90\nG01 X1=P1*3 F1000\nM30\n",
+    );
+    assert_eq!(
+        r.machine.channels()[0]
+            .named_positions()
+            .into_iter()
+            .map(|(n, v)| (n.to_string(), v))
+            .collect::<Vec<_>>(),
+        [
+            ("X1".to_string(), 6.0),
+            ("Y".to_string(), 5.0),
+            ("A1".to_string(), 90.0)
+        ]
+    );
+    // Printed back, a named axis parses to the same block.
+    let b = parse_block("G01 X1 = P1 + 2 Y5").unwrap();
+    assert_eq!(b.to_string(), "G1 X1=P1 + 2 Y5");
+    assert_eq!(
+        parse_block(&b.to_string()).unwrap().to_string(),
+        b.to_string()
+    );
+    // Without `=`, X10 is X with 10 — and this channel's X axis is X1: X alone is no axis.
+    fails_at(&rig, "G01 X10 F1000\nM30\n", 20200, 1, 5, false);
+    // A name the channel does not have, and one named twice.
+    fails_at(&rig, "G01 Z1=5 F1000\nM30\n", 20200, 1, 5, false);
+    fails_at(&rig, "G01 X1=5 X1=6 F1000\nM30\n", 20203, 1, 10, false);
+    // Too long a name is 20200 at the name, in check too.
+    fails_at(
+        &rig,
+        "G01 X123456789012345678=5 F1000\nM30\n",
+        20200,
+        1,
+        5,
+        true,
+    );
+    // An ordinary channel: `X1=5` names an axis it does not have.
+    fails_at(&Rig::new(), "G01 X1=5 F1000\nM30\n", 20200, 1, 5, false);
 }

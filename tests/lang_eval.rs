@@ -200,3 +200,113 @@ fn truth_and_case_tolerances() {
     assert!(!case_matches(5.0, 5.001));
     assert!(case_matches(-1.0, -0.9995));
 }
+
+/// A store with strings beside numbers, as the decoder's `STRING[n]` variables are.
+#[derive(Default)]
+struct Texts(HashMap<String, String>);
+
+impl Vars for Texts {
+    fn get(&self, _key: &VarKey<'_>) -> Option<f64> {
+        None
+    }
+    fn get_str(&self, key: &VarKey<'_>) -> Option<&str> {
+        self.0.get(&key.to_string()).map(String::as_str)
+    }
+}
+
+fn val(text: &str) -> Val {
+    let vars = Texts(
+        [
+            ("V.E.STR1", "Hello world! How are you?"),
+            ("V.E.STR2", "How"),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect(),
+    );
+    let e = parse_expr(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+    eval_value(&e, &vars).unwrap_or_else(|e| panic!("{text}: {e}"))
+}
+
+fn s(t: &str) -> Val {
+    Val::Str(t.to_string())
+}
+
+fn val_err(text: &str) -> u32 {
+    let e = parse_expr(text).unwrap_or_else(|e| panic!("{text}: {e}"));
+    eval_value(&e, &Texts::default()).unwrap_err().code()
+}
+
+/// The examples of TF5200 "Operations for character strings", and DELETE as diagnosis
+/// 21545's example calls it.
+#[test]
+fn string_functions_give_the_manuals_results() {
+    assert_eq!(val("\"Hello\" + \" world!\""), s("Hello world!"));
+    assert_eq!(val("LEFT[\"Hello world!\", 5]"), s("Hello"));
+    assert_eq!(val("MID[\"How are you?\", 3, 5]"), s("are"));
+    assert_eq!(
+        val("RIGHT[\"Hello world! How are you?\", 12]"),
+        s("How are you?")
+    );
+    assert_eq!(val("LEN[\"Hello world! How are you?\"]"), Val::Num(25.0));
+    assert_eq!(val("ORD[\"Hello world!\", 1]"), Val::Num(72.0));
+    assert_eq!(val("ORD[\"Hello world!\", 7]"), Val::Num(119.0));
+    assert_eq!(val("ORD[\"Hello\"]"), Val::Num(72.0));
+    assert_eq!(val("FIND[V.E.STR1, V.E.STR2]"), Val::Num(14.0));
+    assert_eq!(
+        val("FIND[V.E.STR1, \"how\"]"),
+        Val::Num(0.0),
+        "case-sensitive"
+    );
+    assert_eq!(val("DELETE[\"Hello world!\", 7, 5]"), s("Hell!"));
+    assert_eq!(val("\"abc\" == \"abc\""), Val::Num(1.0));
+    assert_eq!(val("\"abc\" != \"abC\""), Val::Num(1.0));
+    assert_eq!(val("LEFT[V.E.STR2, 2] + \"!\" == \"Ho!\""), Val::Num(1.0));
+    // Numbers stay numbers.
+    assert_eq!(val("2 + 3"), Val::Num(5.0));
+    // Characters, not bytes.
+    assert_eq!(val("LEN[\"Größe\"]"), Val::Num(5.0));
+    assert_eq!(val("MID[\"Größe\", 2, 3]"), s("öß"));
+}
+
+#[test]
+fn string_errors_are_the_kernels() {
+    assert_eq!(val_err("DELETE[\"Hello world!\", 7, 100]"), 21545);
+    assert_eq!(val_err("MID[\"abc\", 3, 2]"), 21545, "past the end");
+    assert_eq!(val_err("LEFT[\"abc\", -1]"), 21545);
+    assert_eq!(val_err("ORD[\"abc\", 4]"), 21545);
+    assert_eq!(val_err("\"a\" - \"b\""), 21458);
+    assert_eq!(val_err("\"a\" < \"b\""), 21458);
+    assert_eq!(val_err("\"a\" + 1"), 21458);
+    assert_eq!(val_err("LEN[5]"), 900009);
+    let long = "x".repeat(100);
+    assert_eq!(val_err(&format!("\"{long}\" + \"{long}\"")), 21870);
+    // A literal longer than a string may be is refused by the parser.
+    let e = parse_expr(&format!("\"{}\"", "y".repeat(127))).unwrap_err();
+    assert_eq!((e.code, e.col), (21870, 1));
+    // Where a number is needed, a string is 900008.
+    for text in ["\"abc\"", "LEFT[\"abc\", 1]", "\"a\" + \"b\"", "SIN[\"a\"]"] {
+        assert_eq!(
+            eval(&parse_expr(text).unwrap(), &Texts::default())
+                .unwrap_err()
+                .code(),
+            900008,
+            "{text}"
+        );
+    }
+    assert_eq!(ev("LEN[\"abc\"] * 2"), 6.0);
+}
+
+/// A string holds what a comment would start (`;`, `(`): the quotes come first.
+#[test]
+fn quoted_text_is_not_a_comment() {
+    for (t, printed) in [
+        ("V.L.S = \"a;b\"", "V.L.S=\"a;b\""),
+        ("V.L.S = \"a (b) c\" ; comment", "V.L.S=\"a (b) c\""),
+        ("$IF V.L.S == \"x(y)\"", "$IF V.L.S == \"x(y)\""),
+        ("V.L.S = \"\"", "V.L.S=\"\""),
+    ] {
+        let b = parse_block(t).unwrap_or_else(|e| panic!("{t}: {e}"));
+        assert_eq!(b.to_string(), printed, "{t}");
+    }
+}

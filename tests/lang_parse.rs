@@ -24,6 +24,7 @@ fn without_cols(mut b: Block) -> Block {
                 | Item::GValue { col, .. }
                 | Item::FunctionValue { col, .. } => *col = 0,
                 Item::GCall(c) => c.col = 0,
+                Item::NamedAxis(a) => a.col = 0,
             }
         }
     }
@@ -503,6 +504,7 @@ fn var_declarations() {
             dims: vec![],
             ty: None,
             init: Some(Expr::Num(5.0)),
+            text: None,
             values: vec![]
         }
     );

@@ -345,6 +345,7 @@ fn without_cols(mut b: Block) -> Block {
                 | Item::GValue { col, .. }
                 | Item::FunctionValue { col, .. } => *col = 0,
                 Item::GCall(c) => c.col = 0,
+                Item::NamedAxis(a) => a.col = 0,
             }
         }
     }

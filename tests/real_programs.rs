@@ -77,6 +77,40 @@ fn msg_formats_its_values_as_printf_does_in_file_and_stream() {
 }
 
 #[test]
+fn msg_prints_string_variables_and_string_functions_with_s() {
+    let rig = Rig::new();
+    let text = "#VAR\n\
+        V.L.NAME : STRING[20] = \"GRUNDPLATTE\"\n\
+        V.P.PART : STRING[30]\n\
+        #ENDVAR\n\
+        V.P.PART = LEFT[V.L.NAME, 5] + \"-\" + RIGHT[V.L.NAME, 6]\n\
+        #MSG [\"part %s (%d chars), %-8s|%.3s|\", V.P.PART, LEN[V.P.PART], \"ab\", V.L.NAME]\n\
+        #MSG SAVE [\"%s at %d\", MID[\"How are you?\", 3, 5], FIND[V.L.NAME, \"PLATTE\"]]\n\
+        M30\n";
+    for r in both(&rig, text) {
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        assert_eq!(
+            messages(&r),
+            [
+                (
+                    "part GRUND-PLATTE (12 chars), ab      |GRU|".to_string(),
+                    false
+                ),
+                ("are at 6".to_string(), true),
+            ]
+        );
+    }
+    assert_eq!(check_program(text), []);
+    // A string for %d is 900008, at the #MSG line.
+    let text = "#VAR\nV.L.S : STRING[5] = \"x\"\n#ENDVAR\n#MSG [\"%d\", V.L.S]\nM30\n";
+    for r in both(&rig, text) {
+        assert_eq!(r.finish, Some(Finish::Error), "{}", r.log);
+        assert_eq!(r.error_codes(), [u64::from(codes::EVAL_STRING_AS_NUMBER)]);
+        assert_eq!(r.of("error")[0]["line"].as_u64(), Some(4));
+    }
+}
+
+#[test]
 fn msg_with_the_wrong_number_of_values_is_the_kernels_error_at_its_column() {
     let cases: [(&str, u32, usize); 6] = [
         // Fewer values than elements: 20721 at the closing bracket.

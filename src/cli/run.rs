@@ -385,7 +385,7 @@ fn build_report(
         wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
         blocks: c.stats().blocks,
         position: c
-            .axis_positions()
+            .named_positions()
             .into_iter()
             .map(|(a, v)| (a.to_string(), v))
             .collect::<BTreeMap<_, _>>(),

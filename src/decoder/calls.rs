@@ -40,9 +40,20 @@ impl Decoder {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
     /// values it made count against this tick's declaration budget.
     pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
-        if let Some(crate::lang::block::VarType::String(_)) = d.ty {
-            // Values are numbers here: a string variable is accepted and not kept
-            // (docs/nc-language.md, "Variables"); a use of it is undefined (900005).
+        if let Some(crate::lang::block::VarType::String(max)) = d.ty {
+            // A string variable: its start value (checked by the parser) or "" in every
+            // element (docs/nc-language.md, "Strings").
+            let made = self
+                .vars
+                .declare_str(
+                    d.scope,
+                    &d.name,
+                    &d.dims,
+                    max,
+                    d.text.as_deref().unwrap_or(""),
+                )
+                .map_err(var_error)?;
+            self.declared_this_tick += made;
             return Ok(());
         }
         let init = match &d.init {
@@ -301,10 +312,10 @@ impl Decoder {
     fn format_message(&mut self, m: &crate::lang::Message) -> Res<String> {
         let mut values = Vec::with_capacity(m.args.len());
         for e in &m.args {
-            values.push(self.eval(e)?);
+            values.push(expr::eval_value(e, &expr::Env(self))?);
         }
         crate::lang::msg::format_message(m, &values)
-            .map_err(|e| DecodeError::new(codes::MSG_TOO_LONG, e.to_string()))
+            .map_err(|e| DecodeError::new(e.code(), e.to_string()))
     }
 
     /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).

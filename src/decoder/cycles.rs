@@ -7,6 +7,7 @@
 
 use super::*;
 use crate::lang::block::CycleArg;
+use crate::lang::eval::Val;
 
 impl Decoder {
     pub(super) fn call_cycle(
@@ -21,7 +22,11 @@ impl Decoder {
         let mut texts = Vec::new();
         for (n, a) in params {
             match a {
-                CycleArg::Expr(e) => numbers.push((*n, self.eval(e)?)),
+                // An expression may give a string too (`@P1=V.L.NAME`).
+                CycleArg::Expr(e) => match expr::eval_value(e, &expr::Env(self))? {
+                    Val::Num(v) => numbers.push((*n, v)),
+                    Val::Str(s) => texts.push((*n, Box::from(s))),
+                },
                 CycleArg::Str(s) => texts.push((*n, Box::from(s.as_str()))),
             }
         }

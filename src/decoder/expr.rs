@@ -60,8 +60,8 @@ impl Vars for Env<'_> {
         }
     }
 
-    fn is_string(&self, key: &VarKey<'_>) -> bool {
-        Vars::is_string(&self.0.vars, key)
+    fn get_str(&self, key: &VarKey<'_>) -> Option<&str> {
+        Vars::get_str(&self.0.vars, key)
     }
 }
 
@@ -70,8 +70,8 @@ impl Vars for VarStore {
         VarStore::get(self, &slot(key)?)
     }
 
-    fn is_string(&self, key: &VarKey<'_>) -> bool {
-        slot(key).is_some_and(|s| VarStore::is_string(self, &s))
+    fn get_str(&self, key: &VarKey<'_>) -> Option<&str> {
+        VarStore::get_str(self, &slot(key)?)
     }
 }
 
@@ -81,6 +81,11 @@ pub(super) fn err(e: eval::EvalError) -> DecodeError {
 
 pub fn eval(e: &Expr, vars: &dyn Vars) -> Result<f64, DecodeError> {
     eval::eval(e, vars).map_err(err)
+}
+
+/// [`eval::eval_value`]: a value that may be a string.
+pub fn eval_value(e: &Expr, vars: &dyn Vars) -> Result<eval::Val, DecodeError> {
+    eval::eval_value(e, vars).map_err(err)
 }
 
 pub fn resolve(v: &VarRef, vars: &dyn Vars) -> Result<VarSlot, DecodeError> {

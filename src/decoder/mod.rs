@@ -21,7 +21,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use crate::geometry::{arc, SoftLimits};
-use crate::lang::block::{Block, Body, Call, Command, Item, SplineCommand, Value};
+use crate::lang::block::{AxisName, Block, Body, Call, Command, Item, SplineCommand, Value};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
 use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, QueuedBlock};
@@ -51,6 +51,9 @@ pub struct DecoderSettings {
     pub max_depth: usize,
     /// Axes the channel has, by letter index of `AXIS_LETTERS`.
     pub axes: [bool; MAX_AXES],
+    /// The name of the axis in each slot (`X`, or `X1` for an axis list's `X1`): a program
+    /// writes `X10` for a one-letter name, `X1=10` for a longer one. Resolved once at set-up.
+    pub axis_names: [AxisName; MAX_AXES],
     pub zero_offsets: ZeroOffsets,
     /// How far the end point may lie off the circle, mm.
     pub arc_tolerance_mm: f64,
@@ -66,6 +69,11 @@ pub struct DecoderSettings {
     pub error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
 }
 
+/// Each slot named by its letter, `X` to `C`.
+pub fn letter_names() -> [AxisName; MAX_AXES] {
+    AXIS_LETTERS.map(|l| AxisName::new(std::str::from_utf8(&[l]).unwrap_or("X")).expect("a letter"))
+}
+
 /// Values `#VAR` declarations may make in one tick before decoding waits for the next: a
 /// 100,000-element declaration costs ~0.1 ms to fill, so a tick does at most about two
 /// such, whatever the NC text (a line of ten took 15 s in one tick before).
@@ -77,6 +85,7 @@ impl Default for DecoderSettings {
             blocks_per_tick: 64,
             max_depth: 20,
             axes: [true, true, true, false, false, false],
+            axis_names: letter_names(),
             zero_offsets: [[0.0; MAX_AXES]; 6],
             arc_tolerance_mm: 0.01,
             soft_limits_mm: [SoftLimits::default(); MAX_AXES],
@@ -303,6 +312,10 @@ impl Decoder {
     /// Axes the channel has, by `AXIS_LETTERS` index.
     pub fn axes(&self) -> [bool; MAX_AXES] {
         self.settings.axes
+    }
+    /// The name of the axis in each slot (`X`, `X1`, …), by `AXIS_LETTERS` index.
+    pub fn axis_names(&self) -> &[AxisName; MAX_AXES] {
+        &self.settings.axis_names
     }
     pub fn modal(&self) -> &Modal {
         &self.modal

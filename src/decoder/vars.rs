@@ -15,8 +15,10 @@
 use std::collections::HashMap;
 
 use crate::lang::block::VScope;
+use crate::lang::block::MAX_STRING;
 use crate::lang::codes::{
-    ARRAY_INDEX_RANGE, EVAL_UNDEFINED, MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, TOO_MANY_INDICES,
+    ARRAY_INDEX_RANGE, EVAL_NUMBER_AS_STRING, EVAL_STRING_AS_NUMBER, EVAL_UNDEFINED,
+    MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, STRING_TOO_LONG_FOR_VARIABLE, TOO_MANY_INDICES,
     VARIABLE_MEMORY_FULL,
 };
 
@@ -102,6 +104,12 @@ pub enum VarError {
     NotDeclared(String),
     #[error("{0}: an array has at most {MAX_ARRAY_DIMS} indices")]
     TooManyIndices(String),
+    #[error("{name} : STRING[{max}] cannot hold a string of {len} characters")]
+    StringTooLong { name: String, len: usize, max: u8 },
+    #[error("{0} is a STRING variable: a number cannot be assigned to it")]
+    NumberToString(String),
+    #[error("{0} holds numbers: a string cannot be assigned to it")]
+    StringToNumber(String),
 }
 
 impl VarError {
@@ -113,16 +121,28 @@ impl VarError {
             VarError::OutOfRange(_) => ARRAY_INDEX_RANGE,
             VarError::NotDeclared(_) => EVAL_UNDEFINED,
             VarError::TooManyIndices(_) => TOO_MANY_INDICES,
+            VarError::StringTooLong { .. } => STRING_TOO_LONG_FOR_VARIABLE,
+            VarError::NumberToString(_) => EVAL_NUMBER_AS_STRING,
+            VarError::StringToNumber(_) => EVAL_STRING_AS_NUMBER,
         }
     }
 }
 
-/// One V. variable: a scalar (no sizes, one value) or an array, its values row-major.
+/// One V. variable: a scalar (no sizes, one value) or an array, its values row-major. A
+/// `STRING[n]` variable keeps its strings in `texts` and no numbers.
 #[derive(Debug, Clone)]
 struct Variable {
     sizes: [u32; 3],
     dims: u8,
     values: Box<[f64]>,
+    texts: Option<Box<Texts>>,
+}
+
+/// The strings of a `STRING[max]` variable, row-major; each at most `max` characters.
+#[derive(Debug, Clone)]
+struct Texts {
+    max: u8,
+    values: Box<[Box<str>]>,
 }
 
 impl Variable {
@@ -131,12 +151,16 @@ impl Variable {
             sizes: [0; 3],
             dims: 0,
             values: Box::new([v]),
+            texts: None,
         }
     }
 
     /// Bytes this variable is charged under `name`.
     fn bytes(&self, name: &str) -> usize {
-        cost(name, self.values.len())
+        match &self.texts {
+            Some(t) => text_cost(name, t.values.len(), t.max),
+            None => cost(name, self.values.len()),
+        }
     }
 
     /// The position of an element, if `indices` (of which `dims` count) lie in the array.
@@ -158,6 +182,12 @@ fn cost(name: &str, values: usize) -> usize {
     name.len() + values * std::mem::size_of::<f64>() + ENTRY_BYTES
 }
 
+/// Bytes a `STRING[max]` variable of `values` strings under `name` is charged: each string
+/// as if full, with its pointer and length.
+fn text_cost(name: &str, values: usize, max: u8) -> usize {
+    name.len() + values * (std::mem::size_of::<Box<str>>() + usize::from(max)) + ENTRY_BYTES
+}
+
 /// The variables of one scope (or one V.L. level), with the bytes they are charged.
 #[derive(Debug, Default)]
 struct Scope {
@@ -168,7 +198,16 @@ struct Scope {
 impl Scope {
     fn get(&self, name: &str, indices: &Indices, dims: u8) -> Option<f64> {
         let var = self.vars.get(name)?;
-        var.offset(indices, dims).map(|at| var.values[at])
+        var.offset(indices, dims)
+            .and_then(|at| var.values.get(at).copied())
+    }
+
+    fn get_str(&self, name: &str, indices: &Indices, dims: u8) -> Option<&str> {
+        let var = self.vars.get(name)?;
+        let t = var.texts.as_ref()?;
+        var.offset(indices, dims)
+            .and_then(|at| t.values.get(at))
+            .map(|s| &**s)
     }
 
     fn insert(&mut self, name: &str, var: Variable) {
@@ -256,14 +295,36 @@ impl VarStore {
         })
     }
 
-    /// Whether `k` is a cycle parameter holding a string (`@P1="text"`).
+    /// Whether `k` holds a string: a `STRING[n]` variable, a cycle parameter `@P1="text"`.
     pub fn is_string(&self, k: &VarSlot) -> bool {
-        let VarSlot::CycleParam(n) = k else {
-            return false;
+        self.get_str(k).is_some()
+    }
+
+    /// The string `k` holds, if it holds one.
+    pub fn get_str(&self, k: &VarSlot) -> Option<&str> {
+        match k {
+            VarSlot::CycleParam(n) => self
+                .cycle_level()
+                .and_then(|l| self.cycle_text.get(l))
+                .and_then(|t| t.iter().find(|(m, _)| m == n))
+                .map(|(_, s)| &**s),
+            VarSlot::V {
+                scope,
+                name,
+                indices,
+                dims,
+            } => self.scope_of(*scope, name)?.get_str(name, indices, *dims),
+            VarSlot::P { .. } => None,
+        }
+    }
+
+    /// The declared length of the `STRING[n]` variable `k` names, if it names one.
+    pub fn string_max(&self, k: &VarSlot) -> Option<u8> {
+        let VarSlot::V { scope, name, .. } = k else {
+            return None;
         };
-        self.cycle_level()
-            .and_then(|l| self.cycle_text.get(l))
-            .is_some_and(|t| t.iter().any(|(m, _)| m == n))
+        let var = self.scope_of(*scope, name)?.vars.get(&**name)?;
+        var.texts.as_ref().map(|t| t.max)
     }
 
     /// Bytes the variables of `class` are charged now.
@@ -407,6 +468,11 @@ impl VarStore {
             let Some(var) = target.vars.get_mut(name) else {
                 return Err(VarError::NotDeclared(v_name(scope, name)));
             };
+            if var.texts.is_some() {
+                return Err(VarError::NumberToString(element(
+                    scope, name, indices, dims,
+                )));
+            }
             let Some(at) = var.offset(indices, dims) else {
                 return Err(VarError::OutOfRange(element(scope, name, indices, dims)));
             };
@@ -421,16 +487,133 @@ impl VarStore {
         Ok(())
     }
 
-    /// `#VAR` declaration: `name` in `scope` with the array `sizes` (empty: a scalar), every
-    /// value `init`. A variable of that name in the same scope (V.L.: the same level) is
-    /// replaced. Returns the number of values made, so the decoder can spread the work of
-    /// large declarations over ticks.
-    pub fn declare(
+    /// Assign a string. A `STRING[n]` variable takes at most n characters (21462); a V.
+    /// scalar not yet there is created as a `STRING[126]`; a variable holding numbers, or a P
+    /// parameter, takes none (900008). A cycle parameter becomes a string one.
+    pub fn set_str(&mut self, k: VarSlot, text: &str) -> Result<(), VarError> {
+        let len = text.chars().count();
+        match k {
+            VarSlot::P { number, .. } => Err(VarError::StringToNumber(format!("P{number}"))),
+            VarSlot::CycleParam(n) => {
+                if self.cycle.is_empty() {
+                    self.cycle.push(Vec::new());
+                }
+                let last = self.cycle.len() - 1;
+                self.cycle[last].retain(|(m, _)| *m != n);
+                while self.cycle_text.len() <= last {
+                    self.cycle_text.push(Vec::new());
+                }
+                let level = &mut self.cycle_text[last];
+                match level.iter_mut().find(|(m, _)| *m == n) {
+                    Some(slot) => slot.1 = text.into(),
+                    None => level.push((n, text.into())),
+                }
+                Ok(())
+            }
+            VarSlot::V {
+                scope,
+                name,
+                indices,
+                dims,
+            } => {
+                let existing = match scope {
+                    VScope::Local => self.local.iter().rposition(|s| s.vars.contains_key(&*name)),
+                    _ => self.scope_mut(scope).vars.contains_key(&*name).then_some(0),
+                };
+                if let Some(level) = existing {
+                    let target = match scope {
+                        VScope::Local => &mut self.local[level],
+                        _ => self.scope_mut(scope),
+                    };
+                    let Some(var) = target.vars.get_mut(&*name) else {
+                        return Err(VarError::NotDeclared(v_name(scope, &name)));
+                    };
+                    let at = var.offset(&indices, dims);
+                    let Some(t) = var.texts.as_mut() else {
+                        return Err(VarError::StringToNumber(element(
+                            scope, &name, &indices, dims,
+                        )));
+                    };
+                    let Some(at) = at else {
+                        return Err(VarError::OutOfRange(element(scope, &name, &indices, dims)));
+                    };
+                    if len > usize::from(t.max) {
+                        return Err(VarError::StringTooLong {
+                            name: element(scope, &name, &indices, dims),
+                            len,
+                            max: t.max,
+                        });
+                    }
+                    t.values[at] = text.into();
+                    return Ok(());
+                }
+                if dims > 0 {
+                    return Err(VarError::NotDeclared(v_name(scope, &name)));
+                }
+                let max = MAX_STRING as u8;
+                if len > MAX_STRING {
+                    return Err(VarError::StringTooLong {
+                        name: v_name(scope, &name),
+                        len,
+                        max,
+                    });
+                }
+                self.charge(VarClass::of(scope), text_cost(&name, 1, max), 0)?;
+                let var = Variable {
+                    sizes: [0; 3],
+                    dims: 0,
+                    values: Box::new([]),
+                    texts: Some(Box::new(Texts {
+                        max,
+                        values: Box::new([text.into()]),
+                    })),
+                };
+                self.scope_mut(scope).insert(&name, var);
+                Ok(())
+            }
+        }
+    }
+
+    /// `#VAR` declaration of a `STRING[max]` variable: `name` in `scope` with the array
+    /// `sizes` (empty: a scalar), every element `init` (the parser checked its length).
+    /// Replaces a variable of that name as [`VarStore::declare`] does; returns the number of
+    /// values made.
+    pub fn declare_str(
         &mut self,
         scope: VScope,
         name: &str,
         sizes: &[u32],
-        init: f64,
+        max: u8,
+        init: &str,
+    ) -> Result<usize, VarError> {
+        let elements = self.declared_elements(scope, name, sizes)?;
+        let freed = self
+            .scope_mut(scope)
+            .vars
+            .get(name)
+            .map_or(0, |old| old.bytes(name));
+        self.charge(VarClass::of(scope), text_cost(name, elements, max), freed)?;
+        let init: Box<str> = init.into();
+        let mut var = Variable {
+            sizes: [0; 3],
+            dims: sizes.len() as u8,
+            values: Box::new([]),
+            texts: Some(Box::new(Texts {
+                max,
+                values: vec![init; elements].into_boxed_slice(),
+            })),
+        };
+        var.sizes[..sizes.len()].copy_from_slice(sizes);
+        self.scope_mut(scope).insert(name, var);
+        Ok(elements)
+    }
+
+    /// The number of elements `sizes` declare, within the limits (20974, 20967).
+    fn declared_elements(
+        &self,
+        scope: VScope,
+        name: &str,
+        sizes: &[u32],
     ) -> Result<usize, VarError> {
         if sizes.len() > MAX_ARRAY_DIMS {
             return Err(VarError::TooManyIndices(v_name(scope, name)));
@@ -450,7 +633,22 @@ impl VarStore {
                 limit: CLASS_BYTES,
             });
         }
-        let elements = elements as usize;
+        Ok(elements as usize)
+    }
+
+    /// `#VAR` declaration: `name` in `scope` with the array `sizes` (empty: a scalar), every
+    /// value `init`. A variable of that name in the same scope (V.L.: the same level) is
+    /// replaced. Returns the number of values made, so the decoder can spread the work of
+    /// large declarations over ticks.
+    pub fn declare(
+        &mut self,
+        scope: VScope,
+        name: &str,
+        sizes: &[u32],
+        init: f64,
+    ) -> Result<usize, VarError> {
+        let class = VarClass::of(scope);
+        let elements = self.declared_elements(scope, name, sizes)?;
         let freed = self
             .scope_mut(scope)
             .vars
@@ -461,6 +659,7 @@ impl VarStore {
             sizes: [0; 3],
             dims: sizes.len() as u8,
             values: vec![init; elements].into_boxed_slice(),
+            texts: None,
         };
         var.sizes[..sizes.len()].copy_from_slice(sizes);
         self.scope_mut(scope).insert(name, var);
@@ -617,6 +816,49 @@ mod tests {
         assert_eq!(s.get(&el(VScope::Program, "GRID", &[2, 3])), Some(23.0));
         assert_eq!(s.get(&el(VScope::Program, "GRID", &[1, 0])), Some(10.0));
         assert_eq!(s.get(&el(VScope::Program, "GRID", &[3, 0])), None);
+    }
+
+    #[test]
+    fn string_variables_hold_bounded_strings() {
+        let mut s = VarStore::new();
+        assert_eq!(s.declare_str(VScope::Local, "ROW", &[3], 4, "ab"), Ok(3));
+        assert_eq!(s.bytes(VarClass::Local), text_cost("ROW", 3, 4));
+        assert_eq!(s.get_str(&el(VScope::Local, "ROW", &[2])), Some("ab"));
+        assert_eq!(s.get(&el(VScope::Local, "ROW", &[2])), None, "no number");
+        assert_eq!(s.string_max(&el(VScope::Local, "ROW", &[0])), Some(4));
+        s.set_str(el(VScope::Local, "ROW", &[1]), "wxyz").unwrap();
+        assert_eq!(s.get_str(&el(VScope::Local, "ROW", &[1])), Some("wxyz"));
+        let e = |r: Result<(), VarError>| r.unwrap_err().code();
+        assert_eq!(
+            e(s.set_str(el(VScope::Local, "ROW", &[1]), "vwxyz")),
+            STRING_TOO_LONG_FOR_VARIABLE
+        );
+        assert_eq!(
+            e(s.set_str(el(VScope::Local, "ROW", &[3]), "a")),
+            ARRAY_INDEX_RANGE
+        );
+        assert_eq!(
+            e(s.set(el(VScope::Local, "ROW", &[0]), 1.0)),
+            EVAL_NUMBER_AS_STRING
+        );
+        s.set(v(VScope::Local, "N"), 1.0).unwrap();
+        assert_eq!(
+            e(s.set_str(v(VScope::Local, "N"), "a")),
+            EVAL_STRING_AS_NUMBER
+        );
+        assert_eq!(e(s.set_str(p(1), "a")), EVAL_STRING_AS_NUMBER);
+        // An undeclared scalar becomes a STRING[126]; a string too long for that is refused.
+        s.set_str(v(VScope::Program, "NEW"), "abc").unwrap();
+        assert_eq!(s.string_max(&v(VScope::Program, "NEW")), Some(126));
+        assert_eq!(
+            e(s.set_str(v(VScope::Program, "NEW2"), &"x".repeat(127))),
+            STRING_TOO_LONG_FOR_VARIABLE
+        );
+        // A cycle parameter becomes a string one.
+        s.push_level(vec![(1, 5.0)]);
+        s.set_str(VarSlot::CycleParam(1), "t").unwrap();
+        assert_eq!(s.get(&VarSlot::CycleParam(1)), None);
+        assert_eq!(s.get_str(&VarSlot::CycleParam(1)), Some("t"));
     }
 
     #[test]

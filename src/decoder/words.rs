@@ -10,6 +10,8 @@
 
 use super::modal::FeedMode;
 use super::*;
+use crate::lang::block::VarRef;
+use crate::lang::eval::Val;
 
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
@@ -156,11 +158,7 @@ impl Decoder {
     /// of the block may read them.
     fn collect(&mut self, it: &Item, w: &mut Words) -> Res {
         match it {
-            Item::Assign { target, value, col } => {
-                let key = self.resolve(target).map_err(|e| e.at(*col))?;
-                let v = self.eval(value).map_err(|e| e.at(*col))?;
-                self.set_var(key, v)
-            }
+            Item::Assign { target, value, col } => self.assign(target, value, *col),
             Item::GValue { g, value, col } => {
                 // G132..G134 weight ramps (no effect here); G04's value is its time.
                 let v = match value {
@@ -200,7 +198,22 @@ impl Decoder {
                 }
                 Ok(())
             }
+            Item::NamedAxis(a) => self.collect_named_axis(a, w),
             Item::Word(word) => {
+                if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == word.letter) {
+                    let name = &self.settings.axis_names[i];
+                    if self.settings.axes[i] && name.as_str().len() > 1 {
+                        // The axis in this slot is named `X1`: `X` alone names no axis.
+                        return Err(DecodeError::new(
+                            codes::SYNTAX,
+                            format!(
+                                "axis {} is not configured in this channel (its axis is {name}, written {name}=…)",
+                                word.letter as char
+                            ),
+                        )
+                        .at(word.col));
+                    }
+                }
                 let v = match &word.value {
                     Value::Num(n) => *n,
                     Value::Expr(e) => self.eval(e).map_err(|e| e.at(word.col))?,
@@ -209,6 +222,67 @@ impl Decoder {
                     .map_err(|e| e.at(word.col))
             }
         }
+    }
+
+    /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
+    /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
+    fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
+        let key = self.resolve(target).map_err(|e| e.at(col))?;
+        if matches!(target, VarRef::P { .. }) {
+            let v = self.eval(value).map_err(|e| e.at(col))?;
+            return self.set_var(key, v);
+        }
+        let v = expr::eval_value(value, &expr::Env(self)).map_err(|e| e.at(col))?;
+        // A string where numbers are kept, or a number in a STRING variable, is refused at
+        // the assignment's column; the store's other refusals as for P.
+        match v {
+            Val::Num(v) => self.set_var(key, v).map_err(|e| {
+                if e.code == codes::EVAL_NUMBER_AS_STRING {
+                    e.at(col)
+                } else {
+                    e
+                }
+            }),
+            Val::Str(s) => self.vars.set_str(key, &s).map_err(|e| {
+                let string_fault = matches!(
+                    e,
+                    vars::VarError::StringTooLong { .. } | vars::VarError::StringToNumber(_)
+                );
+                let e = var_error(e);
+                if string_fault {
+                    e.at(col)
+                } else {
+                    e
+                }
+            }),
+        }
+    }
+
+    /// `X1=10`: the axis whose configured name it is (resolved at set-up), as its slot's
+    /// letter would be.
+    fn collect_named_axis(&mut self, a: &crate::lang::block::NamedAxis, w: &mut Words) -> Res {
+        let v = match &a.value {
+            Value::Num(n) => *n,
+            Value::Expr(e) => self.eval(e).map_err(|e| e.at(a.col))?,
+        };
+        let slot =
+            (0..MAX_AXES).find(|&i| self.settings.axes[i] && self.settings.axis_names[i] == a.name);
+        let Some(i) = slot else {
+            return Err(DecodeError::new(
+                codes::SYNTAX,
+                format!("axis {} is not configured in this channel", a.name),
+            )
+            .at(a.col));
+        };
+        if w.axes_set & (1 << i) != 0 {
+            return Err(DecodeError::new(
+                codes::AXIS_TWICE,
+                format!("axis {} programmed twice in the block", a.name),
+            )
+            .at(a.col));
+        }
+        self.collect_word(AXIS_LETTERS[i], v, a.col, w)
+            .map_err(|e| e.at(a.col))
     }
 
     fn collect_word(&mut self, letter: u8, v: f64, col: u32, w: &mut Words) -> Res {
@@ -233,6 +307,14 @@ impl Decoder {
             b'R' => w.radius = Some(v),
             letter => {
                 if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == letter) {
+                    if self.settings.axes[i] && w.axes_set & (1 << i) != 0 {
+                        // `X1=5` and `X5` both name the slot of axis X1 (the parser sees
+                        // only letters twice).
+                        return Err(DecodeError::new(
+                            codes::AXIS_TWICE,
+                            format!("axis {} programmed twice in the block", letter as char),
+                        ));
+                    }
                     if !self.settings.axes[i] {
                         if letter != b'X' {
                             return Err(unconfigured(letter));

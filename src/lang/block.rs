@@ -78,12 +78,82 @@ pub enum Item {
         value: Value,
         col: u32,
     },
+    /// An axis named by more than its letter, `X1=10`, `Z_ACHSE = P1` (TF5200 programming
+    /// manual, "Axis commands": such a name takes `=` before its value). Boxed: rare, and
+    /// `Item` keeps its size. `col` is the name's column.
+    NamedAxis(Box<NamedAxis>),
     /// An implicit subroutine call with transfer parameters, `G805[-27.12, 28.955, , 2.87]`
     /// (TF5200 programming manual, "Implicit subroutine calls (G80–G89/G800..)"): value k
     /// is `@P<k+1>` in the subroutine, a gap (`, ,`) is `None` (trailing gaps are dropped).
     /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
     /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
     GCall(Box<GCall>),
+}
+
+/// An axis named by more than its letter with its value ([`Item::NamedAxis`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedAxis {
+    pub name: AxisName,
+    pub value: Value,
+    pub col: u32,
+}
+
+/// Most characters of an axis name (P-CHAN-00006 `bezeichnung`: "maximum 16 characters").
+pub const AXIS_NAME_MAX: usize = 16;
+
+/// An axis name: a letter X Y Z A B C, then letters, digits and `_` (`X1`, `A1`, `Z_ACHSE`),
+/// at most [`AXIS_NAME_MAX`] characters, upper-case. Fixed size, no allocation: the decoder
+/// compares it with the channel's table, resolved once at set-up.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct AxisName {
+    bytes: [u8; AXIS_NAME_MAX],
+    len: u8,
+}
+
+impl AxisName {
+    /// `name` as an axis name, or `None` if it is not one ncchannel can drive.
+    pub fn new(name: &str) -> Option<Self> {
+        let b = name.as_bytes();
+        let first = b.first()?.to_ascii_uppercase();
+        if b.len() > AXIS_NAME_MAX
+            || !b"XYZABC".contains(&first)
+            || !b[1..]
+                .iter()
+                .all(|c| c.is_ascii_alphanumeric() || *c == b'_')
+        {
+            return None;
+        }
+        let mut bytes = [0u8; AXIS_NAME_MAX];
+        for (d, s) in bytes.iter_mut().zip(b) {
+            *d = s.to_ascii_uppercase();
+        }
+        Some(AxisName {
+            bytes,
+            len: b.len() as u8,
+        })
+    }
+
+    /// The axis letter the name starts with: the interpolator slot the axis takes.
+    pub fn letter(&self) -> u8 {
+        self.bytes[0]
+    }
+
+    pub fn as_str(&self) -> &str {
+        // Built from ASCII only.
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")
+    }
+}
+
+impl std::fmt::Display for AxisName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for AxisName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "AxisName({})", self.as_str())
+    }
 }
 
 /// An implicit subroutine call's G number, transfer parameters and column ([`Item::GCall`]).
@@ -173,6 +243,37 @@ pub enum Expr {
     /// `EXIST[v]`, `IS_NUMBER[v]`, `IS_STRING[v]`: a question about a variable rather than
     /// its value (1 or 0), so an undefined `v` is no error here.
     Test(VarTest, Box<VarRef>),
+    /// A quoted string `"text"` (at most [`MAX_STRING`] characters, no quote inside).
+    Str(Box<str>),
+    /// A string function (TF5200 programming manual, "Operations for character strings"):
+    /// `LEN["abc"]`, `MID[V.L.S, 3, 5]`.
+    StrFunc(StrFunc, Vec<Expr>),
+}
+
+/// Most characters a string value holds: a `STRING[n]` declares n of 1 to 126 (TF5200
+/// programming manual, "Variables"; ISG's editor grammar), and no string value is longer.
+pub const MAX_STRING: usize = 126;
+
+/// The string functions of TF5200 "Operations for character strings" ncchannel evaluates.
+/// Positions count characters from 1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrFunc {
+    /// `LEN[str]`: the number of characters.
+    Len,
+    /// `LEFT[str, anz]`: the first anz characters.
+    Left,
+    /// `RIGHT[str, anz]`: the last anz characters.
+    Right,
+    /// `MID[str, anz, pos]`: anz characters from position pos.
+    Mid,
+    /// `FIND[str1, str2]`: the position of str2's first occurrence in str1 (case-sensitive),
+    /// 0 when there is none.
+    Find,
+    /// `ORD[str]`, `ORD[str, pos]`: the character value at pos (1 when not given).
+    Ord,
+    /// `DELETE[str, anz, pos]`: str without the anz characters from position pos (TF5200
+    /// diagnosis 21545's example).
+    Delete,
 }
 
 /// What `Expr::Test` asks about its variable.
@@ -182,7 +283,8 @@ pub enum VarTest {
     Exist,
     /// `IS_NUMBER[v]`: `v` holds a number.
     IsNumber,
-    /// `IS_STRING[v]`: `v` holds a string (a cycle parameter `@P1="text"`).
+    /// `IS_STRING[v]`: `v` holds a string (a `STRING[n]` variable, a cycle parameter
+    /// `@P1="text"`).
     IsString,
 }
 
@@ -406,6 +508,8 @@ pub struct VarDecl {
     pub ty: Option<VarType>,
     /// The value every element starts with (`= 5`); none for a list or a string.
     pub init: Option<Expr>,
+    /// The start value of a `STRING[n]` variable (`= "GRUNDPLATTE"`), without its quotes.
+    pub text: Option<String>,
     /// An array initialiser `= [10, 11, 12]`: the first elements in row-major order (the
     /// rest stay 0). Empty when there is none.
     pub values: Vec<Expr>,
@@ -424,8 +528,8 @@ pub enum VarType {
     Uns32,
     /// `REAL` or `REAL64`.
     Real,
-    /// `STRING[n]`, n characters at most (1 to 126). ncchannel's values are numbers: a
-    /// string variable is accepted and not kept (docs/nc-language.md, "Variables").
+    /// `STRING[n]`, n characters at most (1 to [`MAX_STRING`]): the variable holds a
+    /// string (docs/nc-language.md, "Strings").
     String(u8),
 }
 

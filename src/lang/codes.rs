@@ -158,6 +158,21 @@ pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
 pub const SOFT_LIMIT: u32 = 21897;
 /// An array index outside the declared array (TF5200 diagnosis ID 21928).
 pub const ARRAY_INDEX_RANGE: u32 = 21928;
+/// An operator other than `+` (concatenation), `==` and `!=` with a string operand, or one
+/// of those with a string and a number (TF5200 diagnosis ID 21458 "Operator für
+/// Zeichenketten nicht erlaubt.": "only the + operator to join two strings or the
+/// comparison operators == and != are allowed").
+pub const STRING_OPERATOR: u32 = 21458;
+/// A string assigned to a `STRING[n]` variable is longer than n (TF5200 diagnosis ID 21462
+/// "String for variable too long.", with the length and the maximum).
+pub const STRING_TOO_LONG_FOR_VARIABLE: u32 = 21462;
+/// A string function's position (or count) outside the string (TF5200 diagnosis ID 21545
+/// "Invalid position in character string for string operation.", whose example is
+/// `DELETE["Hello world!", 7, 100]`).
+pub const STRING_POSITION: u32 = 21545;
+/// A string value (a literal, or the result of `+`) longer than the 126 characters a
+/// `STRING[n]` may hold (TF5200 diagnosis ID 21870 "String exceeds the maximum length.").
+pub const STRING_TOO_LONG: u32 = 21870;
 /// `#FLUSH` while a spline (G151) is active (TF5200 diagnosis ID 120102 "Flushing buffers not
 /// allowed while spline interpolation is active.").
 pub const FLUSH_UNDER_SPLINE: u32 = 120102;
@@ -179,9 +194,12 @@ pub const EVAL_UNDEFINED: u32 = 900005;
 pub const EVAL_BAD_INDEX: u32 = 900006;
 /// Expression: result not finite (`EXP[1000]`, `TAN[90]`).
 pub const EVAL_NOT_FINITE: u32 = 900007;
-/// Expression: a variable holding a string (a cycle parameter `@P1="text"`) used as a
-/// number.
+/// Expression: a string (a `STRING[n]` variable, a cycle parameter `@P1="text"`, a literal,
+/// a string function's result) used as a number, or stored into a numeric variable.
 pub const EVAL_STRING_AS_NUMBER: u32 = 900008;
+/// Expression: a number where a string is needed — the text argument of a string function
+/// (`LEN[5]`), or a value assigned to a `STRING[n]` variable.
+pub const EVAL_NUMBER_AS_STRING: u32 = 900009;
 /// The streaming program is already running (called a second time).
 pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
 /// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
@@ -289,6 +307,13 @@ pub const EMITTED: &[(u32, &str)] = &[
     (CACHE_FILE_TOO_LARGE, "cache file too large"),
     (SOFT_LIMIT, "beyond a software limit"),
     (ARRAY_INDEX_RANGE, "array index outside the array"),
+    (STRING_OPERATOR, "operator not allowed for strings"),
+    (
+        STRING_TOO_LONG_FOR_VARIABLE,
+        "string too long for its variable",
+    ),
+    (STRING_POSITION, "string position outside the string"),
+    (STRING_TOO_LONG, "string longer than 126 characters"),
     (FLUSH_UNDER_SPLINE, "#FLUSH under spline"),
     (FLUSH_UNDER_HSC, "#FLUSH under #HSC"),
     (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
@@ -297,6 +322,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (EVAL_BAD_INDEX, "invalid index"),
     (EVAL_NOT_FINITE, "result not finite"),
     (EVAL_STRING_AS_NUMBER, "string used as a number"),
+    (EVAL_NUMBER_AS_STRING, "number used as a string"),
     (STREAM_ALREADY_ACTIVE, "streaming program already running"),
     (MAIN_END_MISSING, "main program without M30/M02"),
     (SUB_END_MISSING, "subroutine without M17/M29"),
@@ -318,8 +344,8 @@ pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
 
 /// Kernel ids ncchannel emits whose diagnosis page was read, each with the title the page
 /// publishes and, in the comment, the page (infosys.beckhoff.com/content/1033/ +
-/// `tf5200_diagnosis/<n>.html` unless another manual is named). English titles; 20054's
-/// and 21232's English pages are not in the index searched, so their German titles
+/// `tf5200_diagnosis/<n>.html` unless another manual is named). English titles; 20054's,
+/// 21232's and 21458's English pages are not in the index searched, so their German titles
 /// (content/1031/) stand. 20704's diagnosis page was not in the index either: its message
 /// is the one the TwinCAT 2 block search manual quotes (content/1033/blocksearch/
 /// 15328482315, "Exceptions / Errors"), whose TF5200 edition names the same id.
@@ -422,6 +448,13 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 254845323
     (21232, "Unbekannter Formatstring."), // content/1031/tf5200_diagnosis/253866123
     (21928, "Array index is out of data range."), // 256586123
+    (21458, "Operator für Zeichenketten nicht erlaubt."), // content/1031/tf5200_diagnosis/254753931
+    (21462, "String for variable too long."), // 254771339
+    (
+        21545,
+        "Invalid position in character string for string operation.",
+    ), // 255136907
+    (21870, "String exceeds the maximum length."), // 256359819
     (
         120102,
         "Flushing buffers not allowed while spline interpolation is active.",

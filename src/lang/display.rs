@@ -109,6 +109,10 @@ impl Display for Item {
                     Value::Expr(e) => write!(f, "{l}{number}={e}"),
                 }
             }
+            Item::NamedAxis(a) => match &a.value {
+                Value::Num(v) => write!(f, "{}={}", a.name, Num(*v)),
+                Value::Expr(e) => write!(f, "{}={e}", a.name),
+            },
             Item::GCall(c) => {
                 write!(f, "G{}[", c.g)?;
                 for (k, a) in c.args.iter().enumerate() {
@@ -166,7 +170,12 @@ impl Display for Bracketed<'_> {
 fn strength(e: &Expr) -> u8 {
     match e {
         Expr::Num(v) if v.is_sign_negative() => UNARY,
-        Expr::Num(_) | Expr::Var(_) | Expr::Func(..) | Expr::Test(..) => OPERAND,
+        Expr::Num(_)
+        | Expr::Var(_)
+        | Expr::Func(..)
+        | Expr::Test(..)
+        | Expr::Str(_)
+        | Expr::StrFunc(..) => OPERAND,
         Expr::Unary(..) => UNARY,
         Expr::Binary(BinOp::Pow, ..) => POWER,
         Expr::Binary(op, ..) => op.level(),
@@ -236,6 +245,18 @@ impl Display for Expr {
                 f.write_char(']')
             }
             Expr::Test(test, v) => write!(f, "{}[{v}]", test.name()),
+            Expr::Str(t) => write!(f, "\"{t}\""),
+            Expr::StrFunc(func, args) => {
+                f.write_str(func.name())?;
+                f.write_char('[')?;
+                for (k, a) in args.iter().enumerate() {
+                    if k > 0 {
+                        f.write_str(", ")?;
+                    }
+                    a.fmt(f)?;
+                }
+                f.write_char(']')
+            }
         }
     }
 }
@@ -470,6 +491,9 @@ impl Display for VarDecl {
         }
         if let Some(e) = &self.init {
             return write!(f, "={e}");
+        }
+        if let Some(t) = &self.text {
+            return write!(f, "=\"{t}\"");
         }
         if !self.values.is_empty() {
             f.write_str("=[")?;

@@ -10,7 +10,9 @@
 //! (division by 0, square root of a negative number, logarithm <= 0), ours from 900000–999999
 //! otherwise; both are in `super::codes`.
 
-use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
+use super::block::{
+    AxisSel, BinOp, Expr, Func, Index, StrFunc, UnOp, VScope, VarRef, VarTest, MAX_STRING,
+};
 
 /// A variable with every index evaluated: what the decoder stores values under.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -73,11 +75,24 @@ pub trait Vars {
     /// the declared array).
     fn get(&self, key: &VarKey<'_>) -> Option<f64>;
 
-    /// Whether `key` holds a string (a cycle parameter `@P1="text"`): it exists, but has no
-    /// number for [`Vars::get`] to give.
-    fn is_string(&self, _key: &VarKey<'_>) -> bool {
-        false
+    /// The string `key` holds (a `STRING[n]` variable, a cycle parameter `@P1="text"`), if
+    /// it holds one: it exists, but has no number for [`Vars::get`] to give.
+    fn get_str(&self, _key: &VarKey<'_>) -> Option<&str> {
+        None
     }
+
+    /// Whether `key` holds a string.
+    fn is_string(&self, key: &VarKey<'_>) -> bool {
+        self.get_str(key).is_some()
+    }
+}
+
+/// A value of an expression that may be a string: `V.L.NAME = "abc" + V.L.S`, the values of
+/// `#MSG`, the operands of `==` and `!=`. Every string is at most [`MAX_STRING`] characters.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Val {
+    Num(f64),
+    Str(String),
 }
 
 /// Why an expression has no value. `code()` gives the number reported to the operator.
@@ -99,6 +114,22 @@ pub enum EvalError {
     NotFinite,
     #[error("{0} holds a string, not a number")]
     StringAsNumber(String),
+    #[error("{0} is a number where a string is needed")]
+    NumberAsString(String),
+    #[error(
+        "operator {0} not allowed for strings (only + joins two strings, == and != compare them)"
+    )]
+    StringOperator(&'static str),
+    #[error("string of {0} characters: a string holds at most {MAX_STRING}")]
+    StringTooLong(usize),
+    #[error("{func}: argument {arg} is {value}, allowed {min} to {max}")]
+    StringPosition {
+        func: &'static str,
+        arg: usize,
+        value: f64,
+        min: usize,
+        max: usize,
+    },
 }
 
 impl EvalError {
@@ -114,6 +145,10 @@ impl EvalError {
             EvalError::BadIndex(_) => codes::EVAL_BAD_INDEX,
             EvalError::NotFinite => codes::EVAL_NOT_FINITE,
             EvalError::StringAsNumber(_) => codes::EVAL_STRING_AS_NUMBER,
+            EvalError::NumberAsString(_) => codes::EVAL_NUMBER_AS_STRING,
+            EvalError::StringOperator(_) => codes::STRING_OPERATOR,
+            EvalError::StringTooLong(_) => codes::STRING_TOO_LONG,
+            EvalError::StringPosition { .. } => codes::STRING_POSITION,
         }
     }
 }
@@ -153,7 +188,18 @@ pub fn eval(expr: &Expr, vars: &dyn Vars) -> Result<f64, EvalError> {
                 UnOp::Inv => !to_int(x)? as f64,
             }
         }
+        Expr::Binary(op, a, b) if may_be_string(a) || may_be_string(b) => {
+            match binary_value(*op, a, b, vars)? {
+                Val::Num(v) => v,
+                Val::Str(_) => return Err(EvalError::StringAsNumber(expr_text(expr))),
+            }
+        }
         Expr::Binary(op, a, b) => binary(*op, eval(a, vars)?, eval(b, vars)?)?,
+        Expr::Str(_) => return Err(EvalError::StringAsNumber(expr_text(expr))),
+        Expr::StrFunc(func, args) => match str_func(*func, args, vars)? {
+            Val::Num(v) => v,
+            Val::Str(_) => return Err(EvalError::StringAsNumber(expr_text(expr))),
+        },
         Expr::Func(func, args) => {
             let x = match args.first() {
                 Some(a) => eval(a, vars)?,
@@ -176,6 +222,182 @@ pub fn eval(expr: &Expr, vars: &dyn Vars) -> Result<f64, EvalError> {
     } else {
         Err(EvalError::NotFinite)
     }
+}
+
+/// Evaluate `expr`, which may give a string.
+pub fn eval_value(expr: &Expr, vars: &dyn Vars) -> Result<Val, EvalError> {
+    match expr {
+        Expr::Str(t) => Ok(Val::Str(t.to_string())),
+        Expr::Var(r) => {
+            let key = resolve(r, vars)?;
+            if let Some(v) = vars.get(&key) {
+                return Ok(Val::Num(v));
+            }
+            match vars.get_str(&key) {
+                Some(t) => Ok(Val::Str(t.to_string())),
+                None => Err(EvalError::Undefined(key.to_string())),
+            }
+        }
+        Expr::Binary(op, a, b) => match binary_value(*op, a, b, vars)? {
+            Val::Num(v) if !v.is_finite() => Err(EvalError::NotFinite),
+            v => Ok(v),
+        },
+        Expr::StrFunc(func, args) => str_func(*func, args, vars),
+        _ => eval(expr, vars).map(Val::Num),
+    }
+}
+
+/// Whether `e` may give a string, judged from its form: a literal, a string function, a
+/// variable that can hold one (V., @P; P parameters hold numbers), or a `+` of such.
+/// Numeric expressions without any of them keep the plain numeric path.
+fn may_be_string(e: &Expr) -> bool {
+    match e {
+        Expr::Str(_) => true,
+        Expr::StrFunc(f, _) => f.gives_string(),
+        Expr::Var(v) => matches!(**v, VarRef::V { .. } | VarRef::CycleParam(_)),
+        Expr::Binary(BinOp::Add, a, b) => may_be_string(a) || may_be_string(b),
+        _ => false,
+    }
+}
+
+/// `a op b` where an operand may be a string: `+` joins two strings, `==` / `!=` compare
+/// them (case-sensitive); any other operator, or a string with a number, is the kernel's
+/// 21458.
+fn binary_value(op: BinOp, a: &Expr, b: &Expr, vars: &dyn Vars) -> Result<Val, EvalError> {
+    match (eval_value(a, vars)?, eval_value(b, vars)?) {
+        (Val::Num(x), Val::Num(y)) => binary(op, x, y).map(Val::Num),
+        (Val::Str(x), Val::Str(y)) => match op {
+            BinOp::Add => {
+                let len = x.chars().count() + y.chars().count();
+                if len > MAX_STRING {
+                    return Err(EvalError::StringTooLong(len));
+                }
+                let mut s = x;
+                s.push_str(&y);
+                Ok(Val::Str(s))
+            }
+            BinOp::Eq => Ok(Val::Num(bool_num(x == y))),
+            BinOp::Ne => Ok(Val::Num(bool_num(x != y))),
+            _ => Err(EvalError::StringOperator(op.symbol())),
+        },
+        _ => Err(EvalError::StringOperator(op.symbol())),
+    }
+}
+
+/// The expression as written, for an error message (at most a line's worth).
+#[cold]
+fn expr_text(e: &Expr) -> String {
+    let mut t = e.to_string();
+    if t.len() > 80 {
+        let mut end = 77;
+        while !t.is_char_boundary(end) {
+            end -= 1;
+        }
+        t.truncate(end);
+        t.push_str("...");
+    }
+    t
+}
+
+/// The string argument `k` of `func` (a number there is 900009).
+fn str_arg(func: StrFunc, args: &[Expr], k: usize, vars: &dyn Vars) -> Result<String, EvalError> {
+    match args.get(k).map(|a| eval_value(a, vars)).transpose()? {
+        Some(Val::Str(s)) => Ok(s),
+        Some(Val::Num(_)) => Err(EvalError::NumberAsString(format!(
+            "argument {} of {}",
+            k + 1,
+            func.name()
+        ))),
+        None => Err(EvalError::NotFinite),
+    }
+}
+
+/// The whole-number argument `k` of `func`, within `min..=max` (else 21545).
+fn pos_arg(
+    func: StrFunc,
+    args: &[Expr],
+    k: usize,
+    min: usize,
+    max: usize,
+    vars: &dyn Vars,
+) -> Result<usize, EvalError> {
+    let Some(a) = args.get(k) else {
+        return Err(EvalError::NotFinite);
+    };
+    let v = eval(a, vars)?;
+    let r = v.round();
+    if (v - r).abs() > 1e-6 || r < min as f64 || r > max as f64 {
+        return Err(EvalError::StringPosition {
+            func: func.name(),
+            arg: k + 1,
+            value: v,
+            min,
+            max,
+        });
+    }
+    Ok(r as usize)
+}
+
+/// The characters `from..to` (character positions, 0-based) of `s`.
+fn chars_between(s: &str, from: usize, to: usize) -> String {
+    s.chars().skip(from).take(to.saturating_sub(from)).collect()
+}
+
+/// A string function (TF5200 programming manual, "Operations for character strings").
+/// Positions count characters from 1; a count may be 0 to the string's length, a position 1
+/// to its length (outside: 21545).
+fn str_func(func: StrFunc, args: &[Expr], vars: &dyn Vars) -> Result<Val, EvalError> {
+    let s = str_arg(func, args, 0, vars)?;
+    let len = s.chars().count();
+    Ok(match func {
+        StrFunc::Len => Val::Num(len as f64),
+        StrFunc::Left => {
+            let n = pos_arg(func, args, 1, 0, len, vars)?;
+            Val::Str(chars_between(&s, 0, n))
+        }
+        StrFunc::Right => {
+            let n = pos_arg(func, args, 1, 0, len, vars)?;
+            Val::Str(chars_between(&s, len - n, len))
+        }
+        StrFunc::Mid => {
+            let pos = pos_arg(func, args, 2, 1, len.max(1), vars)?;
+            let n = pos_arg(func, args, 1, 0, len + 1 - pos, vars)?;
+            Val::Str(chars_between(&s, pos - 1, pos - 1 + n))
+        }
+        StrFunc::Delete => {
+            let pos = pos_arg(func, args, 2, 1, len.max(1), vars)?;
+            let n = pos_arg(func, args, 1, 0, len + 1 - pos, vars)?;
+            let mut out = chars_between(&s, 0, pos - 1);
+            out.push_str(&chars_between(&s, pos - 1 + n, len));
+            Val::Str(out)
+        }
+        StrFunc::Find => {
+            let needle = str_arg(func, args, 1, vars)?;
+            let at = s
+                .find(needle.as_str())
+                .map_or(0, |b| s[..b].chars().count() + 1);
+            Val::Num(at as f64)
+        }
+        StrFunc::Ord => {
+            let pos = if args.len() > 1 {
+                pos_arg(func, args, 1, 1, len.max(1), vars)?
+            } else {
+                1
+            };
+            match s.chars().nth(pos - 1) {
+                Some(c) => Val::Num(f64::from(u32::from(c))),
+                None => {
+                    return Err(EvalError::StringPosition {
+                        func: func.name(),
+                        arg: 2,
+                        value: pos as f64,
+                        min: 1,
+                        max: len,
+                    })
+                }
+            }
+        }
+    })
 }
 
 /// Evaluate the indices of `var`, so the decoder can assign to (or look up) the result.

@@ -28,8 +28,10 @@ use nom::character::complete::char as ch;
 use nom::error::{ErrorKind, ParseError};
 use nom::IResult;
 
-use super::block::{AxisSel, BinOp, Expr, Func, Index, UnOp, VScope, VarRef, VarTest};
-use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, SYNTAX, UNSUPPORTED};
+use super::block::{
+    AxisSel, BinOp, Expr, Func, Index, StrFunc, UnOp, VScope, VarRef, VarTest, MAX_STRING,
+};
+use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, STRING_TOO_LONG, SYNTAX, UNSUPPORTED};
 use super::error::SyntaxError;
 use super::number::{scan_unsigned, TOO_LARGE};
 
@@ -389,9 +391,73 @@ impl<'a> Ctx<'a> {
                 let (rest, v) = self.var_ref(i)?;
                 Ok((rest, Expr::Var(Box::new(v))))
             }
+            b'"' => self.string(i),
             c if c.is_ascii_alphabetic() => self.named(i),
             _ => fail(i, SYNTAX, "operand expected"),
         }
+    }
+
+    /// `"text"` (`i` at the quote): at most [`MAX_STRING`] characters (more: the kernel's
+    /// 21870 at the quote), no quote inside.
+    #[cold]
+    fn string(&self, i: &'a str) -> PResult<'a, Expr> {
+        let q = &i[1..];
+        let Some(end) = q.find('"') else {
+            return fail(i, SYNTAX, "closing `\"` missing");
+        };
+        let len = q[..end].chars().count();
+        if len > MAX_STRING {
+            return fail(
+                i,
+                STRING_TOO_LONG,
+                format!("string of {len} characters: a string holds at most {MAX_STRING}"),
+            );
+        }
+        self.height.set(0);
+        Ok((&q[end + 1..], Expr::Str(q[..end].into())))
+    }
+
+    /// A string function's arguments after its name (`rest`; `at` is where the name starts).
+    #[cold]
+    fn str_func(&self, func: StrFunc, at: &'a str, rest: &'a str) -> PResult<'a, Expr> {
+        let name = func.name();
+        let j = ws(rest);
+        let Some(j) = j.strip_prefix('[') else {
+            return fail(j, SYNTAX, format!("`[` expected after {name}"));
+        };
+        let _g = self.enter(j)?;
+        let mut args = Vec::with_capacity(3);
+        let mut h = 0;
+        let mut j = ws(j);
+        loop {
+            let (k, e) = self.expr(j)?;
+            h = h.max(self.height.get());
+            args.push(e);
+            let k = ws(k);
+            match k.as_bytes().first() {
+                Some(b',') if args.len() < 3 => j = ws(&k[1..]),
+                Some(b']') => {
+                    j = &k[1..];
+                    break;
+                }
+                _ => return fail(k, SYNTAX, "`,` or `]` expected in function call"),
+            }
+        }
+        let (min, max) = func.arity();
+        if !(min..=max).contains(&args.len()) {
+            let want = if min == max {
+                format!("{min}")
+            } else {
+                format!("{min} or {max}")
+            };
+            return fail(
+                at,
+                SYNTAX,
+                format!("{name} takes {want} argument(s), got {}", args.len()),
+            );
+        }
+        self.set_height(h + 1, at)?;
+        Ok((j, Expr::StrFunc(func, args)))
     }
 
     /// A constant or a function call.
@@ -407,6 +473,9 @@ impl<'a> Ctx<'a> {
         let Some(func) = func_by_name(&name) else {
             if let Some(test) = var_test_by_name(&name) {
                 return self.var_test(test, i, rest);
+            }
+            if let Some(f) = STR_FUNCS.into_iter().find(|f| f.name() == name) {
+                return self.str_func(f, i, rest);
             }
             return fail(i, SYNTAX, format!("unknown function or operand `{name}`"));
         };
@@ -799,6 +868,50 @@ impl Func {
         }
     }
 }
+
+impl StrFunc {
+    /// The least and most arguments: `ORD` takes its position optionally.
+    pub fn arity(self) -> (usize, usize) {
+        match self {
+            StrFunc::Len => (1, 1),
+            StrFunc::Left | StrFunc::Right | StrFunc::Find => (2, 2),
+            StrFunc::Ord => (1, 2),
+            StrFunc::Mid | StrFunc::Delete => (3, 3),
+        }
+    }
+
+    /// The function's name as written in NC text.
+    pub fn name(self) -> &'static str {
+        match self {
+            StrFunc::Len => "LEN",
+            StrFunc::Left => "LEFT",
+            StrFunc::Right => "RIGHT",
+            StrFunc::Mid => "MID",
+            StrFunc::Find => "FIND",
+            StrFunc::Ord => "ORD",
+            StrFunc::Delete => "DELETE",
+        }
+    }
+
+    /// Whether the result is a string (`LEN`, `FIND`, `ORD` give numbers).
+    pub fn gives_string(self) -> bool {
+        matches!(
+            self,
+            StrFunc::Left | StrFunc::Right | StrFunc::Mid | StrFunc::Delete
+        )
+    }
+}
+
+/// Every string function, for lookup by name.
+pub const STR_FUNCS: [StrFunc; 7] = [
+    StrFunc::Len,
+    StrFunc::Left,
+    StrFunc::Right,
+    StrFunc::Mid,
+    StrFunc::Find,
+    StrFunc::Ord,
+    StrFunc::Delete,
+];
 
 /// Every function, for lookup by name.
 pub const FUNCS: [Func; 18] = [

@@ -12,6 +12,7 @@
 
 use super::block::{Command, Expr, Message};
 use super::codes::{MSG_ARG_COUNT, MSG_NO_VALUE, MSG_TOO_MANY_VALUES, MSG_UNKNOWN_FORMAT, SYNTAX};
+use super::eval::Val;
 use super::expr::{fail, keyword, perr, ws, Ctx, PErr};
 use super::parse::verbatim_options;
 
@@ -252,16 +253,32 @@ fn format_elements(line: &str, len: usize) -> Result<usize, nom::Err<PErr<'_>>> 
     Ok(n)
 }
 
-/// A formatted message that would exceed [`MAX_MSG_CHARS`].
+/// Why a message could not be formatted.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("formatted #MSG text longer than {MAX_MSG_CHARS} characters")]
-pub struct MessageTooLong;
+pub enum MessageError {
+    /// The formatted text would exceed [`MAX_MSG_CHARS`] (900136).
+    #[error("formatted #MSG text longer than {MAX_MSG_CHARS} characters")]
+    TooLong,
+    /// A string value for a `%d` or `%f` element (1-based value number; 900008).
+    #[error("#MSG value {0} is a string, but its format element takes a number")]
+    StringAsNumber(usize),
+}
+
+impl MessageError {
+    /// The error id (`super::codes`).
+    pub fn code(&self) -> u32 {
+        match self {
+            MessageError::TooLong => super::codes::MSG_TOO_LONG,
+            MessageError::StringAsNumber(_) => super::codes::EVAL_STRING_AS_NUMBER,
+        }
+    }
+}
 
 /// The message text with `values` in place of its format elements, as `printf` writes them:
 /// `%d` the value truncated toward zero, `%f` with 6 decimals unless a precision is given,
-/// `%s` the number in its shortest form (ncchannel has no string values). A text kept
-/// verbatim (not a quoted string) is returned as it is.
-pub fn format_message(m: &Message, values: &[f64]) -> Result<String, MessageTooLong> {
+/// `%s` a string as it is and a number in its shortest form (precision cuts either). A
+/// text kept verbatim (not a quoted string) is returned as it is.
+pub fn format_message(m: &Message, values: &[Val]) -> Result<String, MessageError> {
     if !m.quoted {
         return Ok(m.text.clone());
     }
@@ -269,6 +286,7 @@ pub fn format_message(m: &Message, values: &[f64]) -> Result<String, MessageTooL
     let b = text.as_bytes();
     let mut out = String::with_capacity(text.len().min(MAX_MSG_CHARS));
     let mut values = values.iter();
+    let mut used = 0;
     let mut k = 0;
     while let Some(p) = b[k..].iter().position(|&c| c == b'%') {
         push(&mut out, &text[k..k + p])?;
@@ -282,8 +300,13 @@ pub fn format_message(m: &Message, values: &[f64]) -> Result<String, MessageTooL
         if s.conv == b'%' {
             push(&mut out, "%")?;
         } else {
-            let v = values.next().copied().unwrap_or(0.0);
-            push(&mut out, &field(s, v))?;
+            used += 1;
+            match values.next() {
+                Some(Val::Str(t)) if s.conv == b'S' => push(&mut out, &text_field(s, t))?,
+                Some(Val::Str(_)) => return Err(MessageError::StringAsNumber(used)),
+                Some(Val::Num(v)) => push(&mut out, &field(s, *v))?,
+                None => push(&mut out, &field(s, 0.0))?,
+            }
         }
         k = at + 1 + len;
     }
@@ -291,9 +314,9 @@ pub fn format_message(m: &Message, values: &[f64]) -> Result<String, MessageTooL
     Ok(out)
 }
 
-fn push(out: &mut String, s: &str) -> Result<(), MessageTooLong> {
+fn push(out: &mut String, s: &str) -> Result<(), MessageError> {
     if out.len() + s.len() > MAX_MSG_CHARS {
-        return Err(MessageTooLong);
+        return Err(MessageError::TooLong);
     }
     out.push_str(s);
     Ok(())
@@ -344,6 +367,15 @@ fn field(s: Spec, v: f64) -> String {
     pad(s, sign.to_string(), body, zero)
 }
 
+/// A string for `%s`: a precision keeps that many characters, a width pads.
+fn text_field(s: Spec, t: &str) -> String {
+    let body = match s.precision {
+        Some(p) => t.chars().take(p).collect(),
+        None => t.to_string(),
+    };
+    pad(s, String::new(), body, false)
+}
+
 fn pad(s: Spec, sign: String, body: String, zero: bool) -> String {
     let len = sign.chars().count() + body.chars().count();
     let fill = s.width.min(MAX_FIELD).saturating_sub(len);
@@ -370,7 +402,8 @@ mod tests {
     }
 
     fn f(text: &str, v: &[f64]) -> String {
-        format_message(&msg(text), v).unwrap()
+        let v: Vec<Val> = v.iter().map(|&x| Val::Num(x)).collect();
+        format_message(&msg(text), &v).unwrap()
     }
 
     #[test]
@@ -384,6 +417,18 @@ mod tests {
         assert_eq!(f("%s %S", &[0.5, 3.0]), "0.5 3");
         assert_eq!(f("%+d % d %.3d", &[5.0, 5.0, 5.0]), "+5  5 005");
         assert_eq!(f("100%% done", &[]), "100% done");
+        let s = |t: &str| Val::Str(t.to_string());
+        assert_eq!(
+            format_message(
+                &msg("[%s|%5s|%-4S|%.2s]"),
+                &[s("ab"), s("ab"), s("ab"), s("abc")]
+            ),
+            Ok("[ab|   ab|ab  |ab]".to_string())
+        );
+        assert_eq!(
+            format_message(&msg("%s %d"), &[s("a"), s("b")]),
+            Err(MessageError::StringAsNumber(2))
+        );
     }
 
     #[test]
@@ -403,8 +448,8 @@ mod tests {
     #[test]
     fn the_formatted_length_is_bounded() {
         let text = "%99.99f".repeat(MAX_MSG_VALUES);
-        let v = vec![1e300; MAX_MSG_VALUES];
-        assert_eq!(format_message(&msg(&text), &v), Err(MessageTooLong));
+        let v = vec![Val::Num(1e300); MAX_MSG_VALUES];
+        assert_eq!(format_message(&msg(&text), &v), Err(MessageError::TooLong));
         assert_eq!(f(&"%99d".repeat(40), &[1.0; 40]).len(), 3960);
     }
 }

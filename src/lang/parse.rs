@@ -9,14 +9,14 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Item, Label, SplineCommand,
-    VScope, Value, VarDecl, VarRef, VarType, Word,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Item, Label,
+    NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, SYNTAX, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G,
-    UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, TOO_MANY_INDICES,
+    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -372,7 +372,9 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) => false,
+        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) | Item::NamedAxis(_) => {
+            false
+        }
     }
 }
 
@@ -421,6 +423,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
+            Item::NamedAxis(a) => (a.col, a.name.to_string()),
         };
         return Err(ctx.err_at(
             col,
@@ -445,6 +448,15 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
+    if crate::vocab::axis::AXIS_LETTERS.contains(&up)
+        && ab
+            .first()
+            .is_some_and(|&c| c.is_ascii_alphanumeric() || c == b'_')
+    {
+        if let Some(r) = named_axis(ctx, i, col, items)? {
+            return Ok(r);
+        }
+    }
     let (neg, skip) = match ab.first() {
         Some(b'[') => return word_expr(ctx, i, up, col, after, false, items),
         Some(b'P' | b'p' | b'V' | b'v' | b'@') if starts_variable(ab) => {
@@ -553,6 +565,41 @@ fn function_value<'a>(
     Ok(r)
 }
 
+/// `X1=10`, `Z_ACHSE = P1*2` (`i` at the name): an axis name of more than one character,
+/// which takes `=` before its value (TF5200 programming manual, "Axis commands"). `None`
+/// when no `=` follows the name (`X10 Y5` is X with 10). A name longer than
+/// [`AXIS_NAME_MAX`] is 20200 at the name.
+#[cold]
+fn named_axis<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    col: u32,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let len = i
+        .bytes()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == b'_')
+        .count();
+    let after = ws(&i[len..]);
+    if !after.starts_with('=') || after.starts_with("==") {
+        return Ok(None);
+    }
+    let Some(name) = AxisName::new(&i[..len]) else {
+        return Err(perr(
+            i,
+            SYNTAX,
+            format!("axis name longer than {AXIS_NAME_MAX} characters"),
+        ));
+    };
+    let (r, e) = ctx.expr(ws(&after[1..]))?;
+    items.push(Item::NamedAxis(Box::new(NamedAxis {
+        name,
+        value: expr_value(e),
+        col,
+    })));
+    Ok(Some(r))
+}
+
 /// `X=10`, `X = P1+2`: an axis given an expression after an equals sign.
 #[cold]
 fn axis_assigned<'a>(
@@ -571,8 +618,8 @@ fn axis_assigned<'a>(
     Ok(r)
 }
 
-/// An axis name: X Y Z A B C and the further axis names U V W. Axis names with digits
-/// (`A1`) are not configurable (`src/params/axes.rs`), so `A1 = 0` stays refused.
+/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`) are
+/// [`named_axis`]'s.
 fn is_axis_letter(up: u8) -> bool {
     matches!(
         up,
@@ -1373,9 +1420,12 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
     }
     let (r, ty) = var_type(ws(r), r)?;
     let j = ws(r);
+    let mut text = None;
     let (r, init, values) = match j.strip_prefix('=') {
         Some(k) if matches!(ty, Some(VarType::String(_))) => {
-            (string_init(ws(k), ty)?, None, Vec::new())
+            let (r, t) = string_init(ws(k), ty)?;
+            text = Some(t.to_string());
+            (r, None, Vec::new())
         }
         Some(k) if !dims.is_empty() && is_list(ws(k)) => {
             let (r, values) = init_list(ctx, ws(k), elements)?;
@@ -1394,6 +1444,7 @@ fn var_decl<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<VarDecl, nom::Err<PErr<'
         dims,
         ty,
         init,
+        text,
         values,
     })
 }
@@ -1442,8 +1493,9 @@ fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
     Ok((&t[len..], Some(ty)))
 }
 
-/// The quoted start value of a `STRING[n]` variable, at most n characters.
-fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>> {
+/// The quoted start value of a `STRING[n]` variable, at most n characters (longer: the
+/// kernel's 21462 at the quote); the rest of the line and the text without its quotes.
+fn string_init(i: &str, ty: Option<VarType>) -> Result<(&str, &str), nom::Err<PErr<'_>>> {
     let Some(q) = i.strip_prefix('"') else {
         return Err(perr(
             i,
@@ -1458,14 +1510,15 @@ fn string_init(i: &str, ty: Option<VarType>) -> Result<&str, nom::Err<PErr<'_>>>
         Some(VarType::String(n)) => usize::from(n),
         _ => 0,
     };
-    if q[..end].chars().count() > max {
+    let len = q[..end].chars().count();
+    if len > max {
         return Err(perr(
             i,
-            SYNTAX,
-            format!("text longer than the STRING[{max}] declared"),
+            STRING_TOO_LONG_FOR_VARIABLE,
+            format!("text of {len} characters longer than the STRING[{max}] declared"),
         ));
     }
-    Ok(&q[end + 1..])
+    Ok((&q[end + 1..], &q[..end]))
 }
 
 /// Does `[` open a list (`[10, 11, 12]`: a comma outside inner brackets) rather than a

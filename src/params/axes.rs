@@ -371,13 +371,23 @@ fn push_axis(
     };
     if axis_index(name).is_none() {
         diags.push(at(format!(
-            "{}: `{name}` is not an axis name ncchannel drives (one of X Y Z A B C)",
+            "{}: `{name}` is not an axis name ncchannel drives (X Y Z A B C, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
             e.name.text
         )));
         return;
     }
     if axes.iter().any(|b| b.name.eq_ignore_ascii_case(name)) {
         diags.push(at(format!("{}: axis `{name}` is named twice", e.name.text)));
+        return;
+    }
+    if let Some(b) = axes
+        .iter()
+        .find(|b| axis_index(&b.name) == axis_index(name))
+    {
+        diags.push(at(format!(
+            "{}: axis `{name}` takes the slot of axis `{}` (ncchannel drives one axis per letter X Y Z A B C)",
+            e.name.text, b.name
+        )));
         return;
     }
     axes.push(AxisConfig {

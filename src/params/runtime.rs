@@ -125,13 +125,14 @@ impl AxisConfig {
     }
 }
 
-/// The interpolator's index (`AXIS_LETTERS`) of an axis name such as `x` or `Z`: the one rule
-/// `setup` relies on, so `check` refuses exactly what `run` could not build.
+/// The interpolator's index (`AXIS_LETTERS`) of an axis name such as `x`, `Z` or `X1`: the
+/// slot of its first letter (an axis name is a letter X Y Z A B C, then at most 15 letters,
+/// digits or `_`: `lang::block::AxisName`). The one rule `setup` relies on, so `check`
+/// refuses exactly what `run` could not build; two axes in one slot (`X` and `X1`) are
+/// refused where the axes are listed.
 pub fn axis_index(name: &str) -> Option<usize> {
-    let n = name.trim();
-    (n.len() == 1)
-        .then(|| n.as_bytes()[0].to_ascii_uppercase())
-        .and_then(|b| AXIS_LETTERS.iter().position(|&l| l == b))
+    let n = crate::lang::block::AxisName::new(name.trim())?;
+    AXIS_LETTERS.iter().position(|&l| l == n.letter())
 }
 
 /// Decoder budgets.
@@ -441,15 +442,15 @@ fn validate_axis(
             at,
             "name",
             format!(
-                "`{}` is not an axis name ncchannel drives (one of X Y Z A B C)",
+                "`{}` is not an axis name ncchannel drives (X Y Z A B C, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
                 a.name
             ),
         );
     }
-    if cfg.axes[..i]
-        .iter()
-        .any(|b| b.name.eq_ignore_ascii_case(&a.name))
-    {
+    if cfg.axes[..i].iter().any(|b| {
+        b.name.eq_ignore_ascii_case(&a.name)
+            || axis_index(&b.name).is_some() && axis_index(&b.name) == axis_index(&a.name)
+    }) {
         fail(
             "axes",
             at,
