@@ -202,7 +202,7 @@ impl Decoder {
             Item::Word(word) => {
                 if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == word.letter) {
                     let name = &self.settings.axis_names[i];
-                    if self.settings.axes[i] && name.as_str().len() > 1 {
+                    if self.settings.axes[i] && !name.is_letter() {
                         // The axis in this slot is named `X1`: `X` alone names no axis.
                         return Err(DecodeError::new(
                             codes::SYNTAX,

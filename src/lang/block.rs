@@ -138,6 +138,12 @@ impl AxisName {
         self.bytes[0]
     }
 
+    /// The name is its letter alone (`X`, not `X1`). Asked for every axis word a block
+    /// programs, so it reads the length rather than building the text.
+    pub fn is_letter(&self) -> bool {
+        self.len == 1
+    }
+
     pub fn as_str(&self) -> &str {
         // Built from ASCII only.
         std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or("")

@@ -448,11 +448,7 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
-    if crate::vocab::axis::AXIS_LETTERS.contains(&up)
-        && ab
-            .first()
-            .is_some_and(|&c| c.is_ascii_alphanumeric() || c == b'_')
-    {
+    if crate::vocab::axis::AXIS_LETTERS.contains(&up) && may_name_axis(ab) {
         if let Some(r) = named_axis(ctx, i, col, items)? {
             return Ok(r);
         }
@@ -598,6 +594,27 @@ fn named_axis<'a>(
         col,
     })));
     Ok(Some(r))
+}
+
+/// Could the text after an axis letter continue a longer axis name given a value (`X1=10`,
+/// `X_2 = 5`, `XP1` is left to [`named_axis`] to tell)? Asked for every axis word: the
+/// digits of `X10.5` or `X10 Y5` are skipped inline and only a letter, `_` or an `=` after
+/// them sends the word to the slow path.
+#[inline]
+fn may_name_axis(ab: &[u8]) -> bool {
+    let digits = ab.iter().take_while(|c| c.is_ascii_digit()).count();
+    match ab.get(digits) {
+        Some(c) if c.is_ascii_alphabetic() || *c == b'_' => true,
+        Some(b'=') => digits > 0,
+        Some(b' ' | b'\t') => {
+            digits > 0
+                && ab[digits..]
+                    .iter()
+                    .find(|&&c| c != b' ' && c != b'\t')
+                    .is_some_and(|&c| c == b'=')
+        }
+        _ => false,
+    }
 }
 
 /// `X=10`, `X = P1+2`: an axis given an expression after an equals sign.
