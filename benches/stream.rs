@@ -10,7 +10,7 @@ use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Cycle, Tick};
 use ncchannel::source::stream::StreamBuffer;
 
-#[path = "../tests/common/streaming_load.rs"]
+#[path = "../tests/support/streaming_load.rs"]
 mod streaming_load;
 use streaming_load::{generated_program, StreamingLoad};
 

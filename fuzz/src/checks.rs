@@ -1,5 +1,5 @@
 //! What each fuzz target asserts about one input. The bodies are plain functions over bytes so
-//! that `tests/fuzz_regressions.rs` runs the same assertions over the kept inputs in
+//! that `tests/hardening/fuzz_regressions.rs` runs the same assertions over the kept inputs in
 //! `cargo test`, with no libFuzzer and no nightly toolchain.
 //!
 //! Every check panics on a finding (that is how libFuzzer sees it); a malformed input that is

@@ -1,3 +1,3 @@
 //! The fuzz targets' bodies. `checks.rs` is also compiled into the main crate's
-//! `tests/fuzz_regressions.rs`, so every kept input runs in plain `cargo test`.
+//! `tests/hardening/fuzz_regressions.rs`, so every kept input runs in plain `cargo test`.
 pub mod checks;

@@ -1,6 +1,6 @@
 // ncchannel's ADS server seen by the unmodified Node `ads-client` 2.x in rawClient mode
 // (no PLC symbols): the COM description table, a 5,000-line stream with 0x708 retries, and a
-// notification on mc_block_count_r. Run by tests/ads_node.rs:
+// notification on mc_block_count_r. Run by tests/ads_clients/ads_node.rs:
 //
 //   NCCHANNEL_ADS_ADDR=127.0.0.1:48898 node tests/node/ads_client_test.js PROGRAM_FILE
 //

@@ -7,7 +7,7 @@ Run against a running server:
 NCCHANNEL_ADS_ADDR (required) is the server's TCP address; NCCHANNEL_ADS_NETID (default
 127.0.0.1.1.1) the target NetId. The channel must be channel 1 and must not be streaming when
 the test starts (e.g. `ncchannel serve` without --start, or the real channels that
-`cargo test --test ads_pyads -- --ignored` starts).
+`cargo test --test ads_clients -- --ignored ads_pyads` starts).
 """
 
 import ctypes

@@ -1,0 +1,142 @@
+//! The server seen by an independent client: the `ads` crate 0.4 (birkenfeld/ads-rs), which
+//! validates flags, invoke ids, addresses and lengths of every response itself.
+
+use std::time::Duration;
+
+use crate::support::ads::*;
+use ads::notif::{Attributes, TransmissionMode};
+use ads::{AdsState, AmsAddr, AmsNetId, Client, Source, Timeouts};
+use ncchannel::ads::objects::offset;
+
+fn connect(srv: &ncchannel::ads::ServerHandle, source_port: u16) -> Client {
+    let source = AmsAddr::new(AmsNetId::new(10, 1, 2, 3, 1, 1), source_port);
+    Client::new(
+        srv.local_addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Addr(source),
+    )
+    .expect("ads crate connects")
+}
+
+fn target() -> AmsAddr {
+    AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 553)
+}
+
+fn ads_code(e: ads::Error) -> u32 {
+    match e {
+        ads::Error::Ads(_, _, code) => code,
+        other => panic!("expected an ADS error, got {other}"),
+    }
+}
+
+#[test]
+fn device_info_state_and_mode_state() {
+    let (srv, _b) = server();
+    let client = connect(&srv, 40001);
+    let dev = client.device(target());
+    let info = dev.get_info().unwrap();
+    assert_eq!(
+        info.name,
+        format!("ncchannel {}", env!("CARGO_PKG_VERSION"))
+    );
+    assert_eq!(dev.get_state().unwrap(), (AdsState::Run, 0));
+    let mut ms = [0u8; 8];
+    dev.read_exact(CH1, offset::MODE_STATE, &mut ms).unwrap();
+    assert_eq!(ms, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
+    dev.write_control(AdsState::Run, 0).unwrap();
+}
+
+#[test]
+fn stream_writes_until_busy_then_0x708() {
+    let (srv, b) = server();
+    let client = connect(&srv, 40002);
+    let dev = client.device(target());
+    let packet = [vec![b'G'; 990], b"\r\n".to_vec()].concat();
+    for _ in 0..4 {
+        dev.write(CH1, offset::STREAM, &packet).unwrap();
+    }
+    let err = dev.write(CH1, offset::STREAM, &packet).unwrap_err();
+    assert_eq!(ads_code(err), 0x708);
+    let err = dev.write(CH1, offset::STREAM, b"N10 no crlf").unwrap_err();
+    assert_eq!(ads_code(err), 0x706);
+    let mut text = [0u8; 128];
+    let n = dev.read(CH1, offset::ERROR_MESSAGE, &mut text).unwrap();
+    assert!(String::from_utf8_lossy(&text[..n]).starts_with("21476"));
+    // Wrong port: the crate reports the AMS header error.
+    let none = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 800));
+    assert_eq!(ads_code(none.get_info().unwrap_err()), 6);
+    drop(client);
+    srv.shutdown();
+    assert_eq!(
+        warnings(&b.events(), 11012),
+        1,
+        "the refused write is the channel's warning 11012"
+    );
+}
+
+/// V.E. variables in the SDA task (port 552) as TwinSharp `ZeroOffsets.cs` reaches variables:
+/// a handle by name (0x46), then plain Read/Write at the handle.
+#[test]
+fn ve_variables_through_an_sda_handle() {
+    let (srv, b) = server();
+    b.backend.write_ve(1, "DEPTH", 0.0).unwrap();
+    let client = connect(&srv, 40003);
+    let sda = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 552));
+    let mut h = [0u8; 4];
+    sda.write_read_exact(0x122301, 0x46, b"V.E.depth", &mut h)
+        .unwrap();
+    let h = u32::from_le_bytes(h);
+    sda.write(0x122301, h, &(-2.25f64).to_le_bytes()).unwrap();
+    let mut out = [0u8; 8];
+    sda.read_exact(0x122301, h, &mut out).unwrap();
+    assert_eq!(f64::from_le_bytes(out), -2.25);
+    let err = sda
+        .write_read_exact(0x122301, 0x46, b"V.E.nothing", &mut [0u8; 4])
+        .unwrap_err();
+    assert_eq!(ads_code(err), 0x70C);
+}
+
+#[test]
+fn notifications_reach_the_crate_on_mode_change() {
+    let (srv, _b) = server();
+    let client = connect(&srv, 40004);
+    let rx = client.get_notification_channel();
+    let dev = client.device(target());
+    let attrs = Attributes::new(
+        8,
+        TransmissionMode::ServerOnChange,
+        Duration::from_millis(1),
+        Duration::from_millis(1),
+    );
+    let handle = dev
+        .add_notification(CH1, offset::MODE_STATE, &attrs)
+        .unwrap();
+    let first = rx
+        .recv_timeout(Duration::from_secs(5))
+        .expect("initial sample");
+    let s: Vec<_> = first.samples().collect();
+    assert_eq!(s[0].handle, handle);
+    assert_eq!(s[0].data, [2, 0, 0, 0, 3, 0, 0, 0], "AUTOMATIC / READY");
+    dev.write(CH1, offset::COMMAND_MODE, &1i32.to_le_bytes())
+        .unwrap();
+    let next = rx
+        .recv_timeout(Duration::from_secs(5))
+        .expect("sample after change");
+    let s: Vec<_> = next.samples().collect();
+    assert_eq!(s[0].data, [1, 0, 0, 0, 3, 0, 0, 0], "STANDBY / READY");
+    dev.delete_notification(handle).unwrap();
+}
+
+#[test]
+fn router_port_request_works_with_the_crate() {
+    let (srv, _b) = server();
+    let client = Client::new(
+        srv.local_addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Request,
+    )
+    .unwrap();
+    assert_eq!(client.source().netid(), AmsNetId::new(127, 0, 0, 1, 1, 1));
+    let dev = client.device(target());
+    assert_eq!(dev.get_state().unwrap().0, AdsState::Run);
+}

@@ -1,0 +1,27 @@
+//! Runs tests/node/ads_client_test.js (the unmodified Node `ads-client` 2.x in rawClient
+//! mode) against the real channels: the description table, a 5,000-line stream with 0x708
+//! retries, a notification on `mc_block_count_r`. Needs Node and `npm install --prefix
+//! tests/node` (done by `.ci/run`), so it is ignored by default:
+//!
+//! `cargo test --test ads_clients -- --ignored ads_node`
+
+use crate::support as common;
+
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_ads_client_streams_5000_lines_and_watches_the_block_count() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let rig = common::Rig::new();
+    let lines = common::streamed_5000_lines();
+    let file = rig.dir.path().join("prog.nc");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let served = common::Served::start(&rig);
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/ads_client_test.js");
+    let (seen, events) = common::run_client(served, &node, script, &[&file]);
+    assert!(
+        seen["busy"].as_u64().unwrap() > 0,
+        "the client was refused at least once"
+    );
+    assert_eq!(seen["final_count"], 5000);
+    assert_eq!(common::block_texts(&events), lines);
+}

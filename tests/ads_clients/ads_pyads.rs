@@ -1,0 +1,98 @@
+//! Runs tests/python/test_pyads.py (unmodified pyads 3.6 + adslib) against the server over
+//! real channels (tests/ads_common). Needs a Python with pyads, so it is ignored by default:
+//!
+//! `NCCHANNEL_PYTHON=/path/to/venv/bin/python cargo test --test ads_clients -- --ignored ads_pyads`
+
+use crate::support as common;
+use crate::support::ads as ads_common;
+
+use std::process::Command;
+
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_talks_to_the_server() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let (srv, _backend) = ads_common::server();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/python/test_pyads.py");
+    let out = Command::new(python)
+        .arg(script)
+        .env("NCCHANNEL_ADS_ADDR", srv.local_addr().to_string())
+        .output()
+        .expect("python runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("skipped"), "{stderr}");
+}
+
+/// A streaming client written with pyads drives the real channels at 1 ms: 5,000 lines,
+/// retries on 0x708, every block executed exactly once and in order.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_streams_5000_lines_into_real_channels() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let lines = common::streamed_5000_lines();
+    let file = rig.dir.path().join("prog.nc");
+    std::fs::write(&file, lines.join("\n") + "\n").unwrap();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/stream_with_pyads.py"
+    );
+    let out = Command::new(python)
+        .arg(script)
+        .arg(&file)
+        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
+        .output()
+        .expect("python runs");
+    let (_, events) = served.finish();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let counts: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let busy = counts["busy"].as_u64().unwrap();
+    assert!(
+        busy > 0,
+        "the pyads client outran the channel at least once"
+    );
+    let notes = counts["notifications"].as_array().unwrap();
+    assert!(
+        notes.iter().any(|n| n[1] == 4),
+        "a notification reported ACTIVE: {notes:?}"
+    );
+    assert_eq!(common::block_texts(&events), lines);
+    let warnings = events
+        .iter()
+        .filter(|e| e["ev"] == "warning" && e["code"] == 11012)
+        .count() as u64;
+    assert_eq!(warnings, busy);
+}
+
+/// The PLC's HLI (port 851) with pyads `read_by_name`/`write_by_name`/notifications by name
+/// against the real channels: the mode-and-state unit starts the streaming program, a stream
+/// runs, `state_r` follows; override at COM 0x09 halves the interpolator's path velocity
+/// (GEO 551); NC errors reach `mc_error.satz_r` with their ISG numbers, one at a time.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_drives_the_hli_unit_and_reads_geo() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/hli_with_pyads.py"
+    );
+    let (seen, events) = common::run_client(served, &python, script, &[]);
+    assert_eq!(seen["errors"][0], 21476);
+    let codes: Vec<_> = common::of(&events, "error")
+        .iter()
+        .map(|e| e["code"].clone())
+        .collect();
+    assert_eq!(
+        codes,
+        [seen["errors"][0].clone(), seen["errors"][1].clone()]
+    );
+}

@@ -1,0 +1,8 @@
+//! Real ADS clients from outside (pyads, Node's ads-client): ignored by default, run with `cargo
+//! test --test ads_clients -- --ignored` once the clients are installed (`.ci/run` shows how).
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod ads_node;
+mod ads_pyads;

@@ -1,0 +1,6 @@
+//! Parameter lists: loading and checking them, `ncchannel check` on them, and a TwinCAT CNC
+//! installation's own lists starting the channel.
+
+mod check_params;
+mod installation;
+mod params;

@@ -1,0 +1,278 @@
+//! `ncchannel serve` stopped by SIGTERM or SIGINT mid-program: an orderly stop. The event log
+//! parses line by line, holds every block the channel executed and ends with the last one,
+//! and the summary is printed. While it runs, a reader tailing the log sees each block soon
+//! after its tick. Also the command-line checks of `run --packet`.
+
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::support::Rig;
+use serde_json::Value;
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_ncchannel")
+}
+
+/// A program that runs for minutes: short moves back and forth.
+fn long_program(rig: &Rig) {
+    let mut text = String::from("N1 G01 F30000\n");
+    for i in 0..20_000 {
+        let x = if i % 2 == 0 { 0.2 } else { 0.0 };
+        text.push_str(&format!("N{} X{x:.3}\n", i + 2));
+    }
+    text.push_str("M30\n");
+    rig.program("long.nc", &text);
+}
+
+/// Start `serve --start long.nc --events FILE`; returns once it listens (its runtime then
+/// starts), with the moment it said so.
+fn serve(rig: &Rig, events: &std::path::Path) -> (Child, Instant, std::thread::JoinHandle<String>) {
+    let mut child = Command::new(bin())
+        .args([
+            "serve",
+            "--bind",
+            "127.0.0.1:0",
+            "--start",
+            "long.nc",
+            "--params",
+        ])
+        .arg(rig.startup())
+        .arg("--events")
+        .arg(events)
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    err.read_line(&mut first).unwrap();
+    let listening = Instant::now();
+    assert!(first.starts_with("listening on"), "{first}");
+    let rest = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = err.read_to_string(&mut s);
+        s
+    });
+    (child, listening, rest)
+}
+
+fn kill(child: &Child, signal: &str) {
+    let ok = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "kill {signal}");
+}
+
+fn wait(child: &mut Child, limit: Duration) -> std::process::ExitStatus {
+    let start = Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        assert!(
+            start.elapsed() < limit,
+            "serve did not stop within {limit:?}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Checks after an orderly stop: every line whole JSON, the last event a block, the block
+/// count the summary prints equal to the block events.
+fn check_stopped_log(log: &str, stderr: &str) {
+    assert!(log.ends_with('\n'), "the log ends with a whole line");
+    let events: Vec<Value> = log
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect();
+    let blocks: Vec<&Value> = events.iter().filter(|e| e["ev"] == "block").collect();
+    assert!(
+        blocks.len() > 10,
+        "the program ran: {} blocks",
+        blocks.len()
+    );
+    let summary = stderr
+        .lines()
+        .find(|l| l.starts_with("stopped after"))
+        .unwrap_or_else(|| panic!("no summary in {stderr}"));
+    // "stopped after T ticks (S s), B blocks; …"
+    let printed: usize = summary
+        .split("), ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no block count in {summary}"));
+    assert_eq!(printed, blocks.len(), "summary: {summary}");
+    // In order, each once.
+    for w in blocks.windows(2) {
+        assert_eq!(
+            w[1]["counter"].as_u64().unwrap(),
+            w[0]["counter"].as_u64().unwrap() + 1
+        );
+    }
+}
+
+fn stopped_by(signal: &str) {
+    let rig = Rig::new();
+    long_program(&rig);
+    let events = rig.dir.path().join("events.jsonl");
+    let (mut child, _, stderr) = serve(&rig, &events);
+    std::thread::sleep(Duration::from_millis(1500));
+    kill(&child, signal);
+    let status = wait(&mut child, Duration::from_secs(30));
+    let stderr = stderr.join().unwrap();
+    assert_eq!(status.code(), Some(0), "orderly stop exits 0: {stderr}");
+    let log = std::fs::read_to_string(&events).unwrap();
+    check_stopped_log(&log, &stderr);
+}
+
+#[test]
+fn serve_stopped_by_sigterm_mid_program_leaves_a_whole_log_and_a_summary() {
+    stopped_by("-TERM");
+}
+
+#[test]
+fn serve_stopped_by_sigint_mid_program_leaves_a_whole_log_and_a_summary() {
+    stopped_by("-INT");
+}
+
+/// A reader tailing `--events` sees each block within 200 ms of its tick (the log is
+/// flushed at least every 100 ms). The tick's wall time is taken as the moment serve said
+/// it listens plus the block's channel time: an upper bound, since the runtime starts after.
+#[test]
+fn a_tailing_reader_sees_each_block_within_200_ms_of_its_tick() {
+    let rig = Rig::new();
+    long_program(&rig);
+    let events = rig.dir.path().join("events.jsonl");
+    let (mut child, listening, stderr) = serve(&rig, &events);
+    let mut f = loop {
+        if let Ok(f) = std::fs::File::open(&events) {
+            break f;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    };
+    let mut pending = String::new();
+    let mut latencies_ms = Vec::new();
+    let until = Instant::now() + Duration::from_secs(4);
+    let mut pos = 0u64;
+    while Instant::now() < until {
+        let mut chunk = String::new();
+        f.seek(SeekFrom::Start(pos)).unwrap();
+        let n = f.read_to_string(&mut chunk).unwrap();
+        pos += n as u64;
+        let now = Instant::now();
+        pending.push_str(&chunk);
+        while let Some(i) = pending.find('\n') {
+            let line: String = pending.drain(..=i).collect();
+            let e: Value = serde_json::from_str(line.trim_end()).unwrap();
+            if e["ev"] == "block" {
+                let tick_at = listening + Duration::from_secs_f64(e["t"].as_f64().unwrap());
+                latencies_ms.push(now.saturating_duration_since(tick_at).as_secs_f64() * 1e3);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    kill(&child, "-INT");
+    wait(&mut child, Duration::from_secs(30));
+    let _ = stderr.join();
+    assert!(
+        latencies_ms.len() > 20,
+        "{} blocks seen",
+        latencies_ms.len()
+    );
+    latencies_ms.sort_by(f64::total_cmp);
+    let q = |p: f64| latencies_ms[((latencies_ms.len() - 1) as f64 * p) as usize];
+    eprintln!(
+        "tail latency over {} blocks: p50 {:.1} ms, p99 {:.1} ms, max {:.1} ms",
+        latencies_ms.len(),
+        q(0.5),
+        q(0.99),
+        q(1.0)
+    );
+    assert!(q(0.99) <= 200.0, "p99 {:.1} ms", q(0.99));
+}
+
+#[test]
+fn run_refuses_a_packet_above_992_up_front() {
+    for bad in ["993", "0", "4096"] {
+        let out = Command::new(bin())
+            .args(["run", "--packet", bad, "--stream", "nc/none.nc"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "--packet {bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("1..=992"), "{err}");
+    }
+}
+
+/// The shipped slow-feeder scenario does what it says: the channel starves and interrupts.
+#[test]
+fn slow_feeder_scenario_starves_the_channel() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/params/soak/slow_feeder.toml");
+    let scenario = ncchannel::soak::scenario::Scenario::load(std::path::Path::new(path)).unwrap();
+    let opts = ncchannel::soak::Options {
+        length: Some(ncchannel::soak::scenario::Length {
+            blocks: Some(20_000),
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let report = ncchannel::soak::run(&scenario, &opts).unwrap();
+    // Memory is left out: tests share one process, its resident set is not this run's.
+    assert!(report
+        .invariants
+        .iter()
+        .all(|v| v.held || v.name == "memory steady"));
+    let c = &report.channels[0];
+    assert!(c.interrupts > 50, "{} interrupts", c.interrupts);
+}
+
+/// `receive --listen` stops in order on SIGTERM: the transfers so far are filed and counted,
+/// the summary printed, exit 0.
+#[test]
+fn receive_listen_stops_in_order_on_sigterm() {
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("prog");
+    let mut child = Command::new(bin())
+        .args([
+            "receive",
+            "--listen",
+            "127.0.0.1:0",
+            "--start",
+            "%",
+            "--end",
+            "M30",
+            "--out",
+        ])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    err.read_line(&mut line).unwrap();
+    let port: u16 = line.trim().rsplit(':').next().unwrap().parse().unwrap();
+    {
+        let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+        s.write_all(b"%A\nN1 X1\nM30\n").unwrap();
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    kill(&child, "-TERM");
+    let status = wait(&mut child, Duration::from_secs(10));
+    let mut stdout = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut stdout)
+        .unwrap();
+    assert_eq!(status.code(), Some(0), "{stdout}");
+    assert!(stdout.contains("1 program(s) filed"), "{stdout}");
+    assert!(stdout.contains("1 transfer(s)"), "{stdout}");
+    assert!(out.join("A.nc").exists());
+}

@@ -1,0 +1,5 @@
+//! Soak runs: the soak scenarios and `serve --soak` (its pyads client tests are ignored by default:
+//! `cargo test --test soak -- --ignored`).
+
+mod serve_soak;
+mod soak;

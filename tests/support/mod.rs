@@ -1,0 +1,326 @@
+//! The one support module of the test binaries (each `tests/<capability>/main.rs` includes it).
+//! Here: a channel rig — parameter lists and programs in a temporary folder, a machine run in
+//! virtual time, the event log captured as JSON values. In submodules: an ADS server and raw
+//! client (`ads`), spawned-process helpers for the abuse tests (`abuse`), motion checks and
+//! generators, and the synthetic streaming load the stream bench shares.
+#![allow(dead_code)]
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use ncchannel::channel::Finish;
+use ncchannel::feeder::Feeder;
+use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::report::event::EventLog;
+use ncchannel::runtime::{Clock, Runtime, Tick};
+use serde_json::Value;
+
+pub struct Rig {
+    pub dir: tempfile::TempDir,
+}
+
+#[derive(Clone, Default)]
+struct Shared(Arc<Mutex<Vec<u8>>>);
+
+impl Write for Shared {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0.lock().unwrap().extend_from_slice(b);
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+pub struct RunResult {
+    pub log: String,
+    pub events: Vec<Value>,
+    pub finish: Option<Finish>,
+    pub machine: Machine,
+    pub ticks: u64,
+}
+
+/// Events of one kind (`ev`), in order.
+pub fn of<'a>(events: &'a [Value], ev: &str) -> Vec<&'a Value> {
+    events.iter().filter(|e| e["ev"] == ev).collect()
+}
+
+/// Texts of the `block` events, in order.
+pub fn block_texts(events: &[Value]) -> Vec<String> {
+    of(events, "block")
+        .iter()
+        .map(|e| e["text"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// The events a channel driven by hand has collected, as JSON values.
+pub fn channel_events(c: &mut ncchannel::channel::Channel) -> Vec<Value> {
+    c.events_mut()
+        .events()
+        .iter()
+        .map(|e| serde_json::to_value(e).unwrap())
+        .collect()
+}
+
+impl RunResult {
+    pub fn of(&self, ev: &str) -> Vec<&Value> {
+        of(&self.events, ev)
+    }
+    /// Texts of the `block` events, in order.
+    pub fn block_texts(&self) -> Vec<String> {
+        block_texts(&self.events)
+    }
+    pub fn error_codes(&self) -> Vec<u64> {
+        self.of("error")
+            .iter()
+            .map(|e| e["code"].as_u64().unwrap())
+            .collect()
+    }
+    /// Where channel 1's `axis` stands at the end, mm.
+    pub fn position(&self, axis: char) -> f64 {
+        self.machine.channels()[0]
+            .axis_positions()
+            .into_iter()
+            .find(|(a, _)| *a == axis)
+            .map(|(_, v)| v)
+            .unwrap()
+    }
+}
+
+impl Rig {
+    /// One channel, streaming program `streaming.nc`, programs in `nc/`, caching on (2 × 200 B).
+    pub fn new() -> Rig {
+        Self::with_runtime("")
+    }
+
+    pub fn with_runtime(runtime_toml: &str) -> Rig {
+        Self::with_cache(Some((2, 200)), runtime_toml)
+    }
+
+    /// Like `with_runtime`, with other cache limits: `Some((max_cache_number,
+    /// max_cache_size))`, or `None` for file caching off.
+    pub fn with_cache(cache: Option<(u32, u32)>, runtime_toml: &str) -> Rig {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("params")).unwrap();
+        std::fs::create_dir_all(dir.path().join("nc")).unwrap();
+        let mut startup = String::from(
+            "kanal_anzahl 1\nsda_mds[0] channel1.lis\npfad[0].prg[0] ../nc\npfad[0].typ[0] 0x03\npfad[0].prioritaet[0] 0\n",
+        );
+        if let Some((files, bytes)) = cache {
+            startup.push_str(&format!(
+                "configuration.channel[0].decoder.function FCT_USE_CACHED_FILES\n\
+                 configuration.channel[0].decoder.max_cache_number {files}\n\
+                 configuration.channel[0].decoder.max_cache_size {bytes}\n"
+            ));
+        }
+        std::fs::write(dir.path().join("params/startup.lis"), startup).unwrap();
+        std::fs::write(
+            dir.path().join("params/channel1.lis"),
+            "streaming_prog_file streaming.nc\n",
+        )
+        .unwrap();
+        if !runtime_toml.is_empty() {
+            std::fs::write(dir.path().join("params/runtime.toml"), runtime_toml).unwrap();
+        }
+        Rig { dir }
+    }
+
+    pub fn startup(&self) -> PathBuf {
+        self.dir.path().join("params/startup.lis")
+    }
+
+    pub fn nc(&self) -> PathBuf {
+        self.dir.path().join("nc")
+    }
+
+    pub fn program(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.nc().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    pub fn machine(&self) -> (Machine, Duration, Shared2) {
+        let config = ncchannel::params::load(&self.startup()).unwrap();
+        let channels = ncchannel::setup::channels(&config, true).unwrap();
+        let shared = Shared::default();
+        let log = EventLog::to_writer(Box::new(shared.clone()));
+        let period = Duration::from_micros(config.runtime.cycle_period_us);
+        (
+            Machine::new(channels, log, StopWhen::ProgramsFinished),
+            period,
+            Shared2(shared),
+        )
+    }
+
+    /// Start `program` on channel 1, feed `stream` (if any) with the built-in feeder, run in
+    /// virtual time until the program finishes or `max_ticks`.
+    pub fn run(&self, program: &str, stream: Option<Feeder>, max_ticks: u64) -> RunResult {
+        self.run_with(program, stream, max_ticks, |_| {})
+    }
+
+    pub fn run_with(
+        &self,
+        program: &str,
+        stream: Option<Feeder>,
+        max_ticks: u64,
+        prepare: impl FnOnce(&mut Machine),
+    ) -> RunResult {
+        let (mut machine, period, shared) = self.machine();
+        if let Some(f) = stream {
+            machine.attach_feeder(1, f);
+        }
+        prepare(&mut machine);
+        let t0 = tick0(period);
+        let _ = machine.channel_mut(1).unwrap().start(&t0, program);
+        let (mut rt, _tx) = Runtime::new(machine, period, Clock::Virtual);
+        rt.run(Some(max_ticks));
+        let ticks = rt.ticks();
+        let (mut machine, _) = rt.into_inner();
+        machine.finish_log().unwrap();
+        let finish = machine.finishes()[0];
+        let log = String::from_utf8(shared.0 .0.lock().unwrap().clone()).unwrap();
+        let events = log
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        RunResult {
+            log,
+            events,
+            finish,
+            machine,
+            ticks,
+        }
+    }
+}
+
+pub struct Shared2(Shared);
+
+impl Shared2 {
+    pub fn text(&self) -> String {
+        String::from_utf8(self.0 .0.lock().unwrap().clone()).unwrap()
+    }
+}
+
+pub fn tick0(period: Duration) -> Tick {
+    Tick {
+        index: 0,
+        period,
+        time: Duration::ZERO,
+    }
+}
+
+pub fn feeder(text: &str, packet: usize, every: u64) -> Feeder {
+    Feeder::new(text.as_bytes().to_vec(), packet, every, false).unwrap()
+}
+
+pub fn crlf(text: &str) -> Vec<u8> {
+    text.replace('\n', "\r\n").into_bytes()
+}
+
+pub fn path_str(p: &Path) -> String {
+    p.display().to_string()
+}
+
+/// The channels in real time behind a real ADS server on a loopback port, in this process.
+pub struct Served {
+    pub server: ncchannel::ads::ServerHandle,
+    stop: ncchannel::runtime::StopHandle,
+    thread: std::thread::JoinHandle<Machine>,
+    log: Shared2,
+}
+
+impl Served {
+    pub fn start(rig: &Rig) -> Served {
+        let (machine, period, log) = rig.machine();
+        let mut machine = machine;
+        machine.set_stop_when(StopWhen::Never);
+        let n = machine.channels().len() as u16;
+        let (mut rt, tx) = Runtime::new(machine, period, Clock::RealTime);
+        let stop = rt.stop_handle();
+        let thread = std::thread::spawn(move || {
+            rt.run(None);
+            rt.into_inner().0
+        });
+        let backend = ncchannel::ads::channel_backend::ChannelBackend::new(tx, n);
+        let config = ncchannel::ads::ServerConfig {
+            bind: "127.0.0.1:0".parse().unwrap(),
+            ..Default::default()
+        };
+        let server = ncchannel::ads::spawn(config, Arc::new(backend)).unwrap();
+        Served {
+            server,
+            stop,
+            thread,
+            log,
+        }
+    }
+
+    /// Stop the runtime and return the event log as JSON values.
+    pub fn finish(self) -> (Machine, Vec<Value>) {
+        self.server.shutdown();
+        self.stop.stop();
+        let mut m = self.thread.join().unwrap();
+        m.finish_log().unwrap();
+        let events = self
+            .log
+            .text()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        (m, events)
+    }
+}
+
+/// The 5,000-line program the ADS end-to-end tests stream: mostly parameter blocks with a
+/// short move every 25 lines, so the channel runs and moves, yet 5,000 lines take seconds,
+/// not minutes, of real time. Ends with M30.
+pub fn streamed_5000_lines() -> Vec<String> {
+    let mut lines: Vec<String> = vec!["N1 G01 F30000".into()];
+    lines.extend((2..5000).map(|i| {
+        if i % 25 == 0 {
+            format!(
+                "N{i} X{:.3} Y{:.3}",
+                (i % 50) as f64 * 0.02,
+                (i % 31) as f64 * 0.02
+            )
+        } else {
+            format!("N{i} P{}={i}", 1 + i % 20)
+        }
+    }));
+    lines.push("M30".into());
+    lines
+}
+
+/// Run an outside client, `program script args…`, against `served` (its address in
+/// `NCCHANNEL_ADS_ADDR`); it must succeed and print one JSON line. Returns that line and the
+/// run's events.
+pub fn run_client(
+    served: Served,
+    program: &str,
+    script: &str,
+    args: &[&Path],
+) -> (Value, Vec<Value>) {
+    let out = std::process::Command::new(program)
+        .arg(script)
+        .args(args)
+        .env("NCCHANNEL_ADS_ADDR", served.server.local_addr().to_string())
+        .output()
+        .unwrap_or_else(|e| panic!("{program} runs: {e}"));
+    let (_, events) = served.finish();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let seen = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    (seen, events)
+}
+
+pub mod abuse;
+pub mod ads;
+pub mod limit_check;
+pub mod queued;
+pub mod random_path;
+pub mod streaming_load;
