@@ -236,6 +236,9 @@ pub struct DecoderStats {
 
 pub struct Decoder {
     settings: DecoderSettings,
+    /// Bit i: the configured axis in slot i has a name longer than its letter (`X1`), so the
+    /// letter alone names no axis. Read for every axis word; built once from the settings.
+    renamed_slots: u8,
     frames: Vec<Frame>,
     stream: StreamReader,
     /// A stream frame is on the frame stack.
@@ -276,8 +279,12 @@ type Res<T = ()> = Result<T, DecodeError>;
 
 impl Decoder {
     pub fn new(settings: DecoderSettings) -> Self {
+        let renamed_slots = (0..MAX_AXES)
+            .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
+            .fold(0u8, |m, i| m | 1 << i);
         Decoder {
             settings,
+            renamed_slots,
             frames: Vec::new(),
             stream: StreamReader::default(),
             stream_active: false,

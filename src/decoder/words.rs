@@ -12,6 +12,7 @@ use super::modal::FeedMode;
 use super::*;
 use crate::lang::block::VarRef;
 use crate::lang::eval::Val;
+use crate::vocab::axis::slot_of;
 
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
@@ -200,9 +201,10 @@ impl Decoder {
             }
             Item::NamedAxis(a) => self.collect_named_axis(a, w),
             Item::Word(word) => {
-                if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == word.letter) {
+                let renamed = self.renamed_slots != 0;
+                if let Some(i) = slot_of(word.letter).filter(|_| renamed) {
                     let name = &self.settings.axis_names[i];
-                    if self.settings.axes[i] && !name.is_letter() {
+                    if self.renamed_slots & (1 << i) != 0 {
                         // The axis in this slot is named `X1`: `X` alone names no axis.
                         return Err(DecodeError::new(
                             codes::SYNTAX,
@@ -306,7 +308,7 @@ impl Decoder {
             b'K' => w.ijk[2] = Some(v),
             b'R' => w.radius = Some(v),
             letter => {
-                if let Some(i) = AXIS_LETTERS.iter().position(|&a| a == letter) {
+                if let Some(i) = slot_of(letter) {
                     if self.settings.axes[i] && w.axes_set & (1 << i) != 0 {
                         // `X1=5` and `X5` both name the slot of axis X1 (the parser sees
                         // only letters twice).
