@@ -264,6 +264,20 @@ impl Channel {
                 total: self.stats().errors,
                 record: crate::machine::error_record(self, i),
             },
+            Op::Start(name) => Reply::Command(self.start(tick, &name)),
+            Op::SearchAt(target) => {
+                self.set_search(target);
+                Reply::Done
+            }
+            Op::SkipMask(mask) => {
+                self.decoder.set_skip_mask(mask);
+                Reply::Done
+            }
+            Op::ObserveStreamBlocks(on) => {
+                self.observe_stream_blocks(on);
+                Reply::Done
+            }
+            Op::DrainExecuted => Reply::Executed(self.drain_executed().collect()),
         }
     }
 

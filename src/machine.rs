@@ -11,9 +11,10 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::Sender;
 
 use crate::channel::{
-    ActiveBlock, Channel, CommandError, ErrorRecord, Finish, HmiCommands, Mode, SearchCommand,
-    State,
+    ActiveBlock, Channel, CommandError, ErrorRecord, ExecutedBlock, Finish, HmiCommands, Mode,
+    SearchCommand, State,
 };
+use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
 use crate::runtime::{Cycle, Flow, Tick};
@@ -40,6 +41,19 @@ pub enum Op {
     Hmi(HmiOp),
     /// The error with this index (0 = the first the channel raised) and the total count.
     ErrorRecord(u64),
+    /// Start this main program at once (`run`, `serve --start`, the soak's restarts): the
+    /// command parameter and ACTIVE in one step, refused as ACTIVE would be.
+    Start(String),
+    /// Block search target for the next start (`run --search`); `None` forgets it.
+    SearchAt(Option<SearchTarget>),
+    /// The decoder's block-skip mask as a whole, bit n = `/n` (`run --skip-mask`, which
+    /// reaches levels the HMI's ten-level `SkipLevels` does not).
+    SkipMask(u16),
+    /// Record every executed stream block for [`Op::DrainExecuted`] (the soak's checks).
+    ObserveStreamBlocks(bool),
+    /// The stream blocks executed since the last drain, in execution order
+    /// ([`Reply::Executed`]).
+    DrainExecuted,
 }
 
 /// The HMI command objects a client writes (see [`crate::channel::HmiCommands`]).
@@ -145,6 +159,8 @@ pub enum Reply {
     /// program (`streaming_prog_file` unset), so nothing ever will. ADS 0x707, not 0x708:
     /// retrying cannot succeed (docs/exactly-once.md).
     StreamNotReady,
+    /// The executed stream blocks [`Op::DrainExecuted`] asked for.
+    Executed(Vec<ExecutedBlock>),
 }
 
 /// A request with its own way back: answered in the tick that serves it.
@@ -357,8 +373,10 @@ impl Cycle for Machine {
                 continue;
             };
             if let Some(packet) = a.feeder.poll(tick.index) {
-                let ok = c.write_stream(tick, packet).is_ok();
-                a.feeder.result(ok);
+                // Through the door like any client's write; a write the channel cannot take
+                // (ERROR, no streaming program) is a refusal the feeder retries.
+                let reply = c.apply(tick, Op::WriteStream(packet.to_vec()));
+                a.feeder.result(matches!(reply, Reply::Stream(Ok(()))));
             }
         }
         for (i, c) in self.channels.iter_mut().enumerate() {

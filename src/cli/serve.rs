@@ -103,21 +103,14 @@ pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
 /// The machine under the soak's supervision: faults injected, invariants checked on what the
 /// external clients make the channels do.
 fn supervised(machine: Machine, sc: &Scenario, config: &crate::params::Config) -> Supervised {
-    let soft_limits = config
-        .channels
-        .iter()
-        .flat_map(|c| &c.axes)
-        .filter_map(|a| {
-            let c = a.name.chars().next()?;
-            Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
-        })
-        .collect();
+    // The soft limits of the first channel's axes, as the in-process soak checks them.
+    let axes = crate::setup::axes(config).unwrap_or_default();
     let programs = config
         .channels
         .iter()
         .map(|c| c.streaming_prog_file.clone())
         .collect();
-    Supervised::new(machine, sc, soft_limits, programs)
+    Supervised::new(machine, sc, &axes, programs)
 }
 
 pub fn execute(mut args: ServeArgs) -> ExitCode {

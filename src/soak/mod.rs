@@ -8,7 +8,6 @@ pub mod feed;
 pub mod generator;
 pub mod invariants;
 pub mod load;
-pub mod plot;
 pub mod report;
 pub mod rng;
 pub mod scenario;
@@ -22,8 +21,8 @@ use crate::runtime::{Clock, RunEnd, Runtime};
 use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
-use invariants::{resident_kib, Tally, Verdict};
-use report::{ChannelReport, CycleFigures, MemoryReport, SoakReport};
+use invariants::resident_kib;
+use report::{CycleFigures, MemoryReport, SoakReport};
 use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
 
@@ -147,74 +146,6 @@ fn progress_bar(enabled: bool) -> ProgressBar {
     }
 }
 
-/// The invariants' verdicts at the end of a run (`growth`: resident set after warm-up, KiB).
-fn verdicts(cycle: &SoakCycle, scenario: &Scenario, growth: Option<i64>) -> Vec<Verdict> {
-    let mut memory = Tally::default();
-    let slack = scenario.invariants.memory_slack_kib;
-    if let Some(g) = growth {
-        if g > slack as i64 {
-            memory.violate(|| {
-                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
-            });
-        }
-    }
-    let order_note = format!("{} blocks checked", cycle.total_blocks);
-    vec![
-        cycle.tallies.order.verdict(
-            "every streamed block executed exactly once, in order, between resets",
-            Some(order_note),
-        ),
-        cycle.tallies.errors.verdict(
-            "no channel error but the expected ones",
-            Some(format!(
-                "expected: {:?}",
-                scenario.invariants.expected_errors
-            )),
-        ),
-        cycle
-            .tallies
-            .limits
-            .verdict("positions within the axis soft limits", None),
-        memory.verdict(
-            "memory steady",
-            growth.map(|g| format!("growth {g} KiB ≤ {slack} KiB")),
-        ),
-    ]
-}
-
-/// Each channel's counters for the report.
-fn channel_reports(cycle: &SoakCycle) -> Vec<ChannelReport> {
-    cycle
-        .slots
-        .iter()
-        .map(|s| {
-            let f = s.feeder.counters();
-            let st = s.channel.stats();
-            ChannelReport {
-                number: s.channel.number(),
-                program: s.program.clone(),
-                blocks: s.counters.blocks,
-                resets: s.counters.resets,
-                error_resets: s.counters.error_resets,
-                restarts: s.counters.restarts,
-                holds: s.counters.holds,
-                overrides: s.counters.overrides,
-                forced_rejections: s.counters.forced_rejections,
-                writes_ok: f.writes_ok,
-                writes_rejected: f.writes_rejected,
-                writes_skipped: f.writes_skipped,
-                bytes: f.bytes,
-                lines_written: f.lines,
-                pauses: f.pauses,
-                interrupts: st.interrupts,
-                warnings: st.warnings,
-                errors: s.counters.errors.clone(),
-                checksum: format!("{:016x}", s.counters.checksum.0),
-            }
-        })
-        .collect()
-}
-
 /// Run a scenario to its end and report.
 pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
     let length = opts
@@ -297,8 +228,13 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     let (cycle, stats) = rt.into_inner();
 
     let growth = warmup_kib.zip(end_kib).map(|(a, b)| b as i64 - a as i64);
-    let invariants = verdicts(&cycle, scenario, growth);
-    let channels = channel_reports(&cycle);
+    let invariants = cycle.tallies.verdicts(
+        cycle.total_blocks,
+        &scenario.invariants.expected_errors,
+        growth,
+        scenario.invariants.memory_slack_kib,
+    );
+    let channels = cycle.slots.iter().map(Slot::report).collect();
     let blocks = cycle.total_blocks;
     Ok(SoakReport {
         scenario: scenario.path.display().to_string(),
