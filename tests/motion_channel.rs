@@ -7,6 +7,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use ncchannel::channel::{Channel, State};
+use ncchannel::machine::{Op, Reply};
 use ncchannel::report::event::{EventKind, EventLog};
 use ncchannel::runtime::Tick;
 
@@ -69,14 +70,20 @@ fn run_stream(
     max_ticks: u64,
 ) -> (Channel, Vec<(u64, EventKind)>, Vec<f64>) {
     let mut c = s.channel();
-    c.start(&tick(0), "streaming.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("streaming.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let mut events = Vec::new();
     let mut velocity = Vec::new();
     for k in 0..max_ticks {
         let t = tick(k);
         for (at, text) in writes {
             if *at == k {
-                c.write_stream(&t, text.as_bytes()).unwrap();
+                assert_eq!(
+                    c.apply(&t, Op::WriteStream(text.as_bytes().to_vec())),
+                    Reply::Stream(Ok(()))
+                );
             }
         }
         c.step(&t);
@@ -188,15 +195,18 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
     let s = Setup::new("", "");
     let mut c = s.channel();
     s.write("nc/long.nc", "N10 G1 X100 F6000\nN20 M30\n");
-    c.start(&tick(0), "long.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("long.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let mut events = Vec::new();
     for k in 1..3000u64 {
         let t = tick(k);
         if k == 300 {
-            c.hold(&t);
+            c.apply(&t, Op::Hold);
         }
         if k == 800 {
-            c.resume(&t);
+            c.apply(&t, Op::Resume);
         }
         c.step(&t);
         if k == 790 {
@@ -226,7 +236,10 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
          N60 M30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "arcs.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("arcs.nc".into())),
+        Reply::Command(Ok(()))
+    );
     for k in 1..20_000 {
         c.step(&tick(k));
         if c.state() != State::Active {
@@ -242,7 +255,10 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
         "N10 G1 X10 Y0 F3000\nN20 G3 X0 Y10.5 I-10 J0\nM30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "bad.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("bad.nc".into())),
+        Reply::Command(Ok(()))
+    );
     for k in 1..5000 {
         c.step(&tick(k));
     }
@@ -265,7 +281,10 @@ fn zero_offsets_from_the_list_named_in_the_startup_list() {
         "N10 G54 G90 G0 X0 Y0\nN20 #FLUSH WAIT\nN30 G55 G0 X1 Z0\nN40 G53 G0 Y7\nM30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "np.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("np.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let mut after_n10 = None;
     for k in 1..10_000u64 {
         c.step(&tick(k));
@@ -443,7 +462,10 @@ fn m5_after_the_last_motion_of_a_paused_stream_takes_effect_when_the_motion_ends
 fn run_file(s: &Setup, name: &str, text: &str, max_ticks: u64) -> (Vec<[f64; 6]>, Vec<f64>) {
     s.write(&format!("nc/{name}"), text);
     let mut c = s.channel();
-    c.start(&tick(0), name).unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start(name.to_string())),
+        Reply::Command(Ok(()))
+    );
     let (mut pos, mut vel) = (Vec::new(), Vec::new());
     for k in 1..max_ticks {
         c.step(&tick(k));
@@ -649,7 +671,10 @@ fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
     s.write("params/tools.lis", "wz[1].radius 50000\n");
     s.write("nc/trc.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "trc.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("trc.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let (mut inside, mut out) = (false, Vec::new());
     for k in 1..200_000u64 {
         c.step(&tick(k));
@@ -718,7 +743,10 @@ fn trc_radius_larger_than_an_inner_arc_is_error_900140() {
     let program = "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F3000\nG3 X6 Y0 I3 J0\nG1 X20\nG40 X30\nM30\n";
     s.write("nc/bad_trc.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "bad_trc.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("bad_trc.nc".into())),
+        Reply::Command(Ok(()))
+    );
     for k in 1..20_000u64 {
         c.step(&tick(k));
         c.events_mut().flush_to(&mut EventLog::disabled());
@@ -742,7 +770,10 @@ fn run_to_error(runtime: &str, program: &str) -> (Vec<ncchannel::channel::ErrorR
     s.write("params/tools.lis", "wz[1].radius 50000\n");
     s.write("nc/lim.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "lim.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("lim.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let mut x_max: f64 = 0.0;
     for k in 1..200_000u64 {
         c.step(&tick(k));

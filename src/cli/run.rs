@@ -9,7 +9,7 @@ use std::time::Duration;
 use crate::channel::Finish;
 use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
-use crate::machine::{Machine, StopWhen};
+use crate::machine::{Machine, Op, Reply, StopWhen};
 use crate::report::event::EventLog;
 use crate::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
@@ -282,15 +282,16 @@ fn run_program(
         period,
         time: Duration::ZERO,
     };
-    let mut start_failed = false;
-    if let Some(c) = machine.channel_mut(args.channel) {
-        c.set_search(args.search);
-        c.decoder_mut().set_skip_mask(args.skip_mask);
-        if let Err(e) = c.start(&tick0, program) {
+    let ch = args.channel;
+    machine.apply(&tick0, ch, Op::SearchAt(args.search));
+    machine.apply(&tick0, ch, Op::SkipMask(args.skip_mask));
+    let start_failed = match machine.apply(&tick0, ch, Op::Start(program.to_string())) {
+        Reply::Command(Err(e)) => {
             eprintln!("ncchannel run: {e}");
-            start_failed = true;
+            true
         }
-    }
+        _ => false,
+    };
     let clock = if args.realtime {
         Clock::RealTime
     } else {

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::{AmsNetId, ServerConfig};
-use crate::machine::{Machine, StopWhen};
+use crate::machine::{Machine, Op, Reply, StopWhen};
 use crate::report::event::{Backlog, EventLog};
 use crate::runtime::{Clock, Runtime, Tick};
 use crate::soak::external::{load_external, Supervised};
@@ -159,10 +159,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             period,
             time: Duration::ZERO,
         };
-        if let Some(c) = machine.channel_mut(1) {
-            if let Err(e) = c.start(&tick0, p) {
-                report(format_args!("ncchannel serve: --start {p}: {e}"));
-            }
+        if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(p.clone())) {
+            report(format_args!("ncchannel serve: --start {p}: {e}"));
         }
     }
     if let Some(sc) = scenario {
