@@ -35,7 +35,7 @@ pub struct ErrorRecord {
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
-use crate::machine::{HmiOp, Op, Reply};
+use crate::machine::{HmiOp, Op, Reply, TraceOp};
 pub use crate::mode::{Mode, State};
 
 /// Why a command was refused.
@@ -278,6 +278,17 @@ impl Channel {
                 Reply::Done
             }
             Op::DrainExecuted => Reply::Executed(self.drain_executed().collect()),
+            Op::Trace(t) => Reply::Trace(match t {
+                TraceOp::Plot { max_samples } => {
+                    self.motion.enable_trace(max_samples);
+                    Ok(())
+                }
+                TraceOp::Csv { path, every } => self
+                    .motion
+                    .enable_csv_trace(&path, every)
+                    .map_err(|e| format!("{}: {e}", path.display())),
+                TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
+            }),
         }
     }
 
@@ -355,15 +366,8 @@ impl Channel {
     pub fn decoder(&self) -> &Decoder {
         &self.decoder
     }
-    pub fn decoder_mut(&mut self) -> &mut Decoder {
-        &mut self.decoder
-    }
     pub fn motion(&self) -> &Motion {
         &self.motion
-    }
-    /// For `--plot`: switch on the motion trace.
-    pub fn motion_mut(&mut self) -> &mut Motion {
-        &mut self.motion
     }
     /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
     pub fn errors(&self) -> &[ErrorRecord] {

@@ -54,6 +54,22 @@ pub enum Op {
     /// The stream blocks executed since the last drain, in execution order
     /// ([`Reply::Executed`]).
     DrainExecuted,
+    /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
+    Trace(TraceOp),
+}
+
+/// What `run` asks of the motion trace.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TraceOp {
+    /// Keep up to this many samples for the plot.
+    Plot { max_samples: usize },
+    /// Write every `every`-th tick's sample into this CSV file (created now).
+    Csv {
+        path: std::path::PathBuf,
+        every: u64,
+    },
+    /// Flush and close the CSV file.
+    FinishCsv,
 }
 
 /// The HMI command objects a client writes (see [`crate::channel::HmiCommands`]).
@@ -161,6 +177,8 @@ pub enum Reply {
     StreamNotReady,
     /// The executed stream blocks [`Op::DrainExecuted`] asked for.
     Executed(Vec<ExecutedBlock>),
+    /// A trace file could not be written: the reason.
+    Trace(Result<(), String>),
 }
 
 /// A request with its own way back: answered in the tick that serves it.
@@ -259,7 +277,8 @@ impl Machine {
         &self.channels
     }
 
-    pub fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
+    /// The channel by number; commands reach it only through [`Machine::apply`].
+    fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
         self.channels.get_mut((number as usize).checked_sub(1)?)
     }
 

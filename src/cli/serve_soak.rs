@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use crate::ads::channel_backend::ChannelBackend;
 use crate::runtime::{Clock, RunEnd, Runtime};
 use crate::soak::external::{resident, Supervised};
-use crate::soak::report::{CycleFigures, MemoryReport, SoakReport};
+use crate::soak::report::{CycleFigures, MemoryReport, RunFigures, SoakReport};
 use crate::soak::scenario::Scenario;
 
 use super::exit;
@@ -117,23 +117,23 @@ fn report_of(
     memory: MemoryReport,
     cycle_figures: CycleFigures,
 ) -> SoakReport {
-    let invariants = cycle.verdicts(memory.growth_kib, scenario.invariants.memory_slack_kib);
-    let blocks = cycle.blocks();
-    SoakReport {
-        scenario: scenario.path.display().to_string(),
+    let run = RunFigures {
         seed: scenario.seed,
-        clock: "real".into(),
+        realtime: true,
         ticks,
         sim_seconds,
         wall_seconds,
-        blocks,
-        blocks_per_wall_second: blocks as f64 / wall_seconds.max(1e-9),
-        all_held: invariants.iter().all(|v| v.held),
+        blocks: cycle.blocks(),
+    };
+    let invariants = cycle.verdicts(memory.growth_kib, scenario.invariants.memory_slack_kib);
+    SoakReport::new(
+        &scenario.path,
+        run,
         invariants,
-        channels: cycle.counters(),
+        cycle.counters(),
         memory,
-        cycle: cycle_figures,
-    }
+        cycle_figures,
+    )
 }
 
 fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {

@@ -22,7 +22,7 @@ use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
 use invariants::resident_kib;
-use report::{CycleFigures, MemoryReport, SoakReport};
+use report::{CycleFigures, MemoryReport, RunFigures, SoakReport};
 use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
 
@@ -220,39 +220,47 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         ));
     }
     bar.finish_and_clear();
-    let wall = start.elapsed();
+    let run = RunFigures {
+        seed,
+        realtime,
+        ticks: rt.ticks(),
+        sim_seconds: rt.time().as_secs_f64(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+        blocks: rt.cycle().total_blocks,
+    };
+    let (cycle, stats) = rt.into_inner();
+    Ok(report_of(&cycle, &stats, scenario, run, warmup_kib, period))
+}
+
+/// The report of a finished run (`warmup_kib`: resident set after warm-up).
+fn report_of(
+    cycle: &SoakCycle,
+    stats: &crate::report::stats::CycleStats,
+    scenario: &Scenario,
+    run: RunFigures,
+    warmup_kib: Option<u64>,
+    period: Duration,
+) -> SoakReport {
     let end_kib = resident_kib();
     let warmup_kib = warmup_kib.or(end_kib);
-    let ticks = rt.ticks();
-    let sim = rt.time().as_secs_f64();
-    let (cycle, stats) = rt.into_inner();
-
     let growth = warmup_kib.zip(end_kib).map(|(a, b)| b as i64 - a as i64);
     let invariants = cycle.tallies.verdicts(
-        cycle.total_blocks,
+        run.blocks,
         &scenario.invariants.expected_errors,
         growth,
         scenario.invariants.memory_slack_kib,
     );
-    let channels = cycle.slots.iter().map(Slot::report).collect();
-    let blocks = cycle.total_blocks;
-    Ok(SoakReport {
-        scenario: scenario.path.display().to_string(),
-        seed,
-        clock: if realtime { "real" } else { "virtual" }.into(),
-        ticks,
-        sim_seconds: sim,
-        wall_seconds: wall.as_secs_f64(),
-        blocks,
-        blocks_per_wall_second: blocks as f64 / wall.as_secs_f64().max(1e-9),
-        all_held: invariants.iter().all(|v| v.held),
+    let memory = MemoryReport {
+        warmup_kib,
+        end_kib,
+        growth_kib: growth,
+    };
+    SoakReport::new(
+        &scenario.path,
+        run,
         invariants,
-        channels,
-        memory: MemoryReport {
-            warmup_kib,
-            end_kib,
-            growth_kib: growth,
-        },
-        cycle: CycleFigures::new(period.as_secs_f64() * 1e6, &stats),
-    })
+        cycle.slots.iter().map(Slot::report).collect(),
+        memory,
+        CycleFigures::new(period.as_secs_f64() * 1e6, stats),
+    )
 }

@@ -76,7 +76,45 @@ pub struct SoakReport {
     pub cycle: CycleFigures,
 }
 
+/// What a run was and how long it took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RunFigures {
+    pub seed: u64,
+    pub realtime: bool,
+    pub ticks: u64,
+    pub sim_seconds: f64,
+    pub wall_seconds: f64,
+    /// Stream blocks checked, all channels.
+    pub blocks: u64,
+}
+
 impl SoakReport {
+    /// The report of a run of `scenario` (`ncchannel soak` and `serve --soak` alike).
+    pub fn new(
+        scenario: &std::path::Path,
+        run: RunFigures,
+        invariants: Vec<Verdict>,
+        channels: Vec<SoakCounters>,
+        memory: MemoryReport,
+        cycle: CycleFigures,
+    ) -> Self {
+        SoakReport {
+            scenario: scenario.display().to_string(),
+            seed: run.seed,
+            clock: if run.realtime { "real" } else { "virtual" }.into(),
+            ticks: run.ticks,
+            sim_seconds: run.sim_seconds,
+            wall_seconds: run.wall_seconds,
+            blocks: run.blocks,
+            blocks_per_wall_second: run.blocks as f64 / run.wall_seconds.max(1e-9),
+            all_held: invariants.iter().all(|v| v.held),
+            invariants,
+            channels,
+            memory,
+            cycle,
+        }
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
     }
