@@ -388,10 +388,7 @@ fn a_refresh_while_the_cycle_runs_leaves_the_running_call_on_the_old_text() {
     let (mut channel, period) = rig.channel();
     let mut t = tick0(period);
     let c = &mut channel;
-    assert_eq!(
-        c.apply(&t, Op::Start("main.nc".into())),
-        Reply::Command(Ok(()))
-    );
+    common::start(c, &t, "main.nc");
     // The X move takes 100 ms; #FLUSH WAIT holds decoding until it is done.
     for _ in 0..20 {
         c.step(&t);

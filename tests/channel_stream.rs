@@ -5,7 +5,7 @@ mod common;
 use common::{crlf, feeder, tick0, Rig};
 use ncchannel::channel::{Finish, State};
 use ncchannel::feeder::Feeder;
-use ncchannel::machine::{Op, Reply};
+use ncchannel::machine::Op;
 
 #[test]
 fn stream_as_main_program_runs_every_block_and_ends() {
@@ -82,19 +82,13 @@ fn packets_written_before_the_read_merge_into_one_segment() {
     let t = tick0(period);
     let c = &mut channel;
     // Data written while no streaming program runs is kept for the next one.
+    assert_eq!(common::write(c, &t, &crlf("N1 P1=1\n")), common::WRITTEN);
     assert_eq!(
-        c.apply(&t, Op::WriteStream(crlf("N1 P1=1\n").to_vec())),
-        Reply::Stream(Ok(()))
-    );
-    assert_eq!(
-        c.apply(&t, Op::WriteStream(crlf("N2 P2=2\nN3 P3=3\n").to_vec())),
-        Reply::Stream(Ok(()))
+        common::write(c, &t, &crlf("N2 P2=2\nN3 P3=3\n")),
+        common::WRITTEN
     );
     assert_eq!(c.stream_fill().0, 9 + 18);
-    assert_eq!(
-        c.apply(&t, Op::Start("streaming.nc".into())),
-        Reply::Command(Ok(()))
-    );
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
     let ev = common::channel_events(c);
     let segs = common::of(&ev, "segment");
@@ -109,22 +103,13 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     let t = tick0(period);
     let c = &mut channel;
     assert_eq!(
-        c.apply(
-            &t,
-            Op::WriteStream(crlf("N1 P1=1\nM30\nN2 P2=2\n").to_vec())
-        ),
+        common::write(c, &t, &crlf("N1 P1=1\nM30\nN2 P2=2\n")),
         common::WRITTEN
     );
-    assert_eq!(
-        c.apply(&t, Op::Start("streaming.nc".into())),
-        Reply::Command(Ok(()))
-    );
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
     // Written after the segment was read: stays in the buffer for the next program.
-    assert_eq!(
-        c.apply(&t, Op::WriteStream(crlf("N9 P9=9\n").to_vec())),
-        Reply::Stream(Ok(()))
-    );
+    assert_eq!(common::write(c, &t, &crlf("N9 P9=9\n")), common::WRITTEN);
     for _ in 0..5 {
         c.step(&t);
     }
@@ -137,14 +122,8 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     assert_eq!(texts, ["N1 P1=1", "M30"]);
     assert_eq!(c.stream_fill().0, 9);
     // The next start runs it.
-    assert_eq!(
-        c.apply(&t, Op::Start("streaming.nc".into())),
-        Reply::Command(Ok(()))
-    );
-    assert_eq!(
-        c.apply(&t, Op::WriteStream(crlf("M30\n").to_vec())),
-        Reply::Stream(Ok(()))
-    );
+    common::start(c, &t, "streaming.nc");
+    assert_eq!(common::write(c, &t, &crlf("M30\n")), common::WRITTEN);
     for _ in 0..5 {
         c.step(&t);
     }
@@ -249,21 +228,12 @@ fn reset_empties_buffer_and_state() {
     let t = tick0(period);
     let c = &mut channel;
     assert_eq!(
-        c.apply(
-            &t,
-            Op::WriteStream(crlf("N1 G01 X100 F600\nN2 X0\n").to_vec())
-        ),
+        common::write(c, &t, &crlf("N1 G01 X100 F600\nN2 X0\n")),
         common::WRITTEN
     );
-    assert_eq!(
-        c.apply(&t, Op::Start("streaming.nc".into())),
-        Reply::Command(Ok(()))
-    );
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
-    assert_eq!(
-        c.apply(&t, Op::WriteStream(crlf("N3 X5\n").to_vec())),
-        Reply::Stream(Ok(()))
-    );
+    assert_eq!(common::write(c, &t, &crlf("N3 X5\n")), common::WRITTEN);
     assert!(c.decoder().reads_stream());
     c.apply(&t, Op::Reset);
     assert_eq!(c.state(), State::Ready);
