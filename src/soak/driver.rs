@@ -288,7 +288,8 @@ impl SoakChannel {
         } else if state == State::Error {
             self.counters.error_resets += 1;
             self.reset(rng, f, tick, door, new_epoch);
-        } else if self.restart_due || state == State::Ready {
+        } else if self.restart_due || (state == State::Ready && !self.counters.program.is_empty()) {
+            // A channel without a program to restart stays READY and counts no restarts.
             if !self.restart_due {
                 self.counters.restarts += 1;
             }
