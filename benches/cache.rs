@@ -13,7 +13,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, RunEnd, Runtime, Tick};
 
@@ -64,7 +64,10 @@ fn machine(dir: &Path) -> (Machine, Duration) {
         period,
         time: Duration::ZERO,
     };
-    m.channel_mut(1).unwrap().start(&t0, "main.nc").unwrap();
+    assert_eq!(
+        m.apply(&t0, 1, Op::Start("main.nc".into())),
+        Reply::Command(Ok(()))
+    );
     (m, period)
 }
 

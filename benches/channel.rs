@@ -7,7 +7,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ncchannel::channel::Finish;
 use ncchannel::feeder::Feeder;
-use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
 
@@ -49,7 +49,10 @@ impl Setup {
             period,
             time: Duration::ZERO,
         };
-        m.channel_mut(1).unwrap().start(&t0, program).unwrap();
+        assert_eq!(
+            m.apply(&t0, 1, Op::Start(program.to_string())),
+            Reply::Command(Ok(()))
+        );
         let (mut rt, _tx) = Runtime::new(m, period, Clock::Virtual);
         rt.run(None);
         let (m, stats) = rt.into_inner();

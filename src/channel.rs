@@ -36,7 +36,7 @@ pub struct ErrorRecord {
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
-use crate::machine::{HmiOp, Op, Reply};
+use crate::machine::{HmiOp, Op, Reply, TraceOp};
 pub use crate::vocab::mode::{Mode, State};
 
 /// Why a command was refused.
@@ -265,6 +265,31 @@ impl Channel {
                 total: self.stats().errors,
                 record: crate::machine::error_record(self, i),
             },
+            Op::Start(name) => Reply::Command(self.start(tick, &name)),
+            Op::SearchAt(target) => {
+                self.set_search(target);
+                Reply::Done
+            }
+            Op::SkipMask(mask) => {
+                self.decoder.set_skip_mask(mask);
+                Reply::Done
+            }
+            Op::ObserveStreamBlocks(on) => {
+                self.observe_stream_blocks(on);
+                Reply::Done
+            }
+            Op::DrainExecuted => Reply::Executed(self.drain_executed().collect()),
+            Op::Trace(t) => Reply::Trace(match t {
+                TraceOp::Plot { max_samples } => {
+                    self.motion.enable_trace(max_samples);
+                    Ok(())
+                }
+                TraceOp::Csv { path, every } => self
+                    .motion
+                    .enable_csv_trace(&path, every)
+                    .map_err(|e| format!("{}: {e}", path.display())),
+                TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
+            }),
         }
     }
 
@@ -342,15 +367,8 @@ impl Channel {
     pub fn decoder(&self) -> &Decoder {
         &self.decoder
     }
-    pub fn decoder_mut(&mut self) -> &mut Decoder {
-        &mut self.decoder
-    }
     pub fn motion(&self) -> &Motion {
         &self.motion
-    }
-    /// For `--plot`: switch on the motion trace.
-    pub fn motion_mut(&mut self) -> &mut Motion {
-        &mut self.motion
     }
     /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
     pub fn errors(&self) -> &[ErrorRecord] {

@@ -11,9 +11,10 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::Sender;
 
 use crate::channel::{
-    ActiveBlock, Channel, CommandError, ErrorRecord, Finish, HmiCommands, Mode, SearchCommand,
-    State,
+    ActiveBlock, Channel, CommandError, ErrorRecord, ExecutedBlock, Finish, HmiCommands, Mode,
+    SearchCommand, State,
 };
+use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
 use crate::runtime::{Cycle, Flow, Tick};
@@ -40,6 +41,35 @@ pub enum Op {
     Hmi(HmiOp),
     /// The error with this index (0 = the first the channel raised) and the total count.
     ErrorRecord(u64),
+    /// Start this main program at once (`run`, `serve --start`, the soak's restarts): the
+    /// command parameter and ACTIVE in one step, refused as ACTIVE would be.
+    Start(String),
+    /// Block search target for the next start (`run --search`); `None` forgets it.
+    SearchAt(Option<SearchTarget>),
+    /// The decoder's block-skip mask as a whole, bit n = `/n` (`run --skip-mask`, which
+    /// reaches levels the HMI's ten-level `SkipLevels` does not).
+    SkipMask(u16),
+    /// Record every executed stream block for [`Op::DrainExecuted`] (the soak's checks).
+    ObserveStreamBlocks(bool),
+    /// The stream blocks executed since the last drain, in execution order
+    /// ([`Reply::Executed`]).
+    DrainExecuted,
+    /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
+    Trace(TraceOp),
+}
+
+/// What `run` asks of the motion trace.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TraceOp {
+    /// Keep up to this many samples for the plot.
+    Plot { max_samples: usize },
+    /// Write every `every`-th tick's sample into this CSV file (created now).
+    Csv {
+        path: std::path::PathBuf,
+        every: u64,
+    },
+    /// Flush and close the CSV file.
+    FinishCsv,
 }
 
 /// The HMI command objects a client writes (see [`crate::channel::HmiCommands`]).
@@ -145,6 +175,10 @@ pub enum Reply {
     /// program (`streaming_prog_file` unset), so nothing ever will. ADS 0x707, not 0x708:
     /// retrying cannot succeed (docs/exactly-once.md).
     StreamNotReady,
+    /// The executed stream blocks [`Op::DrainExecuted`] asked for.
+    Executed(Vec<ExecutedBlock>),
+    /// A trace file could not be written: the reason.
+    Trace(Result<(), String>),
 }
 
 /// A request with its own way back: answered in the tick that serves it.
@@ -243,7 +277,8 @@ impl Machine {
         &self.channels
     }
 
-    pub fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
+    /// The channel by number; commands reach it only through [`Machine::apply`].
+    fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
         self.channels.get_mut((number as usize).checked_sub(1)?)
     }
 
@@ -357,8 +392,10 @@ impl Cycle for Machine {
                 continue;
             };
             if let Some(packet) = a.feeder.poll(tick.index) {
-                let ok = c.write_stream(tick, packet).is_ok();
-                a.feeder.result(ok);
+                // Through the door like any client's write; a write the channel cannot take
+                // (ERROR, no streaming program) is a refusal the feeder retries.
+                let reply = c.apply(tick, Op::WriteStream(packet.to_vec()));
+                a.feeder.result(matches!(reply, Reply::Stream(Ok(()))));
             }
         }
         for (i, c) in self.channels.iter_mut().enumerate() {

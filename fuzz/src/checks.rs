@@ -326,6 +326,7 @@ fn shipped_config() -> Option<&'static ncchannel::params::config::Config> {
 /// no panic, and no tick over [`MAX_TICK`] (of the thread's CPU time: a loaded machine's
 /// scheduler must not make a finding), whatever the NC text.
 pub fn channel_program(data: &[u8]) {
+    use ncchannel::machine::{Op, Reply};
     use ncchannel::runtime::Tick;
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
@@ -364,14 +365,14 @@ pub fn channel_program(data: &[u8]) {
     packets.push(packet);
     packets.push(b"M30\r\n".to_vec());
 
-    if channel.start(&tick(0), &program).is_err() {
+    if channel.apply(&tick(0), Op::Start(program.clone())) != Reply::Command(Ok(())) {
         return;
     }
     let mut next = packets.iter().peekable();
     for k in 1..MAX_TICKS {
         let t = tick(k);
         if let Some(p) = next.peek() {
-            if channel.write_stream(&t, p).is_ok() {
+            if channel.apply(&t, Op::WriteStream(p.to_vec())) == Reply::Stream(Ok(())) {
                 next.next();
             }
         }
@@ -543,10 +544,8 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
         return 0;
     };
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
-    if let Some(c) = machine.channel_mut(1) {
-        c.observe_stream_blocks(true);
-    }
     let period = std::time::Duration::from_micros(config.runtime.cycle_period_us);
+    machine.apply(&tick_at(period, 0), 1, Op::ObserveStreamBlocks(true));
     let mut k: u64 = 0;
     let tick = |index: u64| tick_at(period, index);
     // N numbers of the lines written so far (never reused).
@@ -633,6 +632,7 @@ fn run_ticks(
     k: &mut u64,
     seen: &mut Observed,
 ) {
+    use ncchannel::machine::{Op, Reply};
     use ncchannel::runtime::Cycle;
     for _ in 0..n {
         if *k >= MAX_MACHINE_TICKS {
@@ -643,8 +643,9 @@ fn run_ticks(
         let _ = machine.step(&tick_at(period, *k));
         let took = began.elapsed();
         assert!(took <= MAX_TICK, "tick {k} took {took:?}");
-        if let Some(c) = machine.channel_mut(1) {
-            for b in c.drain_executed() {
+        if let Reply::Executed(executed) = machine.apply(&tick_at(period, *k), 1, Op::DrainExecuted)
+        {
+            for b in executed {
                 let Some(n) = b.n else { continue };
                 assert!(
                     seen.accepted.contains(&n),

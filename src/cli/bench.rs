@@ -124,7 +124,7 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         ));
     }
     if let Some(p) = &args.plot {
-        let svg = crate::soak::plot::lateness_svg(&stats.lateness, &bare, period);
+        let svg = crate::report::plot::lateness_svg(&stats.lateness, &bare, period);
         if let Err(e) = std::fs::write(p, svg) {
             return usage(format!("--plot {}: {e}", p.display()));
         }

@@ -13,8 +13,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
-use std::sync::Arc;
-
 use crate::dnc::{
     self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
     TransferEnd, TransferReport, WriterConfig,
@@ -149,13 +147,12 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
 
     let mut total = Totals::default();
     if let Some(addr) = &args.listen {
-        let server = Server {
-            markers: &markers,
-            cfg: &cfg,
+        let listen = dnc::Listener {
             numbers: writer.numbers(),
-            limits,
+            program_log: Some(log_line),
+            ..dnc::Listener::new(markers.clone(), cfg.clone(), limits)
         };
-        server.serve(&args, addr, &mut total)?;
+        serve(&args, addr, &listen, &mut total)?;
     } else {
         let r = receive_input(&args, &limits, &mut splitter, &mut writer)?;
         log_end(Ok(&r));
@@ -224,111 +221,45 @@ fn receive_input(
     })
 }
 
-/// What every transfer a listening port accepts is split and filed with; the program
-/// numbers are shared so concurrent transfers never take the same one.
-struct Server<'a> {
-    markers: &'a Markers,
-    cfg: &'a WriterConfig,
-    numbers: Arc<std::sync::atomic::AtomicU32>,
-    limits: dnc::TransferLimits,
-}
-
-impl Server<'_> {
-    /// Step 2 with --listen: accept transfers, each on its own thread (at most
-    /// --max-concurrent at once), until --max-transfers or a stop signal; then wait for the
-    /// transfers in progress.
-    fn serve(&self, args: &ReceiveArgs, addr: &str, total: &mut Totals) -> Result<(), Failure> {
-        let addr = parse_listen(addr).map_err(Failure::Usage)?;
-        let listener =
-            TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
-        let local = listener
-            .local_addr()
-            .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
-        say(format_args!("listening on {local}"));
-        // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
-        let signal = super::signal::StopSignal::install().ok();
-        if let Some(sig) = &signal {
-            wake_on_signal(sig.clone(), local);
-        }
-        let (done_tx, done) = std::sync::mpsc::channel();
-        let mut active = 0usize;
-        let mut accepted = 0usize;
-        while args.max_transfers.is_none_or(|m| accepted < m) {
-            while active >= usize::from(args.max_concurrent) && settle_next(&done, total) {
-                active -= 1;
-            }
-            while let Ok(r) = done.try_recv() {
-                settle(r, total);
-                active -= 1;
-            }
-            let Some((stream, peer)) = accept(&listener, local) else {
-                continue;
-            };
-            // After a signal, the wake-up connection is not a transfer.
-            if signal
+/// Step 2 with --listen: accept transfers, each on its own thread (at most
+/// --max-concurrent at once), until --max-transfers or a stop signal; then wait for the
+/// transfers in progress.
+fn serve(
+    args: &ReceiveArgs,
+    addr: &str,
+    listen: &dnc::Listener,
+    total: &mut Totals,
+) -> Result<(), Failure> {
+    let addr = parse_listen(addr).map_err(Failure::Usage)?;
+    let listener =
+        TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
+    let local = listener
+        .local_addr()
+        .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
+    say(format_args!("listening on {local}"));
+    // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
+    let signal = super::signal::StopSignal::install().ok();
+    if let Some(sig) = &signal {
+        wake_on_signal(sig.clone(), local);
+    }
+    let listen = dnc::Listener {
+        max_transfers: args.max_transfers,
+        max_concurrent: args.max_concurrent,
+        ..listen.clone()
+    };
+    listen.serve(
+        &listener,
+        // After a signal, the wake-up connection is not a transfer.
+        || {
+            signal
                 .as_ref()
                 .is_some_and(super::signal::StopSignal::raised)
-            {
-                break;
-            }
-            accepted += 1;
-            match self.spawn_transfer(stream, peer, done_tx.clone()) {
-                Ok(_) => active += 1,
-                Err(e) => {
-                    let r = Err(dnc::DncError::io(peer.to_string(), e));
-                    log_end(r.as_ref());
-                    settle(r, total);
-                }
-            }
-        }
-        // The transfers in progress complete (each within its idle timeout).
-        drop(done_tx);
-        while active > 0 && settle_next(&done, total) {
-            active -= 1;
-        }
-        Ok(())
-    }
-
-    /// One accepted connection received on its own thread, with its own splitter and
-    /// writer; its outcome is sent on `tx`.
-    fn spawn_transfer(
-        &self,
-        stream: std::net::TcpStream,
-        peer: SocketAddr,
-        tx: std::sync::mpsc::Sender<Result<TransferReport, dnc::DncError>>,
-    ) -> io::Result<std::thread::JoinHandle<()>> {
-        let (markers, cfg, numbers, limits) = (
-            self.markers.clone(),
-            self.cfg.clone(),
-            Arc::clone(&self.numbers),
-            self.limits,
-        );
-        std::thread::Builder::new()
-            .name(format!("receive-{peer}"))
-            .spawn(move || {
-                let mut splitter = Splitter::new(markers);
-                let mut writer = ProgramWriter::new(cfg)
-                    .with_log(log_line)
-                    .with_numbers(numbers);
-                let r = dnc::receive_stream(stream, peer, &limits, &mut splitter, &mut writer);
-                log_end(r.as_ref());
-                let _ = tx.send(r);
-            })
-    }
-}
-
-/// Wait for the next transfer to end and settle it; `false` when none is left to wait for.
-fn settle_next(
-    done: &std::sync::mpsc::Receiver<Result<TransferReport, dnc::DncError>>,
-    total: &mut Totals,
-) -> bool {
-    match done.recv() {
-        Ok(r) => {
-            settle(r, total);
-            true
-        }
-        Err(_) => false,
-    }
+        },
+        log_end,
+        |r| settle(r, total),
+        |e| say(format_args!("ncchannel receive: accept on {local}: {e}")),
+    );
+    Ok(())
 }
 
 /// Whatever a transfer came to: filed programs, or refused with its reason (a name the disk
@@ -364,24 +295,6 @@ fn log_end(r: Result<&TransferReport, &dnc::DncError>) {
         TransferEnd::LimitReached(l) => say(format_args!(
             "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
         )),
-    }
-}
-
-/// The next connection, or `None` when accept failed (reported unless merely interrupted
-/// or aborted by the peer, with a short pause so a persistent failure cannot spin).
-fn accept(listener: &TcpListener, local: SocketAddr) -> Option<(std::net::TcpStream, SocketAddr)> {
-    match listener.accept() {
-        Ok(s) => Some(s),
-        Err(e) => {
-            if !matches!(
-                e.kind(),
-                io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
-            ) {
-                say(format_args!("ncchannel receive: accept on {local}: {e}"));
-                std::thread::sleep(Duration::from_millis(50));
-            }
-            None
-        }
     }
 }
 

@@ -9,7 +9,7 @@ use std::time::Duration;
 use crate::channel::Finish;
 use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
-use crate::machine::{Machine, StopWhen};
+use crate::machine::{Machine, Op, Reply, StopWhen, TraceOp};
 use crate::report::event::EventLog;
 use crate::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
@@ -220,19 +220,17 @@ pub fn execute(args: RunArgs) -> ExitCode {
         },
     };
     let period = Duration::from_micros(config.runtime.cycle_period_us);
-    let mut channels = channels;
-    if let Some(c) = channels.get_mut((args.channel as usize).wrapping_sub(1)) {
-        if let Err(msg) = enable_traces(c, &args) {
-            return usage(msg);
-        }
-    }
     let mut machine = Machine::new(channels, log, StopWhen::ProgramsFinished);
+    if let Err(msg) = enable_traces(&mut machine, &args, period) {
+        return usage(msg);
+    }
     if let Some(f) = feeder {
         machine.attach_feeder(args.channel, f);
     }
     let (rt, summary) = run_program(machine, &args, &program, period);
     let ticks = rt.ticks();
-    let time_s = rt.time().as_secs_f64();
+    let end_time = rt.time();
+    let time_s = end_time.as_secs_f64();
     let (mut machine, stats) = rt.into_inner();
     let finish = machine
         .finishes()
@@ -240,10 +238,13 @@ pub fn execute(args: RunArgs) -> ExitCode {
         .copied()
         .flatten();
     let outcome = outcome_of(summary.as_ref().map(|s| s.end), finish);
-    if let Some(c) = machine.channel_mut(args.channel) {
-        if let Err(e) = c.motion_mut().finish_csv_trace() {
-            eprintln!("ncchannel run: --trace: {e}");
-        }
+    let end = Tick {
+        index: ticks,
+        period,
+        time: end_time,
+    };
+    if let Reply::Trace(Err(e)) = machine.apply(&end, args.channel, Op::Trace(TraceOp::FinishCsv)) {
+        eprintln!("ncchannel run: --trace: {e}");
     }
     let report = build_report(
         &machine,
@@ -282,15 +283,16 @@ fn run_program(
         period,
         time: Duration::ZERO,
     };
-    let mut start_failed = false;
-    if let Some(c) = machine.channel_mut(args.channel) {
-        c.set_search(args.search);
-        c.decoder_mut().set_skip_mask(args.skip_mask);
-        if let Err(e) = c.start(&tick0, program) {
+    let ch = args.channel;
+    machine.apply(&tick0, ch, Op::SearchAt(args.search));
+    machine.apply(&tick0, ch, Op::SkipMask(args.skip_mask));
+    let start_failed = match machine.apply(&tick0, ch, Op::Start(program.to_string())) {
+        Reply::Command(Err(e)) => {
             eprintln!("ncchannel run: {e}");
-            start_failed = true;
+            true
         }
-    }
+        _ => false,
+    };
     let clock = if args.realtime {
         Clock::RealTime
     } else {
@@ -312,14 +314,27 @@ fn run_program(
 }
 
 /// `--plot` and `--trace`: the motion trace of the channel that runs the program.
-fn enable_traces(c: &mut crate::channel::Channel, args: &RunArgs) -> Result<(), String> {
+fn enable_traces(machine: &mut Machine, args: &RunArgs, period: Duration) -> Result<(), String> {
+    let tick0 = Tick {
+        index: 0,
+        period,
+        time: Duration::ZERO,
+    };
+    let ch = args.channel;
     if args.plot.is_some() {
-        c.motion_mut().enable_trace(PLOT_SAMPLES);
+        let op = Op::Trace(TraceOp::Plot {
+            max_samples: PLOT_SAMPLES,
+        });
+        machine.apply(&tick0, ch, op);
     }
     if let Some(p) = &args.trace {
-        c.motion_mut()
-            .enable_csv_trace(p, args.trace_every)
-            .map_err(|e| format!("--trace {}: {e}", p.display()))?;
+        let op = Op::Trace(TraceOp::Csv {
+            path: p.clone(),
+            every: args.trace_every,
+        });
+        if let Reply::Trace(Err(e)) = machine.apply(&tick0, ch, op) {
+            return Err(format!("--trace {e}"));
+        }
     }
     Ok(())
 }

@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::{AmsNetId, ServerConfig};
-use crate::machine::{Machine, StopWhen};
+use crate::machine::{Machine, Op, Reply, StopWhen};
 use crate::report::event::{Backlog, EventLog};
 use crate::runtime::{Clock, Runtime, Tick};
 use crate::soak::external::{load_external, Supervised};
@@ -103,21 +103,14 @@ pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
 /// The machine under the soak's supervision: faults injected, invariants checked on what the
 /// external clients make the channels do.
 fn supervised(machine: Machine, sc: &Scenario, config: &crate::params::Config) -> Supervised {
-    let soft_limits = config
-        .channels
-        .iter()
-        .flat_map(|c| &c.axes)
-        .filter_map(|a| {
-            let c = a.name.chars().next()?;
-            Some((c, a.soft_limit_min_mm, a.soft_limit_max_mm))
-        })
-        .collect();
+    // The soft limits of the first channel's axes, as the in-process soak checks them.
+    let axes = crate::setup::axes(config).unwrap_or_default();
     let programs = config
         .channels
         .iter()
         .map(|c| c.streaming_prog_file.clone())
         .collect();
-    Supervised::new(machine, sc, soft_limits, programs)
+    Supervised::new(machine, sc, &axes, programs)
 }
 
 pub fn execute(mut args: ServeArgs) -> ExitCode {
@@ -166,10 +159,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             period,
             time: Duration::ZERO,
         };
-        if let Some(c) = machine.channel_mut(1) {
-            if let Err(e) = c.start(&tick0, p) {
-                report(format_args!("ncchannel serve: --start {p}: {e}"));
-            }
+        if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(p.clone())) {
+            report(format_args!("ncchannel serve: --start {p}: {e}"));
         }
     }
     if let Some(sc) = scenario {

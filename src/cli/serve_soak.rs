@@ -7,60 +7,14 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use serde::Serialize;
-
 use crate::ads::channel_backend::ChannelBackend;
 use crate::runtime::{Clock, RunEnd, Runtime};
-use crate::soak::external::{resident, ExternalCounters, Supervised};
-use crate::soak::invariants::{Tally, Verdict};
+use crate::soak::external::{resident, Supervised};
+use crate::soak::report::{CycleFigures, MemoryReport, RunFigures, SoakReport};
 use crate::soak::scenario::Scenario;
 
 use super::exit;
 use super::serve::{report as say, run_limit, usage, ServeArgs};
-
-/// The report of one `serve --soak` run (`--report` writes it as JSON).
-#[derive(Debug, Serialize)]
-pub struct ServeSoakReport {
-    pub scenario: String,
-    pub seconds: f64,
-    pub ticks: u64,
-    pub channels: Vec<ExternalCounters>,
-    pub invariants: Vec<Verdict>,
-    pub resident_kib_after_warmup: Option<u64>,
-    pub resident_kib_at_end: Option<u64>,
-    pub all_held: bool,
-}
-
-impl ServeSoakReport {
-    fn print_human(&self, w: &mut dyn Write) -> std::io::Result<()> {
-        writeln!(w, "serve --soak {}", self.scenario)?;
-        writeln!(w, "run:      {:.1} s, {} ticks", self.seconds, self.ticks)?;
-        for c in &self.channels {
-            writeln!(
-                w,
-                "channel {}: {} writes / {} lines accepted, {} blocks checked, {} resets ({} after errors), {} restarts, {} holds, {} overrides, {} forced rejections ({} writes refused)",
-                c.channel, c.writes_accepted, c.lines_accepted, c.blocks, c.resets, c.error_resets,
-                c.restarts, c.holds, c.overrides, c.forced_rejections, c.writes_forced_rejected
-            )?;
-        }
-        for v in &self.invariants {
-            let word = if v.held { "held    " } else { "VIOLATED" };
-            writeln!(w, "{word}  {} ({} violations)", v.name, v.violations)?;
-            for d in &v.details {
-                writeln!(w, "          {d}")?;
-            }
-        }
-        writeln!(
-            w,
-            "result:   {}",
-            if self.all_held {
-                "every invariant held"
-            } else {
-                "an invariant was violated"
-            }
-        )
-    }
-}
 
 pub fn run(
     cycle: Supervised,
@@ -115,45 +69,32 @@ pub fn run(
         }
     }
     server.shutdown();
-    let seconds = start.elapsed().as_secs_f64();
+    let wall = start.elapsed().as_secs_f64();
     let ticks = rt.ticks();
-    let (cycle, _stats) = rt.into_inner();
-    let mut invariants = cycle.verdicts();
-    let channels = cycle.counters();
+    let sim_seconds = rt.time().as_secs_f64();
+    let (cycle, stats) = rt.into_inner();
     let end_kib = resident();
-    let mut memory = Tally::default();
-    if let (Some(a), Some(b)) = (warm_kib, end_kib) {
-        if b > a + scenario.invariants.memory_slack_kib {
-            memory.violate(|| format!("resident set grew {} KiB", b - a));
-        }
-    }
-    invariants.push(memory.verdict(
-        "memory steady",
-        Some(format!(
-            "{:?} KiB after warm-up, {:?} KiB at the end",
-            warm_kib, end_kib
-        )),
-    ));
+    let growth = warm_kib.zip(end_kib).map(|(a, b)| b as i64 - a as i64);
+    let report = report_of(
+        &cycle,
+        scenario,
+        (ticks, sim_seconds, wall),
+        MemoryReport {
+            warmup_kib: warm_kib,
+            end_kib,
+            growth_kib: growth,
+        },
+        CycleFigures::new(period.as_secs_f64() * 1e6, &stats),
+    );
+    let all_held = report.all_held;
     let mut machine = cycle.into_machine();
     if let Err(e) = machine.finish_log() {
         say(format_args!("ncchannel serve: event log: {e}"));
     }
-    let all_held = invariants.iter().all(|v| v.held);
-    let report = ServeSoakReport {
-        scenario: scenario.path.display().to_string(),
-        seconds,
-        ticks,
-        channels,
-        invariants,
-        resident_kib_after_warmup: warm_kib,
-        resident_kib_at_end: end_kib,
-        all_held,
-    };
     say(format_args!(""));
     let _ = report.print_human(&mut std::io::stdout());
     if let Some(p) = &args.report {
-        let json = serde_json::to_string_pretty(&report).unwrap_or_default();
-        if let Err(e) = std::fs::write(p, json + "\n") {
+        if let Err(e) = std::fs::write(p, report.to_json() + "\n") {
             say(format_args!(
                 "ncchannel serve: --report {}: {e}",
                 p.display()
@@ -168,12 +109,44 @@ pub fn run(
     })
 }
 
+/// The soak's report of a `serve --soak` run (`times`: ticks, channel seconds, wall seconds).
+fn report_of(
+    cycle: &Supervised,
+    scenario: &Scenario,
+    (ticks, sim_seconds, wall_seconds): (u64, f64, f64),
+    memory: MemoryReport,
+    cycle_figures: CycleFigures,
+) -> SoakReport {
+    let run = RunFigures {
+        seed: scenario.seed,
+        realtime: true,
+        ticks,
+        sim_seconds,
+        wall_seconds,
+        blocks: cycle.blocks(),
+    };
+    let invariants = cycle.verdicts(memory.growth_kib, scenario.invariants.memory_slack_kib);
+    SoakReport::new(
+        &scenario.path,
+        run,
+        invariants,
+        cycle.counters(),
+        memory,
+        cycle_figures,
+    )
+}
+
 fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {
     let c = rt.cycle().counters();
     let lines: u64 = c.iter().map(|c| c.lines_accepted).sum();
-    let blocks: u64 = c.iter().map(|c| c.blocks).sum();
+    let blocks = rt.cycle().blocks();
     let resets: u64 = c.iter().map(|c| c.resets).sum();
-    let violations: u64 = rt.cycle().verdicts().iter().map(|v| v.violations).sum();
+    let violations: u64 = rt
+        .cycle()
+        .verdicts(None, 0)
+        .iter()
+        .map(|v| v.violations)
+        .sum();
     let line = format!(
         "serve --soak: {:.0} s, {lines} lines accepted, {blocks} blocks, {resets} resets, {violations} violations",
         wall.as_secs_f64()

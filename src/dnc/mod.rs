@@ -3,10 +3,11 @@
 //!
 //! Data flows `Read` → [`Splitter`] (pure, any chunk sizes) → [`ProgramSink`] →
 //! [`ProgramWriter`] (temp file, fsync, rename). [`transfer`] ties them to a file, standard
-//! input or a TCP port.
+//! input or one TCP connection; [`listen`] takes a port's connections.
 
 pub mod control_line;
 pub mod error;
+pub mod listen;
 pub mod markers;
 pub mod splitter;
 pub mod transfer;
@@ -14,10 +15,10 @@ pub mod writer;
 
 pub use control_line::{NameInfo, SinumerikName};
 pub use error::DncError;
+pub use listen::{Listener, TransferResult};
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
 pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
 pub use transfer::{
-    receive, receive_connection, receive_connections, receive_limited, receive_stream, Limit,
-    TransferEnd, TransferLimits, TransferReport,
+    receive, receive_limited, receive_stream, Limit, TransferEnd, TransferLimits, TransferReport,
 };
 pub use writer::{Disposition, NameTemplate, ProgramWriter, ReceivedProgram, WriterConfig};

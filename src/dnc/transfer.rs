@@ -3,7 +3,7 @@
 //! serial-over-IP DNC port.
 
 use std::io::{self, Read};
-use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
 use super::error::DncError;
@@ -146,58 +146,6 @@ impl ProgramSink for Discard {
     }
     fn end(&mut self, _: ProgramEnd) -> Result<(), Self::Error> {
         Ok(())
-    }
-}
-
-/// Take TCP transfers one after another: each connection is one transfer, ended when the
-/// sender closes it. Stops after `max_transfers` when given. `idle_timeout` ends a connection
-/// that stays silent that long (as a broken transfer).
-pub fn receive_connections(
-    listener: &TcpListener,
-    max_transfers: Option<usize>,
-    idle_timeout: Option<Duration>,
-    splitter: &mut Splitter,
-    writer: &mut ProgramWriter,
-    mut on_transfer: impl FnMut(&TransferReport),
-) -> Result<usize, DncError> {
-    let limits = TransferLimits {
-        idle_timeout,
-        ..TransferLimits::default()
-    };
-    let mut count = 0;
-    while max_transfers.is_none_or(|m| count < m) {
-        let report = receive_connection(listener, &limits, splitter, writer)?;
-        on_transfer(&report);
-        count += 1;
-    }
-    Ok(count)
-}
-
-/// Take the next TCP transfer within `limits`.
-pub fn receive_connection(
-    listener: &TcpListener,
-    limits: &TransferLimits,
-    splitter: &mut Splitter,
-    writer: &mut ProgramWriter,
-) -> Result<TransferReport, DncError> {
-    let local = listener
-        .local_addr()
-        .map(|a| a.to_string())
-        .unwrap_or_else(|_| "listener".to_string());
-    loop {
-        let (stream, peer) = match listener.accept() {
-            Ok(s) => s,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::Interrupted | io::ErrorKind::ConnectionAborted
-                ) =>
-            {
-                continue
-            }
-            Err(e) => return Err(DncError::io(&local, e)),
-        };
-        return receive_stream(stream, peer, limits, splitter, writer);
     }
 }
 

@@ -1,26 +1,84 @@
-//! The soak cycle: every channel of the scenario with its own client, ticked in one runtime
-//! cycle, with faults injected at random ticks and the invariants checked after each tick.
+//! The soak's one driver core, shared by the in-process soak ([`SoakCycle`], its own client)
+//! and `serve --soak` (`soak::external`, external ADS clients): the fault plan of a channel,
+//! its counters, and the checks after each tick. Everything it does to a channel is an
+//! [`Op`] through the channel's one door ([`Door`]); it only reads the channel (state,
+//! position, errors) through `&self` accessors.
 //!
 //! One tick per channel: faults due → restart after a reset, error or program end → the
-//! client writes (or a forced rejection skips it) → the channel steps → its executed stream
+//! client writes (or a forced rejection refuses it) → the channel steps → its executed stream
 //! blocks are checked against what it owes, its position against the soft limits, its new
 //! errors against the expected ones.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::convert::Infallible;
 
-use super::feed::SoakFeeder;
-use super::invariants::{check_blocks, Checksum, Tally};
+use serde::Serialize;
+
+use super::feed::{Owed, SoakFeeder};
+use super::invariants::{check_blocks, Checksum, Tally, Verdict};
 use super::rng::SplitMix64;
 use super::scenario::Faults;
 use crate::channel::{Channel, State};
+use crate::machine::{Machine, Op, Reply};
 use crate::motion::AxisLimits;
 use crate::runtime::{Cycle, Flow, Tick};
 
-/// Fault schedule of one channel: the next tick (or block count) each fault is due.
-#[derive(Debug)]
-struct Schedule {
-    rng: SplitMix64,
+/// The one way the soak commands a channel, and reads it.
+pub trait Door {
+    /// Apply one operation in this tick, as a client's request would be.
+    fn apply(&mut self, tick: &Tick, op: Op) -> Reply;
+    /// The channel, read-only (state, position, errors for the checks).
+    fn channel(&self) -> &Channel;
+}
+
+impl Door for Channel {
+    fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
+        Channel::apply(self, tick, op)
+    }
+    fn channel(&self) -> &Channel {
+        self
+    }
+}
+
+/// One channel of a [`Machine`] as a door: ops go through [`Machine::apply`].
+pub struct MachineDoor<'a> {
+    machine: &'a mut Machine,
+    number: u32,
+    index: usize,
+}
+
+impl<'a> MachineDoor<'a> {
+    /// The door of channel `number` (1-based), if the machine has it.
+    pub fn new(machine: &'a mut Machine, number: u32) -> Option<Self> {
+        let index = (number as usize).checked_sub(1)?;
+        machine.channels().get(index)?;
+        Some(MachineDoor {
+            machine,
+            number,
+            index,
+        })
+    }
+}
+
+impl Door for MachineDoor<'_> {
+    fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
+        self.machine.apply(tick, self.number, op)
+    }
+    fn channel(&self) -> &Channel {
+        // `new` checked the index, and a machine's channels never change.
+        &self.machine.channels()[self.index]
+    }
+}
+
+/// The tick of the next fault: `now` plus a draw from the range, or never.
+fn draw(rng: &mut SplitMix64, now: u64, r: Option<[u64; 2]>) -> Option<u64> {
+    r.map(|[a, b]| now.saturating_add(rng.range(a, b)))
+}
+
+/// Fault plan of one channel: the next tick (or block count) each fault is due. The random
+/// numbers come from the caller, in a fixed order, so a seed gives the same faults.
+#[derive(Debug, Default)]
+struct FaultPlan {
     reset_at_block: Option<u64>,
     reset_at_tick: Option<u64>,
     hold_at: Option<u64>,
@@ -30,143 +88,58 @@ struct Schedule {
     reject_until: Option<u64>,
 }
 
-/// The tick of the next fault: `now` plus a draw from the range, or never.
-pub(crate) fn draw(rng: &mut SplitMix64, now: u64, r: Option<[u64; 2]>) -> Option<u64> {
-    r.map(|[a, b]| now.saturating_add(rng.range(a, b)))
+impl FaultPlan {
+    fn plan(&mut self, rng: &mut SplitMix64, f: &Faults, blocks: u64, now: u64) {
+        self.reset_at_block = draw(rng, blocks, f.reset_every_blocks);
+        self.reset_at_tick = draw(rng, now, f.reset_every_ticks);
+        self.hold_at = draw(rng, now, f.hold_every_ticks);
+        self.override_at = draw(rng, now, f.override_every_ticks);
+        self.reject_at = draw(rng, now, f.reject_every_ticks);
+    }
+
+    fn reset_due(&self, blocks: u64, now: u64) -> bool {
+        self.reset_at_block.is_some_and(|b| blocks >= b)
+            || self.reset_at_tick.is_some_and(|at| now >= at)
+    }
+
+    fn rejecting(&self, now: u64) -> bool {
+        self.reject_until.is_some_and(|u| now < u)
+    }
 }
 
-/// Counters of one channel's soak.
-#[derive(Debug, Clone, Default)]
-pub struct SlotCounters {
+/// Counters of one soaked channel, as the report shows them.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct SoakCounters {
+    pub number: u32,
+    /// The program restarted after each reset (empty: none).
+    pub program: String,
     /// Stream blocks executed (and checked).
     pub blocks: u64,
-    /// Resets injected by the fault schedule.
+    /// Resets injected by the fault plan.
     pub resets: u64,
     /// Resets after a channel error.
     pub error_resets: u64,
-    /// Program restarts after the program ended (a streamed file's M30).
+    /// Program restarts after the program ended (a streamed file's M30, a client's reset).
     pub restarts: u64,
     pub holds: u64,
     pub overrides: u64,
     pub forced_rejections: u64,
+    /// Stream writes the channel accepted, and their bytes and lines (now owed).
+    pub writes_ok: u64,
+    pub bytes: u64,
+    pub lines_accepted: u64,
+    /// Stream writes the channel refused (a full buffer: 11012).
+    pub writes_rejected: u64,
+    /// Writes a forced rejection refused without touching the channel.
+    pub writes_skipped: u64,
+    /// Pauses the built-in client made (none for external clients).
+    pub pauses: u64,
+    pub interrupts: u64,
+    pub warnings: u64,
     /// Channel errors by number.
     pub errors: BTreeMap<u32, u64>,
-    pub checksum: Checksum,
-}
-
-/// One soaked channel.
-pub struct Slot {
-    pub channel: Channel,
-    pub program: String,
-    pub feeder: SoakFeeder,
-    /// Configured axes: index, soft limits (mm).
-    limits: Vec<(usize, f64, f64)>,
-    schedule: Schedule,
-    errors_seen: usize,
-    pub counters: SlotCounters,
-    /// Start the program again at the next tick.
-    restart_due: bool,
-}
-
-impl Slot {
-    pub fn new(
-        mut channel: Channel,
-        program: String,
-        feeder: SoakFeeder,
-        axes: &[AxisLimits],
-        rng: SplitMix64,
-    ) -> Self {
-        channel.observe_stream_blocks(true);
-        Slot {
-            channel,
-            program,
-            feeder,
-            limits: axes.iter().map(|a| (a.index, a.min_mm, a.max_mm)).collect(),
-            schedule: Schedule {
-                rng,
-                reset_at_block: None,
-                reset_at_tick: None,
-                hold_at: None,
-                hold_until: None,
-                override_at: None,
-                reject_at: None,
-                reject_until: None,
-            },
-            errors_seen: 0,
-            counters: SlotCounters::default(),
-            restart_due: true,
-        }
-    }
-
-    fn plan(&mut self, f: &Faults, now: u64) {
-        let s = &mut self.schedule;
-        s.reset_at_block = draw(&mut s.rng, self.counters.blocks, f.reset_every_blocks);
-        s.reset_at_tick = draw(&mut s.rng, now, f.reset_every_ticks);
-        s.hold_at = draw(&mut s.rng, now, f.hold_every_ticks);
-        s.override_at = draw(&mut s.rng, now, f.override_every_ticks);
-        s.reject_at = draw(&mut s.rng, now, f.reject_every_ticks);
-    }
-
-    fn restart(&mut self, tick: &Tick) {
-        self.feeder.new_epoch(tick.index);
-        // A failed start raises its channel error, which the error check then sees.
-        let _ = self.channel.start(tick, &self.program);
-    }
-
-    fn reset(&mut self, tick: &Tick, f: &Faults) {
-        self.channel.reset(tick);
-        let s = &mut self.schedule;
-        s.hold_until = None;
-        s.reset_at_block = draw(&mut s.rng, self.counters.blocks, f.reset_every_blocks);
-        s.reset_at_tick = draw(&mut s.rng, tick.index, f.reset_every_ticks);
-        self.restart(tick);
-    }
-
-    /// Faults and restarts due at this tick.
-    fn faults(&mut self, tick: &Tick, f: &Faults) {
-        let t = tick.index;
-        let s = &self.schedule;
-        let reset_due = s.reset_at_block.is_some_and(|b| self.counters.blocks >= b)
-            || s.reset_at_tick.is_some_and(|at| t >= at);
-        if reset_due {
-            self.counters.resets += 1;
-            self.reset(tick, f);
-        } else if self.channel.state() == State::Error {
-            self.counters.error_resets += 1;
-            self.reset(tick, f);
-        } else if self.restart_due || self.channel.state() == State::Ready {
-            if !self.restart_due {
-                self.counters.restarts += 1;
-            }
-            self.restart_due = false;
-            self.restart(tick);
-        }
-        let s = &mut self.schedule;
-        if s.hold_until.is_some_and(|u| t >= u) {
-            s.hold_until = None;
-            self.channel.resume(tick);
-        } else if s.hold_at.is_some_and(|h| t >= h) {
-            s.hold_at = draw(&mut s.rng, t, f.hold_every_ticks);
-            if self.channel.state() == State::Active {
-                self.channel.hold(tick);
-                s.hold_until = Some(t + s.rng.range(f.hold_ticks[0], f.hold_ticks[1]));
-                self.counters.holds += 1;
-            }
-        }
-        if s.override_at.is_some_and(|o| t >= o) {
-            s.override_at = draw(&mut s.rng, t, f.override_every_ticks);
-            let [lo, hi] = f.override_pct;
-            let pct = (s.rng.range_f64(lo, hi) * 10.0).round() / 10.0;
-            if self.channel.set_override(pct.clamp(0.0, 200.0)).is_ok() {
-                self.counters.overrides += 1;
-            }
-        }
-        if s.reject_at.is_some_and(|r| t >= r) {
-            s.reject_at = draw(&mut s.rng, t, f.reject_every_ticks);
-            s.reject_until = Some(t + s.rng.range(f.reject_ticks[0], f.reject_ticks[1]));
-            self.counters.forced_rejections += 1;
-        }
-    }
+    /// FNV-1a over (offset, N) of every executed block, hex: equal for equal runs.
+    pub checksum: String,
 }
 
 /// The invariant tallies over all channels.
@@ -177,7 +150,299 @@ pub struct Tallies {
     pub limits: Tally,
 }
 
-/// The soak as a runtime [`Cycle`].
+impl Tallies {
+    /// The verdicts of a run: order, errors, limits, and memory (`growth`: resident set
+    /// after warm-up, KiB, allowed up to `slack_kib`).
+    pub fn verdicts(
+        &self,
+        blocks: u64,
+        expected_errors: &[u32],
+        growth: Option<i64>,
+        slack_kib: u64,
+    ) -> Vec<Verdict> {
+        let mut memory = Tally::default();
+        if let Some(g) = growth {
+            if g > slack_kib as i64 {
+                memory.violate(|| {
+                    format!("resident set grew by {g} KiB after warm-up (allowed {slack_kib} KiB)")
+                });
+            }
+        }
+        vec![
+            self.order.verdict(
+                "every accepted line executed exactly once, in order, between resets",
+                Some(format!("{blocks} blocks checked")),
+            ),
+            self.errors.verdict(
+                "no channel error but the expected ones",
+                Some(format!("expected: {expected_errors:?}")),
+            ),
+            self.limits
+                .verdict("positions within the axis soft limits", None),
+            memory.verdict(
+                "memory steady",
+                growth.map(|g| format!("growth {g} KiB ≤ {slack_kib} KiB")),
+            ),
+        ]
+    }
+}
+
+/// What the soak keeps of one channel: its fault plan, counters and checker state.
+pub struct SoakChannel {
+    plan: FaultPlan,
+    /// Configured axes: index, soft limits (mm).
+    limits: Vec<(usize, f64, f64)>,
+    /// Start the program again at the next tick.
+    restart_due: bool,
+    errors_seen: usize,
+    /// Check that numbered lines run with rising N (external clients: a numbered line is a
+    /// client's line once, so an N not above the last is a line run again, even when the
+    /// client wrote it twice and the offsets differ).
+    numbers_rise: bool,
+    /// The last N executed this epoch.
+    last_n: Option<u32>,
+    sum: Checksum,
+    pub counters: SoakCounters,
+}
+
+impl SoakChannel {
+    /// A channel that restarts `program` (if any) and checks positions against `axes`.
+    pub fn new(number: u32, program: Option<String>, axes: &[AxisLimits]) -> Self {
+        SoakChannel {
+            plan: FaultPlan::default(),
+            limits: axes.iter().map(|a| (a.index, a.min_mm, a.max_mm)).collect(),
+            restart_due: true,
+            errors_seen: 0,
+            numbers_rise: false,
+            last_n: None,
+            sum: Checksum::default(),
+            counters: SoakCounters {
+                number,
+                program: program.unwrap_or_default(),
+                ..Default::default()
+            },
+        }
+    }
+
+    /// Also check that numbered lines run with rising N (for external clients).
+    pub fn with_rising_numbers(mut self) -> Self {
+        self.numbers_rise = true;
+        self
+    }
+
+    /// Draw the first faults (at the first tick).
+    pub fn plan(&mut self, rng: &mut SplitMix64, f: &Faults, now: u64) {
+        self.plan.plan(rng, f, self.counters.blocks, now);
+    }
+
+    /// A forced rejection is running: the client's writes are refused unseen by the channel.
+    pub fn rejecting(&self, now: u64) -> bool {
+        self.plan.rejecting(now)
+    }
+
+    /// A new stream epoch: the rising-N check starts over (what is owed is the caller's).
+    pub fn new_epoch(&mut self) {
+        self.last_n = None;
+    }
+
+    /// Start the program again; `new_epoch` drops what the client owes.
+    fn restart(&mut self, tick: &Tick, door: &mut impl Door, new_epoch: &mut dyn FnMut(u64)) {
+        new_epoch(tick.index);
+        self.new_epoch();
+        if !self.counters.program.is_empty() {
+            // A failed start raises its channel error, which the error check then sees.
+            let _ = door.apply(tick, Op::Start(self.counters.program.clone()));
+        }
+    }
+
+    fn reset(
+        &mut self,
+        rng: &mut SplitMix64,
+        f: &Faults,
+        tick: &Tick,
+        door: &mut impl Door,
+        new_epoch: &mut dyn FnMut(u64),
+    ) {
+        door.apply(tick, Op::Reset);
+        let p = &mut self.plan;
+        p.hold_until = None;
+        p.reset_at_block = draw(rng, self.counters.blocks, f.reset_every_blocks);
+        p.reset_at_tick = draw(rng, tick.index, f.reset_every_ticks);
+        self.restart(tick, door, new_epoch);
+    }
+
+    /// Faults and restarts due at this tick, through the door.
+    pub fn faults(
+        &mut self,
+        rng: &mut SplitMix64,
+        f: &Faults,
+        tick: &Tick,
+        door: &mut impl Door,
+        new_epoch: &mut dyn FnMut(u64),
+    ) {
+        let t = tick.index;
+        let state = door.channel().state();
+        if self.plan.reset_due(self.counters.blocks, t) {
+            self.counters.resets += 1;
+            self.reset(rng, f, tick, door, new_epoch);
+        } else if state == State::Error {
+            self.counters.error_resets += 1;
+            self.reset(rng, f, tick, door, new_epoch);
+        } else if self.restart_due || (state == State::Ready && !self.counters.program.is_empty()) {
+            // A channel without a program to restart stays READY and counts no restarts.
+            if !self.restart_due {
+                self.counters.restarts += 1;
+            }
+            self.restart_due = false;
+            self.restart(tick, door, new_epoch);
+        }
+        let p = &mut self.plan;
+        if p.hold_until.is_some_and(|u| t >= u) {
+            p.hold_until = None;
+            door.apply(tick, Op::Resume);
+        } else if p.hold_at.is_some_and(|h| t >= h) {
+            p.hold_at = draw(rng, t, f.hold_every_ticks);
+            if door.channel().state() == State::Active {
+                door.apply(tick, Op::Hold);
+                p.hold_until = Some(t + rng.range(f.hold_ticks[0], f.hold_ticks[1]));
+                self.counters.holds += 1;
+            }
+        }
+        if p.override_at.is_some_and(|o| t >= o) {
+            p.override_at = draw(rng, t, f.override_every_ticks);
+            let [lo, hi] = f.override_pct;
+            let pct = (rng.range_f64(lo, hi) * 10.0).round() / 10.0;
+            if door.apply(tick, Op::SetOverride(pct.clamp(0.0, 200.0))) == Reply::Command(Ok(())) {
+                self.counters.overrides += 1;
+            }
+        }
+        if p.reject_at.is_some_and(|r| t >= r) {
+            p.reject_at = draw(rng, t, f.reject_every_ticks);
+            p.reject_until = Some(t + rng.range(f.reject_ticks[0], f.reject_ticks[1]));
+            self.counters.forced_rejections += 1;
+        }
+    }
+
+    /// After the tick: the executed stream blocks against what is `owed`, the position
+    /// against the soft limits, new errors against the expected ones. Returns the blocks
+    /// checked.
+    pub fn check(
+        &mut self,
+        tick: &Tick,
+        door: &mut impl Door,
+        owed: &mut VecDeque<Owed>,
+        tallies: &mut Tallies,
+        expected_errors: &[u32],
+    ) -> u64 {
+        let (t, number) = (tick.index, self.counters.number);
+        let executed = match door.apply(tick, Op::DrainExecuted) {
+            Reply::Executed(e) => e,
+            _ => Vec::new(),
+        };
+        if self.numbers_rise {
+            for n in executed.iter().filter_map(|b| b.n) {
+                if let Some(last) = self.last_n.filter(|&last| n <= last) {
+                    tallies.order.violate(|| {
+                        format!("channel {number}: N{n} executed after N{last} (a line run twice or out of order)")
+                    });
+                }
+                self.last_n = Some(n);
+            }
+        }
+        let n = check_blocks(
+            number,
+            owed,
+            executed.into_iter(),
+            &mut tallies.order,
+            &mut self.sum,
+        );
+        self.counters.blocks += n;
+        let c = door.channel();
+        let p = c.position();
+        for &(i, lo, hi) in &self.limits {
+            if !(lo - 1e-9..=hi + 1e-9).contains(&p[i]) {
+                let (v, axis) = (p[i], crate::vocab::axis::AXIS_LETTERS[i] as char);
+                tallies.limits.violate(|| {
+                    format!("channel {number}, tick {t}: {axis} = {v:.4} mm outside [{lo}, {hi}]")
+                });
+            }
+        }
+        let errors = c.errors();
+        if errors.len() > self.errors_seen {
+            for e in &errors[self.errors_seen..] {
+                let (code, msg) = (e.code, &e.msg);
+                *self.counters.errors.entry(code).or_default() += 1;
+                if !expected_errors.contains(&code) {
+                    tallies
+                        .errors
+                        .violate(|| format!("channel {number}, tick {t}: error {code}: {msg}"));
+                }
+            }
+            self.errors_seen = errors.len();
+        }
+        n
+    }
+
+    /// The counters for the report, with the channel's own figures and the checksum.
+    pub fn report(&self, c: &Channel) -> SoakCounters {
+        let st = c.stats();
+        SoakCounters {
+            interrupts: st.interrupts,
+            warnings: st.warnings,
+            checksum: format!("{:016x}", self.sum.0),
+            ..self.counters.clone()
+        }
+    }
+}
+
+/// One channel soaked by its own built-in client.
+pub struct Slot {
+    pub channel: Channel,
+    pub feeder: SoakFeeder,
+    pub core: SoakChannel,
+    rng: SplitMix64,
+}
+
+impl Slot {
+    pub fn new(
+        mut channel: Channel,
+        program: String,
+        feeder: SoakFeeder,
+        axes: &[AxisLimits],
+        rng: SplitMix64,
+    ) -> Self {
+        // Turning observation on emits nothing, so the tick does not matter.
+        let tick0 = Tick {
+            index: 0,
+            period: std::time::Duration::ZERO,
+            time: std::time::Duration::ZERO,
+        };
+        channel.apply(&tick0, Op::ObserveStreamBlocks(true));
+        let core = SoakChannel::new(channel.number(), Some(program), axes);
+        Slot {
+            channel,
+            feeder,
+            core,
+            rng,
+        }
+    }
+
+    /// The counters for the report, the client's writes included.
+    pub fn report(&self) -> SoakCounters {
+        let f = self.feeder.counters();
+        SoakCounters {
+            writes_ok: f.writes_ok,
+            writes_rejected: f.writes_rejected,
+            writes_skipped: f.writes_skipped,
+            bytes: f.bytes,
+            lines_accepted: f.lines,
+            pauses: f.pauses,
+            ..self.core.report(&self.channel)
+        }
+    }
+}
+
+/// The in-process soak as a runtime [`Cycle`].
 pub struct SoakCycle {
     pub slots: Vec<Slot>,
     faults: Faults,
@@ -221,53 +486,33 @@ impl Cycle for SoakCycle {
         if !self.planned {
             self.planned = true;
             for s in &mut self.slots {
-                s.plan(&self.faults, t);
+                s.core.plan(&mut s.rng, &self.faults, t);
             }
         }
         for slot in &mut self.slots {
-            slot.faults(tick, &self.faults);
-            let rejecting = slot.schedule.reject_until.is_some_and(|u| t < u);
-            if rejecting {
+            let feeder = &mut slot.feeder;
+            slot.core.faults(
+                &mut slot.rng,
+                &self.faults,
+                tick,
+                &mut slot.channel,
+                &mut |t| feeder.new_epoch(t),
+            );
+            if slot.core.rejecting(t) {
                 slot.feeder.skip(t);
             } else if let Some(packet) = slot.feeder.poll(t) {
-                let ok = slot.channel.write_stream(tick, packet).is_ok();
-                slot.feeder.result(t, ok);
+                let reply = slot.channel.apply(tick, Op::WriteStream(packet.to_vec()));
+                slot.feeder
+                    .result(t, matches!(reply, Reply::Stream(Ok(()))));
             }
             slot.channel.step(tick);
-            let number = slot.channel.number();
-            let n = check_blocks(
-                number,
+            self.total_blocks += slot.core.check(
+                tick,
+                &mut slot.channel,
                 slot.feeder.owed_mut(),
-                slot.channel.drain_executed(),
-                &mut self.tallies.order,
-                &mut slot.counters.checksum,
+                &mut self.tallies,
+                &self.expected_errors,
             );
-            slot.counters.blocks += n;
-            self.total_blocks += n;
-            let p = slot.channel.position();
-            for &(i, lo, hi) in &slot.limits {
-                if !(lo - 1e-9..=hi + 1e-9).contains(&p[i]) {
-                    let (v, axis) = (p[i], crate::vocab::axis::AXIS_LETTERS[i] as char);
-                    self.tallies.limits.violate(|| {
-                        format!(
-                            "channel {number}, tick {t}: {axis} = {v:.4} mm outside [{lo}, {hi}]"
-                        )
-                    });
-                }
-            }
-            let errors = slot.channel.errors();
-            if errors.len() > slot.errors_seen {
-                for e in &errors[slot.errors_seen..] {
-                    let (code, msg) = (e.code, &e.msg);
-                    *slot.counters.errors.entry(code).or_default() += 1;
-                    if !self.expected_errors.contains(&code) {
-                        self.tallies
-                            .errors
-                            .violate(|| format!("channel {number}, tick {t}: error {code}: {msg}"));
-                    }
-                }
-                slot.errors_seen = errors.len();
-            }
         }
         match self.target_blocks {
             Some(b) if self.total_blocks >= b => Flow::Stop,

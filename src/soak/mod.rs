@@ -8,7 +8,6 @@ pub mod feed;
 pub mod generator;
 pub mod invariants;
 pub mod load;
-pub mod plot;
 pub mod report;
 pub mod rng;
 pub mod scenario;
@@ -22,8 +21,8 @@ use crate::runtime::{Clock, RunEnd, Runtime};
 use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
-use invariants::{resident_kib, Tally, Verdict};
-use report::{ChannelReport, CycleFigures, MemoryReport, SoakReport};
+use invariants::resident_kib;
+use report::{CycleFigures, MemoryReport, RunFigures, SoakReport};
 use rng::SplitMix64;
 use scenario::{ClockSpec, Length, Scenario};
 
@@ -147,74 +146,6 @@ fn progress_bar(enabled: bool) -> ProgressBar {
     }
 }
 
-/// The invariants' verdicts at the end of a run (`growth`: resident set after warm-up, KiB).
-fn verdicts(cycle: &SoakCycle, scenario: &Scenario, growth: Option<i64>) -> Vec<Verdict> {
-    let mut memory = Tally::default();
-    let slack = scenario.invariants.memory_slack_kib;
-    if let Some(g) = growth {
-        if g > slack as i64 {
-            memory.violate(|| {
-                format!("resident set grew by {g} KiB after warm-up (allowed {slack} KiB)")
-            });
-        }
-    }
-    let order_note = format!("{} blocks checked", cycle.total_blocks);
-    vec![
-        cycle.tallies.order.verdict(
-            "every streamed block executed exactly once, in order, between resets",
-            Some(order_note),
-        ),
-        cycle.tallies.errors.verdict(
-            "no channel error but the expected ones",
-            Some(format!(
-                "expected: {:?}",
-                scenario.invariants.expected_errors
-            )),
-        ),
-        cycle
-            .tallies
-            .limits
-            .verdict("positions within the axis soft limits", None),
-        memory.verdict(
-            "memory steady",
-            growth.map(|g| format!("growth {g} KiB ≤ {slack} KiB")),
-        ),
-    ]
-}
-
-/// Each channel's counters for the report.
-fn channel_reports(cycle: &SoakCycle) -> Vec<ChannelReport> {
-    cycle
-        .slots
-        .iter()
-        .map(|s| {
-            let f = s.feeder.counters();
-            let st = s.channel.stats();
-            ChannelReport {
-                number: s.channel.number(),
-                program: s.program.clone(),
-                blocks: s.counters.blocks,
-                resets: s.counters.resets,
-                error_resets: s.counters.error_resets,
-                restarts: s.counters.restarts,
-                holds: s.counters.holds,
-                overrides: s.counters.overrides,
-                forced_rejections: s.counters.forced_rejections,
-                writes_ok: f.writes_ok,
-                writes_rejected: f.writes_rejected,
-                writes_skipped: f.writes_skipped,
-                bytes: f.bytes,
-                lines_written: f.lines,
-                pauses: f.pauses,
-                interrupts: st.interrupts,
-                warnings: st.warnings,
-                errors: s.counters.errors.clone(),
-                checksum: format!("{:016x}", s.counters.checksum.0),
-            }
-        })
-        .collect()
-}
-
 /// Run a scenario to its end and report.
 pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
     let length = opts
@@ -289,34 +220,47 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         ));
     }
     bar.finish_and_clear();
-    let wall = start.elapsed();
+    let run = RunFigures {
+        seed,
+        realtime,
+        ticks: rt.ticks(),
+        sim_seconds: rt.time().as_secs_f64(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+        blocks: rt.cycle().total_blocks,
+    };
+    let (cycle, stats) = rt.into_inner();
+    Ok(report_of(&cycle, &stats, scenario, run, warmup_kib, period))
+}
+
+/// The report of a finished run (`warmup_kib`: resident set after warm-up).
+fn report_of(
+    cycle: &SoakCycle,
+    stats: &crate::vocab::stats::CycleStats,
+    scenario: &Scenario,
+    run: RunFigures,
+    warmup_kib: Option<u64>,
+    period: Duration,
+) -> SoakReport {
     let end_kib = resident_kib();
     let warmup_kib = warmup_kib.or(end_kib);
-    let ticks = rt.ticks();
-    let sim = rt.time().as_secs_f64();
-    let (cycle, stats) = rt.into_inner();
-
     let growth = warmup_kib.zip(end_kib).map(|(a, b)| b as i64 - a as i64);
-    let invariants = verdicts(&cycle, scenario, growth);
-    let channels = channel_reports(&cycle);
-    let blocks = cycle.total_blocks;
-    Ok(SoakReport {
-        scenario: scenario.path.display().to_string(),
-        seed,
-        clock: if realtime { "real" } else { "virtual" }.into(),
-        ticks,
-        sim_seconds: sim,
-        wall_seconds: wall.as_secs_f64(),
-        blocks,
-        blocks_per_wall_second: blocks as f64 / wall.as_secs_f64().max(1e-9),
-        all_held: invariants.iter().all(|v| v.held),
+    let invariants = cycle.tallies.verdicts(
+        run.blocks,
+        &scenario.invariants.expected_errors,
+        growth,
+        scenario.invariants.memory_slack_kib,
+    );
+    let memory = MemoryReport {
+        warmup_kib,
+        end_kib,
+        growth_kib: growth,
+    };
+    SoakReport::new(
+        &scenario.path,
+        run,
         invariants,
-        channels,
-        memory: MemoryReport {
-            warmup_kib,
-            end_kib,
-            growth_kib: growth,
-        },
-        cycle: CycleFigures::new(period.as_secs_f64() * 1e6, &stats),
-    })
+        cycle.slots.iter().map(Slot::report).collect(),
+        memory,
+        CycleFigures::new(period.as_secs_f64() * 1e6, stats),
+    )
 }

@@ -1,10 +1,11 @@
-//! The soak's final report: JSON for machines (`--report FILE`), a summary for people.
+//! The soak's final report, of `ncchannel soak` and `serve --soak` alike: JSON for machines
+//! (`--report FILE`), a summary for people.
 
-use std::collections::BTreeMap;
 use std::io::{self, Write};
 
 use serde::Serialize;
 
+use super::driver::SoakCounters;
 use super::invariants::Verdict;
 use crate::vocab::stats::{CycleStats, Histogram};
 
@@ -50,31 +51,6 @@ impl CycleFigures {
     }
 }
 
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct ChannelReport {
-    pub number: u32,
-    pub program: String,
-    pub blocks: u64,
-    pub resets: u64,
-    pub error_resets: u64,
-    pub restarts: u64,
-    pub holds: u64,
-    pub overrides: u64,
-    pub forced_rejections: u64,
-    pub writes_ok: u64,
-    pub writes_rejected: u64,
-    pub writes_skipped: u64,
-    pub bytes: u64,
-    pub lines_written: u64,
-    pub pauses: u64,
-    pub interrupts: u64,
-    pub warnings: u64,
-    /// Channel errors by number.
-    pub errors: BTreeMap<u32, u64>,
-    /// FNV-1a over (offset, N) of every executed block, hex: equal for equal runs.
-    pub checksum: String,
-}
-
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct MemoryReport {
     /// Resident set after warm-up, KiB (`None` without /proc).
@@ -95,12 +71,50 @@ pub struct SoakReport {
     pub blocks_per_wall_second: f64,
     pub all_held: bool,
     pub invariants: Vec<Verdict>,
-    pub channels: Vec<ChannelReport>,
+    pub channels: Vec<SoakCounters>,
     pub memory: MemoryReport,
     pub cycle: CycleFigures,
 }
 
+/// What a run was and how long it took.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RunFigures {
+    pub seed: u64,
+    pub realtime: bool,
+    pub ticks: u64,
+    pub sim_seconds: f64,
+    pub wall_seconds: f64,
+    /// Stream blocks checked, all channels.
+    pub blocks: u64,
+}
+
 impl SoakReport {
+    /// The report of a run of `scenario` (`ncchannel soak` and `serve --soak` alike).
+    pub fn new(
+        scenario: &std::path::Path,
+        run: RunFigures,
+        invariants: Vec<Verdict>,
+        channels: Vec<SoakCounters>,
+        memory: MemoryReport,
+        cycle: CycleFigures,
+    ) -> Self {
+        SoakReport {
+            scenario: scenario.display().to_string(),
+            seed: run.seed,
+            clock: if run.realtime { "real" } else { "virtual" }.into(),
+            ticks: run.ticks,
+            sim_seconds: run.sim_seconds,
+            wall_seconds: run.wall_seconds,
+            blocks: run.blocks,
+            blocks_per_wall_second: run.blocks as f64 / run.wall_seconds.max(1e-9),
+            all_held: invariants.iter().all(|v| v.held),
+            invariants,
+            channels,
+            memory,
+            cycle,
+        }
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
     }
@@ -129,8 +143,8 @@ impl SoakReport {
             )?;
             writeln!(
                 w,
-                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
-                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
+                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} lines accepted, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
+                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.lines_accepted, c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
             )?;
         }
         let kib = |v: Option<u64>| v.map_or("n/a".to_string(), |k| format!("{k} KiB"));

@@ -6,6 +6,7 @@ use std::time::Duration;
 
 use common::{channel_events, feeder, tick0, Rig};
 use ncchannel::channel::{Channel, Finish, State};
+use ncchannel::machine::{Op, Reply};
 use ncchannel::runtime::Tick;
 use ncchannel::source::store::FsLatency;
 use serde_json::Value;
@@ -58,7 +59,10 @@ fn blocks(events: &[Value]) -> Vec<(String, String)> {
 
 /// Start `program` on a channel driven by hand and step it until it leaves ACTIVE.
 fn run_program(c: &mut Channel, t: &mut Tick, program: &str) {
-    c.start(t, program).unwrap();
+    assert_eq!(
+        c.apply(t, Op::Start(program.to_string())),
+        Reply::Command(Ok(()))
+    );
     for _ in 0..1_000_000 {
         if !matches!(c.state(), State::Active | State::Hold) {
             return;
@@ -285,9 +289,9 @@ fn the_cache_lasts_across_programs_until_a_reset() {
     rig.program("c.cyc", "G1 X5 F6000\nM17\n");
     rig.program("load.nc", "#CACHE LOAD[FILE=c.cyc]\nM30\n");
     rig.program("call.nc", "L CYCLE [NAME=c.cyc]\nG0 X0\nM30\n");
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let mut t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
+    let c = &mut channel;
     run_program(c, &mut t, "load.nc");
     assert_eq!(c.cache().len(), 1);
     run_program(c, &mut t, "call.nc");
@@ -298,7 +302,7 @@ fn the_cache_lasts_across_programs_until_a_reset() {
         "load.nc, the load, call.nc: the call is a hit"
     );
     assert_eq!(c.cache().hits, 1);
-    c.reset(&t);
+    c.apply(&t, Op::Reset);
     assert!(c.cache().is_empty(), "a channel reset clears the cache");
     run_program(c, &mut t, "call.nc");
     assert_eq!(c.state(), State::Ready);
@@ -345,9 +349,9 @@ fn cached_text_stays_until_refreshed_and_a_refresh_picks_up_the_changed_file() {
     rig.program("c.cyc", "G1 X1 F6000\nM17\n");
     rig.program("load.nc", "#CACHE LOAD[FILE=c.cyc]\nM30\n");
     rig.program("call.nc", "L CYCLE [NAME=c.cyc]\nM30\n");
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let mut t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
+    let c = &mut channel;
     run_program(c, &mut t, "load.nc");
     std::fs::write(rig.nc().join("c.cyc"), "G1 X2 F6000\nM17\n").unwrap();
     // The cache holds what was loaded: the change on disk is not seen yet.
@@ -381,10 +385,10 @@ fn a_refresh_while_the_cycle_runs_leaves_the_running_call_on_the_old_text() {
         "main.nc",
         "#CACHE LOAD[FILE=c.cyc]\nL CYCLE [NAME=c.cyc]\nL CYCLE [NAME=c.cyc]\nM30\n",
     );
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let mut t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
-    c.start(&t, "main.nc").unwrap();
+    let c = &mut channel;
+    common::start(c, &t, "main.nc");
     // The X move takes 100 ms; #FLUSH WAIT holds decoding until it is done.
     for _ in 0..20 {
         c.step(&t);

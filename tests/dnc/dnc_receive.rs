@@ -10,7 +10,8 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use ncchannel::dnc::{
-    self, Anchor, Disposition, Markers, ProgramWriter, Splitter, TransferEnd, WriterConfig,
+    self, Anchor, Disposition, Markers, ProgramWriter, Splitter, TransferEnd, TransferLimits,
+    WriterConfig,
 };
 
 const ARCHIVE: &str = "\
@@ -487,13 +488,22 @@ fn library_listener_files_after_the_end_line_and_drops_a_cut_off_connection() {
     let port = listener.local_addr().unwrap().port();
     let out2 = out.clone();
     let server = std::thread::spawn(move || {
-        let mut w = ProgramWriter::new(WriterConfig::new(&out2));
-        let mut s = Splitter::new(markers(&["%"], &["M30"]));
+        let listen = dnc::Listener {
+            max_transfers: Some(2),
+            ..dnc::Listener::new(
+                markers(&["%"], &["M30"]),
+                WriterConfig::new(&out2),
+                TransferLimits::default(),
+            )
+        };
         let mut reports = Vec::new();
-        let n = dnc::receive_connections(&listener, Some(2), None, &mut s, &mut w, |r| {
-            reports.push(r.clone())
-        })
-        .unwrap();
+        let n = listen.serve(
+            &listener,
+            || false,
+            |_| {},
+            |r| reports.push(r.unwrap()),
+            |e| panic!("{e}"),
+        );
         (n, reports)
     });
     let mut c = TcpStream::connect(("127.0.0.1", port)).unwrap();
@@ -523,18 +533,25 @@ fn a_silent_connection_times_out_as_a_broken_transfer() {
     let port = listener.local_addr().unwrap().port();
     let out2 = out.clone();
     let server = std::thread::spawn(move || {
-        let mut w = ProgramWriter::new(WriterConfig::new(&out2));
-        let mut s = Splitter::new(markers(&[], &["M30"]));
+        let listen = dnc::Listener {
+            max_transfers: Some(1),
+            ..dnc::Listener::new(
+                markers(&[], &["M30"]),
+                WriterConfig::new(&out2),
+                TransferLimits {
+                    idle_timeout: Some(Duration::from_millis(200)),
+                    ..TransferLimits::default()
+                },
+            )
+        };
         let mut reports = Vec::new();
-        dnc::receive_connections(
+        listen.serve(
             &listener,
-            Some(1),
-            Some(Duration::from_millis(200)),
-            &mut s,
-            &mut w,
-            |r| reports.push(r.clone()),
-        )
-        .unwrap();
+            || false,
+            |_| {},
+            |r| reports.push(r.unwrap()),
+            |e| panic!("{e}"),
+        );
         reports
     });
     let mut c = TcpStream::connect(("127.0.0.1", port)).unwrap();

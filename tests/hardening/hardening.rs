@@ -7,11 +7,11 @@ use std::process::Command as Process;
 use std::time::Duration;
 
 use crate::support::Rig;
-use ncchannel::channel::{Finish, State};
+use ncchannel::channel::{Channel, Finish, State};
 use ncchannel::decoder::vars::{VarClass, CLASS_BYTES};
 use ncchannel::decoder::DECLARED_VALUES_PER_TICK;
 use ncchannel::lang::{check_program, check_program_counted, parse_block, MAX_PROGRAM_DIAGS};
-use ncchannel::machine::Machine;
+use ncchannel::machine::{Op, Reply};
 use ncchannel::runtime::Tick;
 
 fn tick(period: Duration, k: u64) -> Tick {
@@ -22,25 +22,31 @@ fn tick(period: Duration, k: u64) -> Tick {
     }
 }
 
-/// A channel run by hand: the machine holding it, its tick period and the next tick.
+/// A channel run by hand: the channel, its tick period and the next tick.
 struct Hand {
-    machine: Machine,
+    channel: Channel,
     period: Duration,
     next: u64,
 }
 
 impl Hand {
     fn new(rig: &Rig) -> Hand {
-        let (machine, period, _log) = rig.machine();
+        let (channel, period) = rig.channel();
         Hand {
-            machine,
+            channel,
             period,
             next: 1,
         }
     }
 
-    fn channel(&mut self) -> &mut ncchannel::channel::Channel {
-        self.machine.channel_mut(1).unwrap()
+    fn channel(&self) -> &Channel {
+        &self.channel
+    }
+
+    /// Through the channel's door, as a client.
+    fn apply(&mut self, op: Op) -> Reply {
+        let t = self.now();
+        self.channel.apply(&t, op)
     }
 
     fn now(&self) -> Tick {
@@ -48,17 +54,18 @@ impl Hand {
     }
 
     fn start(&mut self, program: &str) {
-        let t = self.now();
-        self.channel().start(&t, program).unwrap();
+        assert_eq!(
+            self.apply(Op::Start(program.into())),
+            Reply::Command(Ok(()))
+        );
     }
 
     /// One tick.
     fn step(&mut self) -> Option<Finish> {
         let t = self.now();
         self.next += 1;
-        let c = self.channel();
-        c.step(&t);
-        c.take_finish()
+        self.channel.step(&t);
+        self.channel.take_finish()
     }
 
     /// Ticks until the program finishes (or `max` ticks): how it finished, after how many.
@@ -76,8 +83,7 @@ impl Hand {
     }
 
     fn reset(&mut self) {
-        let t = self.now();
-        self.channel().reset(&t);
+        self.apply(Op::Reset);
     }
 }
 
@@ -350,22 +356,28 @@ fn a_bad_stream_write_does_not_abort_a_running_file_program() {
     for _ in 0..10 {
         h.step();
     }
-    let t = h.now();
-    let r = h.channel().write_stream(&t, b"N1 X1\n");
-    assert_eq!(r.unwrap_err().isg_code(), Some(21476));
+    let r = h.apply(Op::WriteStream(b"N1 X1\n".to_vec()));
+    let Reply::Stream(Err(e)) = r else {
+        panic!("{r:?}")
+    };
+    assert_eq!(e.isg_code(), Some(21476));
     let (finish, _) = h.run(200_000);
     assert_eq!(finish, Some(Finish::Ended), "{:?}", h.error_code());
     assert!(h.channel().errors().is_empty());
 
     let mut h = Hand::new(&rig);
     h.start("streaming.nc");
-    let t = h.now();
-    h.channel().write_stream(&t, b"G01 X10 F600\r\n").unwrap();
+    assert_eq!(
+        h.apply(Op::WriteStream(b"G01 X10 F600\r\n".to_vec())),
+        Reply::Stream(Ok(()))
+    );
     for _ in 0..10 {
         h.step();
     }
-    let t = h.now();
-    assert!(h.channel().write_stream(&t, b"N1 X1\n").is_err());
+    assert_ne!(
+        h.apply(Op::WriteStream(b"N1 X1\n".to_vec())),
+        Reply::Stream(Ok(()))
+    );
     assert_eq!(h.run(1000).0, Some(Finish::Error));
     assert_eq!(h.error_code(), Some(21476));
 }

@@ -7,6 +7,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use ncchannel::channel::{Channel, State};
+use ncchannel::machine::{Op, Reply};
 use ncchannel::report::event::{EventKind, EventLog};
 use ncchannel::runtime::Tick;
 
@@ -61,6 +62,20 @@ fn tick(k: u64) -> Tick {
     }
 }
 
+/// The reply to a stream write the channel took.
+const WRITTEN: Reply = Reply::Stream(Ok(()));
+
+/// Start `program` through the channel's door; a refusal fails the test.
+fn start(c: &mut Channel, t: &Tick, program: &str) {
+    let r = c.apply(t, Op::Start(program.to_string()));
+    assert_eq!(r, Reply::Command(Ok(())), "start {program}");
+}
+
+/// Write stream data through the channel's door, as a client does.
+fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
+    c.apply(t, Op::WriteStream(data.to_vec()))
+}
+
 /// Run a streamed program: `writes` are (tick, text) written into the stream interface.
 /// Returns the channel and every event kind with its tick.
 fn run_stream(
@@ -69,14 +84,14 @@ fn run_stream(
     max_ticks: u64,
 ) -> (Channel, Vec<(u64, EventKind)>, Vec<f64>) {
     let mut c = s.channel();
-    c.start(&tick(0), "streaming.nc").unwrap();
+    start(&mut c, &tick(0), "streaming.nc");
     let mut events = Vec::new();
     let mut velocity = Vec::new();
     for k in 0..max_ticks {
         let t = tick(k);
         for (at, text) in writes {
             if *at == k {
-                c.write_stream(&t, text.as_bytes()).unwrap();
+                assert_eq!(write(&mut c, &t, text.as_bytes()), WRITTEN);
             }
         }
         c.step(&t);
@@ -188,15 +203,15 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
     let s = Setup::new("", "");
     let mut c = s.channel();
     s.write("nc/long.nc", "N10 G1 X100 F6000\nN20 M30\n");
-    c.start(&tick(0), "long.nc").unwrap();
+    start(&mut c, &tick(0), "long.nc");
     let mut events = Vec::new();
     for k in 1..3000u64 {
         let t = tick(k);
         if k == 300 {
-            c.hold(&t);
+            c.apply(&t, Op::Hold);
         }
         if k == 800 {
-            c.resume(&t);
+            c.apply(&t, Op::Resume);
         }
         c.step(&t);
         if k == 790 {
@@ -226,7 +241,7 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
          N60 M30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "arcs.nc").unwrap();
+    start(&mut c, &tick(0), "arcs.nc");
     for k in 1..20_000 {
         c.step(&tick(k));
         if c.state() != State::Active {
@@ -242,7 +257,7 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
         "N10 G1 X10 Y0 F3000\nN20 G3 X0 Y10.5 I-10 J0\nM30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "bad.nc").unwrap();
+    start(&mut c, &tick(0), "bad.nc");
     for k in 1..5000 {
         c.step(&tick(k));
     }
@@ -265,7 +280,7 @@ fn zero_offsets_from_the_list_named_in_the_startup_list() {
         "N10 G54 G90 G0 X0 Y0\nN20 #FLUSH WAIT\nN30 G55 G0 X1 Z0\nN40 G53 G0 Y7\nM30\n",
     );
     let mut c = s.channel();
-    c.start(&tick(0), "np.nc").unwrap();
+    start(&mut c, &tick(0), "np.nc");
     let mut after_n10 = None;
     for k in 1..10_000u64 {
         c.step(&tick(k));
@@ -443,7 +458,7 @@ fn m5_after_the_last_motion_of_a_paused_stream_takes_effect_when_the_motion_ends
 fn run_file(s: &Setup, name: &str, text: &str, max_ticks: u64) -> (Vec<[f64; 6]>, Vec<f64>) {
     s.write(&format!("nc/{name}"), text);
     let mut c = s.channel();
-    c.start(&tick(0), name).unwrap();
+    start(&mut c, &tick(0), name);
     let (mut pos, mut vel) = (Vec::new(), Vec::new());
     for k in 1..max_ticks {
         c.step(&tick(k));
@@ -649,7 +664,7 @@ fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
     s.write("params/tools.lis", "wz[1].radius 50000\n");
     s.write("nc/trc.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "trc.nc").unwrap();
+    start(&mut c, &tick(0), "trc.nc");
     let (mut inside, mut out) = (false, Vec::new());
     for k in 1..200_000u64 {
         c.step(&tick(k));
@@ -718,7 +733,7 @@ fn trc_radius_larger_than_an_inner_arc_is_error_900140() {
     let program = "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F3000\nG3 X6 Y0 I3 J0\nG1 X20\nG40 X30\nM30\n";
     s.write("nc/bad_trc.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "bad_trc.nc").unwrap();
+    start(&mut c, &tick(0), "bad_trc.nc");
     for k in 1..20_000u64 {
         c.step(&tick(k));
         c.events_mut().flush_to(&mut EventLog::disabled());
@@ -742,7 +757,7 @@ fn run_to_error(runtime: &str, program: &str) -> (Vec<ncchannel::channel::ErrorR
     s.write("params/tools.lis", "wz[1].radius 50000\n");
     s.write("nc/lim.nc", program);
     let mut c = s.channel();
-    c.start(&tick(0), "lim.nc").unwrap();
+    start(&mut c, &tick(0), "lim.nc");
     let mut x_max: f64 = 0.0;
     for k in 1..200_000u64 {
         c.step(&tick(k));

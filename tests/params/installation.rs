@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use ncchannel::channel::{Channel, State};
+use ncchannel::machine::{Op, Reply};
 use ncchannel::report::event::{EventKind, EventLog};
 use ncchannel::runtime::Tick;
 
@@ -114,6 +115,20 @@ fn tick(k: u64) -> Tick {
     }
 }
 
+/// The reply to a stream write the channel took.
+const WRITTEN: Reply = Reply::Stream(Ok(()));
+
+/// Start `program` through the channel's door; a refusal fails the test.
+fn start(c: &mut Channel, t: &Tick, program: &str) {
+    let r = c.apply(t, Op::Start(program.to_string()));
+    assert_eq!(r, Reply::Command(Ok(())), "start {program}");
+}
+
+/// Write stream data through the channel's door, as a client does.
+fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
+    c.apply(t, Op::WriteStream(data.to_vec()))
+}
+
 /// Step the channel until it is neither active nor held; `writes` go into the stream at
 /// their tick. Every event with its tick.
 fn run(c: &mut Channel, writes: &[(u64, &str)], max_ticks: u64) -> Vec<(u64, EventKind)> {
@@ -122,7 +137,7 @@ fn run(c: &mut Channel, writes: &[(u64, &str)], max_ticks: u64) -> Vec<(u64, Eve
         let t = tick(k);
         for (at, text) in writes {
             if *at == k {
-                c.write_stream(&t, text.as_bytes()).unwrap();
+                assert_eq!(write(c, &t, text.as_bytes()), WRITTEN);
             }
         }
         c.step(&t);
@@ -185,7 +200,7 @@ fn a_move_runs_at_the_axis_lists_velocity_and_acceleration() {
     i.write("prg/rapid.nc", "N10 G00 X200\nN20 M30\n");
     for (prog, v) in [("feed.nc", 100.0), ("rapid.nc", 50.0)] {
         let mut c = i.channel();
-        c.start(&tick(0), prog).unwrap();
+        start(&mut c, &tick(0), prog);
         let ev = run(&mut c, &[], 20_000);
         let measured = end_tick(&ev) as f64 * PERIOD.as_secs_f64();
         let analytic = trapezoid_s(200.0, v, 500.0);
@@ -204,13 +219,13 @@ fn beyond_swe_pos_is_refused_with_21897_and_the_kernels_text() {
     i.write("prg/edge.nc", "N10 G01 X1500 F6000\nN20 M30\n");
     i.write("prg/far.nc", "N10 G01 X1500.001 F6000\nN20 M30\n");
     let mut c = i.channel();
-    c.start(&tick(0), "edge.nc").unwrap();
+    start(&mut c, &tick(0), "edge.nc");
     let ev = run(&mut c, &[], 40_000);
     assert!(!ev.iter().any(|(_, e)| matches!(e, EventKind::Error { .. })));
     assert_eq!(c.position()[0], 1500.0);
 
     let mut c = i.channel();
-    c.start(&tick(0), "far.nc").unwrap();
+    start(&mut c, &tick(0), "far.nc");
     let ev = run(&mut c, &[], 1000);
     let (code, msg) = ev
         .iter()
@@ -248,7 +263,7 @@ fn implicit_subroutines_run_at_program_start_m6_and_program_end() {
         "N10 G01 X2 F6000\nN20 T1 M6\nN30 G01 Y2\nN40 M30\n",
     );
     let mut c = i.channel();
-    c.start(&tick(0), "part.nc").unwrap();
+    start(&mut c, &tick(0), "part.nc");
     let ev = run(&mut c, &[], 20_000);
     let b = blocks(&ev);
     let got: Vec<(&str, u64)> = b
@@ -295,7 +310,7 @@ fn implicit_subroutines_run_in_a_stream_started_under_the_channel_lists_name() {
     implicit_programs(&i);
     let mut c = i.channel();
     // `streaming.nc` is the channel list's streaming_prog_file (P-CHAN-00158).
-    c.start(&tick(0), "streaming.nc").unwrap();
+    start(&mut c, &tick(0), "streaming.nc");
     let ev = run(
         &mut c,
         &[
@@ -337,7 +352,7 @@ fn without_implicit_subroutines_m6_is_an_ordinary_m_function_and_streams_work_as
     let i = Installation::new("");
     i.write("prg/tool.nc", "N4 G01 Z5 F6000\nN6 M17\n");
     let mut c = i.channel();
-    c.start(&tick(0), "streaming.nc").unwrap();
+    start(&mut c, &tick(0), "streaming.nc");
     let ev = run(
         &mut c,
         &[(5, "N10 G01 X2 F6000\r\nN20 M6\r\nN30 M30\r\n")],
@@ -354,7 +369,7 @@ fn a_missing_implicit_subroutine_is_the_program_not_found_error() {
     let i = Installation::new("start_init_prog_file missing.nc\n");
     i.write("prg/p.nc", "N10 G01 X1 F6000\nN20 M30\n");
     let mut c = i.channel();
-    c.start(&tick(0), "p.nc").unwrap();
+    start(&mut c, &tick(0), "p.nc");
     let ev = run(&mut c, &[], 1000);
     let msg = ev
         .iter()
@@ -380,7 +395,7 @@ fn the_shipped_example_installation_runs_its_part() {
     assert_eq!(ch.axes[2].max_velocity_mm_per_min, 15000.0);
     assert_eq!(ch.axes[2].soft_limit_min_mm, -300.0);
     let mut c = ncchannel::setup::channels(&config, true).unwrap().remove(0);
-    c.start(&tick(0), "part.nc").unwrap();
+    start(&mut c, &tick(0), "part.nc");
     let ev = run(&mut c, &[], 60_000);
     let progs: Vec<String> = blocks(&ev).into_iter().map(|(p, _)| p).collect();
     assert_eq!(progs.first().map(String::as_str), Some("init.nc"));
@@ -398,7 +413,7 @@ fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
     i.write("prg/sub.nc", "N50 G01 Y1 F6000\nN51 M6 M17\n");
     i.write("prg/part.nc", "N10 L sub.nc\nN20 M6 M30\n");
     let mut c = i.channel();
-    c.start(&tick(0), "part.nc").unwrap();
+    start(&mut c, &tick(0), "part.nc");
     let ev = run(&mut c, &[], 20_000);
     let got = numbered_blocks(&ev);
     let want: Vec<(String, u64)> = [

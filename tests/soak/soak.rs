@@ -8,7 +8,7 @@ use std::process::Command;
 use std::time::Duration;
 
 use ncchannel::feeder::Feeder;
-use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
 use ncchannel::soak::scenario::{Length, Scenario};
@@ -181,9 +181,8 @@ fn machine_ticks_four_channels_each_with_its_own_stream() {
             ch,
             Feeder::new(text.into_bytes(), 300, ch as u64, false).unwrap(),
         );
-        let c = m.channel_mut(ch).unwrap();
         let prog = format!("stream{ch}.nc");
-        c.start(&tick0, &prog).unwrap();
+        assert_eq!(m.apply(&tick0, ch, Op::Start(prog)), Reply::Command(Ok(())));
     }
     let (mut rt, _tx) = Runtime::new(m, period, Clock::Virtual);
     rt.run(Some(200_000));

@@ -5,6 +5,7 @@ use crate::support as common;
 use common::{crlf, feeder, tick0, Rig};
 use ncchannel::channel::{Finish, State};
 use ncchannel::feeder::Feeder;
+use ncchannel::machine::Op;
 
 #[test]
 fn stream_as_main_program_runs_every_block_and_ends() {
@@ -77,14 +78,17 @@ fn activation_by_global_call_from_a_file_program_and_back() {
 #[test]
 fn packets_written_before_the_read_merge_into_one_segment() {
     let rig = Rig::new();
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
+    let c = &mut channel;
     // Data written while no streaming program runs is kept for the next one.
-    c.write_stream(&t, &crlf("N1 P1=1\n")).unwrap();
-    c.write_stream(&t, &crlf("N2 P2=2\nN3 P3=3\n")).unwrap();
+    assert_eq!(common::write(c, &t, &crlf("N1 P1=1\n")), common::WRITTEN);
+    assert_eq!(
+        common::write(c, &t, &crlf("N2 P2=2\nN3 P3=3\n")),
+        common::WRITTEN
+    );
     assert_eq!(c.stream_fill().0, 9 + 18);
-    c.start(&t, "streaming.nc").unwrap();
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
     let ev = common::channel_events(c);
     let segs = common::of(&ev, "segment");
@@ -95,15 +99,17 @@ fn packets_written_before_the_read_merge_into_one_segment() {
 #[test]
 fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     let rig = Rig::new();
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
-    c.write_stream(&t, &crlf("N1 P1=1\nM30\nN2 P2=2\n"))
-        .unwrap();
-    c.start(&t, "streaming.nc").unwrap();
+    let c = &mut channel;
+    assert_eq!(
+        common::write(c, &t, &crlf("N1 P1=1\nM30\nN2 P2=2\n")),
+        common::WRITTEN
+    );
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
     // Written after the segment was read: stays in the buffer for the next program.
-    c.write_stream(&t, &crlf("N9 P9=9\n")).unwrap();
+    assert_eq!(common::write(c, &t, &crlf("N9 P9=9\n")), common::WRITTEN);
     for _ in 0..5 {
         c.step(&t);
     }
@@ -116,8 +122,8 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     assert_eq!(texts, ["N1 P1=1", "M30"]);
     assert_eq!(c.stream_fill().0, 9);
     // The next start runs it.
-    c.start(&t, "streaming.nc").unwrap();
-    c.write_stream(&t, &crlf("M30\n")).unwrap();
+    common::start(c, &t, "streaming.nc");
+    assert_eq!(common::write(c, &t, &crlf("M30\n")), common::WRITTEN);
     for _ in 0..5 {
         c.step(&t);
     }
@@ -218,16 +224,18 @@ fn a_fast_feeder_gives_no_interrupt() {
 #[test]
 fn reset_empties_buffer_and_state() {
     let rig = Rig::new();
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
-    c.write_stream(&t, &crlf("N1 G01 X100 F600\nN2 X0\n"))
-        .unwrap();
-    c.start(&t, "streaming.nc").unwrap();
+    let c = &mut channel;
+    assert_eq!(
+        common::write(c, &t, &crlf("N1 G01 X100 F600\nN2 X0\n")),
+        common::WRITTEN
+    );
+    common::start(c, &t, "streaming.nc");
     c.step(&t);
-    c.write_stream(&t, &crlf("N3 X5\n")).unwrap();
+    assert_eq!(common::write(c, &t, &crlf("N3 X5\n")), common::WRITTEN);
     assert!(c.decoder().reads_stream());
-    c.reset(&t);
+    c.apply(&t, Op::Reset);
     assert_eq!(c.state(), State::Ready);
     assert_eq!(c.stream_fill(), (0, 4094));
     assert!(!c.decoder().reads_stream());
@@ -262,12 +270,12 @@ fn unknown_main_program_is_20368_and_unknown_subroutine_20369() {
 #[test]
 fn the_error_list_is_bounded_and_counts_the_rest() {
     let rig = Rig::new();
-    let (mut machine, period, _log) = rig.machine();
+    let (mut channel, period) = rig.channel();
     let t = tick0(period);
-    let c = machine.channel_mut(1).unwrap();
+    let c = &mut channel;
     for _ in 0..1000 {
-        let _ = c.write_stream(&t, b"N1 X1\n");
-        c.reset(&t);
+        let _ = c.apply(&t, Op::WriteStream(b"N1 X1\n".to_vec()));
+        c.apply(&t, Op::Reset);
     }
     assert_eq!(c.stats().errors, 1000);
     assert_eq!(c.errors().len(), ncchannel::channel::MAX_LISTED_ERRORS);

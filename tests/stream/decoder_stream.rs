@@ -3,9 +3,12 @@
 
 use crate::support as common;
 
+use std::time::Duration;
+
 use common::{feeder, Rig};
 use ncchannel::channel::Finish;
 use ncchannel::decoder::SearchTarget;
+use ncchannel::machine::Op;
 
 const EXAMPLES: [&str; 6] = [
     "switchstream.nc",
@@ -243,10 +246,7 @@ fn block_skip_follows_the_mask() {
     let r = rig.run("skip.nc", None, 100_000);
     assert_eq!(r.block_texts(), ["X1 F100", "/ X2", "/3 X3", "M30"]);
     let r = rig.run_with("skip.nc", None, 100_000, |m| {
-        m.channel_mut(1)
-            .unwrap()
-            .decoder_mut()
-            .set_skip_mask(1 << 3)
+        m.apply(&common::tick0(Duration::ZERO), 1, Op::SkipMask(1 << 3));
     });
     assert_eq!(r.block_texts(), ["X1 F100", "/ X2", "M30"]);
 }
@@ -286,7 +286,9 @@ fn run_search(
     stream: bool,
     target: Option<SearchTarget>,
 ) -> common::RunResult {
-    let set = |m: &mut ncchannel::machine::Machine| m.channel_mut(1).unwrap().set_search(target);
+    let set = |m: &mut ncchannel::machine::Machine| {
+        m.apply(&common::tick0(Duration::ZERO), 1, Op::SearchAt(target));
+    };
     let r = if stream {
         rig.run_with("streaming.nc", Some(feeder(text, 992, 1)), 1_000_000, set)
     } else {
@@ -350,9 +352,8 @@ fn block_search_target_not_found_is_20704() {
     let rig = rig();
     rig.program("search.nc", SEARCH_PROGRAM);
     let r = rig.run_with("search.nc", None, 1_000_000, |m| {
-        m.channel_mut(1)
-            .unwrap()
-            .set_search(Some(SearchTarget::BlockNumber(999)))
+        let target = Some(SearchTarget::BlockNumber(999));
+        m.apply(&common::tick0(Duration::ZERO), 1, Op::SearchAt(target));
     });
     assert_eq!(r.error_codes(), [20704]);
 }

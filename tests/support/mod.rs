@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use ncchannel::channel::Finish;
+use ncchannel::channel::{Channel, Finish};
 use ncchannel::feeder::Feeder;
-use ncchannel::machine::{Machine, StopWhen};
+use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
 use serde_json::Value;
@@ -154,6 +154,14 @@ impl Rig {
         )
     }
 
+    /// Channel 1 of the rig on its own (its events kept in its buffer), and the cycle time.
+    pub fn channel(&self) -> (Channel, Duration) {
+        let config = ncchannel::params::load(&self.startup()).unwrap();
+        let mut channels = ncchannel::setup::channels(&config, true).unwrap();
+        let period = Duration::from_micros(config.runtime.cycle_period_us);
+        (channels.remove(0), period)
+    }
+
     /// Start `program` on channel 1, feed `stream` (if any) with the built-in feeder, run in
     /// virtual time until the program finishes or `max_ticks`.
     pub fn run(&self, program: &str, stream: Option<Feeder>, max_ticks: u64) -> RunResult {
@@ -173,7 +181,8 @@ impl Rig {
         }
         prepare(&mut machine);
         let t0 = tick0(period);
-        let _ = machine.channel_mut(1).unwrap().start(&t0, program);
+        // A refused start raises its error, which the run then shows.
+        let _ = machine.apply(&t0, 1, Op::Start(program.to_string()));
         let (mut rt, _tx) = Runtime::new(machine, period, Clock::Virtual);
         rt.run(Some(max_ticks));
         let ticks = rt.ticks();
@@ -324,3 +333,17 @@ pub mod limit_check;
 pub mod queued;
 pub mod random_path;
 pub mod streaming_load;
+
+/// The reply to a stream write the channel took.
+pub const WRITTEN: Reply = Reply::Stream(Ok(()));
+
+/// Start `program` through the channel's door; a refusal fails the test.
+pub fn start(c: &mut Channel, t: &Tick, program: &str) {
+    let r = c.apply(t, Op::Start(program.to_string()));
+    assert_eq!(r, Reply::Command(Ok(())), "start {program}");
+}
+
+/// Write stream data through the channel's door, as a client does.
+pub fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
+    c.apply(t, Op::WriteStream(data.to_vec()))
+}
