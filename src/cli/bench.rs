@@ -131,7 +131,7 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         out.line(format_args!("histogram written to {}", p.display()));
     }
     if let Err(e) = out.finish() {
-        super::serve::report(format_args!("ncchannel bench: standard output: {e}"));
+        super::out::say(format_args!("ncchannel bench: standard output: {e}"));
     }
     ExitCode::from(super::exit::OK)
 }

@@ -53,7 +53,7 @@ pub fn execute(args: CheckArgs) -> ExitCode {
         out.line(d.render());
     }
     if let Err(e) = out.finish() {
-        super::serve::report(format_args!("ncchannel check: standard output: {e}"));
+        super::out::say(format_args!("ncchannel check: standard output: {e}"));
     }
     for l in &summaries {
         eprintln!("ncchannel check: {l}");

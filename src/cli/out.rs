@@ -67,3 +67,9 @@ impl Default for Stdout {
         Self::new()
     }
 }
+
+/// A line on standard error, best effort. `eprintln!` panics when stderr is a closed pipe;
+/// a message must never cost the run its event log or its exit code.
+pub(crate) fn say(msg: std::fmt::Arguments<'_>) {
+    let _ = writeln!(io::stderr().lock(), "{msg}");
+}

@@ -20,7 +20,7 @@ use crate::dnc::{
 
 use super::exit;
 // Operator messages never panic on a closed stderr (`eprintln!` would, mid-transfer).
-use super::serve::report as say;
+use super::out::say;
 
 #[derive(Debug, clap::Args)]
 pub struct ReceiveArgs {

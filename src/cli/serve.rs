@@ -15,6 +15,7 @@ use crate::soak::external::{load_external, Supervised};
 use crate::soak::scenario::Scenario;
 
 use super::exit;
+use super::out::say;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct ServeArgs {
@@ -57,7 +58,7 @@ fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
 }
 
 /// The ADS server's settings: the command line over runtime.toml's `[ads]`.
-pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConfig {
+fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConfig {
     let ads = &config.runtime.ads;
     ServerConfig {
         bind: args.bind.unwrap_or(ads.bind.0),
@@ -80,7 +81,7 @@ pub(crate) fn server_config(args: &ServeArgs, config: &crate::params::Config) ->
 
 /// `--seconds`: `None` runs until a signal (no value, `inf`, or longer than `Duration` holds);
 /// a negative or NaN value is a usage error. `Duration::from_secs_f64` would panic on those.
-pub(crate) fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String> {
+fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String> {
     match seconds {
         None => Ok(None),
         Some(s) if s.is_nan() || s < 0.0 => Err(format!("--seconds {s}: not a duration")),
@@ -88,15 +89,8 @@ pub(crate) fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String
     }
 }
 
-/// A line on standard error, best effort. `eprintln!` panics when stderr is a closed pipe;
-/// a message must never cost the run its event log or its exit code.
-pub(crate) fn report(msg: std::fmt::Arguments<'_>) {
-    use std::io::Write;
-    let _ = writeln!(std::io::stderr().lock(), "{msg}");
-}
-
-pub(crate) fn usage(msg: impl std::fmt::Display) -> ExitCode {
-    report(format_args!("ncchannel serve: {msg}"));
+fn usage(msg: impl std::fmt::Display) -> ExitCode {
+    say(format_args!("ncchannel serve: {msg}"));
     ExitCode::from(exit::USAGE)
 }
 
@@ -111,6 +105,32 @@ fn supervised(machine: Machine, sc: &Scenario, config: &crate::params::Config) -
         .map(|c| c.streaming_prog_file.clone())
         .collect();
     Supervised::new(machine, sc, &axes, programs)
+}
+
+/// The event log `--events` asks for. The soak's checks need the channels' events: without
+/// `--events` they go nowhere. Real time: a reader that falls behind loses events (counted),
+/// never the cycle's pace.
+fn event_log(target: Option<&str>, soak: bool) -> Result<EventLog, ExitCode> {
+    match target {
+        None if soak => Ok(EventLog::to_writer(Box::new(std::io::sink()))),
+        None => Ok(EventLog::disabled()),
+        Some(t) => match EventLog::open(t) {
+            Ok(l) => Ok(l.with_backlog(Backlog::Drop)),
+            Err(e) => Err(usage(format!("--events {t}: {e}"))),
+        },
+    }
+}
+
+/// `--start`: channel 1 runs `program` from the first tick; a refusal is reported, not fatal.
+fn start(machine: &mut Machine, period: Duration, program: &str) {
+    let tick0 = Tick {
+        index: 0,
+        period,
+        time: Duration::ZERO,
+    };
+    if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(program.to_string())) {
+        say(format_args!("ncchannel serve: --start {program}: {e}"));
+    }
 }
 
 pub fn execute(mut args: ServeArgs) -> ExitCode {
@@ -140,32 +160,26 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         Ok(c) => c,
         Err(msg) => return usage(msg),
     };
-    let log = match &args.events {
-        // The soak's checks need the channels' events; without --events they go nowhere.
-        None if scenario.is_some() => EventLog::to_writer(Box::new(std::io::sink())),
-        None => EventLog::disabled(),
-        // Real time: a reader that falls behind loses events (counted), never the cycle's pace.
-        Some(t) => match EventLog::open(t) {
-            Ok(l) => l.with_backlog(Backlog::Drop),
-            Err(e) => return usage(format!("--events {t}: {e}")),
-        },
+    let log = match event_log(args.events.as_deref(), scenario.is_some()) {
+        Ok(l) => l,
+        Err(code) => return code,
     };
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, log, StopWhen::Never);
     if let Some(p) = &args.start {
-        let tick0 = Tick {
-            index: 0,
-            period,
-            time: Duration::ZERO,
-        };
-        if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(p.clone())) {
-            report(format_args!("ncchannel serve: --start {p}: {e}"));
-        }
+        start(&mut machine, period, p);
     }
     if let Some(sc) = scenario {
         let cycle = supervised(machine, &sc, &config);
-        return super::serve_soak::run(cycle, &sc, &args, &config, period, nch);
+        let soak = super::serve_soak::SoakServe {
+            server_config: server_config(&args, &config),
+            limit,
+            report: args.report.clone(),
+            period,
+            channels: nch,
+        };
+        return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
     let server_config = server_config(&args, &config);
@@ -175,7 +189,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             Ok(s) => s,
             Err(e) => return usage(format!("cannot listen: {e}")),
         };
-    report(format_args!(
+    say(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),
@@ -183,7 +197,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     ));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
-        Err(e) => report(format_args!(
+        Err(e) => say(format_args!(
             "ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"
         )),
     }
@@ -200,17 +214,17 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    report(format_args!(
+    say(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     ));
     match log {
-        Ok(lines) if args.events.is_some() => report(format_args!("event log: {lines} lines")),
+        Ok(lines) if args.events.is_some() => say(format_args!("event log: {lines} lines")),
         Ok(_) => {}
         Err(e) => {
-            report(format_args!("ncchannel serve: event log: {e}"));
+            say(format_args!("ncchannel serve: event log: {e}"));
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }

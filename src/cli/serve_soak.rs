@@ -3,37 +3,47 @@
 //! or SIGINT/SIGTERM). Exit 0 every invariant held, 1 one was violated.
 
 use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crate::ads::channel_backend::ChannelBackend;
+use crate::ads::ServerConfig;
 use crate::runtime::{Clock, RunEnd, Runtime};
 use crate::soak::external::{resident, Supervised};
 use crate::soak::report::{CycleFigures, MemoryReport, RunFigures, SoakReport};
 use crate::soak::scenario::Scenario;
 
 use super::exit;
-use super::serve::{report as say, run_limit, usage, ServeArgs};
+use super::out::say;
 
-pub fn run(
-    cycle: Supervised,
-    scenario: &Scenario,
-    args: &ServeArgs,
-    config: &crate::params::Config,
-    period: Duration,
-    nch: u16,
-) -> ExitCode {
-    let limit = match run_limit(args.seconds) {
-        Ok(l) => l,
-        Err(msg) => return usage(msg),
-    };
+/// What `serve` settled before handing over: the ADS endpoint, the run limit, the report
+/// file, the cycle time and the channel count.
+pub struct SoakServe {
+    pub server_config: ServerConfig,
+    pub limit: Option<Duration>,
+    pub report: Option<PathBuf>,
+    pub period: Duration,
+    pub channels: u16,
+}
+
+pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
+    let SoakServe {
+        server_config,
+        limit,
+        report: report_path,
+        period,
+        channels: nch,
+    } = soak;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let server_config = super::serve::server_config(args, config);
     let server =
         match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
             Ok(s) => s,
-            Err(e) => return usage(format!("cannot listen: {e}")),
+            Err(e) => {
+                say(format_args!("ncchannel serve: cannot listen: {e}"));
+                return ExitCode::from(exit::USAGE);
+            }
         };
     say(format_args!(
         "listening on {} (soak {}, {nch} channel(s), cycle {} µs)",
@@ -93,7 +103,7 @@ pub fn run(
     }
     say(format_args!(""));
     let _ = report.print_human(&mut std::io::stdout());
-    if let Some(p) = &args.report {
+    if let Some(p) = &report_path {
         if let Err(e) = std::fs::write(p, report.to_json() + "\n") {
             say(format_args!(
                 "ncchannel serve: --report {}: {e}",

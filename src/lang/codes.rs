@@ -576,8 +576,11 @@ pub fn is_known_g(g: u32) -> bool {
 /// M17, M29, M30 have their meaning in the decoder; the others go to the PLC side as
 /// events. Above 65,535 and fractional numbers are 20157.
 pub fn is_known_m(m: u32) -> bool {
-    m <= super::dialect::MAX_M_H
+    m <= MAX_M_H
 }
+
+/// M and H functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)").
+pub const MAX_M_H: u32 = 65_535;
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -306,9 +306,6 @@ pub fn command_support(kw: &[u8]) -> Option<Support> {
         .map(|i| COMMAND_TABLE[i].1)
 }
 
-/// M and H functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)").
-pub const MAX_M_H: u32 = 65_535;
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -990,6 +990,28 @@ pub fn parse_expr(text: &str) -> Result<Expr, SyntaxError> {
     Ok(e)
 }
 
+/// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
+/// return when there is no bracket.
+pub(crate) fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
+    if !i.starts_with('[') {
+        return Ok((none, String::new()));
+    }
+    let mut depth = 0usize;
+    for (k, b) in i.bytes().enumerate() {
+        match b {
+            b'[' => depth += 1,
+            b']' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Ok((&i[k + 1..], i[1..k].trim().to_string()));
+                }
+            }
+            _ => {}
+        }
+    }
+    fail(i, SYNTAX, "`]` missing")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

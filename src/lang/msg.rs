@@ -13,8 +13,8 @@
 use super::block::{Command, Expr, Message};
 use super::codes::{MSG_ARG_COUNT, MSG_NO_VALUE, MSG_TOO_MANY_VALUES, MSG_UNKNOWN_FORMAT, SYNTAX};
 use super::eval::Val;
+use super::expr::verbatim_options;
 use super::expr::{fail, keyword, perr, ws, Ctx, PErr};
-use super::parse::verbatim_options;
 
 /// Most values (format elements) one message may carry: ncchannel's limit, which 20724
 /// reports as its limit value (the kernel's own limit is not published on the page).

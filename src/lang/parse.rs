@@ -20,7 +20,9 @@ use super::codes::{
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
-use super::expr::{fail, keyword, name_or, name_upper, perr, uint, ws, Ctx, PErr, PResult};
+use super::expr::{
+    fail, keyword, name_or, name_upper, perr, uint, verbatim_options, ws, Ctx, PErr, PResult,
+};
 use super::number::{scan_unsigned, TOO_LARGE};
 use super::range::word_value;
 use crate::vocab::flush::FlushKind;
@@ -1102,28 +1104,6 @@ fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
         };
         j = &body[end + 1..];
     }
-}
-
-/// An optional `[ … ]` kept verbatim (brackets may nest), trimmed. `none` is the input to
-/// return when there is no bracket.
-pub(super) fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, String> {
-    if !i.starts_with('[') {
-        return Ok((none, String::new()));
-    }
-    let mut depth = 0usize;
-    for (k, b) in i.bytes().enumerate() {
-        match b {
-            b'[' => depth += 1,
-            b']' => {
-                depth -= 1;
-                if depth == 0 {
-                    return Ok((&i[k + 1..], i[1..k].trim().to_string()));
-                }
-            }
-            _ => {}
-        }
-    }
-    fail(i, SYNTAX, "`]` missing")
 }
 
 /// `#CACHE LOAD [FILE=name]`, `#CACHE CLEAR [FILE=name]`, `#CACHE CLEAR ALL` (TF5200 File Caching;

@@ -36,8 +36,10 @@ pub struct ErrorRecord {
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
-use crate::machine::{HmiOp, Op, Reply, TraceOp};
+pub mod door;
+
 pub use crate::vocab::mode::{Mode, State};
+use door::{HmiOp, Op, Reply, TraceOp};
 
 /// Why a command was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -236,7 +238,7 @@ impl Channel {
             Op::WriteExternal(name, v) => Reply::Value(self.write_external(&name, v).then_some(v)),
             Op::ReadExternal(name) => Reply::Value(self.read_external(&name)),
             Op::Status => {
-                let mut s = crate::machine::status_of(self);
+                let mut s = door::status_of(self);
                 s.tick = tick.index;
                 s.period = tick.period;
                 Reply::Status(Box::new(s))
@@ -263,7 +265,7 @@ impl Channel {
             }),
             Op::ErrorRecord(i) => Reply::ErrorRecord {
                 total: self.stats().errors,
-                record: crate::machine::error_record(self, i),
+                record: door::error_record(self, i),
             },
             Op::Start(name) => Reply::Command(self.start(tick, &name)),
             Op::SearchAt(target) => {

@@ -1,0 +1,220 @@
+//! The one door into a channel: what a client asks ([`Op`]), what it hears back ([`Reply`]),
+//! and the snapshot it reads ([`Status`]). `Channel::apply` answers every `Op` in the tick that
+//! serves it; the machine routes requests to channels, the ADS object tables and the soak build
+//! `Op`s. Defined here, beside the channel, so the channel needs nothing of the machine above it.
+
+use std::time::Duration;
+
+use super::{
+    ActiveBlock, Channel, CommandError, ErrorRecord, ExecutedBlock, HmiCommands, Mode,
+    SearchCommand, State,
+};
+use crate::decoder::SearchTarget;
+use crate::source::stream::StreamWriteError;
+
+/// What a client asks of a channel.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Op {
+    /// Write NC lines into the stream interface.
+    WriteStream(Vec<u8>),
+    CommandMode(i32),
+    CommandState(i32),
+    /// Command parameter: the program name ACTIVE starts.
+    SetProgram(String),
+    Hold,
+    Resume,
+    Reset,
+    /// Feed override, percent.
+    SetOverride(f64),
+    WriteExternal(String, f64),
+    ReadExternal(String),
+    Status,
+    /// An HMI command object (`mc_command_*_w`) of the COM task.
+    Hmi(HmiOp),
+    /// The error with this index (0 = the first the channel raised) and the total count.
+    ErrorRecord(u64),
+    /// Start this main program at once (`run`, `serve --start`, the soak's restarts): the
+    /// command parameter and ACTIVE in one step, refused as ACTIVE would be.
+    Start(String),
+    /// Block search target for the next start (`run --search`); `None` forgets it.
+    SearchAt(Option<SearchTarget>),
+    /// The decoder's block-skip mask as a whole, bit n = `/n` (`run --skip-mask`, which
+    /// reaches levels the HMI's ten-level `SkipLevels` does not).
+    SkipMask(u16),
+    /// Record every executed stream block for [`Op::DrainExecuted`] (the soak's checks).
+    ObserveStreamBlocks(bool),
+    /// The stream blocks executed since the last drain, in execution order
+    /// ([`Reply::Executed`]).
+    DrainExecuted,
+    /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
+    Trace(TraceOp),
+}
+
+/// What `run` asks of the motion trace.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TraceOp {
+    /// Keep up to this many samples for the plot.
+    Plot { max_samples: usize },
+    /// Write every `every`-th tick's sample into this CSV file (created now).
+    Csv {
+        path: std::path::PathBuf,
+        every: u64,
+    },
+    /// Flush and close the CSV file.
+    FinishCsv,
+}
+
+/// The HMI command objects a client writes (see [`crate::channel::HmiCommands`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HmiOp {
+    SingleBlock(bool),
+    /// The M01 switch.
+    OptionalStop(bool),
+    SkipLevels(u32),
+    ExecutionMode(i32),
+    Search(SearchCommand),
+    /// Forget the cycle-time statistics (`cnc_time_reset`).
+    ResetCycleTimes,
+}
+
+/// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
+/// kernel's `cnc_time_*` runtime statistics show their tasks' times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CycleTimes {
+    pub min: Duration,
+    pub max: Duration,
+    pub last: Duration,
+    pub total: Duration,
+    pub ticks: u64,
+}
+
+impl CycleTimes {
+    pub(crate) fn record(&mut self, work: Duration) {
+        self.min = if self.ticks == 0 {
+            work
+        } else {
+            self.min.min(work)
+        };
+        self.max = self.max.max(work);
+        self.last = work;
+        self.total = self.total.saturating_add(work);
+        self.ticks += 1;
+    }
+    /// Mean work time, zero before the first tick.
+    pub fn mean(&self) -> Duration {
+        match u32::try_from(self.ticks) {
+            Ok(0) => Duration::ZERO,
+            Ok(n) => self.total / n,
+            Err(_) => Duration::from_secs_f64(self.total.as_secs_f64() / self.ticks as f64),
+        }
+    }
+}
+
+/// A snapshot of what a client may read of a channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Status {
+    pub mode: Mode,
+    pub state: State,
+    pub block_counter: u64,
+    /// Stream fill: bytes used, bytes free.
+    pub stream_used: usize,
+    pub stream_free: usize,
+    /// Configured axes with their positions (mm / degrees).
+    pub positions: Vec<(char, f64)>,
+    pub last_error: Option<(u32, String)>,
+    pub override_pct: f64,
+    pub blocks: u64,
+    /// Tick that served the request, and the cycle time.
+    pub tick: u64,
+    pub period: Duration,
+    pub cycle_times: CycleTimes,
+    /// The main program running, if any.
+    pub program: Option<String>,
+    pub active_block: Option<ActiveBlock>,
+    /// Modal programmed feed as decoded, mm/min (0 = none yet).
+    pub feed_mm_per_min: f64,
+    /// Path velocity, mm/s.
+    pub velocity_mm_per_s: f64,
+    pub hmi: HmiCommands,
+    /// A block search is running (the decoder skips towards its target).
+    pub searching: bool,
+    /// Blocks handed to the interpolator and not yet done.
+    pub ipo_blocks: usize,
+    /// Errors raised since the channel was built.
+    pub errors_total: u64,
+    /// Positions in the programming coordinate system (mm / degrees), as `positions`.
+    pub pcs_positions: Vec<(char, f64)>,
+    /// The latest operator message of `#MSG` (empty after a reset).
+    pub message: Option<String>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reply {
+    Done,
+    Stream(Result<(), StreamWriteError>),
+    Command(Result<(), CommandError>),
+    Value(Option<f64>),
+    Status(Box<Status>),
+    /// The error asked for (if still kept) and how many the channel raised.
+    ErrorRecord {
+        total: u64,
+        record: Option<(u32, String)>,
+    },
+    /// No channel with that number.
+    NoChannel,
+    /// A stream write refused without touching the buffer: the channel is in ERROR, so
+    /// nothing will drain it before a reset (which deletes the buffer), or it has no streaming
+    /// program (`streaming_prog_file` unset), so nothing ever will. ADS 0x707, not 0x708:
+    /// retrying cannot succeed (docs/exactly-once.md).
+    StreamNotReady,
+    /// The executed stream blocks [`Op::DrainExecuted`] asked for.
+    Executed(Vec<ExecutedBlock>),
+    /// A trace file could not be written: the reason.
+    Trace(Result<(), String>),
+}
+
+/// An error as the ADS objects carry it: number and text.
+fn wire(e: &ErrorRecord) -> (u32, String) {
+    (e.code, e.msg.clone())
+}
+
+/// The `index`-th error of the channel (0 = first): kept in the channel's error list, or the
+/// last error when it is the newest one.
+pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
+    let i = usize::try_from(index).ok()?;
+    if let Some(e) = c.errors().get(i) {
+        return Some(wire(e));
+    }
+    if index + 1 == c.stats().errors {
+        return c.last_error().map(wire);
+    }
+    None
+}
+
+pub fn status_of(c: &Channel) -> Status {
+    let (used, free) = c.stream_fill();
+    Status {
+        mode: c.mode(),
+        state: c.state(),
+        block_counter: c.block_counter(),
+        stream_used: used,
+        stream_free: free,
+        positions: c.axis_positions(),
+        last_error: c.last_error().map(wire),
+        override_pct: c.motion().override_pct(),
+        blocks: c.stats().blocks,
+        tick: 0,
+        period: Duration::ZERO,
+        cycle_times: CycleTimes::default(),
+        program: c.running_program().map(String::from),
+        active_block: c.active_block().cloned(),
+        feed_mm_per_min: c.decoder().modal().feed_mm_per_min,
+        velocity_mm_per_s: c.motion().velocity_mm_per_s(),
+        hmi: c.hmi(),
+        searching: c.decoder().searching(),
+        ipo_blocks: c.ipo_blocks(),
+        errors_total: c.stats().errors,
+        pcs_positions: c.pcs_positions(),
+        message: c.message().map(str::to_string),
+    }
+}
