@@ -15,8 +15,10 @@ use super::parse::gap;
 /// a `\` inside a comment (`X10 ; note \`) continues nothing.
 pub fn continuation(line: &str) -> Option<usize> {
     let b = line.as_bytes();
-    // Most lines have no backslash at all: one vectorised search answers for them.
-    memchr::memchr(b'\\', b)?;
+    // Most lines have no backslash at all: one word-at-a-time search answers for them.
+    if !super::bytes::has_byte(b, b'\\') {
+        return None;
+    }
     let mut last: Option<usize> = None;
     let mut depth = 0usize;
     let mut quoted = false;

@@ -6,6 +6,7 @@
 //! [`parse_var_declaration`] for lines inside them.
 
 pub mod block;
+mod bytes;
 pub mod check;
 pub mod codes;
 pub mod dialect;
