@@ -410,14 +410,14 @@ impl Channel {
     }
     /// Record every executed stream block for [`Channel::drain_executed`]. Whoever turns this
     /// on drains every tick: the record grows by the blocks of one tick only.
-    pub fn observe_stream_blocks(&mut self, on: bool) {
+    fn observe_stream_blocks(&mut self, on: bool) {
         self.observe = on;
         if !on {
             self.executed.clear();
         }
     }
     /// The stream blocks executed since the last call, in execution order.
-    pub fn drain_executed(&mut self) -> std::vec::Drain<'_, ExecutedBlock> {
+    fn drain_executed(&mut self) -> std::vec::Drain<'_, ExecutedBlock> {
         self.executed.drain(..)
     }
     /// The position of each configured axis, in `AXIS_LETTERS` order.
@@ -531,7 +531,7 @@ impl Channel {
     }
 
     /// A client writes NC lines into the stream interface (`mc_program_stream_w`).
-    pub fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
+    fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
         let r = self.stream.write(packet);
         let code = r.as_ref().err().and_then(|e| e.isg_code());
         self.emit(
@@ -570,7 +570,7 @@ impl Channel {
     }
 
     /// Command to mode (0x104).
-    pub fn command_mode(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
+    fn command_mode(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
         let mode = Mode::from_i32(v).ok_or(CommandError::InvalidValue(v))?;
         if matches!(self.state, State::Active | State::Hold) {
             return Err(self.busy());
@@ -590,7 +590,7 @@ impl Channel {
     }
 
     /// Command parameter (0x108): the program to start.
-    pub fn set_program(&mut self, name: &str) {
+    fn set_program(&mut self, name: &str) {
         let name = name.trim_matches(char::from(0)).trim();
         self.program = (!name.is_empty()).then(|| name.to_string());
     }
@@ -600,12 +600,12 @@ impl Channel {
     }
 
     /// Block search target for the next start (`--search`).
-    pub fn set_search(&mut self, target: Option<SearchTarget>) {
+    fn set_search(&mut self, target: Option<SearchTarget>) {
         self.search = target;
     }
 
     /// Command to state (0x105): ACTIVE starts (or resumes), HOLD holds, READY resets.
-    pub fn command_state(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
+    fn command_state(&mut self, tick: &Tick, v: i32) -> Result<(), CommandError> {
         let state = State::from_i32(v).ok_or(CommandError::InvalidValue(v))?;
         match state {
             State::Active => match self.state {
@@ -633,7 +633,7 @@ impl Channel {
     }
 
     /// Start a main program in automatic mode.
-    pub fn start(&mut self, tick: &Tick, name: &str) -> Result<(), CommandError> {
+    fn start(&mut self, tick: &Tick, name: &str) -> Result<(), CommandError> {
         if !matches!(self.state, State::Ready | State::Selected) {
             return Err(self.busy());
         }
@@ -664,7 +664,7 @@ impl Channel {
     }
 
     /// Feed hold (0x136).
-    pub fn hold(&mut self, tick: &Tick) {
+    fn hold(&mut self, tick: &Tick) {
         if self.state == State::Active {
             self.motion.set_hold(true);
             self.set_state(tick, State::Hold);
@@ -672,7 +672,7 @@ impl Channel {
     }
 
     /// Resume after hold (0x137).
-    pub fn resume(&mut self, tick: &Tick) {
+    fn resume(&mut self, tick: &Tick) {
         if self.state == State::Hold {
             self.single_credit = true;
             self.motion.set_hold(false);
@@ -681,7 +681,7 @@ impl Channel {
     }
 
     /// Feed override, percent 0..=200.
-    pub fn set_override(&mut self, pct: f64) -> Result<(), CommandError> {
+    fn set_override(&mut self, pct: f64) -> Result<(), CommandError> {
         if !(0.0..=200.0).contains(&pct) {
             return Err(CommandError::BadOverride(pct));
         }
@@ -690,11 +690,11 @@ impl Channel {
     }
 
     /// V.E. variable written from outside.
-    pub fn write_external(&mut self, name: &str, v: f64) -> bool {
+    fn write_external(&mut self, name: &str, v: f64) -> bool {
         self.decoder.vars_mut().set_external(name, v).is_ok()
     }
 
-    pub fn read_external(&self, name: &str) -> Option<f64> {
+    fn read_external(&self, name: &str) -> Option<f64> {
         self.decoder.vars().get_external(name)
     }
 
@@ -715,25 +715,25 @@ impl Channel {
         self.motion.released_blocks() + self.motion.held_blocks() + self.single_gate.len()
     }
     /// `mc_command_M01_stop_enable_w`: M01 holds the channel while on.
-    pub fn set_optional_stop(&mut self, on: bool) {
+    fn set_optional_stop(&mut self, on: bool) {
         self.hmi.optional_stop = on;
         self.motion.set_optional_stop(on);
     }
 
     /// `mc_command_single_block_w`: stop after each block until the next start.
-    pub fn set_single_block(&mut self, on: bool) {
+    fn set_single_block(&mut self, on: bool) {
         self.hmi.single_block = on;
     }
     /// `mc_command_block_ignore_w`: skip levels 1–10 as a mask (level n = bit n−1); the
     /// decoder skips `/n` blocks of a set level from the next line it reads.
-    pub fn set_skip_levels(&mut self, mask: u32) {
+    fn set_skip_levels(&mut self, mask: u32) {
         let mask = mask & 0x3FF;
         self.hmi.skip_levels = mask;
         self.decoder.set_skip_mask((mask << 1) as u16);
     }
     /// `mc_command_execution_mode_w`: 0 standard, 1 block search at the next start; other
     /// modes (contour visualisation, syntax check, machine lock …) are not modelled.
-    pub fn set_execution_mode(&mut self, mode: i32) -> Result<(), CommandError> {
+    fn set_execution_mode(&mut self, mode: i32) -> Result<(), CommandError> {
         if mode & !EXECUTION_MODE_BLOCK_SEARCH != 0 {
             return Err(CommandError::InvalidValue(mode));
         }
@@ -741,7 +741,7 @@ impl Channel {
         Ok(())
     }
     /// Block-search parameters for the next start in block-search execution mode.
-    pub fn set_search_command(&mut self, search: SearchCommand) {
+    fn set_search_command(&mut self, search: SearchCommand) {
         self.hmi.search = search;
     }
 
@@ -805,7 +805,7 @@ impl Channel {
 
     /// NC reset (0x13C): stream buffer emptied and streaming left, program stack, queue,
     /// cache and errors cleared, motion stopped at once; READY.
-    pub fn reset(&mut self, tick: &Tick) {
+    fn reset(&mut self, tick: &Tick) {
         let dropped = self.stream.clear();
         if dropped > 0 {
             self.emit(

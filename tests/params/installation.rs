@@ -457,7 +457,10 @@ fn an_axis_named_x1_in_the_channel_list_is_programmed_as_x1_equals() {
         "N10 G01 X1=20 Y5 F6000\nN20 Z_ACHSE = 2 * 3\nN30 M30\n",
     );
     let mut c = i.channel();
-    c.start(&tick(0), "named.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("named.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let ev = run(&mut c, &[], 20_000);
     end_tick(&ev);
     let named: Vec<(String, f64)> = c
@@ -476,7 +479,10 @@ fn an_axis_named_x1_in_the_channel_list_is_programmed_as_x1_equals() {
     // X alone is no axis of this channel.
     i.write("prg/bare.nc", "N10 G01 X20 F6000\nN20 M30\n");
     let mut c = i.channel();
-    c.start(&tick(0), "bare.nc").unwrap();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("bare.nc".into())),
+        Reply::Command(Ok(()))
+    );
     let ev = run(&mut c, &[], 20_000);
     assert!(
         ev.iter()
