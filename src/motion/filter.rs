@@ -196,10 +196,6 @@ impl AxisFilter {
         self.jerk.push(c)
     }
 
-    pub fn output(&self) -> Position {
-        self.jerk.out
-    }
-
     /// The output equals the last input: the axes stand where the interpolator stands.
     pub fn settled(&self) -> bool {
         self.corner.settled() && self.jerk.settled()

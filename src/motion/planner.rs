@@ -399,11 +399,6 @@ impl Planner {
     pub fn entries(&self) -> impl Iterator<Item = &Entry> {
         self.window.iter()
     }
-    /// The next entry after the front, if released.
-    pub fn released_after_front(&self) -> Option<&Entry> {
-        (self.released > 1).then(|| &self.window[1])
-    }
-
     /// The front entry is a straight move that ends a run: after it, among the released
     /// entries, the next one that is not a plain block or `#FLUSH CONTINUE` stops the motion
     /// (dwell, `#FLUSH`, `#FLUSH WAIT`, program end). No later release can join it then.

@@ -82,14 +82,6 @@ impl Spline {
         self.pts.back().copied().unwrap_or([0.0; MAX_AXES])
     }
 
-    /// Points received whose curve is not handed out yet.
-    pub fn pending(&self) -> usize {
-        match self.kind {
-            SplineKind::BSpline => 0,
-            SplineKind::Akima => self.received - self.next_segment.min(self.received),
-        }
-    }
-
     /// Point `p` (feed `feed_mm_per_min`) arrives: the segments it completes.
     pub fn push(&mut self, p: Position, feed_mm_per_min: f64, out: &mut Vec<Segment>) {
         self.received += 1;
