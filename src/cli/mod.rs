@@ -23,17 +23,17 @@ pub mod exit {
     /// The program ended normally (or the check found nothing).
     pub const OK: u8 = 0;
     /// A channel error (or a check found errors).
-    pub const CHANNEL_ERROR: u8 = 1;
+    pub(crate) const CHANNEL_ERROR: u8 = 1;
     /// Bad usage or bad parameter lists.
-    pub const USAGE: u8 = 2;
+    pub(crate) const USAGE: u8 = 2;
     /// `--max-ticks` reached before the program ended.
     pub const MAX_TICKS: u8 = 3;
     /// SIGINT or SIGTERM stopped `run --realtime` or `soak --realtime` before the end (the
     /// log, report and summary are complete up to the stop).
-    pub const STOPPED: u8 = 4;
+    pub(crate) const STOPPED: u8 = 4;
     /// A second SIGINT/SIGTERM during the orderly stop: exit at once, as a shell reports a
     /// process killed by SIGINT (128 + 2).
-    pub const SECOND_SIGNAL: u8 = 130;
+    pub(crate) const SECOND_SIGNAL: u8 = 130;
 }
 
 #[derive(Debug, Parser)]

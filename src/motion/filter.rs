@@ -186,7 +186,7 @@ impl AxisFilter {
     }
 
     /// Both windows, s: the lag of a stop and the time the output takes to settle.
-    pub(crate) fn total_window_s(&self) -> f64 {
+    pub fn total_window_s(&self) -> f64 {
         (self.corner.len() + self.jerk.len()) as f64 * self.dt_s
     }
 
