@@ -6,17 +6,17 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub mod bench;
+pub(crate) mod bench;
 pub mod check;
 mod logger;
-pub mod out;
-pub mod receive;
-pub mod run;
-pub mod serve;
-pub mod serve_soak;
-pub mod signal;
-pub mod soak;
-pub mod stream;
+pub(crate) mod out;
+pub(crate) mod receive;
+pub(crate) mod run;
+pub(crate) mod serve;
+pub(crate) mod serve_soak;
+pub(crate) mod signal;
+pub(crate) mod soak;
+pub(crate) mod stream;
 
 /// Exit codes of the command-line contract (README "Two commands").
 pub mod exit {
