@@ -9,18 +9,26 @@
 //! The public surface is what the `ncchannel` binary, the tests, the benches and the fuzz
 //! targets drive; everything else is internal to the crate.
 //!
-//! - [`channel`]: one CNC channel and its door: a request ([`channel::Op`]) goes in, a
-//!   [`channel::Reply`] comes out, [`channel::Status`] is the snapshot a PLC reads.
-//! - [`machine`]: the channels of one installation behind the ADS index groups.
-//! - [`ads`]: the ADS/AMS wire codec, the server that serves a machine, and a client.
-//! - [`runtime`]: the cyclic task that ticks channels on the wall clock.
-//! - [`lang`]: the NC language: the line parser and the program check.
-//! - [`params`]: the start-up and channel parameter lists, read and checked;
-//!   [`channels`] turns a checked list into channels.
-//! - [`report`]: the events of a run and their written form.
-//! - [`soak`] and [`dnc`]: long generated runs, and DNC programs split into streams.
-//! - [`cli`]: the command line of the binary.
-//! - [`vocab`]: the shared words (axes, units, limits) every room uses.
+//! - [`channel`]: one NC channel, the ISG mode and state machine around the parts it owns.
+//!   Its door is the only way in: a request ([`channel::door::Op`]) goes in, a
+//!   [`channel::door::Reply`] comes out, [`channel::door::Status`] is what a PLC reads.
+//! - [`machine`]: the emulated controller as the runtime ticks it: its channels, the built-in
+//!   stream feeders, and the requests other threads send it (it re-exports the door's words).
+//! - [`runtime`]: the fixed-cycle loop that ticks a machine in real or virtual time and keeps
+//!   cycle statistics.
+//! - [`ads`]: ADS over TCP: the AMS/TCP codec, the CNC's ADS tasks, the [`ads::server`] that
+//!   serves them, a [`ads::client`], and the index groups in [`ads::objects`].
+//! - [`lang`]: the NC language: one line to a block ([`lang::parse`]), expressions, and the
+//!   static program check ([`lang::check`]).
+//! - [`params`]: the ISG parameter lists (start-up, channel, axes, tools) and runtime.toml,
+//!   read and checked into a [`params::Config`]; [`channels`] turns one into channels.
+//! - [`report`]: what a run tells the outside: the JSON Lines event log, the summary, plots.
+//! - [`soak`]: scenario-driven long runs with a randomised client, injected faults and
+//!   invariants.
+//! - [`dnc`]: NC data received as one stream and split into programs by start/end markers.
+//! - [`cli`]: the subcommands of the `ncchannel` binary; `main.rs` only parses and dispatches.
+//! - [`vocab`]: the words every room shares: time, modes and states, axes, `#FLUSH`, cache
+//!   operations, ADS ids, cycle statistics.
 //!
 //! A few parts of internal rooms are re-exported at the root for tests and benches that
 //! drive them without a channel around them: the program [`Feeder`] and [`StreamBuffer`],
