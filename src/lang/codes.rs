@@ -20,13 +20,13 @@ pub const WRITE_REJECTED: u32 = 11012;
 /// diagnosis ID 20008 "Feed rate in motion block is 0.").
 pub const NO_FEED: u32 = 20008;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
-pub(crate) const ARC_CENTER_RANGE: u32 = 20020;
+pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
 /// centre undetermined (TF5200 diagnosis ID 20034).
-pub(crate) const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
+pub const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
 /// The centre computed from R lies outside the data format (TF5200 diagnosis ID 20054, whose
 /// example is `G02 X1 R1000000`).
-pub(crate) const ARC_RADIUS_RANGE: u32 = 20054;
+pub const ARC_RADIUS_RANGE: u32 = 20054;
 /// Unknown G function (TF5200 diagnosis ID 20131).
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function (TF5200 diagnosis ID 20157).
@@ -45,69 +45,69 @@ pub const SYNTAX: u32 = 20200;
 pub const AXIS_TWICE: u32 = 20203;
 /// A `$` statement with other words in its block (TF5200 diagnosis ID 20206 "$ command must
 /// be programmed exclusively in NC block.").
-pub(crate) const CONTROL_NOT_ALONE: u32 = 20206;
+pub const CONTROL_NOT_ALONE: u32 = 20206;
 /// A `#` command with other words before it in its block (TF5200 diagnosis ID 20207 "#
 /// command must be programmed exclusively in NC block.").
-pub(crate) const COMMAND_NOT_ALONE: u32 = 20207;
+pub const COMMAND_NOT_ALONE: u32 = 20207;
 /// Unknown `#` command or `$` statement (TF5200 diagnosis ID 20209; page not yet read, see
 /// [`KERNEL_UNREAD`]).
 pub const UNKNOWN_COMMAND: u32 = 20209;
 /// `$ELSE` without its `$IF` (TF5200 diagnosis ID 20214).
-pub(crate) const UNEXPECTED_ELSE: u32 = 20214;
+pub const UNEXPECTED_ELSE: u32 = 20214;
 /// `$ELSEIF` without its `$IF` (TF5200 diagnosis ID 20216).
-pub(crate) const UNEXPECTED_ELSEIF: u32 = 20216;
+pub const UNEXPECTED_ELSEIF: u32 = 20216;
 /// `$ENDIF` without its `$IF` (TF5200 diagnosis ID 20218).
-pub(crate) const UNEXPECTED_ENDIF: u32 = 20218;
+pub const UNEXPECTED_ENDIF: u32 = 20218;
 /// `$CASE` outside `$SWITCH` (TF5200 diagnosis ID 20221).
-pub(crate) const UNEXPECTED_CASE: u32 = 20221;
+pub const UNEXPECTED_CASE: u32 = 20221;
 /// `$DEFAULT` outside `$SWITCH` (TF5200 diagnosis ID 20223).
-pub(crate) const UNEXPECTED_DEFAULT: u32 = 20223;
+pub const UNEXPECTED_DEFAULT: u32 = 20223;
 /// `$ENDSWITCH` without its `$SWITCH` (TF5200 diagnosis ID 20225).
-pub(crate) const UNEXPECTED_ENDSWITCH: u32 = 20225;
+pub const UNEXPECTED_ENDSWITCH: u32 = 20225;
 /// `$ENDFOR` without its `$FOR` (TF5200 diagnosis ID 20232).
-pub(crate) const UNEXPECTED_ENDFOR: u32 = 20232;
+pub const UNEXPECTED_ENDFOR: u32 = 20232;
 /// `$ENDWHILE` without its `$WHILE` (TF5200 diagnosis ID 20237).
-pub(crate) const UNEXPECTED_ENDWHILE: u32 = 20237;
+pub const UNEXPECTED_ENDWHILE: u32 = 20237;
 /// `$ENDDO` without its `$DO` (TF5200 diagnosis ID 20240; page not yet read, see
 /// [`KERNEL_UNREAD`]).
-pub(crate) const UNEXPECTED_ENDDO: u32 = 20240;
+pub const UNEXPECTED_ENDDO: u32 = 20240;
 /// `$BREAK` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20243).
-pub(crate) const UNEXPECTED_BREAK: u32 = 20243;
+pub const UNEXPECTED_BREAK: u32 = 20243;
 /// `$CONTINUE` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20244).
-pub(crate) const UNEXPECTED_CONTINUE: u32 = 20244;
+pub const UNEXPECTED_CONTINUE: u32 = 20244;
 /// `$UNTIL` without its `$REPEAT` (TF5200 diagnosis ID 21469; page not yet read, see
 /// [`KERNEL_UNREAD`]).
-pub(crate) const UNEXPECTED_UNTIL: u32 = 21469;
+pub const UNEXPECTED_UNTIL: u32 = 21469;
 /// Subroutine calls nested deeper than `decoder.max_subroutine_depth` (TF5200 diagnosis ID
 /// 20360 "Stack overflow for global sub-routines."; ncchannel counts local calls too).
-pub(crate) const NESTING_TOO_DEEP: u32 = 20360;
+pub const NESTING_TOO_DEEP: u32 = 20360;
 /// Main program not found (TF5200 diagnosis ID 20368).
-pub(crate) const MAIN_NOT_FOUND: u32 = 20368;
+pub const MAIN_NOT_FOUND: u32 = 20368;
 /// Global subroutine not found (TF5200 diagnosis ID 20369).
-pub(crate) const SUBROUTINE_NOT_FOUND: u32 = 20369;
+pub const SUBROUTINE_NOT_FOUND: u32 = 20369;
 /// Local subroutine not found (TF5200 diagnosis ID 20373).
-pub(crate) const LOCAL_SUB_NOT_FOUND: u32 = 20373;
+pub const LOCAL_SUB_NOT_FOUND: u32 = 20373;
 /// Control blocks still open at program end (TF5200 diagnosis ID 20375).
-pub(crate) const OPEN_CONTROL_BLOCK: u32 = 20375;
+pub const OPEN_CONTROL_BLOCK: u32 = 20375;
 /// M17/M29 where no subroutine runs (TF5200 diagnosis ID 20376).
-pub(crate) const UNEXPECTED_SUB_END: u32 = 20376;
+pub const UNEXPECTED_SUB_END: u32 = 20376;
 /// M30/M02 inside a subroutine, a warning: the program ends (TF5200 diagnosis ID 20377).
-pub(crate) const UNEXPECTED_PROGRAM_END: u32 = 20377;
+pub const UNEXPECTED_PROGRAM_END: u32 = 20377;
 /// Expression: division by zero, also `MOD 0` (TF5200 diagnosis ID 20396 "Division by 0.").
-pub(crate) const EVAL_DIVISION_BY_ZERO: u32 = 20396;
+pub const EVAL_DIVISION_BY_ZERO: u32 = 20396;
 /// Expression: LN/LOG of a number <= 0 (TF5200 diagnosis ID 20399 "Logarithm less
 /// than/equal 0.").
-pub(crate) const EVAL_LOG_NON_POSITIVE: u32 = 20399;
+pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
 /// Block search: M30/M02 or the end of the file reached before the continuation position
 /// (the search target) was found. The TF5200 block search manual ("Exceptions and errors",
 /// tf5200_blocksearch/348601995) names P-ERR-20704 for a continuation position not found;
 /// its TwinCAT 2 edition quotes the message, "program end reached without restart mark
 /// found". The diagnosis page of ID 20704 itself was not in the index searched.
-pub(crate) const SEARCH_NOT_FOUND: u32 = 20704;
+pub const SEARCH_NOT_FOUND: u32 = 20704;
 /// `#FLUSH` while tool radius compensation G41/G42 is active (TF5200 diagnosis ID 20651 "NC
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
-pub(crate) const FLUSH_UNDER_TRC: u32 = 20651;
+pub const FLUSH_UNDER_TRC: u32 = 20651;
 /// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
 /// ID 20721 "Number of parameters and the number of format specifiers do not match.").
 pub const MSG_ARG_COUNT: u32 = 20721;
@@ -121,102 +121,102 @@ pub const MSG_NO_VALUE: u32 = 20726;
 /// "Unbekannter Formatstring.", unknown format string).
 pub const MSG_UNKNOWN_FORMAT: u32 = 21232;
 /// `#TIME` with a dwell time out of range (negative): TF5200 diagnosis ID 20751.
-pub(crate) const DWELL_RANGE_TIME: u32 = 20751;
+pub const DWELL_RANGE_TIME: u32 = 20751;
 /// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
-pub(crate) const DWELL_RANGE_G04: u32 = 20752;
+pub const DWELL_RANGE_G04: u32 = 20752;
 /// Label defined twice in one program level (TF5200 diagnosis ID 20836 "Multiple defined
 /// label").
-pub(crate) const LABEL_TWICE: u32 = 20836;
+pub const LABEL_TWICE: u32 = 20836;
 /// `$GOTO` target not found (TF5200 diagnosis ID 20840).
-pub(crate) const LABEL_NOT_FOUND: u32 = 20840;
+pub const LABEL_NOT_FOUND: u32 = 20840;
 /// Memory for variables of one class (V.P., V.L., V.S., V.E.; ours adds P) used up: a
 /// declaration or a new variable does not fit (TF5200 diagnosis ID 20967).
-pub(crate) const VARIABLE_MEMORY_FULL: u32 = 20967;
+pub const VARIABLE_MEMORY_FULL: u32 = 20967;
 /// An array with more indices than variables have (TF5200 diagnosis ID 20974).
-pub(crate) const TOO_MANY_INDICES: u32 = 20974;
+pub const TOO_MANY_INDICES: u32 = 20974;
 /// Streaming data without a correct CR LF line end (TF5200 diagnosis ID 21476).
 pub const NO_LINE_END: u32 = 21476;
 /// Backward jump in a streaming program (TF5200 diagnosis ID 21477).
-pub(crate) const STREAM_BACKWARD_JUMP: u32 = 21477;
+pub const STREAM_BACKWARD_JUMP: u32 = 21477;
 /// Loop statement in a streaming program (TF5200 diagnosis ID 21478).
-pub(crate) const STREAM_LOOP: u32 = 21478;
+pub const STREAM_LOOP: u32 = 21478;
 /// Local subroutine call (LL) in a streaming program (TF5200 diagnosis ID 21479).
-pub(crate) const STREAM_LOCAL_CALL: u32 = 21479;
+pub const STREAM_LOCAL_CALL: u32 = 21479;
 /// Invalid `#CACHE` programming (TF5200 diagnosis ID 21560).
-pub(crate) const CACHE_SYNTAX: u32 = 21560;
+pub const CACHE_SYNTAX: u32 = 21560;
 /// Double programming inside one `#CACHE` command (TF5200 diagnosis ID 21561).
-pub(crate) const CACHE_DOUBLE: u32 = 21561;
+pub const CACHE_DOUBLE: u32 = 21561;
 /// File cache full (TF5200 diagnosis ID 21562).
-pub(crate) const CACHE_FULL: u32 = 21562;
+pub const CACHE_FULL: u32 = 21562;
 /// File for the cache not found, or unreadable (TF5200 diagnosis ID 21563).
-pub(crate) const CACHE_FILE_NOT_FOUND: u32 = 21563;
+pub const CACHE_FILE_NOT_FOUND: u32 = 21563;
 /// File larger than `max_cache_size` (TF5200 diagnosis ID 21564).
-pub(crate) const CACHE_FILE_TOO_LARGE: u32 = 21564;
+pub const CACHE_FILE_TOO_LARGE: u32 = 21564;
 /// An axis end point (or an arc's extent) outside the axis's software limits: the block is
 /// refused before it moves (TF5200 diagnosis ID 21897 "Axis position is out of permissible
 /// value range", with the axis, the value and both limits).
-pub(crate) const SOFT_LIMIT: u32 = 21897;
+pub const SOFT_LIMIT: u32 = 21897;
 /// An array index outside the declared array (TF5200 diagnosis ID 21928).
-pub(crate) const ARRAY_INDEX_RANGE: u32 = 21928;
+pub const ARRAY_INDEX_RANGE: u32 = 21928;
 /// An operator other than `+` (concatenation), `==` and `!=` with a string operand, or one
 /// of those with a string and a number (TF5200 diagnosis ID 21458 "Operator für
 /// Zeichenketten nicht erlaubt.": "only the + operator to join two strings or the
 /// comparison operators == and != are allowed").
-pub(crate) const STRING_OPERATOR: u32 = 21458;
+pub const STRING_OPERATOR: u32 = 21458;
 /// A string assigned to a `STRING[n]` variable is longer than n (TF5200 diagnosis ID 21462
 /// "String for variable too long.", with the length and the maximum).
-pub(crate) const STRING_TOO_LONG_FOR_VARIABLE: u32 = 21462;
+pub const STRING_TOO_LONG_FOR_VARIABLE: u32 = 21462;
 /// A string function's position (or count) outside the string (TF5200 diagnosis ID 21545
 /// "Invalid position in character string for string operation.", whose example is
 /// `DELETE["Hello world!", 7, 100]`).
-pub(crate) const STRING_POSITION: u32 = 21545;
+pub const STRING_POSITION: u32 = 21545;
 /// A string value (a literal, or the result of `+`) longer than the 126 characters a
 /// `STRING[n]` may hold (TF5200 diagnosis ID 21870 "String exceeds the maximum length.").
-pub(crate) const STRING_TOO_LONG: u32 = 21870;
+pub const STRING_TOO_LONG: u32 = 21870;
 /// `#FLUSH` while a spline (G151) is active (TF5200 diagnosis ID 120102 "Flushing buffers not
 /// allowed while spline interpolation is active.").
-pub(crate) const FLUSH_UNDER_SPLINE: u32 = 120102;
+pub const FLUSH_UNDER_SPLINE: u32 = 120102;
 /// `#FLUSH` while `#HSC` is on (TF5200 diagnosis ID 120434, for HSC in its spline mode 2;
 /// ncchannel does not tell the HSC modes apart).
-pub(crate) const FLUSH_UNDER_HSC: u32 = 120434;
+pub const FLUSH_UNDER_HSC: u32 = 120434;
 
 // ---- Error ids: ours, 900000–999999 (no kernel id with this meaning read) ----------------
 
 /// Expression: square root of a negative number. (The kernel's 20398 may mean this; its page
 /// was not in the index searched, so the id stays ours until it is read.)
-pub(crate) const EVAL_SQRT_NEGATIVE: u32 = 900002;
+pub const EVAL_SQRT_NEGATIVE: u32 = 900002;
 /// Expression: ASIN/ACOS outside -1..1.
-pub(crate) const EVAL_OUT_OF_DOMAIN: u32 = 900003;
+pub const EVAL_OUT_OF_DOMAIN: u32 = 900003;
 /// Expression: undefined variable or parameter. (Candidates to read: the kernel's 20196; its
 /// 20925 "Unknown parameter." covers P parameters only.)
-pub(crate) const EVAL_UNDEFINED: u32 = 900005;
+pub const EVAL_UNDEFINED: u32 = 900005;
 /// Expression: invalid index (P[0.5], P[-1]).
-pub(crate) const EVAL_BAD_INDEX: u32 = 900006;
+pub const EVAL_BAD_INDEX: u32 = 900006;
 /// Expression: result not finite (`EXP[1000]`, `TAN[90]`).
-pub(crate) const EVAL_NOT_FINITE: u32 = 900007;
+pub const EVAL_NOT_FINITE: u32 = 900007;
 /// Expression: a string (a `STRING[n]` variable, a cycle parameter `@P1="text"`, a literal,
 /// a string function's result) used as a number, or stored into a numeric variable.
 pub const EVAL_STRING_AS_NUMBER: u32 = 900008;
 /// Expression: a number where a string is needed — the text argument of a string function
 /// (`LEN[5]`), or a value assigned to a `STRING[n]` variable.
-pub(crate) const EVAL_NUMBER_AS_STRING: u32 = 900009;
+pub const EVAL_NUMBER_AS_STRING: u32 = 900009;
 /// The streaming program is already running (called a second time).
-pub(crate) const STREAM_ALREADY_ACTIVE: u32 = 900102;
+pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
 /// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
-pub(crate) const MAIN_END_MISSING: u32 = 900103;
+pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
-pub(crate) const SUB_END_MISSING: u32 = 900104;
+pub const SUB_END_MISSING: u32 = 900104;
 /// Program file larger than the store reads.
-pub(crate) const PROGRAM_TOO_LARGE: u32 = 900110;
+pub const PROGRAM_TOO_LARGE: u32 = 900110;
 /// Program file could not be read.
-pub(crate) const PROGRAM_UNREADABLE: u32 = 900111;
+pub const PROGRAM_UNREADABLE: u32 = 900111;
 /// Program name not allowed (absolute or leaving the search path).
-pub(crate) const PROGRAM_BAD_NAME: u32 = 900112;
+pub const PROGRAM_BAD_NAME: u32 = 900112;
 /// Circle end point, centre and radius do not agree.
-pub(crate) const ARC_INCONSISTENT: u32 = 900130;
+pub const ARC_INCONSISTENT: u32 = 900130;
 /// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
 /// whole number, …).
-pub(crate) const BAD_VALUE: u32 = 900132;
+pub const BAD_VALUE: u32 = 900132;
 /// A G function, `#` command, V.A./V.G. variable, `#FILENAME` file id or modal cycle call
 /// of the ISG dialect that ncchannel does not model: refused by name rather than given a
 /// wrong meaning (docs/nc-language.md lists them).
@@ -232,9 +232,9 @@ pub const WORD_TWICE: u32 = 900135;
 pub const MSG_TOO_LONG: u32 = 900136;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
 /// elements do not meet, no tool data for the D word, or compensation outside G17.
-pub(crate) const TRC_IMPOSSIBLE: u32 = 900140;
+pub const TRC_IMPOSSIBLE: u32 = 900140;
 /// `#CACHE` while the file cache is disabled.
-pub(crate) const CACHE_NOT_ENABLED: u32 = 900160;
+pub const CACHE_NOT_ENABLED: u32 = 900160;
 
 // ---- End of the error ids ----------------------------------------------------------------
 
