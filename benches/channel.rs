@@ -6,10 +6,10 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ncchannel::channel::Finish;
-use ncchannel::feeder::Feeder;
 use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
+use ncchannel::Feeder;
 
 const BLOCKS: usize = 1_000_000;
 
@@ -38,7 +38,7 @@ impl Setup {
     /// Run `program` (fed from `stream` if given) to its end; returns the tick work p99 in µs.
     fn run(&self, program: &str, stream: Option<&[u8]>) -> (f64, f64, u64) {
         let config = ncchannel::params::load(&self.dir.path().join("p/startup.lis")).unwrap();
-        let channels = ncchannel::setup::channels(&config, false).unwrap();
+        let channels = ncchannel::channels(&config, false).unwrap();
         let period = Duration::from_micros(config.runtime.cycle_period_us);
         let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
         if let Some(s) = stream {

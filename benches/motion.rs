@@ -14,11 +14,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{
+use ncchannel::vocab::axis::Position;
+use ncchannel::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, QueuedBlock, SplineKind,
 };
-use ncchannel::vocab::axis::Position;
+use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
 
 const DT: f64 = 0.001;
 const WINDOW: usize = 32;

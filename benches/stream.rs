@@ -5,10 +5,10 @@ use std::time::Duration;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 
-use ncchannel::feeder::Feeder;
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Cycle, Tick};
-use ncchannel::source::stream::StreamBuffer;
+use ncchannel::Feeder;
+use ncchannel::StreamBuffer;
 
 #[path = "../tests/support/streaming_load.rs"]
 mod streaming_load;

@@ -6,7 +6,7 @@ use std::path::Path;
 
 /// Why a bounded read failed.
 #[derive(Debug, thiserror::Error)]
-pub enum BoundedReadError {
+pub(crate) enum BoundedReadError {
     #[error(transparent)]
     Io(#[from] std::io::Error),
     #[error("{bytes} bytes, more than the limit of {limit} bytes")]
@@ -16,7 +16,7 @@ pub enum BoundedReadError {
 /// The file's bytes, or [`BoundedReadError::TooLarge`] when it holds more than `limit` bytes.
 /// The size is checked before reading (no allocation for a file that is too large) and again
 /// while reading (the file may grow in between: at most `limit + 1` bytes are ever read).
-pub fn read_file(path: &Path, limit: u64) -> Result<Vec<u8>, BoundedReadError> {
+pub(crate) fn read_file(path: &Path, limit: u64) -> Result<Vec<u8>, BoundedReadError> {
     let f = std::fs::File::open(path)?;
     let len = f.metadata()?.len();
     if len > limit {

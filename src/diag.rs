@@ -24,7 +24,7 @@ pub struct Diagnostic {
     pub code: Option<u32>,
     pub message: String,
     /// The offending line's text, for the caret display (without line end).
-    pub source_line: Option<String>,
+    pub(crate) source_line: Option<String>,
 }
 
 impl Diagnostic {
@@ -60,7 +60,7 @@ impl Diagnostic {
     }
 
     /// Attach the offending line so `render` can show it with a caret.
-    pub fn with_source(mut self, line_text: &str) -> Self {
+    pub(crate) fn with_source(mut self, line_text: &str) -> Self {
         self.source_line = Some(line_text.trim_end_matches(['\r', '\n']).to_string());
         self
     }

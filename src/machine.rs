@@ -27,7 +27,7 @@ pub struct Request {
     /// gave up and answers "not applied"). Whoever takes the claim first wins; the other side
     /// then knows, so a request is never both applied and answered as not applied
     /// (docs/exactly-once.md).
-    pub claim: Claim,
+    pub(crate) claim: Claim,
 }
 
 impl Request {

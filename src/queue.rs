@@ -122,18 +122,18 @@ pub struct ArcGeom {
     pub a: usize,
     pub b: usize,
     pub center: [f64; 2],
-    pub radius_mm: f64,
+    pub(crate) radius_mm: f64,
     /// +1 counter-clockwise (G3), −1 clockwise (G2).
     pub dir: f64,
     /// Swept angle, radians (> 0).
-    pub sweep_rad: f64,
+    pub(crate) sweep_rad: f64,
     /// Angle of the start point around the centre, radians.
-    pub start_rad: f64,
+    pub(crate) start_rad: f64,
 }
 
 impl ArcGeom {
     /// Angle at fraction `u` (0..=1) of the sweep, radians.
-    pub fn angle_at(&self, u: f64) -> f64 {
+    pub(crate) fn angle_at(&self, u: f64) -> f64 {
         self.start_rad + self.dir * self.sweep_rad * u
     }
 }
@@ -164,7 +164,7 @@ impl Move {
     }
 
     /// Path length in mm (axes' Euclidean length; arcs: helix length).
-    pub fn length_mm(&self) -> f64 {
+    pub(crate) fn length_mm(&self) -> f64 {
         match self.kind {
             MoveKind::Rapid | MoveKind::Line => {
                 let mut s = 0.0;
@@ -194,7 +194,7 @@ impl Move {
     }
 
     /// Position at fraction `u` (0..=1) of the path.
-    pub fn point_at(&self, u: f64) -> Position {
+    pub(crate) fn point_at(&self, u: f64) -> Position {
         let u = u.clamp(0.0, 1.0);
         let mut p = self.start;
         for (pi, (s, e)) in p.iter_mut().zip(self.start.iter().zip(&self.end)) {
@@ -277,10 +277,10 @@ impl BlockQueue {
     pub fn push(&mut self, b: QueuedBlock) {
         self.items.push_back(b);
     }
-    pub fn front(&self) -> Option<&QueuedBlock> {
+    pub(crate) fn front(&self) -> Option<&QueuedBlock> {
         self.items.front()
     }
-    pub fn pop_front(&mut self) -> Option<QueuedBlock> {
+    pub(crate) fn pop_front(&mut self) -> Option<QueuedBlock> {
         self.items.pop_front()
     }
     pub fn iter(&self) -> impl Iterator<Item = &QueuedBlock> {

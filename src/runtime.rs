@@ -22,7 +22,7 @@ pub const MAX_REQUESTS_PER_TICK: usize = 64;
 
 /// Real time: no request is started closer than this to a tick's deadline. A request costs a
 /// few microseconds; the margin keeps the tick's start on time.
-pub const SERVE_MARGIN: Duration = Duration::from_micros(250);
+pub(crate) const SERVE_MARGIN: Duration = Duration::from_micros(250);
 
 /// Whether the runtime goes on after a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,7 +141,7 @@ impl<C: Cycle> Runtime<C> {
     }
 
     /// Also stop, at a tick boundary, whenever `flag` is set (a signal handler's flag).
-    pub fn stop_on(&mut self, flag: Arc<AtomicBool>) {
+    pub(crate) fn stop_on(&mut self, flag: Arc<AtomicBool>) {
         self.external_stop = Some(flag);
     }
 

@@ -34,7 +34,7 @@ pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
 
 /// Axis limits of a channel's axes (its one axis table: axis lists or runtime.toml), by
 /// `AXIS_LETTERS` index.
-pub fn channel_axes(ch: &ChannelConfig) -> Result<Vec<AxisLimits>, SetupError> {
+pub(crate) fn channel_axes(ch: &ChannelConfig) -> Result<Vec<AxisLimits>, SetupError> {
     ch.axes
         .iter()
         .map(|a| {

@@ -14,8 +14,8 @@ use ncchannel::ads::payload;
 use ncchannel::dnc::markers::{Anchor, Markers};
 use ncchannel::dnc::splitter::{ProgramEnd, ProgramSink, ProgramStart, Splitter};
 use ncchannel::lang::{self, VarKey, Vars};
-use ncchannel::source::stream::{StreamBuffer, MAX_PROGRAM_STREAM_SIZE};
 use ncchannel::vocab::ams::DEFAULT_MAX_FRAME_BYTES;
+use ncchannel::{StreamBuffer, MAX_PROGRAM_STREAM_SIZE};
 
 /// Longest NC line the fuzzers hand to the parser: ISG lines are at most 4000 characters, and
 /// a longer one only slows the fuzzer without reaching new code.
@@ -331,7 +331,7 @@ pub fn channel_program(data: &[u8]) {
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
     };
-    let Ok(mut channels) = ncchannel::setup::channels(config, false) else {
+    let Ok(mut channels) = ncchannel::channels(config, false) else {
         panic!("the shipped parameter lists give no channel")
     };
     let Some(channel) = channels.first_mut() else {
@@ -352,11 +352,10 @@ pub fn channel_program(data: &[u8]) {
     let mut packet = Vec::new();
     for line in data.split(|&b| b == b'\n') {
         let line = line.strip_suffix(b"\r").unwrap_or(line);
-        if line.len() + 2 > ncchannel::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE {
+        if line.len() + 2 > ncchannel::MAX_PROGRAM_STREAM_INPUT_SIZE {
             continue;
         }
-        if packet.len() + line.len() + 2 > ncchannel::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE
-        {
+        if packet.len() + line.len() + 2 > ncchannel::MAX_PROGRAM_STREAM_INPUT_SIZE {
             packets.push(std::mem::take(&mut packet));
         }
         packet.extend_from_slice(line);
@@ -422,7 +421,7 @@ pub fn param_folder(data: &[u8]) {
         }
     }
     if let Ok(config) = ncchannel::params::config::load(&dir.path().join("startup.lis")) {
-        let _ = ncchannel::setup::channels(&config, false);
+        let _ = ncchannel::channels(&config, false);
     }
 }
 
@@ -537,7 +536,7 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
     };
-    let Ok(channels) = ncchannel::setup::channels(config, false) else {
+    let Ok(channels) = ncchannel::channels(config, false) else {
         panic!("the shipped parameter lists give no channel")
     };
     let Some(stream_prog) = config.channels[0].streaming_prog_file.clone() else {

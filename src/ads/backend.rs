@@ -110,7 +110,7 @@ impl dyn CncBackend {
     }
 
     /// Offer one packet (one or more whole CR LF lines) to the stream buffer.
-    pub fn write_stream(&self, ch: u16, data: &[u8]) -> AdsResult {
+    pub(crate) fn write_stream(&self, ch: u16, data: &[u8]) -> AdsResult {
         match self.call(ch, Op::WriteStream(data.to_vec())) {
             Ok(Reply::Stream(Ok(()))) => AdsResult::OK,
             Ok(Reply::Stream(Err(e))) => stream_result(&e),
@@ -120,7 +120,7 @@ impl dyn CncBackend {
     }
 
     /// Read an external variable `V.E.<name>` (name given without the `V.E.` prefix).
-    pub fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError> {
+    pub(crate) fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError> {
         match self.call(ch, Op::ReadExternal(name.to_string()))? {
             Reply::Value(Some(v)) => Ok(v),
             _ => Err(DeviceError::NotFound),
@@ -136,7 +136,7 @@ impl dyn CncBackend {
     }
 
     /// The `index`-th error the channel raised (0 = first), if still kept.
-    pub fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+    pub(crate) fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
         match self.call(ch, Op::ErrorRecord(index))? {
             Reply::ErrorRecord { total, record } => Ok(ErrorRecord {
                 total,

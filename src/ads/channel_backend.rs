@@ -13,7 +13,7 @@ use crate::runtime::{Clock, Runtime, StopHandle};
 
 /// How long a connection thread waits for the runtime. A tick answers within one period;
 /// far longer means the runtime is stopped or hopelessly late, and the client hears "busy".
-pub const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+pub(crate) const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
 
 pub struct ChannelBackend {
     requests: Sender<Request>,

@@ -50,8 +50,8 @@ impl ClientError {
 /// Name and version the device reports.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DeviceInfo {
-    pub major: u8,
-    pub minor: u8,
+    pub(crate) major: u8,
+    pub(crate) minor: u8,
     pub build: u16,
     pub name: String,
 }
@@ -267,12 +267,12 @@ pub struct StreamProgress {
     pub rejections: u64,
     pub elapsed: Duration,
     /// Round trip of a stream write (accepted or busy), µs: median and 99th percentile.
-    pub write_rtt_us_p50: f64,
-    pub write_rtt_us_p99: f64,
+    pub(crate) write_rtt_us_p50: f64,
+    pub(crate) write_rtt_us_p99: f64,
 }
 
 impl StreamProgress {
-    pub fn bytes_per_second(&self) -> f64 {
+    pub(crate) fn bytes_per_second(&self) -> f64 {
         let s = self.elapsed.as_secs_f64();
         if s > 0.0 {
             self.bytes_sent as f64 / s

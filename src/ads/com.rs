@@ -22,23 +22,23 @@ use crate::channel::{Mode, State};
 /// AMS port of the COM task.
 pub const PORT: u16 = 553;
 /// Channel objects, logical addressing: `GROUP_CHANNEL + ch`.
-pub const GROUP_CHANNEL: u32 = 0x120100;
+pub(crate) const GROUP_CHANNEL: u32 = 0x120100;
 /// Channel objects, index-based addressing.
-pub const GROUP_CHANNEL_INDEX: u32 = 0x20100;
+pub(crate) const GROUP_CHANNEL_INDEX: u32 = 0x20100;
 /// Platform axes: `GROUP_PLATFORM_AXIS + axis`.
-pub const GROUP_PLATFORM_AXIS: u32 = 0x120200;
-pub const GROUP_PLATFORM_AXIS_INDEX: u32 = 0x20200;
+pub(crate) const GROUP_PLATFORM_AXIS: u32 = 0x120200;
+pub(crate) const GROUP_PLATFORM_AXIS_INDEX: u32 = 0x20200;
 /// Object description table: `GROUP_DESCRIPTION + ch` (0 lists channel 1).
-pub const GROUP_DESCRIPTION: u32 = 0x130100;
-pub const GROUP_DESCRIPTION_INDEX: u32 = 0x30100;
+pub(crate) const GROUP_DESCRIPTION: u32 = 0x130100;
+pub(crate) const GROUP_DESCRIPTION_INDEX: u32 = 0x30100;
 /// Channel-axis and TwinSharp platform-axis offsets: `AXIS_STRIDE · axis + element`.
-pub const AXIS_STRIDE: u32 = 0x10000;
+pub(crate) const AXIS_STRIDE: u32 = 0x10000;
 /// Offsets of ncchannel's own channel objects (`ncc_*`): the ISG object dump's channel objects
 /// end at 0x3118 and channel axes start at 0x10000 (docs/ads.md).
 pub const VENDOR_OFFSETS: std::ops::RangeInclusive<u32> = 0x8000..=0x8FFF;
 
 /// Longest program name accepted by `mcm_command_parameter_w` (its STRING(300) buffer).
-pub const MAX_PARAMETER_BYTES: usize = 300;
+pub(crate) const MAX_PARAMETER_BYTES: usize = 300;
 /// 0.1 µm per mm: positions on the wire.
 const TENTH_UM_PER_MM: f64 = 10_000.0;
 /// µm/s per mm/min: feeds on the wire.
@@ -629,7 +629,7 @@ fn read_axis(
 }
 
 /// A text argument: up to the first NUL, at most `max` bytes, UTF-8, trimmed.
-pub fn text_arg(data: &[u8], max: usize) -> Result<&str, AdsResult> {
+pub(crate) fn text_arg(data: &[u8], max: usize) -> Result<&str, AdsResult> {
     let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     let text = &data[..end];
     if text.len() > max {

@@ -9,7 +9,7 @@
 use super::result::AdsResult;
 
 /// Bytes of one object description record.
-pub const RECORD_BYTES: usize = 84;
+pub(crate) const RECORD_BYTES: usize = 84;
 /// Bytes of the name and type fields of a record (NUL-padded).
 const TEXT_FIELD_BYTES: usize = 32;
 
@@ -62,7 +62,7 @@ impl AdsType {
 
 /// Who may do what with an object.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Access {
+pub(crate) enum Access {
     Read,
     Write,
     ReadWrite,
@@ -94,7 +94,7 @@ pub struct ObjectInfo {
     pub ty: AdsType,
     /// Bytes a read answers (strings: their whole buffer).
     pub size: u32,
-    pub access: Access,
+    pub(crate) access: Access,
     pub unit: &'static str,
     /// Where the address, type and unit come from.
     pub source: &'static str,
@@ -121,7 +121,11 @@ fn put_text(field: &mut [u8], text: &str) {
 
 /// Reads of a description table (offset 0 = count, offset k = record k, a multiple of 84
 /// bytes = records k, k+1, … in sequence; infosys 855973643).
-pub fn read_table(objects: &[ObjectInfo], offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+pub(crate) fn read_table(
+    objects: &[ObjectInfo],
+    offset: u32,
+    length: u32,
+) -> Result<Vec<u8>, AdsResult> {
     if offset == 0 {
         if length < 4 {
             return Err(AdsResult::INVALID_SIZE);

@@ -11,19 +11,19 @@ use std::fmt;
 use crate::vocab::ams::AmsNetId;
 
 /// Size of the AMS/TCP header: u16 reserved + u32 length.
-pub const TCP_HEADER_LEN: usize = 6;
+pub(crate) const TCP_HEADER_LEN: usize = 6;
 /// Size of the AMS header that follows it.
-pub const AMS_HEADER_LEN: usize = 32;
+pub(crate) const AMS_HEADER_LEN: usize = 32;
 
 /// State flags of a request (ADS command, TCP transport).
 pub const FLAGS_REQUEST: u16 = 0x0004;
 /// State flags of a response; clients (adslib, `ads`) insist on exactly this value.
-pub const FLAGS_RESPONSE: u16 = 0x0005;
+pub(crate) const FLAGS_RESPONSE: u16 = 0x0005;
 
 /// AMS router-level error in the header: the target AMS port does not exist.
-pub const AMS_ERR_PORT_NOT_FOUND: u32 = 6;
+pub(crate) const AMS_ERR_PORT_NOT_FOUND: u32 = 6;
 /// AMS router-level error in the header: the target machine (NetId) is not this one.
-pub const AMS_ERR_MACHINE_NOT_FOUND: u32 = 7;
+pub(crate) const AMS_ERR_MACHINE_NOT_FOUND: u32 = 7;
 
 /// An AMS address: NetId plus AMS port (553 is the CNC's COM task).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

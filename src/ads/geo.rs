@@ -20,11 +20,11 @@ use super::result::AdsResult;
 pub const PORT: u16 = 551;
 /// Position controller, platform instance (ISG sample client `cnc_demo_samples.c` waits
 /// ticks on its tick counter).
-pub const GROUP_POS_CTRL: u32 = 0x120300;
+pub(crate) const GROUP_POS_CTRL: u32 = 0x120300;
 /// Interpolator instance of channel ch: `GROUP_IPO + ch`.
-pub const GROUP_IPO: u32 = 0x121300;
+pub(crate) const GROUP_IPO: u32 = 0x121300;
 /// HLD instance of channel ch: `GROUP_HLD + ch`.
-pub const GROUP_HLD: u32 = 0x123300;
+pub(crate) const GROUP_HLD: u32 = 0x123300;
 /// Attribute add-on of the address query.
 const ADDRESS_QUERY: u32 = 0x600;
 /// Logical-addressing bit of index groups (infosys "logical vs index-based", 312762635).

@@ -29,23 +29,23 @@ use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
 
 pub const PORT: u16 = 851;
-pub const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
-pub const GROUP_VALUE_BY_NAME: u32 = 0xF004;
-pub const GROUP_VALUE_BY_HANDLE: u32 = 0xF005;
-pub const GROUP_RELEASE_HANDLE: u32 = 0xF006;
-pub const GROUP_INFO_BY_NAME: u32 = 0xF009;
+pub(crate) const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
+pub(crate) const GROUP_VALUE_BY_NAME: u32 = 0xF004;
+pub(crate) const GROUP_VALUE_BY_HANDLE: u32 = 0xF005;
+pub(crate) const GROUP_RELEASE_HANDLE: u32 = 0xF006;
+pub(crate) const GROUP_INFO_BY_NAME: u32 = 0xF009;
 /// ADS error "symbol not found".
-pub const SYMBOL_NOT_FOUND: AdsResult = AdsResult(0x710);
+pub(crate) const SYMBOL_NOT_FOUND: AdsResult = AdsResult(0x710);
 /// Longest symbol name accepted.
 const MAX_NAME_BYTES: usize = 255;
 
 /// `HLI_PROC_TRANS_TO_MODE_STATE` (TwinSharp `Structs.cs`): 5 × UDINT, DINT fill, char[299]
 /// parameter, DINT fill = 327 bytes.
-pub const MODE_TRANSITION_BYTES: usize = 327;
+pub(crate) const MODE_TRANSITION_BYTES: usize = 327;
 const PARAMETER_AT: usize = 24;
 const PARAMETER_BYTES: usize = 299;
 /// `HLI_ERROR_SATZ` (TwinSharp `Structs.cs`): 104-byte head + 838-byte body.
-pub const ERROR_RECORD_BYTES: usize = 942;
+pub(crate) const ERROR_RECORD_BYTES: usize = 942;
 /// `TECHNO_UNIT_CH` bytes and `techno_unit_std_sync` entries (`[0..19]`).
 const TECHNO_UNIT_BYTES: usize = 47;
 const TECHNO_UNITS: usize = 20;
@@ -66,7 +66,7 @@ const ADST_BIGTYPE: u32 = 65;
 
 /// The parts of a channel's mode-and-state control unit (the GEO task mirrors them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Unit {
+pub(crate) enum Unit {
     Enable,
     RequestSemaphore,
     CommandSemaphore,
@@ -133,7 +133,7 @@ struct PendingRequest {
 
 /// An HMI (COM) mode-and-state command, for redirection to the PLC.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HmiRequest<'a> {
+pub(crate) enum HmiRequest<'a> {
     ToMode(i32),
     ToState(i32),
     Parameter(&'a str),
@@ -696,7 +696,7 @@ impl Hli {
     /// `request_r` with `request_semaphor_rw` TRUE; the PLC decides and commands through
     /// `command_w`. `None` when the PLC does not operate the unit (the channel executes the
     /// command itself). A to-state while the PLC has not taken the last request is 0x708.
-    pub fn redirect(&self, ch: u16, req: HmiRequest<'_>) -> Option<Result<(), AdsResult>> {
+    pub(crate) fn redirect(&self, ch: u16, req: HmiRequest<'_>) -> Option<Result<(), AdsResult>> {
         // Without a PLC client the image may not exist yet: then nobody set enable_w.
         let img = self.image.get()?;
         let areas = img.areas(ch).ok()?;
@@ -742,7 +742,7 @@ impl Hli {
     }
 
     /// Bytes `[at, at + size)` of a channel's mode-and-state unit (for the GEO mirror).
-    pub fn unit_bytes(
+    pub(crate) fn unit_bytes(
         &self,
         ch: u16,
         unit: Unit,
@@ -766,7 +766,7 @@ impl Hli {
     }
 
     /// `gpCh[ch-1]^.head.plc_present_w` as one byte.
-    pub fn plc_present(&self, ch: u16) -> Result<Vec<u8>, AdsResult> {
+    pub(crate) fn plc_present(&self, ch: u16) -> Result<Vec<u8>, AdsResult> {
         let img = self.image()?;
         let a = img.areas(ch)?;
         Ok(img.memory()[a.plc_present].clone())
@@ -864,7 +864,7 @@ fn symbol_entry(s: &Symbol, handle: u32) -> Vec<u8> {
 /// `HLI_ERROR_SATZ` for error `code` of channel `ch` (TwinSharp `Structs.cs`,
 /// `HLI_ERROR_SATZ_KOPF`, Pack = 1): error_id @0, modul_name @8, cnc_channel @56, time
 /// stamp cycle counter @68, version_name @72, body type @100; the body stays empty.
-pub fn error_record(code: u32, ch: u16, tick: u64) -> [u8; ERROR_RECORD_BYTES] {
+pub(crate) fn error_record(code: u32, ch: u16, tick: u64) -> [u8; ERROR_RECORD_BYTES] {
     let mut r = [0u8; ERROR_RECORD_BYTES];
     r[0..4].copy_from_slice(&code.to_le_bytes());
     put(&mut r[8..24], "ncchannel");

@@ -11,14 +11,14 @@ pub mod backend;
 pub mod channel_backend;
 pub mod client;
 pub mod com;
-pub mod description;
+pub(crate) mod description;
 pub mod frame;
-pub mod geo;
-pub mod hli;
+pub(crate) mod geo;
+pub(crate) mod hli;
 pub mod objects;
 pub mod payload;
 pub mod result;
-pub mod sda;
+pub(crate) mod sda;
 pub mod server;
 #[cfg(test)]
 pub(crate) mod testing;

@@ -22,12 +22,12 @@ use super::sda::Sda;
 use super::{com, geo, hli, sda};
 
 /// AMS port of the CNC's COM task.
-pub const PORT_CNC_COM: u16 = com::PORT;
+pub(crate) const PORT_CNC_COM: u16 = com::PORT;
 /// Every AMS port served.
-pub const PORTS: [u16; 4] = [geo::PORT, sda::PORT, com::PORT, hli::PORT];
+pub(crate) const PORTS: [u16; 4] = [geo::PORT, sda::PORT, com::PORT, hli::PORT];
 
 /// Channel index group base (index-based, as the ISG SDK and `ncchannel stream` use it).
-pub const GROUP_CHANNEL: u32 = com::GROUP_CHANNEL_INDEX;
+pub(crate) const GROUP_CHANNEL: u32 = com::GROUP_CHANNEL_INDEX;
 /// Channel index group base, logical addressing; same objects.
 pub const GROUP_CHANNEL_NEW: u32 = com::GROUP_CHANNEL;
 

@@ -46,9 +46,9 @@ pub struct NotificationRequest {
     /// treated as 3/4).
     pub mode: u32,
     /// Maximum delay in 100 ns units (ADS convention); we send at once, so it is only kept.
-    pub max_delay_100ns: u32,
+    pub(crate) max_delay_100ns: u32,
     /// Cycle time in 100 ns units (ADS convention).
-    pub cycle_time_100ns: u32,
+    pub(crate) cycle_time_100ns: u32,
 }
 
 /// A request payload that does not hold what its command needs.
@@ -196,12 +196,12 @@ pub mod response {
     use super::AdsResult;
 
     /// Write, WriteControl, DelDeviceNotification: the result alone, 4 bytes.
-    pub fn result_only(result: AdsResult) -> Vec<u8> {
+    pub(crate) fn result_only(result: AdsResult) -> Vec<u8> {
         result.0.to_le_bytes().to_vec()
     }
 
     /// ReadDeviceInfo: 24 bytes; `name` is cut to 15 bytes so a NUL always ends it.
-    pub fn device_info(major: u8, minor: u8, build: u16, name: &str) -> Vec<u8> {
+    pub(crate) fn device_info(major: u8, minor: u8, build: u16, name: &str) -> Vec<u8> {
         let mut out = Vec::with_capacity(24);
         out.extend_from_slice(&0u32.to_le_bytes());
         out.push(major);
@@ -216,7 +216,7 @@ pub mod response {
     }
 
     /// Read and ReadWrite: result, length, data (empty data on error).
-    pub fn with_data(result: AdsResult, data: &[u8]) -> Vec<u8> {
+    pub(crate) fn with_data(result: AdsResult, data: &[u8]) -> Vec<u8> {
         let mut out = Vec::with_capacity(8 + data.len());
         out.extend_from_slice(&result.0.to_le_bytes());
         out.extend_from_slice(&(data.len() as u32).to_le_bytes());
@@ -334,7 +334,7 @@ pub fn decode_result(data: &[u8]) -> Result<AdsResult, PayloadError> {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Sample {
     pub handle: u32,
-    pub filetime_100ns: u64,
+    pub(crate) filetime_100ns: u64,
     pub data: Vec<u8>,
 }
 

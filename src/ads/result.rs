@@ -12,28 +12,28 @@ pub struct AdsResult(pub u32);
 impl AdsResult {
     pub const OK: AdsResult = AdsResult(0);
     /// 0x701: the command (service) is not supported.
-    pub const SERVICE_NOT_SUPPORTED: AdsResult = AdsResult(0x701);
+    pub(crate) const SERVICE_NOT_SUPPORTED: AdsResult = AdsResult(0x701);
     /// 0x702: no such index group (or channel).
-    pub const INVALID_GROUP: AdsResult = AdsResult(0x702);
+    pub(crate) const INVALID_GROUP: AdsResult = AdsResult(0x702);
     /// 0x703: no such index offset in that group.
-    pub const INVALID_OFFSET: AdsResult = AdsResult(0x703);
+    pub(crate) const INVALID_OFFSET: AdsResult = AdsResult(0x703);
     /// 0x704: the object cannot be read (or written) this way.
-    pub const ACCESS_DENIED: AdsResult = AdsResult(0x704);
+    pub(crate) const ACCESS_DENIED: AdsResult = AdsResult(0x704);
     /// 0x705: parameter size not correct.
-    pub const INVALID_SIZE: AdsResult = AdsResult(0x705);
+    pub(crate) const INVALID_SIZE: AdsResult = AdsResult(0x705);
     /// 0x706: invalid parameter value (e.g. a stream line without CR LF).
-    pub const INVALID_DATA: AdsResult = AdsResult(0x706);
+    pub(crate) const INVALID_DATA: AdsResult = AdsResult(0x706);
     /// 0x707: device not ready.
     pub const NOT_READY: AdsResult = AdsResult(0x707);
     /// 0x708: device busy (e.g. the stream buffer cannot take the packet now).
     pub const BUSY: AdsResult = AdsResult(0x708);
     /// 0x70C: not found (e.g. an unknown V.E. variable or notification handle).
-    pub const NOT_FOUND: AdsResult = AdsResult(0x70C);
+    pub(crate) const NOT_FOUND: AdsResult = AdsResult(0x70C);
     /// 0x716 ADSERR_DEVICE_NOMOREHDLS: no more notification handles (per-connection bound
     /// reached). Not 0x710, which is "symbol not found" (Beckhoff ADS return codes).
-    pub const NO_MORE_HANDLES: AdsResult = AdsResult(0x716);
+    pub(crate) const NO_MORE_HANDLES: AdsResult = AdsResult(0x716);
     /// 0x714: invalid notification handle.
-    pub const INVALID_HANDLE: AdsResult = AdsResult(0x714);
+    pub(crate) const INVALID_HANDLE: AdsResult = AdsResult(0x714);
 
     pub fn is_ok(self) -> bool {
         self.0 == 0

@@ -21,16 +21,16 @@ use super::result::AdsResult;
 
 pub const PORT: u16 = 552;
 /// Decoder class instance of channel ch: `GROUP_DECODER + ch`.
-pub const GROUP_DECODER: u32 = 0x122300;
-pub const HANDLE_BY_NAME: u32 = 0x46;
-pub const READ_BY_HANDLE: u32 = 0x47;
-pub const READ_BY_NAME: u32 = 0x48;
-pub const WRITE_BY_HANDLE: u32 = 0x49;
-pub const WRITE_BY_NAME: u32 = 0x4A;
+pub(crate) const GROUP_DECODER: u32 = 0x122300;
+pub(crate) const HANDLE_BY_NAME: u32 = 0x46;
+pub(crate) const READ_BY_HANDLE: u32 = 0x47;
+pub(crate) const READ_BY_NAME: u32 = 0x48;
+pub(crate) const WRITE_BY_HANDLE: u32 = 0x49;
+pub(crate) const WRITE_BY_NAME: u32 = 0x4A;
 /// First handle; handles look like the documented `0x20012341`.
 const HANDLE_BASE: u32 = 0x2000_0000;
 /// Distinct variable names a server hands out handles for.
-pub const MAX_HANDLES: usize = 4096;
+pub(crate) const MAX_HANDLES: usize = 4096;
 const MAX_NAME_BYTES: usize = 255;
 /// ADS "insufficient memory": the handle table is full.
 const NO_MEMORY: AdsResult = AdsResult(0x70A);
@@ -88,7 +88,7 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
 }
 
 /// The SDA task of one server: its variable handles.
-pub struct Sda {
+pub(crate) struct Sda {
     backend: Arc<dyn CncBackend>,
     /// Handle n ↔ `names[n]` (upper case, without `V.E.`).
     names: Mutex<Vec<String>>,

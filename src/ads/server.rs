@@ -31,15 +31,15 @@ use crate::vocab::ams::{
 };
 
 /// Default bound on the bytes waiting in one connection's send queue.
-pub const DEFAULT_MAX_SEND_QUEUE_BYTES: usize = 1 << 20;
+pub(crate) const DEFAULT_MAX_SEND_QUEUE_BYTES: usize = 1 << 20;
 /// A write to a client that takes longer than this (its receive window stays shut) ends
 /// the connection.
-pub const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
+pub(crate) const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
 /// Distinct unrouted source NetIds logged per connection; beyond that one summary line.
 const MAX_LOGGED_UNROUTED: usize = 16;
 /// Notification cycle times are clamped to this range.
-pub const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
-pub const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
+pub(crate) const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
+pub(crate) const MAX_NOTIFICATION_CYCLE: Duration = Duration::from_secs(10);
 
 /// Server settings (the runtime config's `[ads]` table maps onto this).
 #[derive(Debug, Clone)]

@@ -118,32 +118,32 @@ pub struct Status {
     pub block_counter: u64,
     /// Stream fill: bytes used, bytes free.
     pub stream_used: usize,
-    pub stream_free: usize,
+    pub(crate) stream_free: usize,
     /// Configured axes with their positions (mm / degrees).
     pub positions: Vec<(char, f64)>,
     pub last_error: Option<(u32, String)>,
-    pub override_pct: f64,
+    pub(crate) override_pct: f64,
     pub blocks: u64,
     /// Tick that served the request, and the cycle time.
     pub tick: u64,
     pub period: Duration,
-    pub cycle_times: CycleTimes,
+    pub(crate) cycle_times: CycleTimes,
     /// The main program running, if any.
     pub program: Option<String>,
-    pub active_block: Option<ActiveBlock>,
+    pub(crate) active_block: Option<ActiveBlock>,
     /// Modal programmed feed as decoded, mm/min (0 = none yet).
     pub feed_mm_per_min: f64,
     /// Path velocity, mm/s.
     pub velocity_mm_per_s: f64,
-    pub hmi: HmiCommands,
+    pub(crate) hmi: HmiCommands,
     /// A block search is running (the decoder skips towards its target).
-    pub searching: bool,
+    pub(crate) searching: bool,
     /// Blocks handed to the interpolator and not yet done.
-    pub ipo_blocks: usize,
+    pub(crate) ipo_blocks: usize,
     /// Errors raised since the channel was built.
-    pub errors_total: u64,
+    pub(crate) errors_total: u64,
     /// Positions in the programming coordinate system (mm / degrees), as `positions`.
-    pub pcs_positions: Vec<(char, f64)>,
+    pub(crate) pcs_positions: Vec<(char, f64)>,
     /// The latest operator message of `#MSG` (empty after a reset).
     pub message: Option<String>,
 }
@@ -191,7 +191,7 @@ pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     None
 }
 
-pub fn status_of(c: &Channel) -> Status {
+pub(crate) fn status_of(c: &Channel) -> Status {
     let (used, free) = c.stream_fill();
     Status {
         mode: c.mode(),

@@ -63,16 +63,16 @@ pub struct ChannelSettings {
     pub number: u32,
     pub decoder: DecoderSettings,
     /// Block queue capacity: lookahead window plus decoder buffer, blocks.
-    pub queue_capacity: usize,
+    pub(crate) queue_capacity: usize,
     pub axes: Vec<AxisLimits>,
     /// Lookahead window (runtime.toml `[planner]`).
     pub planner: PlannerSettings,
-    pub search_dirs: Vec<SearchDir>,
+    pub(crate) search_dirs: Vec<SearchDir>,
     /// `streaming_prog_file`; `None` = streaming off.
-    pub streaming_prog: Option<String>,
+    pub(crate) streaming_prog: Option<String>,
     pub cache: CacheLimits,
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
-    pub fs_latency: FsLatency,
+    pub(crate) fs_latency: FsLatency,
     /// Tool radii by D number for G41/G42, mm (`tools.lis`).
     pub tools: Vec<(u32, f64)>,
 }
@@ -102,21 +102,21 @@ pub struct ChannelStats {
     pub warnings: u64,
     /// Every error raised (the first `MAX_LISTED_ERRORS` are kept with their text).
     pub errors: u64,
-    pub programs_ended: u64,
+    pub(crate) programs_ended: u64,
 }
 
 /// What an HMI commands besides mode and state: the COM task's `mc_command_*` objects
 /// (ISG kernel object list, `SamWieHTWG/web-api` `examples/example1-hello-cnc/cnc_objects.csv`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct HmiCommands {
+pub(crate) struct HmiCommands {
     /// `mc_command_single_block_w`: one block per start.
-    pub single_block: bool,
+    pub(crate) single_block: bool,
     /// `mc_command_M01_stop_enable_w`: M01 stops like M00.
-    pub optional_stop: bool,
+    pub(crate) optional_stop: bool,
     /// `mc_command_block_ignore_w`: skip levels 1–10 as the kernel's mask (level n = bit n−1).
-    pub skip_levels: u32,
+    pub(crate) skip_levels: u32,
     /// `mc_command_execution_mode_w`: bit 0 = block search at the next start.
-    pub execution_mode: i32,
+    pub(crate) execution_mode: i32,
     pub search: SearchCommand,
 }
 
@@ -126,15 +126,15 @@ pub struct SearchCommand {
     /// `mc_cmd_bs_type_w`: 1 file offset, 3 block counter, 4 block number.
     pub kind: u16,
     /// Byte offset in the main program (`mc_command_file_offset_w` / `…pos_start_offset_w`).
-    pub file_offset: i32,
+    pub(crate) file_offset: i32,
     /// `mc_cmd_bs_intern_block_count_w`.
-    pub block_count: u32,
+    pub(crate) block_count: u32,
     /// `mc_cmd_bs_block_number_w`: the N number.
-    pub block_number: u32,
+    pub(crate) block_number: u32,
 }
 
 /// Execution mode bit: block search at the next program start.
-pub const EXECUTION_MODE_BLOCK_SEARCH: i32 = 0x1;
+pub(crate) const EXECUTION_MODE_BLOCK_SEARCH: i32 = 0x1;
 
 impl SearchCommand {
     /// The decoder's search target this command names, if any.
@@ -152,7 +152,7 @@ impl SearchCommand {
 
 /// The block that took effect last: what `mc_active_*` objects show.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ActiveBlock {
+pub(crate) struct ActiveBlock {
     /// Program (file) the block is in.
     pub prog: Arc<str>,
     /// Byte offset of the line in that program (in a stream: since stream start).
@@ -359,7 +359,7 @@ impl Channel {
         &self.cache
     }
     /// Can a streaming program ever run here (and so drain the stream buffer)?
-    pub fn streaming_enabled(&self) -> bool {
+    pub(crate) fn streaming_enabled(&self) -> bool {
         self.store.streaming_enabled()
     }
 
@@ -452,7 +452,7 @@ impl Channel {
     /// Positions in the programming coordinate system: machine positions minus the zero
     /// offset (G54…G59) the decoder has active, which runs ahead of execution by the
     /// lookahead when a program switches offsets.
-    pub fn pcs_positions(&self) -> Vec<(char, f64)> {
+    pub(crate) fn pcs_positions(&self) -> Vec<(char, f64)> {
         let offset = self
             .decoder
             .modal()
@@ -699,19 +699,19 @@ impl Channel {
     }
 
     /// HMI commands as last written (the `mc_command_*_r` objects read them back).
-    pub fn hmi(&self) -> HmiCommands {
+    pub(crate) fn hmi(&self) -> HmiCommands {
         self.hmi
     }
     /// The block that took effect last since the program start.
-    pub fn active_block(&self) -> Option<&ActiveBlock> {
+    pub(crate) fn active_block(&self) -> Option<&ActiveBlock> {
         self.active.as_ref()
     }
     /// The main program running (ACTIVE or HOLD), if any.
-    pub fn running_program(&self) -> Option<&str> {
+    pub(crate) fn running_program(&self) -> Option<&str> {
         self.running_prog.as_deref()
     }
     /// Blocks handed to the interpolator and not yet done (`mc_ipo_buf_level`).
-    pub fn ipo_blocks(&self) -> usize {
+    pub(crate) fn ipo_blocks(&self) -> usize {
         self.motion.released_blocks() + self.motion.held_blocks() + self.single_gate.len()
     }
     /// `mc_command_M01_stop_enable_w`: M01 holds the channel while on.

@@ -193,7 +193,7 @@ fn read_text(path: &Path) -> Result<String, String> {
 
 /// Parameter lists (a start-up list with its channel lists and runtime.toml, or a channel
 /// list alone) and runtime.toml files, through the params room's own checks.
-pub fn check_params_file(path: &Path) -> Vec<Diagnostic> {
+pub(crate) fn check_params_file(path: &Path) -> Vec<Diagnostic> {
     if extension(path) == "toml" {
         return crate::params::runtime::read_runtime(path)
             .err()

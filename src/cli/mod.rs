@@ -6,34 +6,34 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-pub mod bench;
+pub(crate) mod bench;
 pub mod check;
 mod logger;
-pub mod out;
-pub mod receive;
-pub mod run;
-pub mod serve;
-pub mod serve_soak;
-pub mod signal;
-pub mod soak;
-pub mod stream;
+pub(crate) mod out;
+pub(crate) mod receive;
+pub(crate) mod run;
+pub(crate) mod serve;
+pub(crate) mod serve_soak;
+pub(crate) mod signal;
+pub(crate) mod soak;
+pub(crate) mod stream;
 
 /// Exit codes of the command-line contract (README "Two commands").
 pub mod exit {
     /// The program ended normally (or the check found nothing).
     pub const OK: u8 = 0;
     /// A channel error (or a check found errors).
-    pub const CHANNEL_ERROR: u8 = 1;
+    pub(crate) const CHANNEL_ERROR: u8 = 1;
     /// Bad usage or bad parameter lists.
-    pub const USAGE: u8 = 2;
+    pub(crate) const USAGE: u8 = 2;
     /// `--max-ticks` reached before the program ended.
     pub const MAX_TICKS: u8 = 3;
     /// SIGINT or SIGTERM stopped `run --realtime` or `soak --realtime` before the end (the
     /// log, report and summary are complete up to the stop).
-    pub const STOPPED: u8 = 4;
+    pub(crate) const STOPPED: u8 = 4;
     /// A second SIGINT/SIGTERM during the orderly stop: exit at once, as a shell reports a
     /// process killed by SIGINT (128 + 2).
-    pub const SECOND_SIGNAL: u8 = 130;
+    pub(crate) const SECOND_SIGNAL: u8 = 130;
 }
 
 #[derive(Debug, Parser)]

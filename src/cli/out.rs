@@ -11,12 +11,12 @@ use std::fmt::Display;
 use std::io::{self, Write};
 
 /// Is this the error of a write whose reader went away (a closed pipe)?
-pub fn reader_gone(e: &io::Error) -> bool {
+pub(crate) fn reader_gone(e: &io::Error) -> bool {
     e.kind() == io::ErrorKind::BrokenPipe
 }
 
 /// A command's standard output; see the module documentation.
-pub struct Stdout {
+pub(crate) struct Stdout {
     lock: io::StdoutLock<'static>,
     /// The reader has gone: the output ended there.
     gone: bool,

@@ -48,15 +48,15 @@ pub struct ReceiveArgs {
     /// Bytes one transfer may carry; beyond, the transfer ends and the program in progress is
     /// cut off (default with --listen: 256 MiB; unbounded for a file or standard input).
     #[arg(long, value_name = "BYTES")]
-    pub max_transfer_bytes: Option<u64>,
+    pub(crate) max_transfer_bytes: Option<u64>,
     /// With --listen: transfers taken at the same time (a silent or slow sender holds one).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CONCURRENT,
           value_parser = clap::value_parser!(u16).range(1..=64))]
-    pub max_concurrent: u16,
+    pub(crate) max_concurrent: u16,
     /// Programs one transfer may deliver; the next is dropped and the transfer ends
     /// (default with --listen: 1000; unbounded for a file or standard input).
     #[arg(long, value_name = "N")]
-    pub max_programs: Option<usize>,
+    pub(crate) max_programs: Option<usize>,
     /// Replace existing program files (default: keep them and drop the received program).
     #[arg(long)]
     pub overwrite: bool,
@@ -68,7 +68,7 @@ pub struct ReceiveArgs {
     pub at_line_start: bool,
     /// Names for programs whose data names none; `{n}` or `{n:W}` is the number.
     #[arg(long, value_name = "TEMPLATE", default_value = "received_{n}.nc")]
-    pub name_template: String,
+    pub(crate) name_template: String,
     /// Start-up list whose channel decides the default program directory.
     #[arg(long, default_value = "params/startup.lis")]
     pub params: PathBuf,
@@ -79,14 +79,14 @@ pub struct ReceiveArgs {
 
 /// `--listen` defaults: a silent sender frees the port after 30 s; one transfer carries at
 /// most 256 MiB and 1000 programs (docs/ads-limits.md, "receive --listen").
-pub const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
-pub const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
-pub const DEFAULT_MAX_PROGRAMS: usize = 1000;
-pub const DEFAULT_MAX_CONCURRENT: u16 = 4;
+pub(crate) const DEFAULT_IDLE_TIMEOUT_S: f64 = 30.0;
+pub(crate) const DEFAULT_MAX_TRANSFER_BYTES: u64 = 256 << 20;
+pub(crate) const DEFAULT_MAX_PROGRAMS: usize = 1000;
+pub(crate) const DEFAULT_MAX_CONCURRENT: u16 = 4;
 
 /// Where programs go without `--out`: the channel's first main-program search path, from the
 /// parameter lists, so received programs are ready to run.
-pub fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
+pub(crate) fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let config = crate::params::load(params).map_err(|e| {
         for d in e.diagnostics() {
             say(format_args!("{}", d.render()));

@@ -50,7 +50,7 @@ pub struct RunArgs {
     pub raw: bool,
     /// Run at the cycle period in wall-clock time instead of virtual time.
     #[arg(long)]
-    pub realtime: bool,
+    pub(crate) realtime: bool,
     /// Stop after this many ticks (exit code 3).
     #[arg(long)]
     pub max_ticks: Option<u64>,
@@ -60,7 +60,7 @@ pub struct RunArgs {
     /// Block-skip mask: bit n set skips blocks marked `/n` (`/` is `/1`), so 2 skips `/`
     /// and `/1`, 0x6 also `/2`. Decimal or 0x hex.
     #[arg(long, value_parser = parse_skip_mask, default_value = "0")]
-    pub skip_mask: u16,
+    pub(crate) skip_mask: u16,
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
@@ -76,7 +76,7 @@ pub struct RunArgs {
     pub trace: Option<PathBuf>,
     /// One CSV row every this many ticks.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
-    pub trace_every: u64,
+    pub(crate) trace_every: u64,
 }
 
 impl RunArgs {

@@ -47,7 +47,7 @@ pub struct ServeArgs {
     /// Close an ADS connection that completed no frame for this many seconds while in the
     /// middle of a frame or holding no notification handles (default 60; docs/ads-limits.md).
     #[arg(long, value_name = "SECONDS")]
-    pub ads_idle_timeout: Option<f64>,
+    pub(crate) ads_idle_timeout: Option<f64>,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,

@@ -21,7 +21,7 @@ use super::out::say;
 /// What `serve` settled before handing over: the ADS endpoint, the run limit, the report
 /// file, the cycle time and the channel count.
 pub struct SoakServe {
-    pub server_config: ServerConfig,
+    pub(crate) server_config: ServerConfig,
     pub limit: Option<Duration>,
     pub report: Option<PathBuf>,
     pub period: Duration,

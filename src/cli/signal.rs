@@ -15,7 +15,7 @@ use super::exit;
 
 /// The flag SIGINT and SIGTERM set.
 #[derive(Debug, Clone)]
-pub struct StopSignal(Arc<AtomicBool>);
+pub(crate) struct StopSignal(Arc<AtomicBool>);
 
 impl StopSignal {
     /// Register the handlers. Called once per process by the command that runs until stopped.
@@ -40,7 +40,7 @@ impl StopSignal {
     }
 
     /// The flag itself, for [`crate::runtime::Runtime::stop_on`].
-    pub fn flag(&self) -> Arc<AtomicBool> {
+    pub(crate) fn flag(&self) -> Arc<AtomicBool> {
         Arc::clone(&self.0)
     }
 }

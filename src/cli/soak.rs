@@ -15,7 +15,7 @@ pub struct SoakArgs {
     pub scenario: PathBuf,
     /// Run at the cycle period in wall-clock time instead of virtual time.
     #[arg(long)]
-    pub realtime: bool,
+    pub(crate) realtime: bool,
     /// Replace the scenario's length: stop after this many executed blocks.
     #[arg(long)]
     pub blocks: Option<u64>,
@@ -24,7 +24,7 @@ pub struct SoakArgs {
     pub ticks: Option<u64>,
     /// Replace the scenario's length: stop after this many wall-clock seconds.
     #[arg(long)]
-    pub wall_seconds: Option<f64>,
+    pub(crate) wall_seconds: Option<f64>,
     /// Replace the scenario's seed.
     #[arg(long)]
     pub seed: Option<u64>,

@@ -25,7 +25,7 @@ pub struct StreamArgs {
     pub net_id: AmsNetId,
     /// Our AMS NetId (default: local IPv4 address + .1.1).
     #[arg(long)]
-    pub source_net_id: Option<AmsNetId>,
+    pub(crate) source_net_id: Option<AmsNetId>,
     /// Channel number, 1-based (index group 0x20100 + N).
     #[arg(long, default_value_t = 1)]
     pub channel: u16,
@@ -41,7 +41,7 @@ pub struct StreamArgs {
     /// Give up after this many seconds in which data waited and the channel ran no program
     /// to take it (a long move that keeps the buffer full is not a stall).
     #[arg(long, default_value_t = 30)]
-    pub stall_secs: u64,
+    pub(crate) stall_secs: u64,
 }
 
 /// The progress bar over the file's bytes (a log or a pipe gets the final line alone).

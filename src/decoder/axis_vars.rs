@@ -27,7 +27,7 @@ impl Decoder {
 
 impl Decoder {
     /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
-    pub fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
+    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
         self.tool_radii = radii;
     }
 

@@ -8,27 +8,27 @@ use crate::vocab::event::CacheOp;
 /// before it: applied when the frame stack is back at `depth`.
 #[derive(Debug, Clone)]
 pub(super) struct HeldEnd {
-    pub m: u32,
-    pub info: BlockInfo,
-    pub depth: usize,
+    pub(crate) m: u32,
+    pub(crate) info: BlockInfo,
+    pub(crate) depth: usize,
 }
 
 /// Where the running program stands with its implicit subroutine calls.
 #[derive(Debug, Clone, Default)]
 pub(super) struct ImplicitState {
     /// The start subroutine (P-CHAN-00119) is still to be called.
-    pub start_pending: bool,
+    pub(crate) start_pending: bool,
     /// The end subroutine (P-CHAN-00252) has been called.
-    pub end_called: bool,
+    pub(crate) end_called: bool,
     /// Depth of the running M6 subroutine's frame: an M6 inside it is an ordinary M function,
     /// as the kernel does not call the tool change from the tool change.
-    pub m6_depth: Option<usize>,
+    pub(crate) m6_depth: Option<usize>,
     /// Ends held back, innermost last (at most one per frame).
-    pub held: Vec<HeldEnd>,
+    pub(crate) held: Vec<HeldEnd>,
 }
 
 impl ImplicitState {
-    pub fn at_start(calls: &crate::params::channel::ImplicitSubroutines) -> Self {
+    pub(crate) fn at_start(calls: &crate::params::channel::ImplicitSubroutines) -> Self {
         ImplicitState {
             start_pending: calls.at_start.is_some(),
             ..Default::default()

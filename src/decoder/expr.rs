@@ -79,16 +79,16 @@ pub(super) fn err(e: eval::EvalError) -> DecodeError {
     e.into()
 }
 
-pub fn eval(e: &Expr, vars: &dyn Vars) -> Result<f64, DecodeError> {
+pub(crate) fn eval(e: &Expr, vars: &dyn Vars) -> Result<f64, DecodeError> {
     eval::eval(e, vars).map_err(err)
 }
 
 /// [`eval::eval_value`]: a value that may be a string.
-pub fn eval_value(e: &Expr, vars: &dyn Vars) -> Result<eval::Val, DecodeError> {
+pub(crate) fn eval_value(e: &Expr, vars: &dyn Vars) -> Result<eval::Val, DecodeError> {
     eval::eval_value(e, vars).map_err(err)
 }
 
-pub fn resolve(v: &VarRef, vars: &dyn Vars) -> Result<VarSlot, DecodeError> {
+pub(crate) fn resolve(v: &VarRef, vars: &dyn Vars) -> Result<VarSlot, DecodeError> {
     let k = eval::resolve(v, vars).map_err(err)?;
     slot(&k)
         .ok_or_else(|| DecodeError::new(codes::BAD_VALUE, format!("{k}: more than three indices")))

@@ -18,13 +18,13 @@ use crate::lang::eval::is_true;
 
 /// How a `$` statement changes nesting, for skipping and for the label index.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Nesting {
+pub(crate) enum Nesting {
     Open,
     Close,
     Neither,
 }
 
-pub fn nesting(c: &Control) -> Nesting {
+pub(crate) fn nesting(c: &Control) -> Nesting {
     match c {
         Control::If(_)
         | Control::Switch(_)
@@ -43,7 +43,7 @@ pub fn nesting(c: &Control) -> Nesting {
 }
 
 /// Statements that are loops: not allowed in a stream (codes::STREAM_LOOP).
-pub fn is_loop_statement(c: &Control) -> bool {
+pub(crate) fn is_loop_statement(c: &Control) -> bool {
     matches!(
         c,
         Control::For { .. }
@@ -58,7 +58,7 @@ pub fn is_loop_statement(c: &Control) -> bool {
 }
 
 /// Whether `c` closes the loop `e`.
-pub fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
+pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
     matches!(
         (e, c),
         (FlowEntry::For { .. }, Control::EndFor)

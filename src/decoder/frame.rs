@@ -16,7 +16,7 @@ use super::vars::VarSlot;
 
 /// One open control structure of a frame.
 #[derive(Debug, Clone, PartialEq)]
-pub enum FlowEntry {
+pub(crate) enum FlowEntry {
     /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
     If { taken: bool },
     /// `$SWITCH`: the value cases compare against.
@@ -37,7 +37,7 @@ pub enum FlowEntry {
 }
 
 impl FlowEntry {
-    pub fn is_loop(&self) -> bool {
+    pub(crate) fn is_loop(&self) -> bool {
         matches!(
             self,
             FlowEntry::For { .. }
@@ -50,7 +50,7 @@ impl FlowEntry {
 
 /// What the skip machine is looking for.
 #[derive(Debug, Clone, PartialEq)]
-pub enum SkipUntil {
+pub(crate) enum SkipUntil {
     /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
     IfBranch,
     /// A branch has run: the `$ENDIF`.
@@ -72,21 +72,21 @@ pub enum SkipUntil {
 
 /// Skip state: what we look for and how deep inside skipped structures we are.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Skip {
-    pub until: SkipUntil,
+pub(crate) struct Skip {
+    pub(crate) until: SkipUntil,
     /// Structures opened inside the skipped region and not yet closed.
-    pub depth: u32,
+    pub(crate) depth: u32,
 }
 
 impl Skip {
-    pub fn new(until: SkipUntil) -> Self {
+    pub(crate) fn new(until: SkipUntil) -> Self {
         Skip { until, depth: 0 }
     }
 }
 
 /// What kind of program level a frame is; decides which end blocks are allowed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrameKind {
+pub(crate) enum FrameKind {
     Main,
     /// `L file`.
     Global,
@@ -97,59 +97,59 @@ pub enum FrameKind {
 }
 
 #[derive(Debug, Clone)]
-pub enum Source {
+pub(crate) enum Source {
     File(ProgramText),
     Stream,
 }
 
 /// Where a line starts, so loops and backward jumps in files can return to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LinePos {
+pub(crate) struct LinePos {
     /// Byte offset of the line's first byte.
-    pub pos: usize,
+    pub(crate) pos: usize,
     /// Number of lines before it (the line's own number is `line_no + 1`).
-    pub line_no: u32,
+    pub(crate) line_no: u32,
 }
 
 /// One program level.
 #[derive(Debug)]
-pub struct Frame {
-    pub kind: FrameKind,
-    pub source: Source,
-    pub prog: Arc<str>,
+pub(crate) struct Frame {
+    pub(crate) kind: FrameKind,
+    pub(crate) source: Source,
+    pub(crate) prog: Arc<str>,
     /// File frames: byte offset of the next line.
-    pub pos: usize,
+    pub(crate) pos: usize,
     /// File frames: lines read so far.
-    pub line_no: u32,
+    pub(crate) line_no: u32,
     /// Open control structures, innermost last.
-    pub flow: Vec<FlowEntry>,
+    pub(crate) flow: Vec<FlowEntry>,
     /// Set while lines are being skipped (false branch, forward jump, …).
-    pub skip: Option<Skip>,
+    pub(crate) skip: Option<Skip>,
     /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
-    pub comment_block: bool,
+    pub(crate) comment_block: bool,
     /// Inside `#VAR` … `#ENDVAR`.
-    pub var_block: bool,
+    pub(crate) var_block: bool,
     /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
     /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`.
-    pub seen_labels: HashSet<Label>,
+    pub(crate) seen_labels: HashSet<Label>,
     /// File frames: label → position and structural depth, built on the first jump.
-    pub label_index: Option<Arc<LabelIndex>>,
+    pub(crate) label_index: Option<Arc<LabelIndex>>,
 }
 
 /// How many stream labels a frame remembers. A stream may run for days; a label passed more
 /// than this many labels ago is treated as unknown (a jump to it waits forward for it).
-pub const MAX_SEEN_LABELS: usize = 65_536;
+pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
 
 /// All labels of a file with where they stand and how deeply nested they are.
 #[derive(Debug, Default)]
-pub struct LabelIndex {
-    pub labels: std::collections::HashMap<Label, (LinePos, usize)>,
+pub(crate) struct LabelIndex {
+    pub(crate) labels: std::collections::HashMap<Label, (LinePos, usize)>,
     /// `%L NAME` (upper-case) → the line after the head.
-    pub local_subs: std::collections::HashMap<String, LinePos>,
+    pub(crate) local_subs: std::collections::HashMap<String, LinePos>,
 }
 
 impl LabelIndex {
-    pub fn find(&self, t: &GotoTarget) -> Option<(LinePos, usize)> {
+    pub(crate) fn find(&self, t: &GotoTarget) -> Option<(LinePos, usize)> {
         let key = match t {
             GotoTarget::Number(n) => Label::Number(*n),
             GotoTarget::Name(s) => Label::Name(s.clone()),
@@ -159,7 +159,7 @@ impl LabelIndex {
 }
 
 impl Frame {
-    pub fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
+    pub(crate) fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
         Frame {
             kind,
             source,
@@ -175,18 +175,18 @@ impl Frame {
         }
     }
 
-    pub fn is_stream(&self) -> bool {
+    pub(crate) fn is_stream(&self) -> bool {
         matches!(self.source, Source::Stream)
     }
 
-    pub fn line_pos(&self) -> LinePos {
+    pub(crate) fn line_pos(&self) -> LinePos {
         LinePos {
             pos: self.pos,
             line_no: self.line_no,
         }
     }
 
-    pub fn seek(&mut self, at: LinePos) {
+    pub(crate) fn seek(&mut self, at: LinePos) {
         self.pos = at.pos;
         self.line_no = at.line_no;
     }
@@ -194,16 +194,16 @@ impl Frame {
 
 /// One line handed to the interpreter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LineMeta {
+pub(crate) struct LineMeta {
     /// 1-based line number in its program (stream: since stream start).
-    pub line: u32,
+    pub(crate) line: u32,
     /// Byte offset of the line (stream: since stream start).
-    pub offset: u64,
+    pub(crate) offset: u64,
 }
 
 /// The result of asking a frame for its next line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LineRead {
+pub(crate) enum LineRead {
     Line(LineMeta),
     /// A stream frame with no complete line available yet: try again next tick.
     Pending,
@@ -238,7 +238,7 @@ pub(super) fn cut_line(
 }
 
 /// Next line of a file frame.
-pub fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
+pub(crate) fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
     let Source::File(p) = &frame.source else {
         return LineRead::Eof;
     };
@@ -258,7 +258,7 @@ pub fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
 
 /// The channel's reader of its stream interface: the current segment and where we are in it.
 #[derive(Debug, Default)]
-pub struct StreamReader {
+pub(crate) struct StreamReader {
     seg: Vec<u8>,
     /// Reused buffer the stream buffer empties into.
     scratch: Vec<u8>,
@@ -267,18 +267,18 @@ pub struct StreamReader {
     seg_base: u64,
     line_no: u32,
     /// Segments extracted since stream start.
-    pub segments: u64,
+    pub(crate) segments: u64,
 }
 
 /// What reading the stream did besides returning a line, for the event log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StreamNote {
+pub(crate) enum StreamNote {
     Segment { bytes: usize },
 }
 
 impl StreamReader {
     /// Start a new stream: forget everything read before.
-    pub fn restart(&mut self) {
+    pub(crate) fn restart(&mut self) {
         self.seg.clear();
         self.pos = 0;
         self.seg_base = 0;
@@ -287,12 +287,12 @@ impl StreamReader {
     }
 
     /// Bytes of the current segment not yet decoded.
-    pub fn remaining(&self) -> usize {
+    pub(crate) fn remaining(&self) -> usize {
         self.seg.len() - self.pos
     }
 
     /// Next line; pulls a new segment from `buf` only when the current one is used up.
-    pub fn next_line(
+    pub(crate) fn next_line(
         &mut self,
         buf: &mut StreamBuffer,
         out: &mut String,
@@ -332,7 +332,7 @@ impl StreamReader {
 
     /// Drop the rest of the current segment (program end inside a segment, ISG FCT-C19 Data streaming §2.2).
     /// Data still in the stream buffer stays. Returns the bytes dropped.
-    pub fn discard_rest(&mut self) -> usize {
+    pub(crate) fn discard_rest(&mut self) -> usize {
         let n = self.remaining();
         self.seg_base += self.seg.len() as u64;
         self.seg.clear();

@@ -48,29 +48,29 @@ pub struct DecoderSettings {
     /// Lines decoded per tick at most (runtime.toml `decoder.blocks_per_tick`).
     pub blocks_per_tick: usize,
     /// Subroutine nesting depth at most (main program = level 0).
-    pub max_depth: usize,
+    pub(crate) max_depth: usize,
     /// Axes the channel has, by letter index of `AXIS_LETTERS`.
     pub axes: [bool; MAX_AXES],
     /// The name of the axis in each slot (`X`, or `X1` for an axis list's `X1`): a program
     /// writes `X10` for a one-letter name, `X1=10` for a longer one. Resolved once at set-up.
-    pub axis_names: [AxisName; MAX_AXES],
-    pub zero_offsets: ZeroOffsets,
+    pub(crate) axis_names: [AxisName; MAX_AXES],
+    pub(crate) zero_offsets: ZeroOffsets,
     /// How far the end point may lie off the circle, mm.
-    pub arc_tolerance_mm: f64,
+    pub(crate) arc_tolerance_mm: f64,
     /// Software limits per axis (runtime.toml `soft_limit_min_mm` / `soft_limit_max_mm`),
     /// mm in machine coordinates, by `AXIS_LETTERS` index: a block whose end point or arc
     /// lies outside is refused before it moves (21897).
-    pub soft_limits_mm: [SoftLimits; MAX_AXES],
+    pub(crate) soft_limits_mm: [SoftLimits; MAX_AXES],
     /// Global subroutines the channel calls by itself: at program start (P-CHAN-00119), before
     /// the main program's M02/M30 (P-CHAN-00252) and for M6 (P-CHAN-00118).
     pub implicit: crate::params::channel::ImplicitSubroutines,
     /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
     /// is reported with it, ncchannel's detail after it in parentheses.
-    pub error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
+    pub(crate) error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
 }
 
 /// Each slot named by its letter, `X` to `C`.
-pub fn letter_names() -> [AxisName; MAX_AXES] {
+pub(crate) fn letter_names() -> [AxisName; MAX_AXES] {
     AXIS_LETTERS.map(|l| AxisName::new(std::str::from_utf8(&[l]).unwrap_or("X")).expect("a letter"))
 }
 
@@ -148,7 +148,7 @@ impl fmt::Display for DecodeError {
 
 /// What the decoder reports besides queued blocks; the channel turns these into events.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Note {
+pub(crate) enum Note {
     ProgramStart {
         prog: Arc<str>,
         stream: bool,
@@ -215,9 +215,9 @@ pub struct DecoderIo<'a> {
     pub cache: &'a mut Cache,
     pub queue: &'a mut BlockQueue,
     /// Motion has nothing left to do (for `#FLUSH WAIT`).
-    pub motion_idle: bool,
+    pub(crate) motion_idle: bool,
     /// Keep each block's text for the event log (and report cache hits: events are on).
-    pub want_text: bool,
+    pub(crate) want_text: bool,
     /// Channel time at the start of this tick.
     pub now: Duration,
     /// Length of this tick: decoding stops for the tick once simulated file-system latency
@@ -321,7 +321,7 @@ impl Decoder {
         self.settings.axes
     }
     /// The name of the axis in each slot (`X`, `X1`, …), by `AXIS_LETTERS` index.
-    pub fn axis_names(&self) -> &[AxisName; MAX_AXES] {
+    pub(crate) fn axis_names(&self) -> &[AxisName; MAX_AXES] {
         &self.settings.axis_names
     }
     pub fn modal(&self) -> &Modal {
@@ -330,7 +330,7 @@ impl Decoder {
     pub fn vars(&self) -> &VarStore {
         &self.vars
     }
-    pub fn vars_mut(&mut self) -> &mut VarStore {
+    pub(crate) fn vars_mut(&mut self) -> &mut VarStore {
         &mut self.vars
     }
     pub fn stats(&self) -> DecoderStats {
@@ -340,13 +340,13 @@ impl Decoder {
         self.counter
     }
     /// Waiting for stream data that has not arrived.
-    pub fn starved(&self) -> bool {
+    pub(crate) fn starved(&self) -> bool {
         self.starved && self.state == DecoderState::Running
     }
-    pub fn searching(&self) -> bool {
+    pub(crate) fn searching(&self) -> bool {
         self.search.is_some()
     }
-    pub fn set_skip_mask(&mut self, mask: u16) {
+    pub(crate) fn set_skip_mask(&mut self, mask: u16) {
         self.skip_mask = mask;
     }
     pub fn depth(&self) -> usize {
@@ -354,7 +354,7 @@ impl Decoder {
     }
     /// The message reported for error `code`: the kernel's text for it (error text file,
     /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
-    pub fn reported_message(&self, code: u32, detail: String) -> String {
+    pub(crate) fn reported_message(&self, code: u32, detail: String) -> String {
         match self
             .settings
             .error_texts
@@ -367,7 +367,7 @@ impl Decoder {
     }
 
     /// Notes since the last call, oldest first.
-    pub fn take_notes(&mut self, into: &mut Vec<Note>) {
+    pub(crate) fn take_notes(&mut self, into: &mut Vec<Note>) {
         // A swap: both vectors keep their allocations from tick to tick.
         into.clear();
         std::mem::swap(&mut self.notes, into);

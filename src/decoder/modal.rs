@@ -10,7 +10,7 @@ use crate::vocab::axis::{Position, MAX_AXES};
 pub const DEFAULT_PATH_DEV_MM: f64 = 0.05;
 
 /// `PATH_DEV=<mm>` from the bracket text of `#CONTOUR MODE [...]`, if it has a valid one.
-pub fn path_dev_mm(options: &str) -> Option<f64> {
+pub(crate) fn path_dev_mm(options: &str) -> Option<f64> {
     options
         .split(|c: char| c.is_whitespace() || c == '[' || c == ']' || c == ',')
         .filter_map(|w| {
@@ -43,7 +43,7 @@ pub enum Spindle {
 
 /// Tool radius compensation (G40 / G41 / G42).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RadiusComp {
+pub(crate) enum RadiusComp {
     Off,
     Left,
     Right,
@@ -60,7 +60,7 @@ pub enum Units {
 
 impl Units {
     /// mm per programmed length unit.
-    pub fn mm_per_unit(self) -> f64 {
+    pub(crate) fn mm_per_unit(self) -> f64 {
         match self {
             Units::Metric => 1.0,
             Units::Inch => 25.4,
@@ -70,7 +70,7 @@ impl Units {
 
 /// Meaning of the F word (G94 / G95).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FeedMode {
+pub(crate) enum FeedMode {
     /// G94: length per minute (the default).
     PerMinute,
     /// G95: length per spindle revolution; the path feed is F × S, computed at decode time.
@@ -80,7 +80,7 @@ pub enum FeedMode {
 /// Exact-stop / velocity mode at block ends (G60, G08, G09, G359/G360, G900/G901). Kept as
 /// state only: the planner does not read it yet (docs/nc-language.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BlockEnd {
+pub(crate) enum BlockEnd {
     /// Default: continuous path.
     Continuous,
     /// G360: exact stop at every block end (G359 deselects).
@@ -98,35 +98,35 @@ pub struct Modal {
     /// Modal path feed under G94, mm/min; 0 = none programmed yet.
     pub feed_mm_per_min: f64,
     /// Modal feed under G95, mm per spindle revolution; 0 = none programmed yet.
-    pub feed_mm_per_rev: f64,
-    pub feed_mode: FeedMode,
+    pub(crate) feed_mm_per_rev: f64,
+    pub(crate) feed_mode: FeedMode,
     pub units: Units,
     /// G92 reference point offset per axis, mm / degrees, added to programmed absolute
     /// positions after the zero offset.
-    pub g92_offset: [f64; MAX_AXES],
-    pub block_end: BlockEnd,
+    pub(crate) g92_offset: [f64; MAX_AXES],
+    pub(crate) block_end: BlockEnd,
     pub spindle: Spindle,
     /// Programmed spindle speed, rpm.
     pub spindle_rpm: f64,
     /// M7.
-    pub coolant_mist: bool,
+    pub(crate) coolant_mist: bool,
     /// M8.
     pub coolant_flood: bool,
     pub tool: u32,
     /// D word: tool data set for radius compensation.
     pub tool_offset: u32,
     /// Active zero offset: 0 = none (G53 state), 1..=6 = G54..G59.
-    pub zero_offset: usize,
-    pub radius_comp: RadiusComp,
+    pub(crate) zero_offset: usize,
+    pub(crate) radius_comp: RadiusComp,
     /// G261 contouring on (G260 off).
     pub contouring: bool,
     /// `#CONTOUR MODE [DEV PATH_DEV=…]`: corner deviation for G261/G61, mm.
     pub contour_dev_mm: f64,
     /// G151 / `#SPLINE ON`.
     pub spline: bool,
-    pub spline_type: SplineCommand,
+    pub(crate) spline_type: SplineCommand,
     /// `#HSC ON`.
-    pub hsc: bool,
+    pub(crate) hsc: bool,
     /// Programmed end position of the last block in machine coordinates (mm / degrees).
     pub pos: Position,
 }
@@ -163,7 +163,7 @@ impl Modal {
 
     /// The cross-block state a motion block carries to motion (`contour_here`: G61 in the
     /// block).
-    pub fn path_mode(&self, contour_here: bool) -> crate::queue::PathMode {
+    pub(crate) fn path_mode(&self, contour_here: bool) -> crate::queue::PathMode {
         use crate::queue::{CompSide, PathMode, SplineKind};
         PathMode {
             contour_dev_mm: (self.contouring || contour_here).then_some(self.contour_dev_mm),
@@ -184,7 +184,7 @@ impl Modal {
     /// name. TRC, spline and HSC do (TF5200 diagnosis IDs 20651, 120102, 120434); polynomial
     /// contouring does not (kernels since V2.10.1503.08, TF5200 "Flushing NC channel"): the
     /// motion suppresses the blend at the motion blocks around the flush.
-    pub fn flush_refusal(&self) -> Option<(u32, &'static str)> {
+    pub(crate) fn flush_refusal(&self) -> Option<(u32, &'static str)> {
         use crate::lang::codes;
         if self.radius_comp != RadiusComp::Off {
             Some((codes::FLUSH_UNDER_TRC, "tool radius compensation"))
@@ -200,26 +200,26 @@ impl Modal {
 
 /// The outcome of a block's G words beyond the modal groups.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct BlockGs {
+pub(crate) struct BlockGs {
     /// G4 in this block: the X word is the dwell time in seconds.
     pub dwell: bool,
     /// G53 in this block: coordinates are machine coordinates for this block only.
-    pub machine_coords: bool,
+    pub(crate) machine_coords: bool,
     /// G61: contouring at this block's end only.
-    pub contour_this_block: bool,
+    pub(crate) contour_this_block: bool,
     /// G92: the block's axis words set the reference point offset; no motion.
-    pub set_reference: bool,
+    pub(crate) set_reference: bool,
     /// G60 / G09 / G900 / G901: stop at this block's end (state only, as `BlockEnd`).
-    pub stop_this_block: bool,
+    pub(crate) stop_this_block: bool,
     /// G130: the block's axis words are acceleration weightings in percent, not positions
     /// (TF5200 programming manual, "Acceleration weighting"); no motion.
-    pub axis_weights: bool,
+    pub(crate) axis_weights: bool,
 }
 
 /// Apply one G code. `false` for a G code the channel does not know or refuses (the parser
 /// has already said which).
 #[must_use]
-pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
+pub(crate) fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
     match g {
         0 => m.motion = MotionMode::Rapid,
         1 => m.motion = MotionMode::Linear,
@@ -263,7 +263,7 @@ pub fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
 
 /// Apply an M function's modal effect (spindle, coolant). Program ends are handled by the
 /// decoder; other M functions are PLC outputs with no modal state.
-pub fn apply_m(m: &mut Modal, code: u32) {
+pub(crate) fn apply_m(m: &mut Modal, code: u32) {
     match code {
         3 => m.spindle = Spindle::Cw,
         4 => m.spindle = Spindle::Ccw,

@@ -23,7 +23,7 @@ use crate::lang::codes::{
 };
 
 /// Array indices of a variable, evaluated. At most three dimensions, as ISG arrays have.
-pub type Indices = [i64; 3];
+pub(crate) type Indices = [i64; 3];
 
 /// A variable with its indices evaluated: the key of the store.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -52,7 +52,7 @@ pub const CLASS_BYTES: usize = 8 << 20;
 
 /// Bookkeeping charged per entry besides its name and values: a hash-table slot (key and
 /// value, 56 bytes) and allocator headers, rounded.
-pub const ENTRY_BYTES: usize = 64;
+pub(crate) const ENTRY_BYTES: usize = 64;
 
 /// A variable class: each has its own [`CLASS_BYTES`] budget. ISG counts V.P., V.S., V.E.
 /// and V.L. (diagnosis 20967's class parameter); P parameters outside the flat table are a
@@ -269,18 +269,22 @@ impl VarStore {
     }
 
     /// A subroutine or cycle level begins.
-    pub fn push_level(&mut self, cycle_params: Vec<(u32, f64)>) {
+    pub(crate) fn push_level(&mut self, cycle_params: Vec<(u32, f64)>) {
         self.push_cycle_level(cycle_params, Vec::new());
     }
 
     /// A cycle level begins with numeric and string parameters (`@P1=5 @P2="text"`).
-    pub fn push_cycle_level(&mut self, numbers: Vec<(u32, f64)>, texts: Vec<(u32, Box<str>)>) {
+    pub(crate) fn push_cycle_level(
+        &mut self,
+        numbers: Vec<(u32, f64)>,
+        texts: Vec<(u32, Box<str>)>,
+    ) {
         self.local.push(Scope::default());
         self.cycle.push(numbers);
         self.cycle_text.push(texts);
     }
 
-    pub fn pop_level(&mut self) {
+    pub(crate) fn pop_level(&mut self) {
         if self.local.len() > 1 {
             self.local.pop();
             self.cycle.pop();
@@ -490,7 +494,7 @@ impl VarStore {
     /// Assign a string. A `STRING[n]` variable takes at most n characters (21462); a V.
     /// scalar not yet there is created as a `STRING[126]`; a variable holding numbers, or a P
     /// parameter, takes none (900008). A cycle parameter becomes a string one.
-    pub fn set_str(&mut self, k: VarSlot, text: &str) -> Result<(), VarError> {
+    pub(crate) fn set_str(&mut self, k: VarSlot, text: &str) -> Result<(), VarError> {
         let len = text.chars().count();
         match k {
             VarSlot::P { number, .. } => Err(VarError::StringToNumber(format!("P{number}"))),
@@ -578,7 +582,7 @@ impl VarStore {
     /// `sizes` (empty: a scalar), every element `init` (the parser checked its length).
     /// Replaces a variable of that name as [`VarStore::declare`] does; returns the number of
     /// values made.
-    pub fn declare_str(
+    pub(crate) fn declare_str(
         &mut self,
         scope: VScope,
         name: &str,
@@ -640,7 +644,7 @@ impl VarStore {
     /// value `init`. A variable of that name in the same scope (V.L.: the same level) is
     /// replaced. Returns the number of values made, so the decoder can spread the work of
     /// large declarations over ticks.
-    pub fn declare(
+    pub(crate) fn declare(
         &mut self,
         scope: VScope,
         name: &str,
@@ -677,7 +681,7 @@ impl VarStore {
     }
 
     /// V.E. written from outside the channel.
-    pub fn set_external(&mut self, name: &str, v: f64) -> Result<(), VarError> {
+    pub(crate) fn set_external(&mut self, name: &str, v: f64) -> Result<(), VarError> {
         self.set(
             VarSlot::V {
                 scope: VScope::External,
@@ -689,7 +693,7 @@ impl VarStore {
         )
     }
 
-    pub fn get_external(&self, name: &str) -> Option<f64> {
+    pub(crate) fn get_external(&self, name: &str) -> Option<f64> {
         self.get(&VarSlot::V {
             scope: VScope::External,
             name: name.to_ascii_uppercase().into(),

@@ -7,7 +7,7 @@
 //! refused and the program falls back to the numbered name, with a note for the operator.
 
 /// Longest program or workpiece name accepted from the data.
-pub const MAX_NAME_LEN: usize = 100;
+pub(crate) const MAX_NAME_LEN: usize = 100;
 
 /// Rejected names kept per program for the operator message; further ones are dropped.
 const MAX_REJECTED: usize = 4;
@@ -29,7 +29,7 @@ pub struct SinumerikName {
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct NameInfo {
     /// From the first `%_N_` line of the program.
-    pub sinumerik: Option<SinumerikName>,
+    pub(crate) sinumerik: Option<SinumerikName>,
     /// Workpiece from the first `;$PATH=` line, `SHAFT` for `/_N_WKS_DIR/_N_SHAFT_WPD`.
     pub workpiece: Option<String>,
     /// From the first ISG `%name` line (not `%L`, not `%_N_`).
@@ -43,7 +43,7 @@ pub struct NameInfo {
 
 /// Does this line begin a SINUMERIK program (`%_N_…`)? Such a line inside an already named
 /// program starts the next file: MMP interprets every control line in the data.
-pub fn is_sinumerik_start(head: &[u8]) -> bool {
+pub(crate) fn is_sinumerik_start(head: &[u8]) -> bool {
     head.starts_with(b"%_N_")
 }
 
@@ -100,7 +100,7 @@ impl NameInfo {
     /// Did this program have a `%_N_` line, even one whose name was refused? Then a further
     /// `%_N_` line begins the next program: a refused name must never merge its program into
     /// the next one's file.
-    pub fn has_sinumerik_line(&self) -> bool {
+    pub(crate) fn has_sinumerik_line(&self) -> bool {
         self.sinumerik_seen
     }
 
@@ -161,7 +161,7 @@ fn workpiece_of(path: &[u8]) -> Option<&[u8]> {
 }
 
 /// One plain path component or nothing.
-pub fn safe_name(raw: &[u8]) -> Option<String> {
+pub(crate) fn safe_name(raw: &[u8]) -> Option<String> {
     let ok = !raw.is_empty()
         && raw.len() <= MAX_NAME_LEN
         && raw[0] != b'.'

@@ -89,12 +89,12 @@ impl Markers {
     }
 
     /// Does any start marker stand in this line head?
-    pub fn start_in(&self, head: &[u8]) -> bool {
+    pub(crate) fn start_in(&self, head: &[u8]) -> bool {
         any_in(&self.start, self.anchor, head)
     }
 
     /// Does any end marker stand in this line head?
-    pub fn end_in(&self, head: &[u8]) -> bool {
+    pub(crate) fn end_in(&self, head: &[u8]) -> bool {
         any_in(&self.end, self.anchor, head)
     }
 }

@@ -5,13 +5,13 @@
 //! [`ProgramWriter`] (temp file, fsync, rename). [`transfer`] ties them to a file, standard
 //! input or one TCP connection; [`listen`] takes a port's connections.
 
-pub mod control_line;
-pub mod error;
-pub mod listen;
+pub(crate) mod control_line;
+pub(crate) mod error;
+pub(crate) mod listen;
 pub mod markers;
 pub mod splitter;
-pub mod transfer;
-pub mod writer;
+pub(crate) mod transfer;
+pub(crate) mod writer;
 
 pub use control_line::{NameInfo, SinumerikName};
 pub use error::DncError;

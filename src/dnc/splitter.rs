@@ -55,7 +55,7 @@ pub struct SplitSummary {
     /// Programs delivered with `complete == false`.
     pub cut_off: usize,
     /// Did a start marker occur (start-only and start/end mode)?
-    pub start_found: bool,
+    pub(crate) start_found: bool,
     pub bytes_in: u64,
     /// Bytes outside every program (before the first start, between regions, blank lines
     /// between end-only blocks).

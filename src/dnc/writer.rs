@@ -84,7 +84,7 @@ impl NameTemplate {
 #[derive(Debug, Clone)]
 pub struct WriterConfig {
     /// The program directory; created when missing.
-    pub out_dir: PathBuf,
+    pub(crate) out_dir: PathBuf,
     /// Replace an existing file of the same name (otherwise the existing file is kept and the
     /// received program dropped).
     pub overwrite: bool,
@@ -143,7 +143,7 @@ pub struct ReceivedProgram {
 
 impl ReceivedProgram {
     /// Is the program now on disk under its final name?
-    pub fn is_filed(&self) -> bool {
+    pub(crate) fn is_filed(&self) -> bool {
         matches!(
             self.disposition,
             Disposition::Written | Disposition::Replaced
@@ -190,19 +190,19 @@ impl ProgramWriter {
 
     /// Deliver at most `max` more programs; the next ones are dropped as
     /// [`Disposition::OverLimit`]. `None` lifts the limit.
-    pub fn limit_programs(&mut self, max: Option<usize>) {
+    pub(crate) fn limit_programs(&mut self, max: Option<usize>) {
         self.programs_left = max;
         self.over_limit = false;
     }
 
     /// Was a program dropped for the limit of [`ProgramWriter::limit_programs`]?
-    pub fn over_limit(&self) -> bool {
+    pub(crate) fn over_limit(&self) -> bool {
         self.over_limit
     }
 
     /// Number unnamed programs from `numbers`, shared with other writers (concurrent
     /// transfers into one folder).
-    pub fn with_numbers(mut self, numbers: Arc<AtomicU32>) -> Self {
+    pub(crate) fn with_numbers(mut self, numbers: Arc<AtomicU32>) -> Self {
         self.next_number = numbers;
         self
     }
@@ -213,7 +213,7 @@ impl ProgramWriter {
     }
 
     /// Called for every program as soon as it is filed (or dropped).
-    pub fn with_log(mut self, log: impl FnMut(&ReceivedProgram) + 'static) -> Self {
+    pub(crate) fn with_log(mut self, log: impl FnMut(&ReceivedProgram) + 'static) -> Self {
         self.log = Some(Box::new(log));
         self
     }
@@ -223,13 +223,13 @@ impl ProgramWriter {
     }
 
     /// The records since the last call.
-    pub fn take_records(&mut self) -> Vec<ReceivedProgram> {
+    pub(crate) fn take_records(&mut self) -> Vec<ReceivedProgram> {
         std::mem::take(&mut self.records)
     }
 
     /// Drop a program still being written (the transfer was abandoned); dropping the
     /// temporary file removes it.
-    pub fn discard_current(&mut self) {
+    pub(crate) fn discard_current(&mut self) {
         self.current = None;
     }
 

@@ -194,7 +194,7 @@ fn center_from_radius(
 /// The smallest and largest value each axis takes along `mv`: the end points, and for an
 /// arc the circle's extreme points in its plane that lie within the swept angle (the axis
 /// normal to the plane and any other axis move linearly).
-pub fn extent(mv: &Move) -> (Position, Position) {
+pub(crate) fn extent(mv: &Move) -> (Position, Position) {
     let mut lo = [0.0; MAX_AXES];
     let mut hi = [0.0; MAX_AXES];
     for i in 0..MAX_AXES {
@@ -229,7 +229,7 @@ const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
 /// An axis that starts outside its limits (after a reset there, or with limits changed) may
 /// move back inside: the bound on that side is its start, so it may not go further out but
 /// may return — otherwise such an axis could never move again.
-pub fn outside_limits(
+pub(crate) fn outside_limits(
     mv: &Move,
     limits: &[SoftLimits; MAX_AXES],
     enabled: &[bool; MAX_AXES],
@@ -261,11 +261,11 @@ pub fn outside_limits(
 
 /// Where a move leaves an axis' software limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LimitBreach {
+pub(crate) struct LimitBreach {
     /// Index into `AXIS_LETTERS`.
     pub axis: usize,
     /// The farthest value outside, mm.
-    pub value_mm: f64,
+    pub(crate) value_mm: f64,
     /// Below the lower limit (else above the upper).
     pub below: bool,
     /// The value is the move's end point (else a point on the way: an arc's extent).

@@ -6,7 +6,7 @@ pub mod arc;
 
 /// One axis's software limits, mm (machine coordinates); unbounded by default.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SoftLimits {
+pub(crate) struct SoftLimits {
     pub min_mm: f64,
     pub max_mm: f64,
 }

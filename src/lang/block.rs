@@ -99,7 +99,7 @@ pub struct NamedAxis {
 }
 
 /// Most characters of an axis name (P-CHAN-00006 `bezeichnung`: "maximum 16 characters").
-pub const AXIS_NAME_MAX: usize = 16;
+pub(crate) const AXIS_NAME_MAX: usize = 16;
 
 /// An axis name: a letter X Y Z A B C, then letters, digits and `_` (`X1`, `A1`, `Z_ACHSE`),
 /// at most [`AXIS_NAME_MAX`] characters, upper-case. Fixed size, no allocation: the decoder
@@ -140,7 +140,7 @@ impl AxisName {
 
     /// The name is its letter alone (`X`, not `X1`). Asked for every axis word a block
     /// programs, so it reads the length rather than building the text.
-    pub fn is_letter(&self) -> bool {
+    pub(crate) fn is_letter(&self) -> bool {
         self.len == 1
     }
 
@@ -258,7 +258,7 @@ pub enum Expr {
 
 /// Most characters a string value holds: a `STRING[n]` declares n of 1 to 126 (TF5200
 /// programming manual, "Variables"; ISG's editor grammar), and no string value is longer.
-pub const MAX_STRING: usize = 126;
+pub(crate) const MAX_STRING: usize = 126;
 
 /// The string functions of TF5200 "Operations for character strings" ncchannel evaluates.
 /// Positions count characters from 1.

@@ -239,7 +239,7 @@ pub const CACHE_NOT_ENABLED: u32 = 900160;
 // ---- End of the error ids ----------------------------------------------------------------
 
 /// The id for a word other than an axis programmed twice in one block.
-pub fn word_twice(letter: u8) -> u32 {
+pub(crate) fn word_twice(letter: u8) -> u32 {
     match letter.to_ascii_uppercase() {
         b'F' => F_TWICE,
         b'S' => S_TWICE,
@@ -503,25 +503,25 @@ pub const MAX_BLOCK_CHARS: usize = 4000;
 
 /// Deepest nesting of brackets, unary operators, powers and function calls in one
 /// expression. Bounds the parser's recursion so hostile input cannot overflow the stack.
-pub const MAX_EXPR_NESTING: u32 = 64;
+pub(crate) const MAX_EXPR_NESTING: u32 = 64;
 
 /// Largest coordinate a word may carry, mm (or program units): ISG keeps positions in
 /// 0.1 µm as signed 32-bit numbers, so ±214,748.3647 mm is the data format the TF5200
 /// diagnoses 20020 and 20054 speak of. I, J, K beyond it are 20020, R beyond it 20054.
-pub const MAX_COORD_MM: f64 = 214_748.364_7;
+pub(crate) const MAX_COORD_MM: f64 = 214_748.364_7;
 
 /// Most elements one `#VAR` array may have. A bigger declaration is refused at parse time
 /// (20967), so `check` and the decoder agree; together with the per-class byte budgets of
 /// the decoder's variable store it bounds what one line can allocate.
-pub const MAX_ARRAY_ELEMENTS: u64 = 100_000;
+pub(crate) const MAX_ARRAY_ELEMENTS: u64 = 100_000;
 
 /// Most indices (dimensions) of an array variable, as ISG arrays have (20974 beyond).
-pub const MAX_ARRAY_DIMS: usize = 3;
+pub(crate) const MAX_ARRAY_DIMS: usize = 3;
 
 /// Highest expression tree (operators on the longest path from root to a leaf). Bounds the
 /// recursion of evaluating, printing and dropping a tree; a flat chain `1+1+…` of more than
 /// this many operators is 20200 "expression too complex".
-pub const MAX_EXPR_HEIGHT: u32 = 256;
+pub(crate) const MAX_EXPR_HEIGHT: u32 = 256;
 
 /// Address letters of ordinary words. The TF5200 manual's words are G M H F S T D X Y Z A B C I J K R E;
 /// we add U V W as further axis names (ISG axis names are configurable and U/V/W are the usual
@@ -531,7 +531,7 @@ pub const WORD_LETTERS: &[u8] = b"GMHFSTDXYZABCIJKREUVW";
 
 /// Is `b` (already upper-case) an address letter of an ordinary word?
 #[inline]
-pub fn is_word_letter(b: u8) -> bool {
+pub(crate) fn is_word_letter(b: u8) -> bool {
     // A 32-bit mask over 'A'..='Z' keeps the hot path free of a table search.
     const MASK: u32 = {
         let mut m = 0u32;
@@ -560,11 +560,11 @@ pub const KNOWN_G: &[u32] = &[
 /// times", also written `G134 50`), `G129=<expr>` (weighting of rapid traverse velocity),
 /// `G131=<expr>` / `G231=<expr>` (acceleration weighting, TF5200 "Acceleration weighting"),
 /// `G233=<expr>` (weighting for G00) and the dwell `G04 <seconds>`.
-pub const G_WITH_VALUE: &[u32] = &[4, 129, 131, 133, 134, 231, 233];
+pub(crate) const G_WITH_VALUE: &[u32] = &[4, 129, 131, 133, 134, 231, 233];
 
 /// Is `g` one of the implemented G functions ([`KNOWN_G`])?
 #[inline]
-pub fn is_known_g(g: u32) -> bool {
+pub(crate) fn is_known_g(g: u32) -> bool {
     matches!(
         g,
         0..=4 | 17..=19 | 40..=42 | 53..=59 | 61 | 70 | 71 | 90..=92 | 94 | 95 | 97 | 150 | 151
@@ -575,16 +575,16 @@ pub fn is_known_g(g: u32) -> bool {
 /// M functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)"). M0–M9,
 /// M17, M29, M30 have their meaning in the decoder; the others go to the PLC side as
 /// events. Above 65,535 and fractional numbers are 20157.
-pub fn is_known_m(m: u32) -> bool {
+pub(crate) fn is_known_m(m: u32) -> bool {
     m <= MAX_M_H
 }
 
 /// M and H functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)").
-pub const MAX_M_H: u32 = 65_535;
+pub(crate) const MAX_M_H: u32 = 65_535;
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum StrayKind {
+pub(crate) enum StrayKind {
     Else,
     ElseIf,
     EndIf,

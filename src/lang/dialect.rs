@@ -282,7 +282,7 @@ const INERT_FORMS: &[(&str, &[&str])] = &[
 
 /// `s` for the command `kw` (upper-case) whose text after the keyword is `rest`, made
 /// [`Support::Inert`] when it is one of the [`INERT_FORMS`].
-pub fn form_support(s: Support, kw: &[u8], rest: &str) -> Support {
+pub(crate) fn form_support(s: Support, kw: &[u8], rest: &str) -> Support {
     let inert = INERT_FORMS.iter().any(|(k, words)| {
         k.as_bytes() == kw
             && words

@@ -181,7 +181,7 @@ impl<'a> Ctx<'a> {
     }
 
     /// `ascii` must say whether `line` is pure ASCII (then columns are byte offsets).
-    pub fn with_ascii(line: &'a str, ascii: bool) -> Self {
+    pub(crate) fn with_ascii(line: &'a str, ascii: bool) -> Self {
         Ctx {
             line,
             ascii,
@@ -236,7 +236,7 @@ impl<'a> Ctx<'a> {
         perr(&self.line[off..], code, msg)
     }
 
-    pub fn to_error(&self, e: nom::Err<PErr<'_>>) -> SyntaxError {
+    pub(crate) fn to_error(&self, e: nom::Err<PErr<'_>>) -> SyntaxError {
         match e {
             nom::Err::Error(p) | nom::Err::Failure(p) => {
                 SyntaxError::new(p.code, self.col(p.input), p.msg.into_owned())
@@ -264,7 +264,7 @@ impl<'a> Ctx<'a> {
     }
 
     /// `[expr]`: the bracketed form words use (`X[P1*2]`).
-    pub fn bracketed(&self, i: &'a str) -> PResult<'a, Expr> {
+    pub(crate) fn bracketed(&self, i: &'a str) -> PResult<'a, Expr> {
         let (i, _) = ch('[')(i)?;
         let _g = self.enter(i)?;
         let (j, e) = self.expr(ws(i))?;
@@ -837,7 +837,7 @@ impl BinOp {
 
 impl Func {
     /// Number of arguments: ATAN2 takes two, every other function one.
-    pub fn arity(self) -> usize {
+    pub(crate) fn arity(self) -> usize {
         match self {
             Func::Atan2 => 2,
             _ => 1,
@@ -871,7 +871,7 @@ impl Func {
 
 impl StrFunc {
     /// The least and most arguments: `ORD` takes its position optionally.
-    pub fn arity(self) -> (usize, usize) {
+    pub(crate) fn arity(self) -> (usize, usize) {
         match self {
             StrFunc::Len => (1, 1),
             StrFunc::Left | StrFunc::Right | StrFunc::Find => (2, 2),
@@ -894,7 +894,7 @@ impl StrFunc {
     }
 
     /// Whether the result is a string (`LEN`, `FIND`, `ORD` give numbers).
-    pub fn gives_string(self) -> bool {
+    pub(crate) fn gives_string(self) -> bool {
         matches!(
             self,
             StrFunc::Left | StrFunc::Right | StrFunc::Mid | StrFunc::Delete
@@ -903,7 +903,7 @@ impl StrFunc {
 }
 
 /// Every string function, for lookup by name.
-pub const STR_FUNCS: [StrFunc; 7] = [
+pub(crate) const STR_FUNCS: [StrFunc; 7] = [
     StrFunc::Len,
     StrFunc::Left,
     StrFunc::Right,

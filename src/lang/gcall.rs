@@ -13,7 +13,7 @@ use super::expr::{perr, ws, Ctx, PErr};
 pub const G_CALLS: std::ops::RangeInclusive<u32> = 800..=819;
 
 /// Most transfer parameters of one call (the manual's 50).
-pub const MAX_G_CALL_PARAMS: usize = 50;
+pub(crate) const MAX_G_CALL_PARAMS: usize = 50;
 
 /// After `G<g>` (not a fast-path G): for G800–G819 followed by `[`, the bracket as an
 /// [`Item::GCall`] pushed onto `items` and the rest of the line; `None` otherwise.

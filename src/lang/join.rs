@@ -68,7 +68,7 @@ pub struct Joiner {
 
 impl Joiner {
     /// A block has begun and waits for its next line.
-    pub fn is_open(&self) -> bool {
+    pub(crate) fn is_open(&self) -> bool {
         self.open
     }
 

@@ -5,17 +5,17 @@
 //! `#COMMENT` and `#VAR` block state itself and asks [`is_comment_end`] /
 //! [`parse_var_declaration`] for lines inside them.
 
-pub mod block;
+pub(crate) mod block;
 mod bytes;
 pub mod check;
 pub mod codes;
 pub mod dialect;
 mod display;
-pub mod error;
-pub mod eval;
+pub(crate) mod error;
+pub(crate) mod eval;
 pub mod expr;
 pub mod gcall;
-pub mod join;
+pub(crate) mod join;
 pub mod msg;
 mod number;
 pub mod parse;

@@ -255,7 +255,7 @@ fn format_elements(line: &str, len: usize) -> Result<usize, nom::Err<PErr<'_>>> 
 
 /// Why a message could not be formatted.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum MessageError {
+pub(crate) enum MessageError {
     /// The formatted text would exceed [`MAX_MSG_CHARS`] (900136).
     #[error("formatted #MSG text longer than {MAX_MSG_CHARS} characters")]
     TooLong,
@@ -278,7 +278,7 @@ impl MessageError {
 /// `%d` the value truncated toward zero, `%f` with 6 decimals unless a precision is given,
 /// `%s` a string as it is and a number in its shortest form (precision cuts either). A
 /// text kept verbatim (not a quoted string) is returned as it is.
-pub fn format_message(m: &Message, values: &[Val]) -> Result<String, MessageError> {
+pub(crate) fn format_message(m: &Message, values: &[Val]) -> Result<String, MessageError> {
     if !m.quoted {
         return Ok(m.text.clone());
     }

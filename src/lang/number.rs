@@ -8,7 +8,7 @@
 /// Why a literal beyond the largest `f64` (more than 308 digits before the point) is
 /// refused: it would read as infinity, which no word may carry and the canonical text
 /// cannot print back. Error 20200 at the literal.
-pub const TOO_LARGE: &str = "number too large (beyond 1.8e308)";
+pub(crate) const TOO_LARGE: &str = "number too large (beyond 1.8e308)";
 
 /// Exact powers of ten representable in an `f64`.
 const POW10: [f64; 23] = [
@@ -20,7 +20,7 @@ const POW10: [f64; 23] = [
 /// digit. Returns the value and the number of bytes used, or `None` if `s` does not start
 /// with a literal.
 #[inline]
-pub fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
+pub(crate) fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
     let mut i = 0;
     let mut mantissa: u64 = 0;
     let mut digits = 0usize; // significant digits folded into `mantissa`
@@ -72,7 +72,7 @@ pub fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
 }
 
 /// What a refused literal may have run into, for the messages that refuse it.
-pub const LITERAL_LIMIT: &str = "a number has at most 308 integer digits";
+pub(crate) const LITERAL_LIMIT: &str = "a number has at most 308 integer digits";
 
 #[cfg(test)]
 mod tests {

@@ -51,7 +51,7 @@ pub fn word_value(letter: u8, v: f64) -> Result<(), RangeError> {
 }
 
 /// `v` as a whole number 0..=u32::MAX, if it is one (within 1e-9, as `G01` written `G1.0`).
-pub fn whole_u32(v: f64) -> Option<u32> {
+pub(crate) fn whole_u32(v: f64) -> Option<u32> {
     let r = v.round();
     ((v - r).abs() < 1e-9 && (0.0..=f64::from(u32::MAX)).contains(&r)).then_some(r as u32)
 }

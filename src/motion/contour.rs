@@ -25,7 +25,7 @@ const MAX_TURN_MARGIN_RAD: f64 = 1e-3;
 /// G17/G18/G19, collinear, a reversal, zero deviation, or nothing left to cut).
 ///
 /// Returns the new end of `prev`, the arc, and the new start of `next`.
-pub fn blend(prev: &Move, next: &Move, dev_mm: f64) -> Option<(Position, Move, Position)> {
+pub(crate) fn blend(prev: &Move, next: &Move, dev_mm: f64) -> Option<(Position, Move, Position)> {
     if !(matches!(prev.kind, MoveKind::Line) && matches!(next.kind, MoveKind::Line)) {
         return None;
     }

@@ -19,7 +19,7 @@
 use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Longest window, ticks (bounds memory and tick work whatever the limits say).
-pub const MAX_WINDOW_TICKS: usize = 4096;
+pub(crate) const MAX_WINDOW_TICKS: usize = 4096;
 
 /// One moving average: the last `len` inputs.
 #[derive(Debug, Clone)]
@@ -103,7 +103,7 @@ impl Stage {
 
 /// The corner filter followed by the jerk filter.
 #[derive(Debug, Clone)]
-pub struct AxisFilter {
+pub(crate) struct AxisFilter {
     /// Corner smoothing window, s (0 = off).
     corner_s: f64,
     /// Jerk window, s (0 = off): 2·aᵢ / jᵢ, the largest over the axes with a jerk limit.
@@ -115,7 +115,7 @@ pub struct AxisFilter {
 }
 
 impl AxisFilter {
-    pub fn new(corner_s: f64, jerk_s: f64, p: Position) -> Self {
+    pub(crate) fn new(corner_s: f64, jerk_s: f64, p: Position) -> Self {
         let ok = |t: f64| if t.is_finite() { t.max(0.0) } else { 0.0 };
         AxisFilter {
             corner_s: ok(corner_s),
@@ -127,7 +127,7 @@ impl AxisFilter {
     }
 
     /// Window in ticks for `t_s` at `dt_s`: at least `t_s` long (so the bound holds).
-    pub fn ticks(t_s: f64, dt_s: f64) -> usize {
+    pub(crate) fn ticks(t_s: f64, dt_s: f64) -> usize {
         if t_s <= 0.0 || dt_s <= 0.0 {
             return 1;
         }
@@ -136,7 +136,7 @@ impl AxisFilter {
 
     /// Size the windows for tick length `dt_s`; a change refills them with the current output
     /// (only the first tick or a changed cycle period does this).
-    pub fn configure(&mut self, dt_s: f64) {
+    pub(crate) fn configure(&mut self, dt_s: f64) {
         if dt_s <= 0.0 || dt_s == self.dt_s {
             return;
         }
@@ -153,7 +153,7 @@ impl AxisFilter {
     }
 
     /// The windows for tick length `dt_s` with the configured corner and jerk times, ticks.
-    pub fn general_ticks(&self, dt_s: f64) -> (usize, usize) {
+    pub(crate) fn general_ticks(&self, dt_s: f64) -> (usize, usize) {
         (
             Self::ticks(self.corner_s, dt_s),
             Self::ticks(self.jerk_s, dt_s),
@@ -163,7 +163,7 @@ impl AxisFilter {
     /// Use windows of `corner_ticks` and `jerk_ticks` from now on. Only while settled: the
     /// output then equals the input, so refilling the windows with it moves nothing and the
     /// new windows start from rest. Returns whether the windows are the ones asked for.
-    pub fn use_windows(&mut self, corner_ticks: usize, jerk_ticks: usize) -> bool {
+    pub(crate) fn use_windows(&mut self, corner_ticks: usize, jerk_ticks: usize) -> bool {
         let (nc, nj) = (
             corner_ticks.clamp(1, MAX_WINDOW_TICKS),
             jerk_ticks.clamp(1, MAX_WINDOW_TICKS),
@@ -181,7 +181,7 @@ impl AxisFilter {
     }
 
     /// Corner window actually used, s (whole ticks).
-    pub fn corner_window_s(&self) -> f64 {
+    pub(crate) fn corner_window_s(&self) -> f64 {
         self.corner.len() as f64 * self.dt_s
     }
 
@@ -191,35 +191,31 @@ impl AxisFilter {
     }
 
     /// One tick's interpolated position in, the filtered position out.
-    pub fn push(&mut self, p: Position) -> Position {
+    pub(crate) fn push(&mut self, p: Position) -> Position {
         let c = self.corner.push(p);
         self.jerk.push(c)
     }
 
-    pub fn output(&self) -> Position {
-        self.jerk.out
-    }
-
     /// The output equals the last input: the axes stand where the interpolator stands.
-    pub fn settled(&self) -> bool {
+    pub(crate) fn settled(&self) -> bool {
         self.corner.settled() && self.jerk.settled()
     }
 
     /// Stop at once at `p` (reset, start-up position).
-    pub fn fill(&mut self, p: Position) {
+    pub(crate) fn fill(&mut self, p: Position) {
         let (nc, nj) = (self.corner.len(), self.jerk.len());
         self.corner = Stage::new(nc, p);
         self.jerk = Stage::new(nj, p);
     }
 
     /// Filtering does anything at all (with the windows now in use).
-    pub fn active(&self) -> bool {
+    pub(crate) fn active(&self) -> bool {
         self.corner.len() > 1 || self.jerk.len() > 1
     }
 }
 
 /// Jerk window for these axes, s: max over axes with a jerk limit of 2·aᵢ / jᵢ (0 if none).
-pub fn jerk_window_s(axes: &[super::AxisLimits]) -> f64 {
+pub(crate) fn jerk_window_s(axes: &[super::AxisLimits]) -> f64 {
     axes.iter()
         .filter_map(|a| {
             let j = a.max_jerk_mm_per_s3?;

@@ -11,7 +11,7 @@ use crate::queue::Move;
 use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Below this a remaining length counts as the block end, mm.
-pub const END_EPS_MM: f64 = 1e-9;
+pub(crate) const END_EPS_MM: f64 = 1e-9;
 /// Velocities closer than this count as equal, mm/s.
 const V_EPS: f64 = 1e-9;
 /// Phases one block can pass through in one tick: accelerate, cruise, decelerate, plus slack
@@ -20,24 +20,24 @@ const MAX_PHASES: usize = 8;
 
 /// What the profile of one block aims for this tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Profile {
+pub(crate) struct Profile {
     /// Block path length, mm.
-    pub length_mm: f64,
+    pub(crate) length_mm: f64,
     /// Path acceleration and deceleration limit, mm/s² (> 0).
-    pub accel_mm_per_s2: f64,
+    pub(crate) accel_mm_per_s2: f64,
     /// Velocity to cruise at (feed × override, or 0 during a feed hold), mm/s.
-    pub cruise_mm_per_s: f64,
+    pub(crate) cruise_mm_per_s: f64,
     /// Velocity planned at the block end, mm/s.
-    pub exit_mm_per_s: f64,
+    pub(crate) exit_mm_per_s: f64,
 }
 
 /// Where the block stands after [`advance`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Advanced {
+pub(crate) struct Advanced {
     /// Seconds of the offered time used.
-    pub used_s: f64,
+    pub(crate) used_s: f64,
     /// The block end was reached.
-    pub finished: bool,
+    pub(crate) finished: bool,
 }
 
 /// The squared velocity braking at `a` from `v` over `rem` leaves, and the exit the block can
@@ -102,7 +102,7 @@ fn take_phase(
 /// and brake at `a` so the block ends at the planned exit velocity. When the velocity is
 /// already too high to brake to the exit (the override was lowered after planning), it brakes
 /// at `a` all the way and ends faster; the next block then brakes on.
-pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> Advanced {
+pub(crate) fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> Advanced {
     // The swing rule with no window is exactly this rule: braking and accelerating may follow
     // each other at once.
     advance_swing(s_mm, v_mm_per_s, p, dt_s, &mut Swing::new(0.0))
@@ -117,18 +117,18 @@ pub fn advance(s_mm: &mut f64, v_mm_per_s: &mut f64, p: &Profile, dt_s: f64) -> 
 /// needs (2·a / j), and a trapezoid at a filtered by a / j is the time-optimal jerk-limited
 /// profile (docs/motion.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Swing {
+pub(crate) struct Swing {
     /// Least time at constant velocity between accelerating and braking, s.
-    pub window_s: f64,
+    pub(crate) window_s: f64,
     /// Seconds since the last accelerating phase ended (0 while in it).
-    pub since_accel_s: f64,
+    pub(crate) since_accel_s: f64,
     /// Seconds since the last braking phase ended (0 while in it).
-    pub since_brake_s: f64,
+    pub(crate) since_brake_s: f64,
 }
 
 impl Swing {
     /// A run that starts at rest: no phase before it.
-    pub fn new(window_s: f64) -> Self {
+    pub(crate) fn new(window_s: f64) -> Self {
         Swing {
             window_s: window_s.max(0.0),
             since_accel_s: f64::INFINITY,
@@ -195,7 +195,7 @@ fn hold_phase(v: f64, wait: f64, ve: f64, a: f64, rem: f64) -> (f64, f64, f64, b
 /// stops at the highest velocity from which holding it for `window_s` and then braking still
 /// meets the exit at the block end. A feed hold or a lowered override therefore brakes up to
 /// `window_s` later than in [`advance`], as a jerk-limited machine does.
-pub fn advance_swing(
+pub(crate) fn advance_swing(
     s_mm: &mut f64,
     v_mm_per_s: &mut f64,
     p: &Profile,
@@ -309,7 +309,7 @@ pub fn advance_swing(
 
 /// Axis positions at path position `s_mm` of `m` (of length `length_mm`). The block end is
 /// returned exactly at `s_mm >= length_mm`: corners and arc end points are hit, not neared.
-pub fn point_at(m: &Move, length_mm: f64, s_mm: f64) -> Position {
+pub(crate) fn point_at(m: &Move, length_mm: f64, s_mm: f64) -> Position {
     if s_mm >= length_mm || length_mm <= 0.0 {
         return m.end;
     }
@@ -317,7 +317,7 @@ pub fn point_at(m: &Move, length_mm: f64, s_mm: f64) -> Position {
 }
 
 /// Unit tangent of `m` at its start (`at_end` false) or end, by axis.
-pub fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
+pub(crate) fn tangent(m: &Move, length_mm: f64, at_end: bool) -> [f64; MAX_AXES] {
     let mut t = [0.0; MAX_AXES];
     if length_mm <= 0.0 {
         return t;

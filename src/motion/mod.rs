@@ -238,7 +238,7 @@ impl Motion {
     }
 
     /// Blocks released and not yet done (the one executing included).
-    pub fn released_blocks(&self) -> usize {
+    pub(crate) fn released_blocks(&self) -> usize {
         self.planner.released()
     }
 
@@ -258,7 +258,7 @@ impl Motion {
         }
     }
 
-    pub fn override_pct(&self) -> f64 {
+    pub(crate) fn override_pct(&self) -> f64 {
         self.override_pct
     }
 
@@ -268,7 +268,7 @@ impl Motion {
     }
 
     /// The operator's M01 switch (`mc_command_M01_stop_enable_w`): M01 stops only while on.
-    pub fn set_optional_stop(&mut self, on: bool) {
+    pub(crate) fn set_optional_stop(&mut self, on: bool) {
         self.optional_stop = on;
     }
 
@@ -311,20 +311,24 @@ impl Motion {
     }
 
     /// Record per-tick samples for a plot, at most `max_samples` (decimated).
-    pub fn enable_trace(&mut self, max_samples: usize) {
+    pub(crate) fn enable_trace(&mut self, max_samples: usize) {
         self.trace = Some(Trace::new(max_samples));
     }
 
     /// Stream every `every`-th tick's axis positions, path velocity, acceleration and jerk to
     /// a CSV file (`run --trace`).
-    pub fn enable_csv_trace(&mut self, path: &std::path::Path, every: u64) -> std::io::Result<()> {
+    pub(crate) fn enable_csv_trace(
+        &mut self,
+        path: &std::path::Path,
+        every: u64,
+    ) -> std::io::Result<()> {
         let axes: Vec<usize> = self.axes.iter().map(|a| a.index).collect();
         self.csv = Some(CsvTrace::create(path, &axes, every)?);
         Ok(())
     }
 
     /// Close the CSV trace (if any): its first write error, if there was one.
-    pub fn finish_csv_trace(&mut self) -> std::io::Result<()> {
+    pub(crate) fn finish_csv_trace(&mut self) -> std::io::Result<()> {
         match self.csv.take() {
             Some(c) => c.finish(),
             None => Ok(()),
@@ -336,7 +340,7 @@ impl Motion {
     }
 
     /// The channel reported an interrupt here: mark it in the trace.
-    pub fn note_interrupt(&mut self) {
+    pub(crate) fn note_interrupt(&mut self) {
         let s = self.sample();
         if let Some(t) = self.trace.as_mut() {
             t.mark_interrupt(s);

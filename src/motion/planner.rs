@@ -53,21 +53,21 @@ use super::AxisLimits;
 pub const JUNCTION_ACCEL_SHARE: f64 = 0.25;
 /// Share of the profile acceleration an arc may use for its centripetal acceleration; the
 /// tangential ramp gets √(1 − share²) of it, so both together stay within the limit.
-pub const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
+pub(crate) const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
 /// Share of a junction's budget its velocity jumps may use: the rest covers the neighbouring
 /// junctions when several fall into one cycle with unequal corners (the rule looks at the two
 /// blocks on each side of a junction only).
-pub const JUMP_MARGIN: f64 = 0.95;
+pub(crate) const JUMP_MARGIN: f64 = 0.95;
 /// Share of its acceleration a line keeps whatever its junctions claim: a junction that would
 /// leave less is not passed at feed but with the fixed reserve.
-pub const PROFILE_FLOOR: f64 = 0.2;
+pub(crate) const PROFILE_FLOOR: f64 = 0.2;
 /// Share of the axes' full acceleration a contour blend may use for its centripetal
 /// acceleration; its tangential ramp gets √(1 − share²) of it.
-pub const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
+pub(crate) const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
 /// Share of the smallest moving axis' acceleration a contour blend uses in all: sampled once
 /// per cycle, a curve under centripetal and tangential acceleration at once shows slightly
 /// more than the vector's length (0.07 % measured at the full length).
-pub const BLEND_ACCEL_SHARE: f64 = 0.95;
+pub(crate) const BLEND_ACCEL_SHARE: f64 = 0.95;
 /// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
 /// window when a program is mostly assignments or M functions.
 const NON_MOTION_PER_BLOCK: usize = 4;
@@ -92,52 +92,52 @@ impl Default for PlannerSettings {
 
 /// A motion block with what the plan needs of it.
 #[derive(Debug, Clone)]
-pub struct Segment {
-    pub mv: Move,
-    pub length_mm: f64,
+pub(crate) struct Segment {
+    pub(crate) mv: Move,
+    pub(crate) length_mm: f64,
     /// Programmed path velocity at 100 % override (G0: the rapid limit), mm/s.
-    pub programmed_mm_per_s: f64,
+    pub(crate) programmed_mm_per_s: f64,
     /// Highest path velocity the axes allow on this block, whatever the override, mm/s.
-    pub limit_mm_per_s: f64,
+    pub(crate) limit_mm_per_s: f64,
     /// Path acceleration limit the profile uses, mm/s²: on a line the axis limits less what
     /// the junctions at its two ends claim (`Planner::link`).
-    pub accel_mm_per_s2: f64,
+    pub(crate) accel_mm_per_s2: f64,
     /// Path acceleration with every axis' full limit projected on the block, mm/s².
-    pub full_accel_mm_per_s2: f64,
+    pub(crate) full_accel_mm_per_s2: f64,
     /// Per axis, the acceleration the junction at this block's end claims for its velocity
     /// jump, mm/s² (the default reserve until the next block is known).
-    pub end_claim_mm_per_s2: [f64; MAX_AXES],
+    pub(crate) end_claim_mm_per_s2: [f64; MAX_AXES],
     /// Junction with the previous motion block: `None` = the motion stops before this block.
-    pub junction: Option<Junction>,
+    pub(crate) junction: Option<Junction>,
     /// Planned velocity at the block end, mm/s.
-    pub exit_mm_per_s: f64,
+    pub(crate) exit_mm_per_s: f64,
 }
 
 /// What limits the velocity at the start of a block coming from the previous one.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Junction {
+pub(crate) struct Junction {
     /// maxᵢ |Δtᵢ| / budgetᵢ, s²/mm: velocity ≤ dt / k and ≤ √(L / k).
-    pub k_s2_per_mm: f64,
+    pub(crate) k_s2_per_mm: f64,
     /// Per axis, the change of the unit tangent |t2ᵢ − t1ᵢ| (the velocity jump per mm/s).
-    pub jump: [f64; MAX_AXES],
+    pub(crate) jump: [f64; MAX_AXES],
     /// Per axis, the previous block's tangential acceleration at the junction, mm/s².
-    pub prev_load_mm_per_s2: [f64; MAX_AXES],
+    pub(crate) prev_load_mm_per_s2: [f64; MAX_AXES],
     /// Per axis, the acceleration this junction claims from the blocks on both sides, mm/s².
-    pub claim_mm_per_s2: [f64; MAX_AXES],
+    pub(crate) claim_mm_per_s2: [f64; MAX_AXES],
     /// Both blocks are straight: the budget rule applies (else the fixed reserve).
-    pub straight: bool,
+    pub(crate) straight: bool,
     /// The shorter of the two blocks, mm.
-    pub short_mm: f64,
+    pub(crate) short_mm: f64,
     /// The previous block's length, mm.
-    pub prev_length_mm: f64,
+    pub(crate) prev_length_mm: f64,
     /// The previous block's programmed and limit velocity, mm/s.
-    pub prev_programmed_mm_per_s: f64,
-    pub prev_limit_mm_per_s: f64,
+    pub(crate) prev_programmed_mm_per_s: f64,
+    pub(crate) prev_limit_mm_per_s: f64,
 }
 
 impl Junction {
     /// The junction's geometric velocity limit for tick length `dt_s`, mm/s.
-    pub fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
+    pub(crate) fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
         if self.k_s2_per_mm <= 0.0 {
             return f64::INFINITY;
         }
@@ -151,7 +151,7 @@ impl Junction {
     /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
     /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
     /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
-    pub fn smoothed_limit_mm_per_s(
+    pub(crate) fn smoothed_limit_mm_per_s(
         &self,
         window_s: f64,
         prev_cruise_mm_per_s: f64,
@@ -174,14 +174,14 @@ impl Junction {
 
 impl Segment {
     /// The velocity this block aims for at `override_pct`, mm/s.
-    pub fn cruise_mm_per_s(&self, override_pct: f64) -> f64 {
+    pub(crate) fn cruise_mm_per_s(&self, override_pct: f64) -> f64 {
         (self.programmed_mm_per_s * override_pct / 100.0).min(self.limit_mm_per_s)
     }
 }
 
 /// What a window entry does.
 #[derive(Debug, Clone)]
-pub enum EntryKind {
+pub(crate) enum EntryKind {
     Move(Box<Segment>),
     Dwell {
         seconds: f64,
@@ -201,7 +201,7 @@ pub enum EntryKind {
 
 impl EntryKind {
     /// The motion stops before anything after this entry runs.
-    pub fn is_barrier(&self) -> bool {
+    pub(crate) fn is_barrier(&self) -> bool {
         matches!(
             self,
             EntryKind::Dwell { .. }
@@ -214,18 +214,18 @@ impl EntryKind {
 
 /// One block in the window.
 #[derive(Debug, Clone)]
-pub struct Entry {
+pub(crate) struct Entry {
     /// Taken when the `block` event is emitted (`None` for silent second parts).
-    pub info: Option<BlockInfo>,
-    pub kind: EntryKind,
+    pub(crate) info: Option<BlockInfo>,
+    pub(crate) kind: EntryKind,
     /// A motion entry that counts towards the lookahead (a programmed block; not a contour
     /// blend, not the second and later pieces of a spline segment).
-    pub counted: bool,
+    pub(crate) counted: bool,
 }
 
 /// The lookahead window: a prefix of it is released, the rest held.
 #[derive(Debug)]
-pub struct Planner {
+pub(crate) struct Planner {
     axes: [Option<AxisLimits>; MAX_AXES],
     lookahead: usize,
     max_entries: usize,
@@ -245,7 +245,7 @@ pub struct Planner {
     /// Cycle time the junction claims are sized for, s.
     cycle_s: f64,
     /// The front entry is executing (its geometry is fixed).
-    pub front_busy: bool,
+    pub(crate) front_busy: bool,
     /// The spline being built (G151), if any.
     spline: Option<Spline>,
     /// Spline blocks waiting for their curve: (point number, event).
@@ -276,7 +276,7 @@ pub struct Planner {
 }
 
 impl Planner {
-    pub fn new(axes: &[AxisLimits], settings: PlannerSettings) -> Self {
+    pub(crate) fn new(axes: &[AxisLimits], settings: PlannerSettings) -> Self {
         let mut by_index: [Option<AxisLimits>; MAX_AXES] = Default::default();
         for a in axes {
             if a.index < MAX_AXES {
@@ -332,13 +332,13 @@ impl Planner {
         }
     }
 
-    pub fn lookahead(&self) -> usize {
+    pub(crate) fn lookahead(&self) -> usize {
         self.lookahead
     }
 
     /// The corner window the axis filter now uses, s (0 = none): junction velocities are
     /// planned for it, so the plan is recomputed.
-    pub fn set_corner_window_s(&mut self, corner_s: f64) {
+    pub(crate) fn set_corner_window_s(&mut self, corner_s: f64) {
         if corner_s != self.corner_s {
             self.corner_s = corner_s;
             self.relink();
@@ -347,7 +347,7 @@ impl Planner {
     }
 
     /// The cycle time junction claims are sized for, s.
-    pub fn set_cycle_s(&mut self, dt_s: f64) {
+    pub(crate) fn set_cycle_s(&mut self, dt_s: f64) {
         if dt_s > 0.0 && dt_s.is_finite() {
             self.cycle_s = dt_s;
         }
@@ -372,42 +372,37 @@ impl Planner {
             self.link(i);
         }
     }
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.window.len()
     }
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         self.window.is_empty()
     }
     /// Entries released for execution and not yet done.
-    pub fn released(&self) -> usize {
+    pub(crate) fn released(&self) -> usize {
         self.released
     }
     /// Entries held back (the memory effect), blocks waiting for their spline curve included.
-    pub fn held(&self) -> usize {
+    pub(crate) fn held(&self) -> usize {
         self.window.len() - self.released
             + self.spline_infos.len()
             + self.spline_waiting.len()
             + usize::from(self.comp_info.is_some())
             + self.comp_waiting.len()
     }
-    pub fn front(&self) -> Option<&Entry> {
+    pub(crate) fn front(&self) -> Option<&Entry> {
         self.window.front()
     }
-    pub fn front_mut(&mut self) -> Option<&mut Entry> {
+    pub(crate) fn front_mut(&mut self) -> Option<&mut Entry> {
         self.window.front_mut()
     }
-    pub fn entries(&self) -> impl Iterator<Item = &Entry> {
+    pub(crate) fn entries(&self) -> impl Iterator<Item = &Entry> {
         self.window.iter()
     }
-    /// The next entry after the front, if released.
-    pub fn released_after_front(&self) -> Option<&Entry> {
-        (self.released > 1).then(|| &self.window[1])
-    }
-
     /// The front entry is a straight move that ends a run: after it, among the released
     /// entries, the next one that is not a plain block or `#FLUSH CONTINUE` stops the motion
     /// (dwell, `#FLUSH`, `#FLUSH WAIT`, program end). No later release can join it then.
-    pub fn front_is_lone_line(&self) -> bool {
+    pub(crate) fn front_is_lone_line(&self) -> bool {
         let Some(Entry {
             kind: EntryKind::Move(seg),
             ..
@@ -430,7 +425,7 @@ impl Planner {
     /// Path acceleration and jerk limits of a straight move with every axis' full
     /// acceleration (no junction reserve: a lone line has no junction), mm/s², mm/s³
     /// (infinite: no jerk limit on any moving axis).
-    pub fn line_limits(&self, seg: &Segment) -> (f64, f64) {
+    pub(crate) fn line_limits(&self, seg: &Segment) -> (f64, f64) {
         let accel = seg.full_accel_mm_per_s2;
         let t = tangent(&seg.mv, seg.length_mm, false);
         let mut jerk = f64::INFINITY;
@@ -456,13 +451,13 @@ impl Planner {
     }
 
     /// The plan must be recomputed before the next tick's interpolation.
-    pub fn mark_dirty(&mut self) {
+    pub(crate) fn mark_dirty(&mut self) {
         self.dirty = true;
     }
 
     /// Take blocks from the queue into the window while it has room, applying the release
     /// rules.
-    pub fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
+    pub(crate) fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
         while !self.full() {
             let Some(b) = queue.pop_front() else { break };
             self.push(b);
@@ -473,7 +468,7 @@ impl Planner {
     }
 
     /// Put one decoded block into the window (held unless a rule releases it).
-    pub fn push(&mut self, b: QueuedBlock) {
+    pub(crate) fn push(&mut self, b: QueuedBlock) {
         let QueuedBlock {
             info,
             action,
@@ -769,12 +764,12 @@ impl Planner {
     }
 
     /// The error compensation ran into, once.
-    pub fn take_error(&mut self) -> Option<PlanError> {
+    pub(crate) fn take_error(&mut self) -> Option<PlanError> {
         self.error.take()
     }
 
     /// Tool radii by D number, mm (the tool list).
-    pub fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
+    pub(crate) fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
         self.tool_radii = tools;
     }
 
@@ -902,7 +897,7 @@ impl Planner {
     }
 
     /// Release every block in the window.
-    pub fn release_all(&mut self) {
+    pub(crate) fn release_all(&mut self) {
         if self.released != self.window.len() {
             self.released = self.window.len();
             self.dirty = true;
@@ -910,7 +905,7 @@ impl Planner {
     }
 
     /// Remove the front entry (it has been executed).
-    pub fn pop_front(&mut self) -> Option<Entry> {
+    pub(crate) fn pop_front(&mut self) -> Option<Entry> {
         let e = self.window.pop_front()?;
         if e.counted {
             self.moves -= 1;
@@ -920,7 +915,7 @@ impl Planner {
     }
 
     /// Drop everything (reset, error).
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.window.clear();
         self.spline = None;
         self.spline_infos.clear();
@@ -935,7 +930,7 @@ impl Planner {
     }
 
     /// Recompute the exit velocities of the released motion blocks if something changed.
-    pub fn plan_if_needed(&mut self, override_pct: f64, dt_s: f64) {
+    pub(crate) fn plan_if_needed(&mut self, override_pct: f64, dt_s: f64) {
         if self.dirty {
             self.plan(override_pct, dt_s);
             self.dirty = false;

@@ -22,13 +22,13 @@ use crate::queue::{Move, MoveKind, PathMode, SplineKind};
 use crate::vocab::axis::{Position, MAX_AXES};
 
 /// Longest piece a curve segment is cut into, mm.
-pub const MAX_PIECE_MM: f64 = 0.02;
+pub(crate) const MAX_PIECE_MM: f64 = 0.02;
 const MIN_PIECES: usize = 2;
 const MAX_PIECES: usize = 8;
 
 /// The points of the spline being built and what waits for them.
 #[derive(Debug, Clone)]
-pub struct Spline {
+pub(crate) struct Spline {
     kind: SplineKind,
     /// Points not yet fully consumed (B-spline: padded control points; Akima: the last ≤ 6).
     pts: VecDeque<Position>,
@@ -43,14 +43,19 @@ pub struct Spline {
 /// One finished curve segment: the pieces, and the received point it belongs to (its block's
 /// event goes on the first piece).
 #[derive(Debug, Clone)]
-pub struct Segment {
-    pub pieces: Vec<Move>,
-    pub point: usize,
+pub(crate) struct Segment {
+    pub(crate) pieces: Vec<Move>,
+    pub(crate) point: usize,
 }
 
 impl Spline {
     /// A spline starting at `start` (the position before its first block).
-    pub fn new(kind: SplineKind, start: Position, feed_mm_per_min: f64, path: PathMode) -> Self {
+    pub(crate) fn new(
+        kind: SplineKind,
+        start: Position,
+        feed_mm_per_min: f64,
+        path: PathMode,
+    ) -> Self {
         let mut pts = VecDeque::with_capacity(8);
         match kind {
             SplineKind::BSpline => {
@@ -68,30 +73,22 @@ impl Spline {
         }
     }
 
-    pub fn kind(&self) -> SplineKind {
+    pub(crate) fn kind(&self) -> SplineKind {
         self.kind
     }
 
     /// Points received so far (the start point not counted).
-    pub fn received(&self) -> usize {
+    pub(crate) fn received(&self) -> usize {
         self.received
     }
 
     /// The last point received.
-    pub fn last(&self) -> Position {
+    pub(crate) fn last(&self) -> Position {
         self.pts.back().copied().unwrap_or([0.0; MAX_AXES])
     }
 
-    /// Points received whose curve is not handed out yet.
-    pub fn pending(&self) -> usize {
-        match self.kind {
-            SplineKind::BSpline => 0,
-            SplineKind::Akima => self.received - self.next_segment.min(self.received),
-        }
-    }
-
     /// Point `p` (feed `feed_mm_per_min`) arrives: the segments it completes.
-    pub fn push(&mut self, p: Position, feed_mm_per_min: f64, out: &mut Vec<Segment>) {
+    pub(crate) fn push(&mut self, p: Position, feed_mm_per_min: f64, out: &mut Vec<Segment>) {
         self.received += 1;
         self.feed_mm_per_min = feed_mm_per_min;
         self.pts.push_back(p);
@@ -106,7 +103,7 @@ impl Spline {
     }
 
     /// The spline ends: the rest of the curve, ending exactly at the last point.
-    pub fn finish(mut self, out: &mut Vec<Segment>) {
+    pub(crate) fn finish(mut self, out: &mut Vec<Segment>) {
         match self.kind {
             SplineKind::BSpline => {
                 if self.received == 0 {

@@ -13,7 +13,7 @@ pub struct Sample {
     /// Path velocity over the tick, mm/s.
     pub velocity_mm_per_s: f64,
     /// Path acceleration (change of the path velocity), mm/s².
-    pub accel_mm_per_s2: f64,
+    pub(crate) accel_mm_per_s2: f64,
     /// Path jerk, mm/s³.
     pub jerk_mm_per_s3: f64,
 }
@@ -33,7 +33,7 @@ pub struct Trace {
 }
 
 /// Interrupt marks kept at most.
-pub const MAX_INTERRUPT_MARKS: usize = 10_000;
+pub(crate) const MAX_INTERRUPT_MARKS: usize = 10_000;
 
 impl Trace {
     /// `max_samples` at least 2.
@@ -68,13 +68,13 @@ impl Trace {
         self.samples.push(s);
     }
 
-    pub fn mark_interrupt(&mut self, s: Sample) {
+    pub(crate) fn mark_interrupt(&mut self, s: Sample) {
         if self.interrupts.len() < MAX_INTERRUPT_MARKS {
             self.interrupts.push(s);
         }
     }
 
-    pub fn set_plane(&mut self, p: Plane) {
+    pub(crate) fn set_plane(&mut self, p: Plane) {
         self.plane = p;
     }
 
@@ -117,7 +117,7 @@ mod tests {
 /// Nothing is kept in memory beyond the writer's buffer; the first write error stops the
 /// trace and is reported by [`CsvTrace::finish`].
 #[derive(Debug)]
-pub struct CsvTrace {
+pub(crate) struct CsvTrace {
     out: std::io::BufWriter<std::fs::File>,
     /// Axis indices written, in order.
     axes: Vec<usize>,

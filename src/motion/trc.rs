@@ -16,18 +16,18 @@
 use crate::queue::{CompSide, Move, MoveKind, Plane};
 use crate::vocab::axis::Position;
 
-pub use crate::lang::codes::TRC_IMPOSSIBLE;
+pub(crate) use crate::lang::codes::TRC_IMPOSSIBLE;
 /// Below this two points are one, mm.
 const EPS_MM: f64 = 1e-9;
 
 /// Why planning a block failed (compensation impossible, a software limit crossed): an
 /// error number from `lang::codes` and its text, for the channel's error.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PlanError {
-    pub code: u32,
-    pub msg: String,
+pub(crate) struct PlanError {
+    pub(crate) code: u32,
+    pub(crate) msg: String,
     /// The program and line of the refused block, where known.
-    pub block: Option<(String, u64)>,
+    pub(crate) block: Option<(String, u64)>,
 }
 
 fn impossible(msg: String) -> PlanError {
@@ -40,7 +40,7 @@ fn impossible(msg: String) -> PlanError {
 
 /// The state of one compensation run.
 #[derive(Debug, Clone)]
-pub struct Comp {
+pub(crate) struct Comp {
     side: CompSide,
     radius_mm: f64,
     pending: Pending,
@@ -61,7 +61,7 @@ enum Pending {
 
 impl Comp {
     /// Compensation switches on with the selection block `mv`.
-    pub fn select(side: CompSide, radius_mm: f64, mv: Move) -> Self {
+    pub(crate) fn select(side: CompSide, radius_mm: f64, mv: Move) -> Self {
         Comp {
             side,
             radius_mm,
@@ -70,12 +70,12 @@ impl Comp {
         }
     }
 
-    pub fn side(&self) -> CompSide {
+    pub(crate) fn side(&self) -> CompSide {
         self.side
     }
 
     /// The next compensated block `mv` (same side): moves for the window, in order.
-    pub fn next(&mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
+    pub(crate) fn next(&mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
         let b = self.offset(&mv)?;
         match std::mem::replace(&mut self.pending, Pending::Rest { at: mv.end }) {
             Pending::Selection(sel) => {
@@ -97,7 +97,7 @@ impl Comp {
     }
 
     /// A stop or the end of compensation: the waiting element ends at its own offset end.
-    pub fn finish(&mut self, out: &mut Vec<Move>) -> Result<(), PlanError> {
+    pub(crate) fn finish(&mut self, out: &mut Vec<Move>) -> Result<(), PlanError> {
         match std::mem::replace(&mut self.pending, Pending::Rest { at: [0.0; 6] }) {
             Pending::Selection(sel) => {
                 let end = self.offset_point(&sel, true);
@@ -115,7 +115,7 @@ impl Comp {
     }
 
     /// Deselection by the G40 block `mv`: the waiting element, then a line to `mv`'s end.
-    pub fn deselect(mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
+    pub(crate) fn deselect(mut self, mv: Move, out: &mut Vec<Move>) -> Result<(), PlanError> {
         self.finish(out)?;
         if let Pending::Rest { at } = self.pending {
             out.push(line(at, mv.end, &mv));

@@ -31,26 +31,26 @@ use crate::diag::{Diagnostic, Severity};
 use crate::vocab::axis::MAX_AXES;
 
 /// mm (or °) per kernel position unit: 0.1 µm (P-AXIS-00178: 0.1 µm, 0.0001 °).
-pub const MM_PER_POSITION_UNIT: f64 = 1e-4;
+pub(crate) const MM_PER_POSITION_UNIT: f64 = 1e-4;
 /// mm/min per kernel velocity unit: 1 µm/s = 0.06 mm/min (P-AXIS-00212: µm/s, 0.001 °/s).
-pub const MM_PER_MIN_PER_VELOCITY_UNIT: f64 = 60.0 / 1000.0;
+pub(crate) const MM_PER_MIN_PER_VELOCITY_UNIT: f64 = 60.0 / 1000.0;
 /// s per kernel ramp-time unit, µs (P-AXIS-00196).
-pub const S_PER_RAMP_UNIT: f64 = 1e-6;
+pub(crate) const S_PER_RAMP_UNIT: f64 = 1e-6;
 
 /// The kernel's built-in values of the entries read, used where no list sets one.
 /// P-AXIS-00212 vb_max, µm/s.
-pub const DEFAULT_VB_MAX: f64 = 200_000.0;
+pub(crate) const DEFAULT_VB_MAX: f64 = 200_000.0;
 /// P-AXIS-00209 vb_eilgang, µm/s (not above vb_max).
-pub const DEFAULT_VB_EILGANG: f64 = 166_666.0;
+pub(crate) const DEFAULT_VB_EILGANG: f64 = 166_666.0;
 /// P-AXIS-00008 a_max, mm/s².
-pub const DEFAULT_A_MAX: f64 = 1000.0;
+pub(crate) const DEFAULT_A_MAX: f64 = 1000.0;
 /// P-AXIS-00178 / -00177, 0.1 µm.
-pub const DEFAULT_SWE_POS: f64 = 100_000_000.0;
-pub const DEFAULT_SWE_NEG: f64 = -100_000_000.0;
+pub(crate) const DEFAULT_SWE_POS: f64 = 100_000_000.0;
+pub(crate) const DEFAULT_SWE_NEG: f64 = -100_000_000.0;
 /// P-AXIS-00195 … -00198 ramp times, µs.
-pub const DEFAULT_TR: f64 = 50_000.0;
+pub(crate) const DEFAULT_TR: f64 = 50_000.0;
 /// P-AXIS-00201 tr_min, µs.
-pub const DEFAULT_TR_MIN: f64 = 10_000.0;
+pub(crate) const DEFAULT_TR_MIN: f64 = 10_000.0;
 
 /// The ramp times whose shortest sets the jerk (non-linear slope, TF5200 Axis parameter).
 const RAMP_TIMES: [&str; 4] = [
@@ -88,7 +88,7 @@ const USED: [&str; 13] = [
 
 /// P-AXIS-00018: what kind of axis a list describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AxisType {
+pub(crate) enum AxisType {
     /// ACHSTYP_TRANSLATOR (0x0001): positions in mm.
     Linear,
     /// ACHSTYP_ROTATOR (0x0002): positions in degrees.
@@ -99,19 +99,19 @@ pub enum AxisType {
 
 /// One axis as its lists describe it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AxisList {
+pub(crate) struct AxisList {
     pub file: PathBuf,
     /// `kopf.achs_nr` (P-AXIS-00016), default 1.
-    pub logical_number: u16,
+    pub(crate) logical_number: u16,
     /// `kopf.log_achs_name` (P-AXIS-00297) with its line, if set.
     pub name: Option<(String, Entry)>,
-    pub axis_type: AxisType,
+    pub(crate) axis_type: AxisType,
     /// Limits in the axis table's units; `name` is left empty (the channel names the axis).
     pub limits: AxisConfig,
 }
 
 /// Does this list look like an axis list? (It names `kopf.*`, `kenngr.*` or `getriebe[…]`.)
-pub fn is_axis_list(list: &ParamList) -> bool {
+pub(crate) fn is_axis_list(list: &ParamList) -> bool {
     list.entries.iter().any(|e| {
         e.name.segments.first().is_some_and(|s| {
             matches!(s.ident.as_str(), "kopf" | "kenngr") && s.index.is_none()
@@ -122,7 +122,7 @@ pub fn is_axis_list(list: &ParamList) -> bool {
 
 /// Count and warn about the entries of one list (the default list or an axis's own list)
 /// without reading values.
-pub fn tally_axis_list(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ListSummary {
+pub(crate) fn tally_axis_list(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ListSummary {
     super::startup::warn_duplicates(list, diags);
     let mut tally = Tally::new(ListKind::Axis);
     for e in &list.entries {
@@ -135,7 +135,7 @@ pub fn tally_axis_list(list: &ParamList, diags: &mut Vec<Diagnostic>) -> ListSum
 
 /// Read one axis from its list over the default list (`None`: the kernel's defaults only).
 /// Problems go to `diags`; the values then fall back to the defaults.
-pub fn interpret_axis(
+pub(crate) fn interpret_axis(
     default: Option<&ParamList>,
     list: &ParamList,
     diags: &mut Vec<Diagnostic>,
@@ -220,7 +220,7 @@ pub fn interpret_axis(
 /// channel list's `gruppe[0].achse[j]` joined by logical number (P-CHAN-00035 = P-AXIS-00016)
 /// to their axis lists, or — when the channel list names no axes — every axis list's axis
 /// under its `kopf.log_achs_name`. `None` when an axis cannot be set up (reported).
-pub fn channel_axes(
+pub(crate) fn channel_axes(
     chan: &ChannelList,
     axis_lists: &[AxisList],
     runtime: &RuntimeConfig,
@@ -398,7 +398,7 @@ fn push_axis(
 
 /// The jerk limit of an acceleration `a` (mm/s²) built up in `tr_us` µs: a / tr, mm/s³;
 /// no limit for a zero ramp time.
-pub fn jerk_of(a_mm_per_s2: f64, tr_us: f64) -> Option<f64> {
+pub(crate) fn jerk_of(a_mm_per_s2: f64, tr_us: f64) -> Option<f64> {
     (tr_us > 0.0).then(|| a_mm_per_s2 / (tr_us * S_PER_RAMP_UNIT))
 }
 

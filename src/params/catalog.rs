@@ -88,7 +88,7 @@ impl Tally {
 
     /// An entry the interpreter does not read: inert when the catalog knows it, else a
     /// warning that it is unknown.
-    pub fn not_read(&mut self, list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) {
+    pub(crate) fn not_read(&mut self, list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) {
         if is_inert(self.kind, &e.name) {
             self.inert += 1;
         } else {
@@ -156,7 +156,7 @@ fn is_inert(kind: ListKind, name: &Name) -> bool {
 }
 
 /// Start-up entries known and ignored, with their P numbers (TF5200 Start-up parameter).
-pub const INERT_STARTUP: &[(&str, &str)] = &[
+pub(crate) const INERT_STARTUP: &[(&str, &str)] = &[
     (
         "listen",
         "P-STUP-00008 list type ASCII/BINAER: ncchannel reads ASCII lists",
@@ -206,7 +206,7 @@ pub const INERT_STARTUP: &[(&str, &str)] = &[
 ];
 
 /// Channel entries known and ignored (TF5200 Channel parameter).
-pub const INERT_CHANNEL: &[(&str, &str)] = &[
+pub(crate) const INERT_CHANNEL: &[(&str, &str)] = &[
     (
         "gruppe[].bezeichnung",
         "P-CHAN-00005 axis group name: display only",
@@ -242,7 +242,7 @@ pub const INERT_CHANNEL: &[(&str, &str)] = &[
 ];
 
 /// Axis entries known and ignored (TF5200 Axis parameter).
-pub const INERT_AXIS: &[(&str, &str)] = &[
+pub(crate) const INERT_AXIS: &[(&str, &str)] = &[
     (
         "getriebe[].slope_profil.a_beschl",
         "P-AXIS-00001: one acceleration, a_max, is modelled",
@@ -300,7 +300,7 @@ pub const INERT_AXIS: &[(&str, &str)] = &[
 ];
 
 /// Tool entries known and ignored (TF5200 Tool data).
-pub const INERT_TOOLS: &[(&str, &str)] = &[
+pub(crate) const INERT_TOOLS: &[(&str, &str)] = &[
     (
         "wz[].laenge",
         "P-TOOL-00003 tool length: no length compensation",
@@ -358,7 +358,7 @@ const REFERABLE: &[(ListKind, &str, u32, &str)] = &[
 ];
 
 /// The parameter name a reference names, e.g. `P-AXIS-00008.0` → `getriebe[0].dynamik.a_max`.
-pub fn referenced_name(kind: ListKind, r: &ParamRef) -> Option<String> {
+pub(crate) fn referenced_name(kind: ListKind, r: &ParamRef) -> Option<String> {
     let (_, _, _, pat) = REFERABLE
         .iter()
         .find(|(k, g, n, _)| *k == kind && *g == r.group && *n == r.number)?;

@@ -18,9 +18,9 @@ use crate::diag::Diagnostic;
 /// Longest `streaming_prog_file` (ISG FCT-C19 Data streaming: a string of up to 83 characters);
 /// the implicit subroutine names have the same limit (P-CHAN-00118/-00119/-00252: at most 83
 /// characters).
-pub const MAX_STREAMING_PROG_CHARS: usize = 83;
+pub(crate) const MAX_STREAMING_PROG_CHARS: usize = 83;
 /// Longest axis name (P-CHAN-00006: at most 16 characters).
-pub const MAX_AXIS_NAME_CHARS: usize = 16;
+pub(crate) const MAX_AXIS_NAME_CHARS: usize = 16;
 
 /// The global subroutines the channel calls by itself; `None` = no call.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -37,20 +37,20 @@ pub struct ImplicitSubroutines {
 }
 
 /// G800–G819: the implicit calls `g800_prog_file[0…19]` configures (P-CHAN-00187).
-pub const G800_CALLS: usize = 20;
+pub(crate) const G800_CALLS: usize = 20;
 
 /// One axis of the channel's axis group, as the channel list names it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ChannelAxisRef {
+pub(crate) struct ChannelAxisRef {
     /// `gruppe[0].achse[j].bezeichnung` (P-CHAN-00006) with its line.
     pub name: Option<(String, Entry)>,
     /// `gruppe[0].achse[j].log_achs_nr` (P-CHAN-00035) with its line.
-    pub logical_number: Option<(u16, Entry)>,
+    pub(crate) logical_number: Option<(u16, Entry)>,
 }
 
 /// A channel list, checked.
 #[derive(Debug, Clone)]
-pub struct ChannelList {
+pub(crate) struct ChannelList {
     pub list: ParamList,
     /// `None`: streaming is off (parameter missing or empty).
     pub streaming_prog_file: Option<String>,
@@ -78,7 +78,7 @@ fn program_name(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) -> Opt
 
 /// Check a channel list's entries; relative paths are joined to `cnc_dir`, the CNC's working
 /// directory. Problems go to `diags`.
-pub fn interpret_channel(
+pub(crate) fn interpret_channel(
     list: ParamList,
     cnc_dir: &Path,
     diags: &mut Vec<Diagnostic>,

@@ -29,7 +29,7 @@ use crate::diag::{Diagnostic, Severity};
 /// The file name runtime settings are read from, in the start-up list's folder.
 pub const RUNTIME_FILE: &str = "runtime.toml";
 /// The folder name of an installation's lists; the CNC's working directory is its parent.
-pub const LIST_FOLDER: &str = "listen";
+pub(crate) const LIST_FOLDER: &str = "listen";
 
 /// Everything the emulator starts from.
 #[derive(Debug, Clone)]
@@ -52,7 +52,7 @@ pub struct Config {
     /// The error text file the start-up list names (`error_text_of_id`, P-STUP-00168).
     pub error_text_file: Option<PathBuf>,
     /// Its texts by error id; `None`: ncchannel's own texts.
-    pub error_texts: Option<Arc<ErrorTexts>>,
+    pub(crate) error_texts: Option<Arc<ErrorTexts>>,
     /// Every list read, with how many entries were used, inert and unknown.
     pub lists: Vec<ListSummary>,
     /// Warnings found on the way (unknown entries, values without effect).
@@ -80,7 +80,7 @@ pub struct ChannelConfig {
     /// The zero-offset list named by the start-up list (`None`: all offsets 0).
     pub zero_offset_list: Option<PathBuf>,
     /// G54 … G59 offsets by group and axis, mm.
-    pub zero_offsets: ZeroOffsetTable,
+    pub(crate) zero_offsets: ZeroOffsetTable,
     /// The channel list's entries, unknown ones included.
     pub list: ParamList,
 }
@@ -130,7 +130,7 @@ pub fn check_list_file(path: &Path) -> Vec<Diagnostic> {
 /// [`check_list_file`], with the used/inert/unknown counts of every list read. The list kind
 /// is decided by content: a start-up list names `kanal_anzahl` or `sda_mds[…]`, a zero-offset
 /// list `np_grp[…]`, a tool list `wz[…]`, an axis list `kopf.*`, `kenngr.*` or `getriebe[…]`.
-pub fn check_list_file_summarized(path: &Path) -> (Vec<Diagnostic>, Vec<ListSummary>) {
+pub(crate) fn check_list_file_summarized(path: &Path) -> (Vec<Diagnostic>, Vec<ListSummary>) {
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"))

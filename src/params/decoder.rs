@@ -10,21 +10,21 @@ use crate::diag::Diagnostic;
 /// Switches file caching (`#CACHE LOAD`) on.
 pub const FCT_USE_CACHED_FILES: &str = "FCT_USE_CACHED_FILES";
 /// Function names the kernel documents. Only caching changes the emulator's behaviour.
-pub const KNOWN_FUNCTIONS: [&str; 3] = [
+pub(crate) const KNOWN_FUNCTIONS: [&str; 3] = [
     "FCT_DEFAULT",
     FCT_USE_CACHED_FILES,
     "FCT_VOL_COMP_COMPUTATION",
 ];
 
 /// Cache files when caching is on and `max_cache_number` is not given.
-pub const DEFAULT_CACHE_FILES: u32 = 4;
+pub(crate) const DEFAULT_CACHE_FILES: u32 = 4;
 /// Bytes per cache file when caching is on and `max_cache_size` is not given.
-pub const DEFAULT_CACHE_FILE_BYTES: u32 = 4096;
+pub(crate) const DEFAULT_CACHE_FILE_BYTES: u32 = 4096;
 /// Plausibility bound: the kernel allows UNS32, but the emulator holds cached programs in
 /// memory, so more files than this is refused as a typo rather than risked.
-pub const MAX_CACHE_FILES: u32 = 1024;
+pub(crate) const MAX_CACHE_FILES: u32 = 1024;
 /// Plausibility bound on one cache file (64 MiB), same reason.
-pub const MAX_CACHE_FILE_BYTES: u32 = 64 * 1024 * 1024;
+pub(crate) const MAX_CACHE_FILE_BYTES: u32 = 64 * 1024 * 1024;
 /// Longest function string we read.
 const MAX_FUNCTION_CHARS: usize = 1024;
 
@@ -69,7 +69,7 @@ impl Origin {
 
 /// Which decoder parameter an entry sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum DecoderField {
+pub(crate) enum DecoderField {
     Function,
     MaxCacheNumber,
     MaxCacheSize,
@@ -78,7 +78,7 @@ pub enum DecoderField {
 /// The decoder values one list sets; unset fields stay `None` so a channel list overrides
 /// only what it names.
 #[derive(Debug, Clone, Default)]
-pub struct DecoderParams {
+pub(crate) struct DecoderParams {
     functions: Option<Vec<String>>,
     max_cache_number: Option<(u32, Origin)>,
     max_cache_size: Option<(u32, Origin)>,
@@ -113,7 +113,7 @@ impl DecoderParams {
     }
 
     /// `over` (the channel list) wins field by field over `self` (the start-up list).
-    pub fn overlay(self, over: DecoderParams) -> DecoderParams {
+    pub(crate) fn overlay(self, over: DecoderParams) -> DecoderParams {
         DecoderParams {
             functions: over.functions.or(self.functions),
             max_cache_number: over.max_cache_number.or(self.max_cache_number),

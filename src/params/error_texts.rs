@@ -9,7 +9,7 @@ use super::list::{file_error, read_list_text};
 use crate::diag::Diagnostic;
 
 /// Longest text kept per id; the kernel's are one line of well under 200 characters.
-pub const MAX_TEXT_CHARS: usize = 512;
+pub(crate) const MAX_TEXT_CHARS: usize = 512;
 
 /// Error texts by ISG error id.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -59,7 +59,7 @@ impl ErrorTexts {
 }
 
 /// Read an error text file (same size bound and Latin-1 rule as the lists).
-pub fn read_error_texts(path: &Path) -> Result<ErrorTexts, Diagnostic> {
+pub(crate) fn read_error_texts(path: &Path) -> Result<ErrorTexts, Diagnostic> {
     let text = read_list_text(path)?;
     let t = ErrorTexts::parse(&text);
     if t.is_empty() {

@@ -18,13 +18,13 @@ use crate::diag::Diagnostic;
 
 /// Largest list file we read. Real start-up lists are a few KiB; 16 MiB leaves room for
 /// generated lists and keeps a wrong path (a disk image, a log) from being slurped.
-pub const MAX_LIST_BYTES: u64 = 16 * 1024 * 1024;
+pub(crate) const MAX_LIST_BYTES: u64 = 16 * 1024 * 1024;
 
 /// Most entries one list may hold. Bounds memory independent of line length.
-pub const MAX_ENTRIES: usize = 100_000;
+pub(crate) const MAX_ENTRIES: usize = 100_000;
 
 /// Largest index inside `[...]`. ISG tables are small; a huge index is a typo.
-pub const MAX_INDEX: u32 = 65_535;
+pub(crate) const MAX_INDEX: u32 = 65_535;
 
 /// A 1-based line and character column in a list file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,7 +108,7 @@ pub struct Entry {
     pub value: Value,
     pub value_pos: Pos,
     /// The whole line (without line end), for caret diagnostics.
-    pub line_text: String,
+    pub(crate) line_text: String,
 }
 
 /// A parsed list file: its path and its entries in file order.
@@ -131,20 +131,25 @@ impl ParamList {
     }
 
     /// A warning diagnostic pointing at `pos` on `entry`'s line.
-    pub fn warning_at(&self, entry: &Entry, pos: Pos, message: impl Into<String>) -> Diagnostic {
+    pub(crate) fn warning_at(
+        &self,
+        entry: &Entry,
+        pos: Pos,
+        message: impl Into<String>,
+    ) -> Diagnostic {
         Diagnostic::warning(&self.file, pos.line, pos.col, None, message)
             .with_source(&entry.line_text)
     }
 }
 
 /// A file-level problem (unreadable, too large) as a diagnostic at 1:1.
-pub fn file_error(file: &Path, message: impl Into<String>) -> Diagnostic {
+pub(crate) fn file_error(file: &Path, message: impl Into<String>) -> Diagnostic {
     Diagnostic::error(file, 1, 1, None, message)
 }
 
 /// Read a list file with the size bound. Text that is not UTF-8 is taken as Latin-1, the
 /// encoding German installations write umlauts in comments with.
-pub fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
+pub(crate) fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
     let meta = std::fs::metadata(file)
         .map_err(|e| file_error(file, format!("cannot read parameter list: {e}")))?;
     if !meta.is_file() {
@@ -170,7 +175,7 @@ pub fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
 
 /// Read and parse a list file. Malformed lines become errors; parsing goes on after them so
 /// one run reports every bad line.
-pub fn read_list(file: &Path) -> Result<(ParamList, Vec<Diagnostic>), Diagnostic> {
+pub(crate) fn read_list(file: &Path) -> Result<(ParamList, Vec<Diagnostic>), Diagnostic> {
     let text = read_list_text(file)?;
     Ok(parse_list(file, &text))
 }
@@ -269,7 +274,7 @@ pub fn parse_list(file: &Path, text: &str) -> (ParamList, Vec<Diagnostic>) {
 }
 
 /// The word that ends a list (German "end"): the kernel reads no further.
-pub const END_OF_LIST: &str = "Ende";
+pub(crate) const END_OF_LIST: &str = "Ende";
 
 /// `Ende` alone on a line (blanks and a comment after a blank allowed).
 fn is_end_of_list(line: &str) -> bool {

@@ -3,20 +3,20 @@
 //! The rest of the program calls [`load`] with the start-up list and gets a [`Config`], or a
 //! [`ParamError`] listing every problem; `ncchannel check` calls [`check_list_file`].
 
-pub mod axes;
-pub mod catalog;
-pub mod channel;
+pub(crate) mod axes;
+pub(crate) mod catalog;
+pub(crate) mod channel;
 pub mod config;
-pub mod decoder;
-pub mod error;
+pub(crate) mod decoder;
+pub(crate) mod error;
 pub mod error_texts;
 pub mod list;
-pub mod runtime;
-pub mod search_path;
-pub mod startup;
-pub mod tools;
-pub mod value;
-pub mod zero_offsets;
+pub(crate) mod runtime;
+pub(crate) mod search_path;
+pub(crate) mod startup;
+pub(crate) mod tools;
+pub(crate) mod value;
+pub(crate) mod zero_offsets;
 
 pub use config::{check_list_file, load, ChannelConfig, Config, RUNTIME_FILE};
 pub use decoder::{CacheSettings, DecoderSettings, FCT_USE_CACHED_FILES};

@@ -13,7 +13,7 @@ use crate::vocab::ams::{AmsNetId, RouteEntry};
 use crate::vocab::axis::{AXIS_LETTERS, MAX_AXES};
 
 /// Largest runtime.toml we read; the real one is a few KiB.
-pub const MAX_RUNTIME_BYTES: u64 = 1024 * 1024;
+pub(crate) const MAX_RUNTIME_BYTES: u64 = 1024 * 1024;
 
 /// The emulator's own settings.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -130,7 +130,7 @@ impl AxisConfig {
 /// digits or `_`: `lang::block::AxisName`). The one rule `setup` relies on, so `check`
 /// refuses exactly what `run` could not build; two axes in one slot (`X` and `X1`) are
 /// refused where the axes are listed.
-pub fn axis_index(name: &str) -> Option<usize> {
+pub(crate) fn axis_index(name: &str) -> Option<usize> {
     let n = crate::lang::block::AxisName::new(name.trim())?;
     AXIS_LETTERS.iter().position(|&l| l == n.letter())
 }
@@ -166,7 +166,7 @@ pub struct PlannerConfig {
     /// Corner smoothing window in ms (default 0 = off): a moving average over the axis
     /// positions that spreads each junction's velocity jump over this time, so corners of fine
     /// polylines keep speed while every axis keeps its acceleration limit (docs/motion.md).
-    pub corner_smoothing_ms: f64,
+    pub(crate) corner_smoothing_ms: f64,
 }
 
 impl Default for PlannerConfig {
@@ -193,14 +193,14 @@ pub struct AdsConfig {
     /// Simultaneous connections (default 64); more are closed at once.
     pub max_connections: u32,
     /// Notification handles per connection (default 256); more are answered 0x716.
-    pub max_notifications_per_connection: u32,
+    pub(crate) max_notifications_per_connection: u32,
     /// Notification handles, all connections together (default 1024).
-    pub max_notifications_total: u32,
+    pub(crate) max_notifications_total: u32,
     /// Notification samples per second, all connections together (default 10000).
-    pub notification_samples_per_s: u32,
+    pub(crate) notification_samples_per_s: u32,
     /// Seconds without a whole frame after which a connection in the middle of a frame, or
     /// without notification handles, is closed (default 60).
-    pub idle_timeout_s: u32,
+    pub(crate) idle_timeout_s: u32,
 }
 
 impl Default for AdsConfig {
@@ -237,7 +237,7 @@ impl TryFrom<String> for SocketAddrText {
 }
 
 /// Parse and check runtime.toml text. Errors name the key (`ads.net_id`, `axes[1].name`).
-pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {
+pub(crate) fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagnostic>> {
     let cfg: RuntimeConfig = toml::from_str(text).map_err(|e| vec![toml_error(file, text, &e)])?;
     let errs = validate(&cfg, file, text);
     if errs.is_empty() {
@@ -248,7 +248,7 @@ pub fn parse_runtime(file: &Path, text: &str) -> Result<RuntimeConfig, Vec<Diagn
 }
 
 /// Read runtime.toml with the size bound, then parse and check it.
-pub fn read_runtime(file: &Path) -> Result<RuntimeConfig, Vec<Diagnostic>> {
+pub(crate) fn read_runtime(file: &Path) -> Result<RuntimeConfig, Vec<Diagnostic>> {
     use crate::bounded::{read_file, BoundedReadError};
     let err = |m: String| vec![Diagnostic::error(file, 1, 1, None, m)];
     let bytes = read_file(file, MAX_RUNTIME_BYTES).map_err(|e| {

@@ -13,15 +13,15 @@ pub const MAIN_PROGRAMS: u16 = 0x01;
 /// Path type bit: the folder holds global subroutines and cycles.
 pub const SUBROUTINES: u16 = 0x02;
 /// Path type bit: `#MSG SAVE` output folder (accepted, not used by the emulator).
-pub const MSG_SAVE: u16 = 0x04;
+pub(crate) const MSG_SAVE: u16 = 0x04;
 /// Path type bit: debug data `*.dbg` folder (accepted, not used by the emulator).
-pub const DEBUG_DATA: u16 = 0x08;
+pub(crate) const DEBUG_DATA: u16 = 0x08;
 const ALL_TYPES: u16 = MAIN_PROGRAMS | SUBROUTINES | MSG_SAVE | DEBUG_DATA;
 
 /// Program paths per channel (`j = 0 ... 11` in the ISG documentation).
-pub const MAX_PATHS: u32 = 12;
+pub(crate) const MAX_PATHS: u32 = 12;
 /// Longest path string the kernel accepts (P-CHAN-00401: 256 characters).
-pub const MAX_DIR_CHARS: usize = 256;
+pub(crate) const MAX_DIR_CHARS: usize = 256;
 
 /// One folder the channel searches for NC programs.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -38,18 +38,18 @@ pub struct SearchPath {
 }
 
 impl SearchPath {
-    pub fn serves_main_programs(&self) -> bool {
+    pub(crate) fn serves_main_programs(&self) -> bool {
         self.kinds & MAIN_PROGRAMS != 0
     }
 
-    pub fn serves_subroutines(&self) -> bool {
+    pub(crate) fn serves_subroutines(&self) -> bool {
         self.kinds & SUBROUTINES != 0
     }
 }
 
 /// Which field of a path an entry sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PathField {
+pub(crate) enum PathField {
     Dir,
     Kinds,
     Priority,
@@ -65,7 +65,7 @@ struct RawPath<'a> {
 
 /// Collects the path entries of one list for one channel, then checks and resolves them.
 #[derive(Default)]
-pub struct PathCollector<'a> {
+pub(crate) struct PathCollector<'a> {
     paths: BTreeMap<u32, RawPath<'a>>,
 }
 
@@ -247,7 +247,7 @@ fn priority_clash(
 }
 
 /// The folder a list's relative paths are relative to.
-pub fn list_folder(list_file: &Path) -> PathBuf {
+pub(crate) fn list_folder(list_file: &Path) -> PathBuf {
     match list_file.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),

@@ -13,15 +13,15 @@ use super::value::{string_value, uint_value};
 use crate::diag::Diagnostic;
 
 /// Channels one kernel runs (ISG: `pfad[i]` with i = 0 ... 11, "maximum number of channels: 12").
-pub const MAX_CHANNELS: u32 = 12;
+pub(crate) const MAX_CHANNELS: u32 = 12;
 /// Axis lists one kernel reads (P-STUP-00015: `achs_mds[i]`, i = 0 … 31).
-pub const MAX_AXIS_LISTS: u32 = 32;
+pub(crate) const MAX_AXIS_LISTS: u32 = 32;
 /// Longest list path we accept.
 const MAX_PATH_CHARS: usize = 256;
 
 /// Where a list (or other file) the start-up list names is and which line named it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ListRef {
+pub(crate) struct ListRef {
     /// Absolute as written, or joined to the CNC's working directory.
     pub path: PathBuf,
     /// The `sda_mds[i]` line, so a missing file is reported there.
@@ -30,31 +30,31 @@ pub struct ListRef {
 
 /// The start-up list, checked.
 #[derive(Debug, Clone)]
-pub struct StartupList {
+pub(crate) struct StartupList {
     pub list: ParamList,
     /// `kanal_anzahl`; `None` when missing or bad (an error was reported).
-    pub channel_count: Option<u32>,
-    pub channel_lists: BTreeMap<u32, ListRef>,
+    pub(crate) channel_count: Option<u32>,
+    pub(crate) channel_lists: BTreeMap<u32, ListRef>,
     /// `pfad[i].*` per channel, sorted by priority.
     pub search_paths: BTreeMap<u32, Vec<SearchPath>>,
     /// `configuration.channel[i].decoder.*` per channel.
     pub decoder: BTreeMap<u32, DecoderParams>,
     /// `zero_offset_list[i]`: channel i's zero-offset list.
-    pub zero_offset_lists: BTreeMap<u32, ListRef>,
+    pub(crate) zero_offset_lists: BTreeMap<u32, ListRef>,
     /// `zero_offset_list`: the zero-offset list of every channel without its own.
-    pub zero_offset_default: Option<ListRef>,
+    pub(crate) zero_offset_default: Option<ListRef>,
     /// `achs_mds[i]` (P-STUP-00015): the axis lists, by index.
-    pub axis_lists: BTreeMap<u32, ListRef>,
+    pub(crate) axis_lists: BTreeMap<u32, ListRef>,
     /// `default_achs_mds` (P-STUP-00035): the list under every axis list.
-    pub default_axis_list: Option<ListRef>,
+    pub(crate) default_axis_list: Option<ListRef>,
     /// `error_text_of_id` (P-STUP-00168): the kernel's error text file.
-    pub error_texts: Option<ListRef>,
+    pub(crate) error_texts: Option<ListRef>,
     /// Entries used, inert and unknown.
     pub summary: ListSummary,
 }
 
 /// Does this list look like a start-up list? (It names `kanal_anzahl` or `sda_mds[…]`.)
-pub fn is_startup_list(list: &ParamList) -> bool {
+pub(crate) fn is_startup_list(list: &ParamList) -> bool {
     list.entries.iter().any(|e| {
         matches!(
             e.name.segments.as_slice(),
@@ -92,7 +92,7 @@ pub(crate) fn warn_duplicates(list: &ParamList, diags: &mut Vec<Diagnostic>) {
 
 /// Check the start-up list's entries; relative paths are joined to `cnc_dir`, the CNC's
 /// working directory. Problems go to `diags`; the result holds what was good.
-pub fn interpret_startup(
+pub(crate) fn interpret_startup(
     list: ParamList,
     cnc_dir: &Path,
     diags: &mut Vec<Diagnostic>,

@@ -20,15 +20,15 @@ use super::zero_offsets::{int_value, MM_PER_UNIT};
 use crate::diag::Diagnostic;
 
 /// The tool list's file name, in the start-up list's folder.
-pub const TOOLS_FILE: &str = "tools.lis";
+pub(crate) const TOOLS_FILE: &str = "tools.lis";
 /// Highest D number accepted.
-pub const MAX_TOOL: u32 = 10_000;
+pub(crate) const MAX_TOOL: u32 = 10_000;
 
 /// Radius by D number, mm, sorted by D.
-pub type ToolRadii = Vec<(u32, f64)>;
+pub(crate) type ToolRadii = Vec<(u32, f64)>;
 
 /// Does this list look like a tool list? (It names `wz[…]`.)
-pub fn is_tool_list(list: &ParamList) -> bool {
+pub(crate) fn is_tool_list(list: &ParamList) -> bool {
     list.entries.iter().any(|e| {
         e.name
             .segments
@@ -39,7 +39,7 @@ pub fn is_tool_list(list: &ParamList) -> bool {
 
 /// Read and check a tool list. `Err` when the file cannot be read; entry problems go to
 /// `diags`.
-pub fn read_tools(
+pub(crate) fn read_tools(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> Result<(ToolRadii, ListSummary), Diagnostic> {
@@ -49,7 +49,10 @@ pub fn read_tools(
 }
 
 /// Check a parsed tool list.
-pub fn interpret_tools(list: &ParamList, diags: &mut Vec<Diagnostic>) -> (ToolRadii, ListSummary) {
+pub(crate) fn interpret_tools(
+    list: &ParamList,
+    diags: &mut Vec<Diagnostic>,
+) -> (ToolRadii, ListSummary) {
     warn_duplicates(list, diags);
     let mut tally = Tally::new(ListKind::Tools);
     let mut out: ToolRadii = Vec::new();

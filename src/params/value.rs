@@ -5,7 +5,7 @@ use super::list::{Entry, ParamList, ValueKind};
 use crate::diag::Diagnostic;
 
 /// A whole number in `0 ..= max`, written decimal or `0x…`.
-pub fn uint_value(list: &ParamList, e: &Entry, max: u64) -> Result<u64, Diagnostic> {
+pub(crate) fn uint_value(list: &ParamList, e: &Entry, max: u64) -> Result<u64, Diagnostic> {
     let name = &e.name.text;
     let v = match e.value.kind {
         ValueKind::Int(v) if v < 0 => {
@@ -45,7 +45,12 @@ pub fn uint_value(list: &ParamList, e: &Entry, max: u64) -> Result<u64, Diagnost
 
 /// A finite number written as an integer, `0x…` or with a fraction (the kernel's later
 /// builds keep positions as REAL64), in `min ..= max`.
-pub fn number_value(list: &ParamList, e: &Entry, min: f64, max: f64) -> Result<f64, Diagnostic> {
+pub(crate) fn number_value(
+    list: &ParamList,
+    e: &Entry,
+    min: f64,
+    max: f64,
+) -> Result<f64, Diagnostic> {
     let name = &e.name.text;
     let v = match e.value.kind {
         ValueKind::Int(v) => v as f64,
@@ -72,7 +77,7 @@ pub fn number_value(list: &ParamList, e: &Entry, min: f64, max: f64) -> Result<f
 
 /// A reference (`P-AXIS-00008.0`) the list does not resolve: the parameter it names is not
 /// set in the lists read, or is not one ncchannel knows.
-pub fn unresolved(list: &ParamList, e: &Entry) -> Diagnostic {
+pub(crate) fn unresolved(list: &ParamList, e: &Entry) -> Diagnostic {
     list.error_at(
         e,
         e.value_pos,
@@ -84,7 +89,11 @@ pub fn unresolved(list: &ParamList, e: &Entry) -> Diagnostic {
 }
 
 /// A string of at most `max_chars` characters.
-pub fn string_value(list: &ParamList, e: &Entry, max_chars: usize) -> Result<String, Diagnostic> {
+pub(crate) fn string_value(
+    list: &ParamList,
+    e: &Entry,
+    max_chars: usize,
+) -> Result<String, Diagnostic> {
     let s = e.value.as_str();
     let n = s.chars().count();
     if n > max_chars {

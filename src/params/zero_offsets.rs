@@ -15,19 +15,19 @@ use crate::diag::Diagnostic;
 use crate::vocab::axis::MAX_AXES;
 
 /// Zero-offset groups the emulator selects: G54 … G59.
-pub const GROUPS: usize = 6;
+pub(crate) const GROUPS: usize = 6;
 /// Groups and axes the kernel's list may name (more groups exist for G159; 32 axes a channel):
 /// accepted with a warning, not used.
 const MAX_LIST_GROUPS: u32 = 100;
 const MAX_LIST_AXES: u32 = 32;
 /// mm per list unit (0.1 µm).
-pub const MM_PER_UNIT: f64 = 1e-4;
+pub(crate) const MM_PER_UNIT: f64 = 1e-4;
 
 /// Offsets by group (G54 = 0) and axis, mm (degrees for rotary axes).
-pub type ZeroOffsetTable = [[f64; MAX_AXES]; GROUPS];
+pub(crate) type ZeroOffsetTable = [[f64; MAX_AXES]; GROUPS];
 
 /// Does this list look like a zero-offset list? (It names `np_grp[…]`.)
-pub fn is_zero_offset_list(list: &ParamList) -> bool {
+pub(crate) fn is_zero_offset_list(list: &ParamList) -> bool {
     list.entries.iter().any(|e| {
         e.name
             .segments
@@ -38,7 +38,7 @@ pub fn is_zero_offset_list(list: &ParamList) -> bool {
 
 /// Read and check a zero-offset list. `Err` when the file cannot be read; entry problems go to
 /// `diags` (the table then holds the good entries).
-pub fn read_zero_offsets(
+pub(crate) fn read_zero_offsets(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> Result<(ZeroOffsetTable, ListSummary), Diagnostic> {
@@ -48,7 +48,7 @@ pub fn read_zero_offsets(
 }
 
 /// Check a parsed zero-offset list.
-pub fn interpret_zero_offsets(
+pub(crate) fn interpret_zero_offsets(
     list: &ParamList,
     diags: &mut Vec<Diagnostic>,
 ) -> (ZeroOffsetTable, ListSummary) {

@@ -154,7 +154,7 @@ pub enum ProgramEndKind {
 
 impl ProgramEndKind {
     /// The end an M function programmed: the decoder ends a program only with M2 or M30.
-    pub fn from_m(m: u32) -> Self {
+    pub(crate) fn from_m(m: u32) -> Self {
         if m == 2 {
             ProgramEndKind::M2
         } else {
@@ -234,15 +234,15 @@ impl EventBuffer {
 const RECYCLE_BATCHES: usize = 16;
 
 /// Batches (one tick's events each) waiting for the writer at most; see [`Backlog`].
-pub const MAX_QUEUED_BATCHES: usize = 1024;
+pub(crate) const MAX_QUEUED_BATCHES: usize = 1024;
 
 /// With [`Backlog::Drop`], how long [`EventLog::finish`] waits for a writer that is stuck
 /// on a reader that does not read before giving up on it.
-pub const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
+pub(crate) const FINISH_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// What [`EventLog::emit`] does when [`MAX_QUEUED_BATCHES`] batches wait for the writer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Backlog {
+pub(crate) enum Backlog {
     /// Wait for the writer (virtual time: the log is complete, the run slows down).
     Block,
     /// Drop the batch and count its events (real time: the cycle never waits for a reader).
@@ -251,11 +251,11 @@ pub enum Backlog {
 
 /// A file's buffered lines reach the file at least this often, so a `tail -f` of the log
 /// lags the channel by no more than this plus a tick.
-pub const FLUSH_INTERVAL: Duration = Duration::from_millis(100);
+pub(crate) const FLUSH_INTERVAL: Duration = Duration::from_millis(100);
 
 /// When the writer thread hands its buffer to the operating system.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FlushPolicy {
+pub(crate) enum FlushPolicy {
     /// After every batch (one tick's events): a pipe's reader sees each tick at once.
     EveryBatch,
     /// At most [`FLUSH_INTERVAL`] after an event was emitted (files: fewer writes).
@@ -317,7 +317,7 @@ impl EventLog {
     /// Write to any writer, buffered, on a thread of its own, flushed as `policy` says.
     /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
     /// [`EventLog::finish`] never leaves a cut line.
-    pub fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
+    pub(crate) fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
         let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_QUEUED_BATCHES);
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
         let dropped = Arc::new(AtomicU64::new(0));
@@ -395,7 +395,7 @@ impl EventLog {
     }
 
     /// The same log with `backlog` for a full queue (default [`Backlog::Block`]).
-    pub fn with_backlog(mut self, backlog: Backlog) -> Self {
+    pub(crate) fn with_backlog(mut self, backlog: Backlog) -> Self {
         if let Some(w) = &mut self.inner {
             w.backlog = backlog;
         }
@@ -414,7 +414,7 @@ impl EventLog {
 
     /// Move the events out of `events` to the writer, leaving `events` empty (with a recycled
     /// allocation when one is free). Cheap enough for the tick: a swap and a channel send.
-    pub fn emit(&mut self, events: &mut Vec<Event>) {
+    pub(crate) fn emit(&mut self, events: &mut Vec<Event>) {
         if events.is_empty() {
             return;
         }

@@ -1,6 +1,6 @@
 //! What a run tells the outside: cycle statistics, the JSON Lines event log and the report.
 
 pub mod event;
-pub mod plot;
-pub mod progress;
+pub(crate) mod plot;
+pub(crate) mod progress;
 pub mod summary;

@@ -22,12 +22,12 @@ const PATH_PANEL: u32 = 620;
 const INTERRUPT: RGBColor = RGBColor(214, 39, 40);
 
 /// Write the plot of `trace` to `path`.
-pub fn write_svg(path: &Path, trace: &Trace, title: &str) -> std::io::Result<()> {
+pub(crate) fn write_svg(path: &Path, trace: &Trace, title: &str) -> std::io::Result<()> {
     std::fs::write(path, render_svg(trace, title))
 }
 
 /// The plot as SVG text.
-pub fn render_svg(trace: &Trace, title: &str) -> String {
+pub(crate) fn render_svg(trace: &Trace, title: &str) -> String {
     svg_of((WIDTH, HEIGHT), |root| draw(root, trace, title))
 }
 
@@ -222,7 +222,7 @@ fn shares(h: &Histogram, bins: usize) -> Vec<f64> {
 }
 
 /// The lateness histogram as SVG text.
-pub fn lateness_svg(runtime: &Histogram, bare: &Histogram, period: Duration) -> String {
+pub(crate) fn lateness_svg(runtime: &Histogram, bare: &Histogram, period: Duration) -> String {
     svg_of(LATENESS_SIZE, |root| {
         draw_lateness(root, runtime, bare, period)
     })

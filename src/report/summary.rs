@@ -125,7 +125,7 @@ impl Report {
     }
 
     /// Write the report JSON to a file.
-    pub fn write_file(&self, path: &std::path::Path) -> io::Result<()> {
+    pub(crate) fn write_file(&self, path: &std::path::Path) -> io::Result<()> {
         let mut text = self.to_json_pretty();
         text.push('\n');
         std::fs::write(path, text)

@@ -41,7 +41,7 @@ impl Door for Channel {
 }
 
 /// One channel of a [`Machine`] as a door: ops go through [`Machine::apply`].
-pub struct MachineDoor<'a> {
+pub(crate) struct MachineDoor<'a> {
     machine: &'a mut Machine,
     number: u32,
     index: usize,
@@ -118,7 +118,7 @@ pub struct SoakCounters {
     /// Resets injected by the fault plan.
     pub resets: u64,
     /// Resets after a channel error.
-    pub error_resets: u64,
+    pub(crate) error_resets: u64,
     /// Program restarts after the program ended (a streamed file's M30, a client's reset).
     pub restarts: u64,
     pub holds: u64,
@@ -131,7 +131,7 @@ pub struct SoakCounters {
     /// Stream writes the channel refused (a full buffer: 11012).
     pub writes_rejected: u64,
     /// Writes a forced rejection refused without touching the channel.
-    pub writes_skipped: u64,
+    pub(crate) writes_skipped: u64,
     /// Pauses the built-in client made (none for external clients).
     pub pauses: u64,
     pub interrupts: u64,
@@ -153,7 +153,7 @@ pub struct Tallies {
 impl Tallies {
     /// The verdicts of a run: order, errors, limits, and memory (`growth`: resident set
     /// after warm-up, KiB, allowed up to `slack_kib`).
-    pub fn verdicts(
+    pub(crate) fn verdicts(
         &self,
         blocks: u64,
         expected_errors: &[u32],
@@ -225,23 +225,23 @@ impl SoakChannel {
     }
 
     /// Also check that numbered lines run with rising N (for external clients).
-    pub fn with_rising_numbers(mut self) -> Self {
+    pub(crate) fn with_rising_numbers(mut self) -> Self {
         self.numbers_rise = true;
         self
     }
 
     /// Draw the first faults (at the first tick).
-    pub fn plan(&mut self, rng: &mut SplitMix64, f: &Faults, now: u64) {
+    pub(crate) fn plan(&mut self, rng: &mut SplitMix64, f: &Faults, now: u64) {
         self.plan.plan(rng, f, self.counters.blocks, now);
     }
 
     /// A forced rejection is running: the client's writes are refused unseen by the channel.
-    pub fn rejecting(&self, now: u64) -> bool {
+    pub(crate) fn rejecting(&self, now: u64) -> bool {
         self.plan.rejecting(now)
     }
 
     /// A new stream epoch: the rising-N check starts over (what is owed is the caller's).
-    pub fn new_epoch(&mut self) {
+    pub(crate) fn new_epoch(&mut self) {
         self.last_n = None;
     }
 
@@ -449,7 +449,7 @@ pub struct SoakCycle {
     expected_errors: Vec<u32>,
     /// Stop when this many stream blocks ran, all channels together.
     target_blocks: Option<u64>,
-    pub total_blocks: u64,
+    pub(crate) total_blocks: u64,
     pub tallies: Tallies,
     planned: bool,
 }

@@ -20,7 +20,7 @@ use crate::runtime::{Cycle, Flow, Tick};
 const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
 
 /// Load a scenario for external clients: the soak's format, its client keys refused by name.
-pub fn load_external(path: &Path) -> Result<Scenario, String> {
+pub(crate) fn load_external(path: &Path) -> Result<Scenario, String> {
     let shown = path.display();
     let bytes = crate::bounded::read_file(path, super::scenario::MAX_SCENARIO_BYTES)
         .map_err(|e| format!("{shown}: {e}"))?;
@@ -41,7 +41,7 @@ pub fn load_external(path: &Path) -> Result<Scenario, String> {
 }
 
 /// Refuse the scenario keys that make no sense against external clients, naming them.
-pub fn check_external(text: &str) -> Result<(), String> {
+pub(crate) fn check_external(text: &str) -> Result<(), String> {
     let doc: toml::Table = text.parse().map_err(|e| format!("{e}"))?;
     let bad: Vec<&str> = CLIENT_KEYS
         .iter()
@@ -124,7 +124,7 @@ impl Supervised {
         }
     }
 
-    pub fn into_machine(self) -> Machine {
+    pub(crate) fn into_machine(self) -> Machine {
         self.machine
     }
 
@@ -143,7 +143,7 @@ impl Supervised {
     }
 
     /// The verdicts so far (`growth`: resident set after warm-up, KiB).
-    pub fn verdicts(&self, growth: Option<i64>, slack_kib: u64) -> Vec<Verdict> {
+    pub(crate) fn verdicts(&self, growth: Option<i64>, slack_kib: u64) -> Vec<Verdict> {
         self.tallies
             .verdicts(self.blocks(), &self.expected_errors, growth, slack_kib)
     }

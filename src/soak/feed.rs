@@ -18,11 +18,11 @@ pub struct FeederSpec {
     /// Packet size range, bytes; at most 992 (the stream object's input size).
     pub packet_bytes: [usize; 2],
     /// Ticks between write attempts.
-    pub interval_ticks: [u64; 2],
+    pub(crate) interval_ticks: [u64; 2],
     /// Chance per accepted packet that a pause follows.
-    pub pause_chance: f64,
+    pub(crate) pause_chance: f64,
     /// Pause length range, ticks.
-    pub pause_ticks: [u64; 2],
+    pub(crate) pause_ticks: [u64; 2],
 }
 
 impl Default for FeederSpec {
@@ -72,7 +72,7 @@ pub struct Owed {
     /// Its N, when the source numbers its lines (the generator does).
     pub n: Option<u32>,
     /// Every line of the generator yields a block; a file's comment lines do not.
-    pub must_run: bool,
+    pub(crate) must_run: bool,
 }
 
 /// Where the lines come from.
@@ -138,7 +138,7 @@ pub struct FeedCounters {
     pub writes_ok: u64,
     pub writes_rejected: u64,
     /// Attempts skipped by a forced-rejection fault.
-    pub writes_skipped: u64,
+    pub(crate) writes_skipped: u64,
     pub bytes: u64,
     pub lines: u64,
     pub pauses: u64,
@@ -178,7 +178,7 @@ impl SoakFeeder {
 
     /// A new stream after a reset or program end: what was written is no longer owed, the
     /// packet in hand is dropped, offsets and numbering start over.
-    pub fn new_epoch(&mut self, tick: u64) {
+    pub(crate) fn new_epoch(&mut self, tick: u64) {
         self.owed.clear();
         self.packet.clear();
         self.packet_lines.clear();
@@ -254,7 +254,7 @@ impl SoakFeeder {
     }
 
     /// Lines written and not yet executed, oldest first.
-    pub fn owed_mut(&mut self) -> &mut VecDeque<Owed> {
+    pub(crate) fn owed_mut(&mut self) -> &mut VecDeque<Owed> {
         &mut self.owed
     }
 

@@ -21,22 +21,22 @@ pub struct ProgramSpec {
     pub moves: u32,
     pub arcs: u32,
     pub params: u32,
-    pub m_functions: u32,
+    pub(crate) m_functions: u32,
     /// `L name` calls of the `subroutines` (files on the channel's search path).
     pub calls: u32,
     /// `#CACHE LOAD/CLEAR[FILE=…]` of the `cache_files`.
     pub cache_ops: u32,
     /// Largest step of a move per axis, mm.
-    pub step_mm: f64,
+    pub(crate) step_mm: f64,
     /// Feed range, mm/min.
     pub feed_mm_per_min: [f64; 2],
     /// Moves stay within ±box_mm of the origin on X and Y.
-    pub box_mm: f64,
+    pub(crate) box_mm: f64,
     pub subroutines: Vec<String>,
-    pub cache_files: Vec<String>,
+    pub(crate) cache_files: Vec<String>,
     /// Cache entries the program may hold at once (the channel's max_cache_number): a
     /// `#CACHE LOAD` beyond it would be error 21562, so the generator clears one first.
-    pub cache_slots: u32,
+    pub(crate) cache_slots: u32,
 }
 
 impl Default for ProgramSpec {
@@ -145,7 +145,7 @@ impl Generator {
     }
 
     /// A new stream starts (program start after a reset): numbering from N1, preamble first.
-    pub fn new_epoch(&mut self) {
+    pub(crate) fn new_epoch(&mut self) {
         self.next_n = 1;
         self.position_unknown = true;
         self.params_set = 0;
@@ -171,7 +171,7 @@ impl Generator {
     }
 
     /// Append the next line (CR LF ended) to `out`; returns its N.
-    pub fn next_line(&mut self, out: &mut Vec<u8>) -> u32 {
+    pub(crate) fn next_line(&mut self, out: &mut Vec<u8>) -> u32 {
         let n = self.next_n;
         self.next_n = self.next_n.wrapping_add(1).max(1);
         let mut s = String::with_capacity(MAX_LINE_BYTES);

@@ -30,7 +30,7 @@ pub struct Tally {
 }
 
 impl Tally {
-    pub fn violate(&mut self, msg: impl FnOnce() -> String) {
+    pub(crate) fn violate(&mut self, msg: impl FnOnce() -> String) {
         self.violations += 1;
         if self.details.len() < MAX_DETAILS {
             self.details.push(msg());
@@ -54,7 +54,7 @@ impl Tally {
 /// FNV-1a, 64 bit: the running checksum over executed blocks (N and stream offset), equal for
 /// equal runs, so two runs of one seed can be compared by one number.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Checksum(pub u64);
+pub(crate) struct Checksum(pub u64);
 
 impl Default for Checksum {
     fn default() -> Self {
@@ -73,7 +73,7 @@ impl Checksum {
 /// Check executed stream blocks against what the channel owes. Each block must be the next
 /// owed line (lines that yield no block, like a file's comments, may be passed over); a block
 /// nobody wrote, one out of order or one run twice is a violation.
-pub fn check_blocks(
+pub(crate) fn check_blocks(
     channel: u32,
     owed: &mut VecDeque<Owed>,
     executed: impl Iterator<Item = ExecutedBlock>,
@@ -135,7 +135,7 @@ pub fn check_blocks(
 
 /// Resident set size of this process, KiB (`VmRSS` of /proc/self/status); `None` where there
 /// is no /proc.
-pub fn resident_kib() -> Option<u64> {
+pub(crate) fn resident_kib() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = s.lines().find(|l| l.starts_with("VmRSS:"))?;
     line.split_whitespace().nth(1)?.parse().ok()

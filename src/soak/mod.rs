@@ -2,14 +2,14 @@
 //! with a randomised client and injected faults, checking invariants as it goes; see
 //! `ncchannel soak` and the README section "Soak and bench".
 
-pub mod driver;
-pub mod external;
-pub mod feed;
-pub mod generator;
-pub mod invariants;
+pub(crate) mod driver;
+pub(crate) mod external;
+pub(crate) mod feed;
+pub(crate) mod generator;
+pub(crate) mod invariants;
 pub mod load;
 pub mod report;
-pub mod rng;
+pub(crate) mod rng;
 pub mod scenario;
 
 use std::time::{Duration, Instant};

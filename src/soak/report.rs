@@ -12,10 +12,10 @@ use crate::vocab::stats::{CycleStats, Histogram};
 /// Percentiles of one histogram, µs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct Percentiles {
-    pub p50_us: f64,
-    pub p99_us: f64,
-    pub p999_us: f64,
-    pub max_us: f64,
+    pub(crate) p50_us: f64,
+    pub(crate) p99_us: f64,
+    pub(crate) p999_us: f64,
+    pub(crate) max_us: f64,
     pub count: u64,
 }
 
@@ -54,21 +54,21 @@ impl CycleFigures {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct MemoryReport {
     /// Resident set after warm-up, KiB (`None` without /proc).
-    pub warmup_kib: Option<u64>,
-    pub end_kib: Option<u64>,
-    pub growth_kib: Option<i64>,
+    pub(crate) warmup_kib: Option<u64>,
+    pub(crate) end_kib: Option<u64>,
+    pub(crate) growth_kib: Option<i64>,
 }
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct SoakReport {
     pub scenario: String,
     pub seed: u64,
-    pub clock: String,
+    pub(crate) clock: String,
     pub ticks: u64,
-    pub sim_seconds: f64,
-    pub wall_seconds: f64,
+    pub(crate) sim_seconds: f64,
+    pub(crate) wall_seconds: f64,
     pub blocks: u64,
-    pub blocks_per_wall_second: f64,
+    pub(crate) blocks_per_wall_second: f64,
     pub all_held: bool,
     pub invariants: Vec<Verdict>,
     pub channels: Vec<SoakCounters>,
@@ -80,10 +80,10 @@ pub struct SoakReport {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct RunFigures {
     pub seed: u64,
-    pub realtime: bool,
+    pub(crate) realtime: bool,
     pub ticks: u64,
-    pub sim_seconds: f64,
-    pub wall_seconds: f64,
+    pub(crate) sim_seconds: f64,
+    pub(crate) wall_seconds: f64,
     /// Stream blocks checked, all channels.
     pub blocks: u64,
 }

@@ -18,11 +18,11 @@ impl SplitMix64 {
 
     /// A generator for sub-stream `k` (per channel, per fault kind) that does not overlap the
     /// parent's sequence in practice.
-    pub fn fork(&mut self, k: u64) -> Self {
+    pub(crate) fn fork(&mut self, k: u64) -> Self {
         SplitMix64::new(self.next_u64() ^ k.wrapping_mul(0xD605_BBB5_8C8A_BE9B))
     }
 
-    pub fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.state;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -49,12 +49,12 @@ impl SplitMix64 {
     }
 
     /// Uniform in `[lo, hi)`.
-    pub fn range_f64(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn range_f64(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
 
     /// True with probability `p`.
-    pub fn chance(&mut self, p: f64) -> bool {
+    pub(crate) fn chance(&mut self, p: f64) -> bool {
         p > 0.0 && self.unit() < p
     }
 

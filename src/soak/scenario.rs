@@ -46,21 +46,21 @@ pub struct Length {
 #[serde(deny_unknown_fields)]
 pub struct Faults {
     /// NC reset after this many executed blocks of the channel (then the program restarts).
-    pub reset_every_blocks: Option<[u64; 2]>,
+    pub(crate) reset_every_blocks: Option<[u64; 2]>,
     /// NC reset after this many ticks.
-    pub reset_every_ticks: Option<[u64; 2]>,
+    pub(crate) reset_every_ticks: Option<[u64; 2]>,
     /// Feed hold every so many ticks, lasting `hold_ticks`.
     pub hold_every_ticks: Option<[u64; 2]>,
     #[serde(default = "default_hold")]
-    pub hold_ticks: [u64; 2],
+    pub(crate) hold_ticks: [u64; 2],
     /// A new feed override every so many ticks, from `override_pct`.
     pub override_every_ticks: Option<[u64; 2]>,
     #[serde(default = "default_override")]
-    pub override_pct: [f64; 2],
+    pub(crate) override_pct: [f64; 2],
     /// Forced rejections: the feeder's attempts are skipped for `reject_ticks`.
     pub reject_every_ticks: Option<[u64; 2]>,
     #[serde(default = "default_reject")]
-    pub reject_ticks: [u64; 2],
+    pub(crate) reject_ticks: [u64; 2],
 }
 
 impl Default for Faults {
@@ -94,11 +94,11 @@ fn default_reject() -> [u64; 2] {
 #[serde(deny_unknown_fields, default)]
 pub struct InvariantSpec {
     /// Channel error numbers that are part of the scenario (the channel is reset and goes on).
-    pub expected_errors: Vec<u32>,
+    pub(crate) expected_errors: Vec<u32>,
     /// Allowed growth of the resident set from warm-up to the end, KiB.
-    pub memory_slack_kib: u64,
+    pub(crate) memory_slack_kib: u64,
     /// Share of the run (by the length limit) after which the memory baseline is taken.
-    pub warmup: f64,
+    pub(crate) warmup: f64,
 }
 
 impl Default for InvariantSpec {
@@ -124,7 +124,7 @@ pub struct ChannelSpec {
     pub file: Option<PathBuf>,
     pub feeder: Option<FeederSpec>,
     #[serde(rename = "program_mix")]
-    pub program_mix: Option<ProgramSpec>,
+    pub(crate) program_mix: Option<ProgramSpec>,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -136,7 +136,7 @@ pub struct Scenario {
     pub seed: u64,
     /// "virtual" (default) or "realtime".
     #[serde(default)]
-    pub clock: ClockSpec,
+    pub(crate) clock: ClockSpec,
     pub length: Length,
     #[serde(default)]
     pub feeder: FeederSpec,
@@ -158,7 +158,7 @@ pub struct Scenario {
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum ClockSpec {
+pub(crate) enum ClockSpec {
     #[default]
     Virtual,
     Realtime,
@@ -202,11 +202,11 @@ impl Scenario {
     }
 
     /// The start-up list's path.
-    pub fn params_path(&self) -> PathBuf {
+    pub(crate) fn params_path(&self) -> PathBuf {
         self.dir.join(&self.params)
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), String> {
         let l = &self.length;
         if l.blocks.is_none()
             && l.ticks.is_none()

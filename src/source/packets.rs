@@ -39,7 +39,7 @@ pub fn lines(text: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
 /// Packs CR LF lines into packets of at most `max` bytes, all in one buffer: a packet is a
 /// range of [`Packer::data`].
 #[derive(Debug)]
-pub struct Packer {
+pub(crate) struct Packer {
     data: Vec<u8>,
     /// Start of the open packet in `data`.
     start: usize,
@@ -94,7 +94,7 @@ impl Packer {
         &self.data
     }
 
-    pub fn into_data(self) -> Vec<u8> {
+    pub(crate) fn into_data(self) -> Vec<u8> {
         self.data
     }
 }

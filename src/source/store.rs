@@ -21,12 +21,12 @@ use crate::bounded::BoundedReadError;
 
 /// Largest program the store reads into memory. A bound, so a mistaken path to a huge file
 /// cannot exhaust memory; real NC programs that large are streamed instead.
-pub const MAX_PROGRAM_BYTES: u64 = 256 * 1024 * 1024;
+pub(crate) const MAX_PROGRAM_BYTES: u64 = 256 * 1024 * 1024;
 
 /// Type bit of a search path: main programs.
-pub const PATH_MAIN: u8 = 0x01;
+pub(crate) const PATH_MAIN: u8 = 0x01;
 /// Type bit of a search path: subroutines and cycles.
-pub const PATH_SUB: u8 = 0x02;
+pub(crate) const PATH_SUB: u8 = 0x02;
 
 /// One program search path (start-up list `pfad[i].prg[j]`, channel list `path[i].dir`).
 #[derive(Debug, Clone, PartialEq)]
@@ -114,9 +114,9 @@ pub struct StoreStats {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FsLatency {
     /// Charged once per file opened.
-    pub per_open: Duration,
+    pub(crate) per_open: Duration,
     /// Charged per KiB read, pro rata (a 512-byte file costs half of it).
-    pub per_kib: Duration,
+    pub(crate) per_kib: Duration,
 }
 
 impl FsLatency {
@@ -166,7 +166,7 @@ impl ProgramStore {
     }
 
     /// Charge every file-system read with this simulated latency.
-    pub fn with_latency(mut self, latency: FsLatency) -> Self {
+    pub(crate) fn with_latency(mut self, latency: FsLatency) -> Self {
         self.latency = latency;
         self
     }
@@ -181,7 +181,7 @@ impl ProgramStore {
 
     /// Latency charged since the last call: the caller (the decoder) waits it out in channel
     /// time. Zero when no file was read or no latency is configured.
-    pub fn take_owed(&mut self) -> Duration {
+    pub(crate) fn take_owed(&mut self) -> Duration {
         std::mem::take(&mut self.owed)
     }
 
@@ -190,12 +190,12 @@ impl ProgramStore {
     }
 
     /// Whether the channel has a streaming program at all (`streaming_prog_file` set).
-    pub fn streaming_enabled(&self) -> bool {
+    pub(crate) fn streaming_enabled(&self) -> bool {
         self.streaming_prog.is_some()
     }
 
     /// Whether `name` is the virtual streaming program (case-insensitive, as program names are).
-    pub fn is_streaming_program(&self, name: &str) -> bool {
+    pub(crate) fn is_streaming_program(&self, name: &str) -> bool {
         self.streaming_prog
             .as_deref()
             .is_some_and(|s| s.eq_ignore_ascii_case(name))
@@ -211,7 +211,11 @@ impl ProgramStore {
     }
 
     /// Find and read a program file (never the stream), counting the file-system access.
-    pub fn read_file(&mut self, name: &str, kind: ProgramKind) -> Result<ProgramText, StoreError> {
+    pub(crate) fn read_file(
+        &mut self,
+        name: &str,
+        kind: ProgramKind,
+    ) -> Result<ProgramText, StoreError> {
         let path = self.find(name, kind)?;
         let text = read_bounded(&path, name)?;
         self.stats.opens += 1;

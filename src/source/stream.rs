@@ -67,7 +67,7 @@ pub struct StreamCounters {
     /// Writes refused as malformed: empty, too large or without correct line ends.
     pub writes_invalid: u64,
     /// Bytes accepted.
-    pub bytes_written: u64,
+    pub(crate) bytes_written: u64,
     /// Bytes handed out in segments.
     pub bytes_taken: u64,
     /// Segments handed out (takes that found data).

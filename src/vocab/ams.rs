@@ -12,19 +12,19 @@ use std::time::Duration;
 pub const DEFAULT_MAX_FRAME_BYTES: usize = 65_536;
 
 /// Default bind address: loopback only, the standard ADS/TCP port.
-pub const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), 48898);
+pub(crate) const DEFAULT_BIND: SocketAddr = SocketAddr::new(IpAddr::V4(Ipv4Addr::LOCALHOST), 48898);
 /// Default bound on simultaneous connections.
 pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
 /// Default bound on notification handles per connection.
-pub const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
+pub(crate) const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
 /// Default bound on notification handles over the whole server.
-pub const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
+pub(crate) const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
 /// Default budget of notification samples per second over the whole server. Each sample is a
 /// read served by the runtime; 10 000/s is 10 reads a tick at 1 ms, well inside
 /// `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never cost the cycle its period.
 pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 = 10_000;
 /// Default idle timeout (`ads::server::ServerConfig::idle_timeout`).
-pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
+pub(crate) const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
 
 /// A six-byte AMS network id, written `a.b.c.d.e.f`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord, serde::Deserialize)]

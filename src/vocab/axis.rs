@@ -11,7 +11,7 @@ pub type Position = [f64; MAX_AXES];
 /// The slot of an axis letter (upper case), `X` 0 … `C` 5: asked for every axis word of every
 /// block, so a jump table rather than a search of [`AXIS_LETTERS`].
 #[inline]
-pub fn slot_of(letter: u8) -> Option<usize> {
+pub(crate) fn slot_of(letter: u8) -> Option<usize> {
     match letter {
         b'X' => Some(0),
         b'Y' => Some(1),

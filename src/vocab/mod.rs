@@ -8,4 +8,4 @@ pub mod event;
 pub mod flush;
 pub mod mode;
 pub mod stats;
-pub mod tick;
+pub(crate) mod tick;

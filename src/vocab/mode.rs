@@ -30,7 +30,7 @@ pub enum State {
 }
 
 impl Mode {
-    pub fn from_i32(v: i32) -> Option<Mode> {
+    pub(crate) fn from_i32(v: i32) -> Option<Mode> {
         Some(match v {
             1 => Mode::Standby,
             2 => Mode::Automatic,
@@ -43,7 +43,7 @@ impl Mode {
 }
 
 impl State {
-    pub fn from_i32(v: i32) -> Option<State> {
+    pub(crate) fn from_i32(v: i32) -> Option<State> {
         Some(match v {
             1 => State::Deselected,
             2 => State::Selected,

@@ -72,7 +72,7 @@ impl Histogram {
     }
 
     /// Add another histogram's samples to this one.
-    pub fn merge(&mut self, other: &Histogram) {
+    pub(crate) fn merge(&mut self, other: &Histogram) {
         // Same layout on both sides (`empty_hdr`), so `add` has nothing to refuse; were it
         // ever to, the samples are added one bucket at a time instead of being lost.
         if self.hdr.add(&other.hdr).is_err() {
@@ -131,13 +131,13 @@ impl Histogram {
     }
 
     /// The maximum in microseconds.
-    pub fn max_us(&self) -> f64 {
+    pub(crate) fn max_us(&self) -> f64 {
         self.max_ns as f64 / 1000.0
     }
 
     /// The non-empty buckets as (largest value in the bucket in ns, count), ascending: what a
     /// plot of the distribution needs.
-    pub fn buckets(&self) -> impl Iterator<Item = (u64, u64)> + '_ {
+    pub(crate) fn buckets(&self) -> impl Iterator<Item = (u64, u64)> + '_ {
         self.hdr
             .iter_recorded()
             .map(|v| (v.value_iterated_to(), v.count_at_value()))
@@ -158,7 +158,7 @@ pub struct CycleStats {
 
 impl CycleStats {
     /// One line for humans: p50/p99/p99.9/max of both histograms and the overruns.
-    pub fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         format!(
             "work µs p50 {:.2} p99 {:.2} p99.9 {:.2} max {:.2}; lateness µs p50 {:.2} p99 {:.2} p99.9 {:.2} max {:.2}; overruns {}",
             self.work.quantile_us(0.5),

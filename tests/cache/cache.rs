@@ -8,7 +8,7 @@ use common::{channel_events, feeder, tick0, Rig};
 use ncchannel::channel::{Channel, Finish, State};
 use ncchannel::machine::{Op, Reply};
 use ncchannel::runtime::Tick;
-use ncchannel::source::store::FsLatency;
+use ncchannel::FsLatency;
 use serde_json::Value;
 
 /// The seed-002 files the repository ships in `nc/`.

@@ -8,11 +8,11 @@ use std::time::Duration;
 
 use crate::support::Rig;
 use ncchannel::channel::{Channel, Finish, State};
-use ncchannel::decoder::vars::{VarClass, CLASS_BYTES};
-use ncchannel::decoder::DECLARED_VALUES_PER_TICK;
 use ncchannel::lang::{check_program, check_program_counted, parse_block, MAX_PROGRAM_DIAGS};
 use ncchannel::machine::{Op, Reply};
 use ncchannel::runtime::Tick;
+use ncchannel::DECLARED_VALUES_PER_TICK;
+use ncchannel::{VarClass, CLASS_BYTES};
 
 fn tick(period: Duration, k: u64) -> Tick {
     Tick {

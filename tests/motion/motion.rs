@@ -6,12 +6,12 @@ use crate::support::queued::block;
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
-use ncchannel::geometry::arc::{ArcError, ArcSpec};
-use ncchannel::motion::planner::JUNCTION_ACCEL_SHARE;
-use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode, Plane};
 use ncchannel::vocab::axis::Position;
 use ncchannel::vocab::flush::FlushKind;
+use ncchannel::JUNCTION_ACCEL_SHARE;
+use ncchannel::{Action, BlockQueue, Move, MoveKind, PathMode, Plane};
+use ncchannel::{ArcError, ArcSpec};
+use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
 
 /// The positional form reads best in these tables of cases.
 #[allow(clippy::too_many_arguments)]
@@ -25,7 +25,7 @@ fn arc_move(
     feed: f64,
     tol: f64,
 ) -> Result<Move, ArcError> {
-    ncchannel::geometry::arc::arc_move(
+    ncchannel::arc_move(
         &ArcSpec {
             plane,
             ijk,

@@ -50,7 +50,7 @@ impl Setup {
     }
     fn channel(&self) -> Channel {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        ncchannel::setup::channels(&config, true).unwrap().remove(0)
+        ncchannel::channels(&config, true).unwrap().remove(0)
     }
 }
 

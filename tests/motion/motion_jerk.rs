@@ -7,9 +7,9 @@ use crate::support::queued::{block, r50_circle};
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, FILTERED_EPS};
-use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, CompSide, Move, MoveKind, PathMode, SplineKind};
 use ncchannel::vocab::axis::Position;
+use ncchannel::{Action, BlockQueue, CompSide, Move, MoveKind, PathMode, SplineKind};
+use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
 
 const DT: f64 = 0.001;
 

@@ -7,17 +7,17 @@ use std::path::Path;
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
 use crate::support::queued::{block, r50_circle};
-use ncchannel::decoder::modal::DEFAULT_PATH_DEV_MM;
-use ncchannel::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
-use ncchannel::queue::{Action, BlockQueue, Move, MoveKind, PathMode};
 use ncchannel::vocab::axis::Position;
+use ncchannel::DEFAULT_PATH_DEV_MM;
+use ncchannel::{Action, BlockQueue, Move, MoveKind, PathMode};
+use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
 
 const DT: f64 = 0.001;
 
 /// Axis limits and planner settings of the shipped start-up list.
 fn shipped() -> (Vec<AxisLimits>, PlannerSettings) {
     let config = ncchannel::params::load(Path::new("params/startup.lis")).unwrap();
-    let s = ncchannel::setup::channel_settings(&config, &config.channels[0]).unwrap();
+    let s = ncchannel::channel_settings(&config, &config.channels[0]).unwrap();
     (s.axes, s.planner)
 }
 

@@ -4,8 +4,8 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use ncchannel::diag::{Diagnostic, Severity};
 use ncchannel::params::{self, ParamError, RuntimeConfig, MAIN_PROGRAMS, SUBROUTINES};
+use ncchannel::{Diagnostic, Severity};
 use proptest::prelude::*;
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

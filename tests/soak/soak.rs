@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-use ncchannel::feeder::Feeder;
 use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
 use ncchannel::soak::scenario::{Length, Scenario};
 use ncchannel::soak::{run, Options};
+use ncchannel::Feeder;
 
 /// The scenarios shipped in `params/soak/` (their `runtime.toml` is not a scenario).
 fn shipped_scenarios() -> Vec<PathBuf> {
@@ -162,7 +162,7 @@ fn four_channels_stream_independently_in_one_cycle() {
 #[test]
 fn machine_ticks_four_channels_each_with_its_own_stream() {
     let config = ncchannel::params::load(&soak_dir().join("startup4.lis")).unwrap();
-    let channels = ncchannel::setup::channels(&config, false).unwrap();
+    let channels = ncchannel::channels(&config, false).unwrap();
     assert_eq!(channels.len(), 4);
     let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
     let period = Duration::from_millis(1);

@@ -4,8 +4,8 @@ use crate::support as common;
 
 use common::{crlf, feeder, tick0, Rig};
 use ncchannel::channel::{Finish, State};
-use ncchannel::feeder::Feeder;
 use ncchannel::machine::Op;
+use ncchannel::Feeder;
 
 #[test]
 fn stream_as_main_program_runs_every_block_and_ends() {

@@ -7,8 +7,8 @@ use std::time::Duration;
 
 use common::{feeder, Rig};
 use ncchannel::channel::Finish;
-use ncchannel::decoder::SearchTarget;
 use ncchannel::machine::Op;
+use ncchannel::SearchTarget;
 
 const EXAMPLES: [&str; 6] = [
     "switchstream.nc",

@@ -1,7 +1,7 @@
 //! The built-in feeder: whole lines, CR LF, packet limits, form-feed pauses, retries, raw.
 
-use ncchannel::feeder::{Feeder, FeederError};
-use ncchannel::source::packets::LineTooLong;
+use ncchannel::ads::client::LineTooLong;
+use ncchannel::{Feeder, FeederError};
 
 /// Drive the feeder for `ticks` ticks accepting every write; (tick, packet) per write.
 fn run(f: &mut Feeder, ticks: u64) -> Vec<(u64, Vec<u8>)> {

@@ -1,7 +1,7 @@
 //! The stream buffer as the channel and its clients rely on it: 4094/992 limits, whole-or-
 //! nothing writes, CR LF checking, one segment per read, reset.
 
-use ncchannel::source::stream::{
+use ncchannel::{
     StreamBuffer, StreamWriteError, MAX_PROGRAM_STREAM_INPUT_SIZE, MAX_PROGRAM_STREAM_SIZE,
 };
 use proptest::prelude::*;

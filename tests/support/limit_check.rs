@@ -12,7 +12,7 @@
 
 use ncchannel::vocab::axis::{Position, MAX_AXES};
 
-use ncchannel::motion::AxisLimits;
+use ncchannel::AxisLimits;
 
 /// Tolerance for a trapezoid profile without the axis filter: 2 % (see the module header).
 pub const DEFAULT_EPS: f64 = 0.02;

@@ -11,10 +11,10 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use ncchannel::channel::{Channel, Finish};
-use ncchannel::feeder::Feeder;
 use ncchannel::machine::{Machine, Op, Reply, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::runtime::{Clock, Runtime, Tick};
+use ncchannel::Feeder;
 use serde_json::Value;
 
 pub struct Rig {
@@ -143,7 +143,7 @@ impl Rig {
 
     pub fn machine(&self) -> (Machine, Duration, Shared2) {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        let channels = ncchannel::setup::channels(&config, true).unwrap();
+        let channels = ncchannel::channels(&config, true).unwrap();
         let shared = Shared::default();
         let log = EventLog::to_writer(Box::new(shared.clone()));
         let period = Duration::from_micros(config.runtime.cycle_period_us);
@@ -157,7 +157,7 @@ impl Rig {
     /// Channel 1 of the rig on its own (its events kept in its buffer), and the cycle time.
     pub fn channel(&self) -> (Channel, Duration) {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        let mut channels = ncchannel::setup::channels(&config, true).unwrap();
+        let mut channels = ncchannel::channels(&config, true).unwrap();
         let period = Duration::from_micros(config.runtime.cycle_period_us);
         (channels.remove(0), period)
     }

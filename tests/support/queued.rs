@@ -3,11 +3,9 @@
 
 use std::sync::Arc;
 
-use ncchannel::geometry::arc::{arc_move, ArcSpec};
-use ncchannel::queue::{
-    Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, QueuedBlock,
-};
 use ncchannel::vocab::axis::Position;
+use ncchannel::{arc_move, ArcSpec};
+use ncchannel::{Action, BlockInfo, BlockQueue, Move, MoveKind, PathMode, Plane, QueuedBlock};
 
 /// The event of line `line` of `t.nc`.
 pub fn info(line: u32) -> BlockInfo {

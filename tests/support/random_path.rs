@@ -1,9 +1,9 @@
 //! Random motion blocks for the tick-by-tick limit tests: a deterministic generator and
 //! rapids, lines (short and long, in 3-D) and arcs / helices in every plane.
 
-use ncchannel::geometry::arc::{arc_move, ArcSpec};
-use ncchannel::queue::{Move, MoveKind, PathMode, Plane};
 use ncchannel::vocab::axis::Position;
+use ncchannel::{arc_move, ArcSpec};
+use ncchannel::{Move, MoveKind, PathMode, Plane};
 
 /// A small deterministic generator (no dependency): xorshift64*.
 pub struct Rng(pub u64);

@@ -6,10 +6,10 @@
 
 use crossbeam_channel::Sender;
 
-use ncchannel::feeder::{Feeder, FeederError};
 use ncchannel::report::event::{EventBuffer, EventKind, EventLog};
 use ncchannel::runtime::{Cycle, Flow, Tick};
-use ncchannel::source::stream::{StreamBuffer, StreamWriteError, MAX_PROGRAM_STREAM_SIZE};
+use ncchannel::{Feeder, FeederError};
+use ncchannel::{StreamBuffer, StreamWriteError, MAX_PROGRAM_STREAM_SIZE};
 
 /// A stream write from another thread, answered in the tick that serves it.
 #[derive(Debug)]
