@@ -950,8 +950,18 @@ impl<'a> Ctx<'a> {
     fn indirect_p(&self, i: &'a str) -> PResult<'a, Index> {
         let ps = i.bytes().take_while(|c| matches!(c, b'P' | b'p')).count();
         let (r, n) = uint(&i[ps..])?;
-        let depth = u32::try_from(ps).unwrap_or(u32::MAX).saturating_mul(2);
-        self.set_height(depth, i)?;
+        let levels = u32::try_from(ps).unwrap_or(u32::MAX);
+        // Written back (a log line, `check`'s canonical text) each `P` is a bracket,
+        // `P[P[…]]`: the chain nests as deep as those brackets would, or the printed block
+        // would not parse again.
+        if self.depth.get().saturating_add(levels) > MAX_EXPR_NESTING {
+            return Err(nom::Err::Failure(PErr {
+                input: i,
+                code: SYNTAX,
+                msg: Cow::Borrowed("expression nested too deeply"),
+            }));
+        }
+        self.set_height(levels.saturating_mul(2), i)?;
         let mut number = Index::Const(n);
         for _ in 0..ps {
             let inner = VarRef::P {

@@ -598,6 +598,21 @@ fn pp_is_the_parameter_whose_number_a_parameter_holds() {
     assert_eq!(b.to_string(), "P[P1]=P[P[P2]]");
     // P1 undefined: PP1 has no number.
     fails_at(&rig, "G01 X[PP1] F100\nM30\n", 900005, 1, 5, false);
+    // Each P of a chain is a bracket when printed (`P[P[…]]`): a chain deeper than a
+    // bracket nesting may be is refused as that nesting would be, so every block read prints
+    // to a text that reads back.
+    let deep = format!("$IF {}1 >= 1", "P".repeat(80));
+    let e = parse_block(&deep).unwrap_err();
+    assert_eq!(
+        (e.code, e.message.as_str()),
+        (20200, "expression nested too deeply")
+    );
+    let ok = format!("$IF {}1 >= 1", "P".repeat(40));
+    let b = parse_block(&ok).unwrap();
+    assert_eq!(
+        parse_block(&b.to_string()).unwrap().to_string(),
+        b.to_string()
+    );
 }
 
 #[test]
