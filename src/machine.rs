@@ -62,6 +62,9 @@ impl Claim {
 pub struct Attached {
     pub channel: u32,
     pub feeder: Feeder,
+    /// The packet on offer, shared with each write attempt until the channel takes it (the
+    /// feeder offers the same packet again after a refusal).
+    pending: Option<Arc<[u8]>>,
 }
 
 /// When `run` is over.
@@ -101,7 +104,11 @@ impl Machine {
     }
 
     pub fn attach_feeder(&mut self, channel: u32, feeder: Feeder) {
-        self.feeders.push(Attached { channel, feeder });
+        self.feeders.push(Attached {
+            channel,
+            feeder,
+            pending: None,
+        });
     }
 
     pub fn feeders(&self) -> &[Attached] {
@@ -183,8 +190,13 @@ impl Cycle for Machine {
             if let Some(packet) = a.feeder.poll(tick.index) {
                 // Through the door like any client's write; a write the channel cannot take
                 // (ERROR, no streaming program) is a refusal the feeder retries.
-                let reply = c.apply(tick, Op::WriteStream(packet.to_vec()));
-                a.feeder.result(matches!(reply, Reply::Stream(Ok(()))));
+                let data = a.pending.get_or_insert_with(|| Arc::from(packet));
+                let reply = c.apply(tick, Op::WriteStream(Arc::clone(data)));
+                let accepted = matches!(reply, Reply::Stream(Ok(())));
+                if accepted {
+                    a.pending = None;
+                }
+                a.feeder.result(accepted);
             }
         }
         for (i, c) in self.channels.iter_mut().enumerate() {

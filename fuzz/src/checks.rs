@@ -371,7 +371,7 @@ pub fn channel_program(data: &[u8]) {
     for k in 1..MAX_TICKS {
         let t = tick(k);
         if let Some(p) = next.peek() {
-            if channel.apply(&t, Op::WriteStream(p.to_vec())) == Reply::Stream(Ok(())) {
+            if channel.apply(&t, Op::WriteStream(p.as_slice().into())) == Reply::Stream(Ok(())) {
                 next.next();
             }
         }
@@ -484,7 +484,7 @@ fn plain_op(step: ClientStep) -> Option<ncchannel::machine::Op> {
         // check knows every numbered line and whether its write was accepted.
         ClientStep::Raw(mut bytes) => {
             bytes.retain(|b| !matches!(b, b'N' | b'n'));
-            Op::WriteStream(bytes)
+            Op::WriteStream(bytes.into())
         }
         ClientStep::Mode(v) => Op::CommandMode(i32::from(v)),
         ClientStep::State(v) => Op::CommandState(i32::from(v)),
@@ -583,7 +583,7 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
                 flush,
             } => {
                 let (packet, ns) = lines_packet(&mut next_n, lines, x, feed, flush);
-                let op = Op::WriteStream(packet);
+                let op = Op::WriteStream(packet.into());
                 let (reply, applied) = serve_request(&mut machine, &tick(k), op, &tx, &rx, give_up);
                 give_up = false;
                 if applied && matches!(reply, Some(Reply::Stream(Ok(())))) {

@@ -111,7 +111,7 @@ impl dyn CncBackend {
 
     /// Offer one packet (one or more whole CR LF lines) to the stream buffer.
     pub(crate) fn write_stream(&self, ch: u16, data: &[u8]) -> AdsResult {
-        match self.call(ch, Op::WriteStream(data.to_vec())) {
+        match self.call(ch, Op::WriteStream(std::sync::Arc::from(data))) {
             Ok(Reply::Stream(Ok(()))) => AdsResult::OK,
             Ok(Reply::Stream(Err(e))) => stream_result(&e),
             Ok(_) => AdsResult::NOT_READY,

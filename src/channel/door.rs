@@ -3,6 +3,7 @@
 //! serves it; the machine routes requests to channels, the ADS object tables and the soak build
 //! `Op`s. Defined here, beside the channel, so the channel needs nothing of the machine above it.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use super::{
@@ -15,8 +16,9 @@ use crate::source::stream::StreamWriteError;
 /// What a client asks of a channel.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Op {
-    /// Write NC lines into the stream interface.
-    WriteStream(Vec<u8>),
+    /// Write NC lines into the stream interface. Shared bytes: a feeder that must offer the
+    /// same packet again after 11012 hands the same allocation, not a new copy per attempt.
+    WriteStream(Arc<[u8]>),
     CommandMode(i32),
     CommandState(i32),
     /// Command parameter: the program name ACTIVE starts.

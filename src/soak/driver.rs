@@ -501,7 +501,9 @@ impl Cycle for SoakCycle {
             if slot.core.rejecting(t) {
                 slot.feeder.skip(t);
             } else if let Some(packet) = slot.feeder.poll(t) {
-                let reply = slot.channel.apply(tick, Op::WriteStream(packet.to_vec()));
+                let reply = slot
+                    .channel
+                    .apply(tick, Op::WriteStream(std::sync::Arc::from(packet)));
                 slot.feeder
                     .result(t, matches!(reply, Reply::Stream(Ok(()))));
             }

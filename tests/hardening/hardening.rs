@@ -356,7 +356,7 @@ fn a_bad_stream_write_does_not_abort_a_running_file_program() {
     for _ in 0..10 {
         h.step();
     }
-    let r = h.apply(Op::WriteStream(b"N1 X1\n".to_vec()));
+    let r = h.apply(Op::WriteStream(b"N1 X1\n".as_slice().into()));
     let Reply::Stream(Err(e)) = r else {
         panic!("{r:?}")
     };
@@ -368,14 +368,14 @@ fn a_bad_stream_write_does_not_abort_a_running_file_program() {
     let mut h = Hand::new(&rig);
     h.start("streaming.nc");
     assert_eq!(
-        h.apply(Op::WriteStream(b"G01 X10 F600\r\n".to_vec())),
+        h.apply(Op::WriteStream(b"G01 X10 F600\r\n".as_slice().into())),
         Reply::Stream(Ok(()))
     );
     for _ in 0..10 {
         h.step();
     }
     assert_ne!(
-        h.apply(Op::WriteStream(b"N1 X1\n".to_vec())),
+        h.apply(Op::WriteStream(b"N1 X1\n".as_slice().into())),
         Reply::Stream(Ok(()))
     );
     assert_eq!(h.run(1000).0, Some(Finish::Error));

@@ -73,7 +73,7 @@ fn start(c: &mut Channel, t: &Tick, program: &str) {
 
 /// Write stream data through the channel's door, as a client does.
 fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
-    c.apply(t, Op::WriteStream(data.to_vec()))
+    c.apply(t, Op::WriteStream(data.into()))
 }
 
 /// Run a streamed program: `writes` are (tick, text) written into the stream interface.

@@ -126,7 +126,7 @@ fn start(c: &mut Channel, t: &Tick, program: &str) {
 
 /// Write stream data through the channel's door, as a client does.
 fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
-    c.apply(t, Op::WriteStream(data.to_vec()))
+    c.apply(t, Op::WriteStream(data.into()))
 }
 
 /// Step the channel until it is neither active nor held; `writes` go into the stream at

@@ -274,7 +274,7 @@ fn the_error_list_is_bounded_and_counts_the_rest() {
     let t = tick0(period);
     let c = &mut channel;
     for _ in 0..1000 {
-        let _ = c.apply(&t, Op::WriteStream(b"N1 X1\n".to_vec()));
+        let _ = c.apply(&t, Op::WriteStream(b"N1 X1\n".as_slice().into()));
         c.apply(&t, Op::Reset);
     }
     assert_eq!(c.stats().errors, 1000);

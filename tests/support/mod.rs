@@ -345,5 +345,5 @@ pub fn start(c: &mut Channel, t: &Tick, program: &str) {
 
 /// Write stream data through the channel's door, as a client does.
 pub fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
-    c.apply(t, Op::WriteStream(data.to_vec()))
+    c.apply(t, Op::WriteStream(data.into()))
 }
