@@ -550,9 +550,12 @@ impl Channel {
                     "Error writing the object (stream buffer full)".into(),
                 );
             }
-            Err(e @ StreamWriteError::NoLineEnd { .. }) => {
-                let msg =
-                    format!("Streaming data does not contain a correct line end marker ({e})");
+            Err(StreamWriteError::NoLineEnd { offset }) => {
+                // The kernel's text once, then where: the writer's error carries the number
+                // and the text again (for a writer that reports it on its own).
+                let msg = format!(
+                    "Streaming data does not contain a correct line end marker (packet byte {offset})"
+                );
                 if self.decoder.state() == DecoderState::Running && self.decoder.reads_stream() {
                     self.decoder.abort(ERR_NO_LINE_END, msg.clone());
                     self.drain_decoder_notes(tick);

@@ -66,7 +66,8 @@ pub struct ReceiveArgs {
     /// Markers count only at the very beginning of a line.
     #[arg(long)]
     pub at_line_start: bool,
-    /// Names for programs whose data names none; `{n}` or `{n:W}` is the number.
+    /// Names for programs whose data names none: `{n:W}` is the number in W digits,
+    /// zero-padded; without `:W`, as in the default, in 3 (`received_001.nc`).
     #[arg(long, value_name = "TEMPLATE", default_value = "received_{n}.nc")]
     pub(crate) name_template: String,
     /// Start-up list whose channel decides the default program directory.

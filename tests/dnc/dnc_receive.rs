@@ -599,3 +599,22 @@ fn without_out_programs_land_in_the_channels_first_program_path() {
     );
     assert!(d.path().join("progs/PART1.mpf").is_file());
 }
+
+#[test]
+fn receive_help_keeps_the_name_template_on_one_line() {
+    // clap turns a literal `{n}` in help text into a line break: the template's own syntax
+    // must not break the text that explains it.
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args(["receive", "--help"])
+        .output()
+        .expect("ncchannel runs");
+    let help = String::from_utf8_lossy(&out.stdout);
+    let line = help
+        .lines()
+        .find(|l| l.contains("--name-template"))
+        .unwrap_or_default();
+    assert!(
+        line.contains("`{n:W}`") && line.contains("[default: received_{n}.nc]"),
+        "{help}"
+    );
+}

@@ -186,6 +186,12 @@ fn a_line_without_cr_lf_raises_21476_and_stops_the_channel() {
     assert_eq!(r.finish, Some(Finish::Error));
     assert_eq!(r.error_codes(), [21476]);
     assert_eq!(r.machine.channels()[0].state(), State::Error);
+    // The kernel's text once, then where in the packet: no second number, no second text.
+    let msg = r.of("error")[0]["msg"].as_str().unwrap_or("").to_string();
+    assert_eq!(
+        msg,
+        "Streaming data does not contain a correct line end marker (packet byte 7)"
+    );
 }
 
 #[test]
