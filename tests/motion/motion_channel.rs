@@ -7,9 +7,11 @@ use std::process::Command;
 use std::time::Duration;
 
 use ncchannel::channel::{Channel, State};
-use ncchannel::machine::{Op, Reply};
+use ncchannel::machine::Op;
 use ncchannel::report::event::{EventKind, EventLog};
 use ncchannel::runtime::Tick;
+
+use crate::support::{start, write, WRITTEN};
 
 const PERIOD: Duration = Duration::from_millis(1);
 
@@ -60,20 +62,6 @@ fn tick(k: u64) -> Tick {
         period: PERIOD,
         time: PERIOD * k as u32,
     }
-}
-
-/// The reply to a stream write the channel took.
-const WRITTEN: Reply = Reply::Stream(Ok(()));
-
-/// Start `program` through the channel's door; a refusal fails the test.
-fn start(c: &mut Channel, t: &Tick, program: &str) {
-    let r = c.apply(t, Op::Start(program.to_string()));
-    assert_eq!(r, Reply::Command(Ok(())), "start {program}");
-}
-
-/// Write stream data through the channel's door, as a client does.
-fn write(c: &mut Channel, t: &Tick, data: &[u8]) -> Reply {
-    c.apply(t, Op::WriteStream(data.into()))
 }
 
 /// Run a streamed program: `writes` are (tick, text) written into the stream interface.

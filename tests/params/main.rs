@@ -1,6 +1,9 @@
 //! Parameter lists: loading and checking them, `ncchannel check` on them, and a TwinCAT CNC
 //! installation's own lists starting the channel.
 
+#[path = "../support/mod.rs"]
+mod support;
+
 mod check_params;
 mod installation;
 mod params;
