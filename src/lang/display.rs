@@ -114,16 +114,8 @@ impl Display for Item {
                 Value::Expr(e) => write!(f, "{}={e}", a.name),
             },
             Item::GCall(c) => {
-                write!(f, "G{}[", c.g)?;
-                for (k, a) in c.args.iter().enumerate() {
-                    if k > 0 {
-                        f.write_str(", ")?;
-                    }
-                    if let Some(e) = a {
-                        e.fmt(f)?;
-                    }
-                }
-                f.write_char(']')
+                write!(f, "G{}", c.g)?;
+                list(f, &c.args, |f, a| a.as_ref().map_or(Ok(()), |e| e.fmt(f)))
             }
         }
     }
@@ -167,6 +159,22 @@ impl Display for Bracketed<'_> {
 /// How tightly the top of an expression binds as the parser reads it back (higher binds
 /// tighter): binary levels 0 (`||`) to 8 (`* / MOD`), then unary operators, then `**`, then
 /// an operand. A negative literal counts as unary: `-5 ** 2` reads as `-[5 ** 2]`.
+/// `[a, b, …]`: a bracketed list as the parser reads it, each element written by `item`.
+fn list<T>(
+    f: &mut Formatter<'_>,
+    items: impl IntoIterator<Item = T>,
+    mut item: impl FnMut(&mut Formatter<'_>, T) -> fmt::Result,
+) -> fmt::Result {
+    f.write_char('[')?;
+    for (k, x) in items.into_iter().enumerate() {
+        if k > 0 {
+            f.write_str(", ")?;
+        }
+        item(f, x)?;
+    }
+    f.write_char(']')
+}
+
 fn strength(e: &Expr) -> u8 {
     match e {
         Expr::Num(v) if v.is_sign_negative() => UNARY,
@@ -235,27 +243,13 @@ impl Display for Expr {
             }
             Expr::Func(func, args) => {
                 f.write_str(func.name())?;
-                f.write_char('[')?;
-                for (k, a) in args.iter().enumerate() {
-                    if k > 0 {
-                        f.write_str(", ")?;
-                    }
-                    a.fmt(f)?;
-                }
-                f.write_char(']')
+                list(f, args, |f, a| a.fmt(f))
             }
             Expr::Test(test, v) => write!(f, "{}[{v}]", test.name()),
             Expr::Str(t) => write!(f, "\"{t}\""),
             Expr::StrFunc(func, args) => {
                 f.write_str(func.name())?;
-                f.write_char('[')?;
-                for (k, a) in args.iter().enumerate() {
-                    if k > 0 {
-                        f.write_str(", ")?;
-                    }
-                    a.fmt(f)?;
-                }
-                f.write_char(']')
+                list(f, args, |f, a| a.fmt(f))
             }
         }
     }
@@ -496,14 +490,8 @@ impl Display for VarDecl {
             return write!(f, "=\"{t}\"");
         }
         if !self.values.is_empty() {
-            f.write_str("=[")?;
-            for (k, e) in self.values.iter().enumerate() {
-                if k > 0 {
-                    f.write_str(", ")?;
-                }
-                write!(f, "{e}")?;
-            }
-            f.write_char(']')?;
+            f.write_char('=')?;
+            list(f, &self.values, |f, e| e.fmt(f))?;
         }
         Ok(())
     }
