@@ -417,16 +417,22 @@ impl<'a> Ctx<'a> {
         Ok((&q[end + 1..], Expr::Str(q[..end].into())))
     }
 
-    /// A string function's arguments after its name (`rest`; `at` is where the name starts).
-    #[cold]
-    fn str_func(&self, func: StrFunc, at: &'a str, rest: &'a str) -> PResult<'a, Expr> {
-        let name = func.name();
+    /// `[a, b, …]` after a function's name (`rest`): the arguments (room for `expected`,
+    /// at most `most`: a comma after the last allowed one is refused there) and the tallest
+    /// argument's height. The caller checks the count against the function's arity.
+    fn call_args(
+        &self,
+        name: &str,
+        rest: &'a str,
+        expected: usize,
+        most: usize,
+    ) -> PResult<'a, (Vec<Expr>, u32)> {
         let j = ws(rest);
         let Some(j) = j.strip_prefix('[') else {
             return fail(j, SYNTAX, format!("`[` expected after {name}"));
         };
         let _g = self.enter(j)?;
-        let mut args = Vec::with_capacity(3);
+        let mut args = Vec::with_capacity(expected);
         let mut h = 0;
         let mut j = ws(j);
         loop {
@@ -435,14 +441,19 @@ impl<'a> Ctx<'a> {
             args.push(e);
             let k = ws(k);
             match k.as_bytes().first() {
-                Some(b',') if args.len() < 3 => j = ws(&k[1..]),
-                Some(b']') => {
-                    j = &k[1..];
-                    break;
-                }
+                Some(b',') if args.len() < most => j = ws(&k[1..]),
+                Some(b']') => return Ok((&k[1..], (args, h))),
                 _ => return fail(k, SYNTAX, "`,` or `]` expected in function call"),
             }
         }
+    }
+
+    /// A string function's arguments after its name (`rest`; `at` is where the name starts).
+    #[cold]
+    fn str_func(&self, func: StrFunc, at: &'a str, rest: &'a str) -> PResult<'a, Expr> {
+        let name = func.name();
+        // At most three: no string function takes more.
+        let (j, (args, h)) = self.call_args(name, rest, 3, 3)?;
         let (min, max) = func.arity();
         if !(min..=max).contains(&args.len()) {
             let want = if min == max {
@@ -479,28 +490,7 @@ impl<'a> Ctx<'a> {
             }
             return fail(i, SYNTAX, format!("unknown function or operand `{name}`"));
         };
-        let j = ws(rest);
-        let Ok((j, _)) = ch::<&str, PErr<'a>>('[')(j) else {
-            return fail(j, SYNTAX, format!("`[` expected after {name}"));
-        };
-        let _g = self.enter(j)?;
-        let mut args = Vec::with_capacity(func.arity());
-        let mut h = 0;
-        let mut j = ws(j);
-        loop {
-            let (k, e) = self.expr(j)?;
-            h = h.max(self.height.get());
-            args.push(e);
-            let k = ws(k);
-            match k.as_bytes().first() {
-                Some(b',') => j = ws(&k[1..]),
-                Some(b']') => {
-                    j = &k[1..];
-                    break;
-                }
-                _ => return fail(k, SYNTAX, "`,` or `]` expected in function call"),
-            }
-        }
+        let (j, (args, h)) = self.call_args(&name, rest, func.arity(), usize::MAX)?;
         if args.len() != func.arity() {
             return fail(
                 i,
