@@ -11,6 +11,7 @@ pub mod check;
 mod logger;
 pub(crate) mod out;
 pub(crate) mod receive;
+mod receive_stop;
 pub(crate) mod run;
 pub(crate) mod serve;
 pub(crate) mod serve_soak;

@@ -3,8 +3,9 @@
 //!
 //! Standard output carries the receive log (one line per program filed or dropped) and the
 //! summary; operator messages (no start marker, cut-off transfer, kept files, refused names)
-//! go to standard error. Exit 0 when at least one program was filed and none was cut off,
-//! 1 when no program was filed or a transfer broke inside a program, 2 for bad usage.
+//! go to standard error. Exit 0 when at least one program was filed and none was cut off or
+//! lost, 1 when no program was filed, a transfer broke inside a program or the disk refused
+//! one, 2 for bad usage, 130 after a second stop signal.
 
 use std::fs::File;
 use std::io::{self, Write};
@@ -12,6 +13,8 @@ use std::net::{SocketAddr, TcpListener};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
+
+use super::receive_stop;
 
 use crate::dnc::{
     self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
@@ -57,6 +60,10 @@ pub struct ReceiveArgs {
     /// (default with --listen: 1000; unbounded for a file or standard input).
     #[arg(long, value_name = "N")]
     pub(crate) max_programs: Option<usize>,
+    /// With --listen: after SIGINT/SIGTERM, the transfers in progress may run this many seconds
+    /// more; then they are cut (a second signal cuts them at once).
+    #[arg(long, value_name = "SECONDS", default_value_t = dnc::listen::DEFAULT_GRACE.as_secs_f64())]
+    pub(crate) stop_grace: f64,
     /// Replace existing program files (default: keep them and drop the received program).
     #[arg(long)]
     pub overwrite: bool,
@@ -135,10 +142,12 @@ impl From<dnc::DncError> for Failure {
 
 fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     let (markers, template, limits) = settings(&args)?;
+    let grace = seconds("--stop-grace", args.stop_grace, true)?;
     let out = match args.out.clone() {
         Some(o) => o,
         None => default_out_dir(&args.params, args.channel).map_err(Failure::Usage)?,
     };
+    remove_stale_temp_files(&out);
     let mut cfg = WriterConfig::new(&out);
     cfg.overwrite = args.overwrite;
     cfg.keep_partial = args.keep_partial;
@@ -147,26 +156,57 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     let mut splitter = Splitter::new(markers.clone());
 
     let mut total = Totals::default();
+    let mut stopped_at_once = false;
     if let Some(addr) = &args.listen {
         let listen = dnc::Listener {
             numbers: writer.numbers(),
             program_log: Some(log_line),
+            grace,
             ..dnc::Listener::new(markers.clone(), cfg.clone(), limits)
         };
-        serve(&args, addr, &listen, &mut total)?;
+        stopped_at_once = serve(&args, addr, &listen, &mut total)? == dnc::StopLevel::Now;
+        // A transfer thread left behind at a cut may still hold a temporary file.
+        if let Err(e) = dnc::temp_files::remove_own(&out) {
+            say(format_args!("ncchannel receive: {}: {e}", out.display()));
+        }
     } else {
         let r = receive_input(&args, &limits, &mut splitter, &mut writer)?;
         log_end(Ok(&r));
         total.add(&r);
     }
     total.print(&out);
-    Ok(
-        if total.filed > 0 && total.cut_off == 0 && total.refused == 0 {
-            exit::OK
-        } else {
-            exit::CHANNEL_ERROR
-        },
-    )
+    Ok(if stopped_at_once {
+        exit::SECOND_SIGNAL
+    } else if total.filed > 0 && total.cut_off == 0 && total.refused == 0 && total.lost == 0 {
+        exit::OK
+    } else {
+        exit::CHANNEL_ERROR
+    })
+}
+
+/// Temporary files of receivers that no longer run (a second signal, SIGKILL, a power loss)
+/// are removed before anything is received; a failure to do so is only reported.
+fn remove_stale_temp_files(out: &Path) {
+    match dnc::temp_files::remove_stale(out) {
+        Ok(0) => {}
+        Ok(n) => say(format_args!(
+            "ncchannel receive: removed {n} temporary file(s) a stopped receiver left in {}",
+            out.display()
+        )),
+        Err(e) => say(format_args!(
+            "ncchannel receive: {}: cannot remove stale temporary files: {e}",
+            out.display()
+        )),
+    }
+}
+
+/// A time option in seconds (`zero_ok`: 0 is allowed).
+fn seconds(option: &str, s: f64, zero_ok: bool) -> Result<Duration, Failure> {
+    if s.is_finite() && (s > 0.0 || (zero_ok && s == 0.0)) && s < 1e9 {
+        Ok(Duration::from_secs_f64(s))
+    } else {
+        Err(Failure::Usage(format!("{option} {s}: not a positive time")))
+    }
 }
 
 /// Step 1 of `run`: the arguments checked and turned into markers, name template and
@@ -182,14 +222,7 @@ fn settings(args: &ReceiveArgs) -> Result<(Markers, NameTemplate, dnc::TransferL
     }
     let markers = Markers::new(&args.start, &args.end, anchor)?;
     let template = NameTemplate::parse(&args.name_template)?;
-    let idle = match args.idle_timeout {
-        s if s.is_finite() && s > 0.0 && s < 1e9 => Duration::from_secs_f64(s),
-        s => {
-            return Err(Failure::Usage(format!(
-                "--idle-timeout {s}: not a positive time"
-            )))
-        }
-    };
+    let idle = seconds("--idle-timeout", args.idle_timeout, false)?;
     let listening = args.listen.is_some();
     let limits = dnc::TransferLimits {
         idle_timeout: Some(idle),
@@ -224,25 +257,27 @@ fn receive_input(
 
 /// Step 2 with --listen: accept transfers, each on its own thread (at most
 /// --max-concurrent at once), until --max-transfers or a stop signal; then wait for the
-/// transfers in progress.
+/// transfers in progress (after a signal at most --stop-grace). Returns how far a stop was
+/// asked for.
 fn serve(
     args: &ReceiveArgs,
     addr: &str,
     listen: &dnc::Listener,
     total: &mut Totals,
-) -> Result<(), Failure> {
+) -> Result<dnc::StopLevel, Failure> {
     let addr = parse_listen(addr).map_err(Failure::Usage)?;
     let listener =
         TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
     let local = listener
         .local_addr()
         .map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
-    say(format_args!("listening on {local}"));
-    // SIGINT/SIGTERM: the transfer in progress completes, then the loop ends.
-    let signal = super::signal::StopSignal::install().ok();
-    if let Some(sig) = &signal {
-        wake_on_signal(sig.clone(), local);
+    // SIGINT/SIGTERM: no new transfer, the ones in progress get the grace period; a second
+    // signal cuts them at once.
+    let stop = dnc::StopRequest::new();
+    if let Err(e) = receive_stop::on_signals(stop.clone(), local, listen.grace) {
+        return Err(Failure::Io(format!("stop signals: {e}")));
     }
+    say(format_args!("listening on {local}"));
     let listen = dnc::Listener {
         max_transfers: args.max_transfers,
         max_concurrent: args.max_concurrent,
@@ -250,17 +285,12 @@ fn serve(
     };
     listen.serve(
         &listener,
-        // After a signal, the wake-up connection is not a transfer.
-        || {
-            signal
-                .as_ref()
-                .is_some_and(super::signal::StopSignal::raised)
-        },
+        &stop,
         log_end,
         |r| settle(r, total),
         |e| say(format_args!("ncchannel receive: accept on {local}: {e}")),
     );
-    Ok(())
+    Ok(stop.level())
 }
 
 /// Whatever a transfer came to: filed programs, or refused with its reason (a name the disk
@@ -296,24 +326,10 @@ fn log_end(r: Result<&TransferReport, &dnc::DncError>) {
         TransferEnd::LimitReached(l) => say(format_args!(
             "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
         )),
+        TransferEnd::WriteFailed(e) => say(format_args!(
+            "ncchannel receive: transfer{from} stopped: {e}"
+        )),
     }
-}
-
-/// A blocking `accept` does not return for a signal; once the stop flag is set, one
-/// connection to our own port wakes it (the std listener has no other portable wake-up).
-fn wake_on_signal(signal: super::signal::StopSignal, local: SocketAddr) {
-    let mut target = local;
-    if target.ip().is_unspecified() {
-        target.set_ip(std::net::Ipv4Addr::LOCALHOST.into());
-    }
-    let _ = std::thread::Builder::new()
-        .name("receive-stop".into())
-        .spawn(move || {
-            while !signal.raised() {
-                std::thread::sleep(Duration::from_millis(50));
-            }
-            let _ = std::net::TcpStream::connect_timeout(&target, Duration::from_secs(1));
-        });
 }
 
 /// `PORT` → loopback, `ADDR:PORT` as given.
@@ -335,6 +351,7 @@ fn log_line(p: &ReceivedProgram) {
         Disposition::CutOffKept => "cut off, kept",
         Disposition::NameUnusable => "not filed",
         Disposition::OverLimit => "over the limit, dropped",
+        Disposition::WriteFailed => "lost",
     };
     let mut out = io::stdout().lock();
     let _ = writeln!(
@@ -372,6 +389,13 @@ fn log_line(p: &ReceivedProgram) {
             p.first_line,
             p.reason.as_deref().unwrap_or("limit reached")
         )),
+        Disposition::WriteFailed => say(format_args!(
+            "ncchannel receive: {} (lines {}-{}) was lost: {}",
+            p.path.display(),
+            p.first_line,
+            p.last_line,
+            p.reason.as_deref().unwrap_or("the disk refused it")
+        )),
         _ => {}
     }
 }
@@ -384,6 +408,8 @@ struct Totals {
     cut_off: usize,
     /// Transfers refused by an error of the receiver (nothing of them filed).
     refused: usize,
+    /// Programs the disk refused (full, file too large).
+    lost: usize,
     bytes: u64,
 }
 
@@ -396,6 +422,11 @@ impl Totals {
             .iter()
             .filter(|p| p.disposition == Disposition::KeptExisting)
             .count();
+        self.lost += r
+            .programs
+            .iter()
+            .filter(|p| p.disposition == Disposition::WriteFailed)
+            .count();
         self.cut_off += r.split.cut_off;
         self.bytes += r.split.bytes_in;
     }
@@ -403,13 +434,14 @@ impl Totals {
     fn print(&self, out: &Path) {
         let _ = writeln!(
             io::stdout().lock(),
-            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off, {} transfer(s) refused",
+            "{} program(s) filed in {} from {} transfer(s), {} bytes; {} kept existing, {} cut off, {} lost to write errors, {} transfer(s) refused",
             self.filed,
             out.display(),
             self.transfers,
             self.bytes,
             self.kept,
             self.cut_off,
+            self.lost,
             self.refused
         );
     }

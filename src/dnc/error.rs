@@ -33,6 +33,17 @@ pub enum DncError {
         template: String,
         reason: &'static str,
     },
+    /// The disk refused a program (full, file too large): it is lost, and the transfer stops
+    /// after it, so its sender learns that the rest was not taken.
+    #[error(
+        "{path} lost: {source}; the rest of the transfer, from line {next_line}, was not taken"
+    )]
+    ProgramLost {
+        path: PathBuf,
+        next_line: u64,
+        #[source]
+        source: std::io::Error,
+    },
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,

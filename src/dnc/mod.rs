@@ -10,6 +10,8 @@ pub(crate) mod error;
 pub(crate) mod listen;
 pub mod markers;
 pub mod splitter;
+pub mod stop;
+pub mod temp_files;
 pub(crate) mod transfer;
 pub(crate) mod writer;
 
@@ -18,6 +20,7 @@ pub use error::DncError;
 pub use listen::{Listener, TransferResult};
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};
 pub use splitter::{ProgramEnd, ProgramSink, ProgramStart, SplitSummary, Splitter};
+pub use stop::{StopLevel, StopRequest};
 pub use transfer::{
     receive, receive_limited, receive_stream, Limit, TransferEnd, TransferLimits, TransferReport,
 };

@@ -24,6 +24,9 @@ pub enum TransferEnd {
     Broken(String),
     /// The transfer reached one of its [`TransferLimits`]; the rest was not read.
     LimitReached(Limit),
+    /// The disk refused a program ([`super::Disposition::WriteFailed`] names it): the
+    /// transfer stopped there and the rest was not taken.
+    WriteFailed(String),
 }
 
 /// Which of the [`TransferLimits`] ended a transfer.
@@ -64,8 +67,9 @@ impl TransferReport {
     }
 }
 
-/// Receive one transfer to its end. The writer's errors (disk full, no permission) stop the
-/// transfer with `Err`; the program being written is then dropped, never half filed.
+/// Receive one transfer to its end. A program the disk refuses (full, no permission) is lost,
+/// never half filed, and ends the transfer as [`TransferEnd::WriteFailed`]; the programs filed
+/// before it stay filed and are reported.
 pub fn receive<R: Read>(
     input: R,
     splitter: &mut Splitter,
@@ -96,7 +100,7 @@ pub fn receive_limited<R: Read>(
                     .max_bytes
                     .map_or(n, |m| n.min(usize::try_from(m - bytes).unwrap_or(n)));
                 if let Err(e) = splitter.feed(&buf[..allowed], writer) {
-                    return Err(reset(splitter, writer, e));
+                    return Ok(write_failed(splitter, writer, e));
                 }
                 bytes += allowed as u64;
                 if allowed < n {
@@ -116,7 +120,10 @@ pub fn receive_limited<R: Read>(
         TransferEnd::Complete => splitter.finish(writer),
         _ => splitter.abort(writer),
     };
-    let split = split.map_err(|e| reset(splitter, writer, e))?;
+    let split = match split {
+        Ok(s) => s,
+        Err(e) => return Ok(write_failed(splitter, writer, e)),
+    };
     writer.limit_programs(None);
     Ok(TransferReport {
         split,
@@ -126,11 +133,25 @@ pub fn receive_limited<R: Read>(
     })
 }
 
-/// After a writer error: forget the transfer so the next one starts clean.
-fn reset(splitter: &mut Splitter, writer: &mut ProgramWriter, e: DncError) -> DncError {
+/// After a writer error: the transfer ends with what was filed and the program lost (the
+/// writer's records), and both machines are reset so the next transfer starts clean.
+fn write_failed(
+    splitter: &mut Splitter,
+    writer: &mut ProgramWriter,
+    e: DncError,
+) -> TransferReport {
     writer.discard_current();
-    let _ = splitter.abort(&mut Discard);
-    e
+    writer.limit_programs(None);
+    let split = match splitter.abort(&mut Discard) {
+        Ok(s) => s,
+        Err(never) => match never {},
+    };
+    TransferReport {
+        split,
+        programs: writer.take_records(),
+        end: TransferEnd::WriteFailed(e.to_string()),
+        peer: None,
+    }
 }
 
 /// A sink that drops everything.

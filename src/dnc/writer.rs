@@ -5,6 +5,8 @@
 //! The temporary file is the `tempfile` crate's `NamedTempFile`: it is removed when dropped
 //! (a broken transfer, a writer error, the receiver stopping), and `persist_noclobber` gives
 //! the final name only if nothing has it yet, atomically (no window between test and rename).
+//! Its name carries the receiving process's id ([`temp_files`]), so a later run can tell the
+//! files a killed receiver left from those of a receiver still running.
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
@@ -16,6 +18,7 @@ use tempfile::NamedTempFile;
 
 use super::error::DncError;
 use super::splitter::{ProgramEnd, ProgramSink, ProgramStart};
+use super::temp_files;
 
 /// Numbered file names for programs whose data names none: `received_{n}.nc` gives
 /// `received_001.nc`, `received_002.nc`, …; `{n:W}` sets the digits (default 3).
@@ -123,6 +126,9 @@ pub enum Disposition {
     /// The transfer had delivered its limit of programs; this one was dropped and the
     /// transfer ended (`TransferLimits::max_programs`).
     OverLimit,
+    /// The disk refused the program (full, file too large, no permission): it was lost and
+    /// the transfer ended there (`reason` says why).
+    WriteFailed,
 }
 
 /// One line of the receive log.
@@ -137,7 +143,8 @@ pub struct ReceivedProgram {
     pub disposition: Disposition,
     /// Names from the data refused as unsafe.
     pub rejected_names: Vec<String>,
-    /// Why the program was not filed, for [`Disposition::NameUnusable`].
+    /// Why the program was not filed ([`Disposition::NameUnusable`], [`Disposition::OverLimit`],
+    /// [`Disposition::WriteFailed`]).
     pub reason: Option<String>,
 }
 
@@ -157,8 +164,21 @@ type LogFn = Box<dyn FnMut(&ReceivedProgram)>;
 /// How many taken numbered names are skipped at most when looking for a free one.
 const MAX_NUMBER_PROBES: u32 = 100_000;
 
-/// The program being received: its temporary file, removed on drop unless persisted.
-type TempProgram = BufWriter<NamedTempFile>;
+/// The program being received: its temporary file, removed on drop unless persisted, and a
+/// buffered handle on the same file. Writes go through the plain `File`: an error then reads
+/// as the disk's own ("No space left on device"), where tempfile's wrapper would add the
+/// temporary path, which means nothing to the operator.
+struct TempProgram {
+    out: BufWriter<File>,
+    file: NamedTempFile,
+}
+
+impl TempProgram {
+    fn new(file: NamedTempFile) -> io::Result<Self> {
+        let out = BufWriter::with_capacity(64 * 1024, file.as_file().try_clone()?);
+        Ok(TempProgram { out, file })
+    }
+}
 
 /// Files the programs the splitter delivers; see the module doc for the guarantees.
 pub struct ProgramWriter {
@@ -173,6 +193,9 @@ pub struct ProgramWriter {
     programs_left: Option<usize>,
     /// A program was dropped because `programs_left` was 0.
     over_limit: bool,
+    /// The disk refused the program being received: the error, kept until the program's end
+    /// names it (the name lines may come after the failing write).
+    failed: Option<io::Error>,
 }
 
 impl ProgramWriter {
@@ -185,6 +208,7 @@ impl ProgramWriter {
             log: None,
             programs_left: None,
             over_limit: false,
+            failed: None,
         }
     }
 
@@ -231,6 +255,7 @@ impl ProgramWriter {
     /// temporary file removes it.
     pub(crate) fn discard_current(&mut self) {
         self.current = None;
+        self.failed = None;
     }
 
     fn record(&mut self, r: ReceivedProgram) {
@@ -264,10 +289,16 @@ impl ProgramWriter {
     }
 
     fn file(&mut self, end: ProgramEnd) -> Result<(), DncError> {
+        if let Some(e) = self.failed.take() {
+            let (parent, name) = self.final_place(&end);
+            return Err(self.lose(parent.join(name), &end, e));
+        }
         let Some(tmp) = self.current.take() else {
             return Ok(());
         };
         if self.programs_left == Some(0) {
+            // Gone before the record is logged: whoever reads the log finds no temporary file.
+            drop(tmp);
             self.over_limit = true;
             let name = end.name.file_name().map_or_else(String::new, |(_, n)| n);
             self.record(ReceivedProgram {
@@ -284,16 +315,12 @@ impl ProgramWriter {
         if let Some(left) = self.programs_left.as_mut() {
             *left -= 1;
         }
-        let tmp = finish_temp(tmp)?;
-        let (dir, name) = match end.name.file_name() {
-            Some(n) => n,
-            None => (None, self.numbered()),
-        };
-        let parent = match &dir {
-            Some(d) => self.cfg.out_dir.join(d),
-            None => self.cfg.out_dir.clone(),
-        };
+        let (parent, name) = self.final_place(&end);
         let mut target = parent.join(&name);
+        let tmp = match finish_temp(tmp) {
+            Ok(t) => t,
+            Err(e) => return Err(self.lose(target, &end, e)),
+        };
         let mut record = ReceivedProgram {
             path: target.clone(),
             bytes: end.bytes,
@@ -305,6 +332,7 @@ impl ProgramWriter {
         };
         if !end.complete {
             if !self.cfg.keep_partial {
+                drop(tmp);
                 record.disposition = Disposition::CutOffDropped;
                 self.record(record);
                 return Ok(());
@@ -313,20 +341,26 @@ impl ProgramWriter {
             record.path = target.clone();
         }
         if parent.exists() && !parent.is_dir() {
+            drop(tmp);
             record.disposition = Disposition::NameUnusable;
             record.reason = Some(format!("{} is a file, not a folder", parent.display()));
             self.record(record);
             return Ok(());
         }
-        fs::create_dir_all(&parent).map_err(|e| DncError::io(&parent, e))?;
+        if let Err(e) = fs::create_dir_all(&parent) {
+            return Err(self.lose(target, &end, e));
+        }
         if target.is_dir() {
+            drop(tmp);
             record.disposition = Disposition::NameUnusable;
             record.reason = Some(format!("{} is a folder", target.display()));
             self.record(record);
             return Ok(());
         }
-        let placed =
-            place(tmp, &target, self.cfg.overwrite).map_err(|e| DncError::io(&target, e))?;
+        let placed = match place(tmp, &target, self.cfg.overwrite) {
+            Ok(p) => p,
+            Err(e) => return Err(self.lose(target, &end, e)),
+        };
         record.disposition = match (placed, end.complete) {
             (Placed::Kept, _) => Disposition::KeptExisting,
             (_, false) => Disposition::CutOffKept,
@@ -334,23 +368,59 @@ impl ProgramWriter {
             (Placed::Replaced, true) => Disposition::Replaced,
         };
         if placed != Placed::Kept {
-            sync_dir(&parent).map_err(|e| DncError::io(&parent, e))?;
+            // The program is under its name, complete and synced; only the rename's own
+            // durability is in doubt: it counts as filed, and the error stops the transfer.
+            if let Err(e) = sync_dir(&parent) {
+                self.record(record);
+                return Err(DncError::io(&parent, e));
+            }
         }
         self.record(record);
         Ok(())
     }
+
+    /// Where the program of `end` goes: its folder and file name (a numbered name when the
+    /// data names none).
+    fn final_place(&mut self, end: &ProgramEnd) -> (PathBuf, String) {
+        let (dir, name) = match end.name.file_name() {
+            Some(n) => n,
+            None => (None, self.numbered()),
+        };
+        let parent = match &dir {
+            Some(d) => self.cfg.out_dir.join(d),
+            None => self.cfg.out_dir.clone(),
+        };
+        (parent, name)
+    }
+
+    /// The disk refused the program of `end` (to be filed as `target`): record it as lost
+    /// under the name it would have had, and stop the transfer with the error.
+    fn lose(&mut self, target: PathBuf, end: &ProgramEnd, e: io::Error) -> DncError {
+        self.current = None;
+        self.record(ReceivedProgram {
+            path: target.clone(),
+            bytes: end.bytes,
+            first_line: end.first_line,
+            last_line: end.last_line,
+            disposition: Disposition::WriteFailed,
+            rejected_names: end.name.rejected.clone(),
+            reason: Some(e.to_string()),
+        });
+        DncError::ProgramLost {
+            path: target,
+            next_line: end.last_line + 1,
+            source: e,
+        }
+    }
 }
 
-/// Flush a finished program's temporary file to disk.
-fn finish_temp(tmp: TempProgram) -> Result<NamedTempFile, DncError> {
-    let path = tmp.get_ref().path().to_path_buf();
-    let tmp = tmp
+/// Flush a finished program's temporary file to disk (an error drops the file).
+fn finish_temp(tmp: TempProgram) -> io::Result<NamedTempFile> {
+    tmp.out
         .into_inner()
-        .map_err(|e| DncError::io(&path, e.into_error()))?;
-    tmp.as_file()
-        .sync_all()
-        .map_err(|e| DncError::io(tmp.path(), e))?;
-    Ok(tmp)
+        .map_err(io::IntoInnerError::into_error)?;
+    tmp.file.as_file().sync_all()?;
+    Ok(tmp.file)
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -396,25 +466,28 @@ fn sync_dir(dir: &Path) -> io::Result<()> {
 impl ProgramSink for ProgramWriter {
     type Error = DncError;
 
+    /// A refused temporary file (a full disk) is not an error yet: the program's end names
+    /// the program lost ([`ProgramWriter::lose`]).
     fn start(&mut self, _start: &ProgramStart) -> Result<(), DncError> {
         self.discard_current();
         let dir = &self.cfg.out_dir;
-        fs::create_dir_all(dir).map_err(|e| DncError::io(dir, e))?;
-        let file = tempfile::Builder::new()
-            .prefix(".ncchannel-receive-")
-            .suffix(".tmp")
-            .tempfile_in(dir)
-            .map_err(|e| DncError::io(dir, e))?;
-        self.current = Some(BufWriter::with_capacity(64 * 1024, file));
+        match fs::create_dir_all(dir).and_then(|()| temp_files::create(dir)) {
+            Ok(file) => match TempProgram::new(file) {
+                Ok(t) => self.current = Some(t),
+                Err(e) => self.failed = Some(e),
+            },
+            Err(e) => self.failed = Some(e),
+        }
         Ok(())
     }
 
+    /// A refused write drops the temporary file at once and swallows the rest of the
+    /// program: its end, which knows the program's name, reports it lost.
     fn data(&mut self, bytes: &[u8]) -> Result<(), DncError> {
         if let Some(t) = self.current.as_mut() {
-            if let Err(e) = t.write_all(bytes) {
-                let path = t.get_ref().path().to_path_buf();
-                self.discard_current();
-                return Err(DncError::io(path, e));
+            if let Err(e) = t.out.write_all(bytes) {
+                self.current = None;
+                self.failed = Some(e);
             }
         }
         Ok(())

@@ -7,3 +7,5 @@ mod support;
 mod dnc_receive;
 mod dnc_split;
 mod receive_abuse;
+mod receive_disk_full;
+mod receive_stop;
