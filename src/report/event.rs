@@ -9,10 +9,12 @@
 //! reader does not keep up: a pipe nobody reads), [`Backlog::Block`] makes the tick wait —
 //! right in virtual time, where nothing is late — and [`Backlog::Drop`] (real time, `serve`)
 //! drops the batch and counts it: the writer puts an `events_dropped` line into the log when
-//! it catches up, and on stderr at the end. Memory stays bounded either way.
+//! it catches up, and on stderr at the end. Memory stays bounded either way. The writer hands
+//! the operating system whole lines only and reports a write error at once
+//! ([`super::event_writer`]).
 
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, Write};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -22,6 +24,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender};
 use serde::Serialize;
 
+use super::event_writer::LineSink;
 use crate::vocab::event::CacheOp;
 use crate::vocab::flush::FlushKind;
 use crate::vocab::mode::{Mode, State};
@@ -73,6 +76,14 @@ pub enum EventKind {
         bytes: u64,
         ok: bool,
         code: Option<u32>,
+    },
+    /// A stretch of refused stream writes is over (a write got through, or the log ended):
+    /// `count` refusals with `code` since tick `first_tick`. Only the first of them has its
+    /// own `write` and `warning` lines (a writer retrying every 250 µs would flood the log).
+    WritesRefused {
+        count: u64,
+        code: Option<u32>,
+        first_tick: u64,
     },
     /// The decoder took a segment out of the stream buffer.
     Segment {
@@ -286,17 +297,19 @@ impl EventLog {
     /// Write to a file (created or truncated); a named pipe is flushed at every batch.
     pub fn to_file(path: &Path) -> io::Result<Self> {
         let f = File::create(path)?;
-        let policy = if is_pipe(&f) {
-            FlushPolicy::EveryBatch
+        let (policy, trim) = if is_pipe(&f) {
+            (FlushPolicy::EveryBatch, None)
         } else {
-            FlushPolicy::Interval
+            (FlushPolicy::Interval, f.try_clone().ok())
         };
-        Ok(Self::to_writer_with(Box::new(f), policy))
+        let sink = LineSink::new(Box::new(f), trim, path.display().to_string());
+        Ok(Self::to_sink(sink, policy))
     }
 
     /// Write to standard output, flushed at every batch (usually a pipe or a terminal).
     pub fn stdout() -> Self {
-        Self::to_writer_with(Box::new(io::stdout()), FlushPolicy::EveryBatch)
+        let sink = LineSink::new(Box::new(io::stdout()), None, "on standard output".into());
+        Self::to_sink(sink, FlushPolicy::EveryBatch)
     }
 
     /// `-` is standard output, anything else a file path (the `--events` option).
@@ -318,6 +331,11 @@ impl EventLog {
     /// Whole lines only reach the writer: a stop (SIGINT/SIGTERM) that ends the run through
     /// [`EventLog::finish`] never leaves a cut line.
     pub(crate) fn to_writer_with(w: Box<dyn Write + Send>, policy: FlushPolicy) -> Self {
+        Self::to_sink(LineSink::new(w, None, "writer".into()), policy)
+    }
+
+    /// The writer thread taking batches to `sink`.
+    fn to_sink(mut out: LineSink, policy: FlushPolicy) -> Self {
         let (tx, rx) = crossbeam_channel::bounded::<Vec<Event>>(MAX_QUEUED_BATCHES);
         let (recycle_tx, recycle_rx) = crossbeam_channel::bounded(RECYCLE_BATCHES);
         let dropped = Arc::new(AtomicU64::new(0));
@@ -325,19 +343,13 @@ impl EventLog {
         let thread = std::thread::Builder::new()
             .name("ncchannel-events".into())
             .spawn(move || -> io::Result<u64> {
-                let mut out = BufWriter::new(w);
-                let mut lines = 0u64;
                 let mut dropped_total = 0u64;
-                let mut note_dropped = |out: &mut BufWriter<Box<dyn Write + Send>>,
-                                        lines: &mut u64|
-                 -> io::Result<()> {
+                let mut note_dropped = |out: &mut LineSink| {
                     let n = dropped_w.swap(0, Ordering::Relaxed);
                     if n > 0 {
                         dropped_total += n;
-                        writeln!(out, "{{\"ev\":\"events_dropped\",\"events\":{n}}}")?;
-                        *lines += 1;
+                        out.raw_line(&format!("{{\"ev\":\"events_dropped\",\"events\":{n}}}"));
                     }
-                    Ok(())
                 };
                 // When the oldest unflushed line was written; None when all is flushed.
                 let mut dirty_since: Option<Instant> = None;
@@ -349,35 +361,33 @@ impl EventLog {
                         Ok(b) => b,
                         Err(RecvTimeoutError::Timeout) => {
                             if dirty_since.take().is_some() {
-                                out.flush()?;
+                                out.flush();
                             }
                             continue;
                         }
                         Err(RecvTimeoutError::Disconnected) => break,
                     };
-                    note_dropped(&mut out, &mut lines)?;
+                    note_dropped(&mut out);
+                    // After a write error the sink only counts: the tick is never held up.
                     for ev in batch.drain(..) {
-                        serde_json::to_writer(&mut out, &ev).map_err(io::Error::from)?;
-                        out.write_all(b"\n")?;
-                        lines += 1;
+                        out.event(&ev);
                     }
                     // Hand the empty Vec back; if the tick has enough spares, let it go.
                     let _ = recycle_tx.try_send(batch);
                     let since = *dirty_since.get_or_insert_with(Instant::now);
                     if policy == FlushPolicy::EveryBatch || since.elapsed() >= FLUSH_INTERVAL {
-                        out.flush()?;
+                        out.flush();
                         dirty_since = None;
                     }
                 }
-                note_dropped(&mut out, &mut lines)?;
-                out.flush()?;
+                note_dropped(&mut out);
                 if dropped_total > 0 {
                     let _ = writeln!(
                         io::stderr().lock(),
                         "ncchannel: event log: {dropped_total} events dropped (its reader did not keep up); the log marks where"
                     );
                 }
-                Ok(lines)
+                out.finish()
             });
         match thread {
             Ok(thread) => EventLog {
@@ -423,8 +433,8 @@ impl EventLog {
             Some(w) => {
                 let spare = w.recycled.try_recv().unwrap_or_default();
                 let batch = std::mem::replace(events, spare);
-                // The writer only goes away on an I/O error; then events are lost, and
-                // `finish` reports the error.
+                // The writer stays until the end, also after a write error (it then
+                // counts what it cannot write, and `finish` reports it).
                 match w.backlog {
                     Backlog::Block => {
                         let _ = w.batches.send(batch);
