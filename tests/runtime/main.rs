@@ -5,6 +5,7 @@
 mod support;
 
 mod closed_stdout;
+mod event_log_cuts;
 mod runtime;
 mod runtime_events;
 mod serve_signals;

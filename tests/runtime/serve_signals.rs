@@ -115,12 +115,28 @@ fn check_stopped_log(log: &str, stderr: &str) {
     }
 }
 
+/// Whole `block` lines in the log file so far.
+fn block_lines(events: &std::path::Path) -> usize {
+    std::fs::read_to_string(events)
+        .map(|t| t.lines().filter(|l| l.contains(r#""ev":"block""#)).count())
+        .unwrap_or(0)
+}
+
 fn stopped_by(signal: &str) {
     let rig = Rig::new();
     long_program(&rig);
     let events = rig.dir.path().join("events.jsonl");
     let (mut child, _, stderr) = serve(&rig, &events);
-    std::thread::sleep(Duration::from_millis(1500));
+    // Stopped once the program has run a while (the log shows more than 10 blocks), however
+    // slowly a loaded machine runs it.
+    let until = Instant::now() + Duration::from_secs(60);
+    while block_lines(&events) <= 10 {
+        assert!(
+            Instant::now() < until,
+            "the program did not run 10 blocks in 60 s"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
     kill(&child, signal);
     let status = wait(&mut child, Duration::from_secs(30));
     let stderr = stderr.join().unwrap();
