@@ -134,7 +134,9 @@ enum Failure {
 impl From<dnc::DncError> for Failure {
     fn from(e: dnc::DncError) -> Self {
         match e {
-            dnc::DncError::Io { .. } => Failure::Io(e.to_string()),
+            dnc::DncError::Io { .. } | dnc::DncError::ProgramLost { .. } => {
+                Failure::Io(e.to_string())
+            }
             _ => Failure::Usage(e.to_string()),
         }
     }
