@@ -355,6 +355,10 @@ impl Channel {
     pub fn store_stats(&self) -> StoreStats {
         self.store.stats()
     }
+    /// The program files this channel finds by name (its search paths).
+    pub(crate) fn store(&self) -> &ProgramStore {
+        &self.store
+    }
     pub fn cache(&self) -> &Cache {
         &self.cache
     }

@@ -29,7 +29,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=12))]
     pub channels: u32,
     /// Start-up list the channels are built from (its channels are reused in turn when it
-    /// has fewer than --channels).
+    /// has fewer than --channels); outside a clone, the shipped one built into the binary.
     #[arg(long, default_value = "params/soak/startup4.lis")]
     pub params: PathBuf,
     /// Seed of the generated programs and packet sizes.
@@ -59,7 +59,11 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         return usage("--seconds must be in (0, 3600]".into());
     }
-    let params = &args.params;
+    let params = match crate::params::shipped::locate(&args.params) {
+        Ok(p) => p,
+        Err(e) => return usage(e.to_string()),
+    };
+    let params = &params;
     let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),

@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 pub(crate) mod bench;
 pub mod check;
+pub(crate) mod init;
 mod logger;
 pub(crate) mod out;
 pub(crate) mod receive;
@@ -53,6 +54,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Check NC programs and parameter lists; errors as file:line:col.
     Check(check::CheckArgs),
+    /// Write the shipped parameter lists, scenarios and example programs into a folder to edit.
+    Init(init::InitArgs),
     /// Run one program on a channel, optionally streamed by the built-in feeder.
     Run(run::RunArgs),
     /// Serve the channels over ADS/TCP in real time.
@@ -71,6 +74,7 @@ impl Cli {
         match self.command {
             Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
+            Some(Command::Init(args)) => init::execute(args),
             Some(Command::Receive(args)) => receive::execute(args),
             Some(Command::Run(args)) => run::execute(args),
             Some(Command::Serve(args)) => serve::execute(args),

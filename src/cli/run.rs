@@ -30,8 +30,9 @@ pub struct RunArgs {
     /// (with a `/`, or absolute), whose folder is then searched first for it and its
     /// subroutines. Default: the channel's streaming program when --stream is given.
     pub program: Option<String>,
-    /// Start-up list.
-    #[arg(long, default_value = "params/startup.lis")]
+    /// Start-up list: this, else $NCCHANNEL_PARAMS, else ./params/startup.lis, else the set
+    /// built into the binary (`ncchannel init DIR` writes it out to edit).
+    #[arg(long, env = "NCCHANNEL_PARAMS", default_value = "params/startup.lis")]
     pub params: PathBuf,
     /// Channel number, 1-based.
     #[arg(long, default_value_t = 1)]
@@ -114,6 +115,64 @@ fn parse_skip_mask(s: &str) -> Result<u16, String> {
     r.map_err(|_| format!("'{s}' is not a mask from 0 to 65535 (decimal or 0x hex)"))
 }
 
+/// Where the files the arguments name are read from (`params::shipped::locate`): the start-up
+/// list, the --stream file and a PROGRAM path, each from the current folder or, for the
+/// shipped names outside a clone, the set built into the binary. A PROGRAM that is a file of
+/// the current folder is taken as a path (`run far.nc` runs ./far.nc); one written as a path
+/// that exists nowhere is a usage error, before any channel starts.
+fn locate_files(args: &mut RunArgs) -> Result<(), String> {
+    use crate::params::shipped::locate;
+    args.params = locate(&args.params).map_err(|e| e.to_string())?;
+    if let Some(s) = &args.stream {
+        args.stream = Some(locate(s).map_err(|e| e.to_string())?);
+    }
+    if let Some(p) = &args.program {
+        let path = Path::new(p);
+        let as_path = program_path(p).is_some();
+        if as_path || path.is_file() {
+            let found = locate(path).map_err(|e| e.to_string())?;
+            if !found.is_file() {
+                return Err(format!("{p}: no such program file"));
+            }
+            let shown = if found.is_absolute() || as_path {
+                found
+            } else {
+                Path::new(".").join(found)
+            };
+            args.program = Some(shown.to_string_lossy().into_owned());
+        }
+    }
+    Ok(())
+}
+
+/// A PROGRAM given by name must be found through the channel's search paths (or be its
+/// streaming program): otherwise a usage error (exit 2) names the folders searched, instead
+/// of a channel error with a summary of zeros.
+fn program_exists(
+    channels: &[crate::channel::Channel],
+    args: &RunArgs,
+    program: &str,
+) -> Result<(), String> {
+    use crate::source::store::ProgramKind;
+    let Some(c) = channels.get((args.channel as usize).wrapping_sub(1)) else {
+        return Ok(());
+    };
+    let store = c.store();
+    if store.is_streaming_program(program) || store.find(program, ProgramKind::Main).is_ok() {
+        return Ok(());
+    }
+    let dirs: Vec<String> = store
+        .search_dirs()
+        .iter()
+        .map(|d| d.dir.display().to_string())
+        .collect();
+    Err(format!(
+        "program {program} not found in the current folder nor in channel {}'s search paths ({})",
+        args.channel,
+        dirs.join(", ")
+    ))
+}
+
 /// A program argument that is a file path rather than a program name: it holds a path
 /// separator or is absolute. Its folder goes first into the channel's search paths (main
 /// programs and subroutines), and the program is started by its file name.
@@ -180,7 +239,10 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(exit::USAGE)
 }
 
-pub fn execute(args: RunArgs) -> ExitCode {
+pub fn execute(mut args: RunArgs) -> ExitCode {
+    if let Err(msg) = locate_files(&mut args) {
+        return usage(msg);
+    }
     let mut config = match load_config(&args.params) {
         Ok(c) => c,
         Err(msg) => return usage(msg),
@@ -208,6 +270,9 @@ pub fn execute(args: RunArgs) -> ExitCode {
         Ok(p) => p,
         Err(msg) => return usage(msg),
     };
+    if let Err(msg) = program_exists(&channels, &args, &program) {
+        return usage(msg);
+    }
     let feeder = match open_feeder(&args) {
         Ok(f) => f,
         Err(msg) => return usage(msg),

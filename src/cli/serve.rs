@@ -19,8 +19,9 @@ use super::out::say;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct ServeArgs {
-    /// Start-up list.
-    #[arg(long, default_value = "params/startup.lis")]
+    /// Start-up list: this, else $NCCHANNEL_PARAMS, else ./params/startup.lis, else the set
+    /// built into the binary (`ncchannel init DIR` writes it out to edit).
+    #[arg(long, env = "NCCHANNEL_PARAMS", default_value = "params/startup.lis")]
     pub params: PathBuf,
     /// Listen address (default: runtime.toml `ads.bind`, 127.0.0.1:48898). Port 0 picks one.
     #[arg(long)]
@@ -54,7 +55,8 @@ pub struct ServeArgs {
 }
 
 fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
-    load_external(p)
+    let p = crate::params::shipped::locate(p).map_err(|e| e.to_string())?;
+    load_external(&p)
 }
 
 /// The ADS server's settings: the command line over runtime.toml's `[ads]`.
@@ -152,6 +154,10 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             }
             Err(msg) => return usage(msg),
         },
+    };
+    args.params = match crate::params::shipped::locate(&args.params) {
+        Ok(p) => p,
+        Err(e) => return usage(e.to_string()),
     };
     let (config, channels) = match super::run::load_channels(
         &args.params,

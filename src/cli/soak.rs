@@ -11,7 +11,7 @@ use super::exit;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct SoakArgs {
-    /// Scenario file (see params/soak/).
+    /// Scenario file (see params/soak/; outside a clone, the shipped ones built into the binary).
     pub scenario: PathBuf,
     /// Run at the cycle period in wall-clock time instead of virtual time.
     #[arg(long)]
@@ -47,7 +47,11 @@ pub fn execute(args: SoakArgs) -> ExitCode {
     {
         return usage("--wall-seconds must be in (0, 1e7]".into());
     }
-    let path = &args.scenario;
+    let path = match crate::params::shipped::locate(&args.scenario) {
+        Ok(p) => p,
+        Err(e) => return usage(e.to_string()),
+    };
+    let path = &path;
     let scenario = match Scenario::load(path) {
         Ok(s) => s,
         Err(e) => return usage(e.to_string()),

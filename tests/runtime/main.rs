@@ -4,6 +4,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod anywhere;
 mod closed_stdout;
 mod runtime;
 mod runtime_events;
