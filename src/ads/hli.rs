@@ -929,7 +929,9 @@ impl Hli {
                     return Err(AdsResult::INVALID_SIZE);
                 }
                 let i = self.symbol_by_name(data)?;
-                Ok((i as u32 + 1).to_le_bytes().to_vec())
+                let mut reply = handle_reply(&self.image()?.symbols[i], i as u32 + 1);
+                reply.truncate(read_length as usize);
+                Ok(reply)
             }
             GROUP_VALUE_BY_NAME => self.read_symbol(self.symbol_by_name(data)?, read_length),
             GROUP_INFO_BY_NAME => {
@@ -951,6 +953,20 @@ impl Hli {
             _ => self.read(group, offset, read_length),
         }
     }
+}
+
+/// 0xF003's reply: the handle; a client that asks for more (`jisotalo/ads-client`
+/// `createVariableHandle` asks for any length) also gets the symbol's size, the type
+/// decoration (0: no decoration), the type name's length (u16) and the type name with NUL.
+fn handle_reply(s: &Symbol, handle: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(15 + s.ty.len());
+    for w in [handle, s.size as u32, 0] {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+    out.extend_from_slice(&(s.ty.len() as u16).to_le_bytes());
+    out.extend_from_slice(s.ty.as_bytes());
+    out.push(0);
+    out
 }
 
 fn role_source(role: Role) -> &'static str {
