@@ -79,6 +79,7 @@ async function main() {
   // The state followed by a notification on a struct member.
   const states = [];
   const sub = await client.subscribeValue(MS + ".state_r.state", (d) => states.push(d.value), 10, true);
+  await waitFor("the first sample", () => states.length > 0);
 
   await command(client, AUTOMATIC, ACTIVE, "streaming.nc");
   await waitFor("ACTIVE notified", () => states.includes(ACTIVE));
