@@ -318,22 +318,25 @@ impl<'a> DataType<'a> {
     /// The `AdsDatatypeEntry` of this type (`None` when its size is unknown).
     pub(crate) fn entry(&self) -> Option<Vec<u8>> {
         let size = self.size_bytes()?;
-        let (base, dims, items): (&str, Vec<(i32, u32)>, Vec<Vec<u8>>) = match self {
+        let mut dims = Vec::new();
+        let mut items = Vec::new();
+        let base = match self {
             DataType::Array {
                 lower,
                 elements,
                 element,
                 ..
-            } => (element, vec![(*lower, *elements)], Vec::new()),
-            DataType::Struct(s) => {
-                let items = s
-                    .members
-                    .iter()
-                    .map(member_entry)
-                    .collect::<Option<Vec<_>>>()?;
-                ("", Vec::new(), items)
+            } => {
+                dims.push((*lower, *elements));
+                *element
             }
-            _ => ("", Vec::new(), Vec::new()),
+            DataType::Struct(s) => {
+                for mem in s.members {
+                    items.push(member_entry(mem)?);
+                }
+                ""
+            }
+            _ => "",
         };
         Some(encode(&EntryHead {
             name: self.name(),
