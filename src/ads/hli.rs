@@ -19,7 +19,7 @@
 //! (ReadWrite), 0xF004 value by name (ReadWrite), 0xF005 value by handle (Read/Write, offset =
 //! handle), 0xF006 release handle (Write), 0xF009 symbol info by name (ReadWrite); the
 //! uploads and runtime data of [`super::symbols`] (0xF008, 0xF00B, 0xF00C, 0xF00E, 0xF00F,
-//! 0xF100) and data types by name (0xF011) with the layouts of [`super::plc_types`]. A
+//! 0xF100), a symbol's location by name (0xF007) and data types by name (0xF011) with the layouts of [`super::plc_types`]. A
 //! symbol's address (its entry's group and offset) is value-by-handle: 0xF005 and its handle.
 //! Handles are stable per symbol (symbol index + 1), so releasing is bookkeeping-free and a
 //! client that never releases cannot exhaust anything.
@@ -32,9 +32,9 @@ use super::description::{Access, AdsType, ObjectInfo};
 use super::plc_types::DataType;
 use super::result::AdsResult;
 use super::symbols::{
-    self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_SYMBOL_UPLOAD,
-    GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD, GROUP_UPLOAD_INFO,
-    GROUP_UPLOAD_INFO2,
+    self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_LOCATION_BY_NAME,
+    GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
+    GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
 };
 use crate::vocab::mode::Mode;
 
@@ -880,20 +880,15 @@ impl Hli {
             GROUP_SYMBOL_VERSION => symbols::symbol_version(length),
             GROUP_DEVICE_DATA => symbols::device_data(offset, length),
             GROUP_UPLOAD_INFO => symbols::fit(self.uploads()?.info.v1(), length),
-            GROUP_UPLOAD_INFO2 => {
-                // A client asking for more (upload info 3, 64 bytes) gets version 2 and
-                // tells the versions apart by the length (ads-client readPlcUploadInfo).
-                let mut v2 = self.uploads()?.info.v2();
-                v2.truncate(length as usize);
-                if v2.len() < 8 {
-                    return Err(AdsResult::INVALID_SIZE);
-                }
-                Ok(v2)
-            }
+            GROUP_UPLOAD_INFO2 => self.uploads()?.info.for_length(length),
             GROUP_SYMBOL_UPLOAD => symbols::fit(self.uploads()?.symbols.clone(), length),
             GROUP_TYPE_UPLOAD => symbols::fit(self.uploads()?.types.clone(), length),
-            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME
-            | GROUP_RELEASE_HANDLE | GROUP_TYPE_BY_NAME => Err(AdsResult::ACCESS_DENIED),
+            GROUP_HANDLE_BY_NAME
+            | GROUP_VALUE_BY_NAME
+            | GROUP_INFO_BY_NAME
+            | GROUP_RELEASE_HANDLE
+            | GROUP_TYPE_BY_NAME
+            | GROUP_LOCATION_BY_NAME => Err(AdsResult::ACCESS_DENIED),
             _ => Err(AdsResult::INVALID_GROUP),
         }
     }
@@ -938,6 +933,14 @@ impl Hli {
                 let i = self.symbol_by_name(data)?;
                 let entry = symbol_entry(&self.info(self.image()?, i));
                 symbols::fit(entry, read_length)
+            }
+            GROUP_LOCATION_BY_NAME => {
+                let info = self.info(self.image()?, self.symbol_by_name(data)?);
+                let words = [info.group, info.offset, info.size_bytes];
+                symbols::fit(
+                    words.iter().flat_map(|w| w.to_le_bytes()).collect(),
+                    read_length,
+                )
             }
             GROUP_TYPE_BY_NAME => {
                 let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
@@ -1227,7 +1230,12 @@ mod tests {
         let t = testing::channels(1);
         let hli = Hli::new(Arc::clone(&t.backend));
         let info = hli.read(GROUP_UPLOAD_INFO2, 0, 64).unwrap();
-        assert_eq!(info.len(), 24, "upload info 2");
+        assert_eq!(info.len(), 64, "upload info 3");
+        assert_eq!(
+            hli.read(GROUP_UPLOAD_INFO2, 0, 24).unwrap(),
+            info[..24],
+            "upload info 2"
+        );
         let w = |k: usize| {
             u32::from_le_bytes([
                 info[4 * k],

@@ -19,6 +19,8 @@ pub(crate) const GROUP_UPLOAD_INFO: u32 = 0xF00C;
 pub(crate) const GROUP_TYPE_UPLOAD: u32 = 0xF00E;
 /// 0xF00F: upload info 2 (adds data type count and bytes, dynamic symbols).
 pub(crate) const GROUP_UPLOAD_INFO2: u32 = 0xF00F;
+/// 0xF007: a symbol's group, offset and size by name (ReadWrite, name written; 12 bytes).
+pub(crate) const GROUP_LOCATION_BY_NAME: u32 = 0xF007;
 /// 0xF011: one data type entry by name (ReadWrite, name written).
 pub(crate) const GROUP_TYPE_BY_NAME: u32 = 0xF011;
 /// 0xF100: ADS state (u16) and device state (u16) of the runtime, as ReadState answers.
@@ -27,6 +29,12 @@ pub(crate) const GROUP_DEVICE_DATA: u32 = 0xF100;
 pub(crate) const ADS_STATE_RUN: u16 = 5;
 /// The symbol version served: the HLI's symbols are fixed while the server runs.
 const SYMBOL_VERSION: u8 = 1;
+/// Code page of STRING data and names in upload info 3: Windows-1252 (the HLI's names and
+/// texts are ASCII; ads-client reads UTF-8 only for 65001).
+const CODE_PAGE_1252: u32 = 1252;
+/// Upload info 3 flag `IncludesBaseTypes` (ads-client `ADS_UPLOAD_INFO_FLAGS`): the data-type
+/// upload lists the base types too.
+const UPLOAD_INCLUDES_BASE_TYPES: u32 = 0x2;
 /// `ADSSYMBOLFLAG_READONLY`.
 const FLAG_READ_ONLY: u32 = 0x20;
 
@@ -93,6 +101,27 @@ impl UploadInfo {
         .iter()
         .flat_map(|w| w.to_le_bytes())
         .collect()
+    }
+
+    /// 0xF00F asked for 64 bytes: upload info 3 adds invalid dynamic symbols (0), the code
+    /// page and flags, then 28 reserved bytes (ads-client `readPlcUploadInfo`; the `ads`
+    /// crate's `get_symbol_info` reads exactly 64).
+    pub(crate) fn v3(&self) -> Vec<u8> {
+        let mut out = self.v2();
+        for w in [0, CODE_PAGE_1252, UPLOAD_INCLUDES_BASE_TYPES] {
+            out.extend_from_slice(&w.to_le_bytes());
+        }
+        out.resize(64, 0);
+        out
+    }
+
+    /// 0xF00F: version 3 when `length` has room for it, else version 2.
+    pub(crate) fn for_length(&self, length: u32) -> Result<Vec<u8>, AdsResult> {
+        match length {
+            64.. => Ok(self.v3()),
+            24.. => Ok(self.v2()),
+            _ => Err(AdsResult::INVALID_SIZE),
+        }
     }
 }
 
