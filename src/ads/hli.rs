@@ -662,6 +662,7 @@ impl Hli {
         let end = param.iter().position(|&b| b == 0).unwrap_or(param.len());
         let program = String::from_utf8_lossy(&param[..end]).trim().to_string();
         let b = &self.backend;
+        let before = b.status(ch).ok();
         let r = (|| {
             let mode = b.status(ch)?.mode;
             let target = if to_mode == 0 { mode as u32 } else { to_mode };
@@ -683,6 +684,14 @@ impl Hli {
         })();
         if let Err(e) = r {
             log::warn!("HLI channel {ch}: mode/state command {to_mode}/{to_state} refused: {e}");
+            // Refused as a whole: a mode or program set before the to-state was refused is
+            // put back, so the command is applied or refused, never half of it.
+            if let Some(st) = before {
+                let _ = b.command(ch, Op::CommandMode(st.mode as i32));
+                if let Some(p) = st.program {
+                    let _ = b.command(ch, Op::SetProgram(p));
+                }
+            }
             let i = usize::from(ch) - 1;
             let mut refused = img.refused.lock().unwrap_or_else(|p| p.into_inner());
             if refused[i].len() < MAX_REFUSALS_WAITING {
@@ -1181,8 +1190,14 @@ mod tests {
             hli.read(GROUP_VALUE_BY_HANDLE, id, 4).unwrap(),
             REFUSED_TRANSITION_ERROR.to_le_bytes()
         );
-        // STANDBY/SELECTED: refused by the channel; posted after the PLC took the first.
+        // STANDBY/SELECTED: refused by the channel as a whole (the mode stays); posted after
+        // the PLC took the first.
         command(&hli, Mode::Standby as u32, State::Selected as u32, "");
+        assert_eq!(
+            mode_state(b),
+            (Mode::Automatic, State::Ready),
+            "nothing applied"
+        );
         hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
         assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
         assert_eq!(
