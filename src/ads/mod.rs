@@ -17,9 +17,13 @@ pub(crate) mod geo;
 pub(crate) mod hli;
 pub mod objects;
 pub mod payload;
+pub(crate) mod plc_types;
 pub mod result;
 pub(crate) mod sda;
 pub mod server;
+pub(crate) mod sum;
+pub(crate) mod symbols;
+pub(crate) mod system;
 #[cfg(test)]
 pub(crate) mod testing;
 

@@ -777,10 +777,15 @@ fn handle_request(
         }
         Some(Err(e)) => error_payload(header.command, e.result()),
         Some(Ok(req)) => match req {
-            Request::ReadDeviceInfo => {
-                let (major, minor, build) = version_numbers();
-                response::device_info(major, minor, build, &device_name())
-            }
+            Request::ReadDeviceInfo => match Devices::device_info(port) {
+                Some((major, minor, build, name)) => {
+                    response::device_info(major, minor, build, name)
+                }
+                None => {
+                    let (major, minor, build) = version_numbers();
+                    response::device_info(major, minor, build, &device_name())
+                }
+            },
             Request::ReadState => response::state(5, 0),
             Request::WriteControl { ads_state, .. } => response::result_only(if ads_state == 5 {
                 AdsResult::OK

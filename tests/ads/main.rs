@@ -12,4 +12,5 @@ mod ads_housekeeping;
 mod ads_serve;
 mod ads_server;
 mod ads_stream;
+mod ads_symbols;
 mod ads_twinsharp;
