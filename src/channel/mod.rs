@@ -107,7 +107,7 @@ pub struct ChannelStats {
 
 /// What an HMI commands besides mode and state: the COM task's `mc_command_*` objects
 /// (ISG kernel object list, `SamWieHTWG/web-api` `examples/example1-hello-cnc/cnc_objects.csv`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct HmiCommands {
     /// `mc_command_single_block_w`: one block per start.
     pub(crate) single_block: bool,
@@ -121,7 +121,7 @@ pub(crate) struct HmiCommands {
 }
 
 /// Block-search parameters (`mc_cmd_bs_*_w`, TwinSharp `BlockSearch.cs`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SearchCommand {
     /// `mc_cmd_bs_type_w`: 1 file offset, 3 block counter, 4 block number.
     pub kind: u16,
@@ -131,6 +131,22 @@ pub struct SearchCommand {
     pub(crate) block_count: u32,
     /// `mc_cmd_bs_block_number_w`: the N number.
     pub(crate) block_number: u32,
+    /// `mc_cmd_bs_distance_prog_start_w`: path distance from the program start where
+    /// machining is to continue, 0.1 µm.
+    pub(crate) distance_prog_start_tenth_um: f64,
+    /// `mc_cmd_bs_covered_distance_w`: share of the found block already covered, 0.1 %
+    /// (0..=1000).
+    pub(crate) covered_distance_per_mil: f64,
+    /// `mc_cmd_bs_auto_return_w`: return to the contour automatically.
+    pub(crate) auto_return: bool,
+    /// `mc_cmd_bs_deviation_max_w`: largest axis deviation from the continuation position
+    /// at the restart, 0.1 µm.
+    pub(crate) deviation_max_tenth_um: u32,
+    /// `mc_cmd_bs_no_hold_at_restart_w`: resume on the contour without an operator start.
+    pub(crate) no_hold_at_restart: bool,
+    /// `mc_cmd_bs_breakpoint_position_w`: automatic breakpoint, distance from the program
+    /// start, 0.1 µm.
+    pub(crate) breakpoint_tenth_um: f64,
 }
 
 /// Execution mode bit: block search at the next program start.
@@ -712,6 +728,10 @@ impl Channel {
     /// The main program running (ACTIVE or HOLD), if any.
     pub(crate) fn running_program(&self) -> Option<&str> {
         self.running_prog.as_deref()
+    }
+    /// Blocks decoded and waiting for the lookahead window (`mc_slope_buf_level`).
+    pub(crate) fn queued_blocks(&self) -> usize {
+        self.queue.len()
     }
     /// Blocks handed to the interpolator and not yet done (`mc_ipo_buf_level`).
     pub(crate) fn ipo_blocks(&self) -> usize {
