@@ -157,6 +157,9 @@ pub struct Status {
     /// Programs that ran to their end (M02/M30) since the channel was built
     /// (`mc_program_count_r`).
     pub(crate) programs_ended: u64,
+    /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
+    /// set it (`V.G.NP[1..6].V`).
+    pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -230,5 +233,6 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         feed_hold: c.motion().hold(),
         queued_blocks: c.queued_blocks(),
         programs_ended: c.stats().programs_ended,
+        zero_offsets: *c.zero_offsets(),
     }
 }

@@ -729,6 +729,10 @@ impl Channel {
     pub(crate) fn running_program(&self) -> Option<&str> {
         self.running_prog.as_deref()
     }
+    /// The zero-offset table G54…G59 (`V.G.NP[i].V`).
+    pub(crate) fn zero_offsets(&self) -> &ZeroOffsets {
+        &self.zero_offsets
+    }
     /// Blocks decoded and waiting for the lookahead window (`mc_slope_buf_level`).
     pub(crate) fn queued_blocks(&self) -> usize {
         self.queue.len()

@@ -1,8 +1,8 @@
 //! The kernel objects HMIs read, served from the channel's model over a real ADS socket with
 //! ncchannel's own client: feed hold (COM 0x15/0x16), the program counter (0x44F), the
 //! error-message objects (0x257, 0x26), the buffer levels (0x7E, 0x7F, GEO 0x04/0x05), the
-//! block-search-by-distance parameters, axis types and PCS positions, and the description
-//! table's type texts.
+//! block-search-by-distance parameters, axis types and PCS positions, the zero offsets
+//! `V.G.NP[i].V` on the SDA port, and the description table's type texts.
 
 use std::time::{Duration, Instant};
 
@@ -318,4 +318,69 @@ fn description_records_carry_the_kernels_type_texts() {
     ] {
         assert_eq!(record_type(&mut c, name), ty, "{name}");
     }
+}
+
+/// One DINT per axis, as TwinSharp `ZeroOffsets.cs` decodes a zero-offset read.
+fn dints(b: &[u8]) -> Vec<i32> {
+    b.chunks_exact(4)
+        .map(|c| i32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn zero_offsets_read_as_twinsharp_reads_them() {
+    let params = Params::new(1);
+    let list = params.dir.path().join("params/np.lis");
+    std::fs::write(
+        &list,
+        "np_grp[0].achse[0].versch 100000\nnp_grp[1].achse[2].versch -25000\n",
+    )
+    .unwrap();
+    let startup = std::fs::read_to_string(params.startup()).unwrap();
+    std::fs::write(
+        params.startup(),
+        format!("{startup}zero_offset_list np.lis\n"),
+    )
+    .unwrap();
+    let served = Served::start(params);
+    let mut sda = connect(&served, 552);
+    let handle = |sda: &mut AdsClient, name: &str| {
+        u32_at(
+            &sda.read_write(0x122301, 0x46, 4, name.as_bytes()).unwrap(),
+            0,
+        )
+    };
+    let g54 = handle(&mut sda, "V.G.NP[1].V");
+    assert_eq!(
+        handle(&mut sda, "v.g.np[1].v"),
+        g54,
+        "same name, same handle"
+    );
+    // TwinSharp: a plain read of 1024 bytes at the handle; the answer has one DINT per axis.
+    assert_eq!(
+        dints(&sda.read(0x122301, g54, 1024).unwrap()),
+        [100_000, 0, 0]
+    );
+    let g55 = handle(&mut sda, "V.G.NP[2].V");
+    assert_eq!(
+        dints(&sda.read(0x122301, g55, 1024).unwrap()),
+        [0, 0, -25_000]
+    );
+    let by_name = sda
+        .read_write(0x122301, 0x48, 12, b"V.G.NP[2].V\0")
+        .unwrap();
+    assert_eq!(dints(&by_name), [0, 0, -25_000], "read by name");
+    let g59 = handle(&mut sda, "V.G.NP[6].V");
+    assert_eq!(dints(&sda.read(0x122301, g59, 12).unwrap()), [0, 0, 0]);
+    assert_eq!(refused(sda.read(0x122301, g54, 8)), 0x705, "12 bytes");
+    assert_eq!(
+        refused(sda.write(0x122301, g54, &[0; 12])),
+        0x704,
+        "the decoder's table comes from the parameter lists"
+    );
+    assert_eq!(
+        refused(sda.read_write(0x122301, 0x46, 4, b"V.G.NP[0].V")),
+        0x70C,
+        "G54 is index 1"
+    );
 }
