@@ -615,7 +615,7 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
             .to_le_bytes()
             .to_vec(),
         Field::ErrorMessage => return Ok(text(&error_text(v), def.size, length)),
-        Field::FeedHoldCommand => vec![u8::from(v.feed_hold)],
+        Field::FeedHoldCommand => vec![u8::from(h.feed_hold)],
         Field::SlopeBufLevel => (v.queued_blocks as u32).to_le_bytes().to_vec(),
         // A UNS32 counter: it wraps, as the kernel's counters do.
         Field::ProgramCount => (v.programs_ended as u32).to_le_bytes().to_vec(),
@@ -955,19 +955,10 @@ fn write_mcm(
     }
 }
 
-/// Write step: `mc_feedhold_channel_w`. TRUE holds a running program (as
-/// `mcm_automatic_stop_w`), FALSE resumes a held one. A TRUE with no program running is
-/// refused (0x707): there is nothing to hold, and the kernel's channel is not ACTIVE either.
+/// Write step: `mc_feedhold_channel_w`, one BOOL; the channel decides (a TRUE with no
+/// program running is 0x708, as a state command it cannot take now).
 fn write_feed_hold(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
-    let on = bool_arg(data)?;
-    if !on {
-        return unit(backend.command(ch, Op::Resume));
-    }
-    let state = backend.status(ch).map_err(dev)?.state;
-    if !matches!(state, State::Active | State::Hold) {
-        return Err(AdsResult::NOT_READY);
-    }
-    unit(backend.command(ch, Op::Hold))
+    unit(backend.command(ch, Op::Hmi(HmiOp::FeedHold(bool_arg(data)?))))
 }
 
 /// Write step: hold, resume and reset take no argument beyond an optional 4-byte word.

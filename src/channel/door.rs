@@ -77,6 +77,8 @@ pub enum HmiOp {
     Search(SearchCommand),
     /// Forget the cycle-time statistics (`cnc_time_reset`).
     ResetCycleTimes,
+    /// The HMI's feed hold (`mc_feedhold_channel_w`): TRUE holds, FALSE releases.
+    FeedHold(bool),
 }
 
 /// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
@@ -148,9 +150,6 @@ pub struct Status {
     pub(crate) pcs_positions: Vec<(char, f64)>,
     /// The latest operator message of `#MSG` (empty after a reset).
     pub message: Option<String>,
-    /// Feed hold commanded (`mcm_automatic_stop_w`, `mc_feedhold_channel_w`) or a single
-    /// block waiting for its start: motion brakes to a stop and stays there.
-    pub(crate) feed_hold: bool,
     /// Blocks decoded and waiting in the block queue for the lookahead window
     /// (`mc_slope_buf_level`; `ipo_blocks` counts those in the window).
     pub(crate) queued_blocks: usize,
@@ -230,7 +229,6 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
         message: c.message().map(str::to_string),
-        feed_hold: c.motion().hold(),
         queued_blocks: c.queued_blocks(),
         programs_ended: c.stats().programs_ended,
         zero_offsets: *c.zero_offsets(),

@@ -117,6 +117,9 @@ pub(crate) struct HmiCommands {
     pub(crate) skip_levels: u32,
     /// `mc_command_execution_mode_w`: bit 0 = block search at the next start.
     pub(crate) execution_mode: i32,
+    /// `mc_feedhold_channel_w`: the HMI's feed hold holds the running program; only its
+    /// release (or an operator start, a reset, the program's end) lets it go.
+    pub(crate) feed_hold: bool,
     pub search: SearchCommand,
 }
 
@@ -278,6 +281,7 @@ impl Channel {
                     Ok(())
                 }
                 HmiOp::ResetCycleTimes => Ok(()),
+                HmiOp::FeedHold(on) => self.set_feed_hold(tick, on),
             }),
             Op::ErrorRecord(i) => Reply::ErrorRecord {
                 total: self.stats().errors,
@@ -481,6 +485,10 @@ impl Channel {
     }
 
     fn set_state(&mut self, tick: &Tick, state: State) {
+        if !matches!(state, State::Active | State::Hold) {
+            // No program runs: nothing is held.
+            self.hmi.feed_hold = false;
+        }
         if self.state != state {
             self.state = state;
             self.push_state(tick);
@@ -690,8 +698,28 @@ impl Channel {
         }
     }
 
+    /// `mc_feedhold_channel_w`: TRUE holds a running program (refused when none runs: nothing
+    /// to hold); FALSE releases the feed hold and resumes, and only it: a channel held by a
+    /// programmed stop or a single block stays held. Repeating a value changes nothing.
+    fn set_feed_hold(&mut self, tick: &Tick, on: bool) -> Result<(), CommandError> {
+        match (on, self.hmi.feed_hold) {
+            (true, true) | (false, false) => Ok(()),
+            (true, false) if self.state == State::Active => {
+                self.hmi.feed_hold = true;
+                self.hold(tick);
+                Ok(())
+            }
+            (true, false) => Err(self.busy()),
+            (false, true) => {
+                self.resume(tick);
+                Ok(())
+            }
+        }
+    }
+
     /// Resume after hold (0x137).
     fn resume(&mut self, tick: &Tick) {
+        self.hmi.feed_hold = false;
         if self.state == State::Hold {
             self.single_credit = true;
             self.motion.set_hold(false);

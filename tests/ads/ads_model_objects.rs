@@ -92,8 +92,8 @@ fn feed_hold_written_holds_the_channel_and_reads_back() {
     assert_eq!(c.read(CH, 0x15, 1).unwrap(), [0], "no feed hold at start");
     assert_eq!(
         refused(c.write(CH, 0x16, &[1])),
-        0x707,
-        "nothing runs: nothing to hold"
+        0x708,
+        "nothing runs: nothing to hold (yet)"
     );
     start_program(&mut c, 1, "long.nc").unwrap();
     wait_state(&mut c, 4);
@@ -107,14 +107,56 @@ fn feed_hold_written_holds_the_channel_and_reads_back() {
         assert!(Instant::now() < deadline, "motion never stopped");
         std::thread::sleep(Duration::from_millis(2));
     }
+    c.write(CH, 0x16, &[1]).unwrap();
+    assert_eq!(c.read(CH, 0x15, 1).unwrap(), [1], "repeated: still held");
     c.write(CH, 0x16, &[0]).unwrap();
     wait_state(&mut c, 4);
     assert_eq!(c.read(CH, 0x15, 1).unwrap(), [0], "released");
+    c.write(CH, 0x16, &[0]).unwrap();
+    assert_eq!(
+        u32_of(&mut c, CH, 0x109),
+        4,
+        "releasing twice changes nothing"
+    );
+    // An operator start ends the feed hold too.
+    c.write(CH, 0x16, &[1]).unwrap();
+    wait_state(&mut c, 5);
+    c.write(CH, 0x137, &[]).unwrap();
+    wait_state(&mut c, 4);
+    assert_eq!(
+        c.read(CH, 0x15, 1).unwrap(),
+        [0],
+        "mcm_automatic_resume_w released it"
+    );
     assert_eq!(refused(c.read(CH, 0x16, 1)), 0x704, "write-only");
     assert_eq!(refused(c.write(CH, 0x15, &[1])), 0x704, "read-only");
     assert_eq!(refused(c.write(CH, 0x16, &[1, 2, 3])), 0x705);
     c.write(CH, 0x13C, &[]).unwrap();
     wait_state(&mut c, 3);
+}
+
+#[test]
+fn releasing_the_feed_hold_leaves_a_programmed_stop_held() {
+    let params = Params::new(1);
+    params.program("m00.nc", "G01 X1 F6000\nM00\nX2\nM30\n");
+    let served = Served::start(params);
+    let mut c = connect(&served, 553);
+    start_program(&mut c, 1, "m00.nc").unwrap();
+    wait_state(&mut c, 5);
+    assert_eq!(c.read(CH, 0x15, 1).unwrap(), [0], "M00 is no feed hold");
+    c.write(CH, 0x16, &[0]).unwrap();
+    assert_eq!(u32_of(&mut c, CH, 0x109), 5, "still held at M00");
+    assert_eq!(
+        refused(c.write(CH, 0x16, &[1])),
+        0x708,
+        "held by M00: no motion to hold"
+    );
+    c.write(CH, 0x105, &4i32.to_le_bytes()).unwrap();
+    wait_until(
+        "mc_program_count_r",
+        || u32_of(&mut c, CH, 0x44F),
+        |v| v == 1,
+    );
 }
 
 #[test]
