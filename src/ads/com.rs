@@ -220,7 +220,7 @@ static TABLE: &[Def] = &[
     d(CH, 0x13, "mc_command_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::CommandFeed),
     d(CH, 0x14, "mc_active_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::ActiveFeed),
     d(CH, 0x15, "mc_command_feedhold_r", Bool, 1, R, "", SRC_DUMP, F::FeedHoldCommand),
-    d(CH, 0x16, "mc_feedhold_channel_w", Bool, 1, W, "TRUE holds, FALSE resumes", SRC_DUMP, F::FeedHold),
+    d(CH, 0x16, "mc_feedhold_channel_w", Bool, 1, W, "TRUE holds, FALSE releases", SRC_DUMP, F::FeedHold),
     d(CH, 0x1F, "mc_message_r", String, 120, R, "last #MSG text", SRC_DUMP, F::Message),
     d(CH, 0x26, "mc_error_message_r", String, 1330, R, "", SRC_DUMP, F::ErrorMessage),
     d(CH, 0x2B, "mc_actual_logical_axes_number_r", Dword, 4, R, "", SRC_DUMP, F::ChannelAxes),
