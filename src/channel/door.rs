@@ -77,6 +77,8 @@ pub enum HmiOp {
     Search(SearchCommand),
     /// Forget the cycle-time statistics (`cnc_time_reset`).
     ResetCycleTimes,
+    /// The HMI's feed hold (`mc_feedhold_channel_w`): TRUE holds, FALSE releases.
+    FeedHold(bool),
 }
 
 /// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
@@ -148,6 +150,15 @@ pub struct Status {
     pub(crate) pcs_positions: Vec<(char, f64)>,
     /// The latest operator message of `#MSG` (empty after a reset).
     pub message: Option<String>,
+    /// Blocks decoded and waiting in the block queue for the lookahead window
+    /// (`mc_slope_buf_level`; `ipo_blocks` counts those in the window).
+    pub(crate) queued_blocks: usize,
+    /// Programs that ran to their end (M02/M30) since the channel was built
+    /// (`mc_program_count_r`).
+    pub(crate) programs_ended: u64,
+    /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
+    /// set it (`V.G.NP[1..6].V`).
+    pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -218,5 +229,8 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
         message: c.message().map(str::to_string),
+        queued_blocks: c.queued_blocks(),
+        programs_ended: c.stats().programs_ended,
+        zero_offsets: *c.zero_offsets(),
     }
 }

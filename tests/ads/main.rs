@@ -9,6 +9,7 @@ mod ads_channel_commands;
 mod ads_crate_client;
 mod ads_docs;
 mod ads_housekeeping;
+mod ads_model_objects;
 mod ads_serve;
 mod ads_server;
 mod ads_stream;
