@@ -123,6 +123,19 @@ struct ChannelAreas {
     error_semaphore: usize,
 }
 
+impl ChannelAreas {
+    /// The root area holding `unit` of the mode-and-state unit.
+    fn unit_root(&self, unit: Unit) -> usize {
+        match unit {
+            Unit::Enable => self.enable,
+            Unit::RequestSemaphore => self.request_semaphore,
+            Unit::CommandSemaphore => self.command_semaphore,
+            Unit::Request => self.request,
+            Unit::Command => self.command,
+        }
+    }
+}
+
 /// The symbol table and its memory, built once the channels are known.
 struct Image {
     symbols: Vec<Symbol>,
@@ -806,18 +819,33 @@ impl Hli {
     ) -> Result<Vec<u8>, AdsResult> {
         let img = self.image()?;
         let a = img.areas(ch)?;
-        let root = match unit {
-            Unit::Enable => a.enable,
-            Unit::RequestSemaphore => a.request_semaphore,
-            Unit::CommandSemaphore => a.command_semaphore,
-            Unit::Request => a.request,
-            Unit::Command => a.command,
-        };
+        let root = a.unit_root(unit);
         let mem = img.memory();
         let area = &mem[root];
         let mut out = area[at.min(area.len())..(at + size).min(area.len())].to_vec();
         out.resize(size, 0);
         Ok(out)
+    }
+
+    /// Write `data` at byte `at` of channel `ch`'s mode-and-state `unit` (the HLD's view of
+    /// it on port 551); the caller checked the element's size.
+    pub(crate) fn write_unit_bytes(
+        &self,
+        ch: u16,
+        unit: Unit,
+        at: usize,
+        data: &[u8],
+    ) -> Result<(), AdsResult> {
+        let img = self.image()?;
+        let a = img.areas(ch)?;
+        let root = a.unit_root(unit);
+        let mut mem = img.memory();
+        let area = &mut mem[root];
+        let end = at.checked_add(data.len()).ok_or(AdsResult::INVALID_SIZE)?;
+        area.get_mut(at..end)
+            .ok_or(AdsResult::INVALID_SIZE)?
+            .copy_from_slice(data);
+        Ok(())
     }
 
     /// `gpCh[ch-1]^.head.plc_present_w` as one byte.

@@ -110,7 +110,7 @@ impl Devices {
     pub fn write(&self, port: u16, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
         match port {
             com::PORT => com::write(self.backend.as_ref(), &self.hli, group, offset, data),
-            geo::PORT => Err(AdsResult::ACCESS_DENIED),
+            geo::PORT => geo::write(self.backend.as_ref(), &self.hli, group, offset, data),
             sda::PORT => self.sda.write(group, offset, data),
             hli::PORT => self.hli.write(group, offset, data),
             system::PORT => Err(AdsResult::INVALID_GROUP),

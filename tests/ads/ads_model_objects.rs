@@ -426,3 +426,47 @@ fn zero_offsets_read_as_twinsharp_reads_them() {
         "G54 is index 1"
     );
 }
+
+/// Channel 1's HLD instance on the GEO port.
+const HLD: u32 = 0x123301;
+
+/// A handle on port 851 for an HLI symbol of channel 1's mode-and-state unit.
+fn unit_handle(plc: &mut AdsClient, member: &str) -> u32 {
+    let name = format!("HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.{member}");
+    u32_at(&plc.read_write(0xF003, 0, 4, name.as_bytes()).unwrap(), 0)
+}
+
+#[test]
+fn an_hmi_writes_the_mode_and_state_request_on_the_hld_and_the_plc_reads_it() {
+    let served = Served::start(Params::new(1));
+    let mut geo = connect(&served, 551);
+    let mut plc = connect(&served, 851);
+    // request_r.to_mode (0x26), .to_state (0x27), .parameter (0x29), then the semaphore (0x22).
+    geo.write(HLD, 0x26, &2u32.to_le_bytes()).unwrap();
+    geo.write(HLD, 0x27, &4u32.to_le_bytes()).unwrap();
+    geo.write(HLD, 0x29, b"part.nc\0").unwrap();
+    geo.write(HLD, 0x22, &[1]).unwrap();
+    assert_eq!(
+        u32_of(&mut geo, HLD, 0x26),
+        2,
+        "the HLD reads its request back"
+    );
+    let to_state = unit_handle(&mut plc, "request_r.to_state");
+    assert_eq!(
+        u32_of(&mut plc, 0xF005, to_state),
+        4,
+        "the PLC sees the request"
+    );
+    let sem = unit_handle(&mut plc, "request_semaphor_rw");
+    assert_eq!(plc.read(0xF005, sem, 1).unwrap(), [1]);
+    let param = unit_handle(&mut plc, "request_r.parameter");
+    assert_eq!(&plc.read(0xF005, param, 8).unwrap()[..8], b"part.nc\0");
+    // The PLC takes the request: the semaphore falls on the HLD too.
+    plc.write(0xF005, sem, &[0]).unwrap();
+    assert_eq!(geo.read(HLD, 0x22, 1).unwrap(), [0]);
+    // The command side stays the PLC's: 0x704 on the HLD, too long a value 0x705.
+    assert_eq!(refused(geo.write(HLD, 0x2C, &2u32.to_le_bytes())), 0x704);
+    assert_eq!(refused(geo.write(HLD, 0x1F, &3u32.to_le_bytes())), 0x704);
+    assert_eq!(refused(geo.write(HLD, 0x26, &[0; 5])), 0x705);
+    assert_eq!(refused(geo.write(HLD, 0x29, &[b'x'; 301])), 0x705);
+}
