@@ -20,6 +20,7 @@ pub mod payload;
 pub mod result;
 pub(crate) mod sda;
 pub mod server;
+mod slots;
 #[cfg(test)]
 pub(crate) mod testing;
 
@@ -28,3 +29,4 @@ pub use backend::{CncBackend, DeviceError};
 pub use frame::AmsAddr;
 pub use result::AdsResult;
 pub use server::{spawn, ServerConfig, ServerHandle};
+pub use slots::EVICT_QUIET;

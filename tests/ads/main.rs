@@ -13,3 +13,4 @@ mod ads_serve;
 mod ads_server;
 mod ads_stream;
 mod ads_twinsharp;
+mod ads_unholdable;
