@@ -21,7 +21,7 @@ pub(crate) use crate::vocab::ams::DEFAULT_REPLY_TIMEOUT as REPLY_TIMEOUT;
 /// runtime that is back answers within a few periods, and a connection's requests queued
 /// behind each other (a client that sends several at once) are each answered "busy" within
 /// `reply_timeout` + n × this, not n × `reply_timeout`.
-const STALLED_WAIT: Duration = Duration::from_millis(20);
+const STALLED_WAIT: Duration = Duration::from_millis(50);
 
 pub struct ChannelBackend {
     requests: Sender<Request>,

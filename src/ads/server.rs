@@ -1,9 +1,10 @@
 //! The ADS/TCP server: accepts connections, frames requests, answers them through the object
 //! table, and pushes DeviceNotification frames.
 //!
-//! One thread per connection (at most `max_connections`, default 64; more are closed at once
-//! with a log line), one writer thread per connection draining its bounded send queue, plus
-//! one notification thread per connection that has notification handles. Channel calls may
+//! One thread per connection (at most `max_connections`, default 64; beyond that the
+//! connection quiet for longest gives its slot up, or the newcomer is closed: `slots.rs`),
+//! one writer thread per connection draining its bounded send queue, plus one notification
+//! thread per connection that has notification handles. Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
 //! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
@@ -159,6 +160,7 @@ struct Shared {
     /// Log lines that a client can provoke at will, at most one a second each.
     refused_log: RateLimitedLog,
     router_log: RateLimitedLog,
+    evicted_log: RateLimitedLog,
     /// The lines each connection may write (why it ended, unrouted NetIds), all together at
     /// most [`CONN_LINES_PER_S`] a second: a thousand connections ending at once cost a
     /// few lines and a count, not a thousand lines.
@@ -300,6 +302,7 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
         budget: Mutex::new(NotifyBudget::default()),
         refused_log: RateLimitedLog::new(1),
         router_log: RateLimitedLog::new(1),
+        evicted_log: RateLimitedLog::new(1),
         conn_log: RateLimitedLog::new(CONN_LINES_PER_S),
     });
     let accept_shared = Arc::clone(&shared);
@@ -385,7 +388,7 @@ fn admit(shared: &Shared, stream: &TcpStream, peer: SocketAddr) -> Option<(u64, 
             victim,
             quiet,
         } => {
-            shared.refused_log.log(format_args!(
+            shared.evicted_log.log(format_args!(
                 "connection limit {} reached: {victim} (no request for {:.1} s) closed to serve {peer}",
                 shared.config.max_connections,
                 quiet.as_secs_f64()

@@ -29,8 +29,22 @@ const SERVED_WITHIN: Duration = Duration::from_secs(3);
 const TICK_GROUP: u32 = 0x120101;
 const TICK_OFFSET: u32 = 0x251;
 
+/// One spawned `serve` at a time: each test checks the cycle's pace under its abuse, which
+/// two abuses at once on a 2-core machine would measure together.
+static ONE_SERVE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+pub(crate) type Turn = std::sync::MutexGuard<'static, ()>;
+
+/// Wait for the turn to spawn a `serve`.
+pub(crate) fn turn() -> Turn {
+    ONE_SERVE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+}
+
 /// A spawned `ncchannel serve`, its address, NetId and collected standard error.
 pub(crate) struct Serve {
+    _turn: Turn,
     pub(crate) child: Child,
     addr: SocketAddr,
     net_id: AmsNetId,
@@ -46,6 +60,7 @@ impl Serve {
     }
 
     fn start_with(params: &Path, extra: &[&str]) -> Serve {
+        let turn = turn();
         let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
             .current_dir(env!("CARGO_MANIFEST_DIR"))
             .args(["serve", "--bind", "127.0.0.1:0", "--params"])
@@ -56,12 +71,17 @@ impl Serve {
             .spawn()
             .expect("ncchannel serve starts");
         let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
-        Self::from_child(child, &first, stderr)
+        Self::from_child(turn, child, &first, stderr)
     }
 
     /// A started `serve` whose first stderr line was `first` (its stdout, if piped, is held
     /// and never read); `stderr` is what the test collects of the rest.
-    pub(crate) fn from_child(mut child: Child, first: &str, stderr: Arc<Mutex<String>>) -> Serve {
+    pub(crate) fn from_child(
+        turn: Turn,
+        mut child: Child,
+        first: &str,
+        stderr: Arc<Mutex<String>>,
+    ) -> Serve {
         let stdout = child.stdout.take();
         // "listening on 127.0.0.1:PORT (AMS NetId a.b.c.d.e.f, port 553, N channel(s), cycle P µs)"
         let words: Vec<&str> = first.split_whitespace().collect();
@@ -74,6 +94,7 @@ impl Serve {
             .and_then(|i| words[i + 1].parse::<u64>().ok())
             .expect("cycle");
         Serve {
+            _turn: turn,
             child,
             addr,
             net_id,

@@ -72,6 +72,7 @@ fn ads_u32(b: &[u8], at: usize) -> u32 {
 
 #[test]
 fn with_stderr_a_full_pipe_nobody_reads_clients_are_served_and_sigterm_stops_serve() {
+    let turn = crate::ads_abuse::turn();
     let (reader, writer) = std::io::pipe().expect("pipe");
     let child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -89,7 +90,7 @@ fn with_stderr_a_full_pipe_nobody_reads_clients_are_served_and_sigterm_stops_ser
     let mut reader = BufReader::new(reader);
     let mut first = String::new();
     reader.read_line(&mut first).expect("first line");
-    let mut srv = Serve::from_child(child, &first, Arc::new(Mutex::new(String::new())));
+    let mut srv = Serve::from_child(turn, child, &first, Arc::new(Mutex::new(String::new())));
     // Fill the pipe from here (the write end is shared with serve), then nobody reads it: a
     // supervisor that stopped reading. The filler blocks once the pipe is full.
     let filled = Arc::new(Mutex::new(0usize));
