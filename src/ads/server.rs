@@ -161,7 +161,7 @@ struct Shared {
     refused_log: RateLimitedLog,
     router_log: RateLimitedLog,
     evicted_log: RateLimitedLog,
-    /// The lines each connection may write (why it ended, unrouted NetIds), all together at
+    /// The line each connection may write when it ends (why), all together at
     /// most [`CONN_LINES_PER_S`] a second: a thousand connections ending at once cost a
     /// few lines and a count, not a thousand lines.
     conn_log: RateLimitedLog,

@@ -112,6 +112,10 @@ impl Serve {
         self.stderr.lock().unwrap().clone()
     }
 
+    pub(crate) fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
     pub(crate) fn device(&self) -> AmsAddr {
         AmsAddr {
             net_id: self.net_id,
