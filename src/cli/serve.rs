@@ -54,6 +54,10 @@ pub struct ServeArgs {
     pub report: Option<PathBuf>,
 }
 
+/// How long the stop waits for its last stderr lines to be written: a reader that does not
+/// read loses them rather than the exit.
+const FINAL_LINES_WAIT: Duration = Duration::from_millis(100);
+
 fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
     let p = crate::params::shipped::locate(p).map_err(|e| e.to_string())?;
     load_external(&p)
@@ -190,12 +194,15 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
     let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
-    let server =
-        match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
-            Ok(s) => s,
-            Err(e) => return usage(format!("cannot listen: {e}")),
-        };
-    say(format_args!(
+    let reply_timeout = Duration::from_millis(u64::from(config.runtime.ads.reply_timeout_ms));
+    let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
+    let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
+        Ok(s) => s,
+        Err(e) => return usage(format!("cannot listen: {e}")),
+    };
+    // From here on stderr is written through the logger's queue: a supervisor that stops
+    // reading it (a full pipe) must hold up neither the server nor the stop.
+    super::logger::line(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),
@@ -203,7 +210,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     ));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
-        Err(e) => say(format_args!(
+        Err(e) => super::logger::line(format_args!(
             "ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"
         )),
     }
@@ -220,19 +227,23 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    say(format_args!(
+    super::logger::line(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     ));
     match log {
-        Ok(lines) if args.events.is_some() => say(format_args!("event log: {lines} lines")),
+        Ok(lines) if args.events.is_some() => {
+            super::logger::line(format_args!("event log: {lines} lines"))
+        }
         Ok(_) => {}
         Err(e) => {
-            say(format_args!("ncchannel serve: event log: {e}"));
+            super::logger::line(format_args!("ncchannel serve: event log: {e}"));
+            super::logger::flush(FINAL_LINES_WAIT);
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }
+    super::logger::flush(FINAL_LINES_WAIT);
     ExitCode::from(exit::OK)
 }

@@ -15,3 +15,4 @@ mod ads_server;
 mod ads_stream;
 mod ads_symbols;
 mod ads_twinsharp;
+mod ads_unholdable;

@@ -511,7 +511,7 @@ fn runtime_toml_absent_gives_defaults_and_unknown_key_is_an_error() {
     assert_eq!(r.planner.lookahead_blocks, 32);
     assert_eq!((r.fs_latency_us, r.fs_latency_us_per_kib), (0, 0));
     assert_eq!(r.ads.bind.0.to_string(), "127.0.0.1:48898");
-    assert_eq!(r.ads.net_id.to_string(), "127.0.0.1.1.1");
+    assert_eq!(r.ads.net_id.to_string(), "127.0.0.2.1.1");
     assert_eq!(r.ads.max_frame_bytes, 65536);
     assert!(r.ads.allowed_clients.is_empty());
 

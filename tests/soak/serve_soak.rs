@@ -116,8 +116,9 @@ fn ncchannel_stream_as_external_client_under_resets_every_invariant_holds() {
     let file = nc_file(dir.path(), 3_000);
     let report = dir.path().join("report.json");
     let (child, addr, _err) = serve_soak(&sc, 12, &report);
+    // serve_soak gives the server the NetId 127.0.0.1.1.1; `stream` targets it by name.
     let client = Command::new(bin())
-        .args(["stream", "--target", &addr])
+        .args(["stream", "--net-id", "127.0.0.1.1.1", "--target", &addr])
         .arg(&file)
         .output()
         .unwrap();
