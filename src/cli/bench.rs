@@ -15,8 +15,25 @@ use crate::runtime::{bare_loop, Clock, Runtime};
 use crate::soak::load::streaming_channels;
 use crate::vocab::stats::Histogram;
 
+use super::bench_ads::{AdsBench, LineKind};
+
+/// What the bench measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchLoad {
+    /// The cycle's work and lateness against a bare spin_sleep loop, channels streaming
+    /// in-process (default start-up list params/soak/startup4.lis).
+    Cycle,
+    /// The stream interface's throughput over a real ADS/TCP connection: one sequential
+    /// client streaming 17-byte lines into channel 1 (default start-up list params/startup.lis,
+    /// the shipped settings).
+    AdsStream,
+}
+
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
+    /// What to measure.
+    #[arg(long, value_enum, default_value_t = BenchLoad::Cycle)]
+    pub load: BenchLoad,
     /// Cycle time in microseconds.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(10..=1_000_000))]
     pub period_us: u64,
@@ -29,9 +46,16 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=12))]
     pub channels: u32,
     /// Start-up list the channels are built from (its channels are reused in turn when it
-    /// has fewer than --channels); outside a clone, the shipped one built into the binary.
-    #[arg(long, default_value = "params/soak/startup4.lis")]
-    pub params: PathBuf,
+    /// has fewer than --channels); default by --load (outside a clone, the shipped lists built
+    /// into the binary).
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// --load ads-stream: what the streamed 17-byte lines do.
+    #[arg(long, value_enum, default_value_t = LineKind::Params)]
+    pub lines: LineKind,
+    /// --load ads-stream: pause before a write answered busy (0x708) is sent again, µs.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    pub retry_us: u64,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -59,11 +83,26 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         return usage("--seconds must be in (0, 3600]".into());
     }
-    let params = match crate::params::shipped::locate(&args.params) {
-        Ok(p) => p,
-        Err(e) => return usage(e.to_string()),
+    let located = |default: &str| {
+        let given = args.params.clone().unwrap_or_else(|| PathBuf::from(default));
+        crate::params::shipped::locate(&given).map_err(|e| e.to_string())
     };
-    let params = &params;
+    if args.load == BenchLoad::AdsStream {
+        let params = match located("params/startup.lis") {
+            Ok(p) => p,
+            Err(e) => return usage(e),
+        };
+        return super::bench_ads::execute(&AdsBench {
+            params: &params,
+            seconds: args.seconds,
+            lines: args.lines,
+            retry: Duration::from_micros(args.retry_us),
+        });
+    }
+    let params = &match located("params/soak/startup4.lis") {
+        Ok(p) => p,
+        Err(e) => return usage(e),
+    };
     let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub(crate) mod bench;
+pub(crate) mod bench_ads;
 pub mod check;
 pub(crate) mod init;
 mod logger;

@@ -143,8 +143,11 @@ impl SoakReport {
             )?;
             writeln!(
                 w,
-                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} lines accepted, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
-                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.lines_accepted, c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
+                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} lines accepted{}, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
+                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.lines_accepted,
+                // Counted for external clients (`serve --soak`) only.
+                if c.lines_dropped > 0 { format!(" ({} dropped unexecuted by resets)", c.lines_dropped) } else { String::new() },
+                c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
             )?;
         }
         let kib = |v: Option<u64>| v.map_or("n/a".to_string(), |k| format!("{k} KiB"));
