@@ -84,7 +84,10 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         return usage("--seconds must be in (0, 3600]".into());
     }
     let located = |default: &str| {
-        let given = args.params.clone().unwrap_or_else(|| PathBuf::from(default));
+        let given = args
+            .params
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(default));
         crate::params::shipped::locate(&given).map_err(|e| e.to_string())
     };
     if args.load == BenchLoad::AdsStream {

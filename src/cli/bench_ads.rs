@@ -123,11 +123,12 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
         net_id: Some(net_id),
         ..ServerConfig::default()
     };
-    let server =
-        match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
-            Ok(s) => s,
-            Err(e) => return usage(format!("cannot listen: {e}")),
-        };
+    let backend =
+        ChannelBackend::new(requests, nch).with_reply_timeout(config.runtime.ads.reply_timeout());
+    let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
+        Ok(s) => s,
+        Err(e) => return usage(format!("cannot listen: {e}")),
+    };
     let addr = server.local_addr();
     let stop = rt.stop_handle();
     let ticking = std::thread::spawn(move || {

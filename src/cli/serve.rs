@@ -188,14 +188,15 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             report: args.report.clone(),
             period,
             channels: nch,
+            reply_timeout: config.runtime.ads.reply_timeout(),
         };
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
     let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
-    let reply_timeout = Duration::from_millis(u64::from(config.runtime.ads.reply_timeout_ms));
-    let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
+    let backend =
+        ChannelBackend::new(requests, nch).with_reply_timeout(config.runtime.ads.reply_timeout());
     let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
         Ok(s) => s,
         Err(e) => return usage(format!("cannot listen: {e}")),

@@ -26,6 +26,9 @@ pub struct SoakServe {
     pub report: Option<PathBuf>,
     pub period: Duration,
     pub channels: u16,
+    /// runtime.toml `ads.reply_timeout_ms`: when a request the runtime has not answered is
+    /// refused 0x708.
+    pub reply_timeout: Duration,
 }
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
@@ -35,16 +38,17 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         report: report_path,
         period,
         channels: nch,
+        reply_timeout,
     } = soak;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let server =
-        match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
-            Ok(s) => s,
-            Err(e) => {
-                say(format_args!("ncchannel serve: cannot listen: {e}"));
-                return ExitCode::from(exit::USAGE);
-            }
-        };
+    let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
+    let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
+        Ok(s) => s,
+        Err(e) => {
+            say(format_args!("ncchannel serve: cannot listen: {e}"));
+            return ExitCode::from(exit::USAGE);
+        }
+    };
     say(format_args!(
         "listening on {} (soak {}, {nch} channel(s), cycle {} µs)",
         server.local_addr(),

@@ -206,6 +206,13 @@ pub struct AdsConfig {
     pub reply_timeout_ms: u32,
 }
 
+impl AdsConfig {
+    /// `reply_timeout_ms` as the time a request waits for the runtime.
+    pub fn reply_timeout(&self) -> std::time::Duration {
+        std::time::Duration::from_millis(u64::from(self.reply_timeout_ms))
+    }
+}
+
 impl Default for AdsConfig {
     /// The ADS server's own defaults (`vocab::ams`, which `ads::server` uses too), so each
     /// limit has one number.
