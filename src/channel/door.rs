@@ -50,6 +50,9 @@ pub enum Op {
     DrainExecuted,
     /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
     Trace(TraceOp),
+    /// The text of this file program while the decoder runs it ([`Reply::ProgramText`]): the
+    /// live view's listing. A shared handle to the decoder's copy, so the tick copies nothing.
+    ProgramText(Arc<str>),
 }
 
 /// What `run` asks of the motion trace.
@@ -148,6 +151,8 @@ pub struct Status {
     pub(crate) pcs_positions: Vec<(char, f64)>,
     /// The latest operator message of `#MSG` (empty after a reset).
     pub message: Option<String>,
+    /// Path length left in the executing move, mm (the DRO's distance to go).
+    pub distance_to_go_mm: f64,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -173,6 +178,8 @@ pub enum Reply {
     Executed(Vec<ExecutedBlock>),
     /// A trace file could not be written: the reason.
     Trace(Result<(), String>),
+    /// The program text [`Op::ProgramText`] asked for; `None` when no frame runs it.
+    ProgramText(Option<Arc<[u8]>>),
 }
 
 /// An error as the ADS objects carry it: number and text.
@@ -218,5 +225,6 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
         message: c.message().map(str::to_string),
+        distance_to_go_mm: c.motion().distance_to_go_mm(),
     }
 }

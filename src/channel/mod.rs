@@ -292,6 +292,7 @@ impl Channel {
                     .map_err(|e| format!("{}: {e}", path.display())),
                 TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
             }),
+            Op::ProgramText(prog) => Reply::ProgramText(self.decoder.program_text(&prog)),
         }
     }
 
