@@ -296,3 +296,43 @@ impl Drop for Feed {
         self.stop();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(i: usize) -> Event {
+        Arc::from(format!("event: status\ndata: {i}\n\n"))
+    }
+
+    #[test]
+    fn a_page_that_stops_reading_is_dropped_not_buffered() {
+        let pages = Pages::default();
+        let slow = pages.subscribe();
+        let quick = pages.subscribe();
+        for i in 0..=PAGE_QUEUE_UPDATES {
+            pages.broadcast(&ev(i));
+            // The quick page keeps up.
+            assert_eq!(quick.try_recv().ok(), Some(ev(i)));
+        }
+        assert_eq!(pages.connected(), 1);
+        assert_eq!(pages.dropped.load(Ordering::Relaxed), 1);
+        // The slow page gets what was queued, then its stream ends.
+        assert_eq!(slow.try_iter().count(), PAGE_QUEUE_UPDATES);
+        assert!(slow.recv().is_err());
+    }
+
+    #[test]
+    fn a_new_page_hears_the_listing_and_the_recent_errors_only() {
+        let pages = Pages::default();
+        pages.set_listing(0, ev(1000));
+        for i in 0..KEPT_ERRORS + 5 {
+            pages.push_error(0, ev(i));
+        }
+        let page = pages.subscribe();
+        let got: Vec<Event> = page.try_iter().collect();
+        assert_eq!(got.len(), 1 + KEPT_ERRORS);
+        assert_eq!(got[0], ev(1000));
+        assert_eq!(got[1], ev(5));
+    }
+}
