@@ -257,9 +257,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let summary = rt.run(None);
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
-    if let Some(w) = web {
-        w.shutdown();
-    }
+    drop(web); // the web view stops polling and ends its pages' streams
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
