@@ -2,10 +2,10 @@
 //! each update, as a ready Server-Sent Event, to every connected page's bounded queue.
 //!
 //! A poll is one `Status` request per channel, served by the runtime between ticks like any
-//! ADS read; the program text for the listing is asked for only when the executing program
-//! changes, and error records only when the channel's error count grows. A page whose queue
-//! is full is dropped (its stream ends, the browser reconnects), so a slow page costs neither
-//! the runtime nor the other pages anything.
+//! ADS read, and made only while a page is connected; the program text for the listing is
+//! asked for only when the executing program changes, and error records only when the
+//! channel's error count grows. A page whose queue is full is dropped (its stream ends, the
+//! browser reconnects), so a slow page costs neither the runtime nor the other pages anything.
 
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -265,7 +265,10 @@ impl Feed {
                 // Absolute deadlines: the rate stays FEED_PERIOD however long a poll takes.
                 let mut next = Instant::now();
                 while !thread_stop.load(Ordering::Acquire) {
-                    poller.poll();
+                    // No page, no polls: an idle view costs the runtime nothing.
+                    if poller.pages.connected() > 0 {
+                        poller.poll();
+                    }
                     next += FEED_PERIOD;
                     let now = Instant::now();
                     match next.checked_duration_since(now) {
