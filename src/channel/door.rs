@@ -50,6 +50,9 @@ pub enum Op {
     DrainExecuted,
     /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
     Trace(TraceOp),
+    /// The text of this file program while the decoder runs it ([`Reply::ProgramText`]): the
+    /// live view's listing. A shared handle to the decoder's copy, so the tick copies nothing.
+    ProgramText(Arc<str>),
 }
 
 /// What `run` asks of the motion trace.
@@ -159,6 +162,8 @@ pub struct Status {
     /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
     /// set it (`V.G.NP[1..6].V`).
     pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
+    /// Path length left in the executing move, mm (the DRO's distance to go).
+    pub distance_to_go_mm: f64,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -184,6 +189,8 @@ pub enum Reply {
     Executed(Vec<ExecutedBlock>),
     /// A trace file could not be written: the reason.
     Trace(Result<(), String>),
+    /// The program text [`Op::ProgramText`] asked for; `None` when no frame runs it.
+    ProgramText(Option<Arc<[u8]>>),
 }
 
 /// An error as the ADS objects carry it: number and text.
@@ -232,5 +239,6 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         queued_blocks: c.queued_blocks(),
         programs_ended: c.stats().programs_ended,
         zero_offsets: *c.zero_offsets(),
+        distance_to_go_mm: c.motion().distance_to_go_mm(),
     }
 }

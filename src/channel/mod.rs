@@ -224,6 +224,9 @@ pub struct Channel {
     single_flushes: usize,
     /// G54…G59 offsets (mm), for positions in the programming coordinate system.
     zero_offsets: ZeroOffsets,
+    /// The last started main program's name and text (a shared handle to the decoder's copy),
+    /// so the live view lists it after the decoder has read past its end.
+    main_text: Option<(Arc<str>, Arc<[u8]>)>,
 }
 
 impl Channel {
@@ -312,6 +315,7 @@ impl Channel {
                     .map_err(|e| format!("{}: {e}", path.display())),
                 TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
             }),
+            Op::ProgramText(prog) => Reply::ProgramText(self.program_text(&prog)),
         }
     }
 
@@ -357,6 +361,7 @@ impl Channel {
             single_credit: false,
             single_flushes: 0,
             zero_offsets,
+            main_text: None,
         }
     }
 
@@ -689,6 +694,10 @@ impl Channel {
             });
         }
         self.running_prog = Some(name.into());
+        self.main_text = self
+            .decoder
+            .program_text(name)
+            .map(|t| (Arc::from(name), t));
         self.set_state(tick, State::Active);
         self.drain_decoder_notes(tick);
         Ok(())
@@ -756,6 +765,13 @@ impl Channel {
     /// The block that took effect last since the program start.
     pub(crate) fn active_block(&self) -> Option<&ActiveBlock> {
         self.active.as_ref()
+    }
+    /// The text of file program `prog`: an open decoder frame's, or the last main program's.
+    fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+        self.decoder.program_text(prog).or_else(|| {
+            let (name, text) = self.main_text.as_ref()?;
+            (**name == *prog).then(|| Arc::clone(text))
+        })
     }
     /// The main program running (ACTIVE or HOLD), if any.
     pub(crate) fn running_program(&self) -> Option<&str> {

@@ -49,6 +49,14 @@ pub struct ServeArgs {
     /// middle of a frame or holding no notification handles (default 60; docs/ads-limits.md).
     #[arg(long, value_name = "SECONDS")]
     pub(crate) ads_idle_timeout: Option<f64>,
+    /// Serve the live web view on this address (default 127.0.0.1:8080; loopback unless
+    /// --allow-non-loopback). Port 0 picks one.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080", conflicts_with = "soak")]
+    pub http: Option<SocketAddr>,
+    /// Let the web view's operator controls (start, hold, resume, reset, override) command the
+    /// channels; without it they are refused (HTTP 403).
+    #[arg(long, requires = "http")]
+    pub http_controls: bool,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
@@ -139,6 +147,40 @@ fn start(machine: &mut Machine, period: Duration, program: &str) {
     }
 }
 
+/// `--http`: the live web view over its own backend into the same runtime as ADS.
+fn spawn_web(
+    args: &ServeArgs,
+    rt: &mut Runtime<Machine>,
+    requests: crossbeam_channel::Sender<crate::machine::Request>,
+    channels: u16,
+) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
+    let Some(bind) = args.http else {
+        return Ok(None);
+    };
+    let controls = if args.http_controls {
+        crate::http::ControlAccess::Allowed
+    } else {
+        crate::http::ControlAccess::Refused
+    };
+    let config = crate::http::HttpConfig {
+        bind,
+        allow_non_loopback: args.allow_non_loopback,
+        controls,
+    };
+    let backend = Arc::new(ChannelBackend::new(requests, channels));
+    match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
+        Ok(h) => {
+            say(format_args!(
+                "web view on http://{}/ (controls {})",
+                h.local_addr(),
+                if args.http_controls { "on" } else { "off" }
+            ));
+            Ok(Some(h))
+        }
+        Err(e) => Err(usage(format!("--http {bind}: {e}"))),
+    }
+}
+
 pub fn execute(mut args: ServeArgs) -> ExitCode {
     let limit = match run_limit(args.seconds) {
         Ok(l) => l,
@@ -193,6 +235,10 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
+    let web = match spawn_web(&args, &mut rt, requests.clone(), nch) {
+        Ok(w) => w,
+        Err(code) => return code,
+    };
     let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
     let backend =
@@ -225,6 +271,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let summary = rt.run(None);
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
+    drop(web); // the web view stops polling and ends its pages' streams
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
