@@ -272,6 +272,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
     drop(web); // the web view stops polling and ends its pages' streams
+    stopped(rt, &summary, args.events.is_some())
+}
+
+/// After the stop: the summary line and the event log written out (exit 1 when it fails).
+fn stopped(rt: Runtime<Machine>, summary: &crate::runtime::RunSummary, events: bool) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
@@ -282,9 +287,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         stats.describe()
     ));
     match log {
-        Ok(lines) if args.events.is_some() => {
-            super::logger::line(format_args!("event log: {lines} lines"))
-        }
+        Ok(lines) if events => super::logger::line(format_args!("event log: {lines} lines")),
         Ok(_) => {}
         Err(e) => {
             super::logger::line(format_args!("ncchannel serve: event log: {e}"));
