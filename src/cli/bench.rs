@@ -35,7 +35,8 @@ pub struct BenchArgs {
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write a lateness histogram (runtime and bare loop) as SVG here.
+    /// Write a lateness histogram (runtime and bare loop) here: SVG for FILE.svg, PNG for
+    /// FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }
@@ -56,6 +57,14 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::USAGE)
     };
+    if let Some(p) = &args.plot {
+        if crate::destination::is_stdout(p) {
+            return usage("--plot -: the figures go to standard output; name a file".into());
+        }
+        if let Err(e) = crate::report::picture::Format::of(p) {
+            return usage(format!("--plot {e}"));
+        }
+    }
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         return usage("--seconds must be in (0, 3600]".into());
     }
@@ -124,9 +133,13 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         ));
     }
     if let Some(p) = &args.plot {
-        let svg = crate::report::plot::lateness_svg(&stats.lateness, &bare, period);
-        if let Err(e) = std::fs::write(p, svg) {
-            return usage(format!("--plot {}: {e}", p.display()));
+        let picture = crate::report::lateness::Lateness {
+            runtime: &stats.lateness,
+            bare: &bare,
+            period,
+        };
+        if let Err(e) = crate::report::picture::write(p, &picture) {
+            return usage(format!("--plot {e}"));
         }
         out.line(format_args!("histogram written to {}", p.display()));
     }

@@ -116,9 +116,8 @@ mod tests {
 /// ticks — channel time, each configured axis' position, path velocity, acceleration and jerk.
 /// Nothing is kept in memory beyond the writer's buffer; the first write error stops the
 /// trace and is reported by [`CsvTrace::finish`].
-#[derive(Debug)]
 pub(crate) struct CsvTrace {
-    out: std::io::BufWriter<std::fs::File>,
+    out: std::io::BufWriter<Box<dyn std::io::Write + Send>>,
     /// Axis indices written, in order.
     axes: Vec<usize>,
     every: u64,
@@ -126,11 +125,21 @@ pub(crate) struct CsvTrace {
     error: Option<std::io::Error>,
 }
 
+impl std::fmt::Debug for CsvTrace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CsvTrace")
+            .field("axes", &self.axes)
+            .field("every", &self.every)
+            .field("ticks", &self.ticks)
+            .finish_non_exhaustive()
+    }
+}
+
 impl CsvTrace {
-    /// Create `path` and write the header.
+    /// Create `path` (`-`: standard output) and write the header.
     pub fn create(path: &std::path::Path, axes: &[usize], every: u64) -> std::io::Result<Self> {
         use std::io::Write;
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut out = std::io::BufWriter::new(crate::destination::create(path)?);
         let mut header = String::from("time_s");
         for &i in axes {
             let unit = if i < 3 { "mm" } else { "deg" };
