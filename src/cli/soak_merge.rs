@@ -2,7 +2,7 @@
 //! --report FILE`, from however many machines) joined into one verdict, with the exit code of
 //! a soak of the whole campaign.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use crate::soak::campaign::{merge, CampaignReport};
@@ -29,7 +29,7 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
 }
 
 /// Read one shard's campaign report.
-fn read(path: &PathBuf) -> Result<CampaignReport, String> {
+fn read(path: &Path) -> Result<CampaignReport, String> {
     let bytes = crate::bounded::read_file(path, MAX_REPORT_BYTES)
         .map_err(|e| format!("{}: {e}", path.display()))?;
     serde_json::from_slice(&bytes).map_err(|e| {

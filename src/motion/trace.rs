@@ -89,29 +89,6 @@ impl Trace {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn decimation_keeps_the_bound_and_the_time_order() {
-        let mut t = Trace::new(100);
-        for k in 0..10_000 {
-            t.record(Sample {
-                time_s: k as f64,
-                pos: [0.0; 6],
-                velocity_mm_per_s: 0.0,
-                accel_mm_per_s2: 0.0,
-                jerk_mm_per_s3: 0.0,
-            });
-        }
-        assert!(t.samples().len() <= 100);
-        assert!(t.samples().len() >= 50);
-        assert!(t.samples().windows(2).all(|w| w[0].time_s < w[1].time_s));
-        assert_eq!(t.samples()[0].time_s, 0.0);
-    }
-}
-
 /// `run --trace FILE.csv`: the interpolated motion streamed to a file, one row every `every`
 /// ticks — channel time, each configured axis' position, path velocity, acceleration and jerk.
 /// Nothing is kept in memory beyond the writer's buffer; the first write error stops the
@@ -187,5 +164,28 @@ impl CsvTrace {
             return Err(e);
         }
         self.out.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_keeps_the_bound_and_the_time_order() {
+        let mut t = Trace::new(100);
+        for k in 0..10_000 {
+            t.record(Sample {
+                time_s: k as f64,
+                pos: [0.0; 6],
+                velocity_mm_per_s: 0.0,
+                accel_mm_per_s2: 0.0,
+                jerk_mm_per_s3: 0.0,
+            });
+        }
+        assert!(t.samples().len() <= 100);
+        assert!(t.samples().len() >= 50);
+        assert!(t.samples().windows(2).all(|w| w[0].time_s < w[1].time_s));
+        assert_eq!(t.samples()[0].time_s, 0.0);
     }
 }
