@@ -30,7 +30,9 @@ fn read(p: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
-/// What identifies a finished run: its place, scenario, seed, length and per-channel checksums.
+/// What identifies a finished run: its place, scenario, seed, length, per-channel checksums and
+/// verdicts. Not "memory steady": the resident set is the process's, and a process that ran
+/// other runs before (the unsharded campaign) starts this one warmer than a shard that did not.
 fn runs(report: &Value) -> Vec<String> {
     report["runs"]
         .as_array()
@@ -44,9 +46,16 @@ fn runs(report: &Value) -> Vec<String> {
                 .iter()
                 .map(|c| c["checksum"].as_str().unwrap())
                 .collect();
+            let verdicts: Vec<String> = s["invariants"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|v| v["name"] != "memory steady")
+                .map(|v| format!("{} {}", v["name"], v["held"]))
+                .collect();
             format!(
-                "{} {} seed {} {} blocks {} ticks {:?} held {}",
-                r["index"], s["scenario"], s["seed"], s["blocks"], s["ticks"], sums, s["all_held"]
+                "{} {} seed {} {} blocks {} ticks {:?} {:?}",
+                r["index"], s["scenario"], s["seed"], s["blocks"], s["ticks"], sums, verdicts
             )
         })
         .collect()
