@@ -44,6 +44,7 @@ pub(crate) mod bounded;
 pub mod channel;
 pub mod cli;
 pub(crate) mod decoder;
+pub(crate) mod destination;
 pub(crate) mod diag;
 pub mod dnc;
 pub(crate) mod feeder;

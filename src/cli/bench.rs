@@ -59,7 +59,8 @@ pub struct BenchArgs {
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write a lateness histogram (runtime and bare loop) as SVG here.
+    /// Write a lateness histogram (runtime and bare loop) here: SVG for FILE.svg, PNG for
+    /// FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }
@@ -75,23 +76,39 @@ fn print_hist(out: &mut Stdout, name: &str, h: &Histogram) {
     ));
 }
 
+/// The options checked before anything runs: `--plot`'s format and `--seconds`.
+fn check_args(args: &BenchArgs) -> Result<(), String> {
+    if let Some(p) = &args.plot {
+        if crate::destination::is_stdout(p) {
+            return Err("--plot -: the figures go to standard output; name a file".into());
+        }
+        crate::report::picture::Format::of(p).map_err(|e| format!("--plot {e}"))?;
+    }
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
+        return Err("--seconds must be in (0, 3600]".into());
+    }
+    Ok(())
+}
+
+/// The start-up list: --params, else `default` (from the current folder or the shipped set).
+fn start_list(args: &BenchArgs, default: &str) -> Result<PathBuf, String> {
+    let given = args
+        .params
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(default));
+    crate::params::shipped::locate(&given).map_err(|e| e.to_string())
+}
+
 pub fn execute(args: BenchArgs) -> ExitCode {
     let usage = |msg: String| {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::USAGE)
     };
-    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
-        return usage("--seconds must be in (0, 3600]".into());
+    if let Err(msg) = check_args(&args) {
+        return usage(msg);
     }
-    let located = |default: &str| {
-        let given = args
-            .params
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(default));
-        crate::params::shipped::locate(&given).map_err(|e| e.to_string())
-    };
     if args.load == BenchLoad::AdsStream {
-        let params = match located("params/startup.lis") {
+        let params = match start_list(&args, "params/startup.lis") {
             Ok(p) => p,
             Err(e) => return usage(e),
         };
@@ -102,7 +119,7 @@ pub fn execute(args: BenchArgs) -> ExitCode {
             retry: Duration::from_micros(args.retry_us),
         });
     }
-    let params = &match located("params/soak/startup4.lis") {
+    let params = &match start_list(&args, "params/soak/startup4.lis") {
         Ok(p) => p,
         Err(e) => return usage(e),
     };
@@ -170,9 +187,13 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         ));
     }
     if let Some(p) = &args.plot {
-        let svg = crate::report::plot::lateness_svg(&stats.lateness, &bare, period);
-        if let Err(e) = std::fs::write(p, svg) {
-            return usage(format!("--plot {}: {e}", p.display()));
+        let picture = crate::report::lateness::Lateness {
+            runtime: &stats.lateness,
+            bare: &bare,
+            period,
+        };
+        if let Err(e) = crate::report::picture::write(p, &picture) {
+            return usage(format!("--plot {e}"));
         }
         out.line(format_args!("histogram written to {}", p.display()));
     }

@@ -108,7 +108,7 @@ impl FaultPlan {
 }
 
 /// Counters of one soaked channel, as the report shows them.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct SoakCounters {
     pub number: u32,
     /// The program restarted after each reset (empty: none).

@@ -41,7 +41,7 @@ pub struct ResetNotice {
 }
 
 /// Scenario tables that describe the built-in client; an external client has none of them.
-const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
+pub(crate) const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
 
 /// Load a scenario for external clients: the soak's format, its client keys refused by name.
 pub(crate) fn load_external(path: &Path) -> Result<Scenario, String> {
