@@ -131,6 +131,7 @@ impl Machine {
     /// Hand the remaining events to the log and wait for it to write them.
     pub fn finish_log(&mut self) -> std::io::Result<u64> {
         for c in &mut self.channels {
+            c.close_event_stretches();
             c.events_mut().flush_to(&mut self.log);
         }
         std::mem::replace(&mut self.log, EventLog::disabled()).finish()

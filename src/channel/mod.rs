@@ -37,6 +37,7 @@ pub struct ErrorRecord {
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 
 pub mod door;
+mod refusals;
 
 pub use crate::vocab::mode::{Mode, State};
 use door::{HmiOp, Op, Reply, TraceOp};
@@ -210,6 +211,8 @@ pub struct Channel {
     /// Reused buffer for the decoder's notes of a tick.
     decoder_notes: Vec<Note>,
     events: EventBuffer,
+    /// Refused stream writes in a row, logged as one stretch.
+    refusals: refusals::RefusalStretch,
     /// Record executed stream blocks in `executed` (soak checks); off by default.
     observe: bool,
     /// Executed stream blocks since the last [`Channel::drain_executed`].
@@ -353,6 +356,7 @@ impl Channel {
             notes: Vec::new(),
             decoder_notes: Vec::new(),
             events: EventBuffer::new(events_enabled),
+            refusals: refusals::RefusalStretch::default(),
             observe: false,
             executed: Vec::new(),
             hmi: HmiCommands::default(),
@@ -436,6 +440,25 @@ impl Channel {
     }
     pub fn events_mut(&mut self) -> &mut EventBuffer {
         &mut self.events
+    }
+    /// The log ends: a stretch of refused writes still open is closed with its count.
+    pub(crate) fn close_event_stretches(&mut self) {
+        if let Some(tick) = self.refusals.now() {
+            self.close_refusals(&tick);
+        }
+    }
+    /// The `writes_refused` event of a stretch that is over (none when none was open).
+    fn close_refusals(&mut self, tick: &Tick) {
+        if let Some(c) = self.refusals.close() {
+            self.emit(
+                tick,
+                EventKind::WritesRefused {
+                    count: c.count,
+                    code: c.code,
+                    first_tick: c.first_tick,
+                },
+            );
+        }
     }
     /// Record every executed stream block for [`Channel::drain_executed`]. Whoever turns this
     /// on drains every tick: the record grows by the blocks of one tick only.
@@ -567,6 +590,15 @@ impl Channel {
     fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
         let r = self.stream.write(packet);
         let code = r.as_ref().err().and_then(|e| e.isg_code());
+        if matches!(r, Err(StreamWriteError::Full { .. })) {
+            if !self.refusals.refused(tick, code) {
+                // A retry within a stretch: counted, logged when the stretch closes.
+                self.stats.warnings += 1;
+                return r;
+            }
+        } else {
+            self.close_refusals(tick);
+        }
         self.emit(
             tick,
             EventKind::Write {
@@ -1063,6 +1095,7 @@ impl Channel {
 
     /// One cycle: decode, execute, report.
     pub fn step(&mut self, tick: &Tick) {
+        self.refusals.seen(tick);
         if !matches!(self.state, State::Active | State::Hold) {
             return;
         }

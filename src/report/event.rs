@@ -77,6 +77,14 @@ pub enum EventKind {
         ok: bool,
         code: Option<u32>,
     },
+    /// A stretch of refused stream writes is over (a write got through, or the log ended):
+    /// `count` refusals with `code` since tick `first_tick`. Only the first of them has its
+    /// own `write` and `warning` lines (a writer retrying every 250 µs would flood the log).
+    WritesRefused {
+        count: u64,
+        code: Option<u32>,
+        first_tick: u64,
+    },
     /// The decoder took a segment out of the stream buffer.
     Segment {
         bytes: u64,

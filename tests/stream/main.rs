@@ -8,6 +8,7 @@ mod channel_stream;
 mod decoder_stream;
 mod exactly_once;
 mod feeder;
+mod refusal_stretch;
 mod stream;
 mod stream_rate;
 mod stream_stall;
