@@ -373,7 +373,9 @@ impl Decoder {
                 params,
             } => self.call_cycle(name, *local, params, info, io)?,
             Call::Local { name } => {
-                let frame = self.local_frame(name, "local subroutine call (LL)")?;
+                let Some(frame) = self.local_frame(name, "local subroutine call (LL)")? else {
+                    return Ok(());
+                };
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
                 self.frames.push(frame);
@@ -404,6 +406,11 @@ impl Decoder {
             Opened::File(p) => {
                 let prog: Arc<str> = p.name.clone();
                 Ok(Frame::new(kind, Source::File(p), prog))
+            }
+            // Read by the loader: the frame's first line waits for it.
+            Opened::Loading(p) => {
+                let prog: Arc<str> = p.name.clone();
+                Ok(Frame::new(kind, Source::Loading(p), prog))
             }
             Opened::Stream { name } => {
                 if self.stream_active {

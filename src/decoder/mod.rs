@@ -11,6 +11,7 @@ mod cycles;
 mod expr;
 pub mod flow;
 pub mod frame;
+mod labels;
 pub mod modal;
 mod search;
 pub mod vars;
@@ -39,6 +40,8 @@ use frame::{
 use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
 use vars::{VarSlot, VarStore};
 
+use labels::{LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
+pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
 use search::Search;
 pub use search::SearchTarget;
 
@@ -232,6 +235,13 @@ pub struct DecoderStats {
     pub lines: u64,
     /// Blocks queued (those that take effect).
     pub blocks: u64,
+    /// Label scans run (an index built for `$GOTO`/`LL`, or one label searched).
+    pub label_scans: u64,
+    /// Most lines a label scan read in one tick (at most [`LABEL_SCAN_LINES_PER_TICK`]).
+    pub max_scan_lines_per_tick: usize,
+    /// Most bytes a label scan read in one tick (at most [`LABEL_SCAN_BYTES_PER_TICK`]
+    /// plus one line).
+    pub max_scan_bytes_per_tick: usize,
 }
 
 pub struct Decoder {
@@ -262,6 +272,15 @@ pub struct Decoder {
     ready_at: Duration,
     /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
     declared_this_tick: usize,
+    /// A label scan of the top frame's text under way (module `labels`): the line that
+    /// needs it waits, rewound, and runs again when the scan is done.
+    scan: Option<LabelScan>,
+    /// What a finished targeted scan found, for the line that asked for it.
+    scan_found: Option<(ScanGoal, ScanFound)>,
+    /// What label scans read in this tick.
+    scanned_this_tick: ScanWork,
+    /// The line being run has to wait (for a label scan): it is read again later.
+    wait_line: bool,
     line: String,
     /// A block written over several lines (`\` at the end of a line) being collected, and
     /// where its first line stands.
@@ -299,6 +318,10 @@ impl Decoder {
             starved: false,
             ready_at: Duration::ZERO,
             declared_this_tick: 0,
+            scan: None,
+            scan_found: None,
+            scanned_this_tick: ScanWork::default(),
+            wait_line: false,
             line: String::new(),
             joiner: Joiner::default(),
             join_meta: LineMeta { line: 0, offset: 0 },
@@ -390,6 +413,7 @@ impl Decoder {
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
+        self.forget_scan();
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
         self.stream_active = false;
@@ -404,6 +428,18 @@ impl Decoder {
                 let prog = p.name.clone();
                 self.frames
                     .push(Frame::new(FrameKind::Main, Source::File(p), prog.clone()));
+                self.notes.push(Note::ProgramStart {
+                    prog,
+                    stream: false,
+                });
+            }
+            Opened::Loading(p) => {
+                let prog = p.name.clone();
+                self.frames.push(Frame::new(
+                    FrameKind::Main,
+                    Source::Loading(p),
+                    prog.clone(),
+                ));
                 self.notes.push(Note::ProgramStart {
                     prog,
                     stream: false,
@@ -438,6 +474,14 @@ impl Decoder {
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
+        self.forget_scan();
+    }
+
+    /// No label scan under way or waited for.
+    fn forget_scan(&mut self) {
+        self.scan = None;
+        self.scan_found = None;
+        self.wait_line = false;
     }
 
     fn begin_stream(&mut self) {
@@ -452,9 +496,24 @@ impl Decoder {
     /// and decoding goes on in this tick only while `ready_at` lies inside it. So reads of
     /// 200 µs in 1 ms ticks give five per tick, and a 5 ms read pauses decoding for five ticks.
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
+        self.decode(io);
+        self.stats.max_scan_lines_per_tick = self
+            .stats
+            .max_scan_lines_per_tick
+            .max(self.scanned_this_tick.lines);
+        self.stats.max_scan_bytes_per_tick = self
+            .stats
+            .max_scan_bytes_per_tick
+            .max(self.scanned_this_tick.bytes);
+        io.store.end_tick();
+    }
+
+    /// The decoding loop of [`Decoder::step`].
+    fn decode(&mut self, io: &mut DecoderIo<'_>) {
         let mut budget = self.settings.blocks_per_tick;
         let tick_end = io.now + io.period;
         self.declared_this_tick = 0;
+        self.scanned_this_tick = ScanWork::default();
         while budget > 0 && self.state == DecoderState::Running {
             if self.declared_this_tick >= DECLARED_VALUES_PER_TICK {
                 break;
@@ -464,6 +523,9 @@ impl Decoder {
                 self.ready_at = self.ready_at.max(io.now) + owed;
             }
             if self.ready_at >= tick_end {
+                break;
+            }
+            if self.scan.is_some() && !self.advance_scan() {
                 break;
             }
             if self.wait_idle {
@@ -486,6 +548,18 @@ impl Decoder {
                 self.state = DecoderState::Idle;
                 break;
             };
+            if let Source::Loading(p) = &top.source {
+                match io.store.finish_read(p) {
+                    None => break,
+                    Some(Ok(text)) => top.source = Source::File(text),
+                    Some(Err(e)) => {
+                        self.fail(e.into(), LineMeta { line: 0, offset: 0 });
+                        break;
+                    }
+                }
+                // The read's simulated latency is waited for first (top of the loop).
+                continue;
+            }
             let mut line = std::mem::take(&mut self.line);
             let read = if top.is_stream() {
                 let mut note = None;
@@ -508,6 +582,10 @@ impl Decoder {
                     self.line = line;
                     budget -= 1;
                     self.run_joined(io);
+                }
+                LineRead::TooLong(meta) => {
+                    self.line = line;
+                    self.fail(frame::LineTooLong.error(meta.line), meta);
                 }
                 LineRead::Eof => {
                     self.line = line;
@@ -542,6 +620,7 @@ impl Decoder {
                     if let Err(e) = r {
                         self.fail(e, meta);
                     }
+                    self.rewind_if_waiting(meta);
                 }
             }
         }
@@ -565,6 +644,59 @@ impl Decoder {
         }
         self.joiner = joiner;
         self.joiner.close();
+        self.rewind_if_waiting(meta);
+    }
+
+    /// A line that has to wait (for a label scan) did nothing: it is read again, and its
+    /// block counter given back.
+    fn rewind_if_waiting(&mut self, meta: LineMeta) {
+        if !std::mem::take(&mut self.wait_line) {
+            return;
+        }
+        self.counter -= 1;
+        let at = frame::LinePos {
+            pos: usize::try_from(meta.offset).unwrap_or(usize::MAX),
+            line_no: meta.line.saturating_sub(1),
+        };
+        self.top().seek(at);
+    }
+
+    /// Go on with the label scan under way, within what is left of this tick's scan budget.
+    /// `true` when it is done (its result installed) and decoding may go on.
+    fn advance_scan(&mut self) -> bool {
+        let Some(scan) = self.scan.as_mut() else {
+            return true;
+        };
+        let step = scan.advance(&mut self.scanned_this_tick);
+        let warning = scan.take_warning();
+        let goal = scan.goal().clone();
+        if let Some(w) = warning {
+            self.notes.push(Note::Warning {
+                code: w.code,
+                msg: w.msg,
+            });
+        }
+        match step {
+            Ok(ScanStep::Pending) => false,
+            Ok(ScanStep::Done(found)) => {
+                self.scan = None;
+                match found {
+                    ScanFound::Index(index) => self.top().label_index = Some(Arc::new(index)),
+                    other => self.scan_found = Some((goal, other)),
+                }
+                true
+            }
+            Err(e) => {
+                self.scan = None;
+                let top = self.top();
+                let meta = LineMeta {
+                    line: top.line_no + 1,
+                    offset: top.pos as u64,
+                };
+                self.fail(e, meta);
+                false
+            }
+        }
     }
 
     fn fail(&mut self, e: DecodeError, meta: LineMeta) {

@@ -124,6 +124,13 @@ pub const MSG_UNKNOWN_FORMAT: u32 = 21232;
 pub const DWELL_RANGE_TIME: u32 = 20751;
 /// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
 pub const DWELL_RANGE_G04: u32 = 20752;
+/// A warning: the label index of a program file is full (more than
+/// `decoder::MAX_INDEXED_LABELS` labels of a kind); the program goes on and a jump to a label
+/// that found no room is searched from the top of the file (TF5200 diagnosis ID 20829 "Number
+/// of string labels too big for optimised program execution.", class 1, processing continues).
+/// The kernel's page names string labels; ncchannel raises it for block-number labels (`N10:`)
+/// and `%L` sections beyond the bound too, as no kernel id for those was read.
+pub const LABEL_INDEX_FULL: u32 = 20829;
 /// Label defined twice in one program level (TF5200 diagnosis ID 20836 "Multiple defined
 /// label").
 pub const LABEL_TWICE: u32 = 20836;
@@ -291,6 +298,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (MSG_UNKNOWN_FORMAT, "#MSG unknown format element"),
     (DWELL_RANGE_TIME, "#TIME out of range"),
     (DWELL_RANGE_G04, "G04 time out of range"),
+    (LABEL_INDEX_FULL, "label index full: later labels searched"),
     (LABEL_TWICE, "label defined twice"),
     (LABEL_NOT_FOUND, "label not found"),
     (VARIABLE_MEMORY_FULL, "variable memory full"),
@@ -430,6 +438,10 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (
+        20829,
+        "Number of string labels too big for optimised program execution.",
+    ), // 252695435
     (20836, "Multiple defined label"),   // 252721547
     (
         20967,

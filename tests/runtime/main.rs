@@ -5,6 +5,7 @@
 mod support;
 
 mod closed_stdout;
+mod program_loader;
 mod runtime;
 mod runtime_events;
 mod serve_signals;

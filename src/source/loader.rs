@@ -1,0 +1,107 @@
+//! Program files read off the runtime thread: a loader thread reads a large file while the
+//! channel ticks on, and the decoder picks the text up in a later tick.
+//!
+//! Reading a 200 MB program inside a tick took 214 ms of that tick. Now a tick reads a file
+//! itself only while the tick's inline budget ([`INLINE_READ_BYTES_PER_TICK`]) lasts — small
+//! programs and subroutines, read in the tick as before, keep virtual-time runs exact — and
+//! hands anything larger to the loader. Memory stays bounded by `MAX_PROGRAM_BYTES` per file:
+//! the file is read into one buffer of its size, which becomes the program text without a copy.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use crossbeam_channel::{Receiver, Sender, TryRecvError};
+
+use crate::bounded::BoundedReadError;
+
+/// Bytes of program files one tick reads itself at most; a file that does not fit in what is
+/// left goes to the loader thread.
+pub const INLINE_READ_BYTES_PER_TICK: u64 = 64 * 1024;
+
+/// What the loader answers: the file's bytes, or why it could not read them.
+pub(crate) type ReadResult = Result<Vec<u8>, BoundedReadError>;
+
+/// One file to read.
+struct Job {
+    path: PathBuf,
+    limit: u64,
+    reply: Sender<ReadResult>,
+}
+
+/// A read handed to the loader, not yet picked up.
+#[derive(Debug, Clone)]
+pub struct PendingRead {
+    /// The name as the program called it.
+    pub(crate) name: Arc<str>,
+    pub(crate) path: Arc<Path>,
+    reply: Receiver<ReadResult>,
+}
+
+/// What polling a pending read finds.
+#[derive(Debug)]
+pub(crate) enum Poll {
+    Waiting,
+    Done(ReadResult),
+}
+
+impl PendingRead {
+    /// Whether the loader has finished; never waits.
+    pub(crate) fn poll(&self) -> Poll {
+        match self.reply.try_recv() {
+            Ok(r) => Poll::Done(r),
+            Err(TryRecvError::Empty) => Poll::Waiting,
+            Err(TryRecvError::Disconnected) => Poll::Done(Err(BoundedReadError::Io(
+                std::io::Error::other("the program loader stopped"),
+            ))),
+        }
+    }
+}
+
+/// The process's loader thread, started at its first use; `None` when it could not start.
+fn loader() -> Option<&'static Sender<Job>> {
+    static LOADER: OnceLock<Option<Sender<Job>>> = OnceLock::new();
+    LOADER
+        .get_or_init(|| {
+            let (tx, rx) = crossbeam_channel::unbounded::<Job>();
+            std::thread::Builder::new()
+                .name("ncchannel-loader".into())
+                .spawn(move || {
+                    for job in rx {
+                        let r = crate::bounded::read_file(&job.path, job.limit);
+                        // The decoder may have gone (reset): nobody waits for the text.
+                        let _ = job.reply.send(r);
+                    }
+                })
+                .ok()
+                .map(|_| tx)
+        })
+        .as_ref()
+}
+
+/// Hand the read of `path` (at most `limit` bytes) to the loader thread. Without one (it could
+/// not be started) the file is read here, the one case where a tick reads a large file.
+pub(crate) fn spawn_read(name: &str, path: &Path, limit: u64) -> PendingRead {
+    let (tx, rx) = crossbeam_channel::bounded(1);
+    let job = Job {
+        path: path.to_path_buf(),
+        limit,
+        reply: tx,
+    };
+    if let Some(loader) = loader() {
+        if let Err(e) = loader.send(job) {
+            let job = e.into_inner();
+            let _ = job
+                .reply
+                .send(crate::bounded::read_file(&job.path, job.limit));
+        }
+    } else {
+        let _ = job
+            .reply
+            .send(crate::bounded::read_file(&job.path, job.limit));
+    }
+    PendingRead {
+        name: name.into(),
+        path: path.into(),
+        reply: rx,
+    }
+}
