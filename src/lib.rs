@@ -86,7 +86,7 @@ pub use decoder::modal::DEFAULT_PATH_DEV_MM;
 pub use decoder::vars::{VarClass, CLASS_BYTES};
 pub use decoder::{
     SearchTarget, DECLARED_VALUES_PER_TICK, LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK,
-    MAX_INDEXED_LABELS,
+    LINE_BYTES_PER_TICK, MAX_INDEXED_LABELS,
 };
 pub use source::loader::INLINE_READ_BYTES_PER_TICK;
 

@@ -144,6 +144,15 @@ pub(crate) struct Frame {
 /// than this many labels ago is treated as unknown (a jump to it waits forward for it).
 pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
 
+/// A frame that held the last reference to a large file text lets the loader thread free it.
+impl Drop for Frame {
+    fn drop(&mut self) {
+        if let Source::File(p) = &mut self.source {
+            crate::source::loader::release(std::mem::take(&mut p.text));
+        }
+    }
+}
+
 impl Frame {
     pub(crate) fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
         Frame {
@@ -199,10 +208,10 @@ pub(crate) enum LineRead {
     TooLong(LineMeta),
 }
 
-/// Longest line of a program file, bytes. A block is at most `MAX_BLOCK_CHARS` characters, so
-/// no useful line comes near it; the bound keeps the search for a line end, and the copy of the
-/// line, from growing with a file that has no line ends.
-pub const MAX_LINE_BYTES: usize = 64 * 1024;
+/// Longest line of a program file, bytes. A block is at most `MAX_BLOCK_CHARS` (4000)
+/// characters, so no useful line comes near it; the bound keeps the search for a line end, and
+/// the copy of the line, from growing with a file that has no line ends.
+pub const MAX_LINE_BYTES: usize = 16 * 1024;
 
 /// A line longer than [`MAX_LINE_BYTES`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

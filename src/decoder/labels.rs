@@ -74,12 +74,14 @@ impl LabelIndex {
         true
     }
 
-    fn insert_local_sub(&mut self, name: &str, at: LinePos) {
+    /// Record a `%L` section; `false` when there is no room left.
+    fn insert_local_sub(&mut self, name: &str, at: LinePos) -> bool {
         if self.local_subs.len() >= MAX_INDEXED_LABELS {
             self.overflowed = true;
-            return;
+            return false;
         }
         self.local_subs.insert(name.to_ascii_uppercase(), at);
+        true
     }
 }
 
@@ -102,7 +104,7 @@ pub(crate) enum ScanFound {
     LocalSub(Option<LinePos>),
 }
 
-/// A warning the scan raises (the index is full), reported once per scan.
+/// A warning the scan raises (the index is full), reported once per kind and scan.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ScanWarning {
     pub(crate) code: u32,
@@ -139,8 +141,18 @@ pub(crate) struct LabelScan {
     joiner: Joiner,
     /// Where the block being read (maybe over several lines) starts.
     at: LinePos,
-    /// The warning raised when the index filled up, taken once.
-    warning: Option<ScanWarning>,
+    /// Warnings raised when the index filled up, not yet taken.
+    warnings: Vec<ScanWarning>,
+    /// Kinds already warned about (string labels; block-number labels and sections).
+    warned_string: bool,
+    warned_other: bool,
+}
+
+/// A scan that outlives its frame (a reset during the scan) lets the loader free the text.
+impl Drop for LabelScan {
+    fn drop(&mut self) {
+        crate::source::loader::release(std::mem::take(&mut self.text));
+    }
 }
 
 impl LabelScan {
@@ -156,7 +168,9 @@ impl LabelScan {
             line: String::new(),
             joiner: Joiner::default(),
             at: LinePos { pos: 0, line_no: 0 },
-            warning: None,
+            warnings: Vec::new(),
+            warned_string: false,
+            warned_other: false,
         }
     }
 
@@ -164,9 +178,29 @@ impl LabelScan {
         &self.goal
     }
 
-    /// The index-full warning, once.
-    pub(crate) fn take_warning(&mut self) -> Option<ScanWarning> {
-        self.warning.take()
+    /// The index-full warnings raised since the last call.
+    pub(crate) fn take_warnings(&mut self) -> Vec<ScanWarning> {
+        std::mem::take(&mut self.warnings)
+    }
+
+    /// The first item of a kind that found no room: warn once per kind (string labels have
+    /// the kernel's id, block-number labels and `%L` sections ours).
+    fn no_room(&mut self, string: bool, what: String) {
+        let (warned, code) = if string {
+            (&mut self.warned_string, codes::STRING_LABEL_INDEX_FULL)
+        } else {
+            (&mut self.warned_other, codes::LABEL_INDEX_FULL)
+        };
+        if std::mem::replace(warned, true) {
+            return;
+        }
+        self.warnings.push(ScanWarning {
+            code,
+            msg: format!(
+                "more than {MAX_INDEXED_LABELS} for the label index: {what} (line {}) and later ones are searched at each jump or call",
+                self.line_no
+            ),
+        });
     }
 
     /// Read on while `work` (what label scans read in this tick so far, added to here) is
@@ -241,12 +275,15 @@ impl LabelScan {
                     pos: self.pos,
                     line_no: self.line_no,
                 };
-                match &self.goal {
+                let indexed = match &self.goal {
                     ScanGoal::Index => self.index.insert_local_sub(name, after),
                     ScanGoal::LocalSub(want) if name.eq_ignore_ascii_case(want) => {
                         return Ok(Some(ScanFound::LocalSub(Some(after))));
                     }
-                    _ => {}
+                    _ => true,
+                };
+                if !indexed {
+                    self.no_room(false, format!("%L {name}"));
                 }
             }
             Body::Control(c) => match nesting(c) {
@@ -273,16 +310,9 @@ impl LabelScan {
                         ),
                     ));
                 }
-                let first_overflow = !self.index.overflowed;
-                if !self.index.insert_label(l, at) && first_overflow {
-                    self.warning = Some(ScanWarning {
-                        code: codes::LABEL_INDEX_FULL,
-                        msg: format!(
-                            "more than {MAX_INDEXED_LABELS} labels of a kind: label {} (line {}) and later ones are searched at each jump",
-                            label_text(l),
-                            self.line_no
-                        ),
-                    });
+                if !self.index.insert_label(l, at) {
+                    let string = matches!(l, Label::Name(_));
+                    self.no_room(string, format!("label {}", label_text(l)));
                 }
                 Ok(None)
             }

@@ -82,6 +82,12 @@ pub(crate) fn letter_names() -> [AxisName; MAX_AXES] {
 /// such, whatever the NC text (a line of ten took 15 s in one tick before).
 pub const DECLARED_VALUES_PER_TICK: usize = 100_000;
 
+/// Bytes of NC text the decoder reads per tick at most (files and stream alike; one line may
+/// end beyond it). Real blocks are tens of bytes, so `blocks_per_tick` lines stay far inside
+/// it; lines thousands of bytes long (comments in a `#COMMENT` block) no longer make a tick's
+/// work grow with them (64 lines of 60 KB took 30 ms a tick before).
+pub const LINE_BYTES_PER_TICK: usize = 64 * 1024;
+
 impl Default for DecoderSettings {
     fn default() -> Self {
         DecoderSettings {
@@ -239,6 +245,9 @@ pub struct DecoderStats {
     pub label_scans: u64,
     /// Most lines a label scan read in one tick (at most [`LABEL_SCAN_LINES_PER_TICK`]).
     pub max_scan_lines_per_tick: usize,
+    /// Most bytes of NC text decoded in one tick (at most [`LINE_BYTES_PER_TICK`] plus one
+    /// line).
+    pub max_line_bytes_per_tick: usize,
     /// Most bytes a label scan read in one tick (at most [`LABEL_SCAN_BYTES_PER_TICK`]
     /// plus one line).
     pub max_scan_bytes_per_tick: usize,
@@ -279,7 +288,12 @@ pub struct Decoder {
     scan_found: Option<(ScanGoal, ScanFound)>,
     /// What label scans read in this tick.
     scanned_this_tick: ScanWork,
-    /// The line being run has to wait (for a label scan): it is read again later.
+    /// Bytes of NC text decoded in this tick ([`LINE_BYTES_PER_TICK`]).
+    line_bytes_this_tick: usize,
+    /// A `#CACHE LOAD` waiting for the loader.
+    cache_read: Option<calls::CacheRead>,
+    /// The line being run has to wait (for a label scan, a `#CACHE LOAD` read): it is read
+    /// again later.
     wait_line: bool,
     line: String,
     /// A block written over several lines (`\` at the end of a line) being collected, and
@@ -295,6 +309,16 @@ pub struct Decoder {
 }
 
 type Res<T = ()> = Result<T, DecodeError>;
+
+/// Whether the decoder may read its next line in this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Ready {
+    Go,
+    /// Something has just arrived: check everything again.
+    Again,
+    /// Not in this tick.
+    Stop,
+}
 
 impl Decoder {
     pub fn new(settings: DecoderSettings) -> Self {
@@ -321,6 +345,8 @@ impl Decoder {
             scan: None,
             scan_found: None,
             scanned_this_tick: ScanWork::default(),
+            line_bytes_this_tick: 0,
+            cache_read: None,
             wait_line: false,
             line: String::new(),
             joiner: Joiner::default(),
@@ -481,6 +507,7 @@ impl Decoder {
     fn forget_scan(&mut self) {
         self.scan = None;
         self.scan_found = None;
+        self.cache_read = None;
         self.wait_line = false;
     }
 
@@ -505,7 +532,77 @@ impl Decoder {
             .stats
             .max_scan_bytes_per_tick
             .max(self.scanned_this_tick.bytes);
+        self.stats.max_line_bytes_per_tick = self
+            .stats
+            .max_line_bytes_per_tick
+            .max(self.line_bytes_this_tick);
         io.store.end_tick();
+    }
+
+    /// Everything a line waits for: the tick's byte and `#VAR` budgets, simulated
+    /// file-system latency, a label scan, the loader, `#FLUSH WAIT`, room in the queue, the
+    /// start subroutine, a frame's file.
+    fn ready_to_read(&mut self, io: &mut DecoderIo<'_>, tick_end: Duration) -> Ready {
+        if self.declared_this_tick >= DECLARED_VALUES_PER_TICK
+            || self.line_bytes_this_tick >= LINE_BYTES_PER_TICK
+        {
+            return Ready::Stop;
+        }
+        let owed = io.store.take_owed();
+        if !owed.is_zero() {
+            self.ready_at = self.ready_at.max(io.now) + owed;
+        }
+        if self.ready_at >= tick_end {
+            return Ready::Stop;
+        }
+        if self.scan.is_some() && !self.advance_scan() {
+            return Ready::Stop;
+        }
+        match self.cache_read_arrived(io.store) {
+            Some(false) => return Ready::Stop,
+            // The read's simulated latency is waited for first (top of the loop).
+            Some(true) => return Ready::Again,
+            None => {}
+        }
+        if self.wait_idle {
+            if io.queue.is_empty() && io.motion_idle {
+                self.wait_idle = false;
+            } else {
+                return Ready::Stop;
+            }
+        }
+        if !io.queue.has_room() {
+            return Ready::Stop;
+        }
+        if self.implicit.start_pending {
+            if let Err(e) = self.start_subroutine(io) {
+                self.fail(e, LineMeta { line: 0, offset: 0 });
+                return Ready::Stop;
+            }
+        }
+        self.frame_file_arrived(io.store)
+    }
+
+    /// A top frame whose file the loader reads: `Again` when the text has just arrived (its
+    /// simulated latency is waited for first), `Stop` while it has not or could not be read.
+    fn frame_file_arrived(&mut self, store: &mut ProgramStore) -> Ready {
+        let Some(top) = self.frames.last_mut() else {
+            return Ready::Go;
+        };
+        let Source::Loading(p) = &top.source else {
+            return Ready::Go;
+        };
+        match store.finish_read(p) {
+            None => Ready::Stop,
+            Some(Ok(text)) => {
+                top.source = Source::File(text);
+                Ready::Again
+            }
+            Some(Err(e)) => {
+                self.fail(e.into(), LineMeta { line: 0, offset: 0 });
+                Ready::Stop
+            }
+        }
     }
 
     /// The decoding loop of [`Decoder::step`].
@@ -514,52 +611,17 @@ impl Decoder {
         let tick_end = io.now + io.period;
         self.declared_this_tick = 0;
         self.scanned_this_tick = ScanWork::default();
+        self.line_bytes_this_tick = 0;
         while budget > 0 && self.state == DecoderState::Running {
-            if self.declared_this_tick >= DECLARED_VALUES_PER_TICK {
-                break;
-            }
-            let owed = io.store.take_owed();
-            if !owed.is_zero() {
-                self.ready_at = self.ready_at.max(io.now) + owed;
-            }
-            if self.ready_at >= tick_end {
-                break;
-            }
-            if self.scan.is_some() && !self.advance_scan() {
-                break;
-            }
-            if self.wait_idle {
-                if io.queue.is_empty() && io.motion_idle {
-                    self.wait_idle = false;
-                } else {
-                    break;
-                }
-            }
-            if !io.queue.has_room() {
-                break;
-            }
-            if self.implicit.start_pending {
-                if let Err(e) = self.start_subroutine(io) {
-                    self.fail(e, LineMeta { line: 0, offset: 0 });
-                    break;
-                }
+            match self.ready_to_read(io, tick_end) {
+                Ready::Stop => break,
+                Ready::Again => continue,
+                Ready::Go => {}
             }
             let Some(top) = self.frames.last_mut() else {
                 self.state = DecoderState::Idle;
                 break;
             };
-            if let Source::Loading(p) = &top.source {
-                match io.store.finish_read(p) {
-                    None => break,
-                    Some(Ok(text)) => top.source = Source::File(text),
-                    Some(Err(e)) => {
-                        self.fail(e.into(), LineMeta { line: 0, offset: 0 });
-                        break;
-                    }
-                }
-                // The read's simulated latency is waited for first (top of the loop).
-                continue;
-            }
             let mut line = std::mem::take(&mut self.line);
             let read = if top.is_stream() {
                 let mut note = None;
@@ -571,6 +633,10 @@ impl Decoder {
             } else {
                 read_file_line(top, &mut line)
             };
+            if let LineRead::Line(_) = read {
+                // The line and its end (CR LF at most).
+                self.line_bytes_this_tick += line.len() + 2;
+            }
             match read {
                 LineRead::Pending => {
                     self.starved = true;
@@ -661,6 +727,16 @@ impl Decoder {
         self.top().seek(at);
     }
 
+    /// A `#CACHE LOAD` waiting for the loader: `Some(true)` when its text has just arrived,
+    /// `Some(false)` while it has not, `None` when no load waits.
+    fn cache_read_arrived(&mut self, store: &mut ProgramStore) -> Option<bool> {
+        let r = self.cache_read.as_mut().filter(|r| r.read.is_none())?;
+        let read = store.finish_read(&r.pending);
+        let arrived = read.is_some();
+        r.read = read;
+        Some(arrived)
+    }
+
     /// Go on with the label scan under way, within what is left of this tick's scan budget.
     /// `true` when it is done (its result installed) and decoding may go on.
     fn advance_scan(&mut self) -> bool {
@@ -668,9 +744,9 @@ impl Decoder {
             return true;
         };
         let step = scan.advance(&mut self.scanned_this_tick);
-        let warning = scan.take_warning();
+        let warnings = scan.take_warnings();
         let goal = scan.goal().clone();
-        if let Some(w) = warning {
+        for w in warnings {
             self.notes.push(Note::Warning {
                 code: w.code,
                 msg: w.msg,

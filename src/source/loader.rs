@@ -21,11 +21,17 @@ pub const INLINE_READ_BYTES_PER_TICK: u64 = 64 * 1024;
 /// What the loader answers: the file's bytes, or why it could not read them.
 pub(crate) type ReadResult = Result<Vec<u8>, BoundedReadError>;
 
-/// One file to read.
-struct Job {
-    path: PathBuf,
-    limit: u64,
-    reply: Sender<ReadResult>,
+/// What the loader thread does.
+enum Job {
+    /// Read one file.
+    Read {
+        path: PathBuf,
+        limit: u64,
+        reply: Sender<ReadResult>,
+    },
+    /// Free a large text nobody uses any more: unmapping hundreds of MB costs milliseconds,
+    /// which the tick that ended the program must not pay.
+    Free(Arc<Vec<u8>>),
 }
 
 /// A read handed to the loader, not yet picked up.
@@ -67,9 +73,14 @@ fn loader() -> Option<&'static Sender<Job>> {
                 .name("ncchannel-loader".into())
                 .spawn(move || {
                     for job in rx {
-                        let r = crate::bounded::read_file(&job.path, job.limit);
-                        // The decoder may have gone (reset): nobody waits for the text.
-                        let _ = job.reply.send(r);
+                        match job {
+                            Job::Read { path, limit, reply } => {
+                                let r = crate::bounded::read_file(&path, limit);
+                                // The decoder may have gone (reset): nobody waits for the text.
+                                let _ = reply.send(r);
+                            }
+                            Job::Free(text) => drop(text),
+                        }
                     }
                 })
                 .ok()
@@ -82,26 +93,33 @@ fn loader() -> Option<&'static Sender<Job>> {
 /// not be started) the file is read here, the one case where a tick reads a large file.
 pub(crate) fn spawn_read(name: &str, path: &Path, limit: u64) -> PendingRead {
     let (tx, rx) = crossbeam_channel::bounded(1);
-    let job = Job {
+    let job = Job::Read {
         path: path.to_path_buf(),
         limit,
         reply: tx,
     };
-    if let Some(loader) = loader() {
-        if let Err(e) = loader.send(job) {
-            let job = e.into_inner();
-            let _ = job
-                .reply
-                .send(crate::bounded::read_file(&job.path, job.limit));
-        }
-    } else {
-        let _ = job
-            .reply
-            .send(crate::bounded::read_file(&job.path, job.limit));
+    let unsent = match loader() {
+        Some(loader) => loader.send(job).err().map(|e| e.into_inner()),
+        None => Some(job),
+    };
+    if let Some(Job::Read { path, limit, reply }) = unsent {
+        let _ = reply.send(crate::bounded::read_file(&path, limit));
     }
     PendingRead {
         name: name.into(),
         path: path.into(),
         reply: rx,
+    }
+}
+
+/// Let go of a program text: a large one held nowhere else is freed by the loader thread
+/// (freeing it here could cost the tick milliseconds); anything else is dropped here.
+pub(crate) fn release(text: Arc<Vec<u8>>) {
+    if text.len() as u64 <= INLINE_READ_BYTES_PER_TICK || Arc::strong_count(&text) > 1 {
+        return;
+    }
+    if let Some(loader) = loader() {
+        // A loader that has stopped hands the job back: it is dropped here after all.
+        let _ = loader.send(Job::Free(text));
     }
 }

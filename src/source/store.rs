@@ -225,6 +225,16 @@ impl ProgramStore {
         if self.is_streaming_program(name) {
             return Ok(Opened::Stream { name: name.into() });
         }
+        self.open_file(name, kind)
+    }
+
+    /// Open a program file (never the stream): read here while this tick's inline budget
+    /// lasts, else handed to the loader ([`Opened::Loading`]).
+    pub(crate) fn open_file(
+        &mut self,
+        name: &str,
+        kind: ProgramKind,
+    ) -> Result<Opened, StoreError> {
         let path = self.find(name, kind)?;
         let bytes = std::fs::metadata(&path)
             .map_err(|e| StoreError::Unreadable {
@@ -270,18 +280,6 @@ impl ProgramStore {
     pub(crate) fn end_tick(&mut self) {
         self.stats.max_tick_read_bytes = self.stats.max_tick_read_bytes.max(self.read_this_tick);
         self.read_this_tick = 0;
-    }
-
-    /// Find and read a program file (never the stream), counting the file-system access.
-    pub(crate) fn read_file(
-        &mut self,
-        name: &str,
-        kind: ProgramKind,
-    ) -> Result<ProgramText, StoreError> {
-        let path = self.find(name, kind)?;
-        let text = read_bounded(&path, name)?;
-        self.read_this_tick += text.len() as u64;
-        Ok(self.opened(name, path.into(), text))
     }
 
     /// A file read: counted, its latency charged.

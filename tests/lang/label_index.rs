@@ -109,3 +109,25 @@ fn a_label_defined_twice_is_still_found_by_the_sliced_scan() {
     let r = rig.run("twice.nc", None, 200_000);
     assert_eq!(r.error_codes(), [20836]);
 }
+
+#[test]
+fn more_block_number_labels_than_the_index_holds_warn_with_our_id() {
+    let labels = MAX_INDEXED_LABELS + 10;
+    let mut p = String::from("N1 G01 X0 F6000\n$GOTO N9999999\nN2 X99\n");
+    for i in 10..10 + labels {
+        p.push_str(&format!("N{i}:\n"));
+    }
+    p.push_str("N9999999: X6\nM30\n");
+    let rig = Rig::new();
+    rig.program("numbers.nc", &p);
+    let r = rig.run("numbers.nc", None, 2_000_000);
+    let warnings: Vec<u64> = r
+        .of("warning")
+        .iter()
+        .map(|e| e["code"].as_u64().unwrap())
+        .collect();
+    assert_eq!(warnings, [900113]);
+    assert!(r.error_codes().is_empty(), "{:?}", r.error_codes());
+    assert_eq!(r.position('X'), 6.0);
+    assert_scan_bounded(&r, labels);
+}

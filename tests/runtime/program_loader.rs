@@ -74,3 +74,27 @@ fn a_file_without_line_ends_is_refused_at_its_first_line() {
     let e = &r.of("error")[0];
     assert_eq!(e["line"], 1, "{e}");
 }
+
+#[test]
+fn long_lines_are_decoded_a_bounded_number_of_bytes_per_tick() {
+    let rig = Rig::new();
+    // 200 comment lines of 10,000 bytes: before, 64 of them (640 KB) were decoded per tick.
+    let long = "x".repeat(10_000);
+    let mut p = String::from("N1 G01 X1 F6000\n#COMMENT BEGIN\n");
+    for _ in 0..200 {
+        p.push_str(&long);
+        p.push('\n');
+    }
+    p.push_str("#COMMENT END\nX2\nM30\n");
+    rig.program("long_lines.nc", &p);
+    let r = rig.run("long_lines.nc", None, 100_000);
+    assert!(r.error_codes().is_empty(), "{:?}", r.error_codes());
+    assert_eq!(r.block_texts(), ["N1 G01 X1 F6000", "X2", "M30"]);
+    let stats = r.machine.channels()[0].decoder().stats();
+    assert!(
+        stats.max_line_bytes_per_tick
+            <= ncchannel::LINE_BYTES_PER_TICK + ncchannel::MAX_LINE_BYTES + 2,
+        "{stats:?}"
+    );
+    assert!(stats.max_line_bytes_per_tick >= 10_000, "{stats:?}");
+}
