@@ -26,6 +26,7 @@
 //! - [`soak`]: scenario-driven long runs with a randomised client, injected faults and
 //!   invariants.
 //! - [`dnc`]: NC data received as one stream and split into programs by start/end markers.
+//! - [`http`]: the live web view of `serve --http`: an embedded page fed by Server-Sent Events.
 //! - [`cli`]: the subcommands of the `ncchannel` binary; `main.rs` only parses and dispatches.
 //! - [`vocab`]: the words every room shares: time, modes and states, axes, `#FLUSH`, cache
 //!   operations, ADS ids, cycle statistics.
@@ -43,10 +44,12 @@ pub(crate) mod bounded;
 pub mod channel;
 pub mod cli;
 pub(crate) mod decoder;
+pub(crate) mod destination;
 pub(crate) mod diag;
 pub mod dnc;
 pub(crate) mod feeder;
 pub(crate) mod geometry;
+pub mod http;
 pub mod lang;
 pub mod machine;
 pub(crate) mod motion;

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
-use crate::vocab::stats::{CycleStats, Histogram};
+use crate::vocab::stats::{CycleStats, Histogram, LiveCycleStats};
 pub use crate::vocab::tick::Tick;
 
 /// Requests served per tick at most. A flood of requests (say a client hammering the stream
@@ -109,6 +109,8 @@ pub struct Runtime<C: Cycle> {
     resume_at: Option<Instant>,
     next_index: u64,
     stats: CycleStats,
+    /// Lateness and overruns for readers on other threads, once one asked for them.
+    live: Option<Arc<LiveCycleStats>>,
 }
 
 impl<C: Cycle> Runtime<C> {
@@ -131,8 +133,14 @@ impl<C: Cycle> Runtime<C> {
             resume_at: None,
             next_index: 0,
             stats: CycleStats::default(),
+            live: None,
         };
         (rt, tx)
+    }
+
+    /// Lateness and overruns as they happen, for a reader on another thread (the live view).
+    pub fn live_stats(&mut self) -> Arc<LiveCycleStats> {
+        Arc::clone(self.live.get_or_insert_with(Arc::default))
     }
 
     /// A handle that stops the run from any thread.
@@ -239,11 +247,13 @@ impl<C: Cycle> Runtime<C> {
             let flow = self.cycle.step(&tick);
             let work = started.elapsed();
             self.stats.work.record(work);
+            let overrun = late.is_some_and(|late| late + work > self.period);
             if let Some(late) = late {
                 self.stats.lateness.record(late);
-                if late + work > self.period {
-                    self.stats.overruns += 1;
-                }
+                self.stats.overruns += u64::from(overrun);
+            }
+            if let Some(live) = &self.live {
+                live.publish(late, overrun);
             }
             self.next_index += 1;
             if flow == Flow::Stop {

@@ -2,6 +2,7 @@
 //! runtime's fixed-cycle loop and waits for the answer of the tick that serves it.
 
 use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -11,15 +12,24 @@ use super::backend::{CncBackend, DeviceError};
 use crate::machine::{Machine, Op, Reply, Request};
 use crate::runtime::{Clock, Runtime, StopHandle};
 
-/// How long a connection thread waits for the runtime. A tick answers within one period;
+/// How long a connection thread waits for the runtime by default (runtime.toml
+/// `ads.reply_timeout_ms`; `vocab::ams` says why 500 ms). A tick answers within one period;
 /// far longer means the runtime is stopped or hopelessly late, and the client hears "busy".
-pub(crate) const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+pub(crate) use crate::vocab::ams::DEFAULT_REPLY_TIMEOUT as REPLY_TIMEOUT;
+
+/// While the runtime has left a call unanswered, later calls wait at most this long: a
+/// runtime that is back answers within a few periods, and a connection's requests queued
+/// behind each other (a client that sends several at once) are each answered "busy" within
+/// `reply_timeout` + n × this, not n × `reply_timeout`.
+const STALLED_WAIT: Duration = Duration::from_millis(50);
 
 pub struct ChannelBackend {
     requests: Sender<Request>,
     channels: u16,
     /// How long a call waits before answering "busy, not applied" ([`REPLY_TIMEOUT`]).
     reply_timeout: Duration,
+    /// A call timed out and no reply has come since: the runtime is stalled (or stopped).
+    stalled: AtomicBool,
 }
 
 impl ChannelBackend {
@@ -28,6 +38,7 @@ impl ChannelBackend {
             requests,
             channels,
             reply_timeout: REPLY_TIMEOUT,
+            stalled: AtomicBool::new(false),
         }
     }
 
@@ -35,6 +46,15 @@ impl ChannelBackend {
     pub fn with_reply_timeout(mut self, timeout: Duration) -> Self {
         self.reply_timeout = timeout;
         self
+    }
+
+    /// How long the next call waits for the runtime.
+    fn wait_limit(&self) -> Duration {
+        if self.stalled.load(Ordering::Relaxed) {
+            self.reply_timeout.min(STALLED_WAIT)
+        } else {
+            self.reply_timeout
+        }
     }
 }
 
@@ -45,16 +65,22 @@ impl CncBackend for ChannelBackend {
 
     /// One request, answered exactly once: by the runtime's reply when the runtime took the
     /// request's claim, or by "busy" (0x708, not applied) when this side took it first after
-    /// `reply_timeout`. Once the runtime holds the claim its reply is waited for without a
+    /// `reply_timeout` ([`STALLED_WAIT`] while an earlier call is unanswered). Once the runtime holds the claim its reply is waited for without a
     /// limit: it is being applied in the tick running now, and answering "busy" then would
     /// make a retrying client apply it twice.
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
         let (tx, rx) = crossbeam_channel::bounded(1);
         let (req, claim) = Request::new(u32::from(ch), op, tx);
         self.requests.send(req).map_err(|_| DeviceError::NotReady)?;
-        let reply = match rx.recv_timeout(self.reply_timeout) {
-            Ok(r) => Ok(r),
-            Err(RecvTimeoutError::Timeout) if claim.take() => return Err(DeviceError::Busy),
+        let reply = match rx.recv_timeout(self.wait_limit()) {
+            Ok(r) => {
+                self.stalled.store(false, Ordering::Relaxed);
+                Ok(r)
+            }
+            Err(RecvTimeoutError::Timeout) if claim.take() => {
+                self.stalled.store(true, Ordering::Relaxed);
+                return Err(DeviceError::Busy);
+            }
             // The runtime has it: the answer comes when its serve returns.
             Err(RecvTimeoutError::Timeout) => rx.recv().map_err(|_| DeviceError::NotReady),
             // The runtime stopped and dropped the request unapplied.

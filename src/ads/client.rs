@@ -475,10 +475,10 @@ fn wait_empty(
     }
 }
 
-/// The default target address: the CNC COM task on the local NetId.
+/// The default target address: the CNC COM task on the server's default NetId.
 pub fn default_target() -> AmsAddr {
     AmsAddr {
-        net_id: AmsNetId::LOCAL,
+        net_id: crate::vocab::ams::DEFAULT_NET_ID,
         port: PORT_CNC_COM,
     }
 }

@@ -93,6 +93,17 @@ enum Field {
     CommandFeed,
     ActiveFeed,
     ErrorMessage,
+    PlatformErrorMessage,
+    FeedHoldCommand,
+    FeedHold,
+    SlopeBufLevel,
+    ProgramCount,
+    SearchDistance,
+    SearchCovered,
+    SearchAutoReturn,
+    SearchDeviationMax,
+    SearchNoHold,
+    SearchBreakpoint,
     Message,
     ChannelNumber,
     ChannelAxes,
@@ -119,11 +130,13 @@ enum Field {
     NccPositions,
     AxisLogicalNo,
     AxisName,
+    AxisType,
     AxisState,
     AxisChannel,
     AxisPosition,
     AxisPositionHr,
     AxisPositionPcs,
+    AxisPositionPcsHr,
 }
 
 /// One object of the table.
@@ -177,6 +190,7 @@ static TABLE: &[Def] = &[
     d(PL, 0x253, "cnc_version_r", String, 24, R, "", SRC_TS, F::Version),
     d(PL, 0x254, "cnc_number_of_axis_r", Dword, 4, R, "", SRC_TS, F::AxisCount),
     d(PL, 0x255, "cnc_number_of_channel_r", Word, 2, R, "", SRC_TS, F::ChannelCount),
+    d(PL, 0x257, "cnc_error_message_r", String, 1330, R, "channel 1's last error", SRC_DUMP, F::PlatformErrorMessage),
     d(PL, 0x258, "cnc_time_geo_min", Dword, 4, R, "0.1 µs", SRC_DUMP, F::TimeMin),
     d(PL, 0x259, "cnc_time_geo_max", Dword, 4, R, "0.1 µs", SRC_DUMP, F::TimeMax),
     d(PL, 0x25A, "cnc_time_geo_act", Dword, 4, R, "0.1 µs", SRC_DUMP, F::TimeAct),
@@ -205,6 +219,8 @@ static TABLE: &[Def] = &[
     d(CH, 0x12, "mc_active_program_name_r", String, 84, R, "", SRC_DUMP, F::ActiveProgramName),
     d(CH, 0x13, "mc_command_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::CommandFeed),
     d(CH, 0x14, "mc_active_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::ActiveFeed),
+    d(CH, 0x15, "mc_command_feedhold_r", Bool, 1, R, "", SRC_DUMP, F::FeedHoldCommand),
+    d(CH, 0x16, "mc_feedhold_channel_w", Bool, 1, W, "TRUE holds, FALSE releases", SRC_DUMP, F::FeedHold),
     d(CH, 0x1F, "mc_message_r", String, 120, R, "last #MSG text", SRC_DUMP, F::Message),
     d(CH, 0x26, "mc_error_message_r", String, 1330, R, "", SRC_DUMP, F::ErrorMessage),
     d(CH, 0x2B, "mc_actual_logical_axes_number_r", Dword, 4, R, "", SRC_DUMP, F::ChannelAxes),
@@ -212,16 +228,30 @@ static TABLE: &[Def] = &[
     d(CH, 0x3F, "mc_command_execution_mode_w", Dint, 4, W, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x40, "mc_command_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x41, "mc_active_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeActive),
+    d(CH, 0x44, "mc_cmd_bs_distance_prog_start_w", Lreal, 8, W, "0.1 µm", SRC_TS, F::SearchDistance),
+    d(CH, 0x45, "mc_cmd_bs_distance_prog_start_r", Lreal, 8, R, "0.1 µm", SRC_TS, F::SearchDistance),
     d(CH, 0x49, "mc_cmd_bs_type_w", Word, 2, W, "1 offset, 3 counter, 4 N", SRC_TS, F::SearchType),
+    d(CH, 0x4A, "mc_cmd_bs_covered_distance_w", Lreal, 8, W, "0.1 % of the block", SRC_TS, F::SearchCovered),
+    d(CH, 0x4B, "mc_cmd_bs_auto_return_w", Bool, 1, W, "", SRC_TS, F::SearchAutoReturn),
+    d(CH, 0x4C, "mc_cmd_bs_deviation_max_w", Dword, 4, W, "0.1 µm", SRC_TS, F::SearchDeviationMax),
     d(CH, 0x50, "mc_cmd_bs_pos_start_offset_w", Dint, 4, W, "bytes", SRC_DUMP, F::SearchFileOffset),
     d(CH, 0x5E, "mc_cmd_bs_intern_block_count_w", Dword, 4, W, "", SRC_DUMP, F::SearchBlockCount),
     d(CH, 0x5F, "mc_cmd_bs_block_number_w", Dword, 4, W, "N number", SRC_TS, F::SearchBlockNumber),
     d(CH, 0x61, "mc_cmd_bs_type_r", Word, 2, R, "1 offset, 3 counter, 4 N", SRC_TS, F::SearchType),
+    d(CH, 0x62, "mc_cmd_bs_covered_distance_r", Lreal, 8, R, "0.1 % of the block", SRC_TS, F::SearchCovered),
+    d(CH, 0x63, "mc_cmd_bs_auto_return_r", Bool, 1, R, "", SRC_TS, F::SearchAutoReturn),
+    d(CH, 0x64, "mc_cmd_bs_deviation_max_r", Dword, 4, R, "0.1 µm", SRC_TS, F::SearchDeviationMax),
     d(CH, 0x68, "mc_cmd_bs_pos_start_offset_r", Dint, 4, R, "bytes", SRC_DUMP, F::SearchFileOffset),
     d(CH, 0x76, "mc_cmd_bs_intern_block_count_r", Dword, 4, R, "", SRC_DUMP, F::SearchBlockCount),
     d(CH, 0x77, "mc_cmd_bs_block_number_r", Dword, 4, R, "N number", SRC_TS, F::SearchBlockNumber),
+    d(CH, 0x79, "mc_cmd_bs_no_hold_at_restart_w", Bool, 1, W, "", SRC_TS, F::SearchNoHold),
+    d(CH, 0x7A, "mc_cmd_bs_no_hold_at_restart_r", Bool, 1, R, "", SRC_TS, F::SearchNoHold),
+    d(CH, 0x7B, "mc_cmd_bs_breakpoint_position_w", Lreal, 8, W, "0.1 µm from the program start", SRC_TS, F::SearchBreakpoint),
+    d(CH, 0x7C, "mc_cmd_bs_breakpoint_position_r", Lreal, 8, R, "0.1 µm from the program start", SRC_TS, F::SearchBreakpoint),
     d(CH, 0x7E, "mc_ipo_buf_level", Dword, 4, R, "blocks", SRC_DUMP, F::IpoBufLevel),
+    d(CH, 0x7F, "mc_slope_buf_level", Dword, 4, R, "blocks waiting for the lookahead", SRC_DUMP, F::SlopeBufLevel),
     d(CH, 0x90, "mc_program_stream_w", String, 1208, W, "ASCII, whole CR LF lines ≤ 992 bytes", SRC_TS, F::Stream),
+    d(CH, 0x44F, "mc_program_count_r", Dword, 4, R, "programs run to their end", SRC_DUMP, F::ProgramCount),
     d(CH, 0x101, "mcm_active_mode_r", Dint, 4, R, "mode", SRC_DUMP, F::McmActiveMode),
     d(CH, 0x103, "mcm_active_r", ModeState, 8, R, "mode, state", SRC_DUMP, F::McmActive),
     d(CH, 0x104, "mcm_command_to_mode_w", Dint, 4, W, "mode", SRC_DUMP, F::McmToMode),
@@ -240,9 +270,13 @@ static TABLE: &[Def] = &[
     d(CH, 0x8003, "ncc_positions_mm_r", LrealArray, 0, R, "mm per axis", SRC_NCC, F::NccPositions),
     d(CA, 0x01, "mc_axis_{k}_logical_no_r", Word, 2, R, "", SRC_TS, F::AxisLogicalNo),
     d(CA, 0x02, "mc_axis_{k}_name_r", String, 16, R, "", SRC_TS, F::AxisName),
+    d(CA, 0x03, "mc_axis_{k}_type_r", Word, 2, R, "1 translator, 2 rotator", SRC_TS, F::AxisType),
     d(CA, 0x06, "mc_ax_{k}_active_position_pcs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPositionPcs),
     d(CA, 0x07, "mc_ax_{k}_curr_position_pcs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPositionPcs),
     d(CA, 0x09, "mc_axis_{k}_state_r", Word, 2, R, "1 ready, 3 active, 5 hold, 7 error", SRC_TS, F::AxisState),
+    d(CA, 0x35, "mc_ax_{k}_active_position_pcs_hr_r", Lreal, 8, R, "0.1 µm", SRC_DUMP, F::AxisPositionPcsHr),
+    d(CA, 0x36, "mc_ax_{k}_curr_position_pcs_hr_r", Lreal, 8, R, "0.1 µm", SRC_DUMP, F::AxisPositionPcsHr),
+    d(PA, 0x01, "ac_{k}_type_r", Word, 2, R, "1 translator, 2 rotator", SRC_TS, F::AxisType),
     d(PA, 0x02, "ac_{k}_active_position_acs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPosition),
     d(PA, 0x03, "ac_{k}_current_position_acs_r", Dint, 4, R, "0.1 µm", SRC_TS, F::AxisPosition),
     d(PA, 0x09, "ac_{k}_axis_name_r", String, 16, R, "", SRC_TS, F::AxisName),
@@ -447,6 +481,23 @@ fn axis_state(v: &Status) -> u16 {
     }
 }
 
+/// Axis type as the kernel numbers it (TwinSharp `AxisStatus.cs`: 1 translator, 2 rotator,
+/// 4 spindle): A, B and C are ncchannel's rotary axes (degrees), X, Y and Z linear.
+fn axis_type(letter: char) -> u16 {
+    match letter {
+        'A' | 'B' | 'C' => 2,
+        _ => 1,
+    }
+}
+
+/// A channel's last error as the error-message objects show it: number and text.
+fn error_text(v: &Status) -> std::string::String {
+    v.last_error
+        .as_ref()
+        .map(|(code, msg)| format!("{code} {msg}"))
+        .unwrap_or_default()
+}
+
 fn override_tenths(pct: f64) -> u16 {
     (pct * 10.0).round().clamp(0.0, 2000.0) as u16
 }
@@ -528,6 +579,9 @@ fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec
         Field::TimeMax => duration_tenth_us(t.max).to_le_bytes().to_vec(),
         Field::TimeAct => duration_tenth_us(t.last).to_le_bytes().to_vec(),
         Field::TimeAvg => duration_tenth_us(t.mean()).to_le_bytes().to_vec(),
+        // "The first channel drives platform data" (infosys 312764171): ncchannel has no
+        // errors outside its channels.
+        Field::PlatformErrorMessage => return Ok(text(&error_text(&v), def.size, length)),
         _ => return Err(AdsResult::ACCESS_DENIED),
     };
     fixed(bytes, length)
@@ -560,14 +614,17 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
         Field::ActiveFeed => (programmed_um_s * v.override_pct / 100.0)
             .to_le_bytes()
             .to_vec(),
-        Field::ErrorMessage => {
-            let msg = v
-                .last_error
-                .as_ref()
-                .map(|(code, msg)| format!("{code} {msg}"))
-                .unwrap_or_default();
-            return Ok(text(&msg, def.size, length));
-        }
+        Field::ErrorMessage => return Ok(text(&error_text(v), def.size, length)),
+        Field::FeedHoldCommand => vec![u8::from(h.feed_hold)],
+        Field::SlopeBufLevel => (v.queued_blocks as u32).to_le_bytes().to_vec(),
+        // A UNS32 counter: it wraps, as the kernel's counters do.
+        Field::ProgramCount => (v.programs_ended as u32).to_le_bytes().to_vec(),
+        Field::SearchDistance => h.search.distance_prog_start_tenth_um.to_le_bytes().to_vec(),
+        Field::SearchCovered => h.search.covered_distance_per_mil.to_le_bytes().to_vec(),
+        Field::SearchAutoReturn => vec![u8::from(h.search.auto_return)],
+        Field::SearchDeviationMax => h.search.deviation_max_tenth_um.to_le_bytes().to_vec(),
+        Field::SearchNoHold => vec![u8::from(h.search.no_hold_at_restart)],
+        Field::SearchBreakpoint => h.search.breakpoint_tenth_um.to_le_bytes().to_vec(),
         Field::Message => return Ok(text(v.message.as_deref().unwrap_or(""), def.size, length)),
         Field::ChannelAxes => (v.positions.len() as u32).to_le_bytes().to_vec(),
         Field::ChannelNumber => ch.to_le_bytes().to_vec(),
@@ -612,6 +669,7 @@ fn read_axis(
     let bytes = match def.field {
         Field::AxisLogicalNo => logical.to_le_bytes().to_vec(),
         Field::AxisName => return Ok(text(&letter.to_string(), def.size, length)),
+        Field::AxisType => axis_type(letter).to_le_bytes().to_vec(),
         Field::AxisState => axis_state(v).to_le_bytes().to_vec(),
         Field::AxisChannel => ch.to_le_bytes().to_vec(),
         Field::AxisPosition => tenth_um_i32(mm).to_le_bytes().to_vec(),
@@ -622,6 +680,13 @@ fn read_axis(
                 .get(index)
                 .ok_or(AdsResult::INVALID_OFFSET)?;
             tenth_um_i32(pcs).to_le_bytes().to_vec()
+        }
+        Field::AxisPositionPcsHr => {
+            let (_, pcs) = *v
+                .pcs_positions
+                .get(index)
+                .ok_or(AdsResult::INVALID_OFFSET)?;
+            tenth_um(pcs).to_le_bytes().to_vec()
         }
         _ => return Err(AdsResult::ACCESS_DENIED),
     };
@@ -666,6 +731,17 @@ fn bool_arg(data: &[u8]) -> Result<bool, AdsResult> {
     }
 }
 
+/// An LREAL argument (8 bytes) in `0..=max`: distances and shares are never negative.
+fn distance_arg(data: &[u8], max: f64) -> Result<f64, AdsResult> {
+    let bytes: [u8; 8] = data.try_into().map_err(|_| AdsResult::INVALID_SIZE)?;
+    let v = f64::from_le_bytes(bytes);
+    if v.is_finite() && (0.0..=max).contains(&v) {
+        Ok(v)
+    } else {
+        Err(AdsResult::INVALID_DATA)
+    }
+}
+
 fn i32_arg(data: &[u8]) -> Result<i32, AdsResult> {
     i32::try_from(int_arg(data)?).map_err(|_| AdsResult::INVALID_DATA)
 }
@@ -698,7 +774,14 @@ pub fn write(
         Field::SearchType
         | Field::SearchFileOffset
         | Field::SearchBlockCount
-        | Field::SearchBlockNumber => write_search(backend, ch, t.def.field, data),
+        | Field::SearchBlockNumber
+        | Field::SearchDistance
+        | Field::SearchCovered
+        | Field::SearchAutoReturn
+        | Field::SearchDeviationMax
+        | Field::SearchNoHold
+        | Field::SearchBreakpoint => write_search(backend, ch, t.def.field, data),
+        Field::FeedHold => write_feed_hold(backend, ch, data),
         Field::McmToMode
         | Field::McmToState
         | Field::McmFromMode
@@ -796,6 +879,31 @@ fn write_search(
             let n = uint_arg(data)?;
             search(&|s| s.block_number = n)
         }
+        Field::SearchDistance => {
+            let d = distance_arg(data, f64::MAX)?;
+            search(&|s| s.distance_prog_start_tenth_um = d)
+        }
+        Field::SearchCovered => {
+            // TwinSharp `BlockSearch.cs`: "Value range: [0.0 to 1000.0]".
+            let p = distance_arg(data, 1000.0)?;
+            search(&|s| s.covered_distance_per_mil = p)
+        }
+        Field::SearchBreakpoint => {
+            let d = distance_arg(data, f64::MAX)?;
+            search(&|s| s.breakpoint_tenth_um = d)
+        }
+        Field::SearchAutoReturn => {
+            let on = bool_arg(data)?;
+            search(&|s| s.auto_return = on)
+        }
+        Field::SearchNoHold => {
+            let on = bool_arg(data)?;
+            search(&|s| s.no_hold_at_restart = on)
+        }
+        Field::SearchDeviationMax => {
+            let d = uint_arg(data)?;
+            search(&|s| s.deviation_max_tenth_um = d)
+        }
         _ => Err(AdsResult::ACCESS_DENIED),
     }
 }
@@ -845,6 +953,12 @@ fn write_mcm(
         }
         _ => Err(AdsResult::ACCESS_DENIED),
     }
+}
+
+/// Write step: `mc_feedhold_channel_w`, one BOOL; the channel decides (a TRUE with no
+/// program running is 0x708, as a state command it cannot take now).
+fn write_feed_hold(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
+    unit(backend.command(ch, Op::Hmi(HmiOp::FeedHold(bool_arg(data)?))))
 }
 
 /// Write step: hold, resume and reset take no argument beyond an optional 4-byte word.

@@ -13,8 +13,8 @@ pub(crate) const RECORD_BYTES: usize = 84;
 /// Bytes of the name and type fields of a record (NUL-padded).
 const TEXT_FIELD_BYTES: usize = 32;
 
-/// The IEC type names the description records carry (infosys 855973643). `Struct` is an
-/// object the kernel types "NONE" (a structure or a trigger); its type text says what it is.
+/// What a served object holds. The description record carries the kernel's type text
+/// ([`AdsType::record_name`]); the object map in docs/ads.md the layout ([`AdsType::name`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AdsType {
     Bool,
@@ -39,7 +39,22 @@ pub enum AdsType {
 }
 
 impl AdsType {
-    /// The type text of the description record.
+    /// The type text of the description record, as the kernel writes it: one of the IEC names
+    /// infosys 855973643 lists (BOOL, BYTE, WORD, INT, DWORD, DINT, LWORD, LREAL, STRING) for a
+    /// scalar or string, "NONE" for anything else — the ISG object dump types every structure,
+    /// array and trigger "NONE" (`mcm_active_r`, `mc_active_g_functions_r`, `cnc_time_reset`).
+    pub fn record_name(self) -> &'static str {
+        match self {
+            AdsType::Dword2
+            | AdsType::LrealArray
+            | AdsType::ModeState
+            | AdsType::Trigger
+            | AdsType::Named(_) => "NONE",
+            scalar => scalar.name(),
+        }
+    }
+
+    /// The type as IEC 61131-3 declares it (structures by their members), for the object map.
     pub fn name(self) -> &'static str {
         match self {
             AdsType::Bool => "BOOL",
@@ -52,8 +67,8 @@ impl AdsType {
             AdsType::Lreal => "LREAL",
             AdsType::String => "STRING",
             AdsType::Dword2 => "ARRAY [0..1] OF DWORD",
-            AdsType::LrealArray => "ARRAY OF LREAL",
-            AdsType::ModeState => "STRUCT {DINT mode; DINT state}",
+            AdsType::LrealArray => "ARRAY [1..axes] OF LREAL",
+            AdsType::ModeState => "STRUCT mode : DINT; state : DINT; END_STRUCT",
             AdsType::Trigger => "NONE",
             AdsType::Named(n) => n,
         }
@@ -110,7 +125,7 @@ pub fn record(id: u32, o: &ObjectInfo) -> [u8; RECORD_BYTES] {
     r[12..16].copy_from_slice(&o.group.to_le_bytes());
     r[16..20].copy_from_slice(&o.offset.to_le_bytes());
     put_text(&mut r[20..20 + TEXT_FIELD_BYTES], &o.name);
-    put_text(&mut r[52..52 + TEXT_FIELD_BYTES], o.ty.name());
+    put_text(&mut r[52..52 + TEXT_FIELD_BYTES], o.ty.record_name());
     r
 }
 
@@ -183,6 +198,28 @@ mod tests {
         assert_eq!(&r[20..36], b"mc_block_count_r");
         assert!(r[36..52].iter().all(|&b| b == 0));
         assert_eq!(&r[52..57], b"DWORD");
+        assert_eq!(r[57], 0);
+    }
+
+    #[test]
+    fn structures_and_triggers_are_typed_none_as_the_kernel_types_them() {
+        for ty in [
+            AdsType::ModeState,
+            AdsType::Dword2,
+            AdsType::LrealArray,
+            AdsType::Trigger,
+        ] {
+            let r = record(1, &ObjectInfo { ty, ..info("x") });
+            assert_eq!(&r[52..57], b"NONE\0", "{ty:?}");
+        }
+        let r = record(
+            1,
+            &ObjectInfo {
+                ty: AdsType::Lreal,
+                ..info("x")
+            },
+        );
+        assert_eq!(&r[52..58], b"LREAL\0");
     }
 
     #[test]

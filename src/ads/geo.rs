@@ -47,6 +47,7 @@ enum Field {
     PlatformAxes,
     TickCounter,
     AxisCount,
+    SlopeBufLevel,
     IpoBufLevel,
     PathVelocity,
     ProgrammedVelocity,
@@ -110,6 +111,7 @@ static TABLE: &[Def] = &[
     d(PosCtrl, 0x07, "tick counter", Dword, 4, "CNC ticks", SRC_DUMP, F::TickCounter),
     d(Ipo, 0x00, "IPO: elements", Dword, 4, "element types served", SRC, F::Elements),
     d(Ipo, 0x01, "number of axes", Word, 2, "", SRC, F::AxisCount),
+    d(Ipo, 0x04, "slope_buf_level", Dword, 4, "blocks waiting for the lookahead", SRC, F::SlopeBufLevel),
     d(Ipo, 0x05, "ipo_buf_level", Dword, 4, "blocks", SRC, F::IpoBufLevel),
     d(Ipo, 0x15, "Actual velocity on path", Lreal, 8, "µm/s", SRC, F::PathVelocity),
     d(Ipo, 0x16, "Programmed velocity on path", Lreal, 8, "µm/s", SRC, F::ProgrammedVelocity),
@@ -166,11 +168,76 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
             name: d.name.into(),
             ty: d.ty,
             size: d.size,
-            access: Access::Read,
+            access: if writable(d.field) {
+                Access::ReadWrite
+            } else {
+                Access::Read
+            },
             unit: d.unit,
             source: d.source,
         })
         .collect()
+}
+
+/// The HLD elements an HMI writes: the request side of the mode-and-state unit
+/// (`request_semaphor_rw`, `request_r.*`), writable in the kernel's object dump, where the HMI
+/// posts a mode or state request for the PLC to read (ISG "MC_CONTROL_UNIT", infosys
+/// 174725259). Everything else in this task is written by the CNC or the PLC only.
+fn writable(field: Field) -> bool {
+    matches!(
+        field,
+        Field::Unit(Unit::Request | Unit::RequestSemaphore, _)
+    )
+}
+
+/// Find channel `ch`'s table entry of a logical group, or the error a Read or Write gets.
+fn locate(
+    backend: &dyn CncBackend,
+    group: u32,
+    offset: u32,
+) -> Result<(u16, &'static Def), AdsResult> {
+    let group = logical(group);
+    let (class, ch) = if group == GROUP_POS_CTRL {
+        (Class::PosCtrl, 1)
+    } else if (GROUP_IPO + 1..GROUP_IPO + 0x100).contains(&group) {
+        (Class::Ipo, group - GROUP_IPO)
+    } else if (GROUP_HLD + 1..GROUP_HLD + 0x100).contains(&group) {
+        (Class::Hld, group - GROUP_HLD)
+    } else if group == GROUP_IPO + ADDRESS_QUERY || group == GROUP_HLD + ADDRESS_QUERY {
+        return Err(AdsResult::ACCESS_DENIED);
+    } else {
+        return Err(AdsResult::INVALID_GROUP);
+    };
+    if ch > u32::from(backend.channel_count()) {
+        return Err(AdsResult::INVALID_GROUP);
+    }
+    let def = TABLE
+        .iter()
+        .find(|d| d.class == class && d.element == offset)
+        .ok_or(AdsResult::INVALID_OFFSET)?;
+    Ok((ch as u16, def))
+}
+
+/// ADS Write on port 551: the HMI's side of the HLD mode-and-state unit, written into the
+/// same HLI image the PLC reads on port 851; any other element is 0x704, as the kernel's
+/// object dump marks it read-only.
+pub fn write(
+    backend: &dyn CncBackend,
+    hli: &Hli,
+    group: u32,
+    offset: u32,
+    data: &[u8],
+) -> Result<(), AdsResult> {
+    let (ch, def) = locate(backend, group, offset)?;
+    match def.field {
+        Field::Unit(unit, at) if writable(def.field) => {
+            if data.is_empty() || data.len() > def.size as usize {
+                return Err(AdsResult::INVALID_SIZE);
+            }
+            hli.write_unit_bytes(ch, unit, at as usize, data)
+        }
+        _ => Err(AdsResult::ACCESS_DENIED),
+    }
 }
 
 fn logical(group: u32) -> u32 {
@@ -196,26 +263,8 @@ pub fn read(
     offset: u32,
     length: u32,
 ) -> Result<Vec<u8>, AdsResult> {
-    let group = logical(group);
-    let (class, ch) = if group == GROUP_POS_CTRL {
-        (Class::PosCtrl, 1)
-    } else if (GROUP_IPO + 1..GROUP_IPO + 0x100).contains(&group) {
-        (Class::Ipo, group - GROUP_IPO)
-    } else if (GROUP_HLD + 1..GROUP_HLD + 0x100).contains(&group) {
-        (Class::Hld, group - GROUP_HLD)
-    } else if group == GROUP_IPO + ADDRESS_QUERY || group == GROUP_HLD + ADDRESS_QUERY {
-        return Err(AdsResult::ACCESS_DENIED);
-    } else {
-        return Err(AdsResult::INVALID_GROUP);
-    };
-    if ch > u32::from(backend.channel_count()) {
-        return Err(AdsResult::INVALID_GROUP);
-    }
-    let ch = ch as u16;
-    let def = TABLE
-        .iter()
-        .find(|d| d.class == class && d.element == offset)
-        .ok_or(AdsResult::INVALID_OFFSET)?;
+    let (ch, def) = locate(backend, group, offset)?;
+    let class = def.class;
     if let Field::Unit(unit, at) = def.field {
         let bytes = hli.unit_bytes(ch, unit, at as usize, def.size as usize)?;
         return fixed(bytes, length);
@@ -247,6 +296,7 @@ fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<V
         Field::AxisCount => (v.positions.len() as u16).to_le_bytes().to_vec(),
         Field::CycleTime => v.period.as_secs_f64().to_le_bytes().to_vec(),
         Field::TickCounter => (v.tick as u32).to_le_bytes().to_vec(),
+        Field::SlopeBufLevel => (v.queued_blocks as u32).to_le_bytes().to_vec(),
         Field::IpoBufLevel => (v.ipo_blocks as u32).to_le_bytes().to_vec(),
         Field::PathVelocity => (v.velocity_mm_per_s * 1000.0).to_le_bytes().to_vec(),
         Field::ProgrammedVelocity => feed_um_s.to_le_bytes().to_vec(),

@@ -17,16 +17,26 @@
 //!
 //! Services (ADS index groups of the TwinCAT PLC runtime): 0xF003 handle by name
 //! (ReadWrite), 0xF004 value by name (ReadWrite), 0xF005 value by handle (Read/Write, offset =
-//! handle), 0xF006 release handle (Write), 0xF009 symbol info by name (ReadWrite).
+//! handle), 0xF006 release handle (Write), 0xF009 symbol info by name (ReadWrite); the
+//! uploads and runtime data of [`super::symbols`] (0xF008, 0xF00B, 0xF00C, 0xF00E, 0xF00F,
+//! 0xF100), a symbol's location by name (0xF007) and data types by name (0xF011) with the layouts of [`super::plc_types`]. A
+//! symbol's address (its entry's group and offset) is value-by-handle: 0xF005 and its handle.
 //! Handles are stable per symbol (symbol index + 1), so releasing is bookkeeping-free and a
 //! client that never releases cannot exhaust anything.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 use super::backend::{CncBackend, DeviceError, Op};
 use super::description::{Access, AdsType, ObjectInfo};
+use super::plc_types::DataType;
 use super::result::AdsResult;
+use super::symbols::{
+    self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_LOCATION_BY_NAME,
+    GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
+    GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
+};
+use crate::vocab::mode::Mode;
 
 pub const PORT: u16 = 851;
 pub(crate) const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
@@ -52,17 +62,19 @@ const TECHNO_UNITS: usize = 20;
 /// TwinSharp `Constants.cs`: keys `[0..10]`; the kernel dump lists handwheels `[0..5]`.
 const KEYS: usize = 11;
 const HANDWHEELS: usize = 6;
+/// The error id a refused mode-and-state command posts in `mc_error.satz_r`: diagnosis
+/// 270061, the kernel's "target state not permitted in this mode" (infosys
+/// `tf5200_diagnosis/267091851.html`).
+pub(crate) const REFUSED_TRANSITION_ERROR: u32 = 270_061;
+/// Refusals kept for posting per channel; the PLC takes one record at a time.
+const MAX_REFUSALS_WAITING: usize = 16;
 /// Error body type "LEER" (empty): ncchannel's error text travels in `mc_error_message_r`.
 const BODY_EMPTY: u32 = 9;
 
-/// ADS data type ids of symbol info (ADST_*).
-const ADST_INT16: u32 = 2;
-const ADST_INT32: u32 = 3;
-const ADST_UINT16: u32 = 18;
-const ADST_UINT32: u32 = 19;
-const ADST_STRING: u32 = 30;
-const ADST_BIT: u32 = 33;
-const ADST_BIGTYPE: u32 = 65;
+use super::plc_types::adst::{
+    BIGTYPE as ADST_BIGTYPE, BIT as ADST_BIT, INT16 as ADST_INT16, INT32 as ADST_INT32,
+    STRING as ADST_STRING, UINT16 as ADST_UINT16, UINT32 as ADST_UINT32,
+};
 
 /// The parts of a channel's mode-and-state control unit (the GEO task mirrors them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -111,6 +123,19 @@ struct ChannelAreas {
     error_semaphore: usize,
 }
 
+impl ChannelAreas {
+    /// The root area holding `unit` of the mode-and-state unit.
+    fn unit_root(&self, unit: Unit) -> usize {
+        match unit {
+            Unit::Enable => self.enable,
+            Unit::RequestSemaphore => self.request_semaphore,
+            Unit::CommandSemaphore => self.command_semaphore,
+            Unit::Request => self.request,
+            Unit::Command => self.command,
+        }
+    }
+}
+
 /// The symbol table and its memory, built once the channels are known.
 struct Image {
     symbols: Vec<Symbol>,
@@ -120,6 +145,9 @@ struct Image {
     channels: Vec<ChannelAreas>,
     /// Per channel: errors handed to the PLC so far.
     posted: Mutex<Vec<u64>>,
+    /// Per channel: mode-and-state commands refused by the CNC side, waiting to be posted
+    /// as error records (at most [`MAX_REFUSALS_WAITING`]; more are only logged).
+    refused: Mutex<Vec<VecDeque<u32>>>,
     /// Per channel: the HMI's to-mode and parameter waiting for its to-state (redirection).
     pending: Mutex<Vec<PendingRequest>>,
 }
@@ -479,6 +507,7 @@ impl Image {
                 memory: Mutex::new(Vec::new()),
                 channels: Vec::new(),
                 posted: Mutex::new(vec![0; axes_per_channel.len()]),
+                refused: Mutex::new(vec![VecDeque::new(); axes_per_channel.len()]),
                 pending: Mutex::new(vec![PendingRequest::default(); axes_per_channel.len()]),
             },
         };
@@ -515,6 +544,14 @@ impl Image {
 pub struct Hli {
     backend: Arc<dyn CncBackend>,
     image: OnceLock<Image>,
+    uploads: OnceLock<Uploads>,
+}
+
+/// The symbol and data-type uploads, encoded once (the symbols never change while serving).
+struct Uploads {
+    symbols: Vec<u8>,
+    types: Vec<u8>,
+    info: UploadInfo,
 }
 
 impl Hli {
@@ -522,6 +559,7 @@ impl Hli {
         Hli {
             backend,
             image: OnceLock::new(),
+            uploads: OnceLock::new(),
         }
     }
 
@@ -625,7 +663,9 @@ impl Hli {
 
     /// The CNC side of the mode-and-state unit: take `command_w` (to mode, parameter, to
     /// state; 0 = no change) and clear the semaphore. A transition the channel refuses
-    /// leaves mode and state as they are (`state_r` shows it).
+    /// leaves mode and state as they are (`state_r` shows it) and posts error 270061 in
+    /// `mc_error.satz_r`, as the kernel reports a refused transition; so does an MDI block
+    /// (MDI parameter), which the model cannot execute.
     fn take_command(&self, img: &Image, ch: u16) {
         let Ok(areas) = img.areas(ch) else { return };
         let cmd = img.memory()[areas.command].clone();
@@ -635,8 +675,13 @@ impl Hli {
         let end = param.iter().position(|&b| b == 0).unwrap_or(param.len());
         let program = String::from_utf8_lossy(&param[..end]).trim().to_string();
         let b = &self.backend;
+        let before = b.status(ch).ok();
         let r = (|| {
             let mode = b.status(ch)?.mode;
+            let target = if to_mode == 0 { mode as u32 } else { to_mode };
+            if target == Mode::Mdi as u32 && !program.is_empty() {
+                return Err(DeviceError::NotReady);
+            }
             if to_mode != 0 && to_mode != mode as u32 {
                 b.command(ch, Op::CommandMode(to_mode as i32))?;
             }
@@ -652,8 +697,23 @@ impl Hli {
         })();
         if let Err(e) = r {
             log::warn!("HLI channel {ch}: mode/state command {to_mode}/{to_state} refused: {e}");
+            // Refused as a whole: a mode or program set before the to-state was refused is
+            // put back, so the command is applied or refused, never half of it.
+            if let Some(st) = before {
+                let _ = b.command(ch, Op::CommandMode(st.mode as i32));
+                if let Some(p) = st.program {
+                    let _ = b.command(ch, Op::SetProgram(p));
+                }
+            }
+            let i = usize::from(ch) - 1;
+            let mut refused = img.refused.lock().unwrap_or_else(|p| p.into_inner());
+            if refused[i].len() < MAX_REFUSALS_WAITING {
+                refused[i].push_back(REFUSED_TRANSITION_ERROR);
+            }
         }
         img.memory()[areas.command_semaphore][0] = 0;
+        // Shown at once when the PLC has taken the last record (else on its next read).
+        let _ = self.post_error(img, ch);
     }
 
     /// Post the channel's next error into `mc_error.satz_r` when the semaphore is FALSE.
@@ -663,6 +723,14 @@ impl Hli {
             return Ok(());
         }
         let i = usize::from(ch) - 1;
+        let refusal = img.refused.lock().unwrap_or_else(|p| p.into_inner())[i].pop_front();
+        if let Some(code) = refusal {
+            let tick = self.backend.status(ch).map_err(DeviceError::result)?.tick;
+            let mut mem = img.memory();
+            mem[areas.error_record].copy_from_slice(&error_record(code, ch, tick));
+            mem[areas.error_semaphore][0] = 1;
+            return Ok(());
+        }
         let next = img.posted.lock().unwrap_or_else(|p| p.into_inner())[i];
         let mut rec = self
             .backend
@@ -751,18 +819,33 @@ impl Hli {
     ) -> Result<Vec<u8>, AdsResult> {
         let img = self.image()?;
         let a = img.areas(ch)?;
-        let root = match unit {
-            Unit::Enable => a.enable,
-            Unit::RequestSemaphore => a.request_semaphore,
-            Unit::CommandSemaphore => a.command_semaphore,
-            Unit::Request => a.request,
-            Unit::Command => a.command,
-        };
+        let root = a.unit_root(unit);
         let mem = img.memory();
         let area = &mem[root];
         let mut out = area[at.min(area.len())..(at + size).min(area.len())].to_vec();
         out.resize(size, 0);
         Ok(out)
+    }
+
+    /// Write `data` at byte `at` of channel `ch`'s mode-and-state `unit` (the HLD's view of
+    /// it on port 551); the caller checked the element's size.
+    pub(crate) fn write_unit_bytes(
+        &self,
+        ch: u16,
+        unit: Unit,
+        at: usize,
+        data: &[u8],
+    ) -> Result<(), AdsResult> {
+        let img = self.image()?;
+        let a = img.areas(ch)?;
+        let root = a.unit_root(unit);
+        let mut mem = img.memory();
+        let area = &mut mem[root];
+        let end = at.checked_add(data.len()).ok_or(AdsResult::INVALID_SIZE)?;
+        area.get_mut(at..end)
+            .ok_or(AdsResult::INVALID_SIZE)?
+            .copy_from_slice(data);
+        Ok(())
     }
 
     /// `gpCh[ch-1]^.head.plc_present_w` as one byte.
@@ -772,12 +855,77 @@ impl Hli {
         Ok(img.memory()[a.plc_present].clone())
     }
 
+    /// What the symbol entry of symbol `i` says: its address is value-by-handle.
+    fn info<'i>(&self, img: &'i Image, i: usize) -> SymbolInfo<'i> {
+        let s = &img.symbols[i];
+        SymbolInfo {
+            name: &s.name,
+            ty: s.ty,
+            group: GROUP_VALUE_BY_HANDLE,
+            offset: i as u32 + 1,
+            size_bytes: s.size as u32,
+            adst: s.adst,
+            read_only: matches!(img.roles[s.root], Role::ModeState(_) | Role::ErrorRecord(_)),
+        }
+    }
+
+    /// The uploads: one entry per root variable (members are reached through the types, as
+    /// a PLC lists `GVL.struct` and not its members) and every type those refer to.
+    fn uploads(&self) -> Result<&Uploads, AdsResult> {
+        if let Some(u) = self.uploads.get() {
+            return Ok(u);
+        }
+        let img = self.image()?;
+        let mut symbols = Vec::new();
+        let mut count = 0u32;
+        let mut type_names = Vec::new();
+        let mut last_root = None;
+        for (i, s) in img.symbols.iter().enumerate() {
+            if last_root == Some(s.root) {
+                continue;
+            }
+            last_root = Some(s.root);
+            symbols.extend(symbol_entry(&self.info(img, i)));
+            count += 1;
+            if let Some(t) = DataType::lookup(s.ty) {
+                t.closure(&mut type_names);
+            }
+        }
+        let mut types = Vec::new();
+        for name in &type_names {
+            if let Some(e) = DataType::lookup(name).and_then(|t| t.entry()) {
+                types.extend(e);
+            }
+        }
+        let info = UploadInfo {
+            symbols: count,
+            symbol_bytes: symbols.len() as u32,
+            types: type_names.len() as u32,
+            type_bytes: types.len() as u32,
+        };
+        Ok(self.uploads.get_or_init(|| Uploads {
+            symbols,
+            types,
+            info,
+        }))
+    }
+
     /// ADS Read on port 851.
     pub fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
         match group {
             GROUP_VALUE_BY_HANDLE => self.read_symbol(self.symbol_by_handle(offset)?, length),
-            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME
-            | GROUP_RELEASE_HANDLE => Err(AdsResult::ACCESS_DENIED),
+            GROUP_SYMBOL_VERSION => symbols::symbol_version(length),
+            GROUP_DEVICE_DATA => symbols::device_data(offset, length),
+            GROUP_UPLOAD_INFO => symbols::fit(self.uploads()?.info.v1(), length),
+            GROUP_UPLOAD_INFO2 => self.uploads()?.info.for_length(length),
+            GROUP_SYMBOL_UPLOAD => symbols::fit(self.uploads()?.symbols.clone(), length),
+            GROUP_TYPE_UPLOAD => symbols::fit(self.uploads()?.types.clone(), length),
+            GROUP_HANDLE_BY_NAME
+            | GROUP_VALUE_BY_NAME
+            | GROUP_INFO_BY_NAME
+            | GROUP_RELEASE_HANDLE
+            | GROUP_TYPE_BY_NAME
+            | GROUP_LOCATION_BY_NAME => Err(AdsResult::ACCESS_DENIED),
             _ => Err(AdsResult::INVALID_GROUP),
         }
     }
@@ -793,9 +941,8 @@ impl Hli {
                 self.symbol_by_handle(u32::from_le_bytes([a, b, c, d]))
                     .map(|_| ())
             }
-            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME => {
-                Err(AdsResult::ACCESS_DENIED)
-            }
+            GROUP_HANDLE_BY_NAME | GROUP_VALUE_BY_NAME | GROUP_INFO_BY_NAME
+            | GROUP_TYPE_BY_NAME => Err(AdsResult::ACCESS_DENIED),
             _ => Err(AdsResult::INVALID_GROUP),
         }
     }
@@ -804,7 +951,7 @@ impl Hli {
     pub fn read_write(
         &self,
         group: u32,
-        _offset: u32,
+        offset: u32,
         read_length: u32,
         data: &[u8],
     ) -> Result<Vec<u8>, AdsResult> {
@@ -814,21 +961,52 @@ impl Hli {
                     return Err(AdsResult::INVALID_SIZE);
                 }
                 let i = self.symbol_by_name(data)?;
-                Ok((i as u32 + 1).to_le_bytes().to_vec())
+                let mut reply = handle_reply(&self.image()?.symbols[i], i as u32 + 1);
+                reply.truncate(read_length as usize);
+                Ok(reply)
             }
             GROUP_VALUE_BY_NAME => self.read_symbol(self.symbol_by_name(data)?, read_length),
             GROUP_INFO_BY_NAME => {
                 let i = self.symbol_by_name(data)?;
-                let entry = symbol_entry(&self.image()?.symbols[i], i as u32 + 1);
-                if (read_length as usize) < entry.len() {
-                    return Err(AdsResult::INVALID_SIZE);
-                }
-                Ok(entry)
+                let entry = symbol_entry(&self.info(self.image()?, i));
+                symbols::fit(entry, read_length)
+            }
+            GROUP_LOCATION_BY_NAME => {
+                let info = self.info(self.image()?, self.symbol_by_name(data)?);
+                let words = [info.group, info.offset, info.size_bytes];
+                symbols::fit(
+                    words.iter().flat_map(|w| w.to_le_bytes()).collect(),
+                    read_length,
+                )
+            }
+            GROUP_TYPE_BY_NAME => {
+                let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+                let name =
+                    std::str::from_utf8(&data[..end]).map_err(|_| AdsResult::INVALID_DATA)?;
+                let entry = DataType::lookup(name)
+                    .and_then(|t| t.entry())
+                    .ok_or(SYMBOL_NOT_FOUND)?;
+                symbols::fit(entry, read_length)
             }
             GROUP_VALUE_BY_HANDLE | GROUP_RELEASE_HANDLE => Err(AdsResult::ACCESS_DENIED),
-            _ => Err(AdsResult::INVALID_GROUP),
+            // The read-only services (uploads, version, device data) by ReadWrite too.
+            _ => self.read(group, offset, read_length),
         }
     }
+}
+
+/// 0xF003's reply: the handle; a client that asks for more (`jisotalo/ads-client`
+/// `createVariableHandle` asks for any length) also gets the symbol's size, the type
+/// decoration (0: no decoration), the type name's length (u16) and the type name with NUL.
+fn handle_reply(s: &Symbol, handle: u32) -> Vec<u8> {
+    let mut out = Vec::with_capacity(15 + s.ty.len());
+    for w in [handle, s.size as u32, 0] {
+        out.extend_from_slice(&w.to_le_bytes());
+    }
+    out.extend_from_slice(&(s.ty.len() as u16).to_le_bytes());
+    out.extend_from_slice(s.ty.as_bytes());
+    out.push(0);
+    out
 }
 
 fn role_source(role: Role) -> &'static str {
@@ -836,29 +1014,6 @@ fn role_source(role: Role) -> &'static str {
         Role::Plain => "TwinSharp; inert",
         _ => "TwinSharp; HLI docs",
     }
-}
-
-/// `AdsSymbolEntry`: entry length, group, offset, size, data type, flags, name/type/comment
-/// lengths, then the three NUL-terminated texts. The address is value-by-handle.
-fn symbol_entry(s: &Symbol, handle: u32) -> Vec<u8> {
-    let mut out = Vec::with_capacity(30 + s.name.len() + s.ty.len() + 3);
-    out.extend_from_slice(&[0; 4]);
-    out.extend_from_slice(&GROUP_VALUE_BY_HANDLE.to_le_bytes());
-    out.extend_from_slice(&handle.to_le_bytes());
-    out.extend_from_slice(&(s.size as u32).to_le_bytes());
-    out.extend_from_slice(&s.adst.to_le_bytes());
-    out.extend_from_slice(&0u32.to_le_bytes());
-    out.extend_from_slice(&(s.name.len() as u16).to_le_bytes());
-    out.extend_from_slice(&(s.ty.len() as u16).to_le_bytes());
-    out.extend_from_slice(&0u16.to_le_bytes());
-    out.extend_from_slice(s.name.as_bytes());
-    out.push(0);
-    out.extend_from_slice(s.ty.as_bytes());
-    out.push(0);
-    out.push(0);
-    let n = out.len() as u32;
-    out[0..4].copy_from_slice(&n.to_le_bytes());
-    out
 }
 
 /// `HLI_ERROR_SATZ` for error `code` of channel `ch` (TwinSharp `Structs.cs`,
@@ -1017,6 +1172,148 @@ mod tests {
             hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
             [0],
             "posted once"
+        );
+    }
+
+    /// Write `command_w` (to mode, to state, parameter) and hand it over.
+    fn command(hli: &Hli, to_mode: u32, to_state: u32, parameter: &str) {
+        let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+        let mut cmd = vec![0u8; MODE_TRANSITION_BYTES];
+        cmd[8..12].copy_from_slice(&to_mode.to_le_bytes());
+        cmd[12..16].copy_from_slice(&to_state.to_le_bytes());
+        cmd[24..24 + parameter.len()].copy_from_slice(parameter.as_bytes());
+        let h = handle_of(hli, &format!("{ms}.command_w"));
+        hli.write(GROUP_VALUE_BY_HANDLE, h, &cmd).unwrap();
+        let sem = handle_of(hli, &format!("{ms}.command_semaphor_rw"));
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[1]).unwrap();
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "taken"
+        );
+    }
+
+    #[test]
+    fn refused_commands_post_error_270061_one_at_a_time() {
+        let t = testing::channels(1);
+        let b = t.backend.as_ref();
+        let hli = Hli::new(Arc::clone(&t.backend));
+        let err = "HLI_Global_Variables.gpCh[0]^.mc_error";
+        let sem = handle_of(&hli, &format!("{err}.semaphor_rw"));
+        let id = handle_of(&hli, &format!("{err}.satz_r.kopf.error_id"));
+        // MDI with a block: the model has no MDI execution.
+        command(
+            &hli,
+            Mode::Mdi as u32,
+            State::Active as u32,
+            "G01 X10 F1000",
+        );
+        assert_eq!(
+            mode_state(b),
+            (Mode::Automatic, State::Ready),
+            "nothing applied"
+        );
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, id, 4).unwrap(),
+            REFUSED_TRANSITION_ERROR.to_le_bytes()
+        );
+        // STANDBY/SELECTED: refused by the channel as a whole (the mode stays); posted after
+        // the PLC took the first.
+        command(&hli, Mode::Standby as u32, State::Selected as u32, "");
+        assert_eq!(
+            mode_state(b),
+            (Mode::Automatic, State::Ready),
+            "nothing applied"
+        );
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, id, 4).unwrap(),
+            REFUSED_TRANSITION_ERROR.to_le_bytes()
+        );
+        hli.write(GROUP_VALUE_BY_HANDLE, sem, &[0]).unwrap();
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(),
+            [0],
+            "no more"
+        );
+        // An accepted command posts nothing.
+        command(&hli, Mode::Automatic as u32, State::Ready as u32, "");
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [0]);
+    }
+
+    #[test]
+    fn every_member_symbol_is_where_its_root_type_says() {
+        let t = testing::channels(2);
+        let hli = Hli::new(Arc::clone(&t.backend));
+        let img = hli.image().unwrap();
+        let mut roots: HashMap<usize, &Symbol> = HashMap::new();
+        for s in &img.symbols {
+            let ty = DataType::lookup(s.ty).unwrap_or_else(|| panic!("type {}", s.ty));
+            assert_eq!(ty.size_bytes(), Some(s.size as u32), "{}", s.name);
+            assert_eq!(ty.adst(), s.adst, "{}", s.name);
+            let Some(root) = roots.get(&s.root) else {
+                roots.insert(s.root, s);
+                continue;
+            };
+            let path = &s.name[root.name.len()..];
+            let root_ty = DataType::lookup(root.ty).unwrap();
+            assert_eq!(
+                root_ty.member_at(path),
+                Some((s.at as u32, s.size as u32, s.ty)),
+                "{}",
+                s.name
+            );
+        }
+    }
+
+    #[test]
+    fn uploads_agree_with_their_upload_info() {
+        let t = testing::channels(1);
+        let hli = Hli::new(Arc::clone(&t.backend));
+        let info = hli.read(GROUP_UPLOAD_INFO2, 0, 64).unwrap();
+        assert_eq!(info.len(), 64, "upload info 3");
+        assert_eq!(
+            hli.read(GROUP_UPLOAD_INFO2, 0, 24).unwrap(),
+            info[..24],
+            "upload info 2"
+        );
+        let w = |k: usize| {
+            u32::from_le_bytes([
+                info[4 * k],
+                info[4 * k + 1],
+                info[4 * k + 2],
+                info[4 * k + 3],
+            ])
+        };
+        let syms = hli.read(GROUP_SYMBOL_UPLOAD, 0, w(1)).unwrap();
+        assert_eq!(syms.len() as u32, w(1));
+        let mut at = 0;
+        let mut count = 0;
+        while at < syms.len() {
+            at += u32::from_le_bytes([syms[at], syms[at + 1], syms[at + 2], syms[at + 3]]) as usize;
+            count += 1;
+        }
+        assert_eq!((at, count), (syms.len(), w(0)));
+        let types = hli.read(GROUP_TYPE_UPLOAD, 0, w(3)).unwrap();
+        assert_eq!(types.len() as u32, w(3));
+        assert_eq!(
+            hli.read(GROUP_SYMBOL_UPLOAD, 0, w(1) - 1),
+            Err(AdsResult::INVALID_SIZE)
+        );
+        let by_name = hli
+            .read_write(
+                GROUP_TYPE_BY_NAME,
+                0,
+                u32::MAX,
+                b"HLI_PROC_TRANS_TO_MODE_STATE\0",
+            )
+            .unwrap();
+        assert_eq!(&by_name[16..20], &327u32.to_le_bytes());
+        assert_eq!(
+            hli.read_write(GROUP_TYPE_BY_NAME, 0, u32::MAX, b"NO_SUCH_TYPE\0"),
+            Err(SYMBOL_NOT_FOUND)
         );
     }
 

@@ -17,9 +17,14 @@ pub(crate) mod geo;
 pub(crate) mod hli;
 pub mod objects;
 pub mod payload;
+pub(crate) mod plc_types;
 pub mod result;
 pub(crate) mod sda;
 pub mod server;
+mod slots;
+pub(crate) mod sum;
+pub(crate) mod symbols;
+pub(crate) mod system;
 #[cfg(test)]
 pub(crate) mod testing;
 
@@ -28,3 +33,4 @@ pub use backend::{CncBackend, DeviceError};
 pub use frame::AmsAddr;
 pub use result::AdsResult;
 pub use server::{spawn, ServerConfig, ServerHandle};
+pub use slots::EVICT_QUIET;

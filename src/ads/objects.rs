@@ -7,9 +7,11 @@
 //! | 552 | SDA (NC variables) | [`super::sda`] |
 //! | 553 | COM (platform, channel, axis objects; description table) | [`super::com`] |
 //! | 851 | PLC runtime 1 (HLI symbols) | [`super::hli`] |
+//! | 10000 | TwinCAT system service (state, device info) | [`super::system`] |
 //!
 //! Port numbers: TwinSharp `CNC.cs` (`Connect(target, 551/552/553/851)`); 553 is also the
 //! documented COM port (ISG kernel docs 348532363). Any other port answers AMS error 6.
+//! Every port serves the ADS sum commands ([`super::sum`]) over its own objects.
 
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -19,12 +21,13 @@ use super::description::ObjectInfo;
 use super::hli::Hli;
 use super::result::AdsResult;
 use super::sda::Sda;
-use super::{com, geo, hli, sda};
+use super::sum::{self, Port};
+use super::{com, geo, hli, sda, system};
 
 /// AMS port of the CNC's COM task.
 pub(crate) const PORT_CNC_COM: u16 = com::PORT;
 /// Every AMS port served.
-pub(crate) const PORTS: [u16; 4] = [geo::PORT, sda::PORT, com::PORT, hli::PORT];
+pub(crate) const PORTS: [u16; 5] = [geo::PORT, sda::PORT, com::PORT, hli::PORT, system::PORT];
 
 /// Channel index group base (index-based, as the ISG SDK and `ncchannel stream` use it).
 pub(crate) const GROUP_CHANNEL: u32 = com::GROUP_CHANNEL_INDEX;
@@ -98,6 +101,7 @@ impl Devices {
             geo::PORT => geo::read(b, &self.hli, group, offset, length),
             sda::PORT => self.sda.read(group, offset, length),
             hli::PORT => self.hli.read(group, offset, length),
+            system::PORT => Err(AdsResult::INVALID_GROUP),
             _ => Err(AdsResult::SERVICE_NOT_SUPPORTED),
         }
     }
@@ -106,9 +110,10 @@ impl Devices {
     pub fn write(&self, port: u16, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
         match port {
             com::PORT => com::write(self.backend.as_ref(), &self.hli, group, offset, data),
-            geo::PORT => Err(AdsResult::ACCESS_DENIED),
+            geo::PORT => geo::write(self.backend.as_ref(), &self.hli, group, offset, data),
             sda::PORT => self.sda.write(group, offset, data),
             hli::PORT => self.hli.write(group, offset, data),
+            system::PORT => Err(AdsResult::INVALID_GROUP),
             _ => Err(AdsResult::SERVICE_NOT_SUPPORTED),
         }
     }
@@ -122,14 +127,28 @@ impl Devices {
         read_length: u32,
         data: &[u8],
     ) -> Result<Vec<u8>, AdsResult> {
+        if sum::is_sum(group) {
+            let on = OnPort {
+                devices: self,
+                port,
+            };
+            return sum::execute(&on, group, offset, read_length, data);
+        }
         match port {
             // COM objects have no ReadWrite service.
             com::PORT => Err(AdsResult::ACCESS_DENIED),
             geo::PORT => geo::read_write(self.backend.as_ref(), group, offset, read_length, data),
             sda::PORT => self.sda.read_write(group, offset, read_length, data),
             hli::PORT => self.hli.read_write(group, offset, read_length, data),
+            system::PORT => Err(AdsResult::INVALID_GROUP),
             _ => Err(AdsResult::SERVICE_NOT_SUPPORTED),
         }
+    }
+
+    /// ReadDeviceInfo's (major, minor, build, name) on `port`; `None` for the CNC tasks,
+    /// which answer with ncchannel's own (the server's default).
+    pub fn device_info(port: u16) -> Option<(u8, u8, u16, &'static str)> {
+        system::device_info(port)
     }
 
     /// Every object served for channel 1, port by port: the object map.
@@ -140,6 +159,33 @@ impl Devices {
         all.extend(sda::objects(1));
         all.extend(self.hli.objects()?);
         Ok(all)
+    }
+}
+
+/// One port's objects, as the sub-requests of a sum command reach them.
+struct OnPort<'d> {
+    devices: &'d Devices,
+    port: u16,
+}
+
+impl Port for OnPort<'_> {
+    fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+        self.devices.read(self.port, group, offset, length)
+    }
+
+    fn write(&self, group: u32, offset: u32, data: &[u8]) -> Result<(), AdsResult> {
+        self.devices.write(self.port, group, offset, data)
+    }
+
+    fn read_write(
+        &self,
+        group: u32,
+        offset: u32,
+        read_length: u32,
+        data: &[u8],
+    ) -> Result<Vec<u8>, AdsResult> {
+        self.devices
+            .read_write(self.port, group, offset, read_length, data)
     }
 }
 

@@ -8,8 +8,10 @@
 //! also reads and writes a variable with the handle as index offset: `Read/Write(0x1223<ch>,
 //! handle)`; that form is served too.
 //!
-//! ncchannel models the external variables `V.E.<name>` (LREAL, 8 bytes); other variable
-//! kinds (`V.G.*`, `V.A.*`, `V.P.*` …) are not modelled and answer "not found" (0x70C).
+//! Variables served: the external variables `V.E.<name>` (LREAL, 8 bytes, read and write) and
+//! the zero offsets `V.G.NP[i].V`, i = 1…6 for G54…G59 (read only: one DINT per configured
+//! axis of the channel, 0.1 µm, as TwinSharp `ZeroOffsets.cs` reads and decodes them). Other
+//! variable kinds (`V.A.*`, `V.P.*` …) are not modelled and answer "not found" (0x70C).
 //! Handles are `0x2000_0000 + n` for the n-th distinct name asked for (at most
 //! [`MAX_HANDLES`]); the same name always gets the same handle.
 
@@ -18,6 +20,7 @@ use std::sync::{Arc, Mutex};
 use super::backend::{CncBackend, DeviceError};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
+use crate::vocab::axis::slot_of;
 
 pub const PORT: u16 = 552;
 /// Decoder class instance of channel ch: `GROUP_DECODER + ch`.
@@ -37,6 +40,19 @@ const NO_MEMORY: AdsResult = AdsResult(0x70A);
 const LOGICAL: u32 = 0x100000;
 /// Bytes of a value: ncchannel's V.E. variables are LREAL.
 const VALUE_BYTES: usize = 8;
+/// Zero-offset tables `V.G.NP[1]` … `V.G.NP[6]` (G54…G59).
+const ZERO_OFFSETS: std::ops::RangeInclusive<usize> = 1..=6;
+/// 0.1 µm per mm: zero offsets on the wire.
+const TENTH_UM_PER_MM: f64 = 10_000.0;
+
+/// A variable a handle names.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Var {
+    /// `V.E.<name>`, the name upper case without `V.E.`.
+    External(String),
+    /// `V.G.NP[i].V`, i in [`ZERO_OFFSETS`].
+    ZeroOffset(usize),
+}
 
 /// The objects of channel `ch`'s decoder class, for the object map.
 pub fn objects(ch: u16) -> Vec<ObjectInfo> {
@@ -46,7 +62,7 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
         group,
         offset,
         name: name.into(),
-        ty: AdsType::Named("V.E.* → LREAL"),
+        ty: AdsType::Named("V.E.* LREAL; V.G.NP[i].V DINT[axes]"),
         size,
         access,
         unit: "",
@@ -90,12 +106,13 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
 /// The SDA task of one server: its variable handles.
 pub(crate) struct Sda {
     backend: Arc<dyn CncBackend>,
-    /// Handle n ↔ `names[n]` (upper case, without `V.E.`).
-    names: Mutex<Vec<String>>,
+    /// Handle n ↔ `names[n]`.
+    names: Mutex<Vec<Var>>,
 }
 
-/// `V.E.name` (any case) → `NAME`; other variable kinds → not found.
-fn ve_name(data: &[u8]) -> Result<String, AdsResult> {
+/// `V.E.name` (any case) → `NAME`, `V.G.NP[i].V` → zero offset i; other variables → not
+/// found.
+fn var_name(data: &[u8]) -> Result<Var, AdsResult> {
     let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
     if end == 0 || end > MAX_NAME_BYTES {
         return Err(AdsResult::INVALID_SIZE);
@@ -103,12 +120,18 @@ fn ve_name(data: &[u8]) -> Result<String, AdsResult> {
     let text = std::str::from_utf8(&data[..end])
         .map_err(|_| AdsResult::INVALID_DATA)?
         .trim();
-    match text.get(..4) {
-        Some(p) if p.eq_ignore_ascii_case("V.E.") && text.len() > 4 => {
-            Ok(text[4..].to_ascii_uppercase())
-        }
-        _ => Err(AdsResult::NOT_FOUND),
+    let upper = text.to_ascii_uppercase();
+    if let Some(name) = upper.strip_prefix("V.E.").filter(|n| !n.is_empty()) {
+        return Ok(Var::External(name.to_string()));
     }
+    upper
+        .strip_prefix("V.G.NP[")
+        .and_then(|rest| rest.strip_suffix("].V"))
+        .filter(|i| !i.is_empty() && i.bytes().all(|b| b.is_ascii_digit()))
+        .and_then(|i| i.parse::<usize>().ok())
+        .filter(|i| ZERO_OFFSETS.contains(i))
+        .map(Var::ZeroOffset)
+        .ok_or(AdsResult::NOT_FOUND)
 }
 
 fn value_arg(data: &[u8]) -> Result<f64, AdsResult> {
@@ -149,7 +172,7 @@ impl Sda {
         Ok(ch as u16)
     }
 
-    fn name_of(&self, handle: u32) -> Result<String, AdsResult> {
+    fn name_of(&self, handle: u32) -> Result<Var, AdsResult> {
         let i = handle
             .checked_sub(HANDLE_BASE)
             .ok_or(AdsResult::INVALID_OFFSET)? as usize;
@@ -157,11 +180,11 @@ impl Sda {
         names.get(i).cloned().ok_or(AdsResult::NOT_FOUND)
     }
 
-    fn handle(&self, ch: u16, name: String) -> Result<u32, AdsResult> {
-        // Only a variable that exists gets a handle.
-        self.backend
-            .read_ve(ch, &name)
-            .map_err(DeviceError::result)?;
+    fn handle(&self, ch: u16, name: Var) -> Result<u32, AdsResult> {
+        // Only a variable that exists gets a handle (zero offsets 1…6 always do).
+        if let Var::External(n) = &name {
+            self.backend.read_ve(ch, n).map_err(DeviceError::result)?;
+        }
         let mut names = self.names.lock().unwrap_or_else(|p| p.into_inner());
         let i = match names.iter().position(|n| *n == name) {
             Some(i) => i,
@@ -174,25 +197,51 @@ impl Sda {
         Ok(HANDLE_BASE + i as u32)
     }
 
-    fn value(&self, ch: u16, name: &str, read_length: u32) -> Result<Vec<u8>, AdsResult> {
-        if (read_length as usize) < VALUE_BYTES {
+    fn value(&self, ch: u16, var: &Var, read_length: u32) -> Result<Vec<u8>, AdsResult> {
+        let bytes = match var {
+            Var::External(name) => self
+                .backend
+                .read_ve(ch, name)
+                .map_err(DeviceError::result)?
+                .to_le_bytes()
+                .to_vec(),
+            Var::ZeroOffset(i) => self.zero_offset(ch, *i)?,
+        };
+        if (read_length as usize) < bytes.len() {
             return Err(AdsResult::INVALID_SIZE);
         }
-        let v = self
-            .backend
-            .read_ve(ch, name)
-            .map_err(DeviceError::result)?;
-        Ok(v.to_le_bytes().to_vec())
+        Ok(bytes)
     }
 
-    fn store(&self, ch: u16, name: &str, data: &[u8]) -> Result<(), AdsResult> {
-        self.backend
-            .write_ve(ch, name, value_arg(data)?)
-            .map_err(DeviceError::result)
+    /// `V.G.NP[i].V`: one DINT (0.1 µm, saturating) per configured axis of the channel, in
+    /// the channel's axis order.
+    fn zero_offset(&self, ch: u16, i: usize) -> Result<Vec<u8>, AdsResult> {
+        let v = self.backend.status(ch).map_err(DeviceError::result)?;
+        let table = v.zero_offsets.get(i - 1).ok_or(AdsResult::NOT_FOUND)?;
+        Ok(v.positions
+            .iter()
+            .filter_map(|(letter, _)| u8::try_from(*letter).ok().and_then(slot_of))
+            .flat_map(|slot| {
+                let tenth_um = (table[slot] * TENTH_UM_PER_MM).round();
+                (tenth_um.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32).to_le_bytes()
+            })
+            .collect())
+    }
+
+    /// Zero offsets are read only: the decoder takes its table from the parameter lists at
+    /// the start and runs ahead of execution by the lookahead (docs/ads.md).
+    fn store(&self, ch: u16, var: &Var, data: &[u8]) -> Result<(), AdsResult> {
+        match var {
+            Var::External(name) => self
+                .backend
+                .write_ve(ch, name, value_arg(data)?)
+                .map_err(DeviceError::result),
+            Var::ZeroOffset(_) => Err(AdsResult::ACCESS_DENIED),
+        }
     }
 
     /// `{u32 handle, u32 ndims, u32 index × ndims}` → (handle, bytes used). ncchannel's
-    /// V.E. variables are scalars: ndims must be 0.
+    /// variables are read whole: ndims must be 0.
     fn handle_head(data: &[u8]) -> Result<(u32, usize), AdsResult> {
         let handle = u32_at(data, 0)?;
         let ndims = u32_at(data, 4)?;
@@ -224,8 +273,8 @@ impl Sda {
                     .iter()
                     .position(|&b| b == 0)
                     .ok_or(AdsResult::INVALID_DATA)?;
-                let name = ve_name(&data[..end])?;
-                self.store(ch, &name, &data[end + 1..])
+                let var = var_name(&data[..end])?;
+                self.store(ch, &var, &data[end + 1..])
             }
             o if o >= HANDLE_BASE => self.store(ch, &self.name_of(o)?, data),
             HANDLE_BY_NAME | READ_BY_HANDLE | READ_BY_NAME => Err(AdsResult::ACCESS_DENIED),
@@ -247,14 +296,14 @@ impl Sda {
                 if read_length < 4 {
                     return Err(AdsResult::INVALID_SIZE);
                 }
-                let h = self.handle(ch, ve_name(data)?)?;
+                let h = self.handle(ch, var_name(data)?)?;
                 Ok(h.to_le_bytes().to_vec())
             }
             READ_BY_HANDLE => {
                 let (handle, _) = Self::handle_head(data)?;
                 self.value(ch, &self.name_of(handle)?, read_length)
             }
-            READ_BY_NAME => self.value(ch, &ve_name(data)?, read_length),
+            READ_BY_NAME => self.value(ch, &var_name(data)?, read_length),
             WRITE_BY_HANDLE | WRITE_BY_NAME => Err(AdsResult::ACCESS_DENIED),
             _ => Err(AdsResult::INVALID_OFFSET),
         }
@@ -290,7 +339,11 @@ mod tests {
             by_name
         );
         assert_eq!(
-            sda.read_write(0x122301, HANDLE_BY_NAME, 4, b"V.G.NP[1].V"),
+            sda.read_write(0x122301, HANDLE_BY_NAME, 4, b"V.G.NP[7].V"),
+            Err(AdsResult::NOT_FOUND)
+        );
+        assert_eq!(
+            sda.read_write(0x122301, HANDLE_BY_NAME, 4, b"V.G.NP[1].X"),
             Err(AdsResult::NOT_FOUND)
         );
         assert_eq!(

@@ -1,9 +1,10 @@
 //! The ADS/TCP server: accepts connections, frames requests, answers them through the object
 //! table, and pushes DeviceNotification frames.
 //!
-//! One thread per connection (at most `max_connections`, default 64; more are closed at once
-//! with a log line), one writer thread per connection draining its bounded send queue, plus
-//! one notification thread per connection that has notification handles. Channel calls may
+//! One thread per connection (at most `max_connections`, default 64; beyond that the
+//! connection quiet for longest gives its slot up, or the newcomer is closed: `slots.rs`),
+//! one writer thread per connection draining its bounded send queue, plus one notification
+//! thread per connection that has notification handles. Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
 //! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
@@ -24,6 +25,7 @@ use super::frame::{
 use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
+use super::slots::{Admission, Progress, Slots, EVICT_QUIET};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
@@ -129,9 +131,7 @@ impl ServerHandle {
             _ => self.local_addr,
         };
         let _ = TcpStream::connect_timeout(&wake, Duration::from_millis(500));
-        for s in lock(&self.shared.sockets).values() {
-            let _ = s.shutdown(Shutdown::Both);
-        }
+        self.shared.slots.close_all();
         if let Some(h) = self.accept.take() {
             let _ = h.join();
         }
@@ -151,8 +151,8 @@ struct Shared {
     devices: Devices,
     stopping: AtomicBool,
     active: AtomicUsize,
-    /// Clones of every open socket, to close them on shutdown.
-    sockets: Mutex<HashMap<u64, TcpStream>>,
+    /// Every open connection: closed on shutdown, the quietest evicted when full.
+    slots: Slots,
     /// Next AMS port handed out by the router "port connect" command.
     next_router_port: AtomicU16,
     /// Notification handles and sample rate in use over all connections.
@@ -160,7 +160,15 @@ struct Shared {
     /// Log lines that a client can provoke at will, at most one a second each.
     refused_log: RateLimitedLog,
     router_log: RateLimitedLog,
+    evicted_log: RateLimitedLog,
+    /// The line each connection may write when it ends (why), all together at
+    /// most [`CONN_LINES_PER_S`] a second: a thousand connections ending at once cost a
+    /// few lines and a count, not a thousand lines.
+    conn_log: RateLimitedLog,
 }
+
+/// Lines a second of [`Shared::conn_log`].
+const CONN_LINES_PER_S: u64 = 10;
 
 /// What the notification handles of all connections cost together.
 #[derive(Debug, Default)]
@@ -202,30 +210,48 @@ impl Shared {
     }
 }
 
-/// A log line a client can trigger as often as it sends: written at most once a second,
-/// with the count of the lines left out since.
+/// A log line a client can trigger as often as it sends: written at most `per_second` times
+/// a second, with the count of the lines left out since.
 struct RateLimitedLog {
-    state: Mutex<(Option<Instant>, u64)>,
+    per_second: u64,
+    state: Mutex<RateState>,
+}
+
+#[derive(Default)]
+struct RateState {
+    /// Start of the current one-second window and lines written in it.
+    window: Option<Instant>,
+    written: u64,
+    /// Lines left out since the last one written.
+    skipped: u64,
 }
 
 impl RateLimitedLog {
-    const EVERY: Duration = Duration::from_secs(1);
+    const WINDOW: Duration = Duration::from_secs(1);
 
-    fn new() -> Self {
+    fn new(per_second: u64) -> Self {
         RateLimitedLog {
-            state: Mutex::new((None, 0)),
+            per_second,
+            state: Mutex::new(RateState::default()),
         }
     }
 
     fn log(&self, msg: impl std::fmt::Display) {
         let mut st = lock(&self.state);
         let now = Instant::now();
-        if st.0.is_some_and(|t| now.duration_since(t) < Self::EVERY) {
-            st.1 += 1;
+        if st
+            .window
+            .is_none_or(|t| now.duration_since(t) >= Self::WINDOW)
+        {
+            st.window = Some(now);
+            st.written = 0;
+        }
+        if st.written >= self.per_second {
+            st.skipped += 1;
             return;
         }
-        let skipped = std::mem::take(&mut st.1);
-        st.0 = Some(now);
+        st.written += 1;
+        let skipped = std::mem::take(&mut st.skipped);
         drop(st);
         if skipped > 0 {
             log(format_args!(
@@ -265,16 +291,19 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
     }
     let listener = TcpListener::bind(config.bind)?;
     let local_addr = listener.local_addr()?;
+    let max_connections = config.max_connections;
     let shared = Arc::new(Shared {
         config,
         devices: Devices::new(backend),
         stopping: AtomicBool::new(false),
         active: AtomicUsize::new(0),
-        sockets: Mutex::new(HashMap::new()),
+        slots: Slots::new(max_connections),
         next_router_port: AtomicU16::new(32768),
         budget: Mutex::new(NotifyBudget::default()),
-        refused_log: RateLimitedLog::new(),
-        router_log: RateLimitedLog::new(),
+        refused_log: RateLimitedLog::new(1),
+        router_log: RateLimitedLog::new(1),
+        evicted_log: RateLimitedLog::new(1),
+        conn_log: RateLimitedLog::new(CONN_LINES_PER_S),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -288,7 +317,6 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
 }
 
 fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
-    let mut next_id: u64 = 0;
     for stream in listener.incoming() {
         if shared.stopping.load(Ordering::SeqCst) {
             return;
@@ -315,36 +343,75 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
             let _ = stream.shutdown(Shutdown::Both);
             continue;
         }
-        if shared.active.load(Ordering::SeqCst) >= cfg.max_connections {
-            shared.refused_log.log(format_args!(
-                "{peer}: connection limit {} reached: connection closed",
-                cfg.max_connections
-            ));
+        let Some((id, progress)) = admit(&shared, &stream, peer) else {
             let _ = stream.shutdown(Shutdown::Both);
             continue;
-        }
-        next_id += 1;
-        let id = next_id;
-        if let Ok(clone) = stream.try_clone() {
-            lock(&shared.sockets).insert(id, clone);
-        }
+        };
         shared.active.fetch_add(1, Ordering::SeqCst);
         let conn_shared = Arc::clone(&shared);
         let spawned = std::thread::Builder::new()
             .name(format!("ads-conn-{id}"))
             .spawn(move || {
                 let unrouted_ok = ip_listed || conn_shared.config.allow.is_empty();
-                if let Err(e) = serve_connection(stream, peer, unrouted_ok, &conn_shared) {
-                    log(format_args!("{peer}: {e}"));
+                let conn = Conn {
+                    peer,
+                    ip_routed: unrouted_ok,
+                    progress,
+                };
+                let ended = serve_connection(stream, &conn, &conn_shared);
+                // The server's own stop and an eviction (logged when it happened) are no
+                // fault of the client's.
+                let quiet = conn_shared.stopping.load(Ordering::SeqCst)
+                    || conn_shared.slots.was_evicted(id);
+                if let (Err(e), false) = (ended, quiet) {
+                    conn_shared.conn_log.log(format_args!("{peer}: {e}"));
                 }
-                lock(&conn_shared.sockets).remove(&id);
+                conn_shared.slots.leave(id);
                 conn_shared.active.fetch_sub(1, Ordering::SeqCst);
             });
         if spawned.is_err() {
-            lock(&shared.sockets).remove(&id);
+            shared.slots.leave(id);
             shared.active.fetch_sub(1, Ordering::SeqCst);
         }
     }
+}
+
+/// A slot for a new connection from `peer`, or `None` (logged) when the table is full of
+/// connections that made progress lately.
+fn admit(shared: &Shared, stream: &TcpStream, peer: SocketAddr) -> Option<(u64, Arc<Progress>)> {
+    let clone = stream.try_clone().ok()?;
+    match shared.slots.admit(clone, peer) {
+        Admission::Admitted(id, progress) => Some((id, progress)),
+        Admission::Evicted {
+            id,
+            progress,
+            victim,
+            quiet,
+        } => {
+            shared.evicted_log.log(format_args!(
+                "connection limit {} reached: {victim} (no request for {:.1} s) closed to serve {peer}",
+                shared.config.max_connections,
+                quiet.as_secs_f64()
+            ));
+            Some((id, progress))
+        }
+        Admission::Full => {
+            shared.refused_log.log(format_args!(
+                "{peer}: connection limit {} reached (every connection made a request within {} s): connection closed",
+                shared.config.max_connections,
+                EVICT_QUIET.as_secs()
+            ));
+            None
+        }
+    }
+}
+
+/// Who a connection serves.
+struct Conn {
+    peer: SocketAddr,
+    /// The peer's IP is routed (or every client is): frames need no routed source NetId.
+    ip_routed: bool,
+    progress: Arc<Progress>,
 }
 
 /// The writing half of a connection, shared by the request loop and the notifier: a queue
@@ -470,11 +537,6 @@ struct Notification {
     armed: bool,
 }
 
-/// After the AddDeviceNotification response is written, the first sample waits this long, so
-/// the client has registered the handle (Beckhoff's AdsLib adds it to its table only after
-/// the response returns; a sample before that is dropped).
-const FIRST_SAMPLE_DELAY: Duration = Duration::from_millis(20);
-
 /// Per-connection notification table, polled by the notifier thread.
 struct Notifications {
     table: Mutex<HashMap<u32, Notification>>,
@@ -494,12 +556,7 @@ enum ConnError {
     Idle(String),
 }
 
-fn serve_connection(
-    stream: TcpStream,
-    peer: SocketAddr,
-    ip_routed: bool,
-    shared: &Arc<Shared>,
-) -> Result<(), ConnError> {
+fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Result<(), ConnError> {
     stream.set_nodelay(true)?;
     stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
     // Poll often enough to notice an idle timeout or an overflowed send queue.
@@ -522,14 +579,7 @@ fn serve_connection(
         closed: AtomicBool::new(false),
         notifier: Mutex::new(None),
     });
-    let result = request_loop(
-        stream.try_clone()?,
-        peer,
-        ip_routed,
-        shared,
-        &writer,
-        &notifs,
-    );
+    let result = request_loop(stream.try_clone()?, conn, shared, &writer, &notifs);
     notifs.closed.store(true, Ordering::SeqCst);
     let notifier = lock(&notifs.notifier).take();
     if let Some(h) = notifier {
@@ -545,12 +595,12 @@ fn serve_connection(
 
 fn request_loop(
     mut stream: TcpStream,
-    peer: SocketAddr,
-    ip_routed: bool,
+    conn: &Conn,
     shared: &Arc<Shared>,
     writer: &Writer,
     notifs: &Arc<Notifications>,
 ) -> Result<(), ConnError> {
+    let (peer, ip_routed) = (conn.peer, conn.ip_routed);
     let max = shared.config.max_frame_bytes;
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
@@ -577,6 +627,7 @@ fn request_loop(
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
                         send(writer, &reply)?;
+                        conn.progress.mark();
                         if header.command == CommandId::AddDeviceNotification {
                             arm_notifications(notifs);
                         }
@@ -595,6 +646,7 @@ fn request_loop(
                 Frame::Router { command, body } => {
                     if let Some(reply) = handle_router(command, &body, peer, shared) {
                         send(writer, &reply)?;
+                        conn.progress.mark();
                     }
                 }
             }
@@ -697,12 +749,17 @@ fn close_port(shared: &Shared, notifs: &Notifications, body: &[u8]) {
     shared.release(&removed);
 }
 
-/// Let the notifications just added send their first sample, [`FIRST_SAMPLE_DELAY`] from now.
+/// Let the notifications just added send their first sample now. Their response is already
+/// in the connection's send queue, so the sample follows it on the wire (a client learns the
+/// handle before its first sample), one notifier wake-up after the add.
 fn arm_notifications(notifs: &Notifications) {
-    let due = Instant::now() + FIRST_SAMPLE_DELAY;
+    let due = Instant::now();
     for n in lock(&notifs.table).values_mut().filter(|n| !n.armed) {
         n.armed = true;
         n.next_due = due;
+    }
+    if let Some(h) = lock(&notifs.notifier).as_ref() {
+        h.thread().unpark();
     }
 }
 
@@ -777,10 +834,15 @@ fn handle_request(
         }
         Some(Err(e)) => error_payload(header.command, e.result()),
         Some(Ok(req)) => match req {
-            Request::ReadDeviceInfo => {
-                let (major, minor, build) = version_numbers();
-                response::device_info(major, minor, build, &device_name())
-            }
+            Request::ReadDeviceInfo => match Devices::device_info(port) {
+                Some((major, minor, build, name)) => {
+                    response::device_info(major, minor, build, name)
+                }
+                None => {
+                    let (major, minor, build) = version_numbers();
+                    response::device_info(major, minor, build, &device_name())
+                }
+            },
             Request::ReadState => response::state(5, 0),
             Request::WriteControl { ads_state, .. } => response::result_only(if ads_state == 5 {
                 AdsResult::OK
@@ -940,7 +1002,8 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
                 return;
             }
         }
+        // Parked, not asleep: arm_notifications wakes it for a new handle's first sample.
         let wait = next.saturating_duration_since(Instant::now());
-        std::thread::sleep(wait.max(Duration::from_micros(500)));
+        std::thread::park_timeout(wait.max(Duration::from_micros(500)));
     }
 }

@@ -50,6 +50,9 @@ pub enum Op {
     DrainExecuted,
     /// The motion traces of `run --plot` and `--trace` ([`Reply::Trace`]).
     Trace(TraceOp),
+    /// The text of this file program while the decoder runs it ([`Reply::ProgramText`]): the
+    /// live view's listing. A shared handle to the decoder's copy, so the tick copies nothing.
+    ProgramText(Arc<str>),
 }
 
 /// What `run` asks of the motion trace.
@@ -77,6 +80,8 @@ pub enum HmiOp {
     Search(SearchCommand),
     /// Forget the cycle-time statistics (`cnc_time_reset`).
     ResetCycleTimes,
+    /// The HMI's feed hold (`mc_feedhold_channel_w`): TRUE holds, FALSE releases.
+    FeedHold(bool),
 }
 
 /// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
@@ -148,6 +153,17 @@ pub struct Status {
     pub(crate) pcs_positions: Vec<(char, f64)>,
     /// The latest operator message of `#MSG` (empty after a reset).
     pub message: Option<String>,
+    /// Blocks decoded and waiting in the block queue for the lookahead window
+    /// (`mc_slope_buf_level`; `ipo_blocks` counts those in the window).
+    pub(crate) queued_blocks: usize,
+    /// Programs that ran to their end (M02/M30) since the channel was built
+    /// (`mc_program_count_r`).
+    pub(crate) programs_ended: u64,
+    /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
+    /// set it (`V.G.NP[1..6].V`).
+    pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
+    /// Path length left in the executing move, mm (the DRO's distance to go).
+    pub distance_to_go_mm: f64,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -173,6 +189,8 @@ pub enum Reply {
     Executed(Vec<ExecutedBlock>),
     /// A trace file could not be written: the reason.
     Trace(Result<(), String>),
+    /// The program text [`Op::ProgramText`] asked for; `None` when no frame runs it.
+    ProgramText(Option<Arc<[u8]>>),
 }
 
 /// An error as the ADS objects carry it: number and text.
@@ -218,5 +236,9 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
         message: c.message().map(str::to_string),
+        queued_blocks: c.queued_blocks(),
+        programs_ended: c.stats().programs_ended,
+        zero_offsets: *c.zero_offsets(),
+        distance_to_go_mm: c.motion().distance_to_go_mm(),
     }
 }

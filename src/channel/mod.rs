@@ -107,7 +107,7 @@ pub struct ChannelStats {
 
 /// What an HMI commands besides mode and state: the COM task's `mc_command_*` objects
 /// (ISG kernel object list, `SamWieHTWG/web-api` `examples/example1-hello-cnc/cnc_objects.csv`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct HmiCommands {
     /// `mc_command_single_block_w`: one block per start.
     pub(crate) single_block: bool,
@@ -117,11 +117,14 @@ pub(crate) struct HmiCommands {
     pub(crate) skip_levels: u32,
     /// `mc_command_execution_mode_w`: bit 0 = block search at the next start.
     pub(crate) execution_mode: i32,
+    /// `mc_feedhold_channel_w`: the HMI's feed hold holds the running program; only its
+    /// release (or an operator start, a reset, the program's end) lets it go.
+    pub(crate) feed_hold: bool,
     pub search: SearchCommand,
 }
 
 /// Block-search parameters (`mc_cmd_bs_*_w`, TwinSharp `BlockSearch.cs`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SearchCommand {
     /// `mc_cmd_bs_type_w`: 1 file offset, 3 block counter, 4 block number.
     pub kind: u16,
@@ -131,6 +134,22 @@ pub struct SearchCommand {
     pub(crate) block_count: u32,
     /// `mc_cmd_bs_block_number_w`: the N number.
     pub(crate) block_number: u32,
+    /// `mc_cmd_bs_distance_prog_start_w`: path distance from the program start where
+    /// machining is to continue, 0.1 µm.
+    pub(crate) distance_prog_start_tenth_um: f64,
+    /// `mc_cmd_bs_covered_distance_w`: share of the found block already covered, 0.1 %
+    /// (0..=1000).
+    pub(crate) covered_distance_per_mil: f64,
+    /// `mc_cmd_bs_auto_return_w`: return to the contour automatically.
+    pub(crate) auto_return: bool,
+    /// `mc_cmd_bs_deviation_max_w`: largest axis deviation from the continuation position
+    /// at the restart, 0.1 µm.
+    pub(crate) deviation_max_tenth_um: u32,
+    /// `mc_cmd_bs_no_hold_at_restart_w`: resume on the contour without an operator start.
+    pub(crate) no_hold_at_restart: bool,
+    /// `mc_cmd_bs_breakpoint_position_w`: automatic breakpoint, distance from the program
+    /// start, 0.1 µm.
+    pub(crate) breakpoint_tenth_um: f64,
 }
 
 /// Execution mode bit: block search at the next program start.
@@ -205,6 +224,9 @@ pub struct Channel {
     single_flushes: usize,
     /// G54…G59 offsets (mm), for positions in the programming coordinate system.
     zero_offsets: ZeroOffsets,
+    /// The last started main program's name and text (a shared handle to the decoder's copy),
+    /// so the live view lists it after the decoder has read past its end.
+    main_text: Option<(Arc<str>, Arc<[u8]>)>,
 }
 
 impl Channel {
@@ -262,6 +284,7 @@ impl Channel {
                     Ok(())
                 }
                 HmiOp::ResetCycleTimes => Ok(()),
+                HmiOp::FeedHold(on) => self.set_feed_hold(tick, on),
             }),
             Op::ErrorRecord(i) => Reply::ErrorRecord {
                 total: self.stats().errors,
@@ -292,6 +315,7 @@ impl Channel {
                     .map_err(|e| format!("{}: {e}", path.display())),
                 TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
             }),
+            Op::ProgramText(prog) => Reply::ProgramText(self.program_text(&prog)),
         }
     }
 
@@ -337,6 +361,7 @@ impl Channel {
             single_credit: false,
             single_flushes: 0,
             zero_offsets,
+            main_text: None,
         }
     }
 
@@ -354,6 +379,10 @@ impl Channel {
     }
     pub fn store_stats(&self) -> StoreStats {
         self.store.stats()
+    }
+    /// The program files this channel finds by name (its search paths).
+    pub(crate) fn store(&self) -> &ProgramStore {
+        &self.store
     }
     pub fn cache(&self) -> &Cache {
         &self.cache
@@ -465,6 +494,10 @@ impl Channel {
     }
 
     fn set_state(&mut self, tick: &Tick, state: State) {
+        if !matches!(state, State::Active | State::Hold) {
+            // No program runs: nothing is held.
+            self.hmi.feed_hold = false;
+        }
         if self.state != state {
             self.state = state;
             self.push_state(tick);
@@ -661,6 +694,10 @@ impl Channel {
             });
         }
         self.running_prog = Some(name.into());
+        self.main_text = self
+            .decoder
+            .program_text(name)
+            .map(|t| (Arc::from(name), t));
         self.set_state(tick, State::Active);
         self.drain_decoder_notes(tick);
         Ok(())
@@ -674,8 +711,28 @@ impl Channel {
         }
     }
 
+    /// `mc_feedhold_channel_w`: TRUE holds a running program (refused when none runs: nothing
+    /// to hold); FALSE releases the feed hold and resumes, and only it: a channel held by a
+    /// programmed stop or a single block stays held. Repeating a value changes nothing.
+    fn set_feed_hold(&mut self, tick: &Tick, on: bool) -> Result<(), CommandError> {
+        match (on, self.hmi.feed_hold) {
+            (true, true) | (false, false) => Ok(()),
+            (true, false) if self.state == State::Active => {
+                self.hmi.feed_hold = true;
+                self.hold(tick);
+                Ok(())
+            }
+            (true, false) => Err(self.busy()),
+            (false, true) => {
+                self.resume(tick);
+                Ok(())
+            }
+        }
+    }
+
     /// Resume after hold (0x137).
     fn resume(&mut self, tick: &Tick) {
+        self.hmi.feed_hold = false;
         if self.state == State::Hold {
             self.single_credit = true;
             self.motion.set_hold(false);
@@ -709,9 +766,24 @@ impl Channel {
     pub(crate) fn active_block(&self) -> Option<&ActiveBlock> {
         self.active.as_ref()
     }
+    /// The text of file program `prog`: an open decoder frame's, or the last main program's.
+    fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+        self.decoder.program_text(prog).or_else(|| {
+            let (name, text) = self.main_text.as_ref()?;
+            (**name == *prog).then(|| Arc::clone(text))
+        })
+    }
     /// The main program running (ACTIVE or HOLD), if any.
     pub(crate) fn running_program(&self) -> Option<&str> {
         self.running_prog.as_deref()
+    }
+    /// The zero-offset table G54…G59 (`V.G.NP[i].V`).
+    pub(crate) fn zero_offsets(&self) -> &ZeroOffsets {
+        &self.zero_offsets
+    }
+    /// Blocks decoded and waiting for the lookahead window (`mc_slope_buf_level`).
+    pub(crate) fn queued_blocks(&self) -> usize {
+        self.queue.len()
     }
     /// Blocks handed to the interpolator and not yet done (`mc_ipo_buf_level`).
     pub(crate) fn ipo_blocks(&self) -> usize {

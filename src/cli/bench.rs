@@ -15,8 +15,25 @@ use crate::runtime::{bare_loop, Clock, Runtime};
 use crate::soak::load::streaming_channels;
 use crate::vocab::stats::Histogram;
 
+use super::bench_ads::{AdsBench, LineKind};
+
+/// What the bench measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchLoad {
+    /// The cycle's work and lateness against a bare spin_sleep loop, channels streaming
+    /// in-process (default start-up list params/soak/startup4.lis).
+    Cycle,
+    /// The stream interface's throughput over a real ADS/TCP connection: one sequential
+    /// client streaming 17-byte lines into channel 1 (default start-up list params/startup.lis,
+    /// the shipped settings).
+    AdsStream,
+}
+
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
+    /// What to measure.
+    #[arg(long, value_enum, default_value_t = BenchLoad::Cycle)]
+    pub load: BenchLoad,
     /// Cycle time in microseconds.
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(10..=1_000_000))]
     pub period_us: u64,
@@ -29,13 +46,21 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=12))]
     pub channels: u32,
     /// Start-up list the channels are built from (its channels are reused in turn when it
-    /// has fewer than --channels).
-    #[arg(long, default_value = "params/soak/startup4.lis")]
-    pub params: PathBuf,
+    /// has fewer than --channels); default by --load (outside a clone, the shipped lists built
+    /// into the binary).
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+    /// --load ads-stream: what the streamed 17-byte lines do.
+    #[arg(long, value_enum, default_value_t = LineKind::Params)]
+    pub lines: LineKind,
+    /// --load ads-stream: pause before a write answered busy (0x708) is sent again, µs.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
+    pub retry_us: u64,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write a lateness histogram (runtime and bare loop) as SVG here.
+    /// Write a lateness histogram (runtime and bare loop) here: SVG for FILE.svg, PNG for
+    /// FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }
@@ -51,15 +76,53 @@ fn print_hist(out: &mut Stdout, name: &str, h: &Histogram) {
     ));
 }
 
+/// The options checked before anything runs: `--plot`'s format and `--seconds`.
+fn check_args(args: &BenchArgs) -> Result<(), String> {
+    if let Some(p) = &args.plot {
+        if crate::destination::is_stdout(p) {
+            return Err("--plot -: the figures go to standard output; name a file".into());
+        }
+        crate::report::picture::Format::of(p).map_err(|e| format!("--plot {e}"))?;
+    }
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
+        return Err("--seconds must be in (0, 3600]".into());
+    }
+    Ok(())
+}
+
+/// The start-up list: --params, else `default` (from the current folder or the shipped set).
+fn start_list(args: &BenchArgs, default: &str) -> Result<PathBuf, String> {
+    let given = args
+        .params
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(default));
+    crate::params::shipped::locate(&given).map_err(|e| e.to_string())
+}
+
 pub fn execute(args: BenchArgs) -> ExitCode {
     let usage = |msg: String| {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::USAGE)
     };
-    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
-        return usage("--seconds must be in (0, 3600]".into());
+    if let Err(msg) = check_args(&args) {
+        return usage(msg);
     }
-    let params = &args.params;
+    if args.load == BenchLoad::AdsStream {
+        let params = match start_list(&args, "params/startup.lis") {
+            Ok(p) => p,
+            Err(e) => return usage(e),
+        };
+        return super::bench_ads::execute(&AdsBench {
+            params: &params,
+            seconds: args.seconds,
+            lines: args.lines,
+            retry: Duration::from_micros(args.retry_us),
+        });
+    }
+    let params = &match start_list(&args, "params/soak/startup4.lis") {
+        Ok(p) => p,
+        Err(e) => return usage(e),
+    };
     let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),
@@ -124,9 +187,13 @@ pub fn execute(args: BenchArgs) -> ExitCode {
         ));
     }
     if let Some(p) = &args.plot {
-        let svg = crate::report::plot::lateness_svg(&stats.lateness, &bare, period);
-        if let Err(e) = std::fs::write(p, svg) {
-            return usage(format!("--plot {}: {e}", p.display()));
+        let picture = crate::report::lateness::Lateness {
+            runtime: &stats.lateness,
+            bare: &bare,
+            period,
+        };
+        if let Err(e) = crate::report::picture::write(p, &picture) {
+            return usage(format!("--plot {e}"));
         }
         out.line(format_args!("histogram written to {}", p.display()));
     }

@@ -1,7 +1,8 @@
 //! `ncchannel check FILE...`: NC programs and parameter lists, errors with file:line:col.
 //!
-//! NC programs go through [`crate::lang::check_program`]; `.lis` and `.toml` files through
-//! the parameter checker. Directories are walked (sorted, not following the hidden `.`
+//! NC programs go through [`crate::lang::check_program`]; `.lis` files and `runtime.toml`
+//! through the parameter checker; any other `.toml` is a soak scenario (the parameter loader
+//! reads runtime settings only from a file of that name), checked as `ncchannel soak` loads it. Directories are walked (sorted, not following the hidden `.`
 //! entries) and every file with an NC or parameter extension in them is checked. Findings go
 //! to stdout as `file:line:col: error <id>: message` with the line and a caret; a summary goes
 //! to stderr. Exit 0 when nothing was found, 1 on any error (including an unreadable file).
@@ -13,7 +14,8 @@ use crate::diag::{Diagnostic, Severity};
 
 #[derive(Debug, clap::Args)]
 pub struct CheckArgs {
-    /// NC programs, parameter lists (`.lis`, `.toml`) or directories holding them.
+    /// NC programs, parameter lists (`.lis`, `runtime.toml`), soak scenarios (any other
+    /// `.toml`) or directories holding them.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
 }
@@ -135,12 +137,71 @@ fn check_file_summarized(
     path: &Path,
 ) -> (Vec<Diagnostic>, Vec<crate::params::catalog::ListSummary>) {
     if PARAM_EXTENSIONS.contains(&extension(path).as_str()) {
+        if extension(path) == "toml" && !is_runtime_file(path) {
+            return (check_scenario_file(path), Vec::new());
+        }
         if extension(path) == "toml" {
             return (check_params_file(path), Vec::new());
         }
         return crate::params::config::check_list_file_summarized(path);
     }
     (check_program_file(path), Vec::new())
+}
+
+/// Is `path` a runtime settings file (the one name the parameter loader reads them from)?
+fn is_runtime_file(path: &Path) -> bool {
+    path.file_name()
+        .is_some_and(|n| n == crate::params::config::RUNTIME_FILE)
+}
+
+/// Check a soak scenario as the command that reads it loads it (every key, every range):
+/// `ncchannel soak`'s when it describes the built-in client (`[length]`, `[feeder]`, …),
+/// `serve --soak`'s when it has none of those tables; and that the start-up list it names
+/// exists (the list itself is checked where it is named or walked).
+fn check_scenario_file(path: &Path) -> Vec<Diagnostic> {
+    use crate::soak::scenario::{Scenario, ScenarioError};
+    let external = read_text(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .is_some_and(|doc| {
+            !crate::soak::external::CLIENT_KEYS
+                .iter()
+                .any(|k| doc.contains_key(*k))
+        });
+    let loaded = if external {
+        let shown = format!("{}: ", path.display());
+        crate::soak::external::load_external(path).map_err(|m| {
+            let m = m.strip_prefix(&shown).unwrap_or(&m);
+            format!("scenario for serve --soak: {m}")
+        })
+    } else {
+        Scenario::load(path).map_err(|e| match e {
+            ScenarioError::Io { source, .. } => format!("cannot read file: {source}"),
+            ScenarioError::Toml { msg, .. } | ScenarioError::Invalid { msg, .. } => {
+                format!("scenario: {msg}")
+            }
+        })
+    };
+    match loaded {
+        Ok(s) => {
+            let params = s.params_path();
+            if params.is_file() {
+                Vec::new()
+            } else {
+                vec![Diagnostic::error(
+                    path,
+                    0,
+                    0,
+                    None,
+                    format!(
+                        "scenario: the start-up list {} does not exist",
+                        params.display()
+                    ),
+                )]
+            }
+        }
+        Err(msg) => vec![Diagnostic::error(path, 0, 0, None, msg)],
+    }
 }
 
 /// Check an NC program.

@@ -7,8 +7,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub(crate) mod bench;
+pub(crate) mod bench_ads;
 pub mod check;
+pub(crate) mod init;
 mod logger;
+pub(crate) mod manual;
 pub(crate) mod out;
 pub(crate) mod receive;
 pub(crate) mod run;
@@ -16,6 +19,7 @@ pub(crate) mod serve;
 pub(crate) mod serve_soak;
 pub(crate) mod signal;
 pub(crate) mod soak;
+pub(crate) mod soak_merge;
 pub(crate) mod stream;
 
 /// Exit codes of the command-line contract (README "Two commands").
@@ -51,15 +55,22 @@ pub struct Cli {
 pub enum Command {
     /// Measure the runtime's cycle in real time against a bare spin_sleep loop.
     Bench(bench::BenchArgs),
-    /// Check NC programs and parameter lists; errors as file:line:col.
+    /// Check NC programs, parameter lists and soak scenarios; errors as file:line:col.
     Check(check::CheckArgs),
+    /// Write the shipped parameter lists, scenarios and example programs into a folder to edit.
+    Init(init::InitArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(manual::CompletionsArgs),
+    /// Print the man page (roff).
+    Man,
     /// Run one program on a channel, optionally streamed by the built-in feeder.
     Run(run::RunArgs),
     /// Serve the channels over ADS/TCP in real time.
     Serve(serve::ServeArgs),
     /// Split received NC data into programs by start/end markers.
     Receive(receive::ReceiveArgs),
-    /// Soak test: run a scenario (params/soak/*.toml) and check its invariants.
+    /// Soak test: run scenarios (params/soak/*.toml) and check their invariants; a campaign
+    /// of scenarios × seeds, or one shard of it; `soak merge` joins shard reports.
     Soak(soak::SoakArgs),
     /// Stream an NC file into a channel over ADS (whole lines, CR LF, retry when busy).
     Stream(stream::StreamArgs),
@@ -71,6 +82,9 @@ impl Cli {
         match self.command {
             Some(Command::Bench(args)) => bench::execute(args),
             Some(Command::Check(args)) => check::execute(args),
+            Some(Command::Init(args)) => init::execute(args),
+            Some(Command::Completions(args)) => manual::completions(args),
+            Some(Command::Man) => manual::man(),
             Some(Command::Receive(args)) => receive::execute(args),
             Some(Command::Run(args)) => run::execute(args),
             Some(Command::Serve(args)) => serve::execute(args),

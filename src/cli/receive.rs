@@ -70,9 +70,11 @@ pub struct ReceiveArgs {
     /// zero-padded; without `:W`, as in the default, in 3 (`received_001.nc`).
     #[arg(long, value_name = "TEMPLATE", default_value = "received_{n}.nc")]
     pub(crate) name_template: String,
-    /// Start-up list whose channel decides the default program directory.
-    #[arg(long, default_value = "params/startup.lis")]
-    pub params: PathBuf,
+    /// Start-up list whose channel decides the default program directory: this, else
+    /// $NCCHANNEL_PARAMS, else ./params/startup.lis; without any, programs go to the current
+    /// folder.
+    #[arg(long, env = "NCCHANNEL_PARAMS")]
+    pub params: Option<PathBuf>,
     /// Channel (1-based) whose first program path is the default program directory.
     #[arg(long, default_value_t = 1)]
     pub channel: u32,
@@ -87,6 +89,19 @@ pub(crate) const DEFAULT_MAX_CONCURRENT: u16 = 4;
 
 /// Where programs go without `--out`: the channel's first main-program search path, from the
 /// parameter lists, so received programs are ready to run.
+/// The start-up list whose program folder receives programs: the one named, else
+/// ./params/startup.lis when it exists. Not the set built into the binary: received programs
+/// belong to the user, not to a cache folder.
+fn installation_list(given: Option<&Path>) -> Option<PathBuf> {
+    match given {
+        Some(p) => Some(p.to_path_buf()),
+        None => {
+            let p = Path::new(crate::params::shipped::DEFAULT_STARTUP_LIST);
+            p.exists().then(|| p.to_path_buf())
+        }
+    }
+}
+
 pub(crate) fn default_out_dir(params: &Path, channel: u32) -> Result<PathBuf, String> {
     let config = crate::params::load(params).map_err(|e| {
         for d in e.diagnostics() {
@@ -137,7 +152,10 @@ fn run(args: ReceiveArgs) -> Result<u8, Failure> {
     let (markers, template, limits) = settings(&args)?;
     let out = match args.out.clone() {
         Some(o) => o,
-        None => default_out_dir(&args.params, args.channel).map_err(Failure::Usage)?,
+        None => match installation_list(args.params.as_deref()) {
+            Some(params) => default_out_dir(&params, args.channel).map_err(Failure::Usage)?,
+            None => PathBuf::from("."),
+        },
     };
     let mut cfg = WriterConfig::new(&out);
     cfg.overwrite = args.overwrite;

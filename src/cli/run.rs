@@ -30,8 +30,9 @@ pub struct RunArgs {
     /// (with a `/`, or absolute), whose folder is then searched first for it and its
     /// subroutines. Default: the channel's streaming program when --stream is given.
     pub program: Option<String>,
-    /// Start-up list.
-    #[arg(long, default_value = "params/startup.lis")]
+    /// Start-up list: this, else $NCCHANNEL_PARAMS, else ./params/startup.lis, else the set
+    /// built into the binary (`ncchannel init DIR` writes it out to edit).
+    #[arg(long, env = "NCCHANNEL_PARAMS", default_value = "params/startup.lis")]
     pub params: PathBuf,
     /// Channel number, 1-based.
     #[arg(long, default_value_t = 1)]
@@ -64,14 +65,16 @@ pub struct RunArgs {
     /// Event log (JSON Lines): a file, or - for standard output.
     #[arg(long)]
     pub events: Option<String>,
-    /// Write the report JSON here.
+    /// Write the report JSON here (- for standard output).
     #[arg(long)]
     pub report: Option<PathBuf>,
-    /// Draw the tool path and path velocity (interrupts marked) into this SVG file.
+    /// Draw the tool path at 1:1 (working plane and two side views) and the path velocity,
+    /// acceleration and jerk, interrupts marked: SVG for FILE.svg (or - for standard output),
+    /// PNG for FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Write the interpolated motion to this CSV file: time, axis positions, path velocity,
-    /// acceleration and jerk.
+    /// Write the interpolated motion to this CSV file (- for standard output): time, axis
+    /// positions, path velocity, acceleration and jerk.
     #[arg(long)]
     pub trace: Option<PathBuf>,
     /// One CSV row every this many ticks.
@@ -112,6 +115,64 @@ fn parse_skip_mask(s: &str) -> Result<u16, String> {
         None => s.parse::<u16>(),
     };
     r.map_err(|_| format!("'{s}' is not a mask from 0 to 65535 (decimal or 0x hex)"))
+}
+
+/// Where the files the arguments name are read from (`params::shipped::locate`): the start-up
+/// list, the --stream file and a PROGRAM path, each from the current folder or, for the
+/// shipped names outside a clone, the set built into the binary. A PROGRAM that is a file of
+/// the current folder is taken as a path (`run far.nc` runs ./far.nc); one written as a path
+/// that exists nowhere is a usage error, before any channel starts.
+fn locate_files(args: &mut RunArgs) -> Result<(), String> {
+    use crate::params::shipped::locate;
+    args.params = locate(&args.params).map_err(|e| e.to_string())?;
+    if let Some(s) = &args.stream {
+        args.stream = Some(locate(s).map_err(|e| e.to_string())?);
+    }
+    if let Some(p) = &args.program {
+        let path = Path::new(p);
+        let as_path = program_path(p).is_some();
+        if as_path || path.is_file() {
+            let found = locate(path).map_err(|e| e.to_string())?;
+            if !found.is_file() {
+                return Err(format!("{p}: no such program file"));
+            }
+            let shown = if found.is_absolute() || as_path {
+                found
+            } else {
+                Path::new(".").join(found)
+            };
+            args.program = Some(shown.to_string_lossy().into_owned());
+        }
+    }
+    Ok(())
+}
+
+/// A PROGRAM given by name must be found through the channel's search paths (or be its
+/// streaming program): otherwise a usage error (exit 2) names the folders searched, instead
+/// of a channel error with a summary of zeros.
+fn program_exists(
+    channels: &[crate::channel::Channel],
+    args: &RunArgs,
+    program: &str,
+) -> Result<(), String> {
+    use crate::source::store::ProgramKind;
+    let Some(c) = channels.get((args.channel as usize).wrapping_sub(1)) else {
+        return Ok(());
+    };
+    let store = c.store();
+    if store.is_streaming_program(program) || store.find(program, ProgramKind::Main).is_ok() {
+        return Ok(());
+    }
+    let dirs: Vec<String> = store
+        .search_dirs()
+        .iter()
+        .map(|d| d.dir.display().to_string())
+        .collect();
+    Err(format!(
+        "program {program} not found in the current folder nor in channel {}'s search paths ({})",
+        args.channel,
+        dirs.join(", ")
+    ))
 }
 
 /// A program argument that is a file path rather than a program name: it holds a path
@@ -180,7 +241,41 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(exit::USAGE)
 }
 
-pub fn execute(args: RunArgs) -> ExitCode {
+/// The output options that name standard output (`-`): at most one may, and then the human
+/// summary goes to stderr so standard output holds that output alone.
+fn stdout_outputs(args: &RunArgs) -> Vec<&'static str> {
+    let dash = |p: Option<&Path>| p.is_some_and(crate::destination::is_stdout);
+    [
+        ("--events", dash(args.events.as_deref().map(Path::new))),
+        ("--report", dash(args.report.as_deref())),
+        ("--plot", dash(args.plot.as_deref())),
+        ("--trace", dash(args.trace.as_deref())),
+    ]
+    .into_iter()
+    .filter_map(|(name, on)| on.then_some(name))
+    .collect()
+}
+
+/// The output options checked before the run: a picture format the extension names, and at
+/// most one output on standard output.
+fn check_outputs(args: &RunArgs) -> Result<(), String> {
+    if let Some(p) = &args.plot {
+        crate::report::picture::Format::of(p).map_err(|e| format!("--plot {e}"))?;
+    }
+    let on_stdout = stdout_outputs(args);
+    if on_stdout.len() > 1 {
+        return Err(format!(
+            "{} all name standard output (-); at most one may",
+            on_stdout.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+pub fn execute(mut args: RunArgs) -> ExitCode {
+    if let Err(msg) = check_outputs(&args).and_then(|()| locate_files(&mut args)) {
+        return usage(msg);
+    }
     let mut config = match load_config(&args.params) {
         Ok(c) => c,
         Err(msg) => return usage(msg),
@@ -208,6 +303,9 @@ pub fn execute(args: RunArgs) -> ExitCode {
         Ok(p) => p,
         Err(msg) => return usage(msg),
     };
+    if let Err(msg) = program_exists(&channels, &args, &program) {
+        return usage(msg);
+    }
     let feeder = match open_feeder(&args) {
         Ok(f) => f,
         Err(msg) => return usage(msg),
@@ -256,13 +354,19 @@ pub fn execute(args: RunArgs) -> ExitCode {
         period,
     );
     let c = &machine.channels()[args.channel as usize - 1];
+    let mut written = true;
     if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
         let title = format!("ncchannel run {program}");
-        if let Err(e) = crate::report::plot::write_svg(p, trace, &title) {
-            eprintln!("ncchannel run: --plot {}: {e}", p.display());
+        if let Err(e) = crate::report::plot::write(p, trace, &title) {
+            eprintln!("ncchannel run: --plot {e}");
+            written = false;
         }
     }
-    write_outputs(&mut machine, &args, &report);
+    written &= write_outputs(&mut machine, &args, &report);
+    if !written {
+        // An output the user asked for is missing: no run that leaves one out is a success.
+        return ExitCode::from(exit::USAGE);
+    }
     ExitCode::from(match outcome {
         Outcome::Ended => exit::OK,
         Outcome::Error => exit::CHANNEL_ERROR,
@@ -426,21 +530,27 @@ fn build_report(
     }
 }
 
-/// The event log written out, the report file and the human summary.
-fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) {
+/// The event log written out, the report file and the human summary; false when the report
+/// file could not be written.
+fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) -> bool {
     // A reader of `--events -` or of the summary that went away (`| head`) is no error of
     // the run (`super::out`).
     match machine.finish_log() {
         Err(e) if !super::out::reader_gone(&e) => eprintln!("ncchannel run: event log: {e}"),
         _ => {}
     }
+    let mut written = true;
     if let Some(p) = &args.report {
-        if let Err(e) = report.write_file(p) {
-            eprintln!("ncchannel run: --report {}: {e}", p.display());
+        match report.write_file(p) {
+            Err(e) if !super::out::reader_gone(&e) => {
+                eprintln!("ncchannel run: --report {}: {e}", p.display());
+                written = false;
+            }
+            _ => {}
         }
     }
-    // The summary goes to stderr when the events go to stdout, so a pipe gets pure JSON Lines.
-    let to_stderr = args.events.as_deref() == Some("-");
+    // The summary goes to stderr when an output goes to stdout, so a pipe gets that alone.
+    let to_stderr = !stdout_outputs(args).is_empty();
     let printed = if to_stderr {
         report.print_human(&mut std::io::stderr())
     } else {
@@ -450,6 +560,7 @@ fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) {
         Err(e) if !super::out::reader_gone(&e) => eprintln!("ncchannel run: summary: {e}"),
         _ => {}
     }
+    written
 }
 
 /// `--packet`: 1..=992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE, ISG FCT-C19 Data streaming);

@@ -19,8 +19,9 @@ use super::out::say;
 
 #[derive(Debug, Clone, clap::Args)]
 pub struct ServeArgs {
-    /// Start-up list.
-    #[arg(long, default_value = "params/startup.lis")]
+    /// Start-up list: this, else $NCCHANNEL_PARAMS, else ./params/startup.lis, else the set
+    /// built into the binary (`ncchannel init DIR` writes it out to edit).
+    #[arg(long, env = "NCCHANNEL_PARAMS", default_value = "params/startup.lis")]
     pub params: PathBuf,
     /// Listen address (default: runtime.toml `ads.bind`, 127.0.0.1:48898). Port 0 picks one.
     #[arg(long)]
@@ -48,13 +49,26 @@ pub struct ServeArgs {
     /// middle of a frame or holding no notification handles (default 60; docs/ads-limits.md).
     #[arg(long, value_name = "SECONDS")]
     pub(crate) ads_idle_timeout: Option<f64>,
+    /// Serve the live web view on this address (default 127.0.0.1:8080; loopback unless
+    /// --allow-non-loopback). Port 0 picks one.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080", conflicts_with = "soak")]
+    pub http: Option<SocketAddr>,
+    /// Let the web view's operator controls (start, hold, resume, reset, override) command the
+    /// channels; without it they are refused (HTTP 403).
+    #[arg(long, requires = "http")]
+    pub http_controls: bool,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
 }
 
+/// How long the stop waits for its last stderr lines to be written: a reader that does not
+/// read loses them rather than the exit.
+const FINAL_LINES_WAIT: Duration = Duration::from_millis(100);
+
 fn load_scenario(p: &std::path::Path) -> Result<Scenario, String> {
-    load_external(p)
+    let p = crate::params::shipped::locate(p).map_err(|e| e.to_string())?;
+    load_external(&p)
 }
 
 /// The ADS server's settings: the command line over runtime.toml's `[ads]`.
@@ -133,6 +147,40 @@ fn start(machine: &mut Machine, period: Duration, program: &str) {
     }
 }
 
+/// `--http`: the live web view over its own backend into the same runtime as ADS.
+fn spawn_web(
+    args: &ServeArgs,
+    rt: &mut Runtime<Machine>,
+    requests: crossbeam_channel::Sender<crate::machine::Request>,
+    channels: u16,
+) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
+    let Some(bind) = args.http else {
+        return Ok(None);
+    };
+    let controls = if args.http_controls {
+        crate::http::ControlAccess::Allowed
+    } else {
+        crate::http::ControlAccess::Refused
+    };
+    let config = crate::http::HttpConfig {
+        bind,
+        allow_non_loopback: args.allow_non_loopback,
+        controls,
+    };
+    let backend = Arc::new(ChannelBackend::new(requests, channels));
+    match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
+        Ok(h) => {
+            say(format_args!(
+                "web view on http://{}/ (controls {})",
+                h.local_addr(),
+                if args.http_controls { "on" } else { "off" }
+            ));
+            Ok(Some(h))
+        }
+        Err(e) => Err(usage(format!("--http {bind}: {e}"))),
+    }
+}
+
 pub fn execute(mut args: ServeArgs) -> ExitCode {
     let limit = match run_limit(args.seconds) {
         Ok(l) => l,
@@ -152,6 +200,10 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             }
             Err(msg) => return usage(msg),
         },
+    };
+    args.params = match crate::params::shipped::locate(&args.params) {
+        Ok(p) => p,
+        Err(e) => return usage(e.to_string()),
     };
     let (config, channels) = match super::run::load_channels(
         &args.params,
@@ -178,18 +230,26 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             report: args.report.clone(),
             period,
             channels: nch,
+            reply_timeout: config.runtime.ads.reply_timeout(),
         };
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
+    let web = match spawn_web(&args, &mut rt, requests.clone(), nch) {
+        Ok(w) => w,
+        Err(code) => return code,
+    };
     let server_config = server_config(&args, &config);
     let net_id = server_config.net_id;
-    let server =
-        match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
-            Ok(s) => s,
-            Err(e) => return usage(format!("cannot listen: {e}")),
-        };
-    say(format_args!(
+    let backend =
+        ChannelBackend::new(requests, nch).with_reply_timeout(config.runtime.ads.reply_timeout());
+    let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
+        Ok(s) => s,
+        Err(e) => return usage(format!("cannot listen: {e}")),
+    };
+    // From here on stderr is written through the logger's queue: a supervisor that stops
+    // reading it (a full pipe) must hold up neither the server nor the stop.
+    super::logger::line(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),
@@ -197,7 +257,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     ));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
-        Err(e) => say(format_args!(
+        Err(e) => super::logger::line(format_args!(
             "ncchannel serve: cannot handle SIGINT/SIGTERM: {e}"
         )),
     }
@@ -211,22 +271,30 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let summary = rt.run(None);
     // The tick in progress has finished; close the sockets, then write out the log.
     server.shutdown();
+    drop(web); // the web view stops polling and ends its pages' streams
+    stopped(rt, &summary, args.events.is_some())
+}
+
+/// After the stop: the summary line and the event log written out (exit 1 when it fails).
+fn stopped(rt: Runtime<Machine>, summary: &crate::runtime::RunSummary, events: bool) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
     let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
-    say(format_args!(
+    super::logger::line(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,
         summary.wall.as_secs_f64(),
         stats.describe()
     ));
     match log {
-        Ok(lines) if args.events.is_some() => say(format_args!("event log: {lines} lines")),
+        Ok(lines) if events => super::logger::line(format_args!("event log: {lines} lines")),
         Ok(_) => {}
         Err(e) => {
-            say(format_args!("ncchannel serve: event log: {e}"));
+            super::logger::line(format_args!("ncchannel serve: event log: {e}"));
+            super::logger::flush(FINAL_LINES_WAIT);
             return ExitCode::from(exit::CHANNEL_ERROR);
         }
     }
+    super::logger::flush(FINAL_LINES_WAIT);
     ExitCode::from(exit::OK)
 }

@@ -26,6 +26,9 @@ pub struct SoakServe {
     pub report: Option<PathBuf>,
     pub period: Duration,
     pub channels: u16,
+    /// runtime.toml `ads.reply_timeout_ms`: when a request the runtime has not answered is
+    /// refused 0x708.
+    pub reply_timeout: Duration,
 }
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
@@ -35,16 +38,17 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         report: report_path,
         period,
         channels: nch,
+        reply_timeout,
     } = soak;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let server =
-        match crate::ads::spawn(server_config, Arc::new(ChannelBackend::new(requests, nch))) {
-            Ok(s) => s,
-            Err(e) => {
-                say(format_args!("ncchannel serve: cannot listen: {e}"));
-                return ExitCode::from(exit::USAGE);
-            }
-        };
+    let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
+    let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
+        Ok(s) => s,
+        Err(e) => {
+            say(format_args!("ncchannel serve: cannot listen: {e}"));
+            return ExitCode::from(exit::USAGE);
+        }
+    };
     say(format_args!(
         "listening on {} (soak {}, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
@@ -69,6 +73,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         if warm_kib.is_none() && wall >= warmup {
             warm_kib = resident();
         }
+        announce_resets(&mut rt, period, live);
         if s.end == RunEnd::StopRequested || limit.is_some_and(|l| wall >= l) {
             break;
         }
@@ -144,6 +149,42 @@ fn report_of(
         memory,
         cycle_figures,
     )
+}
+
+/// One stderr line per reset the soak made since the last call, so the people behind a
+/// client learn that accepted lines were dropped and when the program restarts.
+fn announce_resets(rt: &mut Runtime<Supervised>, period: Duration, live: bool) {
+    let (notices, lost) = rt.cycle_mut().take_notices();
+    if notices.is_empty() && lost == 0 {
+        return;
+    }
+    let secs = |tick: u64| period.as_secs_f64() * tick as f64;
+    // On a terminal the live status line is cleared first (it is redrawn).
+    let clear = if live { "\r\x1b[2K" } else { "" };
+    let mut err = std::io::stderr().lock();
+    for n in notices {
+        let why = if n.after_error {
+            "after a channel error"
+        } else {
+            "injected"
+        };
+        let restart = n.restart_tick.map_or(String::new(), |t| {
+            format!(
+                "; READY until {:.3} s, then the streaming program restarts",
+                secs(t)
+            )
+        });
+        let _ = writeln!(
+            err,
+            "{clear}serve --soak: {:.3} s: channel {} reset ({why}): {} accepted line(s) dropped unexecuted{restart}",
+            secs(n.tick),
+            n.channel,
+            n.lines_dropped
+        );
+    }
+    if lost > 0 {
+        let _ = writeln!(err, "serve --soak: {lost} more reset(s) not shown");
+    }
 }
 
 fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {

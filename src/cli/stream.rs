@@ -21,7 +21,7 @@ pub struct StreamArgs {
     #[arg(long, default_value = "127.0.0.1:48898")]
     pub target: String,
     /// Target AMS NetId.
-    #[arg(long, default_value = "127.0.0.1.1.1")]
+    #[arg(long, default_value = "127.0.0.2.1.1")]
     pub net_id: AmsNetId,
     /// Our AMS NetId (default: local IPv4 address + .1.1).
     #[arg(long)]

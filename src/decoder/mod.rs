@@ -398,6 +398,14 @@ impl Decoder {
     pub(crate) fn set_skip_mask(&mut self, mask: u16) {
         self.skip_mask = mask;
     }
+    /// The text of the file program `prog` while a frame of it is open (the live view's
+    /// listing); `None` for the stream and for a program no frame runs.
+    pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+        self.frames.iter().rev().find_map(|f| match &f.source {
+            frame::Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
+            _ => None,
+        })
+    }
     pub fn depth(&self) -> usize {
         self.frames.len()
     }

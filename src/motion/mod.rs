@@ -196,6 +196,17 @@ impl Motion {
         }
     }
 
+    /// Path length left in the move executing now, mm (0 between moves, in a dwell or at rest
+    /// before the front move starts): the DRO's distance to go.
+    pub fn distance_to_go_mm(&self) -> f64 {
+        match self.planner.front().map(|e| &e.kind) {
+            Some(EntryKind::Move(seg)) if self.front_started => {
+                (seg.length_mm - self.s_mm).max(0.0)
+            }
+            _ => 0.0,
+        }
+    }
+
     /// Path acceleration of the axes over the last tick (change of the path velocity), mm/s².
     pub fn acceleration_mm_per_s2(&self) -> f64 {
         self.out_a_mm_per_s2

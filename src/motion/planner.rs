@@ -69,8 +69,10 @@ pub(crate) const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
 /// more than the vector's length (0.07 % measured at the full length).
 pub(crate) const BLEND_ACCEL_SHARE: f64 = 0.95;
 /// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
-/// window when a program is mostly assignments or M functions.
-const NON_MOTION_PER_BLOCK: usize = 4;
+/// window when a program is mostly assignments or M functions. It also bounds how many such
+/// blocks one tick takes in: 8 lets the default window (32 blocks, 304 entries) take a whole
+/// stream buffer of 17-byte assignments (241 lines) per tick, the interface's full rate.
+const NON_MOTION_PER_BLOCK: usize = 8;
 
 /// Planner settings (runtime.toml `[planner]`).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -89,36 +89,12 @@ impl Trace {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn decimation_keeps_the_bound_and_the_time_order() {
-        let mut t = Trace::new(100);
-        for k in 0..10_000 {
-            t.record(Sample {
-                time_s: k as f64,
-                pos: [0.0; 6],
-                velocity_mm_per_s: 0.0,
-                accel_mm_per_s2: 0.0,
-                jerk_mm_per_s3: 0.0,
-            });
-        }
-        assert!(t.samples().len() <= 100);
-        assert!(t.samples().len() >= 50);
-        assert!(t.samples().windows(2).all(|w| w[0].time_s < w[1].time_s));
-        assert_eq!(t.samples()[0].time_s, 0.0);
-    }
-}
-
 /// `run --trace FILE.csv`: the interpolated motion streamed to a file, one row every `every`
 /// ticks — channel time, each configured axis' position, path velocity, acceleration and jerk.
 /// Nothing is kept in memory beyond the writer's buffer; the first write error stops the
 /// trace and is reported by [`CsvTrace::finish`].
-#[derive(Debug)]
 pub(crate) struct CsvTrace {
-    out: std::io::BufWriter<std::fs::File>,
+    out: std::io::BufWriter<Box<dyn std::io::Write + Send>>,
     /// Axis indices written, in order.
     axes: Vec<usize>,
     every: u64,
@@ -126,11 +102,21 @@ pub(crate) struct CsvTrace {
     error: Option<std::io::Error>,
 }
 
+impl std::fmt::Debug for CsvTrace {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CsvTrace")
+            .field("axes", &self.axes)
+            .field("every", &self.every)
+            .field("ticks", &self.ticks)
+            .finish_non_exhaustive()
+    }
+}
+
 impl CsvTrace {
-    /// Create `path` and write the header.
+    /// Create `path` (`-`: standard output) and write the header.
     pub fn create(path: &std::path::Path, axes: &[usize], every: u64) -> std::io::Result<Self> {
         use std::io::Write;
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut out = std::io::BufWriter::new(crate::destination::create(path)?);
         let mut header = String::from("time_s");
         for &i in axes {
             let unit = if i < 3 { "mm" } else { "deg" };
@@ -178,5 +164,28 @@ impl CsvTrace {
             return Err(e);
         }
         self.out.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_keeps_the_bound_and_the_time_order() {
+        let mut t = Trace::new(100);
+        for k in 0..10_000 {
+            t.record(Sample {
+                time_s: k as f64,
+                pos: [0.0; 6],
+                velocity_mm_per_s: 0.0,
+                accel_mm_per_s2: 0.0,
+                jerk_mm_per_s3: 0.0,
+            });
+        }
+        assert!(t.samples().len() <= 100);
+        assert!(t.samples().len() >= 50);
+        assert!(t.samples().windows(2).all(|w| w[0].time_s < w[1].time_s));
+        assert_eq!(t.samples()[0].time_s, 0.0);
     }
 }

@@ -13,6 +13,7 @@ pub mod error_texts;
 pub mod list;
 pub(crate) mod runtime;
 pub(crate) mod search_path;
+pub mod shipped;
 pub(crate) mod startup;
 pub(crate) mod tools;
 pub(crate) mod value;

@@ -184,7 +184,7 @@ impl Default for PlannerConfig {
 pub struct AdsConfig {
     /// TCP address to listen on (default 127.0.0.1:48898, the ADS port, local only).
     pub bind: SocketAddrText,
-    /// Our AMS NetId (default 127.0.0.1.1.1).
+    /// Our AMS NetId (default 127.0.0.2.1.1, `vocab::ams::DEFAULT_NET_ID` says why).
     pub net_id: AmsNetId,
     /// Largest AMS/TCP frame accepted, in bytes (default 65536).
     pub max_frame_bytes: u32,
@@ -201,6 +201,16 @@ pub struct AdsConfig {
     /// Seconds without a whole frame after which a connection in the middle of a frame, or
     /// without notification handles, is closed (default 60).
     pub(crate) idle_timeout_s: u32,
+    /// Milliseconds a request waits for the runtime before it is answered 0x708 "busy, not
+    /// applied" (default 500); must stay below the clients' request timeouts (README).
+    pub reply_timeout_ms: u32,
+}
+
+impl AdsConfig {
+    /// `reply_timeout_ms` as the time a request waits for the runtime.
+    pub fn reply_timeout(&self) -> std::time::Duration {
+        std::time::Duration::from_millis(u64::from(self.reply_timeout_ms))
+    }
 }
 
 impl Default for AdsConfig {
@@ -210,7 +220,7 @@ impl Default for AdsConfig {
         use crate::vocab::ams;
         AdsConfig {
             bind: SocketAddrText(ams::DEFAULT_BIND),
-            net_id: AmsNetId([127, 0, 0, 1, 1, 1]),
+            net_id: ams::DEFAULT_NET_ID,
             max_frame_bytes: ams::DEFAULT_MAX_FRAME_BYTES as u32,
             allowed_clients: Vec::new(),
             max_connections: ams::DEFAULT_MAX_CONNECTIONS as u32,
@@ -218,6 +228,7 @@ impl Default for AdsConfig {
             max_notifications_total: ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL as u32,
             notification_samples_per_s: ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S as u32,
             idle_timeout_s: ams::DEFAULT_IDLE_TIMEOUT.as_secs() as u32,
+            reply_timeout_ms: ams::DEFAULT_REPLY_TIMEOUT.as_millis() as u32,
         }
     }
 }
@@ -568,6 +579,7 @@ fn validate_ads(cfg: &RuntimeConfig, fail: &mut impl FnMut(&str, Option<usize>, 
             1_000_000,
         ),
         ("idle_timeout_s", cfg.ads.idle_timeout_s, 86_400),
+        ("reply_timeout_ms", cfg.ads.reply_timeout_ms, 60_000),
     ] {
         if !(1..=max).contains(&v) {
             fail("ads", None, key, format!("{v} is not in 1 ... {max}"));

@@ -1,90 +1,113 @@
-//! The SVG plots, drawn with `plotters` (SVG backend):
-//! - `run --plot FILE.svg`: the tool path in the working plane and the path velocity,
-//!   acceleration and jerk over time, with axes, ticks, legends and the motion interrupts
-//!   marked, from the motion trace;
-//! - `bench --plot`: the lateness histogram, runtime and bare loop on one log-scaled time axis
-//!   with decade ticks, units and a legend, each p99 marked.
+//! `run --plot FILE`: the tool path at 1:1 in the working plane and in two side views along the
+//! tool axis (so a path that bends out of the plane shows its bend), and the path velocity,
+//! acceleration and jerk over channel time, with axes in mm and s, legends and the motion
+//! interrupts marked, from the motion trace. Written as SVG or PNG by `super::picture`.
 
+use std::ops::Range;
 use std::path::Path;
-use std::time::Duration;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::picture::{DrawResult, Picture, PictureError, FAMILY};
 use crate::motion::trace::{Sample, Trace};
+use crate::queue::Plane;
 use crate::vocab::axis::AXIS_LETTERS;
-use crate::vocab::stats::Histogram;
 
-const WIDTH: u32 = 1400;
-const HEIGHT: u32 = 900;
-/// Left panel (path) width, px; the time panels take the rest.
-const PATH_PANEL: u32 = 620;
+const WIDTH: u32 = 1500;
+const HEIGHT: u32 = 1000;
+/// Left column (the path views) width, px; the time panels take the rest.
+const PATH_COLUMN: u32 = 760;
+/// Height of the plane view, px, below the title; the side views take the rest.
+const PLANE_VIEW: u32 = 560;
+/// The tool path's colour in every view (tests find the path by it).
+pub(crate) const PATH: RGBColor = RGBColor(31, 95, 191);
 const INTERRUPT: RGBColor = RGBColor(214, 39, 40);
 
-/// Write the plot of `trace` to `path`.
-pub(crate) fn write_svg(path: &Path, trace: &Trace, title: &str) -> std::io::Result<()> {
-    std::fs::write(path, render_svg(trace, title))
+/// The plot of a run's trace.
+pub(crate) struct RunPlot<'a> {
+    pub trace: &'a Trace,
+    pub title: &'a str,
 }
 
-/// The plot as SVG text.
-pub(crate) fn render_svg(trace: &Trace, title: &str) -> String {
-    svg_of((WIDTH, HEIGHT), |root| draw(root, trace, title))
-}
-
-type DrawResult = Result<(), Box<dyn std::error::Error>>;
-
-/// An SVG document of `size` px drawn by `draw`. Drawing into a string cannot fail for I/O;
-/// a plotting error leaves a partial plot, which is still a valid SVG document.
-fn svg_of(
-    size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> DrawResult,
-) -> String {
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        let _ = draw(&root);
-        let _ = root.present();
-    }
-    svg
+/// Write the plot of `trace` to `path` (SVG or PNG by its extension, `-` SVG on stdout).
+pub(crate) fn write(path: &Path, trace: &Trace, title: &str) -> Result<(), PictureError> {
+    super::picture::write(path, &RunPlot { trace, title })
 }
 
 /// One time panel: caption, axis label, the sampled quantity, colour.
 type Series = (&'static str, &'static str, fn(&Sample) -> f64, RGBColor);
 
-fn draw(root: &DrawingArea<SVGBackend<'_>, Shift>, trace: &Trace, title: &str) -> DrawResult {
-    root.fill(&WHITE)?;
-    let n = trace.interrupts().len();
-    let root = root.titled(
-        &format!("{title} — {n} interrupt(s)"),
-        ("sans-serif", 20).into_font(),
-    )?;
-    let (left, right) = root.split_horizontally(PATH_PANEL);
-    path_panel(&left, trace)?;
-    let rows = right.split_evenly((3, 1));
-    let series: [Series; 3] = [
-        (
-            "path velocity",
-            "v (mm/s)",
-            |s| s.velocity_mm_per_s,
-            RGBColor(44, 160, 44),
-        ),
-        (
-            "path acceleration",
-            "a (mm/s²)",
-            |s| s.accel_mm_per_s2,
-            RGBColor(31, 95, 191),
-        ),
-        (
-            "path jerk",
-            "j (mm/s³)",
-            |s| s.jerk_mm_per_s3,
-            RGBColor(148, 103, 189),
-        ),
-    ];
-    for (area, (name, unit, value, color)) in rows.iter().zip(series) {
-        time_panel(area, trace, name, unit, value, color)?;
+const TIME_SERIES: [Series; 3] = [
+    (
+        "path velocity",
+        "v (mm/s)",
+        |s| s.velocity_mm_per_s,
+        RGBColor(44, 160, 44),
+    ),
+    (
+        "path acceleration",
+        "a (mm/s²)",
+        |s| s.accel_mm_per_s2,
+        RGBColor(255, 127, 14),
+    ),
+    (
+        "path jerk",
+        "j (mm/s³)",
+        |s| s.jerk_mm_per_s3,
+        RGBColor(148, 103, 189),
+    ),
+];
+
+impl Picture for RunPlot<'_> {
+    fn size(&self) -> (u32, u32) {
+        (WIDTH, HEIGHT)
     }
-    Ok(())
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let trace = self.trace;
+        root.fill(&WHITE)?;
+        let n = trace.interrupts().len();
+        let root = root.titled(
+            &format!("{} — {n} interrupt(s)", self.title),
+            (FAMILY, 20).into_font(),
+        )?;
+        let (left, right) = root.split_horizontally(PATH_COLUMN);
+        let (top, bottom) = left.split_vertically(PLANE_VIEW);
+        let plane = trace.plane();
+        let (a, b, normal) = plane.axes();
+        let name = |i: usize| AXIS_LETTERS[i] as char;
+        let caption = format!(
+            "tool path, {} plane {}–{}, 1:1",
+            g_code(plane),
+            name(a),
+            name(b)
+        );
+        path_view(&top, trace, (a, b), &caption, Marks::Interrupts)?;
+        let sides = bottom.split_evenly((1, 2));
+        for (area, first) in sides.iter().zip([a, b]) {
+            let caption = format!("side view {}–{}, 1:1", name(first), name(normal));
+            path_view(area, trace, (first, normal), &caption, Marks::None)?;
+        }
+        let rows = right.split_evenly((3, 1));
+        for (area, series) in rows.iter().zip(TIME_SERIES) {
+            time_panel(area, trace, series)?;
+        }
+        Ok(())
+    }
+}
+
+/// The G code that selects `plane`.
+fn g_code(plane: Plane) -> &'static str {
+    match plane {
+        Plane::Xy => "G17",
+        Plane::Zx => "G18",
+        Plane::Yz => "G19",
+    }
 }
 
 /// Lower and upper bound of `values` with a margin; a flat or empty series still gets a range.
@@ -101,60 +124,99 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn path_panel(area: &DrawingArea<SVGBackend<'_>, Shift>, trace: &Trace) -> DrawResult {
-    let (a, b, _) = trace.plane().axes();
-    let (la, lb) = (AXIS_LETTERS[a] as char, AXIS_LETTERS[b] as char);
+type Chart2d<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A chart on `area` holding `x` and `y` (mm) at one scale for both axes: the range of the
+/// axis with room to spare is widened around its middle until a millimetre is as many pixels
+/// across as up, so a circle is drawn round.
+fn one_to_one<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<Chart2d<'_, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let build = |x: Range<f64>, y: Range<f64>| {
+        ChartBuilder::on(area)
+            .margin(8)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(x, y)
+    };
+    // A chart without a caption draws nothing when built: this one only measures.
+    let (w_px, h_px) = build(x.0..x.1, y.0..y.1)?.plotting_area().dim_in_pixel();
+    let (w_px, h_px) = (f64::from(w_px.max(1)), f64::from(h_px.max(1)));
+    let mm_per_px = ((x.1 - x.0) / w_px).max((y.1 - y.0) / h_px);
+    let (cx, cy) = ((x.0 + x.1) / 2.0, (y.0 + y.1) / 2.0);
+    let (hw, hh) = (mm_per_px * w_px / 2.0, mm_per_px * h_px / 2.0);
+    build((cx - hw)..(cx + hw), (cy - hh)..(cy + hh))
+}
+
+/// What a path view marks besides the path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Marks {
+    /// A red circle where the motion was interrupted (the plane view).
+    Interrupts,
+    None,
+}
+
+/// The tool path projected on the axes `(x, y)`, at 1:1.
+fn path_view<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    trace: &Trace,
+    (x, y): (usize, usize),
+    caption: &str,
+    marks: Marks,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let area = area.margin(6, 6, 6, 6).titled(caption, (FAMILY, 15))?;
     let samples = trace.samples();
-    let (a0, a1) = range(samples.iter().map(|s| s.pos[a]));
-    let (b0, b1) = range(samples.iter().map(|s| s.pos[b]));
-    // Equal scale on both axes, centred.
-    let span = (a1 - a0).max(b1 - b0);
-    let (ca, cb) = ((a0 + a1) / 2.0, (b0 + b1) / 2.0);
-    let mut chart = ChartBuilder::on(&area.margin(10, 10, 10, 10))
-        .caption("tool path", ("sans-serif", 16))
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            (ca - span / 2.0)..(ca + span / 2.0),
-            (cb - span / 2.0)..(cb + span / 2.0),
-        )?;
+    let xr = range(samples.iter().map(|s| s.pos[x]));
+    let yr = range(samples.iter().map(|s| s.pos[y]));
+    let mut chart = one_to_one(&area, xr, yr)?;
     chart
         .configure_mesh()
-        .x_desc(format!("{la} (mm)"))
-        .y_desc(format!("{lb} (mm)"))
+        .x_desc(format!("{} (mm)", AXIS_LETTERS[x] as char))
+        .y_desc(format!("{} (mm)", AXIS_LETTERS[y] as char))
         .draw()?;
     chart
         .draw_series(LineSeries::new(
-            samples.iter().map(|s| (s.pos[a], s.pos[b])),
-            RGBColor(31, 95, 191),
+            samples.iter().map(|s| (s.pos[x], s.pos[y])),
+            PATH,
         ))?
-        .label("axes")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RGBColor(31, 95, 191)));
-    chart
-        .draw_series(
-            trace
-                .interrupts()
-                .iter()
-                .map(|m| Circle::new((m.pos[a], m.pos[b]), 5, INTERRUPT.stroke_width(2))),
-        )?
-        .label("interrupt")
-        .legend(|(x, y)| PathElement::new(vec![(x, y - 5), (x + 20, y + 5)], INTERRUPT));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+        .label("tool path")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], PATH));
+    if marks == Marks::Interrupts && !trace.interrupts().is_empty() {
+        chart
+            .draw_series(
+                trace
+                    .interrupts()
+                    .iter()
+                    .map(|m| Circle::new((m.pos[x], m.pos[y]), 5, INTERRUPT.stroke_width(2))),
+            )?
+            .label("interrupt")
+            .legend(|(x, y)| PathElement::new(vec![(x, y - 5), (x + 20, y + 5)], INTERRUPT));
+    }
+    // The side views' captions say what they show; a legend there would hide the path.
+    if marks == Marks::Interrupts {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+    }
     Ok(())
 }
 
-fn time_panel(
-    area: &DrawingArea<SVGBackend<'_>, Shift>,
+fn time_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
     trace: &Trace,
-    name: &str,
-    unit: &str,
-    value: fn(&Sample) -> f64,
-    color: RGBColor,
-) -> DrawResult {
+    (name, unit, value, color): Series,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let samples = trace.samples();
     let (t0, t1) = match (samples.first(), samples.last()) {
         (Some(f), Some(l)) => (f.time_s, l.time_s.max(f.time_s + 1e-6)),
@@ -162,7 +224,7 @@ fn time_panel(
     };
     let (y0, y1) = range(samples.iter().map(value));
     let mut chart = ChartBuilder::on(&area.margin(5, 10, 5, 10))
-        .caption(name, ("sans-serif", 14))
+        .caption(name, (FAMILY, 14))
         .x_label_area_size(30)
         .y_label_area_size(70)
         .build_cartesian_2d(t0..t1, y0..y1)?;
@@ -197,141 +259,48 @@ fn time_panel(
     Ok(())
 }
 
-// The lateness histogram of `bench --plot`.
-
-/// Size of the lateness histogram, px.
-const LATENESS_SIZE: (u32, u32) = (900, 480);
-/// Bins per decade of the time axis.
-const PER_DECADE: f64 = 10.0;
-/// The time axis starts here, µs (0.1 µs: below any tick's lateness we can measure).
-const LOWEST_US: f64 = 0.1;
-const RUNTIME: RGBColor = RGBColor(214, 39, 40);
-const BARE: RGBColor = RGBColor(31, 95, 191);
-
-/// Share of samples per log-spaced bin (`PER_DECADE` a decade) from [`LOWEST_US`] up.
-fn shares(h: &Histogram, bins: usize) -> Vec<f64> {
-    let mut v = vec![0.0; bins];
-    let n = h.count().max(1) as f64;
-    for (high_ns, c) in h.buckets() {
-        let us = (high_ns as f64 / 1000.0).max(LOWEST_US);
-        let b = ((us / LOWEST_US).log10() * PER_DECADE).floor();
-        let b = (b.max(0.0) as usize).min(bins - 1);
-        v[b] += c as f64 / n;
-    }
-    v
-}
-
-/// The lateness histogram as SVG text.
-pub(crate) fn lateness_svg(runtime: &Histogram, bare: &Histogram, period: Duration) -> String {
-    svg_of(LATENESS_SIZE, |root| {
-        draw_lateness(root, runtime, bare, period)
-    })
-}
-
-fn draw_lateness(
-    root: &DrawingArea<SVGBackend<'_>, Shift>,
-    runtime: &Histogram,
-    bare: &Histogram,
-    period: Duration,
-) -> DrawResult {
-    root.fill(&WHITE)?;
-    let max_us = runtime.max_us().max(bare.max_us()).max(1.0);
-    let decades = (max_us / LOWEST_US).log10().ceil().max(1.0);
-    let hi_us = LOWEST_US * 10f64.powf(decades);
-    let bins = (decades * PER_DECADE) as usize;
-    let series = [
-        ("runtime", RUNTIME, shares(runtime, bins), runtime),
-        ("bare spin_sleep loop", BARE, shares(bare, bins), bare),
-    ];
-    let top_pct = series
-        .iter()
-        .flat_map(|s| s.2.iter())
-        .fold(0.0f64, |a, &b| a.max(b))
-        .max(1e-9)
-        * 100.0
-        * 1.1;
-    let mut chart = ChartBuilder::on(&root.margin(10, 20, 10, 10))
-        .caption(
-            format!("Tick lateness at a {} µs cycle", period.as_micros()),
-            ("sans-serif", 18),
-        )
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d((LOWEST_US..hi_us).log_scale(), 0.0..top_pct)?;
-    chart
-        .configure_mesh()
-        .x_desc("lateness against the ideal tick start (µs, log scale)")
-        .y_desc("share of ticks (%)")
-        .x_label_formatter(&|v| format!("{v}"))
-        .draw()?;
-    let bin_edge = |i: usize| LOWEST_US * 10f64.powf(i as f64 / PER_DECADE);
-    for (name, color, shares, h) in &series {
-        let color = *color;
-        // A step line: each bin's share held across the bin.
-        let steps = shares
-            .iter()
-            .enumerate()
-            .flat_map(|(i, &s)| [(bin_edge(i), s * 100.0), (bin_edge(i + 1), s * 100.0)]);
-        chart
-            .draw_series(LineSeries::new(steps, color.stroke_width(2)))?
-            .label(*name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-        let p99 = h.quantile_us(0.99).clamp(LOWEST_US, hi_us);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(p99, 0.0), (p99, top_pct)],
-                6,
-                4,
-                color.stroke_width(1),
-            ))?
-            .label(format!("{name} p99 {p99:.1} µs"))
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 6, y), (x + 10, y), (x + 16, y)], color)
-            });
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::picture::{encode, Format};
+
+    fn sample(k: f64, pos: [f64; 3]) -> Sample {
+        Sample {
+            time_s: k * 0.001,
+            pos: [pos[0], pos[1], pos[2], 0.0, 0.0, 0.0],
+            velocity_mm_per_s: k,
+            accel_mm_per_s2: 1000.0,
+            jerk_mm_per_s3: 0.0,
+        }
+    }
 
     #[test]
-    fn plot_has_path_velocity_acceleration_jerk_legends_and_interrupt_marks() {
+    fn plot_has_three_path_views_the_time_panels_legends_and_interrupt_marks() {
         let mut t = Trace::new(100);
         for k in 0..10 {
-            t.record(Sample {
-                time_s: k as f64 * 0.001,
-                pos: [k as f64, 2.0 * k as f64, 0.0, 0.0, 0.0, 0.0],
-                velocity_mm_per_s: k as f64,
-                accel_mm_per_s2: 1000.0,
-                jerk_mm_per_s3: 0.0,
-            });
+            let k = f64::from(k);
+            t.record(sample(k, [k, 2.0 * k, 0.0]));
         }
-        t.mark_interrupt(Sample {
-            time_s: 0.005,
-            pos: [5.0, 10.0, 0.0, 0.0, 0.0, 0.0],
-            velocity_mm_per_s: 0.0,
-            accel_mm_per_s2: 0.0,
-            jerk_mm_per_s3: 0.0,
-        });
-        let svg = render_svg(&t, "a <b> & c");
+        t.mark_interrupt(sample(5.0, [5.0, 10.0, 0.0]));
+        let pic = RunPlot {
+            trace: &t,
+            title: "a <b> & c",
+        };
+        let svg = String::from_utf8(encode(&pic, Format::Svg).unwrap()).unwrap();
         assert!(svg.starts_with("<svg"));
         assert!(svg.trim_end().ends_with("</svg>"));
         assert_eq!(svg.matches("<circle").count(), 1, "one interrupt mark");
         for label in [
-            "tool path",
+            "tool path, G17 plane X–Y, 1:1",
+            "side view X–Z, 1:1",
+            "side view Y–Z, 1:1",
             "path velocity",
             "path acceleration",
             "path jerk",
             "channel time (s)",
             "X (mm)",
+            "Z (mm)",
+            "mm/s²",
             "1 interrupt(s)",
             "interrupt",
         ] {
@@ -341,23 +310,22 @@ mod tests {
     }
 
     #[test]
-    fn svg_holds_both_series_axes_and_p99_marks() {
-        let mut a = Histogram::new();
-        let mut b = Histogram::new();
-        for i in 0..1000u64 {
-            a.record_ns(1000 + i * 10);
-            b.record_ns(500 + i);
+    fn png_is_a_png_of_the_plot_size() {
+        let mut t = Trace::new(100);
+        for k in 0..10 {
+            let k = f64::from(k);
+            t.record(sample(k, [k, k, k]));
         }
-        let svg = lateness_svg(&a, &b, Duration::from_millis(1));
-        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
-        for label in [
-            "Tick lateness at a 1000 µs cycle",
-            "share of ticks (%)",
-            "µs, log scale",
-            "runtime p99",
-            "bare spin_sleep loop p99",
-        ] {
-            assert!(svg.contains(label), "{label} missing");
-        }
+        let png = encode(
+            &RunPlot {
+                trace: &t,
+                title: "t",
+            },
+            Format::Png,
+        )
+        .unwrap();
+        let dec = png::Decoder::new(std::io::Cursor::new(png));
+        let reader = dec.read_info().unwrap();
+        assert_eq!((reader.info().width, reader.info().height), (WIDTH, HEIGHT));
     }
 }

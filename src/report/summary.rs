@@ -124,11 +124,11 @@ impl Report {
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
 
-    /// Write the report JSON to a file.
+    /// Write the report JSON to a file (`-`: standard output).
     pub(crate) fn write_file(&self, path: &std::path::Path) -> io::Result<()> {
         let mut text = self.to_json_pretty();
         text.push('\n');
-        std::fs::write(path, text)
+        crate::destination::write(path, text.as_bytes())
     }
 
     /// The human summary: outcome, blocks, simulated and wall time, interrupts, writes.

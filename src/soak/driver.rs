@@ -108,7 +108,7 @@ impl FaultPlan {
 }
 
 /// Counters of one soaked channel, as the report shows them.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct SoakCounters {
     pub number: u32,
     /// The program restarted after each reset (empty: none).
@@ -128,6 +128,9 @@ pub struct SoakCounters {
     pub writes_ok: u64,
     pub bytes: u64,
     pub lines_accepted: u64,
+    /// Accepted lines an injected (or error) reset dropped before they ran (external
+    /// clients; each reset is also announced on stderr by `serve --soak`).
+    pub lines_dropped: u64,
     /// Stream writes the channel refused (a full buffer: 11012).
     pub writes_rejected: u64,
     /// Writes a forced rejection refused without touching the channel.
@@ -194,6 +197,11 @@ pub struct SoakChannel {
     limits: Vec<(usize, f64, f64)>,
     /// Start the program again at the next tick.
     restart_due: bool,
+    /// Ticks the channel stays READY after an injected reset before the program restarts
+    /// (0: in the reset's own tick, as the built-in client's soak does).
+    ready_hold_ticks: u64,
+    /// The tick at which a held READY ends and the program restarts.
+    restart_at: Option<u64>,
     errors_seen: usize,
     /// Check that numbered lines run with rising N (external clients: a numbered line is a
     /// client's line once, so an N not above the last is a line run again, even when the
@@ -212,6 +220,8 @@ impl SoakChannel {
             plan: FaultPlan::default(),
             limits: axes.iter().map(|a| (a.index, a.min_mm, a.max_mm)).collect(),
             restart_due: true,
+            ready_hold_ticks: 0,
+            restart_at: None,
             errors_seen: 0,
             numbers_rise: false,
             last_n: None,
@@ -228,6 +238,17 @@ impl SoakChannel {
     pub(crate) fn with_rising_numbers(mut self) -> Self {
         self.numbers_rise = true;
         self
+    }
+
+    /// Keep the channel READY for `ticks` after each injected reset before restarting the
+    /// program, so a client watching mode and state sees the reset (external clients).
+    pub(crate) fn set_ready_hold(&mut self, ticks: u64) {
+        self.ready_hold_ticks = ticks;
+    }
+
+    /// An injected reset's READY is being held: the program restarts at the returned tick.
+    pub(crate) fn ready_held_until(&self) -> Option<u64> {
+        self.restart_at
     }
 
     /// Draw the first faults (at the first tick).
@@ -268,7 +289,24 @@ impl SoakChannel {
         p.hold_until = None;
         p.reset_at_block = draw(rng, self.counters.blocks, f.reset_every_blocks);
         p.reset_at_tick = draw(rng, tick.index, f.reset_every_ticks);
-        self.restart(tick, door, new_epoch);
+        if self.ready_hold_ticks == 0 {
+            self.restart(tick, door, new_epoch);
+        } else {
+            // The reset ends the epoch now: lines accepted while READY is held belong to the
+            // next one, which the restart reads from the stream buffer's start.
+            new_epoch(tick.index);
+            self.new_epoch();
+            self.restart_at = Some(tick.index.saturating_add(self.ready_hold_ticks));
+        }
+    }
+
+    /// The held READY after an injected reset is over: start the program, keeping what the
+    /// clients wrote meanwhile (a client that started it itself gets a refusal, ignored).
+    fn restart_held(&mut self, tick: &Tick, door: &mut impl Door) {
+        self.restart_at = None;
+        if !self.counters.program.is_empty() && door.channel().state() == State::Ready {
+            let _ = door.apply(tick, Op::Start(self.counters.program.clone()));
+        }
     }
 
     /// Faults and restarts due at this tick, through the door.
@@ -288,6 +326,10 @@ impl SoakChannel {
         } else if state == State::Error {
             self.counters.error_resets += 1;
             self.reset(rng, f, tick, door, new_epoch);
+        } else if let Some(at) = self.restart_at {
+            if t >= at {
+                self.restart_held(tick, door);
+            }
         } else if self.restart_due || (state == State::Ready && !self.counters.program.is_empty()) {
             // A channel without a program to restart stays READY and counts no restarts.
             if !self.restart_due {

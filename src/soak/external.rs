@@ -16,8 +16,32 @@ use crate::machine::{Machine, Op, Reply, Request};
 use crate::motion::AxisLimits;
 use crate::runtime::{Cycle, Flow, Tick};
 
+/// How long a channel stays READY after an injected reset before its streaming program
+/// restarts: longer than the 200 ms default cycle of an on-change notification in
+/// TwinCAT.Ads (Beckhoff InfoSys, `NotificationSettings.Default`) and Node ads-client, with
+/// 50 ms for the server's sampling, so a client watching mode and state sees every reset.
+pub const READY_HOLD: Duration = Duration::from_millis(250);
+
+/// Reset notices kept until `serve --soak` prints them; more in one print interval are
+/// counted, not kept.
+const MAX_PENDING_NOTICES: usize = 64;
+
+/// A reset the soak injected (or made after a channel error), as `serve --soak` announces it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ResetNotice {
+    pub channel: u32,
+    /// The tick of the reset.
+    pub tick: u64,
+    /// After a channel error, rather than by the fault plan.
+    pub after_error: bool,
+    /// Accepted lines the reset dropped before they ran.
+    pub lines_dropped: u64,
+    /// The tick at which the program restarts (READY until then).
+    pub restart_tick: Option<u64>,
+}
+
 /// Scenario tables that describe the built-in client; an external client has none of them.
-const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
+pub(crate) const CLIENT_KEYS: [&str; 5] = ["feeder", "program", "channel", "length", "clock"];
 
 /// Load a scenario for external clients: the soak's format, its client keys refused by name.
 pub(crate) fn load_external(path: &Path) -> Result<Scenario, String> {
@@ -84,6 +108,9 @@ pub struct Supervised {
     watches: Vec<Watch>,
     tallies: Tallies,
     planned: bool,
+    /// Resets not yet announced, and how many did not fit.
+    notices: VecDeque<ResetNotice>,
+    notices_lost: u64,
 }
 
 impl Supervised {
@@ -121,7 +148,15 @@ impl Supervised {
                 .collect(),
             tallies: Tallies::default(),
             planned: false,
+            notices: VecDeque::new(),
+            notices_lost: 0,
         }
+    }
+
+    /// The resets since the last call, oldest first, and how many more were not kept.
+    pub fn take_notices(&mut self) -> (Vec<ResetNotice>, u64) {
+        let lost = std::mem::take(&mut self.notices_lost);
+        (self.notices.drain(..).collect(), lost)
     }
 
     pub(crate) fn into_machine(self) -> Machine {
@@ -226,19 +261,43 @@ impl Cycle for Supervised {
     fn step(&mut self, tick: &Tick) -> Flow {
         if !self.planned {
             self.planned = true;
+            let hold_ticks = READY_HOLD
+                .as_nanos()
+                .div_ceil(tick.period.as_nanos().max(1));
             for w in &mut self.watches {
                 w.core.plan(&mut self.rng, &self.faults, tick.index);
+                w.core
+                    .set_ready_hold(u64::try_from(hold_ticks).unwrap_or(u64::MAX));
             }
         }
         for (i, w) in self.watches.iter_mut().enumerate() {
             let Some(mut door) = MachineDoor::new(&mut self.machine, i as u32 + 1) else {
                 continue;
             };
+            let before = (w.core.counters.resets, w.core.counters.error_resets);
+            let mut dropped = 0u64;
             let (owed, epoch_bytes) = (&mut w.owed, &mut w.epoch_bytes);
             w.core
                 .faults(&mut self.rng, &self.faults, tick, &mut door, &mut |_| {
+                    dropped += owed.len() as u64;
                     Watch::new_epoch(owed, epoch_bytes)
                 });
+            let c = &mut w.core.counters;
+            if (c.resets, c.error_resets) != before {
+                c.lines_dropped += dropped;
+                let notice = ResetNotice {
+                    channel: i as u32 + 1,
+                    tick: tick.index,
+                    after_error: c.error_resets != before.1,
+                    lines_dropped: dropped,
+                    restart_tick: w.core.ready_held_until(),
+                };
+                if self.notices.len() < MAX_PENDING_NOTICES {
+                    self.notices.push_back(notice);
+                } else {
+                    self.notices_lost += 1;
+                }
+            }
         }
         let flow = self.machine.step(tick);
         for (i, w) in self.watches.iter_mut().enumerate() {

@@ -13,7 +13,7 @@ use crate::channel::ExecutedBlock;
 const MAX_DETAILS: usize = 8;
 
 /// One invariant's verdict.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Verdict {
     pub name: String,
     pub held: bool,

@@ -2,6 +2,7 @@
 //! with a randomised client and injected faults, checking invariants as it goes; see
 //! `ncchannel soak` and the README section "Soak and bench".
 
+pub mod campaign;
 pub(crate) mod driver;
 pub(crate) mod external;
 pub(crate) mod feed;

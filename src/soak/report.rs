@@ -1,16 +1,16 @@
 //! The soak's final report, of `ncchannel soak` and `serve --soak` alike: JSON for machines
-//! (`--report FILE`), a summary for people.
+//! (`--report FILE`, read back by `soak merge`), a summary for people.
 
 use std::io::{self, Write};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::driver::SoakCounters;
 use super::invariants::Verdict;
 use crate::vocab::stats::{CycleStats, Histogram};
 
 /// Percentiles of one histogram, µs.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Percentiles {
     pub(crate) p50_us: f64,
     pub(crate) p99_us: f64,
@@ -31,7 +31,7 @@ impl From<&Histogram> for Percentiles {
     }
 }
 
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CycleFigures {
     pub period_us: f64,
     pub work: Percentiles,
@@ -51,7 +51,7 @@ impl CycleFigures {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct MemoryReport {
     /// Resident set after warm-up, KiB (`None` without /proc).
     pub(crate) warmup_kib: Option<u64>,
@@ -59,7 +59,7 @@ pub struct MemoryReport {
     pub(crate) growth_kib: Option<i64>,
 }
 
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SoakReport {
     pub scenario: String,
     pub seed: u64,
@@ -143,8 +143,11 @@ impl SoakReport {
             )?;
             writeln!(
                 w,
-                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} lines accepted, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
-                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.lines_accepted, c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
+                "           writes {} ok / {} rejected / {} skipped, {} bytes, {} lines accepted{}, {} pauses, {} interrupts, {} warnings, errors [{}], checksum {}",
+                c.writes_ok, c.writes_rejected, c.writes_skipped, c.bytes, c.lines_accepted,
+                // Counted for external clients (`serve --soak`) only.
+                if c.lines_dropped > 0 { format!(" ({} dropped unexecuted by resets)", c.lines_dropped) } else { String::new() },
+                c.pauses, c.interrupts, c.warnings, errors.join(" "), c.checksum
             )?;
         }
         let kib = |v: Option<u64>| v.map_or("n/a".to_string(), |k| format!("{k} KiB"));

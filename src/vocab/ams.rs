@@ -25,6 +25,18 @@ pub(crate) const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
 pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 = 10_000;
 /// Default idle timeout (`ads::server::ServerConfig::idle_timeout`).
 pub(crate) const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
+/// Default time a request waits for the runtime before it is answered 0x708 "busy, not
+/// applied" (runtime.toml `ads.reply_timeout_ms`). A tick answers within one period (1 ms);
+/// 500 ms outlasts any tick the runtime's budgets allow by far, yet is a quarter of the
+/// shortest default request timeout of the common clients (Node `ads-client` 2 s; Beckhoff
+/// AdsLib, pyads and TwinCAT.Ads 5 s), so a stalled runtime is reported, never left silent.
+pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_millis(500);
+/// Default AMS NetId of the server (runtime.toml `ads.net_id`): not `127.0.0.1.1.1`, which the
+/// Rust `ads` crate (0.4, `Client::device`) rewrites to the client's own NetId, and not the
+/// `<IPv4>.1.1` a client on loopback derives for itself (the `ads` crate's `Source::Auto`,
+/// pyads, and this server's answer to a router port request), which must differ from the
+/// target's.
+pub const DEFAULT_NET_ID: AmsNetId = AmsNetId([127, 0, 0, 2, 1, 1]);
 
 /// A six-byte AMS network id, written `a.b.c.d.e.f`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord, serde::Deserialize)]

@@ -6,6 +6,7 @@
 //! when the histogram is made, never in the tick. Longer values are counted at one hour; the
 //! exact minimum and maximum are kept on the side.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use hdrhistogram::Histogram as Hdr;
@@ -171,6 +172,51 @@ impl CycleStats {
             self.lateness.max_us(),
             self.overruns
         )
+    }
+}
+
+/// The runtime's lateness and overruns as readers on other threads see them while it runs
+/// (the live web view): a few relaxed atomics the tick stores into, so a reader never waits on
+/// the tick nor the tick on a reader. Work times reach readers through the channel door
+/// (`Status::cycle_times`); lateness is only known to the runtime.
+#[derive(Debug, Default)]
+pub struct LiveCycleStats {
+    ticks: AtomicU64,
+    late_last_ns: AtomicU64,
+    late_max_ns: AtomicU64,
+    overruns: AtomicU64,
+}
+
+/// One reading of [`LiveCycleStats`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LiveCycleReading {
+    pub ticks: u64,
+    pub late_last: Duration,
+    pub late_max: Duration,
+    pub overruns: u64,
+}
+
+impl LiveCycleStats {
+    /// One tick done: its lateness (real time only) and whether it overran.
+    pub(crate) fn publish(&self, late: Option<Duration>, overrun: bool) {
+        self.ticks.fetch_add(1, Ordering::Relaxed);
+        if let Some(late) = late {
+            let ns = u64::try_from(late.as_nanos()).unwrap_or(u64::MAX);
+            self.late_last_ns.store(ns, Ordering::Relaxed);
+            self.late_max_ns.fetch_max(ns, Ordering::Relaxed);
+        }
+        if overrun {
+            self.overruns.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    pub fn read(&self) -> LiveCycleReading {
+        LiveCycleReading {
+            ticks: self.ticks.load(Ordering::Relaxed),
+            late_last: Duration::from_nanos(self.late_last_ns.load(Ordering::Relaxed)),
+            late_max: Duration::from_nanos(self.late_max_ns.load(Ordering::Relaxed)),
+            overruns: self.overruns.load(Ordering::Relaxed),
+        }
     }
 }
 

@@ -29,23 +29,38 @@ const SERVED_WITHIN: Duration = Duration::from_secs(3);
 const TICK_GROUP: u32 = 0x120101;
 const TICK_OFFSET: u32 = 0x251;
 
+/// One spawned `serve` at a time: each test checks the cycle's pace under its abuse, which
+/// two abuses at once on a 2-core machine would measure together.
+static ONE_SERVE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+pub(crate) type Turn = std::sync::MutexGuard<'static, ()>;
+
+/// Wait for the turn to spawn a `serve`.
+pub(crate) fn turn() -> Turn {
+    ONE_SERVE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+}
+
 /// A spawned `ncchannel serve`, its address, NetId and collected standard error.
-struct Serve {
-    child: Child,
+pub(crate) struct Serve {
+    _turn: Turn,
+    pub(crate) child: Child,
     addr: SocketAddr,
     net_id: AmsNetId,
     period: Duration,
-    stderr: Arc<Mutex<String>>,
+    pub(crate) stderr: Arc<Mutex<String>>,
     /// Held and never read (`--events -` into a pipe nobody reads).
     _stdout: Option<ChildStdout>,
 }
 
 impl Serve {
-    fn start(extra: &[&str]) -> Serve {
+    pub(crate) fn start(extra: &[&str]) -> Serve {
         Self::start_with(Path::new("params/startup.lis"), extra)
     }
 
     fn start_with(params: &Path, extra: &[&str]) -> Serve {
+        let turn = turn();
         let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
             .current_dir(env!("CARGO_MANIFEST_DIR"))
             .args(["serve", "--bind", "127.0.0.1:0", "--params"])
@@ -55,8 +70,19 @@ impl Serve {
             .stderr(Stdio::piped())
             .spawn()
             .expect("ncchannel serve starts");
-        let stdout = child.stdout.take();
         let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
+        Self::from_child(turn, child, &first, stderr)
+    }
+
+    /// A started `serve` whose first stderr line was `first` (its stdout, if piped, is held
+    /// and never read); `stderr` is what the test collects of the rest.
+    pub(crate) fn from_child(
+        turn: Turn,
+        mut child: Child,
+        first: &str,
+        stderr: Arc<Mutex<String>>,
+    ) -> Serve {
+        let stdout = child.stdout.take();
         // "listening on 127.0.0.1:PORT (AMS NetId a.b.c.d.e.f, port 553, N channel(s), cycle P µs)"
         let words: Vec<&str> = first.split_whitespace().collect();
         assert_eq!(words.get(..2), Some(&["listening", "on"][..]), "{first}");
@@ -68,6 +94,7 @@ impl Serve {
             .and_then(|i| words[i + 1].parse::<u64>().ok())
             .expect("cycle");
         Serve {
+            _turn: turn,
             child,
             addr,
             net_id,
@@ -77,22 +104,26 @@ impl Serve {
         }
     }
 
-    fn rss_kib(&self) -> u64 {
+    pub(crate) fn rss_kib(&self) -> u64 {
         abuse_common::rss_kib(self.child.id())
     }
 
-    fn log(&self) -> String {
+    pub(crate) fn log(&self) -> String {
         self.stderr.lock().unwrap().clone()
     }
 
-    fn device(&self) -> AmsAddr {
+    pub(crate) fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    pub(crate) fn device(&self) -> AmsAddr {
         AmsAddr {
             net_id: self.net_id,
             port: 553,
         }
     }
 
-    fn connect(&self) -> Conn {
+    pub(crate) fn connect(&self) -> Conn {
         Conn::new(
             TcpStream::connect(self.addr).expect("connect"),
             self.device(),
@@ -101,7 +132,7 @@ impl Serve {
 
     /// A normal client reads the tick counter now and one second later: it must be served at
     /// once and the counter must have advanced at the period. Prints and checks the figures.
-    fn check_healthy(&self, abuse: &str, rss_before: u64) {
+    pub(crate) fn check_healthy(&self, abuse: &str, rss_before: u64) {
         let mut c = self.connect();
         let asked = Instant::now();
         let t0 = c
@@ -143,8 +174,8 @@ impl Drop for Serve {
 }
 
 /// A frame-level client connection.
-struct Conn {
-    stream: TcpStream,
+pub(crate) struct Conn {
+    pub(crate) stream: TcpStream,
     device: AmsAddr,
     buf: Vec<u8>,
     invoke: u32,
@@ -157,7 +188,7 @@ fn client_addr() -> AmsAddr {
     }
 }
 
-fn request(device: AmsAddr, command: CommandId, invoke: u32, data: &[u8]) -> Vec<u8> {
+pub(crate) fn request(device: AmsAddr, command: CommandId, invoke: u32, data: &[u8]) -> Vec<u8> {
     frame::encode(
         &AmsHeader {
             target: device,
@@ -182,7 +213,7 @@ fn tick_request(device: AmsAddr, invoke: u32) -> Vec<u8> {
 }
 
 /// AddDeviceNotification of the tick counter: cyclic (mode 3), no max delay, `cycle_100ns`.
-fn add_notification_payload(cycle_100ns: u32) -> Vec<u8> {
+pub(crate) fn add_notification_payload(cycle_100ns: u32) -> Vec<u8> {
     let mut add = read_req(TICK_GROUP, TICK_OFFSET, 4);
     for v in [3u32, 0, cycle_100ns] {
         add.extend_from_slice(&v.to_le_bytes());
@@ -202,7 +233,7 @@ impl Conn {
         }
     }
 
-    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+    pub(crate) fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
         self.stream.write_all(bytes)
     }
 
@@ -230,20 +261,20 @@ impl Conn {
         }
     }
 
-    fn call(&mut self, command: CommandId, data: &[u8]) -> Option<Vec<u8>> {
+    pub(crate) fn call(&mut self, command: CommandId, data: &[u8]) -> Option<Vec<u8>> {
         self.invoke += 1;
         let bytes = request(self.device, command, self.invoke, data);
         self.send(&bytes).ok()?;
         self.response().map(|(_, d)| d)
     }
 
-    fn read_tick(&mut self) -> Option<u32> {
+    pub(crate) fn read_tick(&mut self) -> Option<u32> {
         let d = self.call(CommandId::Read, &read_req(TICK_GROUP, TICK_OFFSET, 4))?;
         (d.len() >= 12 && u32_at(&d, 0) == 0).then(|| u32_at(&d, 8))
     }
 
     /// True when the server closed the connection within `timeout`.
-    fn closed_within(&mut self, timeout: Duration) -> bool {
+    pub(crate) fn closed_within(&mut self, timeout: Duration) -> bool {
         ads_common::closed_within(&mut self.stream, timeout)
     }
 }

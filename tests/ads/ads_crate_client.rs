@@ -140,3 +140,34 @@ fn router_port_request_works_with_the_crate() {
     let dev = client.device(target());
     assert_eq!(dev.get_state().unwrap().0, AdsState::Run);
 }
+
+/// The `ads` crate's symbol helpers against the PLC runtime (851): `get_symbol_info` (upload
+/// info 3, data-type and symbol uploads, decoded by the crate), `get_location`/`get_size`
+/// (0xF007) and a handle read of what they name.
+#[test]
+fn symbol_and_type_uploads_decode_with_the_ads_crate() {
+    let (srv, _b) = server();
+    let client = connect(&srv, 40009);
+    let dev = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 851));
+    let (symbols, types) = ads::symbol::get_symbol_info(dev).unwrap();
+    let name = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r";
+    let state = symbols
+        .iter()
+        .find(|s| s.name == name)
+        .expect("state_r uploaded");
+    assert_eq!((state.typ.as_str(), state.size), ("HLI_IMCM_MODE_STATE", 8));
+    let ty = &types["HLI_IMCM_MODE_STATE"];
+    let fields: Vec<_> = ty
+        .fields
+        .iter()
+        .map(|f| (f.name.as_str(), f.offset))
+        .collect();
+    assert_eq!(fields, [("mode", Some(0)), ("state", Some(4))]);
+    assert_eq!(types["ARRAY [0..19] OF TECHNO_UNIT_CH"].array, [(0, 19)]);
+    let member = format!("{name}.state");
+    assert_eq!(ads::symbol::get_size(dev, &member).unwrap(), 4);
+    let (group, offset) = ads::symbol::get_location(dev, &member).unwrap();
+    let mut v = [0u8; 4];
+    dev.read_exact(group, offset, &mut v).unwrap();
+    assert_eq!(u32::from_le_bytes(v), 3, "READY");
+}

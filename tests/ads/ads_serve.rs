@@ -148,3 +148,27 @@ fn reset_over_ads_empties_the_stream_and_reads_back_ready() {
     drop(client);
     served.finish();
 }
+
+/// The default AMS NetId of `serve` is one the `ads` crate leaves alone: a client that asks
+/// the router for its own address (`Source::Request`, as for a local PLC) reaches the device
+/// at 127.0.0.2.1.1; `127.0.0.1.1.1`, the NetId the `ads` crate rewrites to the client's own,
+/// is not the server's and answers AMS error 7.
+#[test]
+fn the_ads_crate_reaches_serve_at_its_default_net_id() {
+    let srv = crate::ads_abuse::Serve::start(&[]);
+    assert_eq!(srv.device().net_id.to_string(), "127.0.0.2.1.1");
+    let client = Client::new(
+        srv.addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Request,
+    )
+    .unwrap();
+    let default = AmsAddr::new(AmsNetId::new(127, 0, 0, 2, 1, 1), 553);
+    let info = client.device(default).get_info().unwrap();
+    assert!(info.name.starts_with("ncchannel"), "{}", info.name);
+    let rewritten = client.device(AmsAddr::new(AmsNetId::local(), 553));
+    match rewritten.get_info() {
+        Err(ads::Error::Ads(_, _, 7)) => {}
+        other => panic!("127.0.0.1.1.1 is the client's own NetId: {other:?}"),
+    }
+}

@@ -293,12 +293,16 @@ fn properties_read_with_their_types(com: &ads::Device<'_>, dict: &HashMap<String
     ] {
         assert!(dict[name].writable, "{name}");
     }
-    // Not modelled, so not listed (TwinSharp's getters for them would throw).
-    for name in [
-        "mc_cmd_bs_covered_distance_r",
-        "mc_cmd_bs_distance_prog_start_r",
+    // TwinSharp `BlockSearch.cs` reads these with `ReadAny<double>` / `<bool>` / `<uint>`.
+    for (name, size) in [
+        ("mc_cmd_bs_covered_distance_r", 8),
+        ("mc_cmd_bs_distance_prog_start_r", 8),
+        ("mc_cmd_bs_breakpoint_position_r", 8),
+        ("mc_cmd_bs_auto_return_r", 1),
+        ("mc_cmd_bs_no_hold_at_restart_r", 1),
+        ("mc_cmd_bs_deviation_max_r", 4),
     ] {
-        assert!(!dict.contains_key(name), "{name} is not served");
+        read_named(com, dict, name, size);
     }
 }
 
@@ -309,18 +313,14 @@ fn every_record_reads_back(com: &ads::Device<'_>, dict: &HashMap<String, Record>
             "BOOL" | "BYTE" => Some(1),
             "WORD" | "INT" => Some(2),
             "DWORD" | "DINT" => Some(4),
-            "LWORD" | "LREAL" | "ARRAY [0..1] OF DWORD" | "STRUCT {DINT mode; DINT state}" => {
-                Some(8)
-            }
-            "NONE" => Some(0),
-            "STRING" | "ARRAY OF LREAL" => None,
+            "LWORD" | "LREAL" => Some(8),
+            // The kernel's text for structures, arrays and triggers: a trigger is 0 bytes.
+            "NONE" if r.writable => Some(0),
+            "NONE" | "STRING" => None,
             other => panic!("{name}: unknown type {other}"),
         };
         if let Some(size) = fixed {
             assert_eq!(r.size, size, "{name}: {} is {size} bytes", r.ty);
-        }
-        if r.ty == "ARRAY OF LREAL" {
-            assert_eq!(r.size % 8, 0, "{name}");
         }
         let mut buf = vec![0u8; r.size as usize];
         let got = com.read(r.group, r.offset, &mut buf);

@@ -25,3 +25,33 @@ fn node_ads_client_streams_5000_lines_and_watches_the_block_count() {
     assert_eq!(seen["final_count"], 5000);
     assert_eq!(common::block_texts(&events), lines);
 }
+
+/// The unmodified Node `ads-client` with its DEFAULT settings against the PLC runtime (851):
+/// connect() reads the TwinCAT system service on 10000, upload info, symbol version, device
+/// info and subscribes the runtime state; then getSymbols, readValue of HLI structs,
+/// subscribeValue, writeValue of the mode-and-state unit (the streaming program starts, seen
+/// through a handle and on COM), and a refused MDI block raising error 270061 on the HLI.
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_ads_client_default_connect_reads_and_writes_hli_symbols() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/node/ads_client_plc_test.js"
+    );
+    let (seen, events) = common::run_client(served, &node, script, &[]);
+    assert_eq!(seen["system_state"], "Run");
+    assert_eq!(seen["plc_state"], "Run");
+    assert_eq!(seen["device"], "Plc30 App");
+    assert!(seen["symbols"].as_u64().unwrap() > 100, "{seen}");
+    assert_eq!(seen["refused"], 270061);
+    let states = seen["states"].as_array().unwrap();
+    assert_eq!(states.first(), Some(&serde_json::json!(3)), "READY first");
+    assert!(states.contains(&serde_json::json!(4)), "then ACTIVE");
+    let started = common::of(&events, "state")
+        .iter()
+        .any(|e| e["state"] == "ACTIVE");
+    assert!(started, "the channel ran the streaming program");
+}

@@ -96,3 +96,27 @@ fn pyads_drives_the_hli_unit_and_reads_geo() {
         [seen["errors"][0].clone(), seen["errors"][1].clone()]
     );
 }
+
+/// pyads against the PLC runtime and the TwinCAT system service: `read_state()` on 10000,
+/// `get_all_symbols`, `read_list_by_name` and `write_list_by_name` (sum commands); one sum
+/// write starts the streaming program through the HLI command unit.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_reads_symbols_and_drives_the_hli_by_sum_commands() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/symbols_with_pyads.py"
+    );
+    let (seen, events) = common::run_client(served, &python, script, &[]);
+    assert_eq!(seen["system_state"][0], 5);
+    assert_eq!(seen["system_device"], "TwinCAT System");
+    assert!(seen["symbols"].as_u64().unwrap() > 100, "{seen}");
+    assert_eq!(seen["write_results"], serde_json::json!(["no error"]));
+    assert_eq!(seen["state_after"], 4);
+    let starts = common::of(&events, "program_start");
+    assert_eq!(starts.len(), 1, "started once: {starts:?}");
+    assert_eq!(starts[0]["prog"], "streaming.nc");
+}

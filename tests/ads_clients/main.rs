@@ -5,4 +5,5 @@
 mod support;
 
 mod ads_node;
+mod ads_node_stall;
 mod ads_pyads;

@@ -275,6 +275,8 @@ fn the_corner_speed_falls_with_the_kink_as_the_axes_allow() {
 #[test]
 #[ignore = "writes docs/*.svg"]
 fn docs_plots() {
+    // The plots' text is laid out with the binary's embedded font (plotters' ab_glyph).
+    ncchannel::report::picture::register_font();
     corner_speed_plot(Path::new("docs/corner_speed.svg"));
     contour_corner_plot(Path::new("docs/contour_corner.svg"));
 }

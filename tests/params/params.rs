@@ -61,8 +61,16 @@ fn shipped_files_load_without_error_or_warning() {
         cfg.runtime_file.as_deref(),
         Some(base.join("runtime.toml").as_path())
     );
-    // The shipped runtime.toml writes down exactly the built-in defaults.
-    assert_eq!(cfg.runtime, RuntimeConfig::default());
+    // The shipped runtime.toml writes down the built-in defaults, but for the two decoder
+    // keys that let a client stream 17-byte lines at the interface's full rate: a tick
+    // decodes and passes on a whole 4094-byte buffer of them (241 blocks).
+    let mut expected = RuntimeConfig::default();
+    expected.decoder.blocks_per_tick = 256;
+    expected.decoder.buffer_blocks = 224;
+    assert_eq!(cfg.runtime, expected);
+    let queue = expected.planner.lookahead_blocks + expected.decoder.buffer_blocks;
+    // More than a full buffer of 17-byte lines (240.8) a tick.
+    assert!(expected.decoder.blocks_per_tick.min(queue) as usize > 4094 / 17);
     assert!(params::check_list_file(&startup).is_empty());
     assert!(params::check_list_file(&base.join("channel1.lis")).is_empty());
     assert!(params::check_list_file(&base.join("runtime.toml")).is_empty());
@@ -511,7 +519,7 @@ fn runtime_toml_absent_gives_defaults_and_unknown_key_is_an_error() {
     assert_eq!(r.planner.lookahead_blocks, 32);
     assert_eq!((r.fs_latency_us, r.fs_latency_us_per_kib), (0, 0));
     assert_eq!(r.ads.bind.0.to_string(), "127.0.0.1:48898");
-    assert_eq!(r.ads.net_id.to_string(), "127.0.0.1.1.1");
+    assert_eq!(r.ads.net_id.to_string(), "127.0.0.2.1.1");
     assert_eq!(r.ads.max_frame_bytes, 65536);
     assert!(r.ads.allowed_clients.is_empty());
 

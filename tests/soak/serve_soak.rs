@@ -115,13 +115,15 @@ fn ncchannel_stream_as_external_client_under_resets_every_invariant_holds() {
     let sc = scenario(dir.path());
     let file = nc_file(dir.path(), 3_000);
     let report = dir.path().join("report.json");
-    let (child, addr, _err) = serve_soak(&sc, 12, &report);
+    let (child, addr, err) = serve_soak(&sc, 12, &report);
+    // serve_soak gives the server the NetId 127.0.0.1.1.1; `stream` targets it by name.
     let client = Command::new(bin())
-        .args(["stream", "--target", &addr])
+        .args(["stream", "--net-id", "127.0.0.1.1.1", "--target", &addr])
         .arg(&file)
         .output()
         .unwrap();
     let (code, json, out) = finish(child, &report);
+    let err = err.join().unwrap();
     assert_eq!(
         code,
         0,
@@ -134,6 +136,12 @@ fn ncchannel_stream_as_external_client_under_resets_every_invariant_holds() {
     assert!(c["lines_accepted"].as_u64().unwrap() > 100, "{out}");
     assert!(c["blocks"].as_u64().unwrap() > 100, "{out}");
     assert!(out.contains("every invariant held"), "{out}");
+    // Every reset is announced, with what it dropped and when the program restarts.
+    let announced = err
+        .lines()
+        .filter(|l| l.contains("channel 1 reset (injected)") && l.contains("READY until"))
+        .count() as u64;
+    assert_eq!(announced, c["resets"].as_u64().unwrap(), "{err}");
 }
 
 /// A client that writes an acknowledged packet a second time: its lines run twice, and the
@@ -199,6 +207,20 @@ fn scenario_keys_of_the_built_in_client_are_refused_by_name() {
     assert!(err.contains("feeder") && err.contains("length"), "{err}");
 }
 
+/// Channel time, s, of every reset `serve --soak` announced on stderr.
+fn reset_times(stderr: &str) -> impl Iterator<Item = f64> + '_ {
+    stderr
+        .lines()
+        .filter(|l| l.contains(" reset ("))
+        .filter_map(|l| {
+            l.strip_prefix("serve --soak: ")?
+                .split(" s:")
+                .next()?
+                .parse()
+                .ok()
+        })
+}
+
 fn python() -> String {
     std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into())
 }
@@ -228,14 +250,26 @@ fn pyads_streaming_under_resets_every_invariant_holds() {
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path());
     let report = dir.path().join("report.json");
-    let (child, addr, _err) = serve_soak(&sc, 14, &report);
+    let (child, addr, err) = serve_soak(&sc, 14, &report);
     let client = pyads_client(&addr, 11, false);
     let (code, json, out) = finish(child, &report);
+    let err = err.join().unwrap();
     assert_eq!(code, 0, "{out}");
     assert_eq!(json["all_held"], true, "{out}");
     let c = &json["channels"][0];
-    assert!(c["resets"].as_u64().unwrap() >= 1, "{out}");
+    let resets = c["resets"].as_u64().unwrap() + c["error_resets"].as_u64().unwrap();
+    assert!(resets >= 1, "{out}");
     assert_eq!(c["lines_accepted"], client["lines"], "{out}\n{client}");
+    // A client watching mode and state sees every reset while it runs: READY holds for
+    // 250 ms. The client watches from before 1 s to after 11 s of the server's 14.
+    let during_client = reset_times(&err)
+        .filter(|&t| (1.0..=10.5).contains(&t))
+        .count() as u64;
+    assert!(during_client >= 1, "{err}");
+    assert!(
+        client["ready_seen"].as_u64().unwrap() >= during_client,
+        "{err}\n{client}"
+    );
 }
 
 #[test]

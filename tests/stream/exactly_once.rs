@@ -38,8 +38,8 @@ struct Setup {
 }
 
 /// The real channels in real time behind the ADS server; calls answer 0x708 after
-/// `reply_timeout` (the shipped 2 s, shortened so a slow tick on a fast machine still
-/// outlasts it many times over).
+/// `reply_timeout` (shorter than the shipped 500 ms where a slow tick on a fast machine
+/// must still outlast it many times over).
 fn setup(rig: &Rig, reply_timeout: Duration) -> Setup {
     let (mut machine, period, log) = rig.machine();
     machine.set_stop_when(StopWhen::Never);

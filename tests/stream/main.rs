@@ -9,4 +9,5 @@ mod decoder_stream;
 mod exactly_once;
 mod feeder;
 mod stream;
+mod stream_rate;
 mod stream_stall;

@@ -1,0 +1,129 @@
+//! The page's operator controls: `POST /control/<channel>/<action>` becomes one door
+//! [`Op`], the same a PLC's ADS write makes, and the channel's answer becomes the HTTP status.
+//!
+//! Refused with 403 unless `serve --http-controls` allowed them. A control request must carry
+//! the [`CONTROL_HEADER`] the page sends: a browser lets another web site POST to this address
+//! only without custom headers (a "simple" cross-origin request; Fetch standard, "CORS
+//! protocol"), so that site cannot command the channels through a user's browser.
+
+use super::{Backend, ControlAccess};
+use crate::ads::backend::DeviceError;
+use crate::machine::{Op, Reply};
+use crate::vocab::mode::State;
+
+/// The header every control request carries (any value).
+pub const CONTROL_HEADER: &str = "X-Ncchannel-Control";
+
+/// What an operator asks of a channel.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Start the selected program (or resume), as the ACTIVE command does.
+    Start,
+    /// Start this program (the command parameter and ACTIVE in one step).
+    StartProgram(String),
+    Hold,
+    Resume,
+    Reset,
+    /// Feed override, percent.
+    Override(f64),
+}
+
+/// The HTTP answer to a control request: status code and a line of text.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Answer {
+    pub status: u16,
+    pub text: String,
+}
+
+impl Answer {
+    fn new(status: u16, text: impl Into<String>) -> Self {
+        Answer {
+            status,
+            text: text.into(),
+        }
+    }
+}
+
+/// `<action>` and the request body (the program name, the override percent).
+pub fn parse_action(name: &str, body: &str) -> Result<Action, String> {
+    let body = body.trim();
+    Ok(match name {
+        "start" if body.is_empty() => Action::Start,
+        "start" => Action::StartProgram(body.to_string()),
+        "hold" => Action::Hold,
+        "resume" => Action::Resume,
+        "reset" => Action::Reset,
+        "override" => match body.parse::<f64>() {
+            Ok(p) if p.is_finite() => Action::Override(p),
+            _ => return Err(format!("override: '{body}' is not a percentage")),
+        },
+        other => return Err(format!("unknown control '{other}'")),
+    })
+}
+
+fn op(action: Action) -> Op {
+    match action {
+        Action::Start => Op::CommandState(State::Active as i32),
+        Action::StartProgram(p) => Op::Start(p),
+        Action::Hold => Op::Hold,
+        Action::Resume => Op::Resume,
+        Action::Reset => Op::Reset,
+        Action::Override(p) => Op::SetOverride(p),
+    }
+}
+
+/// Apply one control request: `path_rest` is `<channel>/<action>`.
+pub fn handle(
+    backend: &Backend,
+    access: ControlAccess,
+    has_header: bool,
+    path_rest: &str,
+    body: &str,
+) -> Answer {
+    if access == ControlAccess::Refused {
+        return Answer::new(
+            403,
+            "operator controls are off: start serve with --http-controls to allow them",
+        );
+    }
+    if !has_header {
+        return Answer::new(
+            403,
+            format!("control requests must carry the {CONTROL_HEADER} header (the page sends it)"),
+        );
+    }
+    let Some((ch, name)) = path_rest.split_once('/') else {
+        return Answer::new(404, "use /control/<channel>/<action>");
+    };
+    let Ok(ch) = ch.parse::<u16>() else {
+        return Answer::new(404, format!("no channel '{ch}'"));
+    };
+    let action = match parse_action(name, body) {
+        Ok(a) => a,
+        Err(msg) => return Answer::new(400, msg),
+    };
+    match backend.call(ch, op(action)) {
+        Ok(Reply::Done | Reply::Command(Ok(()))) => Answer::new(200, "done"),
+        Ok(Reply::Command(Err(e))) => Answer::new(409, e.to_string()),
+        Ok(_) => Answer::new(500, "unexpected answer from the channel"),
+        Err(DeviceError::NotFound) => Answer::new(404, format!("no channel {ch}")),
+        Err(e) => Answer::new(503, format!("not applied: {e}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn actions_parse_with_their_values() {
+        assert_eq!(parse_action("start", ""), Ok(Action::Start));
+        assert_eq!(
+            parse_action("start", "demo.nc\n"),
+            Ok(Action::StartProgram("demo.nc".into()))
+        );
+        assert_eq!(parse_action("override", "50"), Ok(Action::Override(50.0)));
+        assert!(parse_action("override", "NaN").is_err());
+        assert!(parse_action("launch", "").is_err());
+    }
+}

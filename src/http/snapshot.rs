@@ -1,0 +1,231 @@
+//! What one update of the live view says about the runtime and each channel, as the page
+//! reads it (JSON): built from a channel's [`Status`] off the runtime's thread.
+
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use crate::machine::Status;
+use crate::vocab::mode::{Mode, State};
+use crate::vocab::stats::LiveCycleReading;
+
+/// One axis of the DRO.
+#[derive(Debug, Clone, Serialize)]
+pub struct AxisView {
+    pub axis: char,
+    /// Machine coordinates, mm (rotary: degrees).
+    pub mcs_mm: f64,
+    /// Programming coordinates (after G54…G59), mm.
+    pub pcs_mm: f64,
+}
+
+/// An error as the page lists it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ErrorView {
+    /// 0 = the first error the channel raised.
+    pub index: u64,
+    /// ISG error number.
+    pub code: u32,
+    pub text: String,
+}
+
+/// One channel in one update.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelView {
+    pub ch: u16,
+    pub mode: Mode,
+    pub state: State,
+    pub axes: Vec<AxisView>,
+    pub distance_to_go_mm: f64,
+    pub feed_mm_per_min: f64,
+    pub velocity_mm_per_s: f64,
+    pub override_pct: f64,
+    /// The main program running, if any.
+    pub program: Option<String>,
+    /// The program the executing block is in (a subroutine's name inside a call).
+    pub block_program: Option<String>,
+    /// 1-based line of the executing block in the listing, when the listing has its text.
+    pub line: Option<usize>,
+    pub block_counter: u64,
+    pub block_n: Option<u32>,
+    pub stream_used_bytes: usize,
+    pub stream_free_bytes: usize,
+    pub blocks: u64,
+    pub errors_total: u64,
+    pub last_error: Option<ErrorView>,
+    pub message: Option<String>,
+}
+
+/// The runtime's cycle statistics in one update.
+#[derive(Debug, Clone, Serialize)]
+pub struct CycleView {
+    pub period_us: f64,
+    pub ticks: u64,
+    pub work_last_us: f64,
+    pub work_mean_us: f64,
+    pub work_max_us: f64,
+    pub late_last_us: f64,
+    pub late_max_us: f64,
+    pub overruns: u64,
+}
+
+/// One update: the `status` event of the stream.
+#[derive(Debug, Clone, Serialize)]
+pub struct Update {
+    /// Counts the feed's updates, so a page can tell how many it missed.
+    pub seq: u64,
+    pub cycle: Option<CycleView>,
+    pub channels: Vec<ChannelView>,
+}
+
+/// A channel's program text for the listing: the `listing` event.
+#[derive(Debug, Clone, Serialize)]
+pub struct ListingView {
+    pub ch: u16,
+    pub program: Option<String>,
+    pub lines: Vec<String>,
+    /// Lines left out after `lines` (the listing is capped at [`MAX_LISTING_LINES`]).
+    pub lines_left_out: usize,
+}
+
+/// Lines of a program the listing shows at most; a bigger program is cut (the page would
+/// not show more usefully, and one event stays bounded).
+pub const MAX_LISTING_LINES: usize = 20_000;
+
+/// A program's text split into lines once, with where each starts, so the executing block's
+/// byte offset finds its line by a binary search on every update.
+#[derive(Debug, Clone)]
+pub struct Listing {
+    pub program: Arc<str>,
+    line_starts: Vec<usize>,
+    text: Arc<[u8]>,
+}
+
+impl Listing {
+    pub fn new(program: Arc<str>, text: Arc<[u8]>) -> Self {
+        let line_starts = std::iter::once(0)
+            .chain(memchr::memchr_iter(b'\n', &text).map(|i| i + 1))
+            .filter(|&s| s < text.len())
+            .collect();
+        Listing {
+            program,
+            line_starts,
+            text,
+        }
+    }
+
+    /// 1-based line holding byte `offset`.
+    pub fn line_of(&self, offset: u64) -> usize {
+        let offset = usize::try_from(offset).unwrap_or(usize::MAX);
+        self.line_starts.partition_point(|&s| s <= offset).max(1)
+    }
+
+    pub fn view(&self, ch: u16) -> ListingView {
+        let lines: Vec<String> = self
+            .line_starts
+            .iter()
+            .take(MAX_LISTING_LINES)
+            .enumerate()
+            .map(|(i, &start)| {
+                let end = self
+                    .line_starts
+                    .get(i + 1)
+                    .copied()
+                    .unwrap_or(self.text.len());
+                let raw = self.text.get(start..end).unwrap_or_default();
+                String::from_utf8_lossy(raw)
+                    .trim_end_matches(['\r', '\n'])
+                    .to_string()
+            })
+            .collect();
+        ListingView {
+            ch,
+            program: Some(self.program.to_string()),
+            lines_left_out: self.line_starts.len() - lines.len(),
+            lines,
+        }
+    }
+}
+
+fn us(d: std::time::Duration) -> f64 {
+    d.as_secs_f64() * 1e6
+}
+
+/// The cycle statistics: work times through the door (every status carries the machine's),
+/// lateness and overruns from the runtime's live counters.
+pub fn cycle_view(s: &Status, live: Option<LiveCycleReading>) -> CycleView {
+    let live = live.unwrap_or_default();
+    CycleView {
+        period_us: us(s.period),
+        ticks: s.cycle_times.ticks,
+        work_last_us: us(s.cycle_times.last),
+        work_mean_us: us(s.cycle_times.mean()),
+        work_max_us: us(s.cycle_times.max),
+        late_last_us: us(live.late_last),
+        late_max_us: us(live.late_max),
+        overruns: live.overruns,
+    }
+}
+
+/// One channel's view; `listing` is the text the page shows for it, if any.
+pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>) -> ChannelView {
+    let block = s.active_block.as_ref();
+    let line = match (block, listing) {
+        (Some(b), Some(l)) if *b.prog == *l.program => Some(l.line_of(b.offset)),
+        _ => None,
+    };
+    let axes = s
+        .positions
+        .iter()
+        .zip(&s.pcs_positions)
+        .map(|(&(axis, mcs_mm), &(_, pcs_mm))| AxisView {
+            axis,
+            mcs_mm,
+            pcs_mm,
+        })
+        .collect();
+    ChannelView {
+        ch,
+        mode: s.mode,
+        state: s.state,
+        axes,
+        distance_to_go_mm: s.distance_to_go_mm,
+        feed_mm_per_min: s.feed_mm_per_min,
+        velocity_mm_per_s: s.velocity_mm_per_s,
+        override_pct: s.override_pct,
+        program: s.program.clone(),
+        block_program: block.map(|b| b.prog.to_string()),
+        line,
+        block_counter: s.block_counter,
+        block_n: block.and_then(|b| b.n),
+        stream_used_bytes: s.stream_used,
+        stream_free_bytes: s.stream_free,
+        blocks: s.blocks,
+        errors_total: s.errors_total,
+        last_error: s.last_error.as_ref().map(|(code, text)| ErrorView {
+            index: s.errors_total.saturating_sub(1),
+            code: *code,
+            text: text.clone(),
+        }),
+        message: s.message.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_find_their_lines() {
+        let l = Listing::new(
+            Arc::from("p.nc"),
+            Arc::from(&b"N10 G01 X1\r\nN20 X2\nN30 M30\n"[..]),
+        );
+        assert_eq!(l.line_of(0), 1);
+        assert_eq!(l.line_of(12), 2);
+        assert_eq!(l.line_of(19), 3);
+        let v = l.view(1);
+        assert_eq!(v.lines, ["N10 G01 X1", "N20 X2", "N30 M30"]);
+        assert_eq!(v.lines_left_out, 0);
+    }
+}

@@ -1,0 +1,107 @@
+//! The live view in a real headless browser: Debian's chromium driven by playwright-core
+//! (tests/node/live_view_test.js) against two views of the same channels, one read-only and
+//! one with controls. Needs chromium and `npm ci --prefix tests/node`, so it is ignored by
+//! default; `.ci/run` installs both and runs it:
+//!
+//! `cargo test --test web -- --ignored browser`
+
+use std::io::{BufRead, BufReader, Read};
+use std::process::{Command, Stdio};
+use std::sync::Arc;
+
+use ncchannel::http::{spawn, ControlAccess, HttpConfig};
+use ncchannel::machine::Op;
+use ncchannel::vocab::mode::State;
+use serde_json::Value;
+
+use super::view;
+
+/// The N number a listing line or the DRO's block field starts with (`N20 G01 …`, `N20 (#8)`).
+fn n_number(text: &str) -> Option<u32> {
+    let digits: String = text
+        .trim()
+        .strip_prefix('N')?
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    digits.parse().ok()
+}
+
+#[test]
+#[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
+fn browser_shows_a_running_channel_its_line_and_its_errors() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let (read_only, channels) = view(ControlAccess::Refused);
+    let config = HttpConfig {
+        bind: "127.0.0.1:0".parse().unwrap(),
+        allow_non_loopback: false,
+        controls: ControlAccess::Allowed,
+    };
+    let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
+    channels.command(2, Op::Start("streaming.nc".into()));
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/live_view_test.js");
+    let mut child = Command::new(&node)
+        .arg(script)
+        .arg(format!("http://{}/", read_only.local_addr()))
+        .arg(format!("http://{}/", with_controls.local_addr()))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{node} runs: {e}"));
+    let mut stderr = child.stderr.take().unwrap();
+    let errors = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+        s
+    });
+    let mut last = String::new();
+    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
+        let line = line.unwrap();
+        if line == "READY_FOR_ERROR" {
+            // A syntax error on channel 2's stream while the page watches.
+            let bad = Op::WriteStream(b"N10 G01 X1 Y=\r\n"[..].into());
+            channels.backend.call(2, bad).unwrap();
+        } else {
+            last = line;
+        }
+    }
+    let status = child.wait().unwrap();
+    let stderr = errors.join().unwrap();
+    assert!(status.success(), "{stderr}");
+    let seen: Value = serde_json::from_str(&last).unwrap_or_else(|e| panic!("{e}: {last}"));
+    eprintln!("browser saw: {seen}");
+
+    let refused = seen["refused"].as_str().unwrap();
+    assert!(
+        refused.contains("403") && refused.contains("--http-controls"),
+        "{refused}"
+    );
+    assert_eq!(seen["state_after_refusal"], "READY");
+    let xs: Vec<f64> = seen["x"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().parse().unwrap())
+        .collect();
+    assert!(xs.windows(2).all(|w| w[0] != w[1]), "{xs:?}");
+    let line = seen["current_line"].as_str().unwrap();
+    let block = seen["block"].as_str().unwrap();
+    assert!(n_number(line).is_some(), "{line}");
+    assert!(seen["listing_lines"].as_u64().unwrap() >= 8);
+    // The highlighted line and the DRO's block come from one update, at most one block apart
+    // (the page reads them one after the other while the program runs).
+    let (n_line, n_block) = (n_number(line).unwrap(), n_number(block).unwrap());
+    assert!(n_line.abs_diff(n_block) <= 10, "{line} / {block}");
+    assert_eq!(seen["held"], true);
+    assert_eq!(channels.status(1).state, State::Hold);
+    let error = seen["error"].as_str().unwrap();
+    let code: u32 = error.split(':').next().unwrap().parse().unwrap();
+    assert!((20_000..30_000).contains(&code), "{error}");
+    assert_eq!(seen["ch2_state"], "ERROR");
+    assert_eq!(channels.status(2).state, State::Error);
+    assert_eq!(
+        seen["foreign"],
+        Value::Array(Vec::new()),
+        "only the view's own address"
+    );
+}

@@ -1,0 +1,35 @@
+//! The live web view of `serve --http`: the page and its event stream over real sockets
+//! (`feed`), the operator controls (`controls`), and the page in a real headless browser
+//! (`browser`, run by `.ci/run`; ignored here only when no chromium is installed).
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod browser;
+mod client;
+mod controls;
+mod feed;
+
+use std::sync::Arc;
+
+use ncchannel::http::{spawn, ControlAccess, HttpConfig, HttpHandle};
+use support::ads::{Channels, Params};
+
+/// Channel 1's program: a square with a rounded corner at 10 mm/s (17 s), long enough to watch.
+pub const SQUARE: &str = "%square\r\nN10 G90 G01 X0 Y0 F600\r\nN20 G01 X40 Y0\r\n\
+N30 G03 X50 Y10 I0 J10\r\nN40 G01 X50 Y40\r\nN50 G01 X0 Y40\r\nN60 G01 X0 Y0\r\nN70 M30\r\n";
+
+/// Two real channels ticking at 1 ms (channel 1 with `square.nc` in its program folder,
+/// both with the streaming program) behind a web view with `controls`.
+pub fn view(controls: ControlAccess) -> (HttpHandle, Channels) {
+    let params = Params::new(2);
+    params.program("square.nc", SQUARE);
+    let channels = Channels::from_params(params);
+    let config = HttpConfig {
+        bind: "127.0.0.1:0".parse().unwrap(),
+        allow_non_loopback: false,
+        controls,
+    };
+    let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
+    (web, channels)
+}
