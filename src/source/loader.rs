@@ -50,15 +50,42 @@ pub(crate) enum Poll {
     Done(ReadResult),
 }
 
+/// How a tick on this thread meets a read the loader has not finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadWait {
+    /// Real time: the tick goes on and the decoder waits ticks for the text.
+    Ticks,
+    /// Virtual time: the clock stops until the text is there, so a run takes the same ticks
+    /// on every machine (the simulated file-system latency is still charged in ticks).
+    StopTheClock,
+}
+
+thread_local! {
+    /// Set by the runtime for the thread its ticks run on ([`set_load_wait`]).
+    static LOAD_WAIT: std::cell::Cell<LoadWait> = const { std::cell::Cell::new(LoadWait::Ticks) };
+}
+
+/// How ticks on the calling thread wait for the loader: the runtime sets this from its clock.
+/// A thread-local, not a parameter, because the choice belongs to the clock, which the
+/// decoder and the file cache that poll reads do not (and should not) know.
+pub fn set_load_wait(wait: LoadWait) {
+    LOAD_WAIT.with(|w| w.set(wait));
+}
+
 impl PendingRead {
-    /// Whether the loader has finished; never waits.
+    /// Whether the loader has finished: never waits in real time; in virtual time waits
+    /// for the read to end (the clock stands still meanwhile).
     pub(crate) fn poll(&self) -> Poll {
-        match self.reply.try_recv() {
+        let r = match LOAD_WAIT.with(std::cell::Cell::get) {
+            LoadWait::Ticks => self.reply.try_recv().map_err(|e| e == TryRecvError::Empty),
+            LoadWait::StopTheClock => self.reply.recv().map_err(|_| false),
+        };
+        match r {
             Ok(r) => Poll::Done(r),
-            Err(TryRecvError::Empty) => Poll::Waiting,
-            Err(TryRecvError::Disconnected) => Poll::Done(Err(BoundedReadError::Io(
-                std::io::Error::other("the program loader stopped"),
-            ))),
+            Err(true) => Poll::Waiting,
+            Err(false) => Poll::Done(Err(BoundedReadError::Io(std::io::Error::other(
+                "the program loader stopped",
+            )))),
         }
     }
 }
