@@ -400,7 +400,7 @@ impl Decoder {
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
-    pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+    pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
         self.frames.iter().rev().find_map(|f| match &f.source {
             frame::Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
             _ => None,
