@@ -83,10 +83,15 @@ pub use queue::{
 /// Arcs from their programmed words (centre, radius, turns) to a queued move.
 pub use geometry::arc::{arc_move, ArcError, ArcSpec};
 
+pub use decoder::frame::MAX_LINE_BYTES;
 /// Decoder limits and kinds that show through a channel's requests and replies.
 pub use decoder::modal::DEFAULT_PATH_DEV_MM;
 pub use decoder::vars::{VarClass, CLASS_BYTES};
-pub use decoder::{SearchTarget, DECLARED_VALUES_PER_TICK};
+pub use decoder::{
+    SearchTarget, DECLARED_VALUES_PER_TICK, LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK,
+    LINE_BYTES_PER_TICK, MAX_INDEXED_LABELS,
+};
+pub use source::loader::INLINE_READ_BYTES_PER_TICK;
 
 /// Findings of a parameter-list check.
 pub use diag::{Diagnostic, Severity};

@@ -211,6 +211,10 @@ impl<C: Cycle> Runtime<C> {
     /// were, so a hiccup is caught up by ticks running back to back, and channel time stays
     /// `index × period`.
     pub fn run(&mut self, max_ticks: Option<u64>) -> RunSummary {
+        crate::source::loader::set_load_wait(match self.clock {
+            Clock::Virtual => crate::source::loader::LoadWait::StopTheClock,
+            Clock::RealTime => crate::source::loader::LoadWait::Ticks,
+        });
         let wall_start = Instant::now();
         let base = self.resume_at.take().unwrap_or(wall_start);
         let first = self.next_index;

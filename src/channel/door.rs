@@ -190,7 +190,7 @@ pub enum Reply {
     /// A trace file could not be written: the reason.
     Trace(Result<(), String>),
     /// The program text [`Op::ProgramText`] asked for; `None` when no frame runs it.
-    ProgramText(Option<Arc<[u8]>>),
+    ProgramText(Option<Arc<Vec<u8>>>),
 }
 
 /// An error as the ADS objects carry it: number and text.

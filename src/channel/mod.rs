@@ -229,7 +229,7 @@ pub struct Channel {
     zero_offsets: ZeroOffsets,
     /// The last started main program's name and text (a shared handle to the decoder's copy),
     /// so the live view lists it after the decoder has read past its end.
-    main_text: Option<(Arc<str>, Arc<[u8]>)>,
+    main_text: Option<(Arc<str>, Arc<Vec<u8>>)>,
 }
 
 impl Channel {
@@ -799,7 +799,7 @@ impl Channel {
         self.active.as_ref()
     }
     /// The text of file program `prog`: an open decoder frame's, or the last main program's.
-    fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+    fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
         self.decoder.program_text(prog).or_else(|| {
             let (name, text) = self.main_text.as_ref()?;
             (**name == *prog).then(|| Arc::clone(text))

@@ -2,7 +2,19 @@
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
 use super::*;
+use crate::source::cache::LoadStep;
+use crate::source::loader::PendingRead;
+use crate::source::store::{ProgramText, StoreError};
 use crate::vocab::event::CacheOp;
+
+/// A `#CACHE LOAD` whose file the loader reads: the line waits, and runs again with the text.
+#[derive(Debug)]
+pub(super) struct CacheRead {
+    pub(crate) file: String,
+    pub(crate) pending: PendingRead,
+    /// The loader's answer, once there.
+    pub(crate) read: Option<Result<ProgramText, StoreError>>,
+}
 
 /// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
 /// before it: applied when the frame stack is back at `depth`.
@@ -252,7 +264,9 @@ impl Decoder {
             }
             Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
                 self.exec_cache(c, io)?;
-                self.emit(info, Action::None, false, io);
+                if !self.wait_line {
+                    self.emit(info, Action::None, false, io);
+                }
             }
             Command::CommentBegin => self.top().comment_block = true,
             // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
@@ -322,7 +336,26 @@ impl Decoder {
     fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
         match c {
             Command::CacheLoad { file } => {
-                let loaded = io.cache.load(file, io.store)?;
+                let loaded = match self.cache_read.take() {
+                    // The line again, after the loader read the file.
+                    Some(CacheRead {
+                        file: f,
+                        read: Some(read),
+                        ..
+                    }) if f.eq_ignore_ascii_case(file) => io.cache.finish_load(file, read)?,
+                    _ => match io.cache.load(file, io.store)? {
+                        LoadStep::Done(loaded) => loaded,
+                        LoadStep::Reading(pending) => {
+                            self.cache_read = Some(CacheRead {
+                                file: file.clone(),
+                                pending,
+                                read: None,
+                            });
+                            self.wait_line = true;
+                            return Ok(());
+                        }
+                    },
+                };
                 self.notes.push(Note::Cache {
                     op: loaded.op(),
                     file: file.clone(),
@@ -373,7 +406,9 @@ impl Decoder {
                 params,
             } => self.call_cycle(name, *local, params, info, io)?,
             Call::Local { name } => {
-                let frame = self.local_frame(name, "local subroutine call (LL)")?;
+                let Some(frame) = self.local_frame(name, "local subroutine call (LL)")? else {
+                    return Ok(());
+                };
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
                 self.frames.push(frame);
@@ -404,6 +439,11 @@ impl Decoder {
             Opened::File(p) => {
                 let prog: Arc<str> = p.name.clone();
                 Ok(Frame::new(kind, Source::File(p), prog))
+            }
+            // Read by the loader: the frame's first line waits for it.
+            Opened::Loading(p) => {
+                let prog: Arc<str> = p.name.clone();
+                Ok(Frame::new(kind, Source::Loading(p), prog))
             }
             Opened::Stream { name } => {
                 if self.stream_active {

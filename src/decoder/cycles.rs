@@ -31,7 +31,10 @@ impl Decoder {
             }
         }
         let frame = if local {
-            self.local_frame(name, "local cycle call (LL CYCLE)")?
+            match self.local_frame(name, "local cycle call (LL CYCLE)")? {
+                Some(f) => f,
+                None => return Ok(()),
+            }
         } else {
             self.open_subroutine(name, FrameKind::Cycle, io)?
         };
@@ -43,9 +46,23 @@ impl Decoder {
 
     /// The frame of `%L name` in the running file, for `LL name` and `LL CYCLE` (`what`
     /// names the call in the streaming error): not in a streaming program, where it is 21479.
-    pub(super) fn local_frame(&mut self, name: &str, what: &str) -> Res<Frame> {
-        let index = self.label_index()?;
-        let Some(at) = index.local_subs.get(&name.to_ascii_uppercase()).copied() else {
+    /// `Ok(None)`: the label index (or a search for the section) is still being built; the
+    /// call line waits and runs again.
+    pub(super) fn local_frame(&mut self, name: &str, what: &str) -> Res<Option<Frame>> {
+        let Some(index) = self.label_index() else {
+            return Ok(None);
+        };
+        let found = match index.local_sub(name) {
+            Some(at) => Some(at),
+            None if index.overflowed => {
+                match self.searched(labels::ScanGoal::LocalSub(name.to_ascii_uppercase())) {
+                    Some(labels::ScanFound::LocalSub(at)) => at,
+                    _ => return Ok(None),
+                }
+            }
+            None => None,
+        };
+        let Some(at) = found else {
             return Err(DecodeError::new(
                 codes::LOCAL_SUB_NOT_FOUND,
                 format!("local subroutine {name} not found"),
@@ -61,6 +78,6 @@ impl Decoder {
         let mut frame = Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
         frame.label_index = Some(index);
         frame.seek(at);
-        Ok(frame)
+        Ok(Some(frame))
     }
 }

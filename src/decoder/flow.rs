@@ -6,12 +6,11 @@
 
 use std::sync::Arc;
 
-use crate::lang::block::{Block, Body, Command, Control, GotoTarget, Item, Label, Value};
-use crate::lang::{continuation, is_comment_end, parse_block, Expr, Joiner, VarRef};
+use crate::lang::block::{Block, Body, Control, GotoTarget, Item, Label, Value};
+use crate::lang::{Expr, VarRef};
 
-use super::frame::{
-    self, FlowEntry, LabelIndex, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS,
-};
+use super::frame::{FlowEntry, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
+use super::labels::{LabelAt, LabelIndex, LabelScan, ScanFound, ScanGoal};
 use super::{whole, DecodeError, Decoder, Res};
 use crate::lang::codes;
 use crate::lang::eval::is_true;
@@ -485,35 +484,73 @@ impl Decoder {
             top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
             return Ok(());
         }
-        let index = self.label_index()?;
-        let Some((at, depth)) = index.find(t) else {
+        // A file frame: the label index, built over several ticks; the line waits for it.
+        let Some(index) = self.label_index() else {
+            return Ok(());
+        };
+        let found = match index.find(t) {
+            Some(at) => Some(at),
+            None if index.overflowed => match self.searched(ScanGoal::Label(goto_label(t))) {
+                Some(ScanFound::Label(at)) => at,
+                _ => return Ok(()),
+            },
+            None => None,
+        };
+        let Some((at, depth)) = found else {
             return Err(DecodeError::new(
                 codes::LABEL_NOT_FOUND,
                 format!("label {} not found", goto_text(t)),
             ));
         };
+        self.jump_to((at, depth));
+        Ok(())
+    }
+
+    /// Continue at a label: its structural depth decides which open structures the jump
+    /// leaves.
+    fn jump_to(&mut self, (at, depth): LabelAt) {
         let top = self.top();
         top.seek(at);
-        // The label's structural depth decides which open structures the jump leaves.
         top.flow.truncate(depth);
         while top.flow.len() < depth {
             top.flow.push(FlowEntry::If { taken: true });
         }
-        Ok(())
     }
 
-    /// The label index of the top file frame, built once per program text.
-    pub(super) fn label_index(&mut self) -> Res<Arc<LabelIndex>> {
+    /// The label index of the top frame's text, once built. `None`: its scan has begun (or
+    /// goes on) and the line asking waits (`wait_line`); it is read again when the scan is
+    /// done. A stream frame has none (its jumps go forward, line by line).
+    pub(super) fn label_index(&mut self) -> Option<Arc<LabelIndex>> {
         let top = self.top();
         if let Some(i) = &top.label_index {
-            return Ok(i.clone());
+            return Some(i.clone());
         }
         let Source::File(p) = &top.source else {
-            return Ok(Arc::new(LabelIndex::default()));
+            return Some(Arc::new(LabelIndex::default()));
         };
-        let index = Arc::new(build_label_index(&p.text)?);
-        self.top().label_index = Some(index.clone());
-        Ok(index)
+        let scan = LabelScan::new(p.text.clone(), ScanGoal::Index);
+        self.begin_scan(scan);
+        None
+    }
+
+    /// What a targeted scan for `goal` found: `None` while it runs (the line waits).
+    pub(super) fn searched(&mut self, goal: ScanGoal) -> Option<ScanFound> {
+        if let Some((g, _)) = &self.scan_found {
+            if *g == goal {
+                return self.scan_found.take().map(|(_, found)| found);
+            }
+        }
+        if let Source::File(p) = &self.top().source {
+            let scan = LabelScan::new(p.text.clone(), goal);
+            self.begin_scan(scan);
+        }
+        None
+    }
+
+    fn begin_scan(&mut self, scan: LabelScan) {
+        self.stats.label_scans += 1;
+        self.scan = Some(scan);
+        self.wait_line = true;
     }
 
     pub(super) fn check_open_flow(&mut self) -> Res {
@@ -525,67 +562,6 @@ impl Decoder {
         }
         Ok(())
     }
-}
-
-/// Scan a whole file once for labels (position and structural depth) and `%L` sections.
-pub(super) fn build_label_index(text: &[u8]) -> Res<LabelIndex> {
-    let mut index = LabelIndex::default();
-    let mut pos = 0usize;
-    let mut line_no = 0u32;
-    let mut depth = 0usize;
-    let mut comment = false;
-    let mut line = String::new();
-    let mut joiner = Joiner::default();
-    let mut at = LinePos { pos, line_no };
-    loop {
-        if !joiner.is_open() {
-            at = LinePos { pos, line_no };
-        }
-        let Some(next) = frame::cut_line(text, pos, &mut line, true) else {
-            break;
-        };
-        pos = next;
-        line_no += 1;
-        if comment {
-            if is_comment_end(&line) {
-                comment = false;
-            }
-            continue;
-        }
-        // A block written over several lines (`\`) is read as the decoder reads it.
-        let joined = joiner.is_open() || continuation(&line).is_some();
-        if joined && !joiner.push(&line) && next < text.len() {
-            continue;
-        }
-        let Ok(block) = parse_block(if joined { joiner.text() } else { &line }) else {
-            continue;
-        };
-        if let Some(l) = &block.label {
-            if index.labels.insert(l.clone(), (at, depth)).is_some() {
-                return Err(DecodeError::new(
-                    codes::LABEL_TWICE,
-                    format!("label {} defined twice (line {})", label_text(l), line_no),
-                ));
-            }
-        }
-        match &block.body {
-            Body::Command(Command::CommentBegin) => comment = true,
-            Body::ProgramHead {
-                name, local: true, ..
-            } => {
-                index
-                    .local_subs
-                    .insert(name.to_ascii_uppercase(), LinePos { pos, line_no });
-            }
-            Body::Control(c) => match nesting(c) {
-                Nesting::Open => depth += 1,
-                Nesting::Close => depth = depth.saturating_sub(1),
-                Nesting::Neither => {}
-            },
-            _ => {}
-        }
-    }
-    Ok(index)
 }
 
 pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {

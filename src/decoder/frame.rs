@@ -9,6 +9,7 @@ use std::collections::HashSet;
 use std::sync::Arc;
 
 use crate::lang::block::{GotoTarget, Label};
+use crate::source::loader::PendingRead;
 use crate::source::store::ProgramText;
 use crate::source::stream::StreamBuffer;
 
@@ -99,6 +100,9 @@ pub(crate) enum FrameKind {
 #[derive(Debug, Clone)]
 pub(crate) enum Source {
     File(ProgramText),
+    /// A file the loader is still reading (off the runtime thread): the frame's first line
+    /// waits for it, as it waits for a simulated file-system read.
+    Loading(PendingRead),
     Stream,
 }
 
@@ -133,28 +137,19 @@ pub(crate) struct Frame {
     /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`.
     pub(crate) seen_labels: HashSet<Label>,
     /// File frames: label → position and structural depth, built on the first jump.
-    pub(crate) label_index: Option<Arc<LabelIndex>>,
+    pub(crate) label_index: Option<Arc<super::labels::LabelIndex>>,
 }
 
 /// How many stream labels a frame remembers. A stream may run for days; a label passed more
 /// than this many labels ago is treated as unknown (a jump to it waits forward for it).
 pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
 
-/// All labels of a file with where they stand and how deeply nested they are.
-#[derive(Debug, Default)]
-pub(crate) struct LabelIndex {
-    pub(crate) labels: std::collections::HashMap<Label, (LinePos, usize)>,
-    /// `%L NAME` (upper-case) → the line after the head.
-    pub(crate) local_subs: std::collections::HashMap<String, LinePos>,
-}
-
-impl LabelIndex {
-    pub(crate) fn find(&self, t: &GotoTarget) -> Option<(LinePos, usize)> {
-        let key = match t {
-            GotoTarget::Number(n) => Label::Number(*n),
-            GotoTarget::Name(s) => Label::Name(s.clone()),
-        };
-        self.labels.get(&key).copied()
+/// A frame that held the last reference to a large file text lets the loader thread free it.
+impl Drop for Frame {
+    fn drop(&mut self) {
+        if let Source::File(p) = &mut self.source {
+            crate::source::loader::release(std::mem::take(&mut p.text));
+        }
     }
 }
 
@@ -209,24 +204,50 @@ pub(crate) enum LineRead {
     Pending,
     /// A file frame at its end.
     Eof,
+    /// A file frame's next line is longer than [`MAX_LINE_BYTES`].
+    TooLong(LineMeta),
+}
+
+/// Longest line of a program file, bytes. A block is at most `MAX_BLOCK_CHARS` (4000)
+/// characters, so no useful line comes near it; the bound keeps the search for a line end, and
+/// the copy of the line, from growing with a file that has no line ends.
+pub const MAX_LINE_BYTES: usize = 16 * 1024;
+
+/// A line longer than [`MAX_LINE_BYTES`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct LineTooLong;
+
+impl LineTooLong {
+    /// The error at 1-based line `line` of a file.
+    pub(crate) fn error(self, line: u32) -> super::DecodeError {
+        super::DecodeError::new(
+            crate::lang::codes::SYNTAX,
+            format!("line {line} is longer than {MAX_LINE_BYTES} bytes"),
+        )
+    }
 }
 
 /// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
-/// offset after the line end, or `None` when no complete line is there.
+/// offset after the line end, or `None` when no complete line is there. Looks at most
+/// [`MAX_LINE_BYTES`] bytes ahead.
 pub(super) fn cut_line(
     text: &[u8],
     pos: usize,
     out: &mut String,
     at_eof_ok: bool,
-) -> Option<usize> {
-    let rest = text.get(pos..)?;
+) -> Result<Option<usize>, LineTooLong> {
+    let Some(rest) = text.get(pos..) else {
+        return Ok(None);
+    };
     if rest.is_empty() {
-        return None;
+        return Ok(None);
     }
-    let (line, next) = match rest.iter().position(|&b| b == b'\n') {
+    let window = &rest[..rest.len().min(MAX_LINE_BYTES + 1)];
+    let (line, next) = match memchr::memchr(b'\n', window) {
         Some(i) => (&rest[..i], pos + i + 1),
+        None if window.len() > MAX_LINE_BYTES => return Err(LineTooLong),
         None if at_eof_ok => (rest, text.len()),
-        None => return None,
+        None => return Ok(None),
     };
     let line = line.strip_suffix(b"\r").unwrap_or(line);
     out.clear();
@@ -234,7 +255,7 @@ pub(super) fn cut_line(
         Ok(s) => out.push_str(s),
         Err(_) => out.push_str(&String::from_utf8_lossy(line)),
     }
-    Some(next)
+    Ok(Some(next))
 }
 
 /// Next line of a file frame.
@@ -244,7 +265,7 @@ pub(crate) fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
     };
     let start = frame.pos;
     match cut_line(&p.text, start, out, true) {
-        Some(next) => {
+        Ok(Some(next)) => {
             frame.pos = next;
             frame.line_no += 1;
             LineRead::Line(LineMeta {
@@ -252,7 +273,11 @@ pub(crate) fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
                 offset: start as u64,
             })
         }
-        None => LineRead::Eof,
+        Ok(None) => LineRead::Eof,
+        Err(LineTooLong) => LineRead::TooLong(LineMeta {
+            line: frame.line_no + 1,
+            offset: start as u64,
+        }),
     }
 }
 
@@ -299,7 +324,8 @@ impl StreamReader {
         note: &mut Option<StreamNote>,
     ) -> LineRead {
         loop {
-            if let Some(next) = cut_line(&self.seg, self.pos, out, false) {
+            // A segment holds at most one buffer's worth of lines: never too long.
+            if let Ok(Some(next)) = cut_line(&self.seg, self.pos, out, false) {
                 let meta = LineMeta {
                     line: self.line_no + 1,
                     offset: self.seg_base + self.pos as u64,

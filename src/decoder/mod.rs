@@ -11,6 +11,7 @@ mod cycles;
 mod expr;
 pub mod flow;
 pub mod frame;
+mod labels;
 pub mod modal;
 mod search;
 pub mod vars;
@@ -39,6 +40,8 @@ use frame::{
 use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
 use vars::{VarSlot, VarStore};
 
+use labels::{LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
+pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
 use search::Search;
 pub use search::SearchTarget;
 
@@ -78,6 +81,12 @@ pub(crate) fn letter_names() -> [AxisName; MAX_AXES] {
 /// 100,000-element declaration costs ~0.1 ms to fill, so a tick does at most about two
 /// such, whatever the NC text (a line of ten took 15 s in one tick before).
 pub const DECLARED_VALUES_PER_TICK: usize = 100_000;
+
+/// Bytes of NC text the decoder reads per tick at most (files and stream alike; one line may
+/// end beyond it). Real blocks are tens of bytes, so `blocks_per_tick` lines stay far inside
+/// it; lines thousands of bytes long (comments in a `#COMMENT` block) no longer make a tick's
+/// work grow with them (64 lines of 60 KB took 30 ms a tick before).
+pub const LINE_BYTES_PER_TICK: usize = 64 * 1024;
 
 impl Default for DecoderSettings {
     fn default() -> Self {
@@ -232,6 +241,16 @@ pub struct DecoderStats {
     pub lines: u64,
     /// Blocks queued (those that take effect).
     pub blocks: u64,
+    /// Label scans run (an index built for `$GOTO`/`LL`, or one label searched).
+    pub label_scans: u64,
+    /// Most lines a label scan read in one tick (at most [`LABEL_SCAN_LINES_PER_TICK`]).
+    pub max_scan_lines_per_tick: usize,
+    /// Most bytes of NC text decoded in one tick (at most [`LINE_BYTES_PER_TICK`] plus one
+    /// line).
+    pub max_line_bytes_per_tick: usize,
+    /// Most bytes a label scan read in one tick (at most [`LABEL_SCAN_BYTES_PER_TICK`]
+    /// plus one line).
+    pub max_scan_bytes_per_tick: usize,
 }
 
 pub struct Decoder {
@@ -262,6 +281,20 @@ pub struct Decoder {
     ready_at: Duration,
     /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
     declared_this_tick: usize,
+    /// A label scan of the top frame's text under way (module `labels`): the line that
+    /// needs it waits, rewound, and runs again when the scan is done.
+    scan: Option<LabelScan>,
+    /// What a finished targeted scan found, for the line that asked for it.
+    scan_found: Option<(ScanGoal, ScanFound)>,
+    /// What label scans read in this tick.
+    scanned_this_tick: ScanWork,
+    /// Bytes of NC text decoded in this tick ([`LINE_BYTES_PER_TICK`]).
+    line_bytes_this_tick: usize,
+    /// A `#CACHE LOAD` waiting for the loader.
+    cache_read: Option<calls::CacheRead>,
+    /// The line being run has to wait (for a label scan, a `#CACHE LOAD` read): it is read
+    /// again later.
+    wait_line: bool,
     line: String,
     /// A block written over several lines (`\` at the end of a line) being collected, and
     /// where its first line stands.
@@ -276,6 +309,16 @@ pub struct Decoder {
 }
 
 type Res<T = ()> = Result<T, DecodeError>;
+
+/// Whether the decoder may read its next line in this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Ready {
+    Go,
+    /// Something has just arrived: check everything again.
+    Again,
+    /// Not in this tick.
+    Stop,
+}
 
 impl Decoder {
     pub fn new(settings: DecoderSettings) -> Self {
@@ -299,6 +342,12 @@ impl Decoder {
             starved: false,
             ready_at: Duration::ZERO,
             declared_this_tick: 0,
+            scan: None,
+            scan_found: None,
+            scanned_this_tick: ScanWork::default(),
+            line_bytes_this_tick: 0,
+            cache_read: None,
+            wait_line: false,
             line: String::new(),
             joiner: Joiner::default(),
             join_meta: LineMeta { line: 0, offset: 0 },
@@ -351,7 +400,7 @@ impl Decoder {
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
-    pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<[u8]>> {
+    pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
         self.frames.iter().rev().find_map(|f| match &f.source {
             frame::Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
             _ => None,
@@ -398,6 +447,7 @@ impl Decoder {
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
+        self.forget_scan();
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
         self.stream_active = false;
@@ -412,6 +462,18 @@ impl Decoder {
                 let prog = p.name.clone();
                 self.frames
                     .push(Frame::new(FrameKind::Main, Source::File(p), prog.clone()));
+                self.notes.push(Note::ProgramStart {
+                    prog,
+                    stream: false,
+                });
+            }
+            Opened::Loading(p) => {
+                let prog = p.name.clone();
+                self.frames.push(Frame::new(
+                    FrameKind::Main,
+                    Source::Loading(p),
+                    prog.clone(),
+                ));
                 self.notes.push(Note::ProgramStart {
                     prog,
                     stream: false,
@@ -446,6 +508,15 @@ impl Decoder {
         self.wait_idle = false;
         self.starved = false;
         self.ready_at = Duration::ZERO;
+        self.forget_scan();
+    }
+
+    /// No label scan under way or waited for.
+    fn forget_scan(&mut self) {
+        self.scan = None;
+        self.scan_found = None;
+        self.cache_read = None;
+        self.wait_line = false;
     }
 
     fn begin_stream(&mut self) {
@@ -460,35 +531,100 @@ impl Decoder {
     /// and decoding goes on in this tick only while `ready_at` lies inside it. So reads of
     /// 200 µs in 1 ms ticks give five per tick, and a 5 ms read pauses decoding for five ticks.
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
+        self.decode(io);
+        self.stats.max_scan_lines_per_tick = self
+            .stats
+            .max_scan_lines_per_tick
+            .max(self.scanned_this_tick.lines);
+        self.stats.max_scan_bytes_per_tick = self
+            .stats
+            .max_scan_bytes_per_tick
+            .max(self.scanned_this_tick.bytes);
+        self.stats.max_line_bytes_per_tick = self
+            .stats
+            .max_line_bytes_per_tick
+            .max(self.line_bytes_this_tick);
+        io.store.end_tick();
+    }
+
+    /// Everything a line waits for: the tick's byte and `#VAR` budgets, simulated
+    /// file-system latency, a label scan, the loader, `#FLUSH WAIT`, room in the queue, the
+    /// start subroutine, a frame's file.
+    fn ready_to_read(&mut self, io: &mut DecoderIo<'_>, tick_end: Duration) -> Ready {
+        if self.declared_this_tick >= DECLARED_VALUES_PER_TICK
+            || self.line_bytes_this_tick >= LINE_BYTES_PER_TICK
+        {
+            return Ready::Stop;
+        }
+        let owed = io.store.take_owed();
+        if !owed.is_zero() {
+            self.ready_at = self.ready_at.max(io.now) + owed;
+        }
+        if self.ready_at >= tick_end {
+            return Ready::Stop;
+        }
+        if self.scan.is_some() && !self.advance_scan() {
+            return Ready::Stop;
+        }
+        match self.cache_read_arrived(io.store) {
+            Some(false) => return Ready::Stop,
+            // The read's simulated latency is waited for first (top of the loop).
+            Some(true) => return Ready::Again,
+            None => {}
+        }
+        if self.wait_idle {
+            if io.queue.is_empty() && io.motion_idle {
+                self.wait_idle = false;
+            } else {
+                return Ready::Stop;
+            }
+        }
+        if !io.queue.has_room() {
+            return Ready::Stop;
+        }
+        if self.implicit.start_pending {
+            if let Err(e) = self.start_subroutine(io) {
+                self.fail(e, LineMeta { line: 0, offset: 0 });
+                return Ready::Stop;
+            }
+        }
+        self.frame_file_arrived(io.store)
+    }
+
+    /// A top frame whose file the loader reads: `Again` when the text has just arrived (its
+    /// simulated latency is waited for first), `Stop` while it has not or could not be read.
+    fn frame_file_arrived(&mut self, store: &mut ProgramStore) -> Ready {
+        let Some(top) = self.frames.last_mut() else {
+            return Ready::Go;
+        };
+        let Source::Loading(p) = &top.source else {
+            return Ready::Go;
+        };
+        match store.finish_read(p) {
+            None => Ready::Stop,
+            Some(Ok(text)) => {
+                top.source = Source::File(text);
+                Ready::Again
+            }
+            Some(Err(e)) => {
+                self.fail(e.into(), LineMeta { line: 0, offset: 0 });
+                Ready::Stop
+            }
+        }
+    }
+
+    /// The decoding loop of [`Decoder::step`].
+    fn decode(&mut self, io: &mut DecoderIo<'_>) {
         let mut budget = self.settings.blocks_per_tick;
         let tick_end = io.now + io.period;
         self.declared_this_tick = 0;
+        self.scanned_this_tick = ScanWork::default();
+        self.line_bytes_this_tick = 0;
         while budget > 0 && self.state == DecoderState::Running {
-            if self.declared_this_tick >= DECLARED_VALUES_PER_TICK {
-                break;
-            }
-            let owed = io.store.take_owed();
-            if !owed.is_zero() {
-                self.ready_at = self.ready_at.max(io.now) + owed;
-            }
-            if self.ready_at >= tick_end {
-                break;
-            }
-            if self.wait_idle {
-                if io.queue.is_empty() && io.motion_idle {
-                    self.wait_idle = false;
-                } else {
-                    break;
-                }
-            }
-            if !io.queue.has_room() {
-                break;
-            }
-            if self.implicit.start_pending {
-                if let Err(e) = self.start_subroutine(io) {
-                    self.fail(e, LineMeta { line: 0, offset: 0 });
-                    break;
-                }
+            match self.ready_to_read(io, tick_end) {
+                Ready::Stop => break,
+                Ready::Again => continue,
+                Ready::Go => {}
             }
             let Some(top) = self.frames.last_mut() else {
                 self.state = DecoderState::Idle;
@@ -505,6 +641,10 @@ impl Decoder {
             } else {
                 read_file_line(top, &mut line)
             };
+            if let LineRead::Line(_) = read {
+                // The line and its end (CR LF at most).
+                self.line_bytes_this_tick += line.len() + 2;
+            }
             match read {
                 LineRead::Pending => {
                     self.starved = true;
@@ -516,6 +656,10 @@ impl Decoder {
                     self.line = line;
                     budget -= 1;
                     self.run_joined(io);
+                }
+                LineRead::TooLong(meta) => {
+                    self.line = line;
+                    self.fail(frame::LineTooLong.error(meta.line), meta);
                 }
                 LineRead::Eof => {
                     self.line = line;
@@ -550,6 +694,7 @@ impl Decoder {
                     if let Err(e) = r {
                         self.fail(e, meta);
                     }
+                    self.rewind_if_waiting(meta);
                 }
             }
         }
@@ -573,6 +718,69 @@ impl Decoder {
         }
         self.joiner = joiner;
         self.joiner.close();
+        self.rewind_if_waiting(meta);
+    }
+
+    /// A line that has to wait (for a label scan) did nothing: it is read again, and its
+    /// block counter given back.
+    fn rewind_if_waiting(&mut self, meta: LineMeta) {
+        if !std::mem::take(&mut self.wait_line) {
+            return;
+        }
+        self.counter -= 1;
+        let at = frame::LinePos {
+            pos: usize::try_from(meta.offset).unwrap_or(usize::MAX),
+            line_no: meta.line.saturating_sub(1),
+        };
+        self.top().seek(at);
+    }
+
+    /// A `#CACHE LOAD` waiting for the loader: `Some(true)` when its text has just arrived,
+    /// `Some(false)` while it has not, `None` when no load waits.
+    fn cache_read_arrived(&mut self, store: &mut ProgramStore) -> Option<bool> {
+        let r = self.cache_read.as_mut().filter(|r| r.read.is_none())?;
+        let read = store.finish_read(&r.pending);
+        let arrived = read.is_some();
+        r.read = read;
+        Some(arrived)
+    }
+
+    /// Go on with the label scan under way, within what is left of this tick's scan budget.
+    /// `true` when it is done (its result installed) and decoding may go on.
+    fn advance_scan(&mut self) -> bool {
+        let Some(scan) = self.scan.as_mut() else {
+            return true;
+        };
+        let step = scan.advance(&mut self.scanned_this_tick);
+        let warnings = scan.take_warnings();
+        let goal = scan.goal().clone();
+        for w in warnings {
+            self.notes.push(Note::Warning {
+                code: w.code,
+                msg: w.msg,
+            });
+        }
+        match step {
+            Ok(ScanStep::Pending) => false,
+            Ok(ScanStep::Done(found)) => {
+                self.scan = None;
+                match found {
+                    ScanFound::Index(index) => self.top().label_index = Some(Arc::new(index)),
+                    other => self.scan_found = Some((goal, other)),
+                }
+                true
+            }
+            Err(e) => {
+                self.scan = None;
+                let top = self.top();
+                let meta = LineMeta {
+                    line: top.line_no + 1,
+                    offset: top.pos as u64,
+                };
+                self.fail(e, meta);
+                false
+            }
+        }
     }
 
     fn fail(&mut self, e: DecodeError, meta: LineMeta) {

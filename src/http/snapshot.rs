@@ -98,11 +98,11 @@ pub const MAX_LISTING_LINES: usize = 20_000;
 pub struct Listing {
     pub program: Arc<str>,
     line_starts: Vec<usize>,
-    text: Arc<[u8]>,
+    text: Arc<Vec<u8>>,
 }
 
 impl Listing {
-    pub fn new(program: Arc<str>, text: Arc<[u8]>) -> Self {
+    pub fn new(program: Arc<str>, text: Arc<Vec<u8>>) -> Self {
         let line_starts = std::iter::once(0)
             .chain(memchr::memchr_iter(b'\n', &text).map(|i| i + 1))
             .filter(|&s| s < text.len())

@@ -124,6 +124,11 @@ pub const MSG_UNKNOWN_FORMAT: u32 = 21232;
 pub const DWELL_RANGE_TIME: u32 = 20751;
 /// G04 with a dwell time out of range (negative): TF5200 diagnosis ID 20752.
 pub const DWELL_RANGE_G04: u32 = 20752;
+/// A warning: more string labels (`[NAME]`) in a program file than its label index holds
+/// (`decoder::MAX_INDEXED_LABELS`); the program goes on and a jump to a label that found no
+/// room is searched from the top of the file (TF5200 diagnosis ID 20829 "Number of string
+/// labels too big for optimised program execution.", class 1, processing continues).
+pub const STRING_LABEL_INDEX_FULL: u32 = 20829;
 /// Label defined twice in one program level (TF5200 diagnosis ID 20836 "Multiple defined
 /// label").
 pub const LABEL_TWICE: u32 = 20836;
@@ -206,6 +211,10 @@ pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
 pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
 pub const SUB_END_MISSING: u32 = 900104;
+/// A warning: more block-number labels (`N10:`) or `%L` sections in a program file than its
+/// label index holds; later ones are searched at each jump or call, as for
+/// [`STRING_LABEL_INDEX_FULL`], whose kernel id names string labels only.
+pub const LABEL_INDEX_FULL: u32 = 900113;
 /// Program file larger than the store reads.
 pub const PROGRAM_TOO_LARGE: u32 = 900110;
 /// Program file could not be read.
@@ -291,6 +300,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     (MSG_UNKNOWN_FORMAT, "#MSG unknown format element"),
     (DWELL_RANGE_TIME, "#TIME out of range"),
     (DWELL_RANGE_G04, "G04 time out of range"),
+    (
+        STRING_LABEL_INDEX_FULL,
+        "string label index full: later ones searched",
+    ),
     (LABEL_TWICE, "label defined twice"),
     (LABEL_NOT_FOUND, "label not found"),
     (VARIABLE_MEMORY_FULL, "variable memory full"),
@@ -326,6 +339,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     (STREAM_ALREADY_ACTIVE, "streaming program already running"),
     (MAIN_END_MISSING, "main program without M30/M02"),
     (SUB_END_MISSING, "subroutine without M17/M29"),
+    (
+        LABEL_INDEX_FULL,
+        "N label or %L section index full: later ones searched",
+    ),
     (PROGRAM_TOO_LARGE, "program file too large"),
     (PROGRAM_UNREADABLE, "program file unreadable"),
     (PROGRAM_BAD_NAME, "program name leaves the search path"),
@@ -430,6 +447,10 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (
+        20829,
+        "Number of string labels too big for optimised program execution.",
+    ), // 252695435
     (20836, "Multiple defined label"),   // 252721547
     (
         20967,

@@ -3,7 +3,8 @@
 
 use thiserror::Error;
 
-use super::store::{ProgramKind, ProgramStore, ProgramText, StoreError};
+use super::loader::PendingRead;
+use super::store::{Opened, ProgramKind, ProgramStore, ProgramText, StoreError};
 use crate::vocab::event::CacheOp;
 
 /// Cache limits from the lists (P-STUP-00050..52 / P-CHAN-00500..504).
@@ -44,6 +45,14 @@ impl CacheError {
             CacheError::Unreadable { .. } => codes::CACHE_FILE_NOT_FOUND,
         }
     }
+}
+
+/// Where `#CACHE LOAD` stands after [`Cache::load`].
+#[derive(Debug)]
+pub enum LoadStep {
+    Done(Loaded),
+    /// The file is large: the loader reads it; hand its text to [`Cache::finish_load`].
+    Reading(PendingRead),
 }
 
 /// What `#CACHE LOAD` did.
@@ -104,50 +113,42 @@ impl Cache {
     }
 
     /// `#CACHE LOAD [FILE=name]`: load, or refresh when already cached. The file is read
-    /// through the store, so the load counts as a file-system open and pays its latency.
-    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<Loaded, CacheError> {
+    /// through the store, so the load counts as a file-system open and pays its latency; a
+    /// file too large for the tick's inline read budget is read by the loader
+    /// ([`LoadStep::Reading`]).
+    pub fn load(&mut self, name: &str, store: &mut ProgramStore) -> Result<LoadStep, CacheError> {
         if !self.limits.enabled {
             return Err(CacheError::NotEnabled);
         }
-        let key = name.to_ascii_lowercase();
-        let existing = self.entries.iter().position(|e| e.key == key);
-        if existing.is_none() && self.entries.len() >= self.limits.max_files {
-            return Err(CacheError::Full {
-                name: name.to_string(),
-                max: self.limits.max_files,
-            });
-        }
+        self.check_room(name)?;
         // Check the size before reading: a huge file is refused without being read.
         let path = store
             .find(name, ProgramKind::Subroutine)
             .map_err(|_| CacheError::NotFound(name.to_string()))?;
         let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-        if bytes > self.limits.max_file_bytes {
-            return Err(CacheError::TooLarge {
-                name: name.to_string(),
-                bytes,
-                max: self.limits.max_file_bytes,
-            });
+        self.check_size(name, bytes)?;
+        let opened = store
+            .open_file(name, ProgramKind::Subroutine)
+            .map_err(|e| read_refusal(name, e))?;
+        match opened {
+            Opened::File(program) => self.finish_load(name, Ok(program)).map(LoadStep::Done),
+            Opened::Loading(p) => Ok(LoadStep::Reading(p)),
+            Opened::Stream { .. } => Err(CacheError::NotFound(name.to_string())),
         }
-        let program = store
-            .read_file(name, ProgramKind::Subroutine)
-            .map_err(|e| match e {
-                StoreError::SubroutineNotFound(_) | StoreError::MainNotFound(_) => {
-                    CacheError::NotFound(name.to_string())
-                }
-                other => CacheError::Unreadable {
-                    name: name.to_string(),
-                    reason: other.to_string(),
-                },
-            })?;
-        if program.text.len() as u64 > self.limits.max_file_bytes {
-            return Err(CacheError::TooLarge {
-                name: name.to_string(),
-                bytes: program.text.len() as u64,
-                max: self.limits.max_file_bytes,
-            });
-        }
-        Ok(match existing {
+    }
+
+    /// The second half of [`Cache::load`]: the file's text (or why it could not be read)
+    /// goes into the cache.
+    pub fn finish_load(
+        &mut self,
+        name: &str,
+        read: Result<ProgramText, StoreError>,
+    ) -> Result<Loaded, CacheError> {
+        let program = read.map_err(|e| read_refusal(name, e))?;
+        self.check_size(name, program.text.len() as u64)?;
+        self.check_room(name)?;
+        let key = name.to_ascii_lowercase();
+        Ok(match self.entries.iter().position(|e| e.key == key) {
             Some(i) => {
                 self.entries[i].program = program;
                 Loaded::Refreshed
@@ -157,6 +158,32 @@ impl Cache {
                 Loaded::New
             }
         })
+    }
+
+    /// A new entry needs a free place (a refresh does not).
+    fn check_room(&self, name: &str) -> Result<(), CacheError> {
+        let cached = self
+            .entries
+            .iter()
+            .any(|e| e.key.eq_ignore_ascii_case(name));
+        if !cached && self.entries.len() >= self.limits.max_files {
+            return Err(CacheError::Full {
+                name: name.to_string(),
+                max: self.limits.max_files,
+            });
+        }
+        Ok(())
+    }
+
+    fn check_size(&self, name: &str, bytes: u64) -> Result<(), CacheError> {
+        if bytes > self.limits.max_file_bytes {
+            return Err(CacheError::TooLarge {
+                name: name.to_string(),
+                bytes,
+                max: self.limits.max_file_bytes,
+            });
+        }
+        Ok(())
     }
 
     /// `#CACHE CLEAR [FILE=name]`: silent when not cached.
@@ -197,6 +224,19 @@ impl Cache {
     }
 }
 
+/// A store refusal as the cache reports it.
+fn read_refusal(name: &str, e: StoreError) -> CacheError {
+    match e {
+        StoreError::SubroutineNotFound(_) | StoreError::MainNotFound(_) => {
+            CacheError::NotFound(name.to_string())
+        }
+        other => CacheError::Unreadable {
+            name: name.to_string(),
+            reason: other.to_string(),
+        },
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,6 +252,14 @@ mod tests {
             }],
             None,
         )
+    }
+
+    /// A load of a small file, done in the call.
+    fn done(r: Result<LoadStep, CacheError>) -> Result<Loaded, CacheError> {
+        r.map(|step| match step {
+            LoadStep::Done(l) => l,
+            LoadStep::Reading(p) => panic!("a small file is read inline: {p:?}"),
+        })
     }
 
     fn limits(max_files: usize, max_file_bytes: u64) -> CacheLimits {
@@ -231,9 +279,9 @@ mod tests {
         fs::write(d.path().join("big.cyc"), vec![b'x'; 11]).unwrap();
         let mut s = store(d.path());
         let mut c = Cache::new(limits(2, 10));
-        assert_eq!(c.load("a.cyc", &mut s), Ok(Loaded::New));
-        assert_eq!(c.load("A.CYC", &mut s), Ok(Loaded::Refreshed));
-        assert_eq!(c.load("b.cyc", &mut s), Ok(Loaded::New));
+        assert_eq!(done(c.load("a.cyc", &mut s)), Ok(Loaded::New));
+        assert_eq!(done(c.load("A.CYC", &mut s)), Ok(Loaded::Refreshed));
+        assert_eq!(done(c.load("b.cyc", &mut s)), Ok(Loaded::New));
         assert_eq!(c.load("c.cyc", &mut s).unwrap_err().code(), 21562);
         c.clear("B.cyc").unwrap();
         assert_eq!(c.load("nope.cyc", &mut s).unwrap_err().code(), 21563);

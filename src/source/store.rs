@@ -9,6 +9,9 @@
 //! charged `per_open + per_kib × KiB` of channel time. The store never sleeps; it only adds the
 //! charge to an account the decoder takes with [`ProgramStore::take_owed`] and turns into "the
 //! read completes at channel time T" (decoding waits, motion keeps running what is queued).
+//!
+//! A tick reads files itself only up to `INLINE_READ_BYTES_PER_TICK`; a larger read goes to
+//! the loader thread (`super::loader`) and the open answers [`Opened::Loading`].
 
 use std::fs;
 use std::path::{Component, Path, PathBuf};
@@ -19,8 +22,10 @@ use thiserror::Error;
 
 use crate::bounded::BoundedReadError;
 
-/// Largest program the store reads into memory. A bound, so a mistaken path to a huge file
-/// cannot exhaust memory; real NC programs that large are streamed instead.
+use super::loader::{self, PendingRead, Poll, INLINE_READ_BYTES_PER_TICK};
+
+/// Largest program the store reads into memory (900110 beyond it). A bound, so a mistaken
+/// path to a huge file cannot exhaust memory; real NC programs that large are streamed instead.
 pub(crate) const MAX_PROGRAM_BYTES: u64 = 256 * 1024 * 1024;
 
 /// Type bit of a search path: main programs.
@@ -53,13 +58,17 @@ pub struct ProgramText {
     pub name: Arc<str>,
     /// Where it was found. Shared like the text: a cache hit copies no path.
     pub path: Arc<Path>,
-    pub text: Arc<[u8]>,
+    /// The file's bytes, as read (shared without a copy: a `Vec` read to its exact size).
+    pub text: Arc<Vec<u8>>,
 }
 
 /// The result of opening a program name.
 #[derive(Debug, Clone)]
 pub enum Opened {
     File(ProgramText),
+    /// A file too large for this tick's inline budget: the loader thread reads it; pick the
+    /// text up with [`ProgramStore::finish_read`].
+    Loading(PendingRead),
     /// The virtual streaming program: read from the stream interface.
     Stream {
         name: Arc<str>,
@@ -108,6 +117,11 @@ pub struct StoreStats {
     pub bytes_read: u64,
     /// Simulated file-system latency charged for those reads (runtime.toml `fs_latency_us…`).
     pub latency: Duration,
+    /// Of the opens, those the loader thread read (too large for the tick's inline budget).
+    pub loaded_off_tick: u64,
+    /// Most bytes of program files read inside one tick (at most
+    /// `INLINE_READ_BYTES_PER_TICK`): the tick work file reads cost.
+    pub max_tick_read_bytes: u64,
 }
 
 /// Simulated cost of a file-system read (runtime.toml `fs_latency_us`, `fs_latency_us_per_kib`).
@@ -149,6 +163,8 @@ pub struct ProgramStore {
     latency: FsLatency,
     /// Latency charged and not yet taken by the decoder.
     owed: Duration,
+    /// Bytes read inside the current tick.
+    read_this_tick: u64,
 }
 
 impl ProgramStore {
@@ -162,6 +178,7 @@ impl ProgramStore {
             stats: StoreStats::default(),
             latency: FsLatency::default(),
             owed: Duration::ZERO,
+            read_this_tick: 0,
         }
     }
 
@@ -202,22 +219,71 @@ impl ProgramStore {
     }
 
     /// Open a program by name: the stream if it is `streaming_prog_file`, else the first file
-    /// found through the search paths of that kind, by priority, names case-insensitive.
+    /// found through the search paths of that kind, by priority, names case-insensitive. A
+    /// file too large for what is left of this tick's inline budget is handed to the loader.
     pub fn open(&mut self, name: &str, kind: ProgramKind) -> Result<Opened, StoreError> {
         if self.is_streaming_program(name) {
             return Ok(Opened::Stream { name: name.into() });
         }
-        self.read_file(name, kind).map(Opened::File)
+        self.open_file(name, kind)
     }
 
-    /// Find and read a program file (never the stream), counting the file-system access.
-    pub(crate) fn read_file(
+    /// Open a program file (never the stream): read here while this tick's inline budget
+    /// lasts, else handed to the loader ([`Opened::Loading`]).
+    pub(crate) fn open_file(
         &mut self,
         name: &str,
         kind: ProgramKind,
-    ) -> Result<ProgramText, StoreError> {
+    ) -> Result<Opened, StoreError> {
         let path = self.find(name, kind)?;
+        let bytes = std::fs::metadata(&path)
+            .map_err(|e| StoreError::Unreadable {
+                name: name.to_string(),
+                reason: e.to_string(),
+            })?
+            .len();
+        if bytes > MAX_PROGRAM_BYTES {
+            return Err(StoreError::TooLarge {
+                name: name.to_string(),
+                bytes,
+                limit: MAX_PROGRAM_BYTES,
+            });
+        }
+        if self.read_this_tick + bytes > INLINE_READ_BYTES_PER_TICK {
+            return Ok(Opened::Loading(loader::spawn_read(
+                name,
+                &path,
+                MAX_PROGRAM_BYTES,
+            )));
+        }
         let text = read_bounded(&path, name)?;
+        self.read_this_tick += text.len() as u64;
+        Ok(Opened::File(self.opened(name, path.into(), text)))
+    }
+
+    /// The text of a read handed to the loader, once it is there (`None`: not yet).
+    pub(crate) fn finish_read(
+        &mut self,
+        pending: &PendingRead,
+    ) -> Option<Result<ProgramText, StoreError>> {
+        match pending.poll() {
+            Poll::Waiting => None,
+            Poll::Done(Ok(text)) => {
+                self.stats.loaded_off_tick += 1;
+                Some(Ok(self.opened(&pending.name, pending.path.clone(), text)))
+            }
+            Poll::Done(Err(e)) => Some(Err(read_error(e, &pending.name))),
+        }
+    }
+
+    /// The end of a tick: its inline reads are counted, the next tick's budget is whole.
+    pub(crate) fn end_tick(&mut self) {
+        self.stats.max_tick_read_bytes = self.stats.max_tick_read_bytes.max(self.read_this_tick);
+        self.read_this_tick = 0;
+    }
+
+    /// A file read: counted, its latency charged.
+    fn opened(&mut self, name: &str, path: Arc<Path>, text: Vec<u8>) -> ProgramText {
         self.stats.opens += 1;
         self.stats.bytes_read += text.len() as u64;
         if !self.latency.is_zero() {
@@ -225,11 +291,11 @@ impl ProgramStore {
             self.owed += cost;
             self.stats.latency += cost;
         }
-        Ok(ProgramText {
+        ProgramText {
             name: name.into(),
-            path: path.into(),
-            text: text.into(),
-        })
+            path,
+            text: Arc::new(text),
+        }
     }
 
     /// Locate a program file without reading it.
@@ -304,7 +370,11 @@ fn find_case_insensitive(dir: &Path, rel: &Path) -> Option<PathBuf> {
 }
 
 fn read_bounded(path: &Path, name: &str) -> Result<Vec<u8>, StoreError> {
-    crate::bounded::read_file(path, MAX_PROGRAM_BYTES).map_err(|e| match e {
+    crate::bounded::read_file(path, MAX_PROGRAM_BYTES).map_err(|e| read_error(e, name))
+}
+
+fn read_error(e: BoundedReadError, name: &str) -> StoreError {
+    match e {
         BoundedReadError::TooLarge { bytes, limit } => StoreError::TooLarge {
             name: name.to_string(),
             bytes,
@@ -314,7 +384,7 @@ fn read_bounded(path: &Path, name: &str) -> Result<Vec<u8>, StoreError> {
             name: name.to_string(),
             reason: e.to_string(),
         },
-    })
+    }
 }
 
 #[cfg(test)]
@@ -339,7 +409,7 @@ mod tests {
         let mut s = store(d.path());
         match s.open("LASER_ON.CYC", ProgramKind::Subroutine).unwrap() {
             Opened::File(p) => assert_eq!(&*p.text, b"M17\r\n"),
-            Opened::Stream { .. } => panic!("not a stream"),
+            other => panic!("not read: {other:?}"),
         }
         assert_eq!(
             s.stats(),
@@ -347,6 +417,8 @@ mod tests {
                 opens: 1,
                 bytes_read: 5,
                 latency: Duration::ZERO,
+                loaded_off_tick: 0,
+                max_tick_read_bytes: 0,
             }
         );
         assert_eq!(s.take_owed(), Duration::ZERO);
@@ -433,7 +505,7 @@ mod tests {
         );
         match s.open("p.nc", ProgramKind::Main).unwrap() {
             Opened::File(p) => assert_eq!(&*p.text, b"B\r\n"),
-            Opened::Stream { .. } => panic!(),
+            other => panic!("{other:?}"),
         }
     }
 

@@ -7,6 +7,7 @@ mod support;
 mod check_program;
 mod dialect;
 mod isg_syntax;
+mod label_index;
 mod lang_eval;
 mod lang_parse;
 mod lang_roundtrip;
