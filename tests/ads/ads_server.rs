@@ -385,9 +385,9 @@ fn stream_object_results_follow_the_buffer() {
     srv.shutdown();
     let events = channels.events();
     assert_eq!(
-        warnings(&events, 11012),
+        refusals(&events, 11012),
         2,
-        "each full write (0x708) is one warning 11012 of the channel"
+        "each full write (0x708) is one refusal 11012 of the channel"
     );
 }
 

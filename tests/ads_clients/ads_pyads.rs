@@ -64,11 +64,7 @@ fn pyads_streams_5000_lines_into_real_channels() {
         "a notification reported ACTIVE: {notes:?}"
     );
     assert_eq!(common::block_texts(&events), lines);
-    let warnings = events
-        .iter()
-        .filter(|e| e["ev"] == "warning" && e["code"] == 11012)
-        .count() as u64;
-    assert_eq!(warnings, busy);
+    assert_eq!(common::refusals(&events, 11012), busy);
 }
 
 /// The PLC's HLI (port 851) with pyads `read_by_name`/`write_by_name`/notifications by name

@@ -162,6 +162,16 @@ pub fn warnings(events: &[Value], code: u64) -> usize {
         .count()
 }
 
+/// Stream writes the channel refused with `code`: a stretch of refusals logs its first as a
+/// `warning` and closes with one `writes_refused` event counting them all.
+pub fn refusals(events: &[Value], code: u64) -> u64 {
+    of(events, "writes_refused")
+        .iter()
+        .filter(|e| e["code"] == code)
+        .map(|e| e["count"].as_u64().unwrap_or(0))
+        .sum()
+}
+
 /// Texts of the `block` events, in order: the lines the channel executed.
 pub fn block_texts(events: &[Value]) -> Vec<String> {
     of(events, "block")
