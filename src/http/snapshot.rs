@@ -219,7 +219,7 @@ mod tests {
     fn offsets_find_their_lines() {
         let l = Listing::new(
             Arc::from("p.nc"),
-            Arc::from(&b"N10 G01 X1\r\nN20 X2\nN30 M30\n"[..]),
+            Arc::new(b"N10 G01 X1\r\nN20 X2\nN30 M30\n".to_vec()),
         );
         assert_eq!(l.line_of(0), 1);
         assert_eq!(l.line_of(12), 2);

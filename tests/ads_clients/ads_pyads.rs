@@ -64,7 +64,7 @@ fn pyads_streams_5000_lines_into_real_channels() {
         "a notification reported ACTIVE: {notes:?}"
     );
     assert_eq!(common::block_texts(&events), lines);
-    assert_eq!(common::refusals(&events, 11012), busy);
+    assert_eq!(ads_common::refusals(&events, 11012), busy);
 }
 
 /// The PLC's HLI (port 851) with pyads `read_by_name`/`write_by_name`/notifications by name
