@@ -37,31 +37,16 @@ fn a_program_the_disk_refuses_is_named_and_the_rest_counted() {
     let root = tempfile::tempdir().expect("tempdir");
     let out = root.path().join("out");
     let script = format!("trap '' XFSZ; ulimit -f {FILE_SIZE_LIMIT_BLOCKS}; exec \"$0\" \"$@\"");
-    let mut child = Command::new("sh")
-        .arg("-c")
+    let mut sh = Command::new("sh");
+    sh.arg("-c")
         .arg(&script)
         .arg(env!("CARGO_BIN_EXE_ncchannel"))
-        .args([
-            "receive",
-            "--listen",
-            "127.0.0.1:0",
-            "--start",
-            "%",
-            "--end",
-            "M30",
-        ])
-        .args(["--max-transfers", "2", "--max-concurrent", "1", "--out"])
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("sh runs the receiver");
-    let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
-    let addr: SocketAddr = first
-        .trim()
-        .strip_prefix("listening on ")
-        .and_then(|a| a.parse().ok())
-        .unwrap_or_else(|| panic!("{first}"));
+        .stdout(Stdio::piped());
+    let (child, addr, stderr) = abuse_common::receive_listening(
+        sh,
+        &out,
+        &["--max-transfers", "2", "--max-concurrent", "1"],
+    );
     let (a, b, big, c) = (
         program("A", 3),
         program("B", 3),

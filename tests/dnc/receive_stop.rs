@@ -24,29 +24,9 @@ struct Listening {
 }
 
 fn listen(out: &Path, extra: &[&str]) -> Listening {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
-        .args([
-            "receive",
-            "--listen",
-            "127.0.0.1:0",
-            "--start",
-            "%",
-            "--end",
-            "M30",
-        ])
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("receive starts");
-    let (first, stderr) = abuse_common::collect(child.stderr.take().expect("stderr"));
-    let addr = first
-        .trim()
-        .strip_prefix("listening on ")
-        .and_then(|a| a.parse().ok())
-        .unwrap_or_else(|| panic!("{first}"));
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_ncchannel"));
+    cmd.stdout(Stdio::null());
+    let (child, addr, stderr) = abuse_common::receive_listening(cmd, out, extra);
     Listening {
         child,
         addr,

@@ -5,7 +5,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -15,35 +15,9 @@ use serde_json::Value;
 /// Generous: only a broken behaviour waits this long.
 const DEADLINE: Duration = Duration::from_secs(60);
 
-/// A program that runs for minutes: short moves back and forth, one block event each.
-fn long_program(rig: &Rig) {
-    let mut text = String::from("N1 G01 F30000\n");
-    for i in 0..20_000 {
-        let x = if i % 2 == 0 { 0.2 } else { 0.0 };
-        text.push_str(&format!("N{} X{x:.3}\n", i + 2));
-    }
-    text.push_str("M30\n");
-    rig.program("long.nc", &text);
-}
-
 /// `serve --start long.nc --events <events>`, its stderr collected as it comes.
 fn serve(rig: &Rig, events: &Path) -> (Child, Arc<Mutex<String>>) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
-        .args([
-            "serve",
-            "--bind",
-            "127.0.0.1:0",
-            "--start",
-            "long.nc",
-            "--params",
-        ])
-        .arg(rig.startup())
-        .arg("--events")
-        .arg(events)
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .expect("serve starts");
+    let mut child = rig.serve_long(events).spawn().expect("serve starts");
     let err = BufReader::new(child.stderr.take().expect("stderr"));
     let text = Arc::new(Mutex::new(String::new()));
     let sink = Arc::clone(&text);
@@ -68,7 +42,7 @@ fn wait_for(what: &str, mut f: impl FnMut() -> bool) {
 #[test]
 fn a_sigkilled_serve_leaves_an_event_log_of_whole_lines() {
     let rig = Rig::new();
-    long_program(&rig);
+    rig.long_program();
     let events = rig.dir.path().join("events.jsonl");
     let (mut child, _err) = serve(&rig, &events);
     // Killed while it writes: after many flushes, at no particular moment.
@@ -96,7 +70,7 @@ fn a_full_disk_under_the_event_log_is_reported_while_serve_runs() {
         return;
     }
     let rig = Rig::new();
-    long_program(&rig);
+    rig.long_program();
     let (mut child, err) = serve(&rig, full);
     let needle = "event log /dev/full: No space left on device";
     wait_for("the report of the failed write", || {

@@ -14,36 +14,10 @@ fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_ncchannel")
 }
 
-/// A program that runs for minutes: short moves back and forth.
-fn long_program(rig: &Rig) {
-    let mut text = String::from("N1 G01 F30000\n");
-    for i in 0..20_000 {
-        let x = if i % 2 == 0 { 0.2 } else { 0.0 };
-        text.push_str(&format!("N{} X{x:.3}\n", i + 2));
-    }
-    text.push_str("M30\n");
-    rig.program("long.nc", &text);
-}
-
 /// Start `serve --start long.nc --events FILE`; returns once it listens (its runtime then
 /// starts), with the moment it said so.
 fn serve(rig: &Rig, events: &std::path::Path) -> (Child, Instant, std::thread::JoinHandle<String>) {
-    let mut child = Command::new(bin())
-        .args([
-            "serve",
-            "--bind",
-            "127.0.0.1:0",
-            "--start",
-            "long.nc",
-            "--params",
-        ])
-        .arg(rig.startup())
-        .arg("--events")
-        .arg(events)
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = rig.serve_long(events).spawn().expect("serve starts");
     let mut err = BufReader::new(child.stderr.take().unwrap());
     let mut first = String::new();
     err.read_line(&mut first).unwrap();
@@ -124,7 +98,7 @@ fn block_lines(events: &std::path::Path) -> usize {
 
 fn stopped_by(signal: &str) {
     let rig = Rig::new();
-    long_program(&rig);
+    rig.long_program();
     let events = rig.dir.path().join("events.jsonl");
     let (mut child, _, stderr) = serve(&rig, &events);
     // Stopped once the program has run a while (the log shows more than 10 blocks), however
@@ -162,7 +136,7 @@ fn serve_stopped_by_sigint_mid_program_leaves_a_whole_log_and_a_summary() {
 #[test]
 fn a_tailing_reader_sees_the_blocks_while_serve_runs() {
     let rig = Rig::new();
-    long_program(&rig);
+    rig.long_program();
     let events = rig.dir.path().join("events.jsonl");
     let (mut child, listening, stderr) = serve(&rig, &events);
     let mut f = loop {
@@ -260,31 +234,22 @@ fn receive_listen_stops_in_order_on_sigterm() {
     use std::io::Write;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("prog");
-    let mut child = Command::new(bin())
-        .args([
-            "receive",
-            "--listen",
-            "127.0.0.1:0",
-            "--start",
-            "%",
-            "--end",
-            "M30",
-            "--out",
-        ])
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    err.read_line(&mut line).unwrap();
-    let port: u16 = line.trim().rsplit(':').next().unwrap().parse().unwrap();
+    let mut cmd = Command::new(bin());
+    cmd.stdout(Stdio::piped());
+    let (mut child, addr, _stderr) = crate::support::abuse::receive_listening(cmd, &out, &[]);
     {
-        let mut s = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
         s.write_all(b"%A\nN1 X1\nM30\n").unwrap();
     }
-    std::thread::sleep(Duration::from_millis(500));
+    // The program is filed when its file is there: then the stop has something to count.
+    let t0 = Instant::now();
+    while !out.join("A.nc").exists() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "A.nc was never filed"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
     kill(&child, "-TERM");
     let status = wait(&mut child, Duration::from_secs(10));
     let mut stdout = String::new();

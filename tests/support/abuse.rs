@@ -3,6 +3,9 @@
 #![allow(dead_code)]
 
 use std::io::{BufRead, BufReader, Read};
+use std::net::SocketAddr;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 
 /// `VmRSS` of process `pid` in KiB, from /proc/<pid>/status.
@@ -33,6 +36,40 @@ pub fn collect(err: impl Read + Send + 'static) -> (String, Arc<Mutex<String>>) 
         }
     });
     (first, text)
+}
+
+/// `receive --listen` on a loopback port splitting by `%` … `M30` into `out`, with `extra`
+/// options, run by `cmd` (the binary itself, or a shell that sets limits and execs it; its
+/// standard output as `cmd` says): the process, the address its first stderr line names, and
+/// its stderr as it comes.
+pub fn receive_listening(
+    mut cmd: Command,
+    out: &Path,
+    extra: &[&str],
+) -> (Child, SocketAddr, Arc<Mutex<String>>) {
+    let mut child = cmd
+        .args([
+            "receive",
+            "--listen",
+            "127.0.0.1:0",
+            "--start",
+            "%",
+            "--end",
+            "M30",
+        ])
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("receive starts");
+    let (first, stderr) = collect(child.stderr.take().expect("stderr"));
+    let addr = first
+        .trim()
+        .strip_prefix("listening on ")
+        .and_then(|a| a.parse().ok())
+        .unwrap_or_else(|| panic!("{first}"));
+    (child, addr, stderr)
 }
 
 /// The collected log once it holds `needle` `times` times, or as it is after `deadline` if it

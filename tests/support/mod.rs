@@ -135,6 +135,38 @@ impl Rig {
         self.dir.path().join("nc")
     }
 
+    /// `serve --bind 127.0.0.1:0 --start long.nc --events <events>` on this rig's lists (see
+    /// [`Rig::long_program`]), standard output discarded, standard error piped.
+    pub fn serve_long(&self, events: &std::path::Path) -> std::process::Command {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"));
+        cmd.args([
+            "serve",
+            "--bind",
+            "127.0.0.1:0",
+            "--start",
+            "long.nc",
+            "--params",
+        ])
+        .arg(self.startup())
+        .arg("--events")
+        .arg(events)
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null());
+        cmd
+    }
+
+    /// `long.nc`: a program that runs for minutes, 20,000 short moves back and forth (one
+    /// block event each), for tests that stop or kill a running channel.
+    pub fn long_program(&self) -> PathBuf {
+        let mut text = String::from("N1 G01 F30000\n");
+        for i in 0..20_000 {
+            let x = if i % 2 == 0 { 0.2 } else { 0.0 };
+            text.push_str(&format!("N{} X{x:.3}\n", i + 2));
+        }
+        text.push_str("M30\n");
+        self.program("long.nc", &text)
+    }
+
     pub fn program(&self, name: &str, text: &str) -> PathBuf {
         let p = self.nc().join(name);
         std::fs::write(&p, text).unwrap();
