@@ -35,7 +35,7 @@ function int32(v) {
 async function main() {
   const seconds = Number(process.argv[2] || 5);
   const client = new Client({
-    targetAmsNetId: process.env.NCCHANNEL_ADS_NETID || "127.0.0.1.1.1",
+    targetAmsNetId: process.env.NCCHANNEL_ADS_NETID || "127.0.0.2.1.1",
     targetAdsPort: 553,
     routerAddress: host,
     routerTcpPort: Number(port),

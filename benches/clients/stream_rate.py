@@ -16,7 +16,7 @@ import time
 import pyads
 
 ADDR = os.environ.get("NCCHANNEL_ADS_ADDR", "127.0.0.1:48898")
-NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
+NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.2.1.1")
 GROUP = 0x20101
 OFF_STREAM, OFF_MODE, OFF_STATE, OFF_PROGRAM, OFF_RESET = 0x90, 0x104, 0x105, 0x108, 0x13C
 BUSY = 0x708

@@ -11,21 +11,13 @@
 // Prints one JSON line (what it saw); exits non-zero on a failed check.
 "use strict";
 const { Client } = require("ads-client");
+const { check, sleep } = require("./common");
 
 const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
 const CH = "HLI_Global_Variables.gpCh[0]^";
 const MS = CH + ".channel_mc_control.mode_and_state";
 const [AUTOMATIC, MDI] = [2, 3];
 const [READY, ACTIVE] = [3, 4];
-
-function check(cond, what) {
-  if (!cond) {
-    console.error("FAILED: " + what);
-    process.exit(1);
-  }
-}
-
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 async function waitFor(what, pred) {
   const deadline = Date.now() + 20000;

@@ -8,19 +8,11 @@
 "use strict";
 const fs = require("fs");
 const { Client } = require("ads-client");
+const { check, sleep, packets } = require("./common");
 
 const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
 const CH = 0x120101;
 const BUSY = 0x708;
-
-function check(cond, what) {
-  if (!cond) {
-    console.error("FAILED: " + what);
-    process.exit(1);
-  }
-}
-
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
 async function main() {
   const client = new Client({
@@ -69,21 +61,7 @@ async function main() {
   await client.writeRaw(CH, 0x108, Buffer.from("streaming.nc\0", "latin1"));
   await client.writeRaw(CH, 0x105, i32(4));
   let busy = 0;
-  let packet = [];
-  let size = 0;
-  const packets = [];
-  for (const line of lines) {
-    const raw = line + "\r\n";
-    if (size + raw.length > 992) {
-      packets.push(packet.join(""));
-      packet = [];
-      size = 0;
-    }
-    packet.push(raw);
-    size += raw.length;
-  }
-  packets.push(packet.join(""));
-  for (const p of packets) {
+  for (const p of packets(lines)) {
     for (;;) {
       try {
         await client.writeRaw(CH, 0x90, Buffer.from(p, "latin1"));

@@ -17,15 +17,9 @@ const fs = require("fs");
 const os = require("os");
 const path = require("path");
 const { chromium } = require("playwright-core");
+const { check } = require("./common");
 
 const TIMEOUT_MS = 30000;
-
-function check(cond, what) {
-  if (!cond) {
-    console.error("FAILED: " + what);
-    process.exit(1);
-  }
-}
 
 async function launch() {
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), "ncchannel-chromium-"));

@@ -9,35 +9,11 @@
 "use strict";
 const fs = require("fs");
 const { Client } = require("ads-client");
+const { check, sleep, packets } = require("./common");
 
 const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
 const CH = 0x120101;
 const BUSY = 0x708;
-
-function check(cond, what) {
-  if (!cond) {
-    console.error("FAILED: " + what);
-    process.exit(1);
-  }
-}
-
-const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
-
-/// Whole lines, CR LF, packets of at most 992 bytes.
-function packets(lines) {
-  const out = [];
-  let packet = "";
-  for (const line of lines) {
-    const raw = line + "\r\n";
-    if (packet.length + raw.length > 992) {
-      out.push(packet);
-      packet = "";
-    }
-    packet += raw;
-  }
-  out.push(packet);
-  return out;
-}
 
 async function main() {
   // Nothing about timeouts is set: ads-client's default timeoutDelay (2000 ms) applies.

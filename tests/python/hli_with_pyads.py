@@ -15,11 +15,12 @@ import ctypes
 import json
 import os
 import struct
-import sys
 import threading
 import time
 
 import pyads
+
+from checks import check, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -29,22 +30,6 @@ CH = 0x120101
 TRANSITION = ctypes.c_uint8 * 327
 ERROR_SATZ = ctypes.c_uint8 * 942
 ADSERR_BUSY = 0x708
-
-
-def check(cond, what):
-    if not cond:
-        print("FAILED: " + what, file=sys.stderr)
-        sys.exit(1)
-
-
-def wait_for(what, pred, timeout=20.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.01)
-    check(False, "timed out waiting for " + what)
 
 
 def transition(to_mode, to_state, parameter=b""):

@@ -15,10 +15,10 @@ through a handle and on the COM task.
 
 import json
 import os
-import sys
-import time
 
 import pyads
+
+from checks import check, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -28,22 +28,6 @@ ADS_STATE_RUN = 5
 GROUP_VALUE_BY_HANDLE = 0xF005
 CH = 0x120101
 MCM_ACTIVE_STATE = 0x109
-
-
-def check(cond, what):
-    if not cond:
-        print("FAILED: " + what, file=sys.stderr)
-        sys.exit(1)
-
-
-def wait_for(what, pred, timeout=20.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.01)
-    check(False, "timed out waiting for " + what)
 
 
 def main():
