@@ -2,8 +2,9 @@
 //! applied (and answered OK) or answered 0x708 and never applied, so a client that retries on
 //! 0x708, as every client must, never gets its lines executed twice.
 //!
-//! The runtime is driven into ticks far longer than the backend's reply timeout by a legal NC
-//! program: with `decoder.blocks_per_tick = 1000000` a long `$FOR` loop is decoded in one tick.
+//! The runtime is driven into ticks far longer than the backend's reply timeout: a [`Cycle`]
+//! around the real machine sleeps in every tick while the file program `slow.nc` runs (the
+//! decoder bounds its own work per tick, so no NC program can make a tick long any more).
 
 use crate::support as common;
 
@@ -11,28 +12,46 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use ads::{AmsAddr, AmsNetId, Client, Source, Timeouts};
-use common::{block_texts, of, Rig};
+use common::{of, Rig};
 use ncchannel::ads::channel_backend::ChannelBackend;
 use ncchannel::ads::objects::offset;
-use ncchannel::machine::StopWhen;
-use ncchannel::runtime::{Clock, Runtime};
+use ncchannel::machine::{Machine, Op, Reply, Request, StopWhen};
+use ncchannel::runtime::{Clock, Cycle, Flow, Runtime, Tick};
 use serde_json::Value;
 
 const CH1: u32 = 0x20101;
 
-/// A program whose first tick decodes `iterations` loop passes, each with a long `$IF`.
-fn slow_program(iterations: u32) -> String {
-    format!(
-        "N10 P2 = 0\n$FOR P1 = 1, {iterations}\n\
-         $IF P1 * 3 + 7 > 1000000 + P2 * 2 - 5 * P1 + 17 * P2 + 3 * P1 - 2 * P2\n\
-         P2 = P2 + 1\n$ENDIF\n$ENDFOR\nN20 M30\n"
-    )
+/// The program during whose ticks the runtime is slow: a few ticks of motion.
+const SLOW_PROGRAM: &str = "N10 P2 = 0\nN20 G01 X0.01 F30000\nN30 X0\nN40 M30\n";
+
+/// The real machine, each of whose ticks lasts `slow_tick` longer while `slow.nc` runs on
+/// channel 1: the shape of a tick doing work that grows with its input.
+struct SlowWhileRunning {
+    machine: Machine,
+    slow_tick: Duration,
+}
+
+impl Cycle for SlowWhileRunning {
+    type Request = Request;
+
+    fn serve(&mut self, req: Request, tick: &Tick) {
+        self.machine.serve(req, tick);
+    }
+
+    fn step(&mut self, tick: &Tick) -> Flow {
+        if let Reply::Status(s) = self.machine.apply(tick, 1, Op::Status) {
+            if s.program.as_deref() == Some("slow.nc") {
+                std::thread::sleep(self.slow_tick);
+            }
+        }
+        self.machine.step(tick)
+    }
 }
 
 struct Setup {
     server: ncchannel::ads::ServerHandle,
     stop: ncchannel::runtime::StopHandle,
-    thread: std::thread::JoinHandle<ncchannel::machine::Machine>,
+    thread: std::thread::JoinHandle<Machine>,
     log: common::Shared2,
     client: Client,
 }
@@ -43,11 +62,15 @@ struct Setup {
 fn setup(rig: &Rig, reply_timeout: Duration) -> Setup {
     let (mut machine, period, log) = rig.machine();
     machine.set_stop_when(StopWhen::Never);
-    let (mut rt, tx) = Runtime::new(machine, period, Clock::RealTime);
+    let cycle = SlowWhileRunning {
+        machine,
+        slow_tick: reply_timeout * 4,
+    };
+    let (mut rt, tx) = Runtime::new(cycle, period, Clock::RealTime);
     let stop = rt.stop_handle();
     let thread = std::thread::spawn(move || {
         rt.run(None);
-        rt.into_inner().0
+        rt.into_inner().0.machine
     });
     let backend = ChannelBackend::new(tx, 1).with_reply_timeout(reply_timeout);
     let config = ncchannel::ads::ServerConfig {
@@ -158,8 +181,8 @@ fn start(dev: &ads::Device, program: &str) {
 /// made meanwhile answers 0x708, the client retries, and the lines must still land once.
 #[test]
 fn a_write_answered_busy_during_a_long_tick_is_never_applied_later() {
-    let rig = Rig::with_runtime("[decoder]\nblocks_per_tick = 1000000\n");
-    rig.program("slow.nc", &slow_program(60_000));
+    let rig = Rig::new();
+    rig.program("slow.nc", SLOW_PROGRAM);
     let s = setup(&rig, Duration::from_millis(100));
     let dev = s.client.device(target());
 
@@ -183,10 +206,10 @@ fn a_write_answered_busy_during_a_long_tick_is_never_applied_later() {
     write_retrying(&dev, b"N3 M30\r\n", Duration::from_secs(60));
     wait_state(&dev, 3, Duration::from_secs(60));
     let events = s.finish();
-    let streamed: Vec<String> = block_texts(&events)
-        .into_iter()
-        .filter(|t| !t.starts_with("N10") && !t.starts_with("N20") && !t.starts_with('$'))
-        .filter(|t| t.starts_with('N'))
+    let streamed: Vec<String> = of(&events, "block")
+        .iter()
+        .filter(|e| e["prog"] == "streaming.nc")
+        .map(|e| e["text"].as_str().unwrap().to_string())
         .collect();
     assert_eq!(streamed, ["N1 P5=1", "N2 P6=2", "N3 M30"], "each line once");
     let applied = of(&events, "write")
@@ -200,10 +223,10 @@ fn a_write_answered_busy_during_a_long_tick_is_never_applied_later() {
 /// hundred lines: every block exactly once, in order.
 #[test]
 fn five_thousand_lines_through_multi_second_ticks_exactly_once_in_order() {
-    let rig = Rig::with_runtime("[decoder]\nblocks_per_tick = 1000000\n");
+    let rig = Rig::new();
     // A second channel would be cleaner; one channel alternates: a slow file program,
     // then a stretch of the stream, and so on, the writes always overlapping slow ticks.
-    rig.program("slow.nc", &slow_program(30_000));
+    rig.program("slow.nc", SLOW_PROGRAM);
     let s = setup(&rig, Duration::from_millis(50));
     let dev = s.client.device(target());
     let lines = common::streamed_5000_lines();
