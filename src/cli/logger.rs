@@ -74,9 +74,16 @@ fn enqueue(text: String) {
     }
 }
 
-/// A line of the command's own (not a `log` record: no time, no part) through the same
-/// queue, for commands that must never wait for stderr (`serve`).
+/// A line of the command's own (not a `log` record: no part), led by its RFC 3339 time,
+/// through the same queue, for commands that must never wait for stderr (`serve`).
 pub(crate) fn line(msg: std::fmt::Arguments<'_>) {
+    let time = humantime::format_rfc3339_millis(SystemTime::now());
+    enqueue(format!("{time} {msg}\n"));
+}
+
+/// The one line a supervisor or test parses to find the server (`listening on ADDR …`):
+/// first, and without a time, so it reads the same as it always has.
+pub(crate) fn handshake(msg: std::fmt::Arguments<'_>) {
     enqueue(format!("{msg}\n"));
 }
 

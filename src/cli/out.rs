@@ -73,3 +73,10 @@ impl Default for Stdout {
 pub(crate) fn say(msg: std::fmt::Arguments<'_>) {
     let _ = writeln!(io::stderr().lock(), "{msg}");
 }
+
+/// A log line on standard error (something that happened while the command ran, as opposed
+/// to a usage error or a summary), led by its RFC 3339 time in UTC (`humantime`), best effort.
+pub(crate) fn log(msg: std::fmt::Arguments<'_>) {
+    let time = humantime::format_rfc3339_millis(std::time::SystemTime::now());
+    say(format_args!("{time} {msg}"));
+}

@@ -23,7 +23,7 @@ use crate::dnc::{
 
 use super::exit;
 // Operator messages never panic on a closed stderr (`eprintln!` would, mid-transfer).
-use super::out::say;
+use super::out::{log, say};
 
 #[derive(Debug, clap::Args)]
 pub struct ReceiveArgs {
@@ -308,7 +308,7 @@ fn serve(
         &stop,
         log_end,
         |r| settle(r, total),
-        |e| say(format_args!("ncchannel receive: accept on {local}: {e}")),
+        |e| log(format_args!("ncchannel receive: accept on {local}: {e}")),
     );
     Ok(stop.level())
 }
@@ -328,11 +328,11 @@ fn settle(r: Result<TransferReport, dnc::DncError>, total: &mut Totals) {
 fn log_end(r: Result<&TransferReport, &dnc::DncError>) {
     let r = match r {
         Ok(r) => r,
-        Err(e) => return say(format_args!("ncchannel receive: transfer refused: {e}")),
+        Err(e) => return log(format_args!("ncchannel receive: transfer refused: {e}")),
     };
     let from = r.peer.map(|p| format!(" from {p}")).unwrap_or_default();
     if r.split.no_start_marker() {
-        say(format_args!(
+        log(format_args!(
             "ncchannel receive: no start marker found in the transfer{from}: all {} bytes discarded",
             r.split.bytes_in
         ));
@@ -340,13 +340,13 @@ fn log_end(r: Result<&TransferReport, &dnc::DncError>) {
     match &r.end {
         TransferEnd::Complete => {}
         TransferEnd::IdleTimeout => {
-            say(format_args!("ncchannel receive: transfer{from} timed out"))
+            log(format_args!("ncchannel receive: transfer{from} timed out"))
         }
-        TransferEnd::Broken(e) => say(format_args!("ncchannel receive: transfer{from} broke: {e}")),
-        TransferEnd::LimitReached(l) => say(format_args!(
+        TransferEnd::Broken(e) => log(format_args!("ncchannel receive: transfer{from} broke: {e}")),
+        TransferEnd::LimitReached(l) => log(format_args!(
             "ncchannel receive: transfer{from} ended at its limit ({l}); the rest was not read"
         )),
-        TransferEnd::WriteFailed(e) => say(format_args!(
+        TransferEnd::WriteFailed(e) => log(format_args!(
             "ncchannel receive: transfer{from} stopped: {e}"
         )),
     }
@@ -384,32 +384,32 @@ fn log_line(p: &ReceivedProgram) {
     );
     let _ = out.flush();
     for name in &p.rejected_names {
-        say(format_args!(
+        log(format_args!(
             "ncchannel receive: name `{name}` in lines {}-{} is not a plain file name; numbered instead",
             p.first_line, p.last_line
         ));
     }
     match p.disposition {
-        Disposition::KeptExisting => say(format_args!(
+        Disposition::KeptExisting => log(format_args!(
             "ncchannel receive: {} exists and was kept; the received program was dropped (use --overwrite)",
             p.path.display()
         )),
-        Disposition::CutOffDropped => say(format_args!(
+        Disposition::CutOffDropped => log(format_args!(
             "ncchannel receive: the transfer ended inside the program from line {}; it was dropped (--keep-partial keeps it)",
             p.first_line
         )),
-        Disposition::NameUnusable => say(format_args!(
+        Disposition::NameUnusable => log(format_args!(
             "ncchannel receive: the program from line {} cannot be filed as {}: {}; it was dropped",
             p.first_line,
             p.path.display(),
             p.reason.as_deref().unwrap_or("name unusable")
         )),
-        Disposition::OverLimit => say(format_args!(
+        Disposition::OverLimit => log(format_args!(
             "ncchannel receive: the program from line {} was dropped: {}",
             p.first_line,
             p.reason.as_deref().unwrap_or("limit reached")
         )),
-        Disposition::WriteFailed => say(format_args!(
+        Disposition::WriteFailed => log(format_args!(
             "ncchannel receive: {} (lines {}-{}) was lost: {}",
             p.path.display(),
             p.first_line,

@@ -249,7 +249,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     };
     // From here on stderr is written through the logger's queue: a supervisor that stops
     // reading it (a full pipe) must hold up neither the server nor the stop.
-    super::logger::line(format_args!(
+    super::logger::handshake(format_args!(
         "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
         server.local_addr(),
         net_id.map(|n| n.to_string()).unwrap_or_default(),

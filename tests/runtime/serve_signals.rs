@@ -70,9 +70,9 @@ fn check_stopped_log(log: &str, stderr: &str) {
     );
     let summary = stderr
         .lines()
-        .find(|l| l.starts_with("stopped after"))
+        .find_map(|l| l.split_once(" stopped after").map(|(_, rest)| rest))
         .unwrap_or_else(|| panic!("no summary in {stderr}"));
-    // "stopped after T ticks (S s), B blocks; …"
+    // "<RFC 3339 time> stopped after T ticks (S s), B blocks; …"
     let printed: usize = summary
         .split("), ")
         .nth(1)
