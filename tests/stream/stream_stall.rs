@@ -27,8 +27,8 @@ fn a_long_move_that_keeps_the_buffer_full_is_not_a_stall() {
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    // The buffer is empty; the decoder's last blocks run within a few ticks.
-    std::thread::sleep(std::time::Duration::from_secs(2));
+    // Every line is in the channel; the 3 s move and the lines behind it run to the end.
+    served.wait_blocks(600, std::time::Duration::from_secs(60));
     let (_, events) = served.finish();
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert!(stderr.contains("rejected busy"), "{stderr}");

@@ -298,6 +298,24 @@ impl Served {
         }
     }
 
+    /// Wait until the event log holds `n` block events (the channel executed that many
+    /// blocks), at most `deadline`: a test waits for the work, not for a time it guessed.
+    pub fn wait_blocks(&self, n: usize, deadline: std::time::Duration) {
+        let t0 = std::time::Instant::now();
+        loop {
+            let blocks = self
+                .log
+                .text()
+                .lines()
+                .filter(|l| l.contains("\"ev\":\"block\""))
+                .count();
+            if blocks >= n || t0.elapsed() > deadline {
+                return;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    }
+
     /// Stop the runtime and return the event log as JSON values.
     pub fn finish(self) -> (Machine, Vec<Value>) {
         self.server.shutdown();
