@@ -726,10 +726,15 @@ impl Channel {
             });
         }
         self.running_prog = Some(name.into());
-        self.main_text = self
+        let kept = self
             .decoder
             .program_text(name)
             .map(|t| (Arc::from(name), t));
+        // The last program's text may be the only hold on hundreds of MB: the loader thread
+        // frees it, not this tick (the decoder's frames release theirs the same way).
+        if let Some((_, old)) = std::mem::replace(&mut self.main_text, kept) {
+            crate::source::loader::release(old);
+        }
         self.set_state(tick, State::Active);
         self.drain_decoder_notes(tick);
         Ok(())
