@@ -195,14 +195,19 @@ fn connections_beyond_the_limit_are_closed_and_the_others_keep_working() {
     a.call(READ_STATE, 1, &[]);
     b.call(READ_STATE, 1, &[]);
     let mut c = Raw::connect(srv.local_addr());
-    assert!(c.closed_within(Duration::from_secs(2)));
+    assert!(c.closed_within(Duration::from_secs(10)));
     assert_eq!(a.call(READ_STATE, 2, &[]).0.invoke_id, 2);
     drop(a);
-    // The freed slot is usable again.
-    let deadline = Instant::now() + Duration::from_secs(2);
+    // The freed slot is usable again once the server has seen the close.
+    let deadline = Instant::now() + Duration::from_secs(30);
     while srv.connections() > 1 && Instant::now() < deadline {
         std::thread::sleep(Duration::from_millis(5));
     }
+    assert_eq!(
+        srv.connections(),
+        1,
+        "the closed connection's slot is freed"
+    );
     let mut d = Raw::connect(srv.local_addr());
     assert_eq!(d.call(READ_STATE, 3, &[]).0.invoke_id, 3);
 }
@@ -217,7 +222,7 @@ fn oversized_and_short_frames_close_only_their_connection() {
     hdr.extend_from_slice(&(10_000_000u32).to_le_bytes());
     huge.send(&hdr);
     assert!(
-        huge.closed_within(Duration::from_secs(2)),
+        huge.closed_within(Duration::from_secs(10)),
         "oversized length must close"
     );
 
@@ -227,7 +232,7 @@ fn oversized_and_short_frames_close_only_their_connection() {
     bad.extend_from_slice(&[0; 8]);
     short.send(&bad);
     assert!(
-        short.closed_within(Duration::from_secs(2)),
+        short.closed_within(Duration::from_secs(10)),
         "length < 32 must close"
     );
 
@@ -235,7 +240,7 @@ fn oversized_and_short_frames_close_only_their_connection() {
     let mut f = request_bytes(READ_STATE, device(), client_addr(1), 1, &[]);
     f[26] = 50; // AMS data length disagrees with the AMS/TCP length
     lying.send(&f);
-    assert!(lying.closed_within(Duration::from_secs(2)));
+    assert!(lying.closed_within(Duration::from_secs(10)));
 
     assert_eq!(good.call(READ_STATE, 9, &[]).0.invoke_id, 9);
 }
@@ -671,7 +676,7 @@ fn notifications_on_unreadable_objects_are_refused_and_handles_are_bounded() {
     assert_eq!(results, [0, 0, 0x716]);
     // Cyclic samples keep coming although nothing changes.
     let mut samples = 0;
-    let deadline = Instant::now() + Duration::from_secs(2);
+    let deadline = Instant::now() + Duration::from_secs(30);
     while samples < 6 && Instant::now() < deadline {
         if let Some(f) = raw.frame_bytes(Duration::from_millis(200)) {
             if f[22] == 8 {
@@ -715,7 +720,7 @@ fn unlisted_ip_addresses_are_disconnected() {
     let (srv, _b) = server_with(cfg);
     let mut raw = Raw::connect(srv.local_addr());
     raw.send(&request_bytes(READ_STATE, device(), client_addr(1), 1, &[]));
-    assert!(raw.closed_within(Duration::from_secs(2)));
+    assert!(raw.closed_within(Duration::from_secs(10)));
 
     let cfg = ServerConfig {
         allow: vec!["127.0.0.1".parse::<RouteEntry>().unwrap()],
@@ -758,7 +763,7 @@ fn shutdown_closes_connections() {
     let mut raw = Raw::connect(srv.local_addr());
     raw.call(READ_STATE, 1, &[]);
     srv.shutdown();
-    assert!(raw.closed_within(Duration::from_secs(2)));
+    assert!(raw.closed_within(Duration::from_secs(10)));
 }
 
 #[test]
@@ -766,7 +771,7 @@ fn router_port_connect_hands_out_an_address() {
     let (srv, _b) = server();
     let mut raw = Raw::connect(srv.local_addr());
     raw.send(&[0x00, 0x10, 2, 0, 0, 0, 0, 0]);
-    let reply = raw.frame_bytes(Duration::from_secs(2)).unwrap();
+    let reply = raw.frame_bytes(Duration::from_secs(10)).unwrap();
     assert_eq!(&reply[..6], &[0x00, 0x10, 8, 0, 0, 0]);
     assert_eq!(&reply[6..12], &[127, 0, 0, 1, 1, 1]);
     assert!(u16::from_le_bytes([reply[12], reply[13]]) >= 32768);

@@ -157,7 +157,8 @@ fn a_client_writing_a_packet_twice_fails_exactly_once_with_exit_1() {
     let sc = dir.path().join("plain.toml");
     std::fs::write(&sc, format!("params = {params:?}\n")).unwrap();
     let report = dir.path().join("report.json");
-    let (child, addr, _err) = serve_soak(&sc, 4, &report);
+    // Long enough for any machine; the test stops it once the lines have run.
+    let (child, addr, _err) = serve_soak(&sc, 120, &report);
     let target = AmsAddr {
         net_id: "127.0.0.1.1.1".parse().unwrap(),
         port: 553,
@@ -173,13 +174,37 @@ fn a_client_writing_a_packet_twice_fails_exactly_once_with_exit_1() {
             Err(e) => panic!("{e}"),
         }
     };
-    std::thread::sleep(Duration::from_millis(200));
     write(b"N1 P1=1\r\nN2 P2=2\r\n");
     write(b"N3 P3=3\r\nN4 P4=4\r\n");
     // On purpose: the acknowledged packet again.
     write(b"N3 P3=3\r\nN4 P4=4\r\n");
     // A move and the end, so the planner releases everything before it.
     write(b"N5 P5=5\r\nN6 G01 X1 F1000\r\nN7 M30\r\n");
+    // Nine blocks executed (the channel's block counter, docs/ads.md): then the stop.
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    loop {
+        let executed = client
+            .read(0x20101, ncchannel::ads::objects::offset::BLOCK_COUNTER, 8)
+            .ok()
+            .and_then(|d| {
+                d.get(..8)
+                    .map(|b| u64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
+            })
+            .unwrap_or(0);
+        if executed >= 9 {
+            break;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "{executed} blocks executed"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
     let (code, json, out) = finish(child, &report);
     assert_eq!(code, 1, "{out}");
     assert_eq!(json["all_held"], false);
