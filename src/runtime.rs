@@ -185,6 +185,12 @@ impl<C: Cycle> Runtime<C> {
     }
 
     /// The cycle and the statistics, when the run is over.
+    /// The statistics so far, leaving empty ones: a caller measuring phases of one run (the
+    /// live-view bench) takes each phase's figures at its end.
+    pub fn take_stats(&mut self) -> CycleStats {
+        std::mem::take(&mut self.stats)
+    }
+
     pub fn into_inner(self) -> (C, CycleStats) {
         (self.cycle, self.stats)
     }

@@ -6,7 +6,7 @@
 //! program at full rate through its own stream interface, decoder and motion (the soak cycle
 //! without faults, so the invariants are checked too).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -27,6 +27,10 @@ pub enum BenchLoad {
     /// client streaming 17-byte lines into channel 1 (default start-up list params/startup.lis,
     /// the shipped settings).
     AdsStream,
+    /// What the live web view of `serve --http` costs the runtime: tick work with no page and
+    /// with --pages pages on the event stream, alternating, and the update rate a page gets
+    /// (default start-up list params/startup.lis).
+    LiveView,
 }
 
 #[derive(Debug, clap::Args)]
@@ -56,6 +60,9 @@ pub struct BenchArgs {
     /// --load ads-stream: pause before a write answered busy (0x708) is sent again, µs.
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
     pub retry_us: u64,
+    /// --load live-view: pages reading the event stream while measured.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=crate::http::MAX_PAGE_CONNECTIONS as u64))]
+    pub pages: u64,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -99,30 +106,41 @@ fn start_list(args: &BenchArgs, default: &str) -> Result<PathBuf, String> {
     crate::params::shipped::locate(&given).map_err(|e| e.to_string())
 }
 
+fn usage(msg: String) -> ExitCode {
+    eprintln!("ncchannel bench: {msg}");
+    ExitCode::from(super::exit::USAGE)
+}
+
 pub fn execute(args: BenchArgs) -> ExitCode {
-    let usage = |msg: String| {
-        eprintln!("ncchannel bench: {msg}");
-        ExitCode::from(super::exit::USAGE)
-    };
     if let Err(msg) = check_args(&args) {
         return usage(msg);
     }
-    if args.load == BenchLoad::AdsStream {
-        let params = match start_list(&args, "params/startup.lis") {
-            Ok(p) => p,
-            Err(e) => return usage(e),
-        };
-        return super::bench_ads::execute(&AdsBench {
+    let default_list = match args.load {
+        BenchLoad::Cycle => "params/soak/startup4.lis",
+        BenchLoad::AdsStream | BenchLoad::LiveView => "params/startup.lis",
+    };
+    let params = match start_list(&args, default_list) {
+        Ok(p) => p,
+        Err(e) => return usage(e),
+    };
+    match args.load {
+        BenchLoad::Cycle => cycle(&args, &params),
+        BenchLoad::AdsStream => super::bench_ads::execute(&AdsBench {
             params: &params,
             seconds: args.seconds,
             lines: args.lines,
             retry: Duration::from_micros(args.retry_us),
-        });
+        }),
+        BenchLoad::LiveView => super::bench_live::execute(&super::bench_live::LiveBench {
+            params: &params,
+            seconds: args.seconds,
+            pages: args.pages as usize,
+        }),
     }
-    let params = &match start_list(&args, "params/soak/startup4.lis") {
-        Ok(p) => p,
-        Err(e) => return usage(e),
-    };
+}
+
+/// `--load cycle`: the runtime with channels streaming in-process against a bare loop.
+fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),

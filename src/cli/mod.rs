@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 pub(crate) mod bench;
 pub(crate) mod bench_ads;
+pub(crate) mod bench_live;
 pub mod check;
 pub(crate) mod init;
 mod logger;

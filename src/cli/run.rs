@@ -192,7 +192,12 @@ fn program_path(program: &str) -> Option<(PathBuf, String)> {
 }
 
 /// Put `dir` first into channel `ch`'s search paths, for main programs and subroutines.
-fn search_first(config: &mut crate::params::Config, ch: usize, dir: PathBuf) {
+pub(crate) fn search_first(
+    config: &mut crate::params::Config,
+    ch: usize,
+    dir: PathBuf,
+    origin: &str,
+) {
     use crate::params::search_path::{SearchPath, MAIN_PROGRAMS, SUBROUTINES};
     if let Some(c) = config.channels.get_mut(ch) {
         c.search_paths.insert(
@@ -201,7 +206,7 @@ fn search_first(config: &mut crate::params::Config, ch: usize, dir: PathBuf) {
                 dir,
                 kinds: MAIN_PROGRAMS | SUBROUTINES,
                 priority: 0,
-                file: PathBuf::from("ncchannel run PROGRAM"),
+                file: PathBuf::from(origin),
                 line: 0,
             },
         );
@@ -220,7 +225,7 @@ pub(crate) fn load_channels(
 }
 
 /// Read and check the parameter lists (diagnostics on stderr).
-fn load_config(params: &Path) -> Result<crate::params::Config, String> {
+pub(crate) fn load_config(params: &Path) -> Result<crate::params::Config, String> {
     let config = match crate::params::load(params) {
         Ok(c) => c,
         Err(e) => {
@@ -286,6 +291,7 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
             &mut config,
             (args.channel as usize).wrapping_sub(1),
             dir.clone(),
+            "ncchannel run PROGRAM",
         );
     }
     let channels = match crate::setup::channels(&config, args.events.is_some()) {

@@ -1,10 +1,12 @@
 //! The live web view of `serve --http`: the page and its event stream over real sockets
-//! (`feed`), the operator controls (`controls`), and the page in a real headless browser
-//! (`browser`, run by `.ci/run`; ignored here only when no chromium is installed).
+//! (`feed`), the operator controls (`controls`), what it costs the runtime (`bench`), and the
+//! page in a real headless browser (`browser`, run by `.ci/run`; ignored here only when no
+//! chromium is installed).
 
 #[path = "../support/mod.rs"]
 mod support;
 
+mod bench;
 mod browser;
 mod client;
 mod controls;
