@@ -255,7 +255,11 @@ impl<C: Cycle> Runtime<C> {
             };
             requests += self.serve_pending(&tick);
             let flow = self.cycle.step(&tick);
-            let work = started.elapsed();
+            // Virtual time: a wait for the program loader stops the clock; it is the
+            // simulated file system's time, counted apart, not the tick's work.
+            let stopped = crate::source::loader::take_clock_stopped();
+            self.stats.clock_stopped += stopped;
+            let work = started.elapsed().saturating_sub(stopped);
             self.stats.work.record(work);
             let overrun = late.is_some_and(|late| late + work > self.period);
             if let Some(late) = late {

@@ -5,7 +5,7 @@
 //! stream segment and pulls the next segment from the stream buffer only when it has decoded
 //! the last line of the previous one (ISG FCT-C19 Data streaming §2.2: one read extracts all data present).
 
-use std::collections::HashSet;
+use std::collections::BTreeSet;
 use std::sync::Arc;
 
 use crate::lang::block::{GotoTarget, Label};
@@ -134,8 +134,9 @@ pub(crate) struct Frame {
     /// Inside `#VAR` … `#ENDVAR`.
     pub(crate) var_block: bool,
     /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
-    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`.
-    pub(crate) seen_labels: HashSet<Label>,
+    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`; a B-tree
+    /// for the reason `LabelIndex` is one.
+    pub(crate) seen_labels: BTreeSet<Label>,
     /// File frames: label → position and structural depth, built on the first jump.
     pub(crate) label_index: Option<Arc<super::labels::LabelIndex>>,
 }
@@ -144,11 +145,21 @@ pub(crate) struct Frame {
 /// than this many labels ago is treated as unknown (a jump to it waits forward for it).
 pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
 
-/// A frame that held the last reference to a large file text lets the loader thread free it.
+/// A frame that held the last reference to a large file text lets the loader thread free it,
+/// and its label tables with it: tens of thousands of labels take milliseconds to free.
 impl Drop for Frame {
     fn drop(&mut self) {
+        use crate::source::loader;
         if let Source::File(p) = &mut self.source {
-            crate::source::loader::release(std::mem::take(&mut p.text));
+            loader::release(std::mem::take(&mut p.text));
+        }
+        if let Some(index) = self.label_index.take() {
+            if index.len() > loader::FREE_HERE_ITEMS {
+                loader::free_off_tick(index);
+            }
+        }
+        if self.seen_labels.len() > loader::FREE_HERE_ITEMS {
+            loader::free_off_tick(std::mem::take(&mut self.seen_labels));
         }
     }
 }
@@ -165,7 +176,7 @@ impl Frame {
             skip: None,
             comment_block: false,
             var_block: false,
-            seen_labels: HashSet::new(),
+            seen_labels: BTreeSet::new(),
             label_index: None,
         }
     }

@@ -12,7 +12,7 @@
 //! again, which "lengthens the program runtime"). A jump to such a label runs a targeted scan,
 //! under the same per-tick budget, from the top of the file.
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use crate::lang::block::{Body, Command, GotoTarget, Label};
@@ -39,18 +39,28 @@ pub(crate) type LabelAt = (LinePos, usize);
 
 /// All labels of a file (up to [`MAX_INDEXED_LABELS`] of each kind) with where they stand
 /// and how deeply nested they are, and the `%L` sections.
+///
+/// B-trees, not hash maps: a hash map doubles by rehashing every key in the insert that fills
+/// it, and at 32,768 labels that one insert cost its tick some 20 ms; a B-tree insert splits
+/// at most one node per level. A finished index is freed by the loader thread
+/// (`Frame`'s `Drop`), since freeing 65,536 labels costs a tick milliseconds too.
 #[derive(Debug, Default)]
 pub(crate) struct LabelIndex {
-    labels: HashMap<Label, LabelAt>,
+    labels: BTreeMap<Label, LabelAt>,
     number_labels: usize,
     string_labels: usize,
     /// `%L NAME` (upper-case) → the line after the head.
-    local_subs: HashMap<String, LinePos>,
+    local_subs: BTreeMap<String, LinePos>,
     /// Some label or section found no room: one missing from the index may still exist.
     pub(crate) overflowed: bool,
 }
 
 impl LabelIndex {
+    /// Labels and sections held.
+    pub(crate) fn len(&self) -> usize {
+        self.labels.len() + self.local_subs.len()
+    }
+
     pub(crate) fn find(&self, t: &GotoTarget) -> Option<LabelAt> {
         self.labels.get(&super::flow::goto_label(t)).copied()
     }
@@ -148,10 +158,15 @@ pub(crate) struct LabelScan {
     warned_other: bool,
 }
 
-/// A scan that outlives its frame (a reset during the scan) lets the loader free the text.
+/// A scan that outlives its frame (a reset during the scan) lets the loader free the text and
+/// the index built so far.
 impl Drop for LabelScan {
     fn drop(&mut self) {
-        crate::source::loader::release(std::mem::take(&mut self.text));
+        use crate::source::loader;
+        loader::release(std::mem::take(&mut self.text));
+        if self.index.len() > loader::FREE_HERE_ITEMS {
+            loader::free_off_tick(std::mem::take(&mut self.index));
+        }
     }
 }
 

@@ -21,8 +21,9 @@ pub struct Block {
 }
 
 /// A jump target: `N40:` defines `Label::Number(40)`, `[LOOP_1]` defines `Label::Name`.
-/// Names are stored upper-case: labels are case-insensitive.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+/// Names are stored upper-case: labels are case-insensitive. Ordered, so label tables can be
+/// B-trees (which never rehash a whole table in one tick).
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Label {
     Number(u32),
     Name(String),

@@ -80,6 +80,10 @@ pub struct CycleReport {
     /// 0 in virtual time, where ticks are never late.
     pub late_us_p99: f64,
     pub overruns: u64,
+    /// Virtual time: seconds of wall time the clock stood still while the program loader read
+    /// a large file (not part of the work figures; absent in older reports).
+    #[serde(default)]
+    pub clock_stopped_s: f64,
 }
 
 impl CycleReport {
@@ -91,6 +95,7 @@ impl CycleReport {
             work_us_max: stats.work.max_us(),
             late_us_p99: stats.lateness.quantile_us(0.99),
             overruns: stats.overruns,
+            clock_stopped_s: stats.clock_stopped.as_secs_f64(),
         }
     }
 }
@@ -183,6 +188,14 @@ impl Report {
             self.cycle.work_us_max,
             self.cycle.late_us_p99,
             self.cycle.overruns
-        )
+        )?;
+        if self.cycle.clock_stopped_s > 0.0 {
+            writeln!(
+                w,
+                "loader:     the clock stood still {:.3} s while large program files were read",
+                self.cycle.clock_stopped_s
+            )?;
+        }
+        Ok(())
     }
 }

@@ -9,6 +9,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
@@ -29,9 +30,9 @@ enum Job {
         limit: u64,
         reply: Sender<ReadResult>,
     },
-    /// Free a large text nobody uses any more: unmapping hundreds of MB costs milliseconds,
-    /// which the tick that ended the program must not pay.
-    Free(Arc<Vec<u8>>),
+    /// Free what nobody uses any more: unmapping hundreds of MB of text, or tens of thousands
+    /// of labels, costs milliseconds, which the tick that ended the program must not pay.
+    Free(Box<dyn Send>),
 }
 
 /// A read handed to the loader, not yet picked up.
@@ -63,6 +64,16 @@ pub enum LoadWait {
 thread_local! {
     /// Set by the runtime for the thread its ticks run on ([`set_load_wait`]).
     static LOAD_WAIT: std::cell::Cell<LoadWait> = const { std::cell::Cell::new(LoadWait::Ticks) };
+    /// Wall time this thread's ticks stood still waiting for the loader since the runtime last
+    /// took it ([`take_clock_stopped`]).
+    static CLOCK_STOPPED: std::cell::Cell<Duration> = const { std::cell::Cell::new(Duration::ZERO) };
+}
+
+/// The wall time the calling thread's ticks waited for the loader with the clock stopped
+/// since the last call, and zero from now on. The runtime takes it after every tick: that
+/// wait is the simulated machine's file system, not the tick's work, and is reported apart.
+pub fn take_clock_stopped() -> Duration {
+    CLOCK_STOPPED.with(|c| c.replace(Duration::ZERO))
 }
 
 /// How ticks on the calling thread wait for the loader: the runtime sets this from its clock.
@@ -78,7 +89,12 @@ impl PendingRead {
     pub(crate) fn poll(&self) -> Poll {
         let r = match LOAD_WAIT.with(std::cell::Cell::get) {
             LoadWait::Ticks => self.reply.try_recv().map_err(|e| e == TryRecvError::Empty),
-            LoadWait::StopTheClock => self.reply.recv().map_err(|_| false),
+            LoadWait::StopTheClock => {
+                let waiting = Instant::now();
+                let r = self.reply.recv().map_err(|_| false);
+                CLOCK_STOPPED.with(|c| c.set(c.get() + waiting.elapsed()));
+                r
+            }
         };
         match r {
             Ok(r) => Poll::Done(r),
@@ -106,7 +122,7 @@ fn loader() -> Option<&'static Sender<Job>> {
                                 // The decoder may have gone (reset): nobody waits for the text.
                                 let _ = reply.send(r);
                             }
-                            Job::Free(text) => drop(text),
+                            Job::Free(garbage) => drop(garbage),
                         }
                     }
                 })
@@ -147,6 +163,18 @@ pub(crate) fn release(text: Arc<Vec<u8>>) {
     }
     if let Some(loader) = loader() {
         // A loader that has stopped hands the job back: it is dropped here after all.
-        let _ = loader.send(Job::Free(text));
+        let _ = loader.send(Job::Free(Box::new(text)));
+    }
+}
+
+/// Tables of at most this many items are freed where they are dropped (microseconds); larger
+/// ones go to the loader thread ([`free_off_tick`]).
+pub(crate) const FREE_HERE_ITEMS: usize = 1024;
+
+/// Let the loader thread drop `value` (a large table), so the tick does not pay for freeing
+/// it. Without a loader it is dropped here.
+pub(crate) fn free_off_tick<T: Send + 'static>(value: T) {
+    if let Some(loader) = loader() {
+        let _ = loader.send(Job::Free(Box::new(value)));
     }
 }

@@ -155,6 +155,9 @@ pub struct CycleStats {
     pub lateness: Histogram,
     /// Ticks whose lateness plus work exceeded the period (real time only).
     pub overruns: u64,
+    /// Virtual time only: wall time the clock stood still while a tick waited for the program
+    /// loader to read a large file (`source::loader`); not part of `work`.
+    pub clock_stopped: Duration,
 }
 
 impl CycleStats {

@@ -63,6 +63,28 @@ fn a_large_main_program_is_read_off_the_tick() {
     let files = r.machine.channels()[0].store_stats();
     assert_eq!((files.opens, files.loaded_off_tick), (1, 1), "{files:?}");
     assert!(files.max_tick_read_bytes <= INLINE_READ_BYTES_PER_TICK);
+    // Virtual time waited for the loader with the clock stopped: that wait is counted apart,
+    // not as the work of the tick that waited.
+    assert!(
+        r.stats.clock_stopped > std::time::Duration::ZERO,
+        "{:?}",
+        r.stats
+    );
+}
+
+#[test]
+fn a_program_read_in_the_tick_stops_no_clock() {
+    let rig = Rig::new();
+    rig.program(
+        "small.nc",
+        "G01 X3 F6000
+M30
+",
+    );
+    let r = rig.run("small.nc", None, 100_000);
+    assert_eq!(r.position('X'), 3.0);
+    assert_eq!(r.machine.channels()[0].store_stats().loaded_off_tick, 0);
+    assert_eq!(r.stats.clock_stopped, std::time::Duration::ZERO);
 }
 
 #[test]

@@ -40,6 +40,8 @@ pub struct RunResult {
     pub finish: Option<Finish>,
     pub machine: Machine,
     pub ticks: u64,
+    /// The runtime's own figures of the run (virtual time).
+    pub stats: ncchannel::vocab::stats::CycleStats,
 }
 
 /// Events of one kind (`ev`), in order.
@@ -218,7 +220,7 @@ impl Rig {
         let (mut rt, _tx) = Runtime::new(machine, period, Clock::Virtual);
         rt.run(Some(max_ticks));
         let ticks = rt.ticks();
-        let (mut machine, _) = rt.into_inner();
+        let (mut machine, stats) = rt.into_inner();
         machine.finish_log().unwrap();
         let finish = machine.finishes()[0];
         let log = String::from_utf8(shared.0 .0.lock().unwrap().clone()).unwrap();
@@ -232,6 +234,7 @@ impl Rig {
             finish,
             machine,
             ticks,
+            stats,
         }
     }
 }
