@@ -12,7 +12,7 @@
 //! cost 395 MB and a 524 ms tick). V.S. survive resets, so their bound is what keeps a
 //! long-running channel from filling up over many programs.
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 
 use crate::lang::block::VScope;
 use crate::lang::block::MAX_STRING;
@@ -26,7 +26,7 @@ use crate::lang::codes::{
 pub(crate) type Indices = [i64; 3];
 
 /// A variable with its indices evaluated: the key of the store.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum VarSlot {
     P {
         number: u32,
@@ -189,10 +189,28 @@ fn text_cost(name: &str, values: usize, max: u8) -> usize {
 }
 
 /// The variables of one scope (or one V.L. level), with the bytes they are charged.
+///
+/// A B-tree, not a hash map, for the reason label tables are one (`decoder::labels`): a scope
+/// may hold some 100,000 variables, and no insert may rehash them all in one tick. A large
+/// scope that ends is freed by the loader thread.
 #[derive(Debug, Default)]
 struct Scope {
-    vars: HashMap<Box<str>, Variable>,
+    vars: BTreeMap<Box<str>, Variable>,
     bytes: usize,
+}
+
+impl Drop for Scope {
+    fn drop(&mut self) {
+        free_large(std::mem::take(&mut self.vars));
+    }
+}
+
+/// Drop a table here when it is small, else on the loader thread (freeing 100,000 entries
+/// costs a tick milliseconds).
+fn free_large<K: Send + 'static, V: Send + 'static>(table: BTreeMap<K, V>) {
+    if table.len() > crate::source::loader::FREE_HERE_ITEMS {
+        crate::source::loader::free_off_tick(table);
+    }
 }
 
 impl Scope {
@@ -218,7 +236,7 @@ impl Scope {
     }
 
     fn clear(&mut self) {
-        self.vars.clear();
+        free_large(std::mem::take(&mut self.vars));
         self.bytes = 0;
     }
 }
@@ -227,7 +245,7 @@ impl Scope {
 pub struct VarStore {
     /// P1..P1023 without indices; NaN = never assigned.
     p_flat: Vec<f64>,
-    p_other: HashMap<VarSlot, f64>,
+    p_other: BTreeMap<VarSlot, f64>,
     program: Scope,
     /// One scope per program level, innermost last.
     local: Vec<Scope>,
@@ -253,7 +271,7 @@ impl VarStore {
     /// Program (or stream) start: P and V.P. start empty, one level of V.L.
     pub fn start_program(&mut self) {
         self.p_flat.iter_mut().for_each(|v| *v = f64::NAN);
-        self.p_other.clear();
+        free_large(std::mem::take(&mut self.p_other));
         self.program.clear();
         self.local.clear();
         self.local.push(Scope::default());

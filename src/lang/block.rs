@@ -227,7 +227,7 @@ pub enum Index {
 }
 
 /// Scope of a `V.` variable.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum VScope {
     /// `V.P.` program-global, cleared at program start.
     Program,
