@@ -215,8 +215,6 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
         }
         out.line(format_args!("histogram written to {}", p.display()));
     }
-    if let Err(e) = out.finish() {
-        super::out::say(format_args!("ncchannel bench: standard output: {e}"));
-    }
+    out.finish_or_say("ncchannel bench");
     ExitCode::from(super::exit::OK)
 }

@@ -254,9 +254,7 @@ fn report(b: &AdsBench<'_>, period: Duration, m: &Measured) -> ExitCode {
         m.rtt.quantile_us(0.99),
         m.rtt.max_us()
     ));
-    if let Err(e) = out.finish() {
-        say(format_args!("ncchannel bench: standard output: {e}"));
-    }
+    out.finish_or_say("ncchannel bench");
     ExitCode::from(super::exit::OK)
 }
 

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::out::{say, Stdout};
+use super::out::Stdout;
 use crate::ads::channel_backend::ChannelBackend;
 use crate::http::{ControlAccess, HttpConfig, HttpHandle};
 use crate::machine::{Machine, Op, Reply, StopWhen};
@@ -291,9 +291,7 @@ fn report(
         with.stats.work.quantile_us(0.5) / without.stats.work.quantile_us(0.5).max(1e-9),
         with.stats.work.quantile_us(0.99) / without.stats.work.quantile_us(0.99).max(1e-9)
     ));
-    if let Err(e) = out.finish() {
-        say(format_args!("ncchannel bench: standard output: {e}"));
-    }
+    out.finish_or_say("ncchannel bench");
     ExitCode::from(super::exit::OK)
 }
 

@@ -54,9 +54,7 @@ pub fn execute(args: CheckArgs) -> ExitCode {
     for d in &diags {
         out.line(d.render());
     }
-    if let Err(e) = out.finish() {
-        super::out::say(format_args!("ncchannel check: standard output: {e}"));
-    }
+    out.finish_or_say("ncchannel check");
     for l in &summaries {
         eprintln!("ncchannel check: {l}");
     }

@@ -53,6 +53,14 @@ impl Stdout {
         self.failed.map_or(Ok(()), Err)
     }
 
+    /// Flush, and say a write error on stderr as `command`'s: the results are written, the
+    /// exit code is the run's (a full disk under `> file` is reported, not a panic).
+    pub fn finish_or_say(self, command: &str) {
+        if let Err(e) = self.finish() {
+            say(format_args!("{command}: standard output: {e}"));
+        }
+    }
+
     fn end(&mut self, e: io::Error) {
         if reader_gone(&e) {
             self.gone = true;
