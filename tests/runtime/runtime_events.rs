@@ -312,7 +312,8 @@ fn report_json_has_the_documented_shape() {
             "work_us_p99",
             "work_us_max",
             "late_us_p99",
-            "overruns"
+            "overruns",
+            "clock_stopped_s"
         ])
     );
     assert_eq!(v["cycle"]["period_us"], 1000.0);
