@@ -749,11 +749,20 @@ fn close_port(shared: &Shared, notifs: &Notifications, body: &[u8]) {
     shared.release(&removed);
 }
 
-/// Let the notifications just added send their first sample now. Their response is already
-/// in the connection's send queue, so the sample follows it on the wire (a client learns the
-/// handle before its first sample), one notifier wake-up after the add.
+/// How long after its AddDeviceNotification response a handle's first sample goes out.
+/// Beckhoff's AdsLib (inside pyads) creates the handle's dispatcher in the calling thread only
+/// once that thread has woken up with the response; a sample its receive thread meets before
+/// then is dropped ("No dispatcher found for notification", `AmsConnection::ReceiveNotification`
+/// in Beckhoff/ADS). Right behind the response, pyads lost its first sample about once in a
+/// hundred on a busy machine. TwinCAT sends the first sample at the notification's next cycle,
+/// not within microseconds either.
+pub const FIRST_SAMPLE_DELAY: Duration = Duration::from_millis(20);
+
+/// Let the notifications just added send their first sample [`FIRST_SAMPLE_DELAY`] from now.
+/// Their response is already in the connection's send queue, so the sample also never
+/// overtakes it on the wire.
 fn arm_notifications(notifs: &Notifications) {
-    let due = Instant::now();
+    let due = Instant::now() + FIRST_SAMPLE_DELAY;
     for n in lock(&notifs.table).values_mut().filter(|n| !n.armed) {
         n.armed = true;
         n.next_due = due;
@@ -1002,7 +1011,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
                 return;
             }
         }
-        // Parked, not asleep: arm_notifications wakes it for a new handle's first sample.
+        // Parked, not asleep: arm_notifications wakes it to plan a new handle's first sample.
         let wait = next.saturating_duration_since(Instant::now());
         std::thread::park_timeout(wait.max(Duration::from_micros(500)));
     }

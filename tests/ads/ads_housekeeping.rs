@@ -51,7 +51,7 @@ fn the_first_sample_follows_the_add_response() {
         // A connection of its own each round: no older handle's samples in between.
         let mut raw = Raw::connect(srv.local_addr());
         // On change (4) with a 10 s cycle: the only sample within the round is the first one,
-        // sent right behind the response, never before it.
+        // sent after the response, never before it.
         add(&mut raw, invoke, 4, 100_000_000);
         let (h, _) = raw.frame();
         assert_eq!(
