@@ -106,7 +106,8 @@ fn start_list(args: &BenchArgs, default: &str) -> Result<PathBuf, String> {
     crate::params::shipped::locate(&given).map_err(|e| e.to_string())
 }
 
-fn usage(msg: String) -> ExitCode {
+/// A usage error of `bench`: said on stderr, exit 2.
+pub(super) fn usage(msg: String) -> ExitCode {
     eprintln!("ncchannel bench: {msg}");
     ExitCode::from(super::exit::USAGE)
 }

@@ -20,9 +20,9 @@ use std::time::{Duration, Instant};
 use super::out::Stdout;
 use crate::ads::channel_backend::ChannelBackend;
 use crate::http::{ControlAccess, HttpConfig, HttpHandle};
-use crate::machine::{Machine, Op, Reply, StopWhen};
+use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
-use crate::runtime::{Clock, Runtime, Tick};
+use crate::runtime::{Clock, Runtime};
 use crate::vocab::stats::CycleStats;
 
 /// The generated program's name in its folder.
@@ -131,10 +131,7 @@ fn settle(rt: &mut Runtime<Machine>, done: impl Fn() -> bool) -> bool {
 }
 
 pub fn execute(b: &LiveBench<'_>) -> ExitCode {
-    let usage = |msg: String| {
-        eprintln!("ncchannel bench: {msg}");
-        ExitCode::from(super::exit::USAGE)
-    };
+    let usage = super::bench::usage;
     let fail = |msg: String| {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::CHANNEL_ERROR)
@@ -164,12 +161,7 @@ pub fn execute(b: &LiveBench<'_>) -> ExitCode {
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
-    if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(PROGRAM.to_string())) {
+    if let Err(e) = super::serve::start_at_first_tick(&mut machine, period, PROGRAM) {
         return fail(format!("starting the generated program: {e}"));
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);

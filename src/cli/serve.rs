@@ -137,13 +137,26 @@ fn event_log(target: Option<&str>, soak: bool) -> Result<EventLog, ExitCode> {
 
 /// `--start`: channel 1 runs `program` from the first tick; a refusal is reported, not fatal.
 fn start(machine: &mut Machine, period: Duration, program: &str) {
+    if let Err(e) = start_at_first_tick(machine, period, program) {
+        say(format_args!("ncchannel serve: --start {program}: {e}"));
+    }
+}
+
+/// Channel 1 starts `program` before the runtime's first tick (`serve --start`, the live-view
+/// bench): the channel's refusal, if it refuses.
+pub(super) fn start_at_first_tick(
+    machine: &mut Machine,
+    period: Duration,
+    program: &str,
+) -> Result<(), String> {
     let tick0 = Tick {
         index: 0,
         period,
         time: Duration::ZERO,
     };
-    if let Reply::Command(Err(e)) = machine.apply(&tick0, 1, Op::Start(program.to_string())) {
-        say(format_args!("ncchannel serve: --start {program}: {e}"));
+    match machine.apply(&tick0, 1, Op::Start(program.to_string())) {
+        Reply::Command(Err(e)) => Err(e.to_string()),
+        _ => Ok(()),
     }
 }
 

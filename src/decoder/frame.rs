@@ -154,13 +154,11 @@ impl Drop for Frame {
             loader::release(std::mem::take(&mut p.text));
         }
         if let Some(index) = self.label_index.take() {
-            if index.len() > loader::FREE_HERE_ITEMS {
-                loader::free_off_tick(index);
-            }
+            let items = index.len();
+            loader::release_table(index, items);
         }
-        if self.seen_labels.len() > loader::FREE_HERE_ITEMS {
-            loader::free_off_tick(std::mem::take(&mut self.seen_labels));
-        }
+        let seen = self.seen_labels.len();
+        loader::release_table(std::mem::take(&mut self.seen_labels), seen);
     }
 }
 

@@ -164,9 +164,8 @@ impl Drop for LabelScan {
     fn drop(&mut self) {
         use crate::source::loader;
         loader::release(std::mem::take(&mut self.text));
-        if self.index.len() > loader::FREE_HERE_ITEMS {
-            loader::free_off_tick(std::mem::take(&mut self.index));
-        }
+        let items = self.index.len();
+        loader::release_table(std::mem::take(&mut self.index), items);
     }
 }
 

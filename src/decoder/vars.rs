@@ -205,12 +205,11 @@ impl Drop for Scope {
     }
 }
 
-/// Drop a table here when it is small, else on the loader thread (freeing 100,000 entries
+/// Let go of a table: a large one is freed by the loader thread (freeing 100,000 entries
 /// costs a tick milliseconds).
 fn free_large<K: Send + 'static, V: Send + 'static>(table: BTreeMap<K, V>) {
-    if table.len() > crate::source::loader::FREE_HERE_ITEMS {
-        crate::source::loader::free_off_tick(table);
-    }
+    let items = table.len();
+    crate::source::loader::release_table(table, items);
 }
 
 impl Scope {

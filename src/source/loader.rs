@@ -168,13 +168,16 @@ pub(crate) fn release(text: Arc<Vec<u8>>) {
 }
 
 /// Tables of at most this many items are freed where they are dropped (microseconds); larger
-/// ones go to the loader thread ([`free_off_tick`]).
-pub(crate) const FREE_HERE_ITEMS: usize = 1024;
+/// ones go to the loader thread ([`release_table`]).
+const FREE_HERE_ITEMS: usize = 1024;
 
-/// Let the loader thread drop `value` (a large table), so the tick does not pay for freeing
-/// it. Without a loader it is dropped here.
-pub(crate) fn free_off_tick<T: Send + 'static>(value: T) {
+/// Let go of a table of `items` entries: a large one is dropped by the loader thread, so the
+/// tick does not pay for freeing it; a small one (or any, without a loader) is dropped here.
+pub(crate) fn release_table<T: Send + 'static>(table: T, items: usize) {
+    if items <= FREE_HERE_ITEMS {
+        return;
+    }
     if let Some(loader) = loader() {
-        let _ = loader.send(Job::Free(Box::new(value)));
+        let _ = loader.send(Job::Free(Box::new(table)));
     }
 }
