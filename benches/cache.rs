@@ -87,10 +87,10 @@ fn run(m: Machine, period: Duration) -> Outcome {
     let sim = rt.time();
     let (m, _) = rt.into_inner();
     let c = &m.channels()[0];
-    assert!(c.errors().is_empty(), "{:?}", c.errors());
+    assert!(c.report().errors.is_empty(), "{:?}", c.report().errors);
     Outcome {
-        opens: c.store_stats().opens,
-        hits: c.cache().hits,
+        opens: c.report().store.opens,
+        hits: c.report().cache.hits,
         sim,
         wall,
     }

@@ -60,7 +60,7 @@ impl Setup {
         (
             stats.work.quantile_us(0.5),
             stats.work.quantile_us(0.99),
-            m.channels()[0].stats().blocks,
+            m.channels()[0].report().stats.blocks,
         )
     }
 }

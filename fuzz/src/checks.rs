@@ -674,7 +674,7 @@ fn serve_request(
 ) -> (Option<ncchannel::machine::Reply>, bool) {
     use ncchannel::runtime::Cycle;
     let write = matches!(op, ncchannel::machine::Op::WriteStream(_));
-    let before = machine.channels()[0].stream_fill();
+    let before = machine.channels()[0].report().stream_fill;
     let (req, caller) = ncchannel::machine::Request::new(1, op, tx.clone());
     let gave_up = give_up && caller.take();
     machine.serve(req, tick);
@@ -684,7 +684,7 @@ fn serve_request(
         assert!(reply.is_none(), "answered after its caller gave up");
         if write {
             assert_eq!(
-                machine.channels()[0].stream_fill(),
+                machine.channels()[0].report().stream_fill,
                 before,
                 "a write applied after its caller gave up"
             );

@@ -7,11 +7,17 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::{
-    ActiveBlock, Channel, CommandError, ErrorRecord, ExecutedBlock, HmiCommands, Mode,
-    SearchCommand, State,
+    ActiveBlock, Channel, ChannelStats, CommandError, ErrorRecord, ExecutedBlock, HmiCommands,
+    Mode, SearchCommand, State,
 };
-use crate::decoder::SearchTarget;
-use crate::source::stream::StreamWriteError;
+use crate::decoder::modal::Modal;
+use crate::decoder::vars::VarClass;
+use crate::decoder::{DecoderStats, SearchTarget};
+use crate::lang::block::AxisName;
+use crate::motion::trace::Trace;
+use crate::source::store::StoreStats;
+use crate::source::stream::{StreamCounters, StreamWriteError};
+use crate::vocab::axis::Position;
 
 /// What a client asks of a channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -166,6 +172,79 @@ pub struct Status {
     pub distance_to_go_mm: f64,
 }
 
+/// What a channel tells after a run (and what tests read between ticks): its counters and
+/// those of the parts it owns, the errors, the position, the motion trace. Built on demand by
+/// [`Channel::report`], never by the tick.
+#[derive(Debug, Clone)]
+pub struct ChannelReport {
+    /// 1-based channel number.
+    pub number: u32,
+    pub mode: Mode,
+    pub state: State,
+    pub stats: ChannelStats,
+    /// Program files opened and read, by the program store.
+    pub store: StoreStats,
+    pub cache: CacheStats,
+    /// What passed through the stream interface.
+    pub stream: StreamCounters,
+    /// Stream fill level: (used, free) bytes.
+    pub stream_fill: (usize, usize),
+    pub decoder: DecoderStats,
+    /// The decoder's modal state (it runs ahead of execution by the lookahead).
+    pub modal: Modal,
+    /// The decoder reads the stream interface (a streaming program runs).
+    pub reads_stream: bool,
+    /// Block counter of the running program (ISG: every decoded line).
+    pub block_counter: u64,
+    /// Machine position of every axis slot, mm / degrees.
+    pub position: Position,
+    /// The configured axes' positions under their configured names (`X`, `X1`), in
+    /// `AXIS_LETTERS` order, mm / degrees.
+    pub named_positions: Vec<(AxisName, f64)>,
+    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
+    pub errors: Vec<ErrorRecord>,
+    pub last_error: Option<ErrorRecord>,
+    /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
+    pub message: Option<String>,
+    /// Command parameter (0x108): the program `ACTIVE` starts.
+    pub program: Option<String>,
+    /// Blocks the lookahead window holds and may not release yet (the memory effect): what
+    /// the axes wait for during an interrupt.
+    pub held_blocks: usize,
+    /// The motion trace `run --plot` asked for ([`TraceOp::Plot`]), if on.
+    pub trace: Option<Trace>,
+    /// Bytes of variables by class, in [`VarClass`] order.
+    var_bytes: [usize; VAR_CLASSES.len()],
+}
+
+/// The variable classes a report counts, in the order of `ChannelReport::var_bytes`.
+const VAR_CLASSES: [VarClass; 5] = [
+    VarClass::P,
+    VarClass::Program,
+    VarClass::Local,
+    VarClass::SelfRetaining,
+    VarClass::External,
+];
+
+impl ChannelReport {
+    /// Bytes the decoder's variables of `class` take (what the class's limit counts).
+    pub fn var_bytes(&self, class: VarClass) -> usize {
+        VAR_CLASSES
+            .iter()
+            .position(|c| *c == class)
+            .map_or(0, |i| self.var_bytes[i])
+    }
+}
+
+/// The file cache's counters and contents.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct CacheStats {
+    /// Calls served from the cache.
+    pub hits: u64,
+    /// Names of the cached files, in the cache's order.
+    pub files: Vec<String>,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Reply {
     Done,
@@ -221,17 +300,17 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         stream_free: free,
         positions: c.axis_positions(),
         last_error: c.last_error().map(wire),
-        override_pct: c.motion().override_pct(),
+        override_pct: c.motion.override_pct(),
         blocks: c.stats().blocks,
         tick: 0,
         period: Duration::ZERO,
         cycle_times: CycleTimes::default(),
         program: c.running_program().map(String::from),
         active_block: c.active_block().cloned(),
-        feed_mm_per_min: c.decoder().modal().feed_mm_per_min,
-        velocity_mm_per_s: c.motion().velocity_mm_per_s(),
+        feed_mm_per_min: c.decoder.modal().feed_mm_per_min,
+        velocity_mm_per_s: c.motion.velocity_mm_per_s(),
         hmi: c.hmi(),
-        searching: c.decoder().searching(),
+        searching: c.decoder.searching(),
         ipo_blocks: c.ipo_blocks(),
         errors_total: c.stats().errors,
         pcs_positions: c.pcs_positions(),
@@ -239,6 +318,35 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         queued_blocks: c.queued_blocks(),
         programs_ended: c.stats().programs_ended,
         zero_offsets: *c.zero_offsets(),
-        distance_to_go_mm: c.motion().distance_to_go_mm(),
+        distance_to_go_mm: c.motion.distance_to_go_mm(),
+    }
+}
+
+pub(crate) fn report_of(c: &Channel) -> ChannelReport {
+    ChannelReport {
+        number: c.number,
+        mode: c.mode(),
+        state: c.state(),
+        stats: c.stats(),
+        store: c.store.stats(),
+        cache: CacheStats {
+            hits: c.cache.hits,
+            files: c.cache.names().map(String::from).collect(),
+        },
+        stream: *c.stream.counters(),
+        stream_fill: (c.stream.used(), c.stream.free()),
+        decoder: c.decoder.stats(),
+        modal: c.decoder.modal().clone(),
+        reads_stream: c.decoder.reads_stream(),
+        block_counter: c.decoder.counter(),
+        position: c.motion.position(),
+        named_positions: c.named_positions(),
+        errors: c.errors().to_vec(),
+        last_error: c.last_error().cloned(),
+        message: c.message().map(String::from),
+        program: c.program.clone(),
+        held_blocks: c.motion.held_blocks(),
+        trace: c.motion.trace().cloned(),
+        var_bytes: VAR_CLASSES.map(|class| c.decoder.vars().bytes(class)),
     }
 }

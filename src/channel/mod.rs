@@ -16,7 +16,7 @@ use crate::queue::{Action, BlockQueue, QueuedBlock};
 use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
-use crate::source::store::{FsLatency, ProgramStore, SearchDir, StoreStats};
+use crate::source::store::{FsLatency, ProgramStore, SearchDir};
 use crate::source::stream::{StreamBuffer, StreamWriteError};
 use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 
@@ -39,7 +39,14 @@ pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 pub mod door;
 mod refusals;
 
+pub use crate::decoder::modal::Modal;
+pub use crate::decoder::vars::VarClass;
+pub use crate::decoder::DecoderStats;
+pub use crate::motion::trace::Trace;
+pub use crate::source::store::StoreStats;
+pub use crate::source::stream::StreamCounters;
 pub use crate::vocab::mode::{Mode, State};
+pub use door::{CacheStats, ChannelReport, Status};
 use door::{HmiOp, Op, Reply, TraceOp};
 
 /// Why a command was refused.
@@ -369,69 +376,77 @@ impl Channel {
         }
     }
 
-    pub fn number(&self) -> u32 {
-        self.number
-    }
-    pub fn mode(&self) -> Mode {
-        self.mode
-    }
-    pub fn state(&self) -> State {
-        self.state
-    }
-    pub fn stats(&self) -> ChannelStats {
-        self.stats
-    }
-    pub fn store_stats(&self) -> StoreStats {
-        self.store.stats()
-    }
-    /// The program files this channel finds by name (its search paths).
-    pub(crate) fn store(&self) -> &ProgramStore {
-        &self.store
-    }
-    pub fn cache(&self) -> &Cache {
-        &self.cache
-    }
-    /// Can a streaming program ever run here (and so drain the stream buffer)?
-    pub(crate) fn streaming_enabled(&self) -> bool {
-        self.store.streaming_enabled()
+    /// The live snapshot a client reads (what `Op::Status` answers, without the tick's
+    /// index and period).
+    pub fn status(&self) -> Status {
+        door::status_of(self)
     }
 
-    pub fn stream(&self) -> &StreamBuffer {
-        &self.stream
+    /// Everything a channel tells after a run: counters, errors, position, trace.
+    pub fn report(&self) -> ChannelReport {
+        door::report_of(self)
     }
-    pub fn decoder(&self) -> &Decoder {
-        &self.decoder
+
+    /// The channel number; for the soak's driver (`src/soak/driver.rs`), which reads
+    /// channels directly until it drives a `Machine`.
+    pub(crate) fn number(&self) -> u32 {
+        self.number
     }
-    pub fn motion(&self) -> &Motion {
-        &self.motion
+    fn mode(&self) -> Mode {
+        self.mode
     }
-    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
-    pub fn errors(&self) -> &[ErrorRecord] {
+    /// The ISG state; for the machine's run loop (`src/machine.rs`) and the soak's driver,
+    /// which read it every tick, where a `status()` would allocate.
+    pub(crate) fn state(&self) -> State {
+        self.state
+    }
+    /// The counters; for `src/soak/driver.rs` and the benchmark commands
+    /// (`src/cli/bench_ads.rs`, `src/cli/bench_live.rs`) until they read `report()`.
+    pub(crate) fn stats(&self) -> ChannelStats {
+        self.stats
+    }
+    /// Does channel program `name` exist: the streaming program, or a main program in the
+    /// search paths? `Err` lists the folders searched (`run`'s usage error).
+    pub(crate) fn find_program(&self, name: &str) -> Result<(), Vec<String>> {
+        use crate::source::store::ProgramKind;
+        let store = &self.store;
+        if store.is_streaming_program(name) || store.find(name, ProgramKind::Main).is_ok() {
+            return Ok(());
+        }
+        Err(store
+            .search_dirs()
+            .iter()
+            .map(|d| d.dir.display().to_string())
+            .collect())
+    }
+    /// Can a streaming program ever run here (and so drain the stream buffer)?
+    fn streaming_enabled(&self) -> bool {
+        self.store.streaming_enabled()
+    }
+    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first; for
+    /// `src/soak/driver.rs` until it reads `report()`.
+    pub(crate) fn errors(&self) -> &[ErrorRecord] {
         &self.errors
     }
     /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
-    pub fn message(&self) -> Option<&str> {
+    fn message(&self) -> Option<&str> {
         self.message.as_deref()
     }
 
-    pub fn last_error(&self) -> Option<&ErrorRecord> {
+    fn last_error(&self) -> Option<&ErrorRecord> {
         self.last_error.as_ref()
     }
-    /// Blocks the lookahead window holds and may not release yet (the memory effect): what
-    /// the axes wait for during an interrupt.
-    pub fn held_blocks(&self) -> usize {
-        self.motion.held_blocks()
-    }
 
-    pub fn position(&self) -> Position {
+    /// The machine position; for `src/soak/driver.rs` until it reads `report()`.
+    pub(crate) fn position(&self) -> Position {
         self.motion.position()
     }
     /// Block counter of the running program (ISG: every decoded line).
-    pub fn block_counter(&self) -> u64 {
+    fn block_counter(&self) -> u64 {
         self.decoder.counter()
     }
     /// Stream fill level: (used, free) bytes.
-    pub fn stream_fill(&self) -> (usize, usize) {
+    fn stream_fill(&self) -> (usize, usize) {
         (self.stream.used(), self.stream.free())
     }
     /// How the last program run finished, taken once.
@@ -473,13 +488,13 @@ impl Channel {
         self.executed.drain(..)
     }
     /// The position of each configured axis, in `AXIS_LETTERS` order.
-    pub fn axis_positions(&self) -> Vec<(char, f64)> {
+    fn axis_positions(&self) -> Vec<(char, f64)> {
         self.positions_less(&[0.0; MAX_AXES])
     }
 
     /// The position of each configured axis under its configured name (`X`, `X1`), in
     /// `AXIS_LETTERS` order. [`Channel::axis_positions`] names each by its slot's letter.
-    pub fn named_positions(&self) -> Vec<(crate::lang::block::AxisName, f64)> {
+    fn named_positions(&self) -> Vec<(crate::lang::block::AxisName, f64)> {
         let p = self.motion.position();
         let configured = self.decoder.axes();
         let names = self.decoder.axis_names();
@@ -661,10 +676,6 @@ impl Channel {
     fn set_program(&mut self, name: &str) {
         let name = name.trim_matches(char::from(0)).trim();
         self.program = (!name.is_empty()).then(|| name.to_string());
-    }
-
-    pub fn program(&self) -> Option<&str> {
-        self.program.as_deref()
     }
 
     /// Block search target for the next start (`--search`).

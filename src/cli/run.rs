@@ -155,19 +155,12 @@ fn program_exists(
     args: &RunArgs,
     program: &str,
 ) -> Result<(), String> {
-    use crate::source::store::ProgramKind;
     let Some(c) = channels.get((args.channel as usize).wrapping_sub(1)) else {
         return Ok(());
     };
-    let store = c.store();
-    if store.is_streaming_program(program) || store.find(program, ProgramKind::Main).is_ok() {
+    let Err(dirs) = c.find_program(program) else {
         return Ok(());
-    }
-    let dirs: Vec<String> = store
-        .search_dirs()
-        .iter()
-        .map(|d| d.dir.display().to_string())
-        .collect();
+    };
     Err(format!(
         "program {program} not found in the current folder nor in channel {}'s search paths ({})",
         args.channel,
@@ -359,9 +352,9 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
         &stats,
         period,
     );
-    let c = &machine.channels()[args.channel as usize - 1];
+    let c = machine.channels()[args.channel as usize - 1].report();
     let mut written = true;
-    if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
+    if let (Some(p), Some(trace)) = (&args.plot, &c.trace) {
         let title = format!("ncchannel run {program}");
         if let Err(e) = crate::report::plot::write(p, trace, &title) {
             eprintln!("ncchannel run: --plot {e}");
@@ -502,22 +495,22 @@ fn build_report(
     stats: &crate::vocab::stats::CycleStats,
     period: Duration,
 ) -> Report {
-    let c = &machine.channels()[args.channel as usize - 1];
+    let c = machine.channels()[args.channel as usize - 1].report();
     Report {
         outcome,
         ticks,
         time_s,
         wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
-        blocks: c.stats().blocks,
+        blocks: c.stats.blocks,
         position: c
-            .named_positions()
+            .named_positions
             .into_iter()
             .map(|(a, v)| (a.to_string(), v))
             .collect::<BTreeMap<_, _>>(),
-        stream: StreamReport::from(c.stream().counters()),
-        interrupts: c.stats().interrupts,
+        stream: StreamReport::from(&c.stream),
+        interrupts: c.stats.interrupts,
         errors: c
-            .errors()
+            .errors
             .iter()
             .map(|e| ErrorReport {
                 code: e.code,
@@ -528,10 +521,10 @@ fn build_report(
             .collect(),
         cycle: CycleReport::new(period, stats),
         files: FilesReport {
-            opens: c.store_stats().opens,
-            bytes_read: c.store_stats().bytes_read,
-            cache_hits: c.cache().hits,
-            latency_s: c.store_stats().latency.as_secs_f64(),
+            opens: c.store.opens,
+            bytes_read: c.store.bytes_read,
+            cache_hits: c.cache.hits,
+            latency_s: c.store.latency.as_secs_f64(),
         },
     }
 }

@@ -292,7 +292,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
 fn stopped(rt: Runtime<Machine>, summary: &crate::runtime::RunSummary, events: bool) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
-    let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
+    let blocks: u64 = machine
+        .channels()
+        .iter()
+        .map(|c| c.report().stats.blocks)
+        .sum();
     super::logger::line(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,

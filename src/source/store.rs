@@ -57,6 +57,11 @@ pub struct ProgramText {
     /// The name as the program called it.
     pub name: Arc<str>,
     /// Where it was found. Shared like the text: a cache hit copies no path.
+    #[allow(
+        dead_code,
+        reason = "read by nothing in the crate since the channel keeps its parts to itself; \
+                  the loader (src/source/loader.rs) still sets it"
+    )]
     pub path: Arc<Path>,
     /// The file's bytes, as read (shared without a copy: a `Vec` read to its exact size).
     pub text: Arc<Vec<u8>>,
@@ -186,10 +191,6 @@ impl ProgramStore {
     pub(crate) fn with_latency(mut self, latency: FsLatency) -> Self {
         self.latency = latency;
         self
-    }
-
-    pub fn latency(&self) -> FsLatency {
-        self.latency
     }
 
     pub fn stats(&self) -> StoreStats {

@@ -36,7 +36,9 @@ impl Cycle for StallOnce {
 
     fn step(&mut self, tick: &Tick) -> Flow {
         let mut stalled = self.stalled.lock().unwrap();
-        if stalled.is_none() && self.machine.channels()[0].stats().blocks >= STALL_AFTER_BLOCKS {
+        if stalled.is_none()
+            && self.machine.channels()[0].report().stats.blocks >= STALL_AFTER_BLOCKS
+        {
             let began = Instant::now();
             std::thread::sleep(STALL);
             *stalled = Some(began.elapsed());

@@ -86,5 +86,5 @@ fn a_retry_storm_is_one_stretch_of_three_lines_with_the_right_count() {
     // 4 accepted, the stretch's 3 lines, the accepted short write.
     assert_eq!(events.len(), 8, "{events:?}");
     // The channel's own count of warnings still counts every refusal.
-    assert_eq!(c.stats().warnings, refusals);
+    assert_eq!(c.report().stats.warnings, refusals);
 }

@@ -53,7 +53,7 @@ fn stream_for(startup: &Path, ticks: u64) -> (u64, Vec<Option<u32>>) {
             pending = packet(next);
         }
         ch.step(&tick(t));
-        assert_eq!(ch.state(), State::Active);
+        assert_eq!(ch.status().state, State::Active);
         if let Reply::Executed(e) = ch.apply(&tick(t), Op::DrainExecuted) {
             executed.extend(e.into_iter().map(|b| b.n));
         }

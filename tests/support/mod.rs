@@ -83,7 +83,8 @@ impl RunResult {
     /// Where channel 1's `axis` stands at the end, mm.
     pub fn position(&self, axis: char) -> f64 {
         self.machine.channels()[0]
-            .axis_positions()
+            .status()
+            .positions
             .into_iter()
             .find(|(a, _)| *a == axis)
             .map(|(_, v)| v)
