@@ -281,53 +281,53 @@ fn wire(e: &ErrorRecord) -> (u32, String) {
 /// last error when it is the newest one.
 pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     let i = usize::try_from(index).ok()?;
-    if let Some(e) = c.errors().get(i) {
+    if let Some(e) = c.log.errors().get(i) {
         return Some(wire(e));
     }
-    if index + 1 == c.stats().errors {
-        return c.last_error().map(wire);
+    if index + 1 == c.log.stats().errors {
+        return c.log.last_error().map(wire);
     }
     None
 }
 
 pub(crate) fn status_of(c: &Channel) -> Status {
-    let (used, free) = c.stream_fill();
+    let stats = c.log.stats();
     Status {
-        mode: c.mode(),
-        state: c.state(),
-        block_counter: c.block_counter(),
-        stream_used: used,
-        stream_free: free,
+        mode: c.isg.mode(),
+        state: c.isg.state(),
+        block_counter: c.decoder.counter(),
+        stream_used: c.stream.used(),
+        stream_free: c.stream.free(),
         positions: c.axis_positions(),
-        last_error: c.last_error().map(wire),
+        last_error: c.log.last_error().map(wire),
         override_pct: c.motion.override_pct(),
-        blocks: c.stats().blocks,
+        blocks: stats.blocks,
         tick: 0,
         period: Duration::ZERO,
         cycle_times: CycleTimes::default(),
-        program: c.running_program().map(String::from),
-        active_block: c.active_block().cloned(),
+        program: c.run.running().map(String::from),
+        active_block: c.run.active_block().cloned(),
         feed_mm_per_min: c.decoder.modal().feed_mm_per_min,
         velocity_mm_per_s: c.motion.velocity_mm_per_s(),
-        hmi: c.hmi(),
+        hmi: c.hmi.commands(),
         searching: c.decoder.searching(),
         ipo_blocks: c.ipo_blocks(),
-        errors_total: c.stats().errors,
+        errors_total: stats.errors,
         pcs_positions: c.pcs_positions(),
-        message: c.message().map(str::to_string),
-        queued_blocks: c.queued_blocks(),
-        programs_ended: c.stats().programs_ended,
-        zero_offsets: *c.zero_offsets(),
+        message: c.log.message().map(str::to_string),
+        queued_blocks: c.queue.len(),
+        programs_ended: stats.programs_ended,
+        zero_offsets: c.zero_offsets,
         distance_to_go_mm: c.motion.distance_to_go_mm(),
     }
 }
 
 pub(crate) fn report_of(c: &Channel) -> ChannelReport {
     ChannelReport {
-        number: c.number,
-        mode: c.mode(),
-        state: c.state(),
-        stats: c.stats(),
+        number: c.log.number(),
+        mode: c.isg.mode(),
+        state: c.isg.state(),
+        stats: c.log.stats(),
         store: c.store.stats(),
         cache: CacheStats {
             hits: c.cache.hits,
@@ -341,10 +341,10 @@ pub(crate) fn report_of(c: &Channel) -> ChannelReport {
         block_counter: c.decoder.counter(),
         position: c.motion.position(),
         named_positions: c.named_positions(),
-        errors: c.errors().to_vec(),
-        last_error: c.last_error().cloned(),
-        message: c.message().map(String::from),
-        program: c.program.clone(),
+        errors: c.log.errors().to_vec(),
+        last_error: c.log.last_error().cloned(),
+        message: c.log.message().map(String::from),
+        program: c.hmi.program().map(String::from),
         held_blocks: c.motion.held_blocks(),
         trace: c.motion.trace().cloned(),
         var_bytes: VAR_CLASSES.map(|class| c.decoder.vars().bytes(class)),
