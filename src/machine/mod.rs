@@ -1,0 +1,237 @@
+//! The emulated controller as the runtime ticks it: its channels, the built-in stream feeders,
+//! and the requests other threads (ADS connections, tests) send it.
+//!
+//! One tick: serve requests → feeders write → each channel decodes, executes, reports →
+//! events leave for the log. Nothing here blocks or does I/O.
+
+pub mod remote;
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use crossbeam_channel::Sender;
+
+pub use crate::channel::door::{CycleTimes, HmiOp, Op, Reply, Status, TraceOp};
+use crate::channel::{Channel, Finish, State};
+use crate::feeder::Feeder;
+use crate::report::event::EventLog;
+use crate::runtime::{Cycle, Flow, Tick};
+
+/// A request with its own way back: answered in the tick that serves it.
+#[derive(Debug)]
+pub struct Request {
+    /// 1-based channel number.
+    pub channel: u32,
+    pub op: Op,
+    pub reply: Sender<Reply>,
+    /// Who decides this request's fate: the runtime (it applies it) or the waiting caller (it
+    /// gave up and answers "not applied"). Whoever takes the claim first wins; the other side
+    /// then knows, so a request is never both applied and answered as not applied
+    /// (docs/exactly-once.md).
+    pub(crate) claim: Claim,
+}
+
+impl Request {
+    /// A request and the caller's half of its claim.
+    pub fn new(channel: u32, op: Op, reply: Sender<Reply>) -> (Self, Claim) {
+        let claim = Claim::default();
+        let caller = claim.clone();
+        (
+            Request {
+                channel,
+                op,
+                reply,
+                claim,
+            },
+            caller,
+        )
+    }
+}
+
+/// A one-shot flag shared by a request and the thread waiting for its reply.
+#[derive(Debug, Clone, Default)]
+pub struct Claim(Arc<AtomicBool>);
+
+impl Claim {
+    /// Take the claim; true when this side got it (the other side had not taken it yet).
+    pub fn take(&self) -> bool {
+        !self.0.swap(true, Ordering::AcqRel)
+    }
+}
+
+/// A built-in client streaming a file into one channel.
+pub struct Attached {
+    pub channel: u32,
+    pub feeder: Feeder,
+    /// The packet on offer, shared with each write attempt until the channel takes it (the
+    /// feeder offers the same packet again after a refusal).
+    pending: Option<Arc<[u8]>>,
+}
+
+/// When `run` is over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopWhen {
+    /// Never by itself (`serve`).
+    Never,
+    /// When every channel that ran a program has finished it (`run`, `soak`).
+    ProgramsFinished,
+}
+
+pub struct Machine {
+    channels: Vec<Channel>,
+    feeders: Vec<Attached>,
+    log: EventLog,
+    stop_when: StopWhen,
+    /// Per channel: how its last program finished.
+    finishes: Vec<Option<Finish>>,
+    cycle_times: CycleTimes,
+    /// Wall time the channels' ticks waited for the program loader with the clock stopped,
+    /// not yet taken by the runtime ([`Cycle::take_clock_stopped`]).
+    clock_stopped: Duration,
+}
+
+impl Machine {
+    pub fn new(channels: Vec<Channel>, log: EventLog, stop_when: StopWhen) -> Self {
+        let n = channels.len();
+        Machine {
+            channels,
+            feeders: Vec::new(),
+            log,
+            stop_when,
+            finishes: vec![None; n],
+            cycle_times: CycleTimes::default(),
+            clock_stopped: Duration::ZERO,
+        }
+    }
+
+    pub fn set_stop_when(&mut self, w: StopWhen) {
+        self.stop_when = w;
+    }
+
+    pub fn attach_feeder(&mut self, channel: u32, feeder: Feeder) {
+        self.feeders.push(Attached {
+            channel,
+            feeder,
+            pending: None,
+        });
+    }
+
+    pub fn feeders(&self) -> &[Attached] {
+        &self.feeders
+    }
+
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// The channel by number; commands reach it only through [`Machine::apply`].
+    fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
+        self.channels.get_mut((number as usize).checked_sub(1)?)
+    }
+
+    pub fn finishes(&self) -> &[Option<Finish>] {
+        &self.finishes
+    }
+
+    /// Hand the remaining events to the log and wait for it to write them.
+    pub fn finish_log(&mut self) -> std::io::Result<u64> {
+        for c in &mut self.channels {
+            c.close_event_stretches();
+            c.events_mut().flush_to(&mut self.log);
+        }
+        std::mem::replace(&mut self.log, EventLog::disabled()).finish()
+    }
+
+    /// Events from every channel, in channel order within a tick.
+    fn publish(&mut self) {
+        if !self.log.enabled() {
+            return;
+        }
+        for c in &mut self.channels {
+            c.events_mut().flush_to(&mut self.log);
+        }
+    }
+
+    /// Route one request to its channel (the runtime serves requests through this). The
+    /// cycle-time statistics are the machine's, so their reset and the times in a status are
+    /// filled in here.
+    pub fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
+        if op == Op::Hmi(HmiOp::ResetCycleTimes) {
+            self.cycle_times = CycleTimes::default();
+            return Reply::Done;
+        }
+        let times = self.cycle_times;
+        let Some(c) = self.channel_mut(channel) else {
+            return Reply::NoChannel;
+        };
+        match c.apply(tick, op) {
+            Reply::Status(mut s) => {
+                s.cycle_times = times;
+                Reply::Status(s)
+            }
+            r => r,
+        }
+    }
+}
+
+impl Cycle for Machine {
+    type Request = Request;
+
+    fn serve(&mut self, req: Request, tick: &Tick) {
+        // The caller gave up waiting and already answered "not applied": leave it so.
+        if !req.claim.take() {
+            return;
+        }
+        let reply = self.apply(tick, req.channel, req.op);
+        // A client that went away no longer needs its answer.
+        let _ = req.reply.send(reply);
+    }
+
+    fn step(&mut self, tick: &Tick) -> Flow {
+        let work_start = Instant::now();
+        for a in &mut self.feeders {
+            let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
+                continue;
+            };
+            if let Some(packet) = a.feeder.poll(tick.index) {
+                // Through the door like any client's write; a write the channel cannot take
+                // (ERROR, no streaming program) is a refusal the feeder retries.
+                let data = a.pending.get_or_insert_with(|| Arc::from(packet));
+                let reply = c.apply(tick, Op::WriteStream(Arc::clone(data)));
+                let accepted = matches!(reply, Reply::Stream(Ok(())));
+                if accepted {
+                    a.pending = None;
+                }
+                a.feeder.result(accepted);
+            }
+        }
+        for (i, c) in self.channels.iter_mut().enumerate() {
+            self.clock_stopped += c.step(tick);
+            if let Some(f) = c.take_finish() {
+                self.finishes[i] = Some(f);
+            }
+        }
+        self.publish();
+        self.cycle_times.record(work_start.elapsed());
+        match self.stop_when {
+            StopWhen::Never => Flow::Continue,
+            StopWhen::ProgramsFinished => {
+                let running = self
+                    .channels
+                    .iter()
+                    .any(|c| matches!(c.state(), State::Active | State::Hold));
+                let any_finished = self.finishes.iter().any(Option::is_some);
+                if !running && any_finished {
+                    Flow::Stop
+                } else {
+                    Flow::Continue
+                }
+            }
+        }
+    }
+
+    fn take_clock_stopped(&mut self) -> Duration {
+        std::mem::take(&mut self.clock_stopped)
+    }
+}

@@ -1,0 +1,245 @@
+//! The channels seen from other threads: one door, `call(channel, Op) → Reply`
+//! ([`CncBackend`]), shared by the ADS object table and the web view, and its runtime
+//! implementation ([`ChannelBackend`]): each call becomes a request into the fixed-cycle loop
+//! and waits for the answer of the tick that serves it, answered exactly once — applied, or
+//! busy and not applied (the claim, docs/exactly-once.md). [`Ticking`] runs a machine so on a
+//! thread of its own.
+//!
+//! Channel numbers are 1-based everywhere here (`1..=channel_count()`). The `impl dyn
+//! CncBackend` block holds the few translations of a [`Reply`] that callers share (a status,
+//! a command's result); they are not part of the door, so a backend implements only the two
+//! methods.
+
+use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use crossbeam_channel::{RecvTimeoutError, Sender};
+
+use super::{Machine, Op, Reply, Request, Status};
+use crate::channel::CommandError;
+use crate::runtime::{Clock, Runtime, StopHandle};
+
+/// How long a connection thread waits for the runtime by default (runtime.toml
+/// `ads.reply_timeout_ms`; `vocab::ams` says why 500 ms). A tick answers within one period;
+/// far longer means the runtime is stopped or hopelessly late, and the client hears "busy".
+pub(crate) use crate::vocab::ams::DEFAULT_REPLY_TIMEOUT as REPLY_TIMEOUT;
+
+/// While the runtime has left a call unanswered, later calls wait at most this long: a
+/// runtime that is back answers within a few periods, and a connection's requests queued
+/// behind each other (a client that sends several at once) are each answered "busy" within
+/// `reply_timeout` + n × this, not n × `reply_timeout`.
+const STALLED_WAIT: Duration = Duration::from_millis(50);
+
+pub struct ChannelBackend {
+    requests: Sender<Request>,
+    channels: u16,
+    /// How long a call waits before answering "busy, not applied" ([`REPLY_TIMEOUT`]).
+    reply_timeout: Duration,
+    /// A call timed out and no reply has come since: the runtime is stalled (or stopped).
+    stalled: AtomicBool,
+}
+
+impl ChannelBackend {
+    pub fn new(requests: Sender<Request>, channels: u16) -> Self {
+        ChannelBackend {
+            requests,
+            channels,
+            reply_timeout: REPLY_TIMEOUT,
+            stalled: AtomicBool::new(false),
+        }
+    }
+
+    /// The same backend answering "busy" after `timeout` instead of [`REPLY_TIMEOUT`].
+    pub fn with_reply_timeout(mut self, timeout: Duration) -> Self {
+        self.reply_timeout = timeout;
+        self
+    }
+
+    /// How long the next call waits for the runtime.
+    fn wait_limit(&self) -> Duration {
+        if self.stalled.load(Ordering::Relaxed) {
+            self.reply_timeout.min(STALLED_WAIT)
+        } else {
+            self.reply_timeout
+        }
+    }
+}
+
+impl CncBackend for ChannelBackend {
+    fn channel_count(&self) -> u16 {
+        self.channels
+    }
+
+    /// One request, answered exactly once: by the runtime's reply when the runtime took the
+    /// request's claim, or by "busy" (0x708, not applied) when this side took it first after
+    /// `reply_timeout` ([`STALLED_WAIT`] while an earlier call is unanswered). Once the runtime holds the claim its reply is waited for without a
+    /// limit: it is being applied in the tick running now, and answering "busy" then would
+    /// make a retrying client apply it twice.
+    fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
+        let (tx, rx) = crossbeam_channel::bounded(1);
+        let (req, claim) = Request::new(u32::from(ch), op, tx);
+        self.requests.send(req).map_err(|_| DeviceError::NotReady)?;
+        let reply = match rx.recv_timeout(self.wait_limit()) {
+            Ok(r) => {
+                self.stalled.store(false, Ordering::Relaxed);
+                Ok(r)
+            }
+            Err(RecvTimeoutError::Timeout) if claim.take() => {
+                self.stalled.store(true, Ordering::Relaxed);
+                return Err(DeviceError::Busy);
+            }
+            // The runtime has it: the answer comes when its serve returns.
+            Err(RecvTimeoutError::Timeout) => rx.recv().map_err(|_| DeviceError::NotReady),
+            // The runtime stopped and dropped the request unapplied.
+            Err(RecvTimeoutError::Disconnected) => Err(DeviceError::NotReady),
+        }?;
+        match reply {
+            Reply::NoChannel => Err(DeviceError::NotFound),
+            r => Ok(r),
+        }
+    }
+}
+
+/// A machine ticking in real time on a thread of its own, reached through the
+/// [`ChannelBackend`] [`Ticking::start`] returns: the shape of `ncchannel serve`, for callers
+/// that run the channels in-process (the ADS tests drive real channels through it).
+pub struct Ticking {
+    stop: StopHandle,
+    thread: Option<JoinHandle<Machine>>,
+}
+
+impl Ticking {
+    /// Start `machine` at `period` (real time) and give the backend that reaches its channels.
+    pub fn start(machine: Machine, period: Duration) -> io::Result<(ChannelBackend, Ticking)> {
+        let channels = u16::try_from(machine.channels().len()).unwrap_or(u16::MAX);
+        let (mut rt, tx) = Runtime::new(machine, period, Clock::RealTime);
+        let stop = rt.stop_handle();
+        let thread = std::thread::Builder::new()
+            .name("runtime".into())
+            .spawn(move || {
+                rt.run(None);
+                rt.into_inner().0
+            })?;
+        Ok((
+            ChannelBackend::new(tx, channels),
+            Ticking {
+                stop,
+                thread: Some(thread),
+            },
+        ))
+    }
+
+    /// Stop at the next tick boundary and give the machine back (`None` if its thread
+    /// panicked).
+    pub fn stop(mut self) -> Option<Machine> {
+        self.stop_and_join()
+    }
+
+    fn stop_and_join(&mut self) -> Option<Machine> {
+        self.stop.stop();
+        self.thread.take()?.join().ok()
+    }
+}
+
+impl Drop for Ticking {
+    fn drop(&mut self) {
+        self.stop_and_join();
+    }
+}
+
+/// Why a channel request failed (the ADS server maps each to one ADS result code).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum DeviceError {
+    /// The channel cannot do that in its current mode/state (0x707).
+    #[error("device not ready")]
+    NotReady,
+    /// Try again shortly (0x708).
+    #[error("device busy")]
+    Busy,
+    /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
+    #[error("invalid parameter value")]
+    InvalidValue,
+    /// A named thing does not exist, e.g. an unknown V.E. variable (0x70C).
+    #[error("not found")]
+    NotFound,
+}
+
+/// The remote handle of the channels, shared by the ADS object table and the web view.
+/// `ch` is 1-based.
+pub trait CncBackend: Send + Sync + 'static {
+    /// Number of channels; index groups exist for `1..=channel_count()`.
+    fn channel_count(&self) -> u16;
+    /// Apply `op` to channel `ch` and return the channel's answer. `Err` only when the
+    /// request never reached the channel: [`DeviceError::Busy`] when it was not applied in
+    /// time and never will be (docs/exactly-once.md), [`DeviceError::NotReady`] when the
+    /// runtime is gone, [`DeviceError::NotFound`] for a channel that does not exist.
+    fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError>;
+}
+
+/// One entry of a channel's error history and how many errors it raised in all.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ErrorRecord {
+    pub total: u64,
+    /// ISG error number and text; `None` when that error is no longer kept.
+    pub error: Option<(u32, String)>,
+}
+
+/// How a refused command maps onto a device error: a value the channel does not know is
+/// invalid (ADS 0x706), a command its mode/state does not allow now is busy (0x708: the same
+/// command succeeds once the state changes), a start without a program or that failed is not
+/// ready (0x707).
+fn command_error(e: &CommandError) -> DeviceError {
+    match e {
+        CommandError::InvalidValue(_) | CommandError::BadOverride(_) => DeviceError::InvalidValue,
+        CommandError::Busy { .. } => DeviceError::Busy,
+        CommandError::NoProgram | CommandError::StartFailed { .. } => DeviceError::NotReady,
+    }
+}
+
+impl dyn CncBackend {
+    /// Everything the COM, GEO and HLI objects show of a channel, in one snapshot.
+    pub fn status(&self, ch: u16) -> Result<Status, DeviceError> {
+        match self.call(ch, Op::Status)? {
+            Reply::Status(s) => Ok(*s),
+            _ => Err(DeviceError::NotReady),
+        }
+    }
+
+    /// A command whose answer is only "done" or why not.
+    pub fn command(&self, ch: u16, op: Op) -> Result<(), DeviceError> {
+        match self.call(ch, op)? {
+            Reply::Command(Ok(())) | Reply::Done => Ok(()),
+            Reply::Command(Err(e)) => Err(command_error(&e)),
+            _ => Err(DeviceError::NotReady),
+        }
+    }
+
+    /// Read an external variable `V.E.<name>` (name given without the `V.E.` prefix).
+    pub(crate) fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError> {
+        match self.call(ch, Op::ReadExternal(name.to_string()))? {
+            Reply::Value(Some(v)) => Ok(v),
+            _ => Err(DeviceError::NotFound),
+        }
+    }
+
+    /// Write an external variable `V.E.<name>`.
+    pub fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError> {
+        match self.call(ch, Op::WriteExternal(name.to_string(), value))? {
+            Reply::Value(Some(_)) => Ok(()),
+            _ => Err(DeviceError::InvalidValue),
+        }
+    }
+
+    /// The `index`-th error the channel raised (0 = first), if still kept.
+    pub(crate) fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+        match self.call(ch, Op::ErrorRecord(index))? {
+            Reply::ErrorRecord { total, record } => Ok(ErrorRecord {
+                total,
+                error: record,
+            }),
+            _ => Err(DeviceError::NotReady),
+        }
+    }
+}
