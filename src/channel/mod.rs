@@ -1098,8 +1098,16 @@ impl Channel {
         }
     }
 
-    /// One cycle: decode, execute, report.
-    pub fn step(&mut self, tick: &Tick) {
+    /// One cycle: decode, execute, report. Returns the wall time the tick waited for the
+    /// program loader with the clock stopped (virtual time; zero in real time), which the
+    /// cycle reports apart from the tick's work.
+    pub fn step(&mut self, tick: &Tick) -> std::time::Duration {
+        self.store.begin_tick(tick.clock);
+        self.run_tick(tick);
+        self.store.take_clock_stopped()
+    }
+
+    fn run_tick(&mut self, tick: &Tick) {
         self.refusals.seen(tick);
         if !matches!(self.state, State::Active | State::Hold) {
             return;
