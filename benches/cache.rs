@@ -63,6 +63,7 @@ fn machine(dir: &Path) -> (Machine, Duration) {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     assert_eq!(
         m.apply(&t0, 1, Op::Start("main.nc".into())),

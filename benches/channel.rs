@@ -48,6 +48,7 @@ impl Setup {
             index: 0,
             period,
             time: Duration::ZERO,
+            clock: ncchannel::runtime::Clock::Virtual,
         };
         assert_eq!(
             m.apply(&t0, 1, Op::Start(program.to_string())),

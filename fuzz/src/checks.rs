@@ -345,6 +345,7 @@ pub fn channel_program(data: &[u8]) {
         index,
         period,
         time: period * u32::try_from(index).unwrap_or(u32::MAX),
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     // Whole lines with CR LF, cut into packets of at most 992 bytes; longer lines are left out
     // (the stream interface refuses them whole, which the stream_buffer target covers).
@@ -619,6 +620,7 @@ fn tick_at(period: std::time::Duration, index: u64) -> ncchannel::runtime::Tick 
         index,
         period,
         time: period * u32::try_from(index).unwrap_or(u32::MAX),
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 

@@ -241,11 +241,6 @@ impl Channel {
         door::report_of(self)
     }
 
-    /// The channel number; for the soak's driver (`src/soak/driver.rs`), which reads
-    /// channels directly until it drives a `Machine`.
-    pub(crate) fn number(&self) -> u32 {
-        self.log.number()
-    }
     /// The ISG state; for the machine's run loop (`src/machine.rs`) and the soak's driver,
     /// which read it every tick, where a `status()` would allocate.
     pub(crate) fn state(&self) -> State {
@@ -581,8 +576,17 @@ impl Channel {
 
     /// One cycle: the requests of this tick are already applied; the decoder reads the
     /// stream or its files, the planner and interpolator move, and what happened becomes
-    /// events.
-    pub fn step(&mut self, tick: &Tick) {
+    /// events. Returns the wall time the tick waited for the program loader with the clock
+    /// stopped (virtual time; zero in real time), which the cycle reports apart from the
+    /// tick's work.
+    pub fn step(&mut self, tick: &Tick) -> std::time::Duration {
+        self.store.begin_tick(tick.clock);
+        self.run_tick(tick);
+        self.store.take_clock_stopped()
+    }
+
+    /// The tick's named steps: decode, execute, hold after a single block, note an interrupt.
+    fn run_tick(&mut self, tick: &Tick) {
         self.log.seen(tick);
         if !self.isg.running() {
             return;

@@ -15,12 +15,12 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::out::{say, Stdout};
-use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::client::{self, AdsClient, ClientError};
 use crate::ads::frame::AmsAddr;
 use crate::ads::objects::{offset, GROUP_CHANNEL, PORT_CNC_COM};
 use crate::ads::result::AdsResult;
 use crate::ads::ServerConfig;
+use crate::machine::remote::ChannelBackend;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, Runtime};

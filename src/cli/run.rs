@@ -335,14 +335,7 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
         .copied()
         .flatten();
     let outcome = outcome_of(summary.as_ref().map(|s| s.end), finish);
-    let end = Tick {
-        index: ticks,
-        period,
-        time: end_time,
-    };
-    if let Reply::Trace(Err(e)) = machine.apply(&end, args.channel, Op::Trace(TraceOp::FinishCsv)) {
-        eprintln!("ncchannel run: --trace: {e}");
-    }
+    finish_trace(&mut machine, args.channel, ticks, end_time, period);
     let report = build_report(
         &machine,
         &args,
@@ -381,11 +374,7 @@ fn run_program(
     program: &str,
     period: Duration,
 ) -> (Runtime<Machine>, Option<crate::runtime::RunSummary>) {
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
+    let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
     machine.apply(&tick0, ch, Op::SearchAt(args.search));
     machine.apply(&tick0, ch, Op::SkipMask(args.skip_mask));
@@ -416,13 +405,28 @@ fn run_program(
     (rt, summary)
 }
 
+/// `--trace`: the CSV file's last rows written out, at the tick the run ended.
+fn finish_trace(
+    machine: &mut Machine,
+    channel: u32,
+    ticks: u64,
+    end_time: Duration,
+    period: Duration,
+) {
+    let end = Tick {
+        index: ticks,
+        period,
+        time: end_time,
+        clock: Clock::Virtual,
+    };
+    if let Reply::Trace(Err(e)) = machine.apply(&end, channel, Op::Trace(TraceOp::FinishCsv)) {
+        eprintln!("ncchannel run: --trace: {e}");
+    }
+}
+
 /// `--plot` and `--trace`: the motion trace of the channel that runs the program.
 fn enable_traces(machine: &mut Machine, args: &RunArgs, period: Duration) -> Result<(), String> {
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
+    let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
     if args.plot.is_some() {
         let op = Op::Trace(TraceOp::Plot {

@@ -19,6 +19,7 @@ fn tick(period: Duration, k: u64) -> Tick {
         index: k,
         period,
         time: period * k as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 

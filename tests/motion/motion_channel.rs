@@ -61,6 +61,7 @@ fn tick(k: u64) -> Tick {
         index: k,
         period: PERIOD,
         time: PERIOD * k as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 

@@ -170,6 +170,7 @@ fn machine_ticks_four_channels_each_with_its_own_stream() {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     for ch in 1..=4u32 {
         let mut text = String::from("N1 G90 G01 F30000\n");

@@ -19,6 +19,7 @@ fn tick(index: u64, period: Duration) -> Tick {
         index,
         period,
         time: period * u32::try_from(index).expect("small tick index"),
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 

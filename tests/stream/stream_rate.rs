@@ -36,6 +36,7 @@ fn stream_for(startup: &Path, ticks: u64) -> (u64, Vec<Option<u32>>) {
         index,
         period,
         time: period * index as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     assert_eq!(
         ch.apply(&tick(0), Op::Start("streaming.nc".into())),

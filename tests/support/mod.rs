@@ -253,6 +253,7 @@ pub fn tick0(period: Duration) -> Tick {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -288,7 +289,7 @@ impl Served {
             rt.run(None);
             rt.into_inner().0
         });
-        let backend = ncchannel::ads::channel_backend::ChannelBackend::new(tx, n);
+        let backend = ncchannel::machine::remote::ChannelBackend::new(tx, n);
         let config = ncchannel::ads::ServerConfig {
             bind: "127.0.0.1:0".parse().unwrap(),
             ..Default::default()
