@@ -229,10 +229,16 @@ const VAR_CLASSES: [VarClass; 5] = [
 impl ChannelReport {
     /// Bytes the decoder's variables of `class` take (what the class's limit counts).
     pub fn var_bytes(&self, class: VarClass) -> usize {
-        VAR_CLASSES
-            .iter()
-            .position(|c| *c == class)
-            .map_or(0, |i| self.var_bytes[i])
+        // Exhaustive: a new class must find its place in `VAR_CLASSES`.
+        let i = match class {
+            VarClass::P => 0,
+            VarClass::Program => 1,
+            VarClass::Local => 2,
+            VarClass::SelfRetaining => 3,
+            VarClass::External => 4,
+        };
+        debug_assert_eq!(VAR_CLASSES[i], class);
+        self.var_bytes[i]
     }
 }
 

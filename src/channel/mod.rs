@@ -85,6 +85,8 @@ pub struct ChannelSettings {
     pub tools: Vec<(u32, f64)>,
 }
 
+/// One NC channel: its parts (mode and state, HMI commands, program run, log) and what it
+/// owns. Read through [`Channel::status`] and [`Channel::report`].
 pub struct Channel {
     /// Mode and state (HLI numbers).
     isg: Isg,
@@ -241,7 +243,7 @@ impl Channel {
         door::report_of(self)
     }
 
-    /// The ISG state; for the machine's run loop (`src/machine.rs`) and the soak's driver,
+    /// The ISG state; for the machine's run loop (`src/machine/mod.rs`) and the soak's driver,
     /// which read it every tick, where a `status()` would allocate.
     pub(crate) fn state(&self) -> State {
         self.isg.state()
