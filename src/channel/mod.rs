@@ -248,17 +248,14 @@ impl Channel {
     pub(crate) fn state(&self) -> State {
         self.isg.state()
     }
-    /// The counters; for `src/soak/driver.rs` and the benchmark commands
-    /// (`src/cli/bench_ads.rs`, `src/cli/bench_live.rs`) until they read `report()`.
-    pub(crate) fn stats(&self) -> ChannelStats {
-        self.log.stats()
-    }
-    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first; for
-    /// `src/soak/driver.rs` until it reads `report()`.
+    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first; for the
+    /// soak's per-tick check of new errors (`src/soak/driver.rs`), where `report()` would copy
+    /// the list every tick.
     pub(crate) fn errors(&self) -> &[ErrorRecord] {
         self.log.errors()
     }
-    /// The machine position; for `src/soak/driver.rs` until it reads `report()`.
+    /// The machine position; for the soak's per-tick soft-limit check (`src/soak/driver.rs`),
+    /// where `status()` would allocate.
     pub(crate) fn position(&self) -> Position {
         self.motion.position()
     }

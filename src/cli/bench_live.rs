@@ -182,7 +182,7 @@ pub fn execute(b: &LiveBench<'_>) -> Result<ExitCode, String> {
         .cycle()
         .channels()
         .first()
-        .map_or(0, |c| c.stats().blocks);
+        .map_or(0, |c| c.report().stats.blocks);
     Ok(report(b, period, &without, &with, updates, executed))
 }
 

@@ -420,7 +420,7 @@ impl SoakChannel {
 
     /// The counters for the report, with the channel's own figures and the checksum.
     pub fn report(&self, c: &Channel) -> SoakCounters {
-        let st = c.stats();
+        let st = c.report().stats;
         SoakCounters {
             interrupts: st.interrupts,
             warnings: st.warnings,
