@@ -39,19 +39,21 @@ use crate::queue::{Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, Spl
 use crate::vocab::axis::MAX_AXES;
 use crate::vocab::flush::FlushKind;
 
-use crate::geometry::arc::outside_limits;
-use crate::geometry::SoftLimits;
-use crate::lang::codes;
-
 use super::interpolator::tangent;
-use super::spline::Spline;
-use super::trc::{Comp, PlanError};
+use super::spline;
+use super::trc::PlanError;
 use super::AxisLimits;
 
 mod entry;
+mod limits;
+mod radius_comp;
+mod spline_feed;
 
 use entry::Junction;
 pub(crate) use entry::{Entry, EntryKind, Segment};
+use limits::LimitCheck;
+use radius_comp::RadiusComp;
+use spline_feed::SplineFeed;
 
 /// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
 /// profile uses the rest.
@@ -157,33 +159,15 @@ pub(crate) struct Planner {
     cycle_s: f64,
     /// The front entry is executing (its geometry is fixed).
     pub(crate) front_busy: bool,
-    /// The spline being built (G151), if any.
-    spline: Option<Spline>,
-    /// Spline blocks waiting for their curve: (point number, event).
-    spline_infos: VecDeque<(usize, Option<BlockInfo>)>,
-    /// Plain blocks programmed after spline point n, waiting for its curve.
-    spline_waiting: VecDeque<(usize, Option<BlockInfo>)>,
-    /// Reused buffer of finished curve segments.
-    spline_out: Vec<super::spline::Segment>,
-    /// Tool radius compensation under way (G41/G42), if any.
-    comp: Option<Comp>,
-    /// The event of the block whose element waits in the compensator.
-    comp_info: Option<BlockInfo>,
-    /// Plain blocks programmed after the waiting element.
-    comp_waiting: VecDeque<Option<BlockInfo>>,
-    /// Reused buffer of compensated moves.
-    comp_out: Vec<Move>,
-    /// Tool radii by D number, mm.
-    tool_radii: Vec<(u32, f64)>,
+    /// Tool radius compensation hand-off.
+    comp: RadiusComp,
+    /// Spline hand-off.
+    spline: SplineFeed,
+    /// Software limits on the path after compensation, contouring and splines.
+    limits: LimitCheck,
     /// An error found while planning (compensation impossible, a software limit on the path
     /// the axes follow), for the channel.
     error: Option<PlanError>,
-    /// Software limits per axis (the decoder's check, on the path after compensation,
-    /// contouring and splines).
-    soft_limits: [SoftLimits; MAX_AXES],
-    soft_enabled: [bool; MAX_AXES],
-    /// Program and line of the last block that entered the window with its event.
-    last_block: Option<(std::sync::Arc<str>, u32)>,
 }
 
 impl Planner {
@@ -199,15 +183,7 @@ impl Planner {
                 JUNCTION_ACCEL_SHARE * a.max_accel_mm_per_s2.max(1e-6)
             })
         });
-        let soft_limits = std::array::from_fn(|i| {
-            by_index[i]
-                .as_ref()
-                .map_or(SoftLimits::default(), |a: &AxisLimits| SoftLimits {
-                    min_mm: a.min_mm,
-                    max_mm: a.max_mm,
-                })
-        });
-        let soft_enabled = std::array::from_fn(|i| by_index[i].is_some());
+        let limits = LimitCheck::new(&by_index);
         let lookahead = settings.lookahead_blocks.max(1);
         let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
         Planner {
@@ -220,21 +196,12 @@ impl Planner {
             release_next_move: false,
             dirty: false,
             front_busy: false,
-            spline: None,
-            spline_infos: VecDeque::new(),
-            spline_waiting: VecDeque::new(),
-            spline_out: Vec::new(),
-            comp: None,
-            comp_info: None,
-            comp_waiting: VecDeque::new(),
-            comp_out: Vec::new(),
-            tool_radii: Vec::new(),
+            comp: RadiusComp::default(),
+            spline: SplineFeed::default(),
+            limits,
             error: None,
             reserve,
             cycle_s: 0.001,
-            soft_limits,
-            soft_enabled,
-            last_block: None,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
@@ -295,11 +262,7 @@ impl Planner {
     }
     /// Entries held back (the memory effect), blocks waiting for their spline curve included.
     pub(crate) fn held(&self) -> usize {
-        self.window.len() - self.released
-            + self.spline_infos.len()
-            + self.spline_waiting.len()
-            + usize::from(self.comp_info.is_some())
-            + self.comp_waiting.len()
+        self.window.len() - self.released + self.spline.held() + self.comp.held()
     }
     pub(crate) fn front(&self) -> Option<&Entry> {
         self.window.front()
@@ -394,17 +357,16 @@ impl Planner {
         // block waits behind the element or point it follows; anything else ends the spline
         // first, then (unless it is a compensated move) the waiting compensated element.
         let comp_move = matches!(&action, Action::Move(mv)
-            if mv.path.comp != CompSide::Off || self.comp.is_some());
+            if mv.path.comp != CompSide::Off || self.comp.is_on());
         let spline_move = matches!(&action, Action::Move(mv)
             if !comp_move && mv.path.spline.is_some() && matches!(mv.kind, MoveKind::Line));
         if matches!(action, Action::None) {
-            if let Some(sp) = self.spline.as_ref() {
-                let at = sp.received();
-                self.spline_waiting.push_back((at, info));
+            if let Some(at) = self.spline.received() {
+                self.spline.wait(at, info);
                 return;
             }
-            if self.comp.is_some() {
-                self.comp_waiting.push_back(info);
+            if self.comp.is_on() {
+                self.comp.wait(info);
                 return;
             }
         }
@@ -453,7 +415,7 @@ impl Planner {
         let is_move = matches!(kind, EntryKind::Move(_));
         let counted = counted && is_move;
         if let Some(i) = &info {
-            self.last_block = Some((i.prog.clone(), i.line));
+            self.limits.entered(i);
         }
         // A programmed move was checked by the decoder with the same rule, and a contour
         // trims it to a piece of itself; what compensation and splines make of it is new.
@@ -510,40 +472,28 @@ impl Planner {
     /// A G1 point in spline mode: into the spline (a new one if the type changed), and the
     /// curve it completes into the window.
     fn spline_point(&mut self, info: Option<BlockInfo>, kind: SplineKind, mv: &Move) {
-        if self.spline.as_ref().is_some_and(|s| s.kind() != kind) {
+        if self.spline.other_kind(kind) {
             self.finish_spline();
         }
-        let sp = self
-            .spline
-            .get_or_insert_with(|| Spline::new(kind, mv.start, mv.feed_mm_per_min, mv.path));
-        if mv.end == sp.last() {
-            // No motion: the block takes effect like a plain one, in order.
-            let at = sp.received();
-            self.spline_waiting.push_back((at, info));
-            return;
+        let mut out = self.spline.take_out();
+        if self.spline.point(info, kind, mv, &mut out) {
+            self.emit_spline(&mut out);
         }
-        let at = sp.received() + 1;
-        self.spline_infos.push_back((at, info));
-        let mut out = std::mem::take(&mut self.spline_out);
-        if let Some(sp) = self.spline.as_mut() {
-            sp.push(mv.end, mv.feed_mm_per_min, &mut out);
-        }
-        self.emit_spline(&mut out);
-        self.spline_out = out;
+        self.spline.put_out(out);
     }
 
     /// A move while compensation is on, or the block that switches it on or off.
     fn comp_move(&mut self, info: Option<BlockInfo>, mv: Move) {
         let side = mv.path.comp;
-        let mut out = std::mem::take(&mut self.comp_out);
-        let done = match (self.comp.take(), side) {
+        let mut out = self.comp.take_out();
+        let done = match (self.comp.take_active(), side) {
             (None, CompSide::Off) => Ok(()),
-            (None, _) => self.comp_select(info, mv),
+            (None, _) => self.comp.select(info, mv),
             (Some(c), CompSide::Off) => {
                 let r = c.deselect(mv, &mut out);
                 // The G40 line is this block's; what comes before it is the waiting element's.
                 let last = out.pop();
-                let pending = self.comp_info.take();
+                let pending = self.comp.take_info();
                 self.emit_comp(&mut out, pending);
                 if let Some(l) = last {
                     out.push(l);
@@ -553,73 +503,50 @@ impl Planner {
             }
             (Some(mut c), s) if s == c.side() => {
                 let r = c.next(mv, &mut out);
-                let pending = std::mem::replace(&mut self.comp_info, info);
+                let pending = self.comp.replace_info(info);
                 self.emit_comp(&mut out, pending);
-                self.comp = Some(c);
+                self.comp.put_active(c);
                 r
             }
             (Some(mut c), _) => {
                 let r = c.finish(&mut out);
-                let pending = self.comp_info.take();
+                let pending = self.comp.take_info();
                 self.emit_comp(&mut out, pending);
-                r.and_then(|()| self.comp_select(info, mv))
+                r.and_then(|()| self.comp.select(info, mv))
             }
         };
         if let Err(e) = done {
-            self.comp = None;
-            self.comp_info = None;
-            self.comp_waiting.clear();
+            self.comp.clear();
             self.error = Some(e);
         }
         out.clear();
-        self.comp_out = out;
-    }
-
-    /// G41/G42 switches on with `mv`, the radius of its D word's tool.
-    fn comp_select(&mut self, info: Option<BlockInfo>, mv: Move) -> Result<(), PlanError> {
-        let d = mv.path.tool_offset;
-        let radius = if d == 0 {
-            0.0
-        } else {
-            self.tool_radii
-                .iter()
-                .find(|(n, _)| *n == d)
-                .map(|(_, r)| *r)
-                .ok_or_else(|| PlanError {
-                    code: super::trc::TRC_IMPOSSIBLE,
-                    msg: format!("tool radius compensation: no tool data for D{d}"),
-                    block: None,
-                })?
-        };
-        self.comp = Some(Comp::select(mv.path.comp, radius, mv));
-        self.comp_info = info;
-        Ok(())
+        self.comp.put_out(out);
     }
 
     /// Finish the element waiting in the compensator, if any. Inlined check: this runs for
     /// every block, and almost always finds nothing.
     #[inline]
     fn comp_finish(&mut self) {
-        if self.comp.is_some() {
+        if self.comp.is_on() {
             self.comp_finish_now();
         }
     }
 
     /// A stop while compensation is on: the waiting element ends at its own offset end.
     fn comp_finish_now(&mut self) {
-        let Some(mut c) = self.comp.take() else {
+        let Some(mut c) = self.comp.take_active() else {
             return;
         };
-        let mut out = std::mem::take(&mut self.comp_out);
+        let mut out = self.comp.take_out();
         let r = c.finish(&mut out);
-        let pending = self.comp_info.take();
+        let pending = self.comp.take_info();
         self.emit_comp(&mut out, pending);
-        self.comp = Some(c);
+        self.comp.put_active(c);
         if let Err(e) = r {
-            self.comp = None;
+            self.comp.drop_active();
             self.error = Some(e);
         }
-        self.comp_out = out;
+        self.comp.put_out(out);
     }
 
     /// Compensated moves of one block into the window (its event on the first), then the
@@ -636,42 +563,18 @@ impl Planner {
         if let Some(i) = info {
             self.push_entry(Some(i), EntryKind::Plain, false);
         }
-        while let Some(i) = self.comp_waiting.pop_front() {
+        while let Some(i) = self.comp.pop_waiting() {
             self.push_entry(i, EntryKind::Plain, false);
         }
     }
 
-    /// Software limits on the path the axes follow (21897): a move entering the window —
-    /// compensated, a contour blend, a spline piece — that takes an axis beyond a limit
-    /// stops the channel before the axes get there (the window runs ahead of them). The
-    /// decoder checks the programmed end points; this catches what compensation, contouring
-    /// and splines add to them.
+    /// Software limits on the path the axes follow (planner/limits.rs), once: the first
+    /// error stays until the channel takes it.
     fn check_limits(&mut self, mv: &Move) {
         if self.error.is_some() {
             return;
         }
-        let Some(b) = outside_limits(mv, &self.soft_limits, &self.soft_enabled) else {
-            return;
-        };
-        let path = if mv.path.comp != CompSide::Off {
-            "compensated path reaches"
-        } else if mv.path.spline.is_some() {
-            "spline reaches"
-        } else if mv.path.contour_dev_mm.is_some() && !b.at_end {
-            "contour reaches"
-        } else if b.at_end {
-            "end point"
-        } else {
-            "arc reaches"
-        };
-        self.error = Some(PlanError {
-            code: codes::SOFT_LIMIT,
-            msg: b.message(path),
-            block: self
-                .last_block
-                .as_ref()
-                .map(|(p, l)| (p.to_string(), u64::from(*l))),
-        });
+        self.error = self.limits.check(mv);
     }
 
     /// The error compensation ran into, once.
@@ -681,66 +584,50 @@ impl Planner {
 
     /// Tool radii by D number, mm (the tool list).
     pub(crate) fn set_tool_radii(&mut self, tools: Vec<(u32, f64)>) {
-        self.tool_radii = tools;
+        self.comp.set_tool_radii(tools);
     }
 
     /// Finish the spline being built, if any (inlined check, as `comp_finish`).
     #[inline]
     fn finish_spline(&mut self) {
-        if self.spline.is_some() {
+        if self.spline.is_building() {
             self.finish_spline_now();
         }
     }
 
     /// End the spline: the rest of its curve and everything waiting for it.
     fn finish_spline_now(&mut self) {
-        let Some(sp) = self.spline.take() else { return };
-        let mut out = std::mem::take(&mut self.spline_out);
+        let Some(sp) = self.spline.take_spline() else {
+            return;
+        };
+        let mut out = self.spline.take_out();
         sp.finish(&mut out);
         self.emit_spline(&mut out);
         // Blocks whose curve never came (nothing moved): in order, as plain entries.
-        let mut rest: Vec<(usize, Option<BlockInfo>)> = self
-            .spline_infos
-            .drain(..)
-            .chain(self.spline_waiting.drain(..))
-            .collect();
-        rest.sort_by_key(|(at, _)| *at);
-        for (_, info) in rest {
+        for (_, info) in self.spline.drain_rest() {
             self.push_entry(info, EntryKind::Plain, false);
         }
-        self.spline_out = out;
+        self.spline.put_out(out);
     }
 
     /// Curve segments into the window: each segment's first piece carries its block's event,
     /// and plain blocks programmed after that block follow it.
-    fn emit_spline(&mut self, out: &mut Vec<super::spline::Segment>) {
+    fn emit_spline(&mut self, out: &mut Vec<spline::Segment>) {
         for seg in out.drain(..) {
             let mut info = None;
-            while self
-                .spline_infos
-                .front()
-                .is_some_and(|(at, _)| *at <= seg.point)
-            {
-                if let Some((_, i)) = self.spline_infos.pop_front() {
-                    if info.is_some() {
-                        self.push_entry(i, EntryKind::Plain, false);
-                    } else {
-                        info = i;
-                    }
+            while let Some(i) = self.spline.pop_info_upto(seg.point) {
+                if info.is_some() {
+                    self.push_entry(i, EntryKind::Plain, false);
+                } else {
+                    info = i;
                 }
             }
             for (k, mv) in seg.pieces.into_iter().enumerate() {
                 let kind = EntryKind::Move(Box::new(self.segment(mv)));
                 self.push_entry(if k == 0 { info.take() } else { None }, kind, k == 0);
             }
-            while self
-                .spline_waiting
-                .front()
-                .is_some_and(|(at, _)| *at <= seg.point)
-            {
-                if let Some((_, i)) = self.spline_waiting.pop_front() {
-                    self.push_entry(i, EntryKind::Plain, false);
-                }
+            while let Some(i) = self.spline.pop_waiting_upto(seg.point) {
+                self.push_entry(i, EntryKind::Plain, false);
             }
         }
     }
@@ -828,12 +715,8 @@ impl Planner {
     /// Drop everything (reset, error).
     pub(crate) fn clear(&mut self) {
         self.window.clear();
-        self.spline = None;
-        self.spline_infos.clear();
-        self.spline_waiting.clear();
-        self.comp = None;
-        self.comp_info = None;
-        self.comp_waiting.clear();
+        self.spline.clear();
+        self.comp.clear();
         self.released = 0;
         self.moves = 0;
         self.release_next_move = false;
