@@ -44,23 +44,22 @@ use super::spline;
 use super::trc::PlanError;
 use super::AxisLimits;
 
+mod axes;
+mod blend;
 mod entry;
 mod limits;
 mod radius_comp;
 mod spline_feed;
+mod velocity;
 
+use axes::AxisTable;
 use entry::Junction;
 pub(crate) use entry::{Entry, EntryKind, Segment};
 use limits::LimitCheck;
 use radius_comp::RadiusComp;
 use spline_feed::SplineFeed;
 
-/// Share of each axis' acceleration kept for velocity jumps at block junctions; the velocity
-/// profile uses the rest.
-pub const JUNCTION_ACCEL_SHARE: f64 = 0.25;
-/// Share of the profile acceleration an arc may use for its centripetal acceleration; the
-/// tangential ramp gets √(1 − share²) of it, so both together stay within the limit.
-pub(crate) const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
+pub use axes::JUNCTION_ACCEL_SHARE;
 /// Share of a junction's budget its velocity jumps may use: the rest covers the neighbouring
 /// junctions when several fall into one cycle with unequal corners (the rule looks at the two
 /// blocks on each side of a junction only).
@@ -68,13 +67,6 @@ pub(crate) const JUMP_MARGIN: f64 = 0.95;
 /// Share of its acceleration a line keeps whatever its junctions claim: a junction that would
 /// leave less is not passed at feed but with the fixed reserve.
 pub(crate) const PROFILE_FLOOR: f64 = 0.2;
-/// Share of the axes' full acceleration a contour blend may use for its centripetal
-/// acceleration; its tangential ramp gets √(1 − share²) of it.
-pub(crate) const BLEND_CENTRIPETAL_SHARE: f64 = 0.8;
-/// Share of the smallest moving axis' acceleration a contour blend uses in all: sampled once
-/// per cycle, a curve under centripetal and tangential acceleration at once shows slightly
-/// more than the vector's length (0.07 % measured at the full length).
-pub(crate) const BLEND_ACCEL_SHARE: f64 = 0.95;
 /// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
 /// window when a program is mostly assignments or M functions. It also bounds how many such
 /// blocks one tick takes in: 8 lets the default window (32 blocks, 304 entries) take a whole
@@ -139,7 +131,8 @@ impl Junction {
 /// The lookahead window: a prefix of it is released, the rest held.
 #[derive(Debug)]
 pub(crate) struct Planner {
-    axes: [Option<AxisLimits>; MAX_AXES],
+    /// Axis limits and the junction reserve.
+    axes: AxisTable,
     lookahead: usize,
     max_entries: usize,
     window: VecDeque<Entry>,
@@ -153,8 +146,6 @@ pub(crate) struct Planner {
     dirty: bool,
     /// Corner smoothing window, s (0 = off).
     corner_s: f64,
-    /// Per axis, the fixed junction reserve [`JUNCTION_ACCEL_SHARE`]·aᵢ, mm/s².
-    reserve: [f64; MAX_AXES],
     /// Cycle time the junction claims are sized for, s.
     cycle_s: f64,
     /// The front entry is executing (its geometry is fixed).
@@ -172,22 +163,12 @@ pub(crate) struct Planner {
 
 impl Planner {
     pub(crate) fn new(axes: &[AxisLimits], settings: PlannerSettings) -> Self {
-        let mut by_index: [Option<AxisLimits>; MAX_AXES] = Default::default();
-        for a in axes {
-            if a.index < MAX_AXES {
-                by_index[a.index] = Some(a.clone());
-            }
-        }
-        let reserve = std::array::from_fn(|i| {
-            by_index[i].as_ref().map_or(0.0, |a: &AxisLimits| {
-                JUNCTION_ACCEL_SHARE * a.max_accel_mm_per_s2.max(1e-6)
-            })
-        });
-        let limits = LimitCheck::new(&by_index);
+        let axes = AxisTable::new(axes);
+        let limits = LimitCheck::new(axes.by_index());
         let lookahead = settings.lookahead_blocks.max(1);
         let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
         Planner {
-            axes: by_index,
+            axes,
             lookahead,
             max_entries,
             window: VecDeque::with_capacity(max_entries),
@@ -200,7 +181,6 @@ impl Planner {
             spline: SplineFeed::default(),
             limits,
             error: None,
-            reserve,
             cycle_s: 0.001,
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
@@ -234,7 +214,7 @@ impl Planner {
     /// Every junction in the window afresh (the corner window changed: claims are made only
     /// without one). The executing front keeps its acceleration.
     fn relink(&mut self) {
-        let reserve = self.reserve;
+        let reserve = self.axes.reserve();
         for i in 0..self.window.len() {
             if i == 0 && self.front_busy {
                 continue;
@@ -300,24 +280,7 @@ impl Planner {
     /// acceleration (no junction reserve: a lone line has no junction), mm/s², mm/s³
     /// (infinite: no jerk limit on any moving axis).
     pub(crate) fn line_limits(&self, seg: &Segment) -> (f64, f64) {
-        let accel = seg.full_accel_mm_per_s2;
-        let t = tangent(&seg.mv, seg.length_mm, false);
-        let mut jerk = f64::INFINITY;
-        for (i, ti) in t.iter().enumerate() {
-            let s = ti.abs();
-            if s <= 1e-12 {
-                continue;
-            }
-            let Some(j) = self.axes[i]
-                .as_ref()
-                .and_then(|ax| ax.max_jerk_mm_per_s3)
-                .filter(|j| j.is_finite() && *j > 0.0)
-            else {
-                continue;
-            };
-            jerk = jerk.min(j / s);
-        }
-        (accel, jerk)
+        velocity::line_limits(&self.axes, seg)
     }
 
     fn full(&self) -> bool {
@@ -404,7 +367,7 @@ impl Planner {
                 if let Some(arc) = self.blend_corner(&mut mv) {
                     self.push_move(None, arc);
                 }
-                EntryKind::Move(Box::new(self.segment(mv)))
+                EntryKind::Move(Box::new(velocity::segment(&self.axes, mv)))
             }
         };
         self.push_entry(info, kind, true);
@@ -457,8 +420,8 @@ impl Planner {
     /// A silent motion entry (a contour blend) at the back of the window; it does not count
     /// towards the lookahead.
     fn push_move(&mut self, info: Option<BlockInfo>, mv: Move) {
-        let mut seg = self.segment(mv);
-        self.blend_dynamics(&mut seg);
+        let mut seg = velocity::segment(&self.axes, mv);
+        blend::blend_dynamics(&self.axes, &mut seg);
         self.check_limits(&seg.mv);
         let kind = EntryKind::Move(Box::new(seg));
         self.window.push_back(Entry {
@@ -557,7 +520,7 @@ impl Planner {
             if mv.length_mm() <= 0.0 && info.is_none() {
                 continue;
             }
-            let kind = EntryKind::Move(Box::new(self.segment(mv)));
+            let kind = EntryKind::Move(Box::new(velocity::segment(&self.axes, mv)));
             self.push_entry(info.take(), kind, k == 0);
         }
         if let Some(i) = info {
@@ -623,42 +586,13 @@ impl Planner {
                 }
             }
             for (k, mv) in seg.pieces.into_iter().enumerate() {
-                let kind = EntryKind::Move(Box::new(self.segment(mv)));
+                let kind = EntryKind::Move(Box::new(velocity::segment(&self.axes, mv)));
                 self.push_entry(if k == 0 { info.take() } else { None }, kind, k == 0);
             }
             while let Some(i) = self.spline.pop_waiting_upto(seg.point) {
                 self.push_entry(i, EntryKind::Plain, false);
             }
         }
-    }
-
-    /// A contour blend is passed at what the axes allow: of the smallest moving axis' full
-    /// acceleration, what passing at feed takes for the centripetal part (at most
-    /// [`BLEND_CENTRIPETAL_SHARE`]), the rest of the vector for the tangential ramp (a programmed arc keeps the junction reserve and the
-    /// even split: it may be long and start or end at a corner). A blend is tangent to both
-    /// lines, so it needs no reserve of its own.
-    fn blend_dynamics(&self, seg: &mut Segment) {
-        let Some(c) = seg.mv.arc() else { return };
-        let min_accel = [c.a, c.b]
-            .iter()
-            .filter_map(|&i| self.axes[i].as_ref())
-            .map(|ax| BLEND_ACCEL_SHARE * ax.max_accel_mm_per_s2.max(1e-6))
-            .fold(f64::INFINITY, f64::min);
-        if !(min_accel.is_finite() && c.radius_mm > 0.0) {
-            return;
-        }
-        let vmax = [c.a, c.b]
-            .iter()
-            .filter_map(|&i| self.axes[i].as_ref())
-            .map(|ax| ax.max_velocity_mm_per_min.max(1e-6) / 60.0)
-            .fold(f64::INFINITY, f64::min);
-        // The centripetal share passing at feed takes (a blend of a nearly straight corner
-        // needs almost none and leaves the ramp nearly all), at most the constant.
-        let feed = seg.programmed_mm_per_s.min(vmax);
-        let share = (feed * feed / (c.radius_mm * min_accel)).min(BLEND_CENTRIPETAL_SHARE);
-        let v = (share * min_accel * c.radius_mm).sqrt();
-        seg.limit_mm_per_s = v.min(vmax);
-        seg.accel_mm_per_s2 = (1.0 - share * share).sqrt() * min_accel;
     }
 
     /// Contouring: if the last motion block in the window ends in a corner it should blend
@@ -769,86 +703,6 @@ impl Planner {
         }
     }
 
-    /// A motion block's nominal velocity, velocity limit, path acceleration and junction.
-    fn segment(&self, mv: Move) -> Segment {
-        let length_mm = mv.length_mm();
-        let t0 = tangent(&mv, length_mm, false);
-        // Largest share of the path velocity each axis takes anywhere on the block.
-        let mut share = [0.0; MAX_AXES];
-        for (i, s) in share.iter_mut().enumerate() {
-            *s = t0[i].abs();
-        }
-        let mut curvature = 0.0;
-        if let MoveKind::Arc {
-            plane,
-            radius_mm,
-            sweep_rad,
-            ..
-        } = mv.kind
-        {
-            let (a, b, _) = plane.axes();
-            if length_mm > 0.0 {
-                // The circle part's share: on a full turn each plane axis takes all of it.
-                let k = radius_mm * sweep_rad / length_mm;
-                share[a] = k;
-                share[b] = k;
-                if radius_mm > 0.0 {
-                    curvature = k * k / radius_mm;
-                }
-            }
-        }
-        let mut limit = f64::INFINITY;
-        let mut full = f64::INFINITY;
-        let mut rapid = f64::INFINITY;
-        let mut min_accel = f64::INFINITY;
-        for (i, s) in share.iter().enumerate() {
-            if *s <= 1e-12 {
-                continue;
-            }
-            let Some(ax) = &self.axes[i] else { continue };
-            let vmax = ax.max_velocity_mm_per_min.max(1e-6) / 60.0;
-            let amax = ax.max_accel_mm_per_s2.max(1e-6);
-            limit = limit.min(vmax / s);
-            rapid = rapid.min(ax.rapid_mm_per_min.max(1e-6) / 60.0 / s);
-            full = full.min(amax / s);
-            min_accel = min_accel.min(amax);
-        }
-        let mut accel = full * (1.0 - JUNCTION_ACCEL_SHARE);
-        if curvature > 0.0 && min_accel.is_finite() {
-            // Centripetal v²·κ ≤ share·a; the tangential ramp gets the rest of the vector.
-            let reserve_accel = min_accel * (1.0 - JUNCTION_ACCEL_SHARE);
-            limit = limit.min((ARC_CENTRIPETAL_SHARE * reserve_accel / curvature).sqrt());
-            let tangential = (1.0 - ARC_CENTRIPETAL_SHARE * ARC_CENTRIPETAL_SHARE).sqrt();
-            accel = accel.min(tangential * reserve_accel);
-        }
-        if !limit.is_finite() {
-            // No configured axis moves (zero length, or an axis without limits): nothing to
-            // limit, the block ends at once or moves at its feed.
-            limit = f64::MAX;
-        }
-        if !accel.is_finite() {
-            accel = f64::MAX;
-        }
-        if !full.is_finite() {
-            full = f64::MAX;
-        }
-        let programmed = match mv.kind {
-            MoveKind::Rapid => rapid.min(limit),
-            _ => mv.feed_mm_per_min.max(0.0) / 60.0,
-        };
-        Segment {
-            mv,
-            length_mm,
-            programmed_mm_per_s: programmed,
-            limit_mm_per_s: limit,
-            accel_mm_per_s2: accel,
-            full_accel_mm_per_s2: full,
-            end_claim_mm_per_s2: self.reserve,
-            junction: None,
-            exit_mm_per_s: 0.0,
-        }
-    }
-
     /// The last motion entry before window index `i`, unless a barrier lies between.
     fn move_before(&self, i: usize) -> Option<usize> {
         for j in (0..i).rev() {
@@ -907,7 +761,7 @@ impl Planner {
             let v = prev.cruise_mm_per_s(100.0).min(next.cruise_mm_per_s(100.0));
             self.claim(&jump, v, short_mm, (prev, &t_prev), (next, &t_next))
         } else {
-            self.reserve
+            self.axes.reserve()
         };
         let prev_busy = p == 0 && self.front_busy;
         let prev_start = tangent(&prev.mv, prev.length_mm, false);
@@ -927,10 +781,10 @@ impl Planner {
             if !prev_busy && straight {
                 prev.end_claim_mm_per_s2 = claim;
                 let start = prev.junction.map_or([0.0; MAX_AXES], |j| j.claim_mm_per_s2);
-                prev.accel_mm_per_s2 = line_accel(&self.axes, prev, &prev_start, &start);
+                prev.accel_mm_per_s2 = line_accel(self.axes.by_index(), prev, &prev_start, &start);
                 let a = prev.accel_mm_per_s2;
                 if let Some(j) = prev.junction.as_mut() {
-                    j.k_s2_per_mm = junction_k(&self.axes, j, a, &prev_start);
+                    j.k_s2_per_mm = junction_k(self.axes.by_index(), j, a, &prev_start);
                 }
             }
             prev.accel_mm_per_s2
@@ -943,9 +797,14 @@ impl Planner {
         }
         if let EntryKind::Move(next) = &mut self.window[i].kind {
             if straight {
-                next.accel_mm_per_s2 = line_accel(&self.axes, next, &t_next, &claim);
+                next.accel_mm_per_s2 = line_accel(self.axes.by_index(), next, &t_next, &claim);
             }
-            junction.k_s2_per_mm = junction_k(&self.axes, &junction, next.accel_mm_per_s2, &t_next);
+            junction.k_s2_per_mm = junction_k(
+                self.axes.by_index(),
+                &junction,
+                next.accel_mm_per_s2,
+                &t_next,
+            );
             next.junction = Some(junction);
         }
     }
@@ -963,14 +822,14 @@ impl Planner {
         let per_s = (1.0 / self.cycle_s).max(v / short_mm);
         let mut need = [0.0; MAX_AXES];
         for k in 0..MAX_AXES {
-            let Some(ax) = &self.axes[k] else { continue };
+            let Some(ax) = self.axes.get(k) else { continue };
             let a = ax.max_accel_mm_per_s2.max(1e-6);
             need[k] = v * jump[k] * per_s / JUMP_MARGIN;
             let floor = PROFILE_FLOOR
                 * (prev.full_accel_mm_per_s2 * t_prev[k].abs())
                     .max(next.full_accel_mm_per_s2 * t_next[k].abs());
             if !need[k].is_finite() || need[k] + floor > a {
-                return self.reserve;
+                return self.axes.reserve();
             }
         }
         need
