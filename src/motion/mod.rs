@@ -377,7 +377,7 @@ impl Motion {
         self.time_s += dt_s;
         self.filter.configure(self.dt_s);
         if !self.ended {
-            self.planner.front_busy = self.front_started;
+            self.planner.set_front_busy(self.front_started);
             self.planner.set_cycle_s(self.dt_s);
             self.planner.take_from(queue);
             if let Some(e) = self.planner.take_error() {

@@ -1,8 +1,12 @@
 //! Contour blends (G261 / G61 corner rounding): the arc that replaces a corner between the
 //! window's last motion block and the next one, and the dynamics it is passed with.
 
+use crate::queue::Move;
+
+use super::super::contour;
 use super::axes::AxisTable;
 use super::entry::Segment;
+use super::window::Window;
 
 /// Share of the axes' full acceleration a contour blend may use for its centripetal
 /// acceleration; its tangential ramp gets √(1 − share²) of it.
@@ -39,4 +43,23 @@ pub(super) fn blend_dynamics(axes: &AxisTable, seg: &mut Segment) {
     let v = (share * min_accel * c.radius_mm).sqrt();
     seg.limit_mm_per_s = v.min(vmax);
     seg.accel_mm_per_s2 = (1.0 - share * share).sqrt() * min_accel;
+}
+
+/// Contouring: if the last motion block in the window ends in a corner it should blend
+/// (G261 / G61), shorten it and `next` and return the blend arc (see [`contour`]).
+/// The window's front is not changed once it executes (`front_busy`).
+pub(super) fn blend_corner(window: &mut Window, next: &mut Move, front_busy: bool) -> Option<Move> {
+    let at = window.last_move_unflushed();
+    let i = at.filter(|&i| i > 0 || !front_busy)?;
+    let prev = window.segment_mut(i)?;
+    let dev = prev.mv.path.contour_dev_mm?;
+    let (p1, arc, p2) = contour::blend(&prev.mv, next, dev)?;
+    prev.mv.end = p1;
+    prev.length_mm = prev.mv.length_mm();
+    if let Some(j) = prev.junction.as_mut() {
+        j.short_mm = j.short_mm.min(prev.length_mm);
+    }
+    next.start = p2;
+    window.mark_dirty();
+    Some(arc)
 }

@@ -3,23 +3,7 @@
 //! window, the program end), contour blends (G261/G61) and the velocity plan over the released
 //! motion blocks.
 //!
-//! Release rules. Motion blocks taken from the block queue are *held* until one of these
-//! releases every block in the window: the window holds `lookahead_blocks` motion blocks (it is
-//! full); the program end (M30/M2) enters it; a `#FLUSH`, `#FLUSH CONTINUE` or `#FLUSH WAIT`
-//! enters it. `#FLUSH CONTINUE` also releases the next motion block the moment it arrives, so a
-//! stream that delivers it in time continues without a stop ("if the next motion block is
-//! presented in good time before an NC block end, motion is resumed without stopping"). A
-//! non-motion block or a dwell with nothing held before it is released at once: it takes no
-//! part in cross-block planning.
-//!
-//! Velocity plan. Every released motion block gets a nominal velocity (programmed feed, G0 at
-//! the axes' rapid rates, lowered so no axis exceeds its maximum velocity; arcs also so the
-//! centripetal acceleration stays within the axes' limit), a path acceleration (the axis limits
-//! projected on the path direction) and an entry velocity limit at its junction with the
-//! previous block. A backward pass from the last released block, which always ends at rest,
-//! gives every block the highest exit velocity from which everything after it can still brake
-//! in time: so a feed that starves is safe, and a block released before the deceleration point
-//! lifts the plan without a stop.
+//! The release rules are in `window.rs`, the velocity plan in `velocity.rs`.
 //!
 //! Junction rule. At a corner the direction jumps from t1 to t2 and each axis' velocity jumps
 //! by v·|t2ᵢ − t1ᵢ| within one tick, on top of the tangential acceleration of the blocks on
@@ -33,7 +17,14 @@
 //! Non-motion blocks between two moves do not break the junction; a dwell, the program
 //! end, `#FLUSH` and `#FLUSH WAIT` do (the motion stops there).
 
-use std::collections::VecDeque;
+mod axes;
+mod blend;
+mod entry;
+mod limits;
+mod radius_comp;
+mod spline_feed;
+mod velocity;
+mod window;
 
 use crate::queue::{Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind};
 use crate::vocab::axis::MAX_AXES;
@@ -43,35 +34,23 @@ use super::interpolator::tangent;
 use super::spline;
 use super::trc::PlanError;
 use super::AxisLimits;
-
-mod axes;
-mod blend;
-mod entry;
-mod limits;
-mod radius_comp;
-mod spline_feed;
-mod velocity;
-
 use axes::AxisTable;
 use entry::Junction;
-pub(crate) use entry::{Entry, EntryKind, Segment};
 use limits::LimitCheck;
 use radius_comp::RadiusComp;
 use spline_feed::SplineFeed;
+use window::Window;
 
 pub use axes::JUNCTION_ACCEL_SHARE;
+pub(crate) use entry::{Entry, EntryKind, Segment};
+
 /// Share of a junction's budget its velocity jumps may use: the rest covers the neighbouring
 /// junctions when several fall into one cycle with unequal corners (the rule looks at the two
 /// blocks on each side of a junction only).
-pub(crate) const JUMP_MARGIN: f64 = 0.95;
+const JUMP_MARGIN: f64 = 0.95;
 /// Share of its acceleration a line keeps whatever its junctions claim: a junction that would
 /// leave less is not passed at feed but with the fixed reserve.
-pub(crate) const PROFILE_FLOOR: f64 = 0.2;
-/// Non-motion blocks the window holds beyond its motion blocks, per motion block: bounds the
-/// window when a program is mostly assignments or M functions. It also bounds how many such
-/// blocks one tick takes in: 8 lets the default window (32 blocks, 304 entries) take a whole
-/// stream buffer of 17-byte assignments (241 lines) per tick, the interface's full rate.
-const NON_MOTION_PER_BLOCK: usize = 8;
+const PROFILE_FLOOR: f64 = 0.2;
 
 /// Planner settings (runtime.toml `[planner]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -91,65 +70,17 @@ impl Default for PlannerSettings {
     }
 }
 
-impl Junction {
-    /// The junction's geometric velocity limit for tick length `dt_s`, mm/s.
-    pub(crate) fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
-        if self.k_s2_per_mm <= 0.0 {
-            return f64::INFINITY;
-        }
-        (dt_s / self.k_s2_per_mm).min((self.short_mm / self.k_s2_per_mm).sqrt())
-    }
-
-    /// The limit when a corner filter of `window_s` spreads the velocity jump (0 = no filter).
-    ///
-    /// Each junction owns the time τ = min(window, time on the previous block, time on the
-    /// next block) at the blocks' cruise velocities; owned times of successive junctions do not
-    /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
-    /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
-    /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
-    pub(crate) fn smoothed_limit_mm_per_s(
-        &self,
-        window_s: f64,
-        prev_cruise_mm_per_s: f64,
-        length_mm: f64,
-        cruise_mm_per_s: f64,
-    ) -> f64 {
-        if window_s <= 0.0 {
-            return 0.0;
-        }
-        if self.k_s2_per_mm <= 0.0 {
-            return f64::INFINITY;
-        }
-        let time_on = |l: f64, v: f64| if v > 0.0 { l / v } else { f64::INFINITY };
-        let tau = window_s
-            .min(time_on(self.prev_length_mm, prev_cruise_mm_per_s))
-            .min(time_on(length_mm, cruise_mm_per_s));
-        0.5 * tau / self.k_s2_per_mm
-    }
-}
-
-/// The lookahead window: a prefix of it is released, the rest held.
+/// The lookahead window and the parts that feed and plan it.
 #[derive(Debug)]
 pub(crate) struct Planner {
     /// Axis limits and the junction reserve.
     axes: AxisTable,
-    lookahead: usize,
-    max_entries: usize,
-    window: VecDeque<Entry>,
-    /// Entries at the front that may execute.
-    released: usize,
-    /// Motion blocks in the window.
-    moves: usize,
-    /// `#FLUSH CONTINUE` seen: release the next motion block when it arrives.
-    release_next_move: bool,
-    /// The plan must be recomputed (new releases, override change).
-    dirty: bool,
+    /// The entries, held and released.
+    window: Window,
     /// Corner smoothing window, s (0 = off).
     corner_s: f64,
     /// Cycle time the junction claims are sized for, s.
     cycle_s: f64,
-    /// The front entry is executing (its geometry is fixed).
-    pub(crate) front_busy: bool,
     /// Tool radius compensation hand-off.
     comp: RadiusComp,
     /// Spline hand-off.
@@ -159,39 +90,38 @@ pub(crate) struct Planner {
     /// An error found while planning (compensation impossible, a software limit on the path
     /// the axes follow), for the channel.
     error: Option<PlanError>,
+    /// The front entry is executing (its geometry is fixed).
+    front_busy: bool,
 }
 
 impl Planner {
     pub(crate) fn new(axes: &[AxisLimits], settings: PlannerSettings) -> Self {
         let axes = AxisTable::new(axes);
         let limits = LimitCheck::new(axes.by_index());
-        let lookahead = settings.lookahead_blocks.max(1);
-        let max_entries = lookahead * (1 + NON_MOTION_PER_BLOCK) + 16;
         Planner {
-            axes,
-            lookahead,
-            max_entries,
-            window: VecDeque::with_capacity(max_entries),
-            released: 0,
-            moves: 0,
-            release_next_move: false,
-            dirty: false,
-            front_busy: false,
-            comp: RadiusComp::default(),
-            spline: SplineFeed::default(),
-            limits,
-            error: None,
-            cycle_s: 0.001,
+            window: Window::new(settings.lookahead_blocks),
             corner_s: if settings.corner_smoothing_s.is_finite() {
                 settings.corner_smoothing_s.max(0.0)
             } else {
                 0.0
             },
+            cycle_s: 0.001,
+            comp: RadiusComp::default(),
+            spline: SplineFeed::default(),
+            limits,
+            error: None,
+            front_busy: false,
+            axes,
         }
     }
 
     pub(crate) fn lookahead(&self) -> usize {
-        self.lookahead
+        self.window.lookahead()
+    }
+
+    /// The front entry executes (its geometry and acceleration are fixed) or not.
+    pub(crate) fn set_front_busy(&mut self, busy: bool) {
+        self.front_busy = busy;
     }
 
     /// The corner window the axis filter now uses, s (0 = none): junction velocities are
@@ -200,7 +130,7 @@ impl Planner {
         if corner_s != self.corner_s {
             self.corner_s = corner_s;
             self.relink();
-            self.dirty = true;
+            self.window.mark_dirty();
         }
     }
 
@@ -211,25 +141,6 @@ impl Planner {
         }
     }
 
-    /// Every junction in the window afresh (the corner window changed: claims are made only
-    /// without one). The executing front keeps its acceleration.
-    fn relink(&mut self) {
-        let reserve = self.axes.reserve();
-        for i in 0..self.window.len() {
-            if i == 0 && self.front_busy {
-                continue;
-            }
-            if let EntryKind::Move(seg) = &mut self.window[i].kind {
-                seg.end_claim_mm_per_s2 = reserve;
-                if is_straight(&seg.mv) {
-                    seg.accel_mm_per_s2 = seg.full_accel_mm_per_s2 * (1.0 - JUNCTION_ACCEL_SHARE);
-                }
-            }
-        }
-        for i in 0..self.window.len() {
-            self.link(i);
-        }
-    }
     pub(crate) fn len(&self) -> usize {
         self.window.len()
     }
@@ -238,11 +149,11 @@ impl Planner {
     }
     /// Entries released for execution and not yet done.
     pub(crate) fn released(&self) -> usize {
-        self.released
+        self.window.released()
     }
     /// Entries held back (the memory effect), blocks waiting for their spline curve included.
     pub(crate) fn held(&self) -> usize {
-        self.window.len() - self.released + self.spline.held() + self.comp.held()
+        self.window.held() + self.spline.held() + self.comp.held()
     }
     pub(crate) fn front(&self) -> Option<&Entry> {
         self.window.front()
@@ -257,23 +168,7 @@ impl Planner {
     /// entries, the next one that is not a plain block or `#FLUSH CONTINUE` stops the motion
     /// (dwell, `#FLUSH`, `#FLUSH WAIT`, program end). No later release can join it then.
     pub(crate) fn front_is_lone_line(&self) -> bool {
-        let Some(Entry {
-            kind: EntryKind::Move(seg),
-            ..
-        }) = self.window.front()
-        else {
-            return false;
-        };
-        if !matches!(seg.mv.kind, MoveKind::Line | MoveKind::Rapid) || seg.length_mm <= 0.0 {
-            return false;
-        }
-        for e in self.window.iter().take(self.released).skip(1) {
-            match &e.kind {
-                EntryKind::Plain | EntryKind::Flush(FlushKind::Continue) => {}
-                k => return k.is_barrier(),
-            }
-        }
-        false
+        self.window.front_is_lone_line()
     }
 
     /// Path acceleration and jerk limits of a straight move with every axis' full
@@ -283,24 +178,20 @@ impl Planner {
         velocity::line_limits(&self.axes, seg)
     }
 
-    fn full(&self) -> bool {
-        self.moves >= self.lookahead || self.window.len() >= self.max_entries
-    }
-
     /// The plan must be recomputed before the next tick's interpolation.
     pub(crate) fn mark_dirty(&mut self) {
-        self.dirty = true;
+        self.window.mark_dirty();
     }
 
     /// Take blocks from the queue into the window while it has room, applying the release
     /// rules.
     pub(crate) fn take_from(&mut self, queue: &mut crate::queue::BlockQueue) {
-        while !self.full() {
+        while !self.window.full() {
             let Some(b) = queue.pop_front() else { break };
             self.push(b);
         }
-        if self.full() {
-            self.release_all();
+        if self.window.full() {
+            self.window.release_all();
         }
     }
 
@@ -364,7 +255,7 @@ impl Planner {
                 prog: prog.unwrap_or_else(|| std::sync::Arc::from("")),
             },
             Action::Move(mut mv) => {
-                if let Some(arc) = self.blend_corner(&mut mv) {
+                if let Some(arc) = blend::blend_corner(&mut self.window, &mut mv, self.front_busy) {
                     self.push_move(None, arc);
                 }
                 EntryKind::Move(Box::new(velocity::segment(&self.axes, mv)))
@@ -387,33 +278,22 @@ impl Planner {
                 self.check_limits(&seg.mv);
             }
         }
-        let release = match &kind {
-            EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
-            EntryKind::Move(_) => self.release_next_move,
-            // Nothing held before it: it takes no part in cross-block planning, so it runs
-            // when interpolation reaches it, not when more motion arrives.
-            EntryKind::Plain | EntryKind::Dwell { .. } => self.held() == 0,
-        };
+        let release = self.window.releases(&kind, self.held() == 0);
         let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
-        self.window.push_back(Entry {
+        let at = self.window.push_back(Entry {
             info,
             kind,
             counted,
         });
         if is_move {
-            self.link(self.window.len() - 1);
-        }
-        if counted {
-            self.moves += 1;
-        }
-        if is_move && self.release_next_move {
-            self.release_next_move = false;
+            self.link(at);
+            self.window.moved_in(counted);
         }
         if release {
-            self.release_all();
+            self.window.release_all();
         }
         if continue_after {
-            self.release_next_move = true;
+            self.window.release_next_move();
         }
     }
 
@@ -424,12 +304,12 @@ impl Planner {
         blend::blend_dynamics(&self.axes, &mut seg);
         self.check_limits(&seg.mv);
         let kind = EntryKind::Move(Box::new(seg));
-        self.window.push_back(Entry {
+        let at = self.window.push_back(Entry {
             info,
             kind,
             counted: false,
         });
-        self.link(self.window.len() - 1);
+        self.link(at);
     }
 
     /// A G1 point in spline mode: into the spline (a new one if the type changed), and the
@@ -595,55 +475,9 @@ impl Planner {
         }
     }
 
-    /// Contouring: if the last motion block in the window ends in a corner it should blend
-    /// (G261 / G61), shorten it and `next` and return the blend arc (see [`super::contour`]).
-    /// The window's front is not changed once it executes.
-    fn blend_corner(&mut self, next: &mut Move) -> Option<Move> {
-        let mut at = None;
-        for (i, e) in self.window.iter().enumerate().rev() {
-            match &e.kind {
-                EntryKind::Move(_) => {
-                    at = Some(i);
-                    break;
-                }
-                // A flush of any kind suppresses the blend at the motion blocks around it
-                // (TF5200 "Flushing NC channel"), `#FLUSH CONTINUE` included.
-                k if k.is_barrier() || matches!(k, EntryKind::Flush(_)) => return None,
-                _ => {}
-            }
-        }
-        let i = at.filter(|&i| i > 0 || !self.front_busy)?;
-        let EntryKind::Move(prev) = &mut self.window[i].kind else {
-            return None;
-        };
-        let dev = prev.mv.path.contour_dev_mm?;
-        let (p1, arc, p2) = super::contour::blend(&prev.mv, next, dev)?;
-        prev.mv.end = p1;
-        prev.length_mm = prev.mv.length_mm();
-        if let Some(j) = prev.junction.as_mut() {
-            j.short_mm = j.short_mm.min(prev.length_mm);
-        }
-        next.start = p2;
-        self.dirty = true;
-        Some(arc)
-    }
-
-    /// Release every block in the window.
-    pub(crate) fn release_all(&mut self) {
-        if self.released != self.window.len() {
-            self.released = self.window.len();
-            self.dirty = true;
-        }
-    }
-
     /// Remove the front entry (it has been executed).
     pub(crate) fn pop_front(&mut self) -> Option<Entry> {
-        let e = self.window.pop_front()?;
-        if e.counted {
-            self.moves -= 1;
-        }
-        self.released = self.released.saturating_sub(1);
-        Some(e)
+        self.window.pop_front()
     }
 
     /// Drop everything (reset, error).
@@ -651,68 +485,33 @@ impl Planner {
         self.window.clear();
         self.spline.clear();
         self.comp.clear();
-        self.released = 0;
-        self.moves = 0;
-        self.release_next_move = false;
-        self.dirty = false;
     }
 
     /// Recompute the exit velocities of the released motion blocks if something changed.
     pub(crate) fn plan_if_needed(&mut self, override_pct: f64, dt_s: f64) {
-        if self.dirty {
-            self.plan(override_pct, dt_s);
-            self.dirty = false;
+        if self.window.take_dirty() {
+            velocity::plan(&mut self.window, self.corner_s, override_pct, dt_s);
         }
     }
 
-    /// Backward pass over the released blocks: the last one ends at rest; each block's exit is
-    /// the next block's admissible entry velocity.
-    fn plan(&mut self, override_pct: f64, dt_s: f64) {
-        let mut next_entry = 0.0_f64;
-        let mut stop = true;
-        for e in self.window.iter_mut().take(self.released).rev() {
-            match &mut e.kind {
-                EntryKind::Move(seg) => {
-                    seg.exit_mm_per_s = if stop { 0.0 } else { next_entry };
-                    let entry_limit = match seg.junction {
-                        None => 0.0,
-                        Some(j) => {
-                            let prev_cruise = (j.prev_programmed_mm_per_s * override_pct / 100.0)
-                                .min(j.prev_limit_mm_per_s);
-                            let cruise = seg.cruise_mm_per_s(override_pct);
-                            j.limit_mm_per_s(dt_s)
-                                .max(j.smoothed_limit_mm_per_s(
-                                    self.corner_s,
-                                    prev_cruise,
-                                    seg.length_mm,
-                                    cruise,
-                                ))
-                                .min(prev_cruise)
-                                .min(cruise)
-                        }
-                    };
-                    let reachable = (seg.exit_mm_per_s * seg.exit_mm_per_s
-                        + 2.0 * seg.accel_mm_per_s2 * seg.length_mm)
-                        .sqrt();
-                    next_entry = entry_limit.min(reachable).max(0.0);
-                    stop = false;
+    /// Every junction in the window afresh (the corner window changed: claims are made only
+    /// without one). The executing front keeps its acceleration.
+    fn relink(&mut self) {
+        let reserve = self.axes.reserve();
+        for i in 0..self.window.len() {
+            if i == 0 && self.front_busy {
+                continue;
+            }
+            if let Some(seg) = self.window.segment_mut(i) {
+                seg.end_claim_mm_per_s2 = reserve;
+                if is_straight(&seg.mv) {
+                    seg.accel_mm_per_s2 = seg.full_accel_mm_per_s2 * (1.0 - JUNCTION_ACCEL_SHARE);
                 }
-                k if k.is_barrier() => stop = true,
-                _ => {}
             }
         }
-    }
-
-    /// The last motion entry before window index `i`, unless a barrier lies between.
-    fn move_before(&self, i: usize) -> Option<usize> {
-        for j in (0..i).rev() {
-            match &self.window[j].kind {
-                EntryKind::Move(_) => return Some(j),
-                k if k.is_barrier() => return None,
-                _ => {}
-            }
+        for i in 0..self.window.len() {
+            self.link(i);
         }
-        None
     }
 
     /// Join the motion entry at window index `i` to the one before it (the corner-speed rule,
@@ -728,20 +527,20 @@ impl Planner {
     /// [`JUNCTION_ACCEL_SHARE`] and is passed at what it allows (nearly a stop). Next to an
     /// arc, or with a corner filter, every junction uses the fixed reserve.
     fn link(&mut self, i: usize) {
-        let Some(EntryKind::Move(next)) = self.window.get(i).map(|e| &e.kind) else {
+        let Some(next) = self.window.segment(i) else {
             return;
         };
-        let Some(p) = self.move_before(i) else {
-            if let Some(EntryKind::Move(next)) = self.window.get_mut(i).map(|e| &mut e.kind) {
+        let Some(p) = self.window.move_before(i) else {
+            if let Some(next) = self.window.segment_mut(i) {
                 next.junction = None;
             }
             return;
         };
-        let EntryKind::Move(prev) = &self.window[p].kind else {
+        let Some(prev) = self.window.segment(p) else {
             return;
         };
         if next.length_mm <= 0.0 || prev.length_mm <= 0.0 {
-            if let EntryKind::Move(next) = &mut self.window[i].kind {
+            if let Some(next) = self.window.segment_mut(i) {
                 next.junction = None;
             }
             return;
@@ -777,7 +576,7 @@ impl Planner {
             prev_limit_mm_per_s: prev.limit_mm_per_s,
         };
         // The previous block gives what this junction claims (unless it already runs).
-        let prev_accel = if let EntryKind::Move(prev) = &mut self.window[p].kind {
+        let prev_accel = if let Some(prev) = self.window.segment_mut(p) {
             if !prev_busy && straight {
                 prev.end_claim_mm_per_s2 = claim;
                 let start = prev.junction.map_or([0.0; MAX_AXES], |j| j.claim_mm_per_s2);
@@ -795,7 +594,7 @@ impl Planner {
         for (k, l) in junction.prev_load_mm_per_s2.iter_mut().enumerate() {
             *l = prev_accel * t_prev[k].abs();
         }
-        if let EntryKind::Move(next) = &mut self.window[i].kind {
+        if let Some(next) = self.window.segment_mut(i) {
             if straight {
                 next.accel_mm_per_s2 = line_accel(self.axes.by_index(), next, &t_next, &claim);
             }
@@ -836,6 +635,43 @@ impl Planner {
     }
 }
 
+impl Junction {
+    /// The junction's geometric velocity limit for tick length `dt_s`, mm/s.
+    pub(crate) fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
+        if self.k_s2_per_mm <= 0.0 {
+            return f64::INFINITY;
+        }
+        (dt_s / self.k_s2_per_mm).min((self.short_mm / self.k_s2_per_mm).sqrt())
+    }
+
+    /// The limit when a corner filter of `window_s` spreads the velocity jump (0 = no filter).
+    ///
+    /// Each junction owns the time τ = min(window, time on the previous block, time on the
+    /// next block) at the blocks' cruise velocities; owned times of successive junctions do not
+    /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
+    /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
+    /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
+    pub(crate) fn smoothed_limit_mm_per_s(
+        &self,
+        window_s: f64,
+        prev_cruise_mm_per_s: f64,
+        length_mm: f64,
+        cruise_mm_per_s: f64,
+    ) -> f64 {
+        if window_s <= 0.0 {
+            return 0.0;
+        }
+        if self.k_s2_per_mm <= 0.0 {
+            return f64::INFINITY;
+        }
+        let time_on = |l: f64, v: f64| if v > 0.0 { l / v } else { f64::INFINITY };
+        let tau = window_s
+            .min(time_on(self.prev_length_mm, prev_cruise_mm_per_s))
+            .min(time_on(length_mm, cruise_mm_per_s));
+        0.5 * tau / self.k_s2_per_mm
+    }
+}
+
 /// A line's path acceleration: every axis' limit less the larger claim of its two junctions,
 /// projected on the line, mm/s².
 fn line_accel(
@@ -863,7 +699,7 @@ fn line_accel(
 }
 
 /// A block whose tangent is the same along it (the budget rule's tangential load is exact).
-fn is_straight(mv: &Move) -> bool {
+pub(super) fn is_straight(mv: &Move) -> bool {
     matches!(mv.kind, MoveKind::Line | MoveKind::Rapid)
 }
 

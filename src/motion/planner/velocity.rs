@@ -15,11 +15,50 @@ use crate::vocab::axis::MAX_AXES;
 
 use super::super::interpolator::tangent;
 use super::axes::{AxisTable, JUNCTION_ACCEL_SHARE};
-use super::entry::Segment;
+use super::entry::{EntryKind, Segment};
+use super::window::Window;
 
 /// Share of the profile acceleration an arc may use for its centripetal acceleration; the
 /// tangential ramp gets √(1 − share²) of it, so both together stay within the limit.
 const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
+
+/// Backward pass over the released blocks: the last one ends at rest; each block's exit is
+/// the next block's admissible entry velocity (`corner_s`: the corner filter's window, s).
+pub(super) fn plan(window: &mut Window, corner_s: f64, override_pct: f64, dt_s: f64) {
+    let mut next_entry = 0.0_f64;
+    let mut stop = true;
+    for e in window.released_mut().rev() {
+        match &mut e.kind {
+            EntryKind::Move(seg) => {
+                seg.exit_mm_per_s = if stop { 0.0 } else { next_entry };
+                let entry_limit = match seg.junction {
+                    None => 0.0,
+                    Some(j) => {
+                        let prev_cruise = (j.prev_programmed_mm_per_s * override_pct / 100.0)
+                            .min(j.prev_limit_mm_per_s);
+                        let cruise = seg.cruise_mm_per_s(override_pct);
+                        j.limit_mm_per_s(dt_s)
+                            .max(j.smoothed_limit_mm_per_s(
+                                corner_s,
+                                prev_cruise,
+                                seg.length_mm,
+                                cruise,
+                            ))
+                            .min(prev_cruise)
+                            .min(cruise)
+                    }
+                };
+                let reachable = (seg.exit_mm_per_s * seg.exit_mm_per_s
+                    + 2.0 * seg.accel_mm_per_s2 * seg.length_mm)
+                    .sqrt();
+                next_entry = entry_limit.min(reachable).max(0.0);
+                stop = false;
+            }
+            k if k.is_barrier() => stop = true,
+            _ => {}
+        }
+    }
+}
 
 /// A motion block's nominal velocity, velocity limit, path acceleration and (not yet linked)
 /// junction.
