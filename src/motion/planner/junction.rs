@@ -41,7 +41,7 @@ pub(super) struct JunctionRule {
 
 impl Junction {
     /// The junction's geometric velocity limit for tick length `dt_s`, mm/s.
-    pub(crate) fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
+    pub(super) fn limit_mm_per_s(&self, dt_s: f64) -> f64 {
         if self.k_s2_per_mm <= 0.0 {
             return f64::INFINITY;
         }
@@ -55,7 +55,7 @@ impl Junction {
     /// overlap, so the jumps inside any window sum to at most share·aᵢ·Σ τ ≤ 2·share·aᵢ·window
     /// when each jump is v·|Δtᵢ| ≤ share·aᵢ·τ / 2. The filter averages them over the window:
     /// at most share·aᵢ of added acceleration on any axis (docs/motion.md).
-    pub(crate) fn smoothed_limit_mm_per_s(
+    pub(super) fn smoothed_limit_mm_per_s(
         &self,
         window_s: f64,
         prev_cruise_mm_per_s: f64,
