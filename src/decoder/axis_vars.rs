@@ -5,7 +5,8 @@
 //! refuses the manual's other V.A. and V.G. variables by name (docs/nc-language.md,
 //! "Constructs of real programs").
 
-use super::*;
+use super::{modal, Decoder};
+use crate::vocab::axis::AXIS_LETTERS;
 
 impl Decoder {
     /// `V.A.ABS.<axis>`: the axis' end point of the previous block in program coordinates

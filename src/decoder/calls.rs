@@ -1,11 +1,22 @@
 //! Subroutine and cycle calls, their return, and the `#` commands (`#FLUSH`, `#CACHE`,
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
-use super::*;
+use std::sync::Arc;
+
+use super::error::{var_error, DecodeError, Res};
+use super::frame::{Frame, FrameKind, LineMeta, Source};
+use super::io::DecoderIo;
+use super::note::Note;
+use super::{expr, words, Decoder};
+use crate::lang::block::{Block, Call, Command, SplineCommand, Value};
+use crate::lang::codes;
+use crate::queue::{Action, BlockInfo};
 use crate::source::cache::LoadStep;
 use crate::source::loader::PendingRead;
+use crate::source::store::{Opened, ProgramKind};
 use crate::source::store::{ProgramText, StoreError};
 use crate::vocab::event::CacheOp;
+use crate::vocab::flush::FlushKind;
 
 /// A `#CACHE LOAD` whose file the loader reads: the line waits, and runs again with the text.
 #[derive(Debug)]

@@ -5,9 +5,14 @@
 //! it, and using it as a number is 900008 (docs/nc-language.md, "Constructs of real
 //! programs").
 
-use super::*;
+use super::error::{DecodeError, Res};
+use super::frame::{Frame, FrameKind, Source};
+use super::io::DecoderIo;
+use super::{expr, labels, Decoder};
 use crate::lang::block::CycleArg;
+use crate::lang::codes;
 use crate::lang::eval::Val;
+use crate::queue::{Action, BlockInfo};
 
 impl Decoder {
     pub(super) fn call_cycle(

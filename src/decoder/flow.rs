@@ -9,11 +9,13 @@ use std::sync::Arc;
 use crate::lang::block::{Block, Body, Control, GotoTarget, Item, Label, Value};
 use crate::lang::{Expr, VarRef};
 
+use super::error::{DecodeError, Res};
 use super::frame::{FlowEntry, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
 use super::labels::{LabelAt, LabelIndex, LabelScan, ScanFound, ScanGoal};
-use super::{whole, DecodeError, Decoder, Res};
+use super::Decoder;
 use crate::lang::codes;
 use crate::lang::eval::is_true;
+use crate::lang::range::whole_u32 as whole;
 
 /// How a `$` statement changes nesting, for skipping and for the label index.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,36 +8,35 @@
 mod axis_vars;
 mod calls;
 mod cycles;
+mod error;
 mod expr;
 pub mod flow;
 pub mod frame;
+mod io;
 mod labels;
 pub mod modal;
+mod note;
 mod search;
+mod settings;
 pub mod vars;
 mod words;
 
-use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::geometry::{arc, SoftLimits};
-use crate::lang::block::{AxisName, Block, Body, Call, Command, Item, SplineCommand, Value};
+use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
-use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, QueuedBlock};
-use crate::source::cache::Cache;
+use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
-use crate::source::stream::StreamBuffer;
-use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
-use crate::vocab::flush::FlushKind;
+use crate::vocab::axis::{Position, MAX_AXES};
 
 use flow::{goto_text, is_loop_statement};
 use frame::{
     read_file_line, Frame, FrameKind, LineMeta, LineRead, Skip, SkipUntil, Source, StreamNote,
     StreamReader,
 };
-use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
+use modal::Modal;
 use vars::{VarSlot, VarStore};
 
 use labels::{LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
@@ -45,165 +44,12 @@ pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEX
 use search::Search;
 pub use search::SearchTarget;
 
-/// What the decoder needs from the configuration.
-#[derive(Debug, Clone)]
-pub struct DecoderSettings {
-    /// Lines decoded per tick at most (runtime.toml `decoder.blocks_per_tick`).
-    pub blocks_per_tick: usize,
-    /// Subroutine nesting depth at most (main program = level 0).
-    pub(crate) max_depth: usize,
-    /// Axes the channel has, by letter index of `AXIS_LETTERS`.
-    pub axes: [bool; MAX_AXES],
-    /// The name of the axis in each slot (`X`, or `X1` for an axis list's `X1`): a program
-    /// writes `X10` for a one-letter name, `X1=10` for a longer one. Resolved once at set-up.
-    pub(crate) axis_names: [AxisName; MAX_AXES],
-    pub(crate) zero_offsets: ZeroOffsets,
-    /// How far the end point may lie off the circle, mm.
-    pub(crate) arc_tolerance_mm: f64,
-    /// Software limits per axis (runtime.toml `soft_limit_min_mm` / `soft_limit_max_mm`),
-    /// mm in machine coordinates, by `AXIS_LETTERS` index: a block whose end point or arc
-    /// lies outside is refused before it moves (21897).
-    pub(crate) soft_limits_mm: [SoftLimits; MAX_AXES],
-    /// Global subroutines the channel calls by itself: at program start (P-CHAN-00119), before
-    /// the main program's M02/M30 (P-CHAN-00252) and for M6 (P-CHAN-00118).
-    pub implicit: crate::params::channel::ImplicitSubroutines,
-    /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
-    /// is reported with it, ncchannel's detail after it in parentheses.
-    pub(crate) error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
-}
-
-/// Each slot named by its letter, `X` to `C`.
-pub(crate) fn letter_names() -> [AxisName; MAX_AXES] {
-    AXIS_LETTERS.map(|l| AxisName::new(std::str::from_utf8(&[l]).unwrap_or("X")).expect("a letter"))
-}
-
-/// Values `#VAR` declarations may make in one tick before decoding waits for the next: a
-/// 100,000-element declaration costs ~0.1 ms to fill, so a tick does at most about two
-/// such, whatever the NC text (a line of ten took 15 s in one tick before).
-pub const DECLARED_VALUES_PER_TICK: usize = 100_000;
-
-/// Bytes of NC text the decoder reads per tick at most (files and stream alike; one line may
-/// end beyond it). Real blocks are tens of bytes, so `blocks_per_tick` lines stay far inside
-/// it; lines thousands of bytes long (comments in a `#COMMENT` block) no longer make a tick's
-/// work grow with them (64 lines of 60 KB took 30 ms a tick before).
-pub const LINE_BYTES_PER_TICK: usize = 64 * 1024;
-
-impl Default for DecoderSettings {
-    fn default() -> Self {
-        DecoderSettings {
-            blocks_per_tick: 64,
-            max_depth: 20,
-            axes: [true, true, true, false, false, false],
-            axis_names: letter_names(),
-            zero_offsets: [[0.0; MAX_AXES]; 6],
-            arc_tolerance_mm: 0.01,
-            soft_limits_mm: [SoftLimits::default(); MAX_AXES],
-            implicit: Default::default(),
-            error_texts: None,
-        }
-    }
-}
-
-/// A decoding error: the ISG number, the message and the column when the parser knows it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DecodeError {
-    pub code: u32,
-    pub msg: String,
-    pub col: Option<u32>,
-}
-
-impl DecodeError {
-    pub fn new(code: u32, msg: impl Into<String>) -> Self {
-        DecodeError {
-            code,
-            msg: msg.into(),
-            col: None,
-        }
-    }
-    fn at(mut self, col: u32) -> Self {
-        self.col = Some(col);
-        self
-    }
-}
-
-/// A parser error keeps its number, message and column.
-impl From<crate::lang::SyntaxError> for DecodeError {
-    fn from(e: crate::lang::SyntaxError) -> Self {
-        DecodeError::new(e.code, e.message).at(e.col)
-    }
-}
-
-/// Each error type that carries an ISG (or our) number converts with its number and text.
-macro_rules! numbered_error {
-    ($($t:ty),*) => {$(
-        impl From<$t> for DecodeError {
-            fn from(e: $t) -> Self {
-                DecodeError::new(e.code(), e.to_string())
-            }
-        }
-    )*};
-}
-numbered_error!(
-    crate::source::store::StoreError,
-    crate::source::cache::CacheError,
-    crate::lang::EvalError
-);
-
-impl fmt::Display for DecodeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} {}", self.code, self.msg)
-    }
-}
-
-/// What the decoder reports besides queued blocks; the channel turns these into events.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Note {
-    ProgramStart {
-        prog: Arc<str>,
-        stream: bool,
-    },
-    Segment {
-        bytes: usize,
-    },
-    Discard {
-        bytes: usize,
-    },
-    Warning {
-        code: u32,
-        msg: String,
-    },
-    Error {
-        code: u32,
-        msg: String,
-        prog: Arc<str>,
-        line: u32,
-        col: Option<u32>,
-    },
-    Search {
-        target: SearchTarget,
-        found: bool,
-    },
-    Cache {
-        op: crate::vocab::event::CacheOp,
-        file: String,
-    },
-    /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).
-    Message {
-        text: String,
-        save: bool,
-    },
-    /// An H function (0..=65535) decoded: handed to the PLC side, with its value when
-    /// programmed with one (`H20=5`).
-    HFunction {
-        h: u32,
-        value: Option<f64>,
-    },
-    /// An M function programmed with a value (`M200=1200`): handed to the PLC side.
-    MFunction {
-        m: u32,
-        value: f64,
-    },
-}
+pub use error::DecodeError;
+use error::{var_error, Res};
+pub use io::DecoderIo;
+pub(crate) use note::Note;
+pub(crate) use settings::letter_names;
+pub use settings::{DecoderSettings, DECLARED_VALUES_PER_TICK, LINE_BYTES_PER_TICK};
 
 /// Where the decoder stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -215,23 +61,6 @@ pub enum DecoderState {
     Ended,
     /// An error stopped decoding; only a reset clears it.
     Failed,
-}
-
-/// The channel's parts the decoder reads from and writes to during one step.
-pub struct DecoderIo<'a> {
-    pub stream: &'a mut StreamBuffer,
-    pub store: &'a mut ProgramStore,
-    pub cache: &'a mut Cache,
-    pub queue: &'a mut BlockQueue,
-    /// Motion has nothing left to do (for `#FLUSH WAIT`).
-    pub(crate) motion_idle: bool,
-    /// Keep each block's text for the event log (and report cache hits: events are on).
-    pub(crate) want_text: bool,
-    /// Channel time at the start of this tick.
-    pub now: Duration,
-    /// Length of this tick: decoding stops for the tick once simulated file-system latency
-    /// has used it up.
-    pub period: Duration,
 }
 
 /// Counters for the report.
@@ -307,8 +136,6 @@ pub struct Decoder {
     /// The implicit subroutine calls' state in the running program.
     implicit: calls::ImplicitState,
 }
-
-type Res<T = ()> = Result<T, DecodeError>;
 
 /// Whether the decoder may read its next line in this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -978,14 +805,6 @@ impl Decoder {
     fn resolve(&self, v: &crate::lang::block::VarRef) -> Res<VarSlot> {
         expr::resolve(v, &expr::Env(self))
     }
-}
-
-/// A whole number written as a float (`G01` parses as 1.0).
-pub(crate) use crate::lang::range::whole_u32 as whole;
-
-/// The variable store's refusal with its number (20967, 21928, 20974, `codes::EVAL_UNDEFINED`).
-fn var_error(e: vars::VarError) -> DecodeError {
-    DecodeError::new(e.code(), e.to_string())
 }
 
 /// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).

@@ -1,7 +1,15 @@
 //! Block search: run a program up to a target block, collecting modal state without queueing
 //! motion, then move from where the machine stood to where the program stands.
 
-use super::*;
+use std::fmt;
+
+use super::frame::LineMeta;
+use super::io::DecoderIo;
+use super::note::Note;
+use super::Decoder;
+use crate::lang::block::Block;
+use crate::queue::{Action, Move, MoveKind};
+use crate::vocab::axis::Position;
 
 /// Block search target (TF5200 block search).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

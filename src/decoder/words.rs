@@ -8,11 +8,22 @@
 //! The parser has already refused what a block may not hold (a letter twice, a dwell with
 //! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
 
+use super::error::{var_error, DecodeError, Res};
+use super::frame::{FrameKind, LineMeta};
+use super::io::DecoderIo;
 use super::modal::FeedMode;
-use super::*;
+use super::modal::{apply_g, apply_m, BlockGs, MotionMode};
+use super::note::Note;
+use super::{expr, vars, Decoder};
+use crate::geometry::arc;
 use crate::lang::block::VarRef;
+use crate::lang::block::{Block, Item, Value};
+use crate::lang::codes;
 use crate::lang::eval::Val;
+use crate::lang::range::whole_u32 as whole;
+use crate::queue::{Action, BlockInfo, Move, MoveKind};
 use crate::vocab::axis::slot_of;
+use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 
 /// M or H functions one block may hold.
 const MAX_FUNCTIONS: usize = 8;
