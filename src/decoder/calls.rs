@@ -4,8 +4,9 @@
 use std::sync::Arc;
 
 use super::error::{var_error, DecodeError, Res};
-use super::frame::{Frame, FrameKind, LineMeta, Source};
+use super::frame::{Frame, FrameKind, Source};
 use super::io::DecoderIo;
+use super::line::LineMeta;
 use super::note::Note;
 use super::{expr, words, Decoder};
 use crate::lang::block::{Block, Call, Command, SplineCommand, Value};

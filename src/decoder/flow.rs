@@ -6,57 +6,20 @@
 
 use std::sync::Arc;
 
-use crate::lang::block::{Block, Body, Control, GotoTarget, Item, Label, Value};
+use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
-use super::frame::{FlowEntry, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
+use super::frame::{FlowEntry, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
 use super::labels::{LabelAt, LabelIndex, LabelScan, ScanFound, ScanGoal};
+use super::line::{LineMeta, LinePos};
 use super::Decoder;
 use crate::lang::codes;
+use crate::lang::control::{
+    block_ends_program, control_name, goto_label, goto_text, items_have_m, label_matches,
+    label_text, nesting, Nesting,
+};
 use crate::lang::eval::is_true;
-use crate::lang::range::whole_u32 as whole;
-
-/// How a `$` statement changes nesting, for skipping and for the label index.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Nesting {
-    Open,
-    Close,
-    Neither,
-}
-
-pub(crate) fn nesting(c: &Control) -> Nesting {
-    match c {
-        Control::If(_)
-        | Control::Switch(_)
-        | Control::For { .. }
-        | Control::While(_)
-        | Control::Do
-        | Control::Repeat => Nesting::Open,
-        Control::EndIf
-        | Control::EndSwitch
-        | Control::EndFor
-        | Control::EndWhile
-        | Control::EndDo(_)
-        | Control::Until(_) => Nesting::Close,
-        _ => Nesting::Neither,
-    }
-}
-
-/// Statements that are loops: not allowed in a stream (codes::STREAM_LOOP).
-pub(crate) fn is_loop_statement(c: &Control) -> bool {
-    matches!(
-        c,
-        Control::For { .. }
-            | Control::EndFor
-            | Control::While(_)
-            | Control::EndWhile
-            | Control::Do
-            | Control::EndDo(_)
-            | Control::Repeat
-            | Control::Until(_)
-    )
-}
 
 /// Whether `c` closes the loop `e`.
 pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
@@ -571,66 +534,5 @@ pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {
         v <= end + 1e-9
     } else {
         v >= end - 1e-9
-    }
-}
-
-pub(super) fn items_have_m(items: &[Item], codes: &[u32]) -> bool {
-    items.iter().any(|i| match i {
-        Item::Word(w) if w.letter == b'M' => match w.value {
-            Value::Num(v) => whole(v).is_some_and(|m| codes.contains(&m)),
-            Value::Expr(_) => false,
-        },
-        _ => false,
-    })
-}
-
-pub(super) fn block_ends_program(b: &Block) -> bool {
-    matches!(&b.body, Body::Items(items) if items_have_m(items, &[2, 30]))
-}
-
-pub(super) fn goto_label(t: &GotoTarget) -> Label {
-    match t {
-        GotoTarget::Number(n) => Label::Number(*n),
-        GotoTarget::Name(s) => Label::Name(s.clone()),
-    }
-}
-
-pub(super) fn label_matches(l: &Label, t: &GotoTarget) -> bool {
-    *l == goto_label(t)
-}
-
-pub(super) fn label_text(l: &Label) -> String {
-    match l {
-        Label::Number(n) => format!("N{n}"),
-        Label::Name(s) => format!("[{s}]"),
-    }
-}
-
-pub(super) fn goto_text(t: &GotoTarget) -> String {
-    label_text(&goto_label(t))
-}
-
-pub(super) fn control_name(c: &Control) -> &'static str {
-    match c {
-        Control::If(_) => "$IF",
-        Control::IfGoto(..) => "$IF … $GOTO",
-        Control::ElseIf(_) => "$ELSEIF",
-        Control::Else => "$ELSE",
-        Control::EndIf => "$ENDIF",
-        Control::Switch(_) => "$SWITCH",
-        Control::Case(_) => "$CASE",
-        Control::Default => "$DEFAULT",
-        Control::Break => "$BREAK",
-        Control::EndSwitch => "$ENDSWITCH",
-        Control::For { .. } => "$FOR",
-        Control::EndFor => "$ENDFOR",
-        Control::While(_) => "$WHILE",
-        Control::EndWhile => "$ENDWHILE",
-        Control::Do => "$DO",
-        Control::EndDo(_) => "$ENDDO",
-        Control::Repeat => "$REPEAT",
-        Control::Until(_) => "$UNTIL",
-        Control::Continue => "$CONTINUE",
-        Control::Goto(_) => "$GOTO",
     }
 }

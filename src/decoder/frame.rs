@@ -13,6 +13,10 @@ use crate::source::loader::PendingRead;
 use crate::source::store::ProgramText;
 use crate::source::stream::StreamBuffer;
 
+use super::labels::LabelIndex;
+pub(crate) use super::line::LinePos;
+pub use super::line::MAX_LINE_BYTES;
+use super::line::{cut_line, LineMeta, LineRead, LineTooLong};
 use super::vars::VarSlot;
 
 /// One open control structure of a frame.
@@ -106,15 +110,6 @@ pub(crate) enum Source {
     Stream,
 }
 
-/// Where a line starts, so loops and backward jumps in files can return to it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LinePos {
-    /// Byte offset of the line's first byte.
-    pub(crate) pos: usize,
-    /// Number of lines before it (the line's own number is `line_no + 1`).
-    pub(crate) line_no: u32,
-}
-
 /// One program level.
 #[derive(Debug)]
 pub(crate) struct Frame {
@@ -138,7 +133,7 @@ pub(crate) struct Frame {
     /// for the reason `LabelIndex` is one.
     pub(crate) seen_labels: BTreeSet<Label>,
     /// File frames: label → position and structural depth, built on the first jump.
-    pub(crate) label_index: Option<Arc<super::labels::LabelIndex>>,
+    pub(crate) label_index: Option<Arc<LabelIndex>>,
 }
 
 /// How many stream labels a frame remembers. A stream may run for days; a label passed more
@@ -194,77 +189,6 @@ impl Frame {
         self.pos = at.pos;
         self.line_no = at.line_no;
     }
-}
-
-/// One line handed to the interpreter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LineMeta {
-    /// 1-based line number in its program (stream: since stream start).
-    pub(crate) line: u32,
-    /// Byte offset of the line (stream: since stream start).
-    pub(crate) offset: u64,
-}
-
-/// The result of asking a frame for its next line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum LineRead {
-    Line(LineMeta),
-    /// A stream frame with no complete line available yet: try again next tick.
-    Pending,
-    /// A file frame at its end.
-    Eof,
-    /// A file frame's next line is longer than [`MAX_LINE_BYTES`].
-    TooLong(LineMeta),
-}
-
-/// Longest line of a program file, bytes. A block is at most `MAX_BLOCK_CHARS` (4000)
-/// characters, so no useful line comes near it; the bound keeps the search for a line end, and
-/// the copy of the line, from growing with a file that has no line ends.
-pub const MAX_LINE_BYTES: usize = 16 * 1024;
-
-/// A line longer than [`MAX_LINE_BYTES`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LineTooLong;
-
-impl LineTooLong {
-    /// The error at 1-based line `line` of a file.
-    pub(crate) fn error(self, line: u32) -> super::DecodeError {
-        super::DecodeError::new(
-            crate::lang::codes::SYNTAX,
-            format!("line {line} is longer than {MAX_LINE_BYTES} bytes"),
-        )
-    }
-}
-
-/// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
-/// offset after the line end, or `None` when no complete line is there. Looks at most
-/// [`MAX_LINE_BYTES`] bytes ahead.
-pub(super) fn cut_line(
-    text: &[u8],
-    pos: usize,
-    out: &mut String,
-    at_eof_ok: bool,
-) -> Result<Option<usize>, LineTooLong> {
-    let Some(rest) = text.get(pos..) else {
-        return Ok(None);
-    };
-    if rest.is_empty() {
-        return Ok(None);
-    }
-    let window = &rest[..rest.len().min(MAX_LINE_BYTES + 1)];
-    let (line, next) = match memchr::memchr(b'\n', window) {
-        Some(i) => (&rest[..i], pos + i + 1),
-        None if window.len() > MAX_LINE_BYTES => return Err(LineTooLong),
-        None if at_eof_ok => (rest, text.len()),
-        None => return Ok(None),
-    };
-    let line = line.strip_suffix(b"\r").unwrap_or(line);
-    out.clear();
-    match std::str::from_utf8(line) {
-        Ok(s) => out.push_str(s),
-        Err(_) => out.push_str(&String::from_utf8_lossy(line)),
-    }
-    Ok(Some(next))
 }
 
 /// Next line of a file frame.

@@ -18,10 +18,10 @@ use std::sync::Arc;
 use crate::lang::block::{Body, Command, GotoTarget, Label};
 use crate::lang::{continuation, is_comment_end, parse_block, Joiner};
 
-use super::flow::{label_text, nesting, Nesting};
-use super::frame::{cut_line, LinePos};
-use super::DecodeError;
+use super::error::DecodeError;
+use super::line::{cut_line, LinePos};
 use crate::lang::codes;
+use crate::lang::control::{goto_label, label_text, nesting, Nesting};
 
 /// Labels of one kind (block-number labels `N10:`, string labels `[NAME]`) the index holds;
 /// `%L` sections likewise. Memory stays proportional to this, not to the file: a label
@@ -62,7 +62,7 @@ impl LabelIndex {
     }
 
     pub(crate) fn find(&self, t: &GotoTarget) -> Option<LabelAt> {
-        self.labels.get(&super::flow::goto_label(t)).copied()
+        self.labels.get(&goto_label(t)).copied()
     }
 
     pub(crate) fn local_sub(&self, name: &str) -> Option<LinePos> {

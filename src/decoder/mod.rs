@@ -14,6 +14,7 @@ pub mod flow;
 pub mod frame;
 mod io;
 mod labels;
+mod line;
 pub mod modal;
 mod note;
 mod search;
@@ -31,11 +32,9 @@ use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
 
-use flow::{goto_text, is_loop_statement};
-use frame::{
-    read_file_line, Frame, FrameKind, LineMeta, LineRead, Skip, SkipUntil, Source, StreamNote,
-    StreamReader,
-};
+use crate::lang::control::{goto_text, is_loop_statement};
+use frame::{read_file_line, Frame, FrameKind, Skip, SkipUntil, Source, StreamNote, StreamReader};
+use line::{LineMeta, LineRead, LineTooLong};
 use modal::Modal;
 use vars::{VarSlot, VarStore};
 
@@ -486,7 +485,7 @@ impl Decoder {
                 }
                 LineRead::TooLong(meta) => {
                     self.line = line;
-                    self.fail(frame::LineTooLong.error(meta.line), meta);
+                    self.fail(LineTooLong.error(meta.line), meta);
                 }
                 LineRead::Eof => {
                     self.line = line;
@@ -555,7 +554,7 @@ impl Decoder {
             return;
         }
         self.counter -= 1;
-        let at = frame::LinePos {
+        let at = line::LinePos {
             pos: usize::try_from(meta.offset).unwrap_or(usize::MAX),
             line_no: meta.line.saturating_sub(1),
         };

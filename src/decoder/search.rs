@@ -3,8 +3,8 @@
 
 use std::fmt;
 
-use super::frame::LineMeta;
 use super::io::DecoderIo;
+use super::line::LineMeta;
 use super::note::Note;
 use super::Decoder;
 use crate::lang::block::Block;

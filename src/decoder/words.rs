@@ -9,8 +9,9 @@
 //! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
 
 use super::error::{var_error, DecodeError, Res};
-use super::frame::{FrameKind, LineMeta};
+use super::frame::FrameKind;
 use super::io::DecoderIo;
+use super::line::LineMeta;
 use super::modal::FeedMode;
 use super::modal::{apply_g, apply_m, BlockGs, MotionMode};
 use super::note::Note;
