@@ -8,25 +8,15 @@ use super::frame::{Frame, FrameKind, Source};
 use super::io::DecoderIo;
 use super::line::LineMeta;
 use super::note::Note;
+use super::reader::CacheRead;
 use super::{expr, words, Decoder};
 use crate::lang::block::{Block, Call, Command, SplineCommand, Value};
 use crate::lang::codes;
 use crate::queue::{Action, BlockInfo};
 use crate::source::cache::LoadStep;
-use crate::source::loader::PendingRead;
 use crate::source::store::{Opened, ProgramKind};
-use crate::source::store::{ProgramText, StoreError};
 use crate::vocab::event::CacheOp;
 use crate::vocab::flush::FlushKind;
-
-/// A `#CACHE LOAD` whose file the loader reads: the line waits, and runs again with the text.
-#[derive(Debug)]
-pub(super) struct CacheRead {
-    pub(crate) file: String,
-    pub(crate) pending: PendingRead,
-    /// The loader's answer, once there.
-    pub(crate) read: Option<Result<ProgramText, StoreError>>,
-}
 
 /// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
 /// before it: applied when the frame stack is back at `depth`.
@@ -77,7 +67,7 @@ impl Decoder {
                     d.text.as_deref().unwrap_or(""),
                 )
                 .map_err(var_error)?;
-            self.declared_this_tick += made;
+            self.reader.count_declared(made);
             return Ok(());
         }
         let init = match &d.init {
@@ -93,23 +83,19 @@ impl Decoder {
             .declare(d.scope, &d.name, &d.dims, init)
             .map_err(var_error)?;
         self.vars.fill(d.scope, &d.name, &values);
-        self.declared_this_tick += made;
+        self.reader.count_declared(made);
         Ok(())
     }
 
     /// M17/M29: back to the caller, past the call line.
     pub(super) fn return_from_subroutine(&mut self) {
-        if let Some(f) = self.frames.pop() {
-            if f.is_stream() {
-                self.discard_stream_rest();
-                self.stream_active = false;
-            }
+        if self.reader.pop(&mut self.notes).is_some() {
             self.vars.pop_level();
         }
         if self
             .implicit
             .m6_depth
-            .is_some_and(|d| self.frames.len() < d)
+            .is_some_and(|d| self.reader.depth() < d)
         {
             self.implicit.m6_depth = None;
         }
@@ -129,7 +115,7 @@ impl Decoder {
         params: Vec<(u32, f64)>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.frames.len() > self.settings.max_depth {
+        if self.reader.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
@@ -137,7 +123,7 @@ impl Decoder {
         }
         let frame = self.open_subroutine(name, kind, io)?;
         self.vars.push_level(params);
-        self.frames.push(frame);
+        self.reader.push(frame);
         Ok(())
     }
 
@@ -164,7 +150,7 @@ impl Decoder {
                 format!("unknown G function G{g}"),
             ));
         };
-        let depth = self.frames.len();
+        let depth = self.reader.depth();
         let kind = if params.is_empty() {
             FrameKind::Global
         } else {
@@ -203,9 +189,9 @@ impl Decoder {
         info: BlockInfo,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let depth = self.frames.len();
+        let depth = self.reader.depth();
         self.call_global(name, io)?;
-        self.implicit.m6_depth = Some(self.frames.len());
+        self.implicit.m6_depth = Some(self.reader.depth());
         if let Some(m) = end_m {
             self.implicit.held.push(HeldEnd { m, info, depth });
         }
@@ -219,7 +205,7 @@ impl Decoder {
         if main && !self.implicit.end_called {
             if let Some(name) = self.settings.implicit.at_end.clone() {
                 self.implicit.end_called = true;
-                let depth = self.frames.len();
+                let depth = self.reader.depth();
                 self.call_global(&name, io)?;
                 self.implicit.held.push(HeldEnd { m, info, depth });
                 return Ok(());
@@ -233,7 +219,7 @@ impl Decoder {
     /// After a return: an end held back for the frame now on top is applied.
     pub(super) fn resume_held_end(&mut self, io: &mut DecoderIo<'_>) -> Res {
         let held = match self.implicit.held.last() {
-            Some(h) if h.depth == self.frames.len() => self.implicit.held.pop(),
+            Some(h) if h.depth == self.reader.depth() => self.implicit.held.pop(),
             _ => None,
         };
         let Some(h) = held else {
@@ -271,12 +257,12 @@ impl Decoder {
                 }
                 self.emit(info, Action::Flush(*kind), false, io);
                 if *kind == FlushKind::Wait && self.search.is_none() {
-                    self.wait_idle = true;
+                    self.reader.wait_for_idle();
                 }
             }
             Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
                 self.exec_cache(c, io)?;
-                if !self.wait_line {
+                if !self.reader.line_waits() {
                     self.emit(info, Action::None, false, io);
                 }
             }
@@ -348,7 +334,7 @@ impl Decoder {
     fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
         match c {
             Command::CacheLoad { file } => {
-                let loaded = match self.cache_read.take() {
+                let loaded = match self.reader.take_cache_read() {
                     // The line again, after the loader read the file.
                     Some(CacheRead {
                         file: f,
@@ -358,12 +344,11 @@ impl Decoder {
                     _ => match io.cache.load(file, io.store)? {
                         LoadStep::Done(loaded) => loaded,
                         LoadStep::Reading(pending) => {
-                            self.cache_read = Some(CacheRead {
+                            self.reader.wait_for_cache_read(CacheRead {
                                 file: file.clone(),
                                 pending,
                                 read: None,
                             });
-                            self.wait_line = true;
                             return Ok(());
                         }
                     },
@@ -400,7 +385,7 @@ impl Decoder {
         meta: LineMeta,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.frames.len() > self.settings.max_depth {
+        if self.reader.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
@@ -423,7 +408,7 @@ impl Decoder {
                 };
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
-                self.frames.push(frame);
+                self.reader.push(frame);
             }
         }
         Ok(())
@@ -458,13 +443,13 @@ impl Decoder {
                 Ok(Frame::new(kind, Source::Loading(p), prog))
             }
             Opened::Stream { name } => {
-                if self.stream_active {
+                if self.reader.stream_active() {
                     return Err(DecodeError::new(
                         codes::STREAM_ALREADY_ACTIVE,
                         "the streaming program is already running",
                     ));
                 }
-                self.begin_stream();
+                self.reader.begin_stream();
                 self.notes.push(Note::ProgramStart {
                     prog: name.clone(),
                     stream: true,

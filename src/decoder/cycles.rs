@@ -45,7 +45,7 @@ impl Decoder {
         };
         self.emit(info, Action::None, false, io);
         self.vars.push_cycle_level(numbers, texts);
-        self.frames.push(frame);
+        self.reader.push(frame);
         Ok(())
     }
 
@@ -54,13 +54,16 @@ impl Decoder {
     /// `Ok(None)`: the label index (or a search for the section) is still being built; the
     /// call line waits and runs again.
     pub(super) fn local_frame(&mut self, name: &str, what: &str) -> Res<Option<Frame>> {
-        let Some(index) = self.label_index() else {
+        let Some(index) = self.reader.label_index() else {
             return Ok(None);
         };
         let found = match index.local_sub(name) {
             Some(at) => Some(at),
             None if index.overflowed => {
-                match self.searched(labels::ScanGoal::LocalSub(name.to_ascii_uppercase())) {
+                match self
+                    .reader
+                    .searched(labels::ScanGoal::LocalSub(name.to_ascii_uppercase()))
+                {
                     Some(labels::ScanFound::LocalSub(at)) => at,
                     _ => return Ok(None),
                 }

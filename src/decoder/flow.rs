@@ -4,14 +4,12 @@
 //! or a forward jump only sets a skip state, and the lines that follow are examined one by one
 //! as they arrive — which is what makes these statements work across stream packets.
 
-use std::sync::Arc;
-
 use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
-use super::frame::{FlowEntry, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
-use super::labels::{LabelAt, LabelIndex, LabelScan, ScanFound, ScanGoal};
+use super::frame::{FlowEntry, Skip, SkipUntil, MAX_SEEN_LABELS};
+use super::labels::{LabelAt, ScanFound, ScanGoal};
 use super::line::{LineMeta, LinePos};
 use super::Decoder;
 use crate::lang::codes;
@@ -450,15 +448,17 @@ impl Decoder {
             return Ok(());
         }
         // A file frame: the label index, built over several ticks; the line waits for it.
-        let Some(index) = self.label_index() else {
+        let Some(index) = self.reader.label_index() else {
             return Ok(());
         };
         let found = match index.find(t) {
             Some(at) => Some(at),
-            None if index.overflowed => match self.searched(ScanGoal::Label(goto_label(t))) {
-                Some(ScanFound::Label(at)) => at,
-                _ => return Ok(()),
-            },
+            None if index.overflowed => {
+                match self.reader.searched(ScanGoal::Label(goto_label(t))) {
+                    Some(ScanFound::Label(at)) => at,
+                    _ => return Ok(()),
+                }
+            }
             None => None,
         };
         let Some((at, depth)) = found else {
@@ -480,42 +480,6 @@ impl Decoder {
         while top.flow.len() < depth {
             top.flow.push(FlowEntry::If { taken: true });
         }
-    }
-
-    /// The label index of the top frame's text, once built. `None`: its scan has begun (or
-    /// goes on) and the line asking waits (`wait_line`); it is read again when the scan is
-    /// done. A stream frame has none (its jumps go forward, line by line).
-    pub(super) fn label_index(&mut self) -> Option<Arc<LabelIndex>> {
-        let top = self.top();
-        if let Some(i) = &top.label_index {
-            return Some(i.clone());
-        }
-        let Source::File(p) = &top.source else {
-            return Some(Arc::new(LabelIndex::default()));
-        };
-        let scan = LabelScan::new(p.text.clone(), ScanGoal::Index);
-        self.begin_scan(scan);
-        None
-    }
-
-    /// What a targeted scan for `goal` found: `None` while it runs (the line waits).
-    pub(super) fn searched(&mut self, goal: ScanGoal) -> Option<ScanFound> {
-        if let Some((g, _)) = &self.scan_found {
-            if *g == goal {
-                return self.scan_found.take().map(|(_, found)| found);
-            }
-        }
-        if let Source::File(p) = &self.top().source {
-            let scan = LabelScan::new(p.text.clone(), goal);
-            self.begin_scan(scan);
-        }
-        None
-    }
-
-    fn begin_scan(&mut self, scan: LabelScan) {
-        self.stats.label_scans += 1;
-        self.scan = Some(scan);
-        self.wait_line = true;
     }
 
     pub(super) fn check_open_flow(&mut self) -> Res {

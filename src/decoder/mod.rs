@@ -17,6 +17,7 @@ mod labels;
 mod line;
 pub mod modal;
 mod note;
+mod reader;
 mod search;
 mod settings;
 pub mod vars;
@@ -27,18 +28,18 @@ use std::time::Duration;
 
 use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
-use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
+use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, VarLine};
 use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
 
 use crate::lang::control::{goto_text, is_loop_statement};
-use frame::{read_file_line, Frame, FrameKind, Skip, SkipUntil, Source, StreamNote, StreamReader};
+use frame::{Frame, FrameKind, Skip, SkipUntil, Source};
 use line::{LineMeta, LineRead, LineTooLong};
 use modal::Modal;
+use reader::{FileArrival, Reader};
 use vars::{VarSlot, VarStore};
 
-use labels::{LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
 pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
 use search::Search;
 pub use search::SearchTarget;
@@ -86,10 +87,8 @@ pub struct Decoder {
     /// Bit i: the configured axis in slot i has a name longer than its letter (`X1`), so the
     /// letter alone names no axis. Read for every axis word; built once from the settings.
     renamed_slots: u8,
-    frames: Vec<Frame>,
-    stream: StreamReader,
-    /// A stream frame is on the frame stack.
-    stream_active: bool,
+    /// The frame stack, the line joiner and what a line waits for.
+    reader: Reader,
     vars: VarStore,
     modal: Modal,
     /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
@@ -100,34 +99,6 @@ pub struct Decoder {
     search: Option<Search>,
     /// Bit n set: blocks with `/n` are skipped (`/` is `/1`).
     skip_mask: u16,
-    /// `#FLUSH WAIT`: decoding waits until motion is empty.
-    wait_idle: bool,
-    /// The top frame is a stream that has no complete line: motion may starve.
-    starved: bool,
-    /// Channel time when the last simulated file-system read completes (runtime.toml
-    /// `fs_latency_us`). Decoding does nothing before it; motion runs on meanwhile.
-    ready_at: Duration,
-    /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
-    declared_this_tick: usize,
-    /// A label scan of the top frame's text under way (module `labels`): the line that
-    /// needs it waits, rewound, and runs again when the scan is done.
-    scan: Option<LabelScan>,
-    /// What a finished targeted scan found, for the line that asked for it.
-    scan_found: Option<(ScanGoal, ScanFound)>,
-    /// What label scans read in this tick.
-    scanned_this_tick: ScanWork,
-    /// Bytes of NC text decoded in this tick ([`LINE_BYTES_PER_TICK`]).
-    line_bytes_this_tick: usize,
-    /// A `#CACHE LOAD` waiting for the loader.
-    cache_read: Option<calls::CacheRead>,
-    /// The line being run has to wait (for a label scan, a `#CACHE LOAD` read): it is read
-    /// again later.
-    wait_line: bool,
-    line: String,
-    /// A block written over several lines (`\` at the end of a line) being collected, and
-    /// where its first line stands.
-    joiner: Joiner,
-    join_meta: LineMeta,
     notes: Vec<Note>,
     stats: DecoderStats,
     /// The word collection of the block being executed, kept between blocks.
@@ -154,9 +125,7 @@ impl Decoder {
         Decoder {
             settings,
             renamed_slots,
-            frames: Vec::new(),
-            stream: StreamReader::default(),
-            stream_active: false,
+            reader: Reader::default(),
             vars: VarStore::new(),
             modal: Modal::defaults([0.0; MAX_AXES]),
             tool_radii: Vec::new(),
@@ -164,19 +133,6 @@ impl Decoder {
             state: DecoderState::Idle,
             search: None,
             skip_mask: 0,
-            wait_idle: false,
-            starved: false,
-            ready_at: Duration::ZERO,
-            declared_this_tick: 0,
-            scan: None,
-            scan_found: None,
-            scanned_this_tick: ScanWork::default(),
-            line_bytes_this_tick: 0,
-            cache_read: None,
-            wait_line: false,
-            line: String::new(),
-            joiner: Joiner::default(),
-            join_meta: LineMeta { line: 0, offset: 0 },
             notes: Vec::new(),
             stats: DecoderStats::default(),
             words: None,
@@ -189,7 +145,7 @@ impl Decoder {
     }
     /// The running program reads the stream interface (a stream frame is on the stack).
     pub fn reads_stream(&self) -> bool {
-        self.stream_active
+        self.reader.stream_active()
     }
     /// Axes the channel has, by `AXIS_LETTERS` index.
     pub fn axes(&self) -> [bool; MAX_AXES] {
@@ -209,14 +165,17 @@ impl Decoder {
         &mut self.vars
     }
     pub fn stats(&self) -> DecoderStats {
-        self.stats
+        DecoderStats {
+            label_scans: self.reader.label_scans(),
+            ..self.stats
+        }
     }
     pub fn counter(&self) -> u64 {
         self.counter
     }
     /// Waiting for stream data that has not arrived.
     pub(crate) fn starved(&self) -> bool {
-        self.starved && self.state == DecoderState::Running
+        self.reader.starved() && self.state == DecoderState::Running
     }
     pub(crate) fn searching(&self) -> bool {
         self.search.is_some()
@@ -227,13 +186,10 @@ impl Decoder {
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
     pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
-        self.frames.iter().rev().find_map(|f| match &f.source {
-            frame::Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
-            _ => None,
-        })
+        self.reader.program_text(prog)
     }
     pub fn depth(&self) -> usize {
-        self.frames.len()
+        self.reader.depth()
     }
     /// The message reported for error `code`: the kernel's text for it (error text file,
     /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
@@ -265,18 +221,12 @@ impl Decoder {
         machine_pos: Position,
         search: Option<SearchTarget>,
     ) -> Res {
-        self.frames.clear();
-        self.joiner = Joiner::default();
+        self.reader.start();
         self.modal = Modal::defaults(machine_pos);
         self.vars.start_program();
         self.counter = 0;
-        self.wait_idle = false;
-        self.starved = false;
-        self.ready_at = Duration::ZERO;
-        self.forget_scan();
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
-        self.stream_active = false;
         self.implicit = calls::ImplicitState::at_start(&self.settings.implicit);
         self.search = search.map(|target| Search {
             target,
@@ -286,7 +236,7 @@ impl Decoder {
         match opened {
             Opened::File(p) => {
                 let prog = p.name.clone();
-                self.frames
+                self.reader
                     .push(Frame::new(FrameKind::Main, Source::File(p), prog.clone()));
                 self.notes.push(Note::ProgramStart {
                     prog,
@@ -295,7 +245,7 @@ impl Decoder {
             }
             Opened::Loading(p) => {
                 let prog = p.name.clone();
-                self.frames.push(Frame::new(
+                self.reader.push(Frame::new(
                     FrameKind::Main,
                     Source::Loading(p),
                     prog.clone(),
@@ -306,8 +256,8 @@ impl Decoder {
                 });
             }
             Opened::Stream { name } => {
-                self.begin_stream();
-                self.frames
+                self.reader.begin_stream();
+                self.reader
                     .push(Frame::new(FrameKind::Main, Source::Stream, name.clone()));
                 self.notes.push(Note::ProgramStart {
                     prog: name,
@@ -321,33 +271,13 @@ impl Decoder {
 
     /// Channel reset: frames, stream position, parameters and modal state go; V.S. stays.
     pub fn reset(&mut self, machine_pos: Position) {
-        self.frames.clear();
-        self.joiner = Joiner::default();
-        self.stream.restart();
-        self.stream_active = false;
+        self.reader.reset();
         self.vars.reset();
         self.modal = Modal::defaults(machine_pos);
         self.counter = 0;
         self.state = DecoderState::Idle;
         self.search = None;
         self.implicit = calls::ImplicitState::default();
-        self.wait_idle = false;
-        self.starved = false;
-        self.ready_at = Duration::ZERO;
-        self.forget_scan();
-    }
-
-    /// No label scan under way or waited for.
-    fn forget_scan(&mut self) {
-        self.scan = None;
-        self.scan_found = None;
-        self.cache_read = None;
-        self.wait_line = false;
-    }
-
-    fn begin_stream(&mut self) {
-        self.stream.restart();
-        self.stream_active = true;
     }
 
     /// Decode up to the per-tick budget.
@@ -358,18 +288,10 @@ impl Decoder {
     /// 200 µs in 1 ms ticks give five per tick, and a 5 ms read pauses decoding for five ticks.
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
         self.decode(io);
-        self.stats.max_scan_lines_per_tick = self
-            .stats
-            .max_scan_lines_per_tick
-            .max(self.scanned_this_tick.lines);
-        self.stats.max_scan_bytes_per_tick = self
-            .stats
-            .max_scan_bytes_per_tick
-            .max(self.scanned_this_tick.bytes);
-        self.stats.max_line_bytes_per_tick = self
-            .stats
-            .max_line_bytes_per_tick
-            .max(self.line_bytes_this_tick);
+        let (scanned, line_bytes) = self.reader.tick_work();
+        self.stats.max_scan_lines_per_tick = self.stats.max_scan_lines_per_tick.max(scanned.lines);
+        self.stats.max_scan_bytes_per_tick = self.stats.max_scan_bytes_per_tick.max(scanned.bytes);
+        self.stats.max_line_bytes_per_tick = self.stats.max_line_bytes_per_tick.max(line_bytes);
         io.store.end_tick();
     }
 
@@ -377,33 +299,27 @@ impl Decoder {
     /// file-system latency, a label scan, the loader, `#FLUSH WAIT`, room in the queue, the
     /// start subroutine, a frame's file.
     fn ready_to_read(&mut self, io: &mut DecoderIo<'_>, tick_end: Duration) -> Ready {
-        if self.declared_this_tick >= DECLARED_VALUES_PER_TICK
-            || self.line_bytes_this_tick >= LINE_BYTES_PER_TICK
-        {
+        if self.reader.budget_spent() {
             return Ready::Stop;
         }
         let owed = io.store.take_owed();
-        if !owed.is_zero() {
-            self.ready_at = self.ready_at.max(io.now) + owed;
-        }
-        if self.ready_at >= tick_end {
+        if self.reader.busy(owed, io.now, tick_end) {
             return Ready::Stop;
         }
-        if self.scan.is_some() && !self.advance_scan() {
+        if self.reader.scanning() && !self.advance_scan() {
             return Ready::Stop;
         }
-        match self.cache_read_arrived(io.store) {
+        match self.reader.cache_read_arrived(io.store) {
             Some(false) => return Ready::Stop,
             // The read's simulated latency is waited for first (top of the loop).
             Some(true) => return Ready::Again,
             None => {}
         }
-        if self.wait_idle {
-            if io.queue.is_empty() && io.motion_idle {
-                self.wait_idle = false;
-            } else {
-                return Ready::Stop;
-            }
+        if self
+            .reader
+            .waits_for_idle(io.queue.is_empty() && io.motion_idle)
+        {
+            return Ready::Stop;
         }
         if !io.queue.has_room() {
             return Ready::Stop;
@@ -420,103 +336,75 @@ impl Decoder {
     /// A top frame whose file the loader reads: `Again` when the text has just arrived (its
     /// simulated latency is waited for first), `Stop` while it has not or could not be read.
     fn frame_file_arrived(&mut self, store: &mut ProgramStore) -> Ready {
-        let Some(top) = self.frames.last_mut() else {
-            return Ready::Go;
-        };
-        let Source::Loading(p) = &top.source else {
-            return Ready::Go;
-        };
-        match store.finish_read(p) {
-            None => Ready::Stop,
-            Some(Ok(text)) => {
-                top.source = Source::File(text);
-                Ready::Again
-            }
-            Some(Err(e)) => {
-                self.fail(e.into(), LineMeta { line: 0, offset: 0 });
+        match self.reader.frame_file_arrived(store) {
+            FileArrival::Ready => Ready::Go,
+            FileArrival::Arrived => Ready::Again,
+            FileArrival::Waiting => Ready::Stop,
+            FileArrival::Failed(e) => {
+                self.fail(e, LineMeta { line: 0, offset: 0 });
                 Ready::Stop
             }
         }
     }
 
-    /// The decoding loop of [`Decoder::step`].
+    /// The decoding loop of [`Decoder::step`]: read a line, then join, run or end the frame.
     fn decode(&mut self, io: &mut DecoderIo<'_>) {
         let mut budget = self.settings.blocks_per_tick;
         let tick_end = io.now + io.period;
-        self.declared_this_tick = 0;
-        self.scanned_this_tick = ScanWork::default();
-        self.line_bytes_this_tick = 0;
+        self.reader.begin_tick();
         while budget > 0 && self.state == DecoderState::Running {
             match self.ready_to_read(io, tick_end) {
                 Ready::Stop => break,
                 Ready::Again => continue,
                 Ready::Go => {}
             }
-            let Some(top) = self.frames.last_mut() else {
+            if self.reader.last().is_none() {
                 self.state = DecoderState::Idle;
                 break;
-            };
-            let mut line = std::mem::take(&mut self.line);
-            let read = if top.is_stream() {
-                let mut note = None;
-                let r = self.stream.next_line(io.stream, &mut line, &mut note);
-                if let Some(StreamNote::Segment { bytes }) = note {
-                    self.notes.push(Note::Segment { bytes });
-                }
-                r
-            } else {
-                read_file_line(top, &mut line)
-            };
-            if let LineRead::Line(_) = read {
-                // The line and its end (CR LF at most).
-                self.line_bytes_this_tick += line.len() + 2;
             }
+            let mut line = self.reader.take_line();
+            let read = self.reader.read_line(io.stream, &mut line, &mut self.notes);
             match read {
                 LineRead::Pending => {
-                    self.starved = true;
-                    self.line = line;
+                    self.reader.put_line(line);
                     break;
                 }
-                LineRead::Eof if self.joiner.is_open() => {
+                LineRead::Eof if self.reader.joining() => {
                     // The file ends in a continued line: the block is what there is.
-                    self.line = line;
+                    self.reader.put_line(line);
                     budget -= 1;
                     self.run_joined(io);
                 }
                 LineRead::TooLong(meta) => {
-                    self.line = line;
+                    self.reader.put_line(line);
                     self.fail(LineTooLong.error(meta.line), meta);
                 }
                 LineRead::Eof => {
-                    self.line = line;
+                    self.reader.put_line(line);
                     budget -= 1;
                     if let Err(e) = self.end_of_file(io) {
                         let meta = LineMeta {
-                            line: self.frames.last().map_or(0, |f| f.line_no),
+                            line: self.reader.last().map_or(0, |f| f.line_no),
                             offset: 0,
                         };
                         self.fail(e, meta);
                     }
                 }
                 LineRead::Line(meta) => {
-                    self.starved = false;
                     budget -= 1;
                     self.stats.lines += 1;
-                    if self.joiner.is_open()
+                    if self.reader.joining()
                         || (continuation(&line).is_some() && !self.top().comment_block)
                     {
-                        if !self.joiner.is_open() {
-                            self.join_meta = meta;
-                        }
-                        if self.joiner.push(&line) {
+                        if self.reader.join(&line, meta) {
                             self.run_joined(io);
                         }
-                        self.line = line;
+                        self.reader.put_line(line);
                         continue;
                     }
                     self.counter += 1;
                     let r = self.process_line(&line, meta, io);
-                    self.line = line;
+                    self.reader.put_line(line);
                     if let Err(e) = r {
                         self.fail(e, meta);
                     }
@@ -529,8 +417,7 @@ impl Decoder {
     /// Run the block collected from several lines; an error's column names the line it
     /// was written in.
     fn run_joined(&mut self, io: &mut DecoderIo<'_>) {
-        let joiner = std::mem::take(&mut self.joiner);
-        let meta = self.join_meta;
+        let (joiner, meta) = self.reader.take_joined();
         self.counter += 1;
         let r = self.process_line(joiner.text(), meta, io);
         if let Err(mut e) = r {
@@ -542,67 +429,24 @@ impl Decoder {
             }
             self.fail(e, at);
         }
-        self.joiner = joiner;
-        self.joiner.close();
+        self.reader.put_joined(joiner);
         self.rewind_if_waiting(meta);
     }
 
     /// A line that has to wait (for a label scan) did nothing: it is read again, and its
     /// block counter given back.
     fn rewind_if_waiting(&mut self, meta: LineMeta) {
-        if !std::mem::take(&mut self.wait_line) {
-            return;
+        if self.reader.rewind_if_waiting(meta) {
+            self.counter -= 1;
         }
-        self.counter -= 1;
-        let at = line::LinePos {
-            pos: usize::try_from(meta.offset).unwrap_or(usize::MAX),
-            line_no: meta.line.saturating_sub(1),
-        };
-        self.top().seek(at);
-    }
-
-    /// A `#CACHE LOAD` waiting for the loader: `Some(true)` when its text has just arrived,
-    /// `Some(false)` while it has not, `None` when no load waits.
-    fn cache_read_arrived(&mut self, store: &mut ProgramStore) -> Option<bool> {
-        let r = self.cache_read.as_mut().filter(|r| r.read.is_none())?;
-        let read = store.finish_read(&r.pending);
-        let arrived = read.is_some();
-        r.read = read;
-        Some(arrived)
     }
 
     /// Go on with the label scan under way, within what is left of this tick's scan budget.
     /// `true` when it is done (its result installed) and decoding may go on.
     fn advance_scan(&mut self) -> bool {
-        let Some(scan) = self.scan.as_mut() else {
-            return true;
-        };
-        let step = scan.advance(&mut self.scanned_this_tick);
-        let warnings = scan.take_warnings();
-        let goal = scan.goal().clone();
-        for w in warnings {
-            self.notes.push(Note::Warning {
-                code: w.code,
-                msg: w.msg,
-            });
-        }
-        match step {
-            Ok(ScanStep::Pending) => false,
-            Ok(ScanStep::Done(found)) => {
-                self.scan = None;
-                match found {
-                    ScanFound::Index(index) => self.top().label_index = Some(Arc::new(index)),
-                    other => self.scan_found = Some((goal, other)),
-                }
-                true
-            }
-            Err(e) => {
-                self.scan = None;
-                let top = self.top();
-                let meta = LineMeta {
-                    line: top.line_no + 1,
-                    offset: top.pos as u64,
-                };
+        match self.reader.advance_scan(&mut self.notes) {
+            Ok(done) => done,
+            Err((e, meta)) => {
                 self.fail(e, meta);
                 false
             }
@@ -611,7 +455,7 @@ impl Decoder {
 
     fn fail(&mut self, e: DecodeError, meta: LineMeta) {
         let prog = self
-            .frames
+            .reader
             .last()
             .map(|f| f.prog.clone())
             .unwrap_or_else(|| Arc::from(""));
@@ -637,16 +481,14 @@ impl Decoder {
 
     /// Raise an error from outside the decoder's own lines (e.g. stream data without CR LF).
     pub fn abort(&mut self, code: u32, msg: impl Into<String>) {
-        let line = self.frames.last().map_or(0, |f| f.line_no);
+        let line = self.reader.last().map_or(0, |f| f.line_no);
         self.fail(DecodeError::new(code, msg), LineMeta { line, offset: 0 });
     }
 
     fn top(&mut self) -> &mut Frame {
-        // process_line and friends run only with a frame on the stack (checked in step).
-        let i = self.frames.len() - 1;
-        &mut self.frames[i]
+        // process_line and friends run only with a frame on the stack (checked in decode).
+        self.reader.top()
     }
-
     fn process_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
         let top = self.top();
         if top.comment_block {
@@ -720,7 +562,7 @@ impl Decoder {
     }
 
     fn info(&self, block: &Block, text: &str, meta: LineMeta, io: &DecoderIo<'_>) -> BlockInfo {
-        let top = &self.frames[self.frames.len() - 1];
+        let top = self.reader.current();
         BlockInfo {
             prog: top.prog.clone(),
             line: meta.line,
@@ -750,20 +592,8 @@ impl Decoder {
 
     /// M30/M2: the program ends; in a stream the rest of the current segment goes.
     fn end_program(&mut self) {
-        if self.stream_active {
-            self.discard_stream_rest();
-            self.stream_active = false;
-        }
-        self.frames.clear();
+        self.reader.end_program(&mut self.notes);
         self.state = DecoderState::Ended;
-        self.starved = false;
-    }
-
-    fn discard_stream_rest(&mut self) {
-        let bytes = self.stream.discard_rest();
-        if bytes > 0 {
-            self.notes.push(Note::Discard { bytes });
-        }
     }
 
     fn end_of_file(&mut self, _io: &mut DecoderIo<'_>) -> Res {

@@ -72,7 +72,7 @@ impl Decoder {
         let hit = match s.target {
             SearchTarget::BlockNumber(n) => block.n == Some(n),
             SearchTarget::Counter(k) => self.counter >= k,
-            SearchTarget::Offset(o) => self.frames.len() == 1 && meta.offset >= o,
+            SearchTarget::Offset(o) => self.reader.depth() == 1 && meta.offset >= o,
         };
         if hit {
             self.finish_search(s, block, text, meta, io);
