@@ -8,10 +8,11 @@ use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
-use super::frame::{FlowEntry, Skip, SkipUntil, MAX_SEEN_LABELS};
+use super::frame::{FlowEntry, Frame, Skip, SkipUntil, MAX_SEEN_LABELS};
+use super::interp::Interpreter;
 use super::labels::{LabelAt, ScanFound, ScanGoal};
 use super::line::{LineMeta, LinePos};
-use super::Decoder;
+use super::reader::Reader;
 use crate::lang::codes;
 use crate::lang::control::{
     block_ends_program, control_name, goto_label, goto_text, items_have_m, label_matches,
@@ -30,11 +31,11 @@ pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
     )
 }
 
-impl Decoder {
+impl Frame {
     /// Record a label passed in a stream: a label seen twice is codes::LABEL_TWICE; a later `$GOTO` to a
     /// seen label is a backward jump.
     pub(super) fn note_label(&mut self, l: &Label) -> Res {
-        let top = self.top();
+        let top = self;
         if !top.is_stream() {
             return Ok(());
         }
@@ -52,8 +53,8 @@ impl Decoder {
 
     /// One line while skipping. Returns whether the line is to be executed after all (the
     /// label line a forward jump was looking for).
-    pub(super) fn skip_line(&mut self, block: &Block) -> Res<bool> {
-        let Some(skip) = self.top().skip.clone() else {
+    pub(super) fn skip_line(&mut self, block: &Block, ip: &Interpreter) -> Res<bool> {
+        let Some(skip) = self.skip.clone() else {
             return Ok(true);
         };
         if let SkipUntil::Label(t) = &skip.until {
@@ -61,10 +62,10 @@ impl Decoder {
         }
         if skip.until == SkipUntil::LocalSubroutine {
             match &block.body {
-                Body::Items(items) if items_have_m(items, &[17, 29]) => self.top().skip = None,
+                Body::Items(items) if items_have_m(items, &[17, 29]) => self.skip = None,
                 // A section without M17/M29 ends at the next main program head, which runs.
                 Body::ProgramHead { local: false, .. } => {
-                    self.top().skip = None;
+                    self.skip = None;
                     return Ok(true);
                 }
                 _ => {}
@@ -77,23 +78,23 @@ impl Decoder {
         if self.skip_nested(c, skip.depth) {
             return Ok(false);
         }
-        self.skip_reaches(&skip.until, c)
+        self.skip_reaches(&skip.until, c, ip)
     }
 
     /// A forward jump (streams): the line with the label runs; structures passed on the way
     /// keep the flow stack right; a program end before the label is 20840.
     fn skip_to_label(&mut self, block: &Block, t: &GotoTarget) -> Res<bool> {
-        let is_stream = self.top().is_stream();
+        let is_stream = self.is_stream();
         if let Some(l) = &block.label {
             self.note_label(l)?;
             if label_matches(l, t) {
-                self.top().skip = None;
+                self.skip = None;
                 return Ok(true);
             }
         }
         if let Body::Control(c) = &block.body {
             // Structures opened or closed between jump and label keep the stack right.
-            let top = self.top();
+            let top = self;
             match c {
                 Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
                 Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
@@ -120,13 +121,13 @@ impl Decoder {
     fn skip_nested(&mut self, c: &Control, depth: u32) -> bool {
         match nesting(c) {
             Nesting::Open => {
-                if let Some(s) = self.top().skip.as_mut() {
+                if let Some(s) = self.skip.as_mut() {
                     s.depth += 1;
                 }
                 true
             }
             Nesting::Close if depth > 0 => {
-                if let Some(s) = self.top().skip.as_mut() {
+                if let Some(s) = self.skip.as_mut() {
                     s.depth -= 1;
                 }
                 true
@@ -137,44 +138,44 @@ impl Decoder {
 
     /// A statement at the skipped structure's own level: does it end the skip? `true` when
     /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
-    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control) -> Res<bool> {
+    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control, ip: &Interpreter) -> Res<bool> {
         match (until, c) {
-            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(self.eval(e)?) => {
-                self.top().skip = None;
+            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(ip.eval(e)?) => {
+                self.skip = None;
                 self.set_if_taken();
             }
             (SkipUntil::IfBranch, Control::Else) => {
-                self.top().skip = None;
+                self.skip = None;
                 self.set_if_taken();
             }
             (SkipUntil::IfBranch | SkipUntil::IfEnd, Control::EndIf) => {
-                let top = self.top();
+                let top = self;
                 top.skip = None;
                 top.flow.pop();
             }
             (SkipUntil::Case, Control::Case(e)) => {
-                let v = self.eval(e)?;
-                if let Some(FlowEntry::Switch { value }) = self.top().flow.last() {
+                let v = ip.eval(e)?;
+                if let Some(FlowEntry::Switch { value }) = self.flow.last() {
                     if crate::lang::eval::case_matches(*value, v) {
-                        self.top().skip = None;
+                        self.skip = None;
                     }
                 }
             }
-            (SkipUntil::Case, Control::Default) => self.top().skip = None,
+            (SkipUntil::Case, Control::Default) => self.skip = None,
             (SkipUntil::Case | SkipUntil::SwitchEnd, Control::EndSwitch) => {
-                let top = self.top();
+                let top = self;
                 top.skip = None;
                 top.flow.pop();
             }
             (SkipUntil::LoopExit, c) => {
-                let top = self.top();
+                let top = self;
                 if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
                     top.flow.pop();
                 }
             }
             (SkipUntil::LoopContinue, c) => {
-                let top = self.top();
+                let top = self;
                 if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
                     return Ok(true);
@@ -186,53 +187,65 @@ impl Decoder {
     }
 
     pub(super) fn set_if_taken(&mut self) {
-        if let Some(FlowEntry::If { taken }) = self.top().flow.last_mut() {
+        if let Some(FlowEntry::If { taken }) = self.flow.last_mut() {
             *taken = true;
         }
     }
 
-    pub(super) fn skip(&mut self, until: SkipUntil) {
-        self.top().skip = Some(Skip::new(until));
+    pub(super) fn begin_skip(&mut self, until: SkipUntil) {
+        self.skip = Some(Skip::new(until));
     }
+}
 
-    pub(super) fn stray(&self, c: &Control) -> DecodeError {
-        use crate::lang::codes::StrayKind as K;
-        let kind = match c {
-            Control::Else => Some(K::Else),
-            Control::ElseIf(_) => Some(K::ElseIf),
-            Control::EndIf => Some(K::EndIf),
-            Control::Case(_) => Some(K::Case),
-            Control::Default => Some(K::Default),
-            Control::Break => Some(K::Break),
-            Control::EndSwitch => Some(K::EndSwitch),
-            Control::EndFor => Some(K::EndFor),
-            Control::EndWhile => Some(K::EndWhile),
-            Control::EndDo(_) => Some(K::EndDo),
-            Control::Until(_) => Some(K::Until),
-            Control::Continue => Some(K::Continue),
-            _ => None,
-        };
-        let code = kind.map_or(codes::SYNTAX, K::code);
-        DecodeError::new(code, format!("unexpected {}", control_name(c)))
-    }
+/// The error for a `$` statement met outside its structure.
+pub(super) fn stray(c: &Control) -> DecodeError {
+    use crate::lang::codes::StrayKind as K;
+    let kind = match c {
+        Control::Else => Some(K::Else),
+        Control::ElseIf(_) => Some(K::ElseIf),
+        Control::EndIf => Some(K::EndIf),
+        Control::Case(_) => Some(K::Case),
+        Control::Default => Some(K::Default),
+        Control::Break => Some(K::Break),
+        Control::EndSwitch => Some(K::EndSwitch),
+        Control::EndFor => Some(K::EndFor),
+        Control::EndWhile => Some(K::EndWhile),
+        Control::EndDo(_) => Some(K::EndDo),
+        Control::Until(_) => Some(K::Until),
+        Control::Continue => Some(K::Continue),
+        _ => None,
+    };
+    let code = kind.map_or(codes::SYNTAX, K::code);
+    DecodeError::new(code, format!("unexpected {}", control_name(c)))
+}
 
-    pub(super) fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
+impl Frame {
+    /// Run a `$` statement. A jump it makes is returned, for [`goto`] to make with the
+    /// reader's label index.
+    pub(super) fn exec_control<'c>(
+        &mut self,
+        c: &'c Control,
+        meta: LineMeta,
+        ip: &mut Interpreter,
+    ) -> Res<Option<&'c GotoTarget>> {
         match c {
-            Control::Break | Control::Continue => self.exec_leave(c),
+            Control::Break | Control::Continue => self.exec_leave(c).map(|()| None),
             Control::For {
                 var,
                 start,
                 end,
                 step,
-            } => self.exec_for(var, start, end, step.as_deref()),
-            Control::EndFor => self.exec_end_for(c),
+            } => self
+                .exec_for(var, start, end, step.as_deref(), ip)
+                .map(|()| None),
+            Control::EndFor => self.exec_end_for(c, ip).map(|()| None),
             Control::While(_)
             | Control::EndWhile
             | Control::Do
             | Control::EndDo(_)
             | Control::Repeat
-            | Control::Until(_) => self.exec_loop(c, meta),
-            _ => self.exec_branch(c),
+            | Control::Until(_) => self.exec_loop(c, meta, ip).map(|()| None),
+            _ => self.exec_branch(c, ip),
         }
     }
 
@@ -243,52 +256,53 @@ impl Decoder {
         e: &crate::lang::block::Expr,
         entry: impl FnOnce(bool) -> FlowEntry,
         or_skip: SkipUntil,
+        ip: &Interpreter,
     ) -> Res {
-        let v = is_true(self.eval(e)?);
-        self.top().flow.push(entry(v));
+        let v = is_true(ip.eval(e)?);
+        self.flow.push(entry(v));
         if !v {
-            self.skip(or_skip);
+            self.begin_skip(or_skip);
         }
         Ok(())
     }
 
     /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
-    fn exec_branch(&mut self, c: &Control) -> Res {
+    fn exec_branch<'c>(&mut self, c: &'c Control, ip: &Interpreter) -> Res<Option<&'c GotoTarget>> {
         match c {
             Control::If(e) => {
-                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch)?
+                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch, ip)?
             }
-            Control::IfGoto(e, t) if is_true(self.eval(e)?) => self.goto(t)?,
-            Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
-                Some(FlowEntry::If { .. }) => self.skip(SkipUntil::IfEnd),
-                _ => return Err(self.stray(c)),
+            Control::IfGoto(e, t) if is_true(ip.eval(e)?) => return Ok(Some(t)),
+            Control::ElseIf(_) | Control::Else => match self.flow.last() {
+                Some(FlowEntry::If { .. }) => self.begin_skip(SkipUntil::IfEnd),
+                _ => return Err(stray(c)),
             },
-            Control::EndIf => match self.top().flow.last() {
+            Control::EndIf => match self.flow.last() {
                 Some(FlowEntry::If { .. }) => {
-                    self.top().flow.pop();
+                    self.flow.pop();
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
             Control::Switch(e) => {
-                let value = self.eval(e)?;
-                self.top().flow.push(FlowEntry::Switch { value });
-                self.skip(SkipUntil::Case);
+                let value = ip.eval(e)?;
+                self.flow.push(FlowEntry::Switch { value });
+                self.begin_skip(SkipUntil::Case);
             }
             // Executing into a later case: fall through (no `$BREAK` before it).
-            Control::Case(_) | Control::Default => match self.top().flow.last() {
+            Control::Case(_) | Control::Default => match self.flow.last() {
                 Some(FlowEntry::Switch { .. }) => {}
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
-            Control::EndSwitch => match self.top().flow.last() {
+            Control::EndSwitch => match self.flow.last() {
                 Some(FlowEntry::Switch { .. }) => {
-                    self.top().flow.pop();
+                    self.flow.pop();
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
-            Control::Goto(t) => self.goto(t)?,
+            Control::Goto(t) => return Ok(Some(t)),
             _ => {}
         }
-        Ok(())
+        Ok(None)
     }
 
     /// `$BREAK` and `$CONTINUE`: close the structures they leave, skip to the end.
@@ -296,7 +310,6 @@ impl Decoder {
         match c {
             Control::Break => {
                 let inner = self
-                    .top()
                     .flow
                     .iter()
                     .rev()
@@ -305,34 +318,34 @@ impl Decoder {
                 match inner {
                     Some(FlowEntry::Switch { .. }) => {
                         // Close inner $IFs between the $BREAK and its switch.
-                        while matches!(self.top().flow.last(), Some(FlowEntry::If { .. })) {
-                            self.top().flow.pop();
+                        while matches!(self.flow.last(), Some(FlowEntry::If { .. })) {
+                            self.flow.pop();
                         }
-                        self.skip(SkipUntil::SwitchEnd);
+                        self.begin_skip(SkipUntil::SwitchEnd);
                     }
                     Some(_) => {
                         while matches!(
-                            self.top().flow.last(),
+                            self.flow.last(),
                             Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                         ) {
-                            self.top().flow.pop();
+                            self.flow.pop();
                         }
-                        self.skip(SkipUntil::LoopExit);
+                        self.begin_skip(SkipUntil::LoopExit);
                     }
-                    None => return Err(self.stray(c)),
+                    None => return Err(stray(c)),
                 }
             }
             Control::Continue => {
-                if !self.top().flow.iter().any(FlowEntry::is_loop) {
-                    return Err(self.stray(c));
+                if !self.flow.iter().any(FlowEntry::is_loop) {
+                    return Err(stray(c));
                 }
                 while matches!(
-                    self.top().flow.last(),
+                    self.flow.last(),
                     Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                 ) {
-                    self.top().flow.pop();
+                    self.flow.pop();
                 }
-                self.skip(SkipUntil::LoopContinue);
+                self.begin_skip(SkipUntil::LoopContinue);
             }
             _ => {}
         }
@@ -340,12 +353,19 @@ impl Decoder {
     }
 
     /// `$FOR`: set the variable to its start and enter the body, or skip it.
-    fn exec_for(&mut self, var: &VarRef, start: &Expr, end: &Expr, step: Option<&Expr>) -> Res {
-        let key = self.resolve(var)?;
-        let start = self.eval(start)?;
-        let end = self.eval(end)?;
+    fn exec_for(
+        &mut self,
+        var: &VarRef,
+        start: &Expr,
+        end: &Expr,
+        step: Option<&Expr>,
+        ip: &mut Interpreter,
+    ) -> Res {
+        let key = ip.resolve(var)?;
+        let start = ip.eval(start)?;
+        let end = ip.eval(end)?;
         let step = match step {
-            Some(s) => self.eval(s)?,
+            Some(s) => ip.eval(s)?,
             None => 1.0,
         };
         if step == 0.0 || !step.is_finite() {
@@ -354,79 +374,82 @@ impl Decoder {
                 "$FOR step must not be 0",
             ));
         }
-        self.set_var(key.clone(), start)?;
-        let body = self.top().line_pos();
-        self.top().flow.push(FlowEntry::For {
+        ip.set_var(key.clone(), start)?;
+        let body = self.line_pos();
+        self.flow.push(FlowEntry::For {
             var: key,
             end,
             step,
             body,
         });
         if !for_continues(start, end, step) {
-            self.skip(SkipUntil::LoopExit);
+            self.begin_skip(SkipUntil::LoopExit);
         }
         Ok(())
     }
 
     /// `$ENDFOR`: step the variable and go round again, or leave the loop.
-    fn exec_end_for(&mut self, c: &Control) -> Res {
-        match self.top().flow.last().cloned() {
+    fn exec_end_for(&mut self, c: &Control, ip: &mut Interpreter) -> Res {
+        match self.flow.last().cloned() {
             Some(FlowEntry::For {
                 var,
                 end,
                 step,
                 body,
             }) => {
-                let v = self.vars.get(&var).unwrap_or(0.0) + step;
-                self.set_var(var, v)?;
+                let v = ip.var(&var).unwrap_or(0.0) + step;
+                ip.set_var(var, v)?;
                 if for_continues(v, end, step) {
-                    self.top().seek(body);
+                    self.seek(body);
                 } else {
-                    self.top().flow.pop();
+                    self.flow.pop();
                 }
             }
-            _ => return Err(self.stray(c)),
+            _ => return Err(stray(c)),
         }
         Ok(())
     }
 
     /// `$WHILE`, `$DO` and `$REPEAT` loops.
-    fn exec_loop(&mut self, c: &Control, meta: LineMeta) -> Res {
+    fn exec_loop(&mut self, c: &Control, meta: LineMeta, ip: &Interpreter) -> Res {
         let here = LinePos {
             pos: meta.offset as usize,
             line_no: meta.line - 1,
         };
         match c {
-            Control::While(e) => {
-                self.open_conditional(e, |_| FlowEntry::While { head: here }, SkipUntil::LoopExit)?
-            }
-            Control::EndWhile => match self.top().flow.last().cloned() {
+            Control::While(e) => self.open_conditional(
+                e,
+                |_| FlowEntry::While { head: here },
+                SkipUntil::LoopExit,
+                ip,
+            )?,
+            Control::EndWhile => match self.flow.last().cloned() {
                 Some(FlowEntry::While { head }) => {
                     // Back to the $WHILE line, which evaluates and pushes again.
-                    self.top().flow.pop();
-                    self.top().seek(head);
+                    self.flow.pop();
+                    self.seek(head);
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
             Control::Do | Control::Repeat => {
-                let body = self.top().line_pos();
+                let body = self.line_pos();
                 let entry = match c {
                     Control::Do => FlowEntry::Do { body },
                     _ => FlowEntry::Repeat { body },
                 };
-                self.top().flow.push(entry);
+                self.flow.push(entry);
             }
             // `$ENDDO cond` loops while cond holds, `$UNTIL cond` until it holds.
             Control::EndDo(e) | Control::Until(e) => {
-                let (body, again_if) = match (c, self.top().flow.last()) {
+                let (body, again_if) = match (c, self.flow.last()) {
                     (Control::EndDo(_), Some(FlowEntry::Do { body })) => (*body, true),
                     (Control::Until(_), Some(FlowEntry::Repeat { body })) => (*body, false),
-                    _ => return Err(self.stray(c)),
+                    _ => return Err(stray(c)),
                 };
-                if is_true(self.eval(e)?) == again_if {
-                    self.top().seek(body);
+                if is_true(ip.eval(e)?) == again_if {
+                    self.seek(body);
                 } else {
-                    self.top().flow.pop();
+                    self.flow.pop();
                 }
             }
             _ => {}
@@ -434,47 +457,10 @@ impl Decoder {
         Ok(())
     }
 
-    pub(super) fn goto(&mut self, t: &GotoTarget) -> Res {
-        let top = self.top();
-        if top.is_stream() {
-            let key = goto_label(t);
-            if top.seen_labels.contains(&key) {
-                return Err(DecodeError::new(
-                    codes::STREAM_BACKWARD_JUMP,
-                    format!("backward jump to {} in streaming program", goto_text(t)),
-                ));
-            }
-            top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
-            return Ok(());
-        }
-        // A file frame: the label index, built over several ticks; the line waits for it.
-        let Some(index) = self.reader.label_index() else {
-            return Ok(());
-        };
-        let found = match index.find(t) {
-            Some(at) => Some(at),
-            None if index.overflowed => {
-                match self.reader.searched(ScanGoal::Label(goto_label(t))) {
-                    Some(ScanFound::Label(at)) => at,
-                    _ => return Ok(()),
-                }
-            }
-            None => None,
-        };
-        let Some((at, depth)) = found else {
-            return Err(DecodeError::new(
-                codes::LABEL_NOT_FOUND,
-                format!("label {} not found", goto_text(t)),
-            ));
-        };
-        self.jump_to((at, depth));
-        Ok(())
-    }
-
     /// Continue at a label: its structural depth decides which open structures the jump
     /// leaves.
-    fn jump_to(&mut self, (at, depth): LabelAt) {
-        let top = self.top();
+    pub(super) fn jump_to(&mut self, (at, depth): LabelAt) {
+        let top = self;
         top.seek(at);
         top.flow.truncate(depth);
         while top.flow.len() < depth {
@@ -483,7 +469,7 @@ impl Decoder {
     }
 
     pub(super) fn check_open_flow(&mut self) -> Res {
-        if !self.top().flow.is_empty() {
+        if !self.flow.is_empty() {
             return Err(DecodeError::new(
                 codes::OPEN_CONTROL_BLOCK,
                 "open control blocks at program end",
@@ -491,6 +477,43 @@ impl Decoder {
         }
         Ok(())
     }
+}
+
+/// `$GOTO`: in a stream a forward skip to the label; in a file a jump by the label index of
+/// the top frame's text, which the reader builds over several ticks.
+pub(super) fn goto(rd: &mut Reader, t: &GotoTarget) -> Res {
+    let top = rd.top();
+    if top.is_stream() {
+        let key = goto_label(t);
+        if top.seen_labels.contains(&key) {
+            return Err(DecodeError::new(
+                codes::STREAM_BACKWARD_JUMP,
+                format!("backward jump to {} in streaming program", goto_text(t)),
+            ));
+        }
+        top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
+        return Ok(());
+    }
+    // A file frame: the label index, built over several ticks; the line waits for it.
+    let Some(index) = rd.label_index() else {
+        return Ok(());
+    };
+    let found = match index.find(t) {
+        Some(at) => Some(at),
+        None if index.overflowed => match rd.searched(ScanGoal::Label(goto_label(t))) {
+            Some(ScanFound::Label(at)) => at,
+            _ => return Ok(()),
+        },
+        None => None,
+    };
+    let Some((at, depth)) = found else {
+        return Err(DecodeError::new(
+            codes::LABEL_NOT_FOUND,
+            format!("label {} not found", goto_text(t)),
+        ));
+    };
+    rd.top().jump_to((at, depth));
+    Ok(())
 }
 
 pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {

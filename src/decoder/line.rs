@@ -2,6 +2,7 @@
 //! segment, and the bound on its length.
 
 use super::error::DecodeError;
+use crate::lang::block::Block;
 
 /// Where a line starts, so loops and backward jumps in files can return to it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -19,6 +20,15 @@ pub(crate) struct LineMeta {
     pub(crate) line: u32,
     /// Byte offset of the line (stream: since stream start).
     pub(crate) offset: u64,
+}
+
+/// A parsed block with its text and where its line stands: what a queued block's
+/// `BlockInfo` is made from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BlockAt<'a> {
+    pub(crate) block: &'a Block,
+    pub(crate) text: &'a str,
+    pub(crate) meta: LineMeta,
 }
 
 /// The result of asking a frame for its next line.

@@ -5,23 +5,19 @@
 //! pulls a new stream segment only when it has decoded the previous one: that is the whole of
 //! the channel's back-pressure.
 
-mod axis_vars;
-mod calls;
-mod cycles;
 mod error;
-mod expr;
 pub mod flow;
 pub mod frame;
+mod interp;
 mod io;
 mod labels;
 mod line;
 pub mod modal;
 mod note;
 mod reader;
-mod search;
+mod search_target;
 mod settings;
 pub mod vars;
-mod words;
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -29,23 +25,22 @@ use std::time::Duration;
 use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, VarLine};
-use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
 
 use crate::lang::control::{goto_text, is_loop_statement};
 use frame::{Frame, FrameKind, Skip, SkipUntil, Source};
-use line::{LineMeta, LineRead, LineTooLong};
+use interp::Interpreter;
+use line::{BlockAt, LineMeta, LineRead, LineTooLong};
 use modal::Modal;
 use reader::{FileArrival, Reader};
-use vars::{VarSlot, VarStore};
+use vars::VarStore;
 
 pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
-use search::Search;
-pub use search::SearchTarget;
+pub use search_target::SearchTarget;
 
 pub use error::DecodeError;
-use error::{var_error, Res};
+use error::Res;
 pub use io::DecoderIo;
 pub(crate) use note::Note;
 pub(crate) use settings::letter_names;
@@ -83,28 +78,15 @@ pub struct DecoderStats {
 }
 
 pub struct Decoder {
-    settings: DecoderSettings,
-    /// Bit i: the configured axis in slot i has a name longer than its letter (`X1`), so the
-    /// letter alone names no axis. Read for every axis word; built once from the settings.
-    renamed_slots: u8,
     /// The frame stack, the line joiner and what a line waits for.
     reader: Reader,
-    vars: VarStore,
-    modal: Modal,
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
-    tool_radii: Vec<(u32, f64)>,
-    /// ISG block counter of the current program.
-    counter: u64,
+    /// Modal state, variables, calls: what a block does.
+    interp: Interpreter,
     state: DecoderState,
-    search: Option<Search>,
-    /// Bit n set: blocks with `/n` are skipped (`/` is `/1`).
-    skip_mask: u16,
+    /// What happened besides queued blocks, since the channel last took them.
     notes: Vec<Note>,
+    /// Counters for the report (blocks and label scans are counted by the parts).
     stats: DecoderStats,
-    /// The word collection of the block being executed, kept between blocks.
-    words: Option<Box<words::Words>>,
-    /// The implicit subroutine calls' state in the running program.
-    implicit: calls::ImplicitState,
 }
 
 /// Whether the decoder may read its next line in this tick.
@@ -119,24 +101,12 @@ enum Ready {
 
 impl Decoder {
     pub fn new(settings: DecoderSettings) -> Self {
-        let renamed_slots = (0..MAX_AXES)
-            .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
-            .fold(0u8, |m, i| m | 1 << i);
         Decoder {
-            settings,
-            renamed_slots,
             reader: Reader::default(),
-            vars: VarStore::new(),
-            modal: Modal::defaults([0.0; MAX_AXES]),
-            tool_radii: Vec::new(),
-            counter: 0,
+            interp: Interpreter::new(settings),
             state: DecoderState::Idle,
-            search: None,
-            skip_mask: 0,
             notes: Vec::new(),
             stats: DecoderStats::default(),
-            words: None,
-            implicit: calls::ImplicitState::default(),
         }
     }
 
@@ -149,39 +119,44 @@ impl Decoder {
     }
     /// Axes the channel has, by `AXIS_LETTERS` index.
     pub fn axes(&self) -> [bool; MAX_AXES] {
-        self.settings.axes
+        self.interp.settings().axes
     }
     /// The name of the axis in each slot (`X`, `X1`, …), by `AXIS_LETTERS` index.
     pub(crate) fn axis_names(&self) -> &[AxisName; MAX_AXES] {
-        &self.settings.axis_names
+        &self.interp.settings().axis_names
     }
     pub fn modal(&self) -> &Modal {
-        &self.modal
+        self.interp.modal()
     }
     pub fn vars(&self) -> &VarStore {
-        &self.vars
+        self.interp.vars()
     }
     pub(crate) fn vars_mut(&mut self) -> &mut VarStore {
-        &mut self.vars
+        self.interp.vars_mut()
     }
     pub fn stats(&self) -> DecoderStats {
         DecoderStats {
+            blocks: self.interp.blocks(),
             label_scans: self.reader.label_scans(),
             ..self.stats
         }
     }
     pub fn counter(&self) -> u64 {
-        self.counter
+        self.interp.counter()
     }
     /// Waiting for stream data that has not arrived.
     pub(crate) fn starved(&self) -> bool {
         self.reader.starved() && self.state == DecoderState::Running
     }
     pub(crate) fn searching(&self) -> bool {
-        self.search.is_some()
+        self.interp.searching()
     }
     pub(crate) fn set_skip_mask(&mut self, mask: u16) {
-        self.skip_mask = mask;
+        self.interp.set_skip_mask(mask);
+    }
+    /// The tool list's radii by D number, mm (`V.G.WZ[j].R` and `V.G.WZ_AKT.R`).
+    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
+        self.interp.set_tool_radii(radii);
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
@@ -195,7 +170,8 @@ impl Decoder {
     /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
     pub(crate) fn reported_message(&self, code: u32, detail: String) -> String {
         match self
-            .settings
+            .interp
+            .settings()
             .error_texts
             .as_deref()
             .and_then(|t| t.get(code))
@@ -222,16 +198,9 @@ impl Decoder {
         search: Option<SearchTarget>,
     ) -> Res {
         self.reader.start();
-        self.modal = Modal::defaults(machine_pos);
-        self.vars.start_program();
-        self.counter = 0;
+        self.interp.start(machine_pos, search);
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
-        self.implicit = calls::ImplicitState::at_start(&self.settings.implicit);
-        self.search = search.map(|target| Search {
-            target,
-            from: machine_pos,
-        });
         let opened = store.open(name, ProgramKind::Main)?;
         match opened {
             Opened::File(p) => {
@@ -272,12 +241,8 @@ impl Decoder {
     /// Channel reset: frames, stream position, parameters and modal state go; V.S. stays.
     pub fn reset(&mut self, machine_pos: Position) {
         self.reader.reset();
-        self.vars.reset();
-        self.modal = Modal::defaults(machine_pos);
-        self.counter = 0;
+        self.interp.reset(machine_pos);
         self.state = DecoderState::Idle;
-        self.search = None;
-        self.implicit = calls::ImplicitState::default();
     }
 
     /// Decode up to the per-tick budget.
@@ -324,11 +289,12 @@ impl Decoder {
         if !io.queue.has_room() {
             return Ready::Stop;
         }
-        if self.implicit.start_pending {
-            if let Err(e) = self.start_subroutine(io) {
-                self.fail(e, LineMeta { line: 0, offset: 0 });
-                return Ready::Stop;
-            }
+        if let Err(e) = self
+            .interp
+            .start_subroutine(&mut self.reader, &mut self.notes, io)
+        {
+            self.fail(e, LineMeta { line: 0, offset: 0 });
+            return Ready::Stop;
         }
         self.frame_file_arrived(io.store)
     }
@@ -349,7 +315,7 @@ impl Decoder {
 
     /// The decoding loop of [`Decoder::step`]: read a line, then join, run or end the frame.
     fn decode(&mut self, io: &mut DecoderIo<'_>) {
-        let mut budget = self.settings.blocks_per_tick;
+        let mut budget = self.interp.settings().blocks_per_tick;
         let tick_end = io.now + io.period;
         self.reader.begin_tick();
         while budget > 0 && self.state == DecoderState::Running {
@@ -394,7 +360,7 @@ impl Decoder {
                     budget -= 1;
                     self.stats.lines += 1;
                     if self.reader.joining()
-                        || (continuation(&line).is_some() && !self.top().comment_block)
+                        || (continuation(&line).is_some() && !self.reader.current().comment_block)
                     {
                         if self.reader.join(&line, meta) {
                             self.run_joined(io);
@@ -402,7 +368,7 @@ impl Decoder {
                         self.reader.put_line(line);
                         continue;
                     }
-                    self.counter += 1;
+                    self.interp.count_line();
                     let r = self.process_line(&line, meta, io);
                     self.reader.put_line(line);
                     if let Err(e) = r {
@@ -418,7 +384,7 @@ impl Decoder {
     /// was written in.
     fn run_joined(&mut self, io: &mut DecoderIo<'_>) {
         let (joiner, meta) = self.reader.take_joined();
-        self.counter += 1;
+        self.interp.count_line();
         let r = self.process_line(joiner.text(), meta, io);
         if let Err(mut e) = r {
             let mut at = meta;
@@ -437,7 +403,7 @@ impl Decoder {
     /// block counter given back.
     fn rewind_if_waiting(&mut self, meta: LineMeta) {
         if self.reader.rewind_if_waiting(meta) {
-            self.counter -= 1;
+            self.interp.give_back_line();
         }
     }
 
@@ -460,7 +426,8 @@ impl Decoder {
             .map(|f| f.prog.clone())
             .unwrap_or_else(|| Arc::from(""));
         let msg = match self
-            .settings
+            .interp
+            .settings()
             .error_texts
             .as_deref()
             .and_then(|t| t.get(e.code))
@@ -476,7 +443,7 @@ impl Decoder {
             col: e.col,
         });
         self.state = DecoderState::Failed;
-        self.search = None;
+        self.interp.end_search();
     }
 
     /// Raise an error from outside the decoder's own lines (e.g. stream data without CR LF).
@@ -485,12 +452,20 @@ impl Decoder {
         self.fail(DecodeError::new(code, msg), LineMeta { line, offset: 0 });
     }
 
-    fn top(&mut self) -> &mut Frame {
-        // process_line and friends run only with a frame on the stack (checked in decode).
-        self.reader.top()
-    }
+    /// Run one line (a block, or a line of a `#COMMENT`/`#VAR` block); the main program's
+    /// end decoded in it ends decoding.
     fn process_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
-        let top = self.top();
+        let r = self.run_line(text, meta, io);
+        if self.interp.take_ended() {
+            self.state = DecoderState::Ended;
+        }
+        r
+    }
+
+    /// The steps of one line: comment and `#VAR` blocks, parse, the flow's skipping and
+    /// labels, block search, `/n` skipping, then the block's body.
+    fn run_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
+        let top = self.reader.top();
         if top.comment_block {
             if is_comment_end(text) {
                 top.comment_block = false;
@@ -505,7 +480,10 @@ impl Decoder {
                 VarLine::End => top.var_block = false,
                 // The comment block ends inside the `#VAR` block: both flags hold.
                 VarLine::CommentBegin => top.comment_block = true,
-                VarLine::Decl(d) => self.declare(&d)?,
+                VarLine::Decl(d) => {
+                    let made = self.interp.declare(&d)?;
+                    self.reader.count_declared(made);
+                }
             }
             return Ok(());
         }
@@ -516,89 +494,59 @@ impl Decoder {
             Err(_) if skipping => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        if self.top().is_stream() {
+        if self.reader.current().is_stream() {
             stream_allows(&block)?;
         }
         if skipping {
-            let run_it = self.skip_line(&block)?;
+            let run_it = self.reader.top().skip_line(&block, &self.interp)?;
             if !run_it {
                 return Ok(());
             }
         } else if let Some(l) = &block.label {
-            self.note_label(l)?;
+            self.reader.top().note_label(l)?;
         }
-        if self.search.is_some() {
-            self.search_block(&block, text, meta, io);
+        let at = BlockAt {
+            block: &block,
+            text,
+            meta,
+        };
+        if self.interp.searching() {
+            self.interp
+                .search_block(at, &mut self.reader, &mut self.notes, io);
         }
         if let Some(level) = block.skip_level {
-            if self.skip_mask & (1u16 << level.min(15)) != 0 {
+            if self.interp.skips_level(level) {
                 return Ok(());
             }
         }
+        let (ip, rd, notes) = (&mut self.interp, &mut self.reader, &mut self.notes);
         match &block.body {
             Body::Items(items) if items.is_empty() => Ok(()),
-            Body::Items(items) => self.exec_items(items, &block, text, meta, io),
-            Body::Control(c) => self.exec_control(c, meta),
-            Body::Command(c) => self.exec_command(c, &block, text, meta, io),
-            Body::Call(c) => self.exec_call(c, &block, text, meta, io),
-            Body::ProgramHead { .. } if self.top().kind == FrameKind::Local => {
+            Body::Items(items) => ip.exec_items(items, at, rd, notes, io),
+            Body::Control(c) => match rd.top().exec_control(c, meta, ip)? {
+                Some(target) => flow::goto(rd, target),
+                None => Ok(()),
+            },
+            Body::Command(c) => ip.exec_command(c, at, rd, notes, io),
+            Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
+            Body::ProgramHead { .. } if rd.current().kind == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                self.check_open_flow()?;
-                self.return_from_subroutine();
-                self.resume_held_end(io)
+                rd.top().check_open_flow()?;
+                ip.return_from_subroutine(rd, notes);
+                ip.resume_held_end(rd, notes, io)
             }
             Body::ProgramHead { local: true, .. } => {
                 // A local subroutine section met while running: it runs only when called.
-                let top = self.top();
-                top.skip = Some(Skip::new(SkipUntil::LocalSubroutine));
+                rd.top().begin_skip(SkipUntil::LocalSubroutine);
                 Ok(())
             }
             Body::ProgramHead { local: false, .. } => Ok(()),
         }
     }
 
-    fn set_var(&mut self, k: VarSlot, v: f64) -> Res {
-        self.vars.set(k, v).map_err(var_error)
-    }
-
-    fn info(&self, block: &Block, text: &str, meta: LineMeta, io: &DecoderIo<'_>) -> BlockInfo {
-        let top = self.reader.current();
-        BlockInfo {
-            prog: top.prog.clone(),
-            line: meta.line,
-            offset: meta.offset,
-            counter: self.counter,
-            n: block.n,
-            text: io.want_text.then(|| text.into()),
-            stream: top.is_stream(),
-        }
-    }
-
-    /// Queue a block that takes effect. During block search nothing is queued: the block
-    /// was evaluated, its state collected.
-    fn emit(&mut self, info: BlockInfo, action: Action, silent: bool, io: &mut DecoderIo<'_>) {
-        if self.search.is_some() {
-            return;
-        }
-        if !silent {
-            self.stats.blocks += 1;
-        }
-        io.queue.push(QueuedBlock {
-            info,
-            action,
-            silent,
-        });
-    }
-
-    /// M30/M2: the program ends; in a stream the rest of the current segment goes.
-    fn end_program(&mut self) {
-        self.reader.end_program(&mut self.notes);
-        self.state = DecoderState::Ended;
-    }
-
     fn end_of_file(&mut self, _io: &mut DecoderIo<'_>) -> Res {
-        let searching = self.search.is_some();
-        let top = self.top();
+        let searching = self.interp.searching();
+        let top = self.reader.top();
         if let Some(Skip {
             until: SkipUntil::Label(t),
             ..
@@ -625,14 +573,6 @@ impl Decoder {
                 "end of subroutine without M17/M29",
             )),
         }
-    }
-
-    fn eval(&self, e: &crate::lang::block::Expr) -> Res<f64> {
-        expr::eval(e, &expr::Env(self))
-    }
-
-    fn resolve(&self, v: &crate::lang::block::VarRef) -> Res<VarSlot> {
-        expr::resolve(v, &expr::Env(self))
     }
 }
 

@@ -2,7 +2,7 @@
 
 use std::sync::Arc;
 
-use super::search::SearchTarget;
+use super::search_target::SearchTarget;
 
 /// What the decoder reports besides queued blocks; the channel turns these into events.
 #[derive(Debug, Clone, PartialEq)]

@@ -3,14 +3,15 @@
 
 use std::sync::Arc;
 
-use super::error::{var_error, DecodeError, Res};
-use super::frame::{Frame, FrameKind, Source};
-use super::io::DecoderIo;
-use super::line::LineMeta;
-use super::note::Note;
-use super::reader::CacheRead;
-use super::{expr, words, Decoder};
-use crate::lang::block::{Block, Call, Command, SplineCommand, Value};
+use super::{expr, words, Interpreter};
+use crate::decoder::error::{var_error, DecodeError, Res};
+use crate::decoder::frame::{Frame, FrameKind, Source};
+use crate::decoder::io::DecoderIo;
+use crate::decoder::line::BlockAt;
+use crate::decoder::note::Note;
+use crate::decoder::reader::CacheRead;
+use crate::decoder::reader::Reader;
+use crate::lang::block::{Call, Command, SplineCommand, Value};
 use crate::lang::codes;
 use crate::queue::{Action, BlockInfo};
 use crate::source::cache::LoadStep;
@@ -50,10 +51,10 @@ impl ImplicitState {
     }
 }
 
-impl Decoder {
+impl Interpreter {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
     /// values it made count against this tick's declaration budget.
-    pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
+    pub(in crate::decoder) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res<usize> {
         if let Some(crate::lang::block::VarType::String(max)) = d.ty {
             // A string variable: its start value (checked by the parser) or "" in every
             // element (docs/nc-language.md, "Strings").
@@ -67,8 +68,7 @@ impl Decoder {
                     d.text.as_deref().unwrap_or(""),
                 )
                 .map_err(var_error)?;
-            self.reader.count_declared(made);
-            return Ok(());
+            return Ok(made);
         }
         let init = match &d.init {
             Some(e) => self.eval(e)?,
@@ -83,28 +83,33 @@ impl Decoder {
             .declare(d.scope, &d.name, &d.dims, init)
             .map_err(var_error)?;
         self.vars.fill(d.scope, &d.name, &values);
-        self.reader.count_declared(made);
-        Ok(())
+        Ok(made)
     }
 
     /// M17/M29: back to the caller, past the call line.
-    pub(super) fn return_from_subroutine(&mut self) {
-        if self.reader.pop(&mut self.notes).is_some() {
+    pub(in crate::decoder) fn return_from_subroutine(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+    ) {
+        if rd.pop(notes).is_some() {
             self.vars.pop_level();
         }
-        if self
-            .implicit
-            .m6_depth
-            .is_some_and(|d| self.reader.depth() < d)
-        {
+        if self.implicit.m6_depth.is_some_and(|d| rd.depth() < d) {
             self.implicit.m6_depth = None;
         }
     }
 
     /// A global subroutine call without a call line (an implicit call): the frame is pushed,
     /// its blocks run as those of `L name` would.
-    pub(super) fn call_global(&mut self, name: &str, io: &mut DecoderIo<'_>) -> Res {
-        self.call_implicit(name, FrameKind::Global, Vec::new(), io)
+    pub(super) fn call_global(
+        &mut self,
+        name: &str,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        self.call_implicit(name, FrameKind::Global, Vec::new(), rd, notes, io)
     }
 
     /// An implicit call of `name` as `kind`, with `params` as its `@P` values.
@@ -113,17 +118,19 @@ impl Decoder {
         name: &str,
         kind: FrameKind,
         params: Vec<(u32, f64)>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.reader.depth() > self.settings.max_depth {
+        if rd.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
             ));
         }
-        let frame = self.open_subroutine(name, kind, io)?;
+        let frame = self.open_subroutine(name, kind, rd, notes, io)?;
         self.vars.push_level(params);
-        self.reader.push(frame);
+        rd.push(frame);
         Ok(())
     }
 
@@ -140,8 +147,9 @@ impl Decoder {
         &mut self,
         g: u32,
         params: &[(u32, f64)],
-        end_m: Option<u32>,
-        info: BlockInfo,
+        end: Option<(u32, BlockInfo)>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         let Some(name) = self.g800_subroutine(g).map(str::to_string) else {
@@ -150,26 +158,31 @@ impl Decoder {
                 format!("unknown G function G{g}"),
             ));
         };
-        let depth = self.reader.depth();
+        let depth = rd.depth();
         let kind = if params.is_empty() {
             FrameKind::Global
         } else {
             FrameKind::Cycle
         };
-        self.call_implicit(&name, kind, params.to_vec(), io)?;
-        if let Some(m) = end_m {
+        self.call_implicit(&name, kind, params.to_vec(), rd, notes, io)?;
+        if let Some((m, info)) = end {
             self.implicit.held.push(HeldEnd { m, info, depth });
         }
         Ok(())
     }
 
     /// Program start: `start_init_prog_file` (P-CHAN-00119) is called as the first action.
-    pub(super) fn start_subroutine(&mut self, io: &mut DecoderIo<'_>) -> Res {
+    pub(in crate::decoder) fn start_subroutine(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         if !std::mem::take(&mut self.implicit.start_pending) {
             return Ok(());
         }
         match self.settings.implicit.at_start.clone() {
-            Some(name) => self.call_global(&name, io),
+            Some(name) => self.call_global(&name, rd, notes, io),
             None => Ok(()),
         }
     }
@@ -187,11 +200,13 @@ impl Decoder {
         name: &str,
         end_m: Option<u32>,
         info: BlockInfo,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let depth = self.reader.depth();
-        self.call_global(name, io)?;
-        self.implicit.m6_depth = Some(self.reader.depth());
+        let depth = rd.depth();
+        self.call_global(name, rd, notes, io)?;
+        self.implicit.m6_depth = Some(rd.depth());
         if let Some(m) = end_m {
             self.implicit.held.push(HeldEnd { m, info, depth });
         }
@@ -200,26 +215,38 @@ impl Decoder {
 
     /// M02/M30 of the main program: first the end subroutine (P-CHAN-00252), once; then the
     /// end itself.
-    pub(super) fn program_end(&mut self, m: u32, info: BlockInfo, io: &mut DecoderIo<'_>) -> Res {
-        let main = self.top().kind == FrameKind::Main;
+    pub(super) fn program_end(
+        &mut self,
+        m: u32,
+        info: BlockInfo,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let main = rd.top().kind == FrameKind::Main;
         if main && !self.implicit.end_called {
             if let Some(name) = self.settings.implicit.at_end.clone() {
                 self.implicit.end_called = true;
-                let depth = self.reader.depth();
-                self.call_global(&name, io)?;
+                let depth = rd.depth();
+                self.call_global(&name, rd, notes, io)?;
                 self.implicit.held.push(HeldEnd { m, info, depth });
                 return Ok(());
             }
         }
         self.emit(info, Action::End { m }, true, io);
-        self.end_program();
+        self.end_program(rd, notes);
         Ok(())
     }
 
     /// After a return: an end held back for the frame now on top is applied.
-    pub(super) fn resume_held_end(&mut self, io: &mut DecoderIo<'_>) -> Res {
+    pub(in crate::decoder) fn resume_held_end(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         let held = match self.implicit.held.last() {
-            Some(h) if h.depth == self.reader.depth() => self.implicit.held.pop(),
+            Some(h) if h.depth == rd.depth() => self.implicit.held.pop(),
             _ => None,
         };
         let Some(h) = held else {
@@ -227,26 +254,26 @@ impl Decoder {
         };
         match h.m {
             17 | 29 => {
-                self.check_open_flow()?;
-                self.return_from_subroutine();
-                self.resume_held_end(io)
+                rd.top().check_open_flow()?;
+                self.return_from_subroutine(rd, notes);
+                self.resume_held_end(rd, notes, io)
             }
             m => {
-                self.program_end_checks(m)?;
-                self.program_end(m, h.info, io)
+                self.program_end_checks(m, rd, notes)?;
+                self.program_end(m, h.info, rd, notes, io)
             }
         }
     }
 
-    pub(super) fn exec_command(
+    pub(in crate::decoder) fn exec_command(
         &mut self,
         c: &Command,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         match c {
             Command::Flush(kind) => {
                 if let Some((code, what)) = self.modal.flush_refusal() {
@@ -257,16 +284,16 @@ impl Decoder {
                 }
                 self.emit(info, Action::Flush(*kind), false, io);
                 if *kind == FlushKind::Wait && self.search.is_none() {
-                    self.reader.wait_for_idle();
+                    rd.wait_for_idle();
                 }
             }
             Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
-                self.exec_cache(c, io)?;
-                if !self.reader.line_waits() {
+                self.exec_cache(c, rd, notes, io)?;
+                if !rd.line_waits() {
                     self.emit(info, Action::None, false, io);
                 }
             }
-            Command::CommentBegin => self.top().comment_block = true,
+            Command::CommentBegin => rd.top().comment_block = true,
             // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
             Command::CommentEnd => {}
             Command::Spline(s) => {
@@ -282,24 +309,24 @@ impl Decoder {
                 self.emit(info, Action::None, false, io);
             }
             Command::ContourMode { options } => {
-                if let Some(dev) = super::modal::path_dev_mm(options) {
+                if let Some(dev) = crate::decoder::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.emit(info, Action::None, false, io)
             }
             // `ON [...]`: the parameters, then G261; `OFF`: G260.
             Command::ContourSwitch { on, options } => {
-                if let Some(dev) = super::modal::path_dev_mm(options) {
+                if let Some(dev) = crate::decoder::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.modal.contouring = *on;
                 self.emit(info, Action::None, false, io)
             }
-            Command::Var => self.top().var_block = true,
+            Command::Var => rd.top().var_block = true,
             Command::EndVar => {}
             Command::Msg(m) => {
                 let text = self.format_message(m)?;
-                self.notes.push(Note::Message {
+                notes.push(Note::Message {
                     text,
                     save: m.save(),
                 });
@@ -331,10 +358,16 @@ impl Decoder {
     }
 
     /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).
-    fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
+    fn exec_cache(
+        &mut self,
+        c: &Command,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         match c {
             Command::CacheLoad { file } => {
-                let loaded = match self.reader.take_cache_read() {
+                let loaded = match rd.take_cache_read() {
                     // The line again, after the loader read the file.
                     Some(CacheRead {
                         file: f,
@@ -344,7 +377,7 @@ impl Decoder {
                     _ => match io.cache.load(file, io.store)? {
                         LoadStep::Done(loaded) => loaded,
                         LoadStep::Reading(pending) => {
-                            self.reader.wait_for_cache_read(CacheRead {
+                            rd.wait_for_cache_read(CacheRead {
                                 file: file.clone(),
                                 pending,
                                 read: None,
@@ -353,21 +386,21 @@ impl Decoder {
                         }
                     },
                 };
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: loaded.op(),
                     file: file.clone(),
                 });
             }
             Command::CacheClear { file } => {
                 io.cache.clear(file)?;
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::Clear,
                     file: file.clone(),
                 });
             }
             Command::CacheClearAll => {
                 io.cache.clear_all()?;
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::ClearAll,
                     file: String::new(),
                 });
@@ -377,38 +410,42 @@ impl Decoder {
         Ok(())
     }
 
-    pub(super) fn exec_call(
+    pub(in crate::decoder) fn exec_call(
         &mut self,
         c: &Call,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.reader.depth() > self.settings.max_depth {
+        if rd.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
             ));
         }
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         match c {
             Call::Global { file } => {
-                self.call_global(file, io)?;
+                self.call_global(file, rd, notes, io)?;
                 self.emit(info, Action::None, false, io);
             }
             Call::Cycle {
                 name,
                 local,
                 params,
-            } => self.call_cycle(name, *local, params, info, io)?,
+            } => {
+                if self.call_cycle(name, *local, params, rd, notes, io)? {
+                    self.emit(info, Action::None, false, io);
+                }
+            }
             Call::Local { name } => {
-                let Some(frame) = self.local_frame(name, "local subroutine call (LL)")? else {
+                let Some(frame) = self.local_frame(rd, name, "local subroutine call (LL)")? else {
                     return Ok(());
                 };
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
-                self.reader.push(frame);
+                rd.push(frame);
             }
         }
         Ok(())
@@ -419,12 +456,14 @@ impl Decoder {
         &mut self,
         name: &str,
         kind: FrameKind,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res<Frame> {
         if let Some(p) = io.cache.get(name) {
             if io.want_text {
                 // Only with events on: the hot call path stays free of the allocation.
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::Hit,
                     file: name.to_string(),
                 });
@@ -443,14 +482,14 @@ impl Decoder {
                 Ok(Frame::new(kind, Source::Loading(p), prog))
             }
             Opened::Stream { name } => {
-                if self.reader.stream_active() {
+                if rd.stream_active() {
                     return Err(DecodeError::new(
                         codes::STREAM_ALREADY_ACTIVE,
                         "the streaming program is already running",
                     ));
                 }
-                self.reader.begin_stream();
-                self.notes.push(Note::ProgramStart {
+                rd.begin_stream();
+                notes.push(Note::ProgramStart {
                     prog: name.clone(),
                     stream: true,
                 });

@@ -8,17 +8,19 @@
 //! The parser has already refused what a block may not hold (a letter twice, a dwell with
 //! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
 
-use super::error::{var_error, DecodeError, Res};
-use super::frame::FrameKind;
-use super::io::DecoderIo;
-use super::line::LineMeta;
-use super::modal::FeedMode;
-use super::modal::{apply_g, apply_m, BlockGs, MotionMode};
-use super::note::Note;
-use super::{expr, vars, Decoder};
+use super::{expr, Interpreter};
+use crate::decoder::error::{var_error, DecodeError, Res};
+use crate::decoder::frame::FrameKind;
+use crate::decoder::io::DecoderIo;
+use crate::decoder::line::BlockAt;
+use crate::decoder::modal::FeedMode;
+use crate::decoder::modal::{apply_g, apply_m, BlockGs, MotionMode};
+use crate::decoder::note::Note;
+use crate::decoder::reader::Reader;
+use crate::decoder::vars;
 use crate::geometry::arc;
 use crate::lang::block::VarRef;
-use crate::lang::block::{Block, Item, Value};
+use crate::lang::block::{Item, Value};
 use crate::lang::codes;
 use crate::lang::eval::Val;
 use crate::lang::range::whole_u32 as whole;
@@ -116,20 +118,20 @@ impl Words {
     }
 }
 
-impl Decoder {
-    pub(super) fn exec_items(
+impl Interpreter {
+    pub(in crate::decoder) fn exec_items(
         &mut self,
         items: &[Item],
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         // One `Words` reused from block to block (see `Words::clear`), boxed so taking it
         // out of the decoder moves a pointer.
         let mut w = self.words.take().unwrap_or_default();
         w.clear();
-        let r = self.exec_words(items, block, text, meta, io, &mut w);
+        let r = self.exec_words(items, at, rd, notes, io, &mut w);
         self.words = Some(w);
         r
     }
@@ -138,9 +140,9 @@ impl Decoder {
     fn exec_words(
         &mut self,
         items: &[Item],
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
         w: &mut Words,
     ) -> Res {
@@ -148,7 +150,7 @@ impl Decoder {
             self.collect(it, w)?;
         }
         let gs = self.modal_changes(w)?;
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         let mut queued = false;
         if gs.dwell {
             let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
@@ -164,7 +166,7 @@ impl Decoder {
             self.emit(info.clone(), Action::Move(mv), false, io);
             queued = true;
         }
-        self.end_of_block(w, info, queued, io)
+        self.end_of_block(w, info, queued, rd, notes, io)
     }
 
     /// Step 1: one item. Assignments take effect at once, in written order, so a later word
@@ -546,14 +548,16 @@ impl Decoder {
         w: &Words,
         info: BlockInfo,
         queued: bool,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         for (&h, &value) in w.hs().iter().zip(&w.h_values) {
-            self.notes.push(Note::HFunction { h, value });
+            notes.push(Note::HFunction { h, value });
         }
         for (&m, &value) in w.ms().iter().zip(&w.m_values) {
             if let Some(value) = value {
-                self.notes.push(Note::MFunction { m, value });
+                notes.push(Note::MFunction { m, value });
             }
         }
         let stop = w.ms().iter().copied().find(|m| matches!(m, 0 | 1));
@@ -574,7 +578,7 @@ impl Decoder {
             .copied()
             .find(|m| matches!(m, 2 | 30 | 17 | 29));
         if let Some(m @ (17 | 29)) = end_m {
-            if self.top().kind == FrameKind::Main {
+            if rd.top().kind == FrameKind::Main {
                 return Err(DecodeError::new(
                     codes::UNEXPECTED_SUB_END,
                     format!("unexpected M{m} in main program"),
@@ -592,21 +596,21 @@ impl Decoder {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
             }
-            return self.call_g800(g, &w.call_params, end_m, info, io);
+            return self.call_g800(g, &w.call_params, end_m.map(|m| (m, info)), rd, notes, io);
         }
         if let Some(name) = self.m6_subroutine(w) {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
             }
-            return self.call_m6(&name, end_m, info, io);
+            return self.call_m6(&name, end_m, info, rd, notes, io);
         }
         if let Some(17 | 29) = end_m {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            self.check_open_flow()?;
-            self.return_from_subroutine();
-            return self.resume_held_end(io);
+            rd.top().check_open_flow()?;
+            self.return_from_subroutine(rd, notes);
+            return self.resume_held_end(rd, notes, io);
         }
         let Some(m) = end_m else {
             if !queued {
@@ -614,11 +618,11 @@ impl Decoder {
             }
             return Ok(());
         };
-        self.program_end_checks(m)?;
+        self.program_end_checks(m, rd, notes)?;
         if !queued {
             self.emit(info.clone(), Action::None, false, io);
         }
-        self.program_end(m, info, io)
+        self.program_end(m, info, rd, notes, io)
     }
 
     /// G800–G819 in this block (`col` its column): its subroutine must be configured
@@ -644,21 +648,26 @@ impl Decoder {
 
     /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in
     /// the main program every control block must be closed.
-    pub(super) fn program_end_checks(&mut self, m: u32) -> Res {
+    pub(super) fn program_end_checks(
+        &mut self,
+        m: u32,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+    ) -> Res {
         if let Some(s) = self.search {
             return Err(DecodeError::new(
                 codes::SEARCH_NOT_FOUND,
                 format!("block search target {} not found", s.target),
             ));
         }
-        if self.top().kind != FrameKind::Main {
-            self.notes.push(Note::Warning {
+        if rd.top().kind != FrameKind::Main {
+            notes.push(Note::Warning {
                 code: codes::UNEXPECTED_PROGRAM_END,
                 msg: format!("M{m} in a subroutine: the program ends"),
             });
             Ok(())
         } else {
-            self.check_open_flow()
+            rd.top().check_open_flow()
         }
     }
 }
