@@ -5,9 +5,11 @@
 //! stack they work on is the [`Reader`]'s, passed in.
 
 mod axis_vars;
+mod block_words;
 mod calls;
 mod cycles;
 mod expr;
+mod implicit;
 mod search;
 mod words;
 
@@ -17,14 +19,14 @@ use super::line::BlockAt;
 use super::modal::Modal;
 use super::note::Note;
 use super::reader::Reader;
+use super::search_target::{Search, SearchTarget};
 use super::settings::DecoderSettings;
 use super::vars::{VarSlot, VarStore};
 use crate::lang::block::{Expr, VarRef};
 use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::vocab::axis::{Position, MAX_AXES};
-use calls::ImplicitState;
-use search::{Search, SearchTarget};
-use words::Words;
+use block_words::Words;
+use implicit::ImplicitState;
 
 /// Modal state, variables and the running program's calls.
 #[derive(Debug)]

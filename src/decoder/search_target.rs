@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use crate::vocab::axis::Position;
+
 /// Block search target (TF5200 block search).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SearchTarget {
@@ -39,4 +41,12 @@ impl std::str::FromStr for SearchTarget {
             )),
         }
     }
+}
+
+#[derive(Debug, Clone, Copy)]
+/// A block search under way.
+pub(crate) struct Search {
+    pub(crate) target: SearchTarget,
+    /// Machine position when the search began: the positioning move starts here.
+    pub(crate) from: Position,
 }

@@ -3,7 +3,8 @@
 
 use std::sync::Arc;
 
-use super::{expr, words, Interpreter};
+use super::implicit::HeldEnd;
+use super::{block_words, expr, Interpreter};
 use crate::decoder::error::{var_error, DecodeError, Res};
 use crate::decoder::frame::{Frame, FrameKind, Source};
 use crate::decoder::io::DecoderIo;
@@ -18,38 +19,6 @@ use crate::source::cache::LoadStep;
 use crate::source::store::{Opened, ProgramKind};
 use crate::vocab::event::CacheOp;
 use crate::vocab::flush::FlushKind;
-
-/// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
-/// before it: applied when the frame stack is back at `depth`.
-#[derive(Debug, Clone)]
-pub(super) struct HeldEnd {
-    pub(crate) m: u32,
-    pub(crate) info: BlockInfo,
-    pub(crate) depth: usize,
-}
-
-/// Where the running program stands with its implicit subroutine calls.
-#[derive(Debug, Clone, Default)]
-pub(super) struct ImplicitState {
-    /// The start subroutine (P-CHAN-00119) is still to be called.
-    pub(crate) start_pending: bool,
-    /// The end subroutine (P-CHAN-00252) has been called.
-    pub(crate) end_called: bool,
-    /// Depth of the running M6 subroutine's frame: an M6 inside it is an ordinary M function,
-    /// as the kernel does not call the tool change from the tool change.
-    pub(crate) m6_depth: Option<usize>,
-    /// Ends held back, innermost last (at most one per frame).
-    pub(crate) held: Vec<HeldEnd>,
-}
-
-impl ImplicitState {
-    pub(crate) fn at_start(calls: &crate::params::channel::ImplicitSubroutines) -> Self {
-        ImplicitState {
-            start_pending: calls.at_start.is_some(),
-            ..Default::default()
-        }
-    }
-}
 
 impl Interpreter {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
@@ -188,7 +157,7 @@ impl Interpreter {
     }
 
     /// M6 with `m6_prog_file` (P-CHAN-00118) set, outside the M6 subroutine itself: its name.
-    pub(super) fn m6_subroutine(&self, w: &words::Words) -> Option<String> {
+    pub(super) fn m6_subroutine(&self, w: &block_words::Words) -> Option<String> {
         let name = self.settings.implicit.at_m6.as_ref()?;
         (self.implicit.m6_depth.is_none() && w.has_m(6)).then(|| name.clone())
     }

@@ -6,16 +6,8 @@ use crate::decoder::io::DecoderIo;
 use crate::decoder::line::BlockAt;
 use crate::decoder::note::Note;
 use crate::decoder::reader::Reader;
-pub(crate) use crate::decoder::search_target::SearchTarget;
+use crate::decoder::search_target::{Search, SearchTarget};
 use crate::queue::{Action, Move, MoveKind};
-use crate::vocab::axis::Position;
-
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Search {
-    pub(super) target: SearchTarget,
-    /// Machine position when the search began: the positioning move starts here.
-    pub(super) from: Position,
-}
 
 impl Interpreter {
     /// A block met during block search: is it the target? Then the search ends here.

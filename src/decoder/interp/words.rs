@@ -8,6 +8,7 @@
 //! The parser has already refused what a block may not hold (a letter twice, a dwell with
 //! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
 
+use super::block_words::{Words, MAX_FUNCTIONS};
 use super::{expr, Interpreter};
 use crate::decoder::error::{var_error, DecodeError, Res};
 use crate::decoder::frame::FrameKind;
@@ -27,96 +28,6 @@ use crate::lang::range::whole_u32 as whole;
 use crate::queue::{Action, BlockInfo, Move, MoveKind};
 use crate::vocab::axis::slot_of;
 use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
-
-/// M or H functions one block may hold.
-const MAX_FUNCTIONS: usize = 8;
-/// G functions one block may hold (a CAM header writes six or seven).
-const MAX_GS: usize = 16;
-
-/// Step 1's result: the block's words by meaning, values evaluated, not yet applied.
-#[derive(Debug, Default)]
-pub(super) struct Words {
-    /// G numbers in written order, with their columns.
-    gs: [(u32, u32); MAX_GS],
-    n_gs: usize,
-    /// Axis values as programmed (program units), by `AXIS_LETTERS` index.
-    /// Plain values and a bit mask rather than `Option`s: this struct is built for every
-    /// block, and reading `Option<f64>`s back showed as store-forwarding stalls in a profile.
-    axes: [f64; MAX_AXES],
-    /// Bit i: axis i is programmed.
-    axes_set: u8,
-    /// Column of an X word on a channel without X: an error unless X is a dwell time.
-    unconfigured_x_col: Option<u32>,
-    /// I, J, K as programmed (program units).
-    ijk: [Option<f64>; 3],
-    /// R as programmed (program units).
-    radius: Option<f64>,
-    /// F as programmed, with its column.
-    feed: Option<(f64, u32)>,
-    /// S, rpm.
-    spindle_rpm: Option<f64>,
-    tool: Option<u32>,
-    tool_offset: Option<u32>,
-    /// `G04 <t>` / `G04 P<t>`: the dwell time in seconds.
-    dwell_s: Option<f64>,
-    ms: [u32; MAX_FUNCTIONS],
-    /// The value of each M programmed with one (`M200=1200`), by its place in `ms`.
-    m_values: [Option<f64>; MAX_FUNCTIONS],
-    n_ms: usize,
-    hs: [u32; MAX_FUNCTIONS],
-    h_values: [Option<f64>; MAX_FUNCTIONS],
-    n_hs: usize,
-    /// G800–G819 (number, column): an implicit subroutine call at the end of the block.
-    call: Option<(u32, u32)>,
-    /// Its transfer parameters as `@P` number and value (gaps left out).
-    call_params: Vec<(u32, f64)>,
-}
-
-impl Words {
-    /// Empty again for the next block. The fixed arrays keep their stale entries: only the
-    /// first `n_*` count, so clearing them would be a memset per block for nothing.
-    fn clear(&mut self) {
-        self.n_gs = 0;
-        self.axes_set = 0;
-        self.unconfigured_x_col = None;
-        self.ijk = [None; 3];
-        self.radius = None;
-        self.feed = None;
-        self.spindle_rpm = None;
-        self.tool = None;
-        self.tool_offset = None;
-        self.dwell_s = None;
-        self.n_ms = 0;
-        self.n_hs = 0;
-        // `call_params` count only with `call`, and are cleared when it is set.
-        self.call = None;
-    }
-
-    fn gs(&self) -> &[(u32, u32)] {
-        &self.gs[..self.n_gs]
-    }
-
-    fn push_g(&mut self, g: u32, col: u32) -> Res {
-        if self.n_gs == MAX_GS {
-            return Err(DecodeError::new(
-                codes::SYNTAX,
-                "too many G functions in one block",
-            ));
-        }
-        self.gs[self.n_gs] = (g, col);
-        self.n_gs += 1;
-        Ok(())
-    }
-    fn ms(&self) -> &[u32] {
-        &self.ms[..self.n_ms]
-    }
-    pub(super) fn has_m(&self, m: u32) -> bool {
-        self.ms().contains(&m)
-    }
-    fn hs(&self) -> &[u32] {
-        &self.hs[..self.n_hs]
-    }
-}
 
 impl Interpreter {
     pub(in crate::decoder) fn exec_items(
