@@ -4,21 +4,138 @@
 //! or a forward jump only sets a skip state, and the lines that follow are examined one by one
 //! as they arrive — which is what makes these statements work across stream packets.
 
+use std::collections::BTreeSet;
+
 use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
-use super::frame::{FlowEntry, Frame, Skip, SkipUntil, MAX_SEEN_LABELS};
-use super::interp::Interpreter;
-use super::labels::{LabelAt, ScanFound, ScanGoal};
 use super::line::{LineMeta, LinePos};
-use super::reader::Reader;
+use super::vars::VarSlot;
 use crate::lang::codes;
 use crate::lang::control::{
     block_ends_program, control_name, goto_label, goto_text, items_have_m, label_matches,
     label_text, nesting, Nesting,
 };
 use crate::lang::eval::is_true;
+
+/// One open control structure of a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum FlowEntry {
+    /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
+    If { taken: bool },
+    /// `$SWITCH`: the value cases compare against.
+    Switch { value: f64 },
+    /// `$FOR var = start, end, step`: the body starts at `body`.
+    For {
+        var: VarSlot,
+        end: f64,
+        step: f64,
+        body: LinePos,
+    },
+    /// `$WHILE`: `head` is the `$WHILE` line itself (the condition is evaluated there).
+    While { head: LinePos },
+    /// `$DO` … `$ENDDO cond`.
+    Do { body: LinePos },
+    /// `$REPEAT` … `$UNTIL cond`.
+    Repeat { body: LinePos },
+}
+
+impl FlowEntry {
+    pub(crate) fn is_loop(&self) -> bool {
+        matches!(
+            self,
+            FlowEntry::For { .. }
+                | FlowEntry::While { .. }
+                | FlowEntry::Do { .. }
+                | FlowEntry::Repeat { .. }
+        )
+    }
+}
+
+/// What the skip machine is looking for.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum SkipUntil {
+    /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
+    IfBranch,
+    /// A branch has run: the `$ENDIF`.
+    IfEnd,
+    /// `$SWITCH` looking for its case: a matching `$CASE`, `$DEFAULT` or `$ENDSWITCH`.
+    Case,
+    /// After `$BREAK` in a switch: the `$ENDSWITCH`.
+    SwitchEnd,
+    /// A false `$WHILE` or a `$BREAK` in a loop: past the loop's end statement.
+    LoopExit,
+    /// `$CONTINUE`: the loop's end statement, which is then evaluated.
+    LoopContinue,
+    /// A forward `$GOTO` (streams): the line with this label.
+    Label(GotoTarget),
+    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
+    /// next `%name` head when it has none.
+    LocalSubroutine,
+}
+
+/// Skip state: what we look for and how deep inside skipped structures we are.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Skip {
+    pub(crate) until: SkipUntil,
+    /// Structures opened inside the skipped region and not yet closed.
+    pub(crate) depth: u32,
+}
+
+impl Skip {
+    pub(crate) fn new(until: SkipUntil) -> Self {
+        Skip { until, depth: 0 }
+    }
+}
+
+/// How many stream labels a frame remembers. A stream may run for days; a label passed more
+/// than this many labels ago is treated as unknown (a jump to it waits forward for it).
+pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
+
+/// A frame's control flow: the structures open in it, what the skip machine looks for, and
+/// (streams) the labels passed.
+#[derive(Debug, Default)]
+pub(crate) struct Flow {
+    /// Open control structures, innermost last.
+    stack: Vec<FlowEntry>,
+    /// Set while lines are being skipped (false branch, forward jump, …).
+    skip: Option<Skip>,
+    /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
+    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`; a B-tree
+    /// for the reason `LabelIndex` is one.
+    seen_labels: BTreeSet<Label>,
+}
+
+/// A large set of labels passed is freed by the loader thread, as the frame's text is
+/// (`Frame`'s `Drop`).
+impl Drop for Flow {
+    fn drop(&mut self) {
+        let seen = self.seen_labels.len();
+        crate::source::loader::release_table(std::mem::take(&mut self.seen_labels), seen);
+    }
+}
+
+/// Where a frame goes on after a `$` statement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum FlowStep<'c> {
+    /// The next line.
+    Next,
+    /// Back to a loop's head or body.
+    Seek(LinePos),
+    /// To a label (`$GOTO`).
+    Goto(&'c GotoTarget),
+}
+
+/// What the skip machine asks of the interpreter: expressions evaluated, the `$FOR`
+/// variable resolved, read and set.
+pub(super) trait Env {
+    fn eval(&self, e: &Expr) -> Res<f64>;
+    fn resolve(&self, v: &VarRef) -> Res<VarSlot>;
+    /// A variable's value (`None`: not defined).
+    fn var(&self, k: &VarSlot) -> Option<f64>;
+    fn set_var(&mut self, k: VarSlot, v: f64) -> Res;
+}
 
 /// Whether `c` closes the loop `e`.
 pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
@@ -31,12 +148,12 @@ pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
     )
 }
 
-impl Frame {
+impl Flow {
     /// Record a label passed in a stream: a label seen twice is codes::LABEL_TWICE; a later `$GOTO` to a
     /// seen label is a backward jump.
-    pub(super) fn note_label(&mut self, l: &Label) -> Res {
+    pub(super) fn note_label(&mut self, l: &Label, stream: bool) -> Res {
         let top = self;
-        if !top.is_stream() {
+        if !stream {
             return Ok(());
         }
         if top.seen_labels.contains(l) {
@@ -53,12 +170,12 @@ impl Frame {
 
     /// One line while skipping. Returns whether the line is to be executed after all (the
     /// label line a forward jump was looking for).
-    pub(super) fn skip_line(&mut self, block: &Block, ip: &Interpreter) -> Res<bool> {
+    pub(super) fn skip_line(&mut self, block: &Block, stream: bool, ip: &impl Env) -> Res<bool> {
         let Some(skip) = self.skip.clone() else {
             return Ok(true);
         };
         if let SkipUntil::Label(t) = &skip.until {
-            return self.skip_to_label(block, t);
+            return self.skip_to_label(block, t, stream);
         }
         if skip.until == SkipUntil::LocalSubroutine {
             match &block.body {
@@ -83,10 +200,9 @@ impl Frame {
 
     /// A forward jump (streams): the line with the label runs; structures passed on the way
     /// keep the flow stack right; a program end before the label is 20840.
-    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget) -> Res<bool> {
-        let is_stream = self.is_stream();
+    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget, is_stream: bool) -> Res<bool> {
         if let Some(l) = &block.label {
-            self.note_label(l)?;
+            self.note_label(l, is_stream)?;
             if label_matches(l, t) {
                 self.skip = None;
                 return Ok(true);
@@ -96,13 +212,15 @@ impl Frame {
             // Structures opened or closed between jump and label keep the stack right.
             let top = self;
             match c {
-                Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
-                Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
-                Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
-                    top.flow.pop();
+                Control::If(_) => top.stack.push(FlowEntry::If { taken: true }),
+                Control::Switch(_) => top.stack.push(FlowEntry::Switch { value: f64::NAN }),
+                Control::EndIf if matches!(top.stack.last(), Some(FlowEntry::If { .. })) => {
+                    top.stack.pop();
                 }
-                Control::EndSwitch if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) => {
-                    top.flow.pop();
+                Control::EndSwitch
+                    if matches!(top.stack.last(), Some(FlowEntry::Switch { .. })) =>
+                {
+                    top.stack.pop();
                 }
                 _ => {}
             }
@@ -138,7 +256,7 @@ impl Frame {
 
     /// A statement at the skipped structure's own level: does it end the skip? `true` when
     /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
-    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control, ip: &Interpreter) -> Res<bool> {
+    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control, ip: &impl Env) -> Res<bool> {
         match (until, c) {
             (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(ip.eval(e)?) => {
                 self.skip = None;
@@ -151,11 +269,11 @@ impl Frame {
             (SkipUntil::IfBranch | SkipUntil::IfEnd, Control::EndIf) => {
                 let top = self;
                 top.skip = None;
-                top.flow.pop();
+                top.stack.pop();
             }
             (SkipUntil::Case, Control::Case(e)) => {
                 let v = ip.eval(e)?;
-                if let Some(FlowEntry::Switch { value }) = self.flow.last() {
+                if let Some(FlowEntry::Switch { value }) = self.stack.last() {
                     if crate::lang::eval::case_matches(*value, v) {
                         self.skip = None;
                     }
@@ -165,18 +283,18 @@ impl Frame {
             (SkipUntil::Case | SkipUntil::SwitchEnd, Control::EndSwitch) => {
                 let top = self;
                 top.skip = None;
-                top.flow.pop();
+                top.stack.pop();
             }
             (SkipUntil::LoopExit, c) => {
                 let top = self;
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                if top.stack.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
-                    top.flow.pop();
+                    top.stack.pop();
                 }
             }
             (SkipUntil::LoopContinue, c) => {
                 let top = self;
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                if top.stack.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
                     return Ok(true);
                 }
@@ -187,13 +305,43 @@ impl Frame {
     }
 
     pub(super) fn set_if_taken(&mut self) {
-        if let Some(FlowEntry::If { taken }) = self.flow.last_mut() {
+        if let Some(FlowEntry::If { taken }) = self.stack.last_mut() {
             *taken = true;
         }
     }
 
     pub(super) fn begin_skip(&mut self, until: SkipUntil) {
         self.skip = Some(Skip::new(until));
+    }
+
+    /// Lines are being skipped (a false branch, a forward jump, …).
+    pub(super) fn skipping(&self) -> bool {
+        self.skip.is_some()
+    }
+
+    /// The label a forward jump is skipping to, if it is one.
+    pub(super) fn skipping_to(&self) -> Option<&GotoTarget> {
+        match &self.skip {
+            Some(Skip {
+                until: SkipUntil::Label(t),
+                ..
+            }) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// A `$GOTO` in a stream: a jump to a label already passed is a backward jump (21477);
+    /// to another, the lines are skipped up to the label.
+    pub(super) fn skip_to(&mut self, t: &GotoTarget) -> Res {
+        let key = goto_label(t);
+        if self.seen_labels.contains(&key) {
+            return Err(DecodeError::new(
+                codes::STREAM_BACKWARD_JUMP,
+                format!("backward jump to {} in streaming program", goto_text(t)),
+            ));
+        }
+        self.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
+        Ok(())
     }
 }
 
@@ -219,33 +367,38 @@ pub(super) fn stray(c: &Control) -> DecodeError {
     DecodeError::new(code, format!("unexpected {}", control_name(c)))
 }
 
-impl Frame {
-    /// Run a `$` statement. A jump it makes is returned, for [`goto`] to make with the
-    /// reader's label index.
+impl Flow {
+    /// Run a `$` statement of the line at `meta`, `next` being where the line after it
+    /// starts. Where the frame goes on is returned: a loop's way back for the frame to seek,
+    /// a jump for the reader to make with its label index (`Reader::goto`).
     pub(super) fn exec_control<'c>(
         &mut self,
         c: &'c Control,
         meta: LineMeta,
-        ip: &mut Interpreter,
-    ) -> Res<Option<&'c GotoTarget>> {
+        next: LinePos,
+        ip: &mut impl Env,
+    ) -> Res<FlowStep<'c>> {
+        let back = |at: Option<LinePos>| at.map_or(FlowStep::Next, FlowStep::Seek);
         match c {
-            Control::Break | Control::Continue => self.exec_leave(c).map(|()| None),
+            Control::Break | Control::Continue => self.exec_leave(c).map(|()| FlowStep::Next),
             Control::For {
                 var,
                 start,
                 end,
                 step,
             } => self
-                .exec_for(var, start, end, step.as_deref(), ip)
-                .map(|()| None),
-            Control::EndFor => self.exec_end_for(c, ip).map(|()| None),
+                .exec_for(var, start, end, step.as_deref(), next, ip)
+                .map(|()| FlowStep::Next),
+            Control::EndFor => self.exec_end_for(c, ip).map(back),
             Control::While(_)
             | Control::EndWhile
             | Control::Do
             | Control::EndDo(_)
             | Control::Repeat
-            | Control::Until(_) => self.exec_loop(c, meta, ip).map(|()| None),
-            _ => self.exec_branch(c, ip),
+            | Control::Until(_) => self.exec_loop(c, meta, next, ip).map(back),
+            _ => self
+                .exec_branch(c, ip)
+                .map(|t| t.map_or(FlowStep::Next, FlowStep::Goto)),
         }
     }
 
@@ -256,10 +409,10 @@ impl Frame {
         e: &crate::lang::block::Expr,
         entry: impl FnOnce(bool) -> FlowEntry,
         or_skip: SkipUntil,
-        ip: &Interpreter,
+        ip: &impl Env,
     ) -> Res {
         let v = is_true(ip.eval(e)?);
-        self.flow.push(entry(v));
+        self.stack.push(entry(v));
         if !v {
             self.begin_skip(or_skip);
         }
@@ -267,35 +420,35 @@ impl Frame {
     }
 
     /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
-    fn exec_branch<'c>(&mut self, c: &'c Control, ip: &Interpreter) -> Res<Option<&'c GotoTarget>> {
+    fn exec_branch<'c>(&mut self, c: &'c Control, ip: &impl Env) -> Res<Option<&'c GotoTarget>> {
         match c {
             Control::If(e) => {
                 self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch, ip)?
             }
             Control::IfGoto(e, t) if is_true(ip.eval(e)?) => return Ok(Some(t)),
-            Control::ElseIf(_) | Control::Else => match self.flow.last() {
+            Control::ElseIf(_) | Control::Else => match self.stack.last() {
                 Some(FlowEntry::If { .. }) => self.begin_skip(SkipUntil::IfEnd),
                 _ => return Err(stray(c)),
             },
-            Control::EndIf => match self.flow.last() {
+            Control::EndIf => match self.stack.last() {
                 Some(FlowEntry::If { .. }) => {
-                    self.flow.pop();
+                    self.stack.pop();
                 }
                 _ => return Err(stray(c)),
             },
             Control::Switch(e) => {
                 let value = ip.eval(e)?;
-                self.flow.push(FlowEntry::Switch { value });
+                self.stack.push(FlowEntry::Switch { value });
                 self.begin_skip(SkipUntil::Case);
             }
             // Executing into a later case: fall through (no `$BREAK` before it).
-            Control::Case(_) | Control::Default => match self.flow.last() {
+            Control::Case(_) | Control::Default => match self.stack.last() {
                 Some(FlowEntry::Switch { .. }) => {}
                 _ => return Err(stray(c)),
             },
-            Control::EndSwitch => match self.flow.last() {
+            Control::EndSwitch => match self.stack.last() {
                 Some(FlowEntry::Switch { .. }) => {
-                    self.flow.pop();
+                    self.stack.pop();
                 }
                 _ => return Err(stray(c)),
             },
@@ -310,7 +463,7 @@ impl Frame {
         match c {
             Control::Break => {
                 let inner = self
-                    .flow
+                    .stack
                     .iter()
                     .rev()
                     .find(|e| e.is_loop() || matches!(e, FlowEntry::Switch { .. }))
@@ -318,17 +471,17 @@ impl Frame {
                 match inner {
                     Some(FlowEntry::Switch { .. }) => {
                         // Close inner $IFs between the $BREAK and its switch.
-                        while matches!(self.flow.last(), Some(FlowEntry::If { .. })) {
-                            self.flow.pop();
+                        while matches!(self.stack.last(), Some(FlowEntry::If { .. })) {
+                            self.stack.pop();
                         }
                         self.begin_skip(SkipUntil::SwitchEnd);
                     }
                     Some(_) => {
                         while matches!(
-                            self.flow.last(),
+                            self.stack.last(),
                             Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                         ) {
-                            self.flow.pop();
+                            self.stack.pop();
                         }
                         self.begin_skip(SkipUntil::LoopExit);
                     }
@@ -336,14 +489,14 @@ impl Frame {
                 }
             }
             Control::Continue => {
-                if !self.flow.iter().any(FlowEntry::is_loop) {
+                if !self.stack.iter().any(FlowEntry::is_loop) {
                     return Err(stray(c));
                 }
                 while matches!(
-                    self.flow.last(),
+                    self.stack.last(),
                     Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                 ) {
-                    self.flow.pop();
+                    self.stack.pop();
                 }
                 self.begin_skip(SkipUntil::LoopContinue);
             }
@@ -359,7 +512,8 @@ impl Frame {
         start: &Expr,
         end: &Expr,
         step: Option<&Expr>,
-        ip: &mut Interpreter,
+        next: LinePos,
+        ip: &mut impl Env,
     ) -> Res {
         let key = ip.resolve(var)?;
         let start = ip.eval(start)?;
@@ -375,8 +529,8 @@ impl Frame {
             ));
         }
         ip.set_var(key.clone(), start)?;
-        let body = self.line_pos();
-        self.flow.push(FlowEntry::For {
+        let body = next;
+        self.stack.push(FlowEntry::For {
             var: key,
             end,
             step,
@@ -389,8 +543,8 @@ impl Frame {
     }
 
     /// `$ENDFOR`: step the variable and go round again, or leave the loop.
-    fn exec_end_for(&mut self, c: &Control, ip: &mut Interpreter) -> Res {
-        match self.flow.last().cloned() {
+    fn exec_end_for(&mut self, c: &Control, ip: &mut impl Env) -> Res<Option<LinePos>> {
+        match self.stack.last().cloned() {
             Some(FlowEntry::For {
                 var,
                 end,
@@ -400,18 +554,24 @@ impl Frame {
                 let v = ip.var(&var).unwrap_or(0.0) + step;
                 ip.set_var(var, v)?;
                 if for_continues(v, end, step) {
-                    self.seek(body);
+                    return Ok(Some(body));
                 } else {
-                    self.flow.pop();
+                    self.stack.pop();
                 }
             }
             _ => return Err(stray(c)),
         }
-        Ok(())
+        Ok(None)
     }
 
     /// `$WHILE`, `$DO` and `$REPEAT` loops.
-    fn exec_loop(&mut self, c: &Control, meta: LineMeta, ip: &Interpreter) -> Res {
+    fn exec_loop(
+        &mut self,
+        c: &Control,
+        meta: LineMeta,
+        next: LinePos,
+        ip: &impl Env,
+    ) -> Res<Option<LinePos>> {
         let here = LinePos {
             pos: meta.offset as usize,
             line_no: meta.line - 1,
@@ -423,53 +583,52 @@ impl Frame {
                 SkipUntil::LoopExit,
                 ip,
             )?,
-            Control::EndWhile => match self.flow.last().cloned() {
+            Control::EndWhile => match self.stack.last().cloned() {
                 Some(FlowEntry::While { head }) => {
                     // Back to the $WHILE line, which evaluates and pushes again.
-                    self.flow.pop();
-                    self.seek(head);
+                    self.stack.pop();
+                    return Ok(Some(head));
                 }
                 _ => return Err(stray(c)),
             },
             Control::Do | Control::Repeat => {
-                let body = self.line_pos();
+                let body = next;
                 let entry = match c {
                     Control::Do => FlowEntry::Do { body },
                     _ => FlowEntry::Repeat { body },
                 };
-                self.flow.push(entry);
+                self.stack.push(entry);
             }
             // `$ENDDO cond` loops while cond holds, `$UNTIL cond` until it holds.
             Control::EndDo(e) | Control::Until(e) => {
-                let (body, again_if) = match (c, self.flow.last()) {
+                let (body, again_if) = match (c, self.stack.last()) {
                     (Control::EndDo(_), Some(FlowEntry::Do { body })) => (*body, true),
                     (Control::Until(_), Some(FlowEntry::Repeat { body })) => (*body, false),
                     _ => return Err(stray(c)),
                 };
                 if is_true(ip.eval(e)?) == again_if {
-                    self.seek(body);
+                    return Ok(Some(body));
                 } else {
-                    self.flow.pop();
+                    self.stack.pop();
                 }
             }
             _ => {}
         }
-        Ok(())
+        Ok(None)
     }
 
     /// Continue at a label: its structural depth decides which open structures the jump
     /// leaves.
-    pub(super) fn jump_to(&mut self, (at, depth): LabelAt) {
+    pub(super) fn leave_to_depth(&mut self, depth: usize) {
         let top = self;
-        top.seek(at);
-        top.flow.truncate(depth);
-        while top.flow.len() < depth {
-            top.flow.push(FlowEntry::If { taken: true });
+        top.stack.truncate(depth);
+        while top.stack.len() < depth {
+            top.stack.push(FlowEntry::If { taken: true });
         }
     }
 
     pub(super) fn check_open_flow(&mut self) -> Res {
-        if !self.flow.is_empty() {
+        if !self.stack.is_empty() {
             return Err(DecodeError::new(
                 codes::OPEN_CONTROL_BLOCK,
                 "open control blocks at program end",
@@ -477,43 +636,6 @@ impl Frame {
         }
         Ok(())
     }
-}
-
-/// `$GOTO`: in a stream a forward skip to the label; in a file a jump by the label index of
-/// the top frame's text, which the reader builds over several ticks.
-pub(super) fn goto(rd: &mut Reader, t: &GotoTarget) -> Res {
-    let top = rd.top();
-    if top.is_stream() {
-        let key = goto_label(t);
-        if top.seen_labels.contains(&key) {
-            return Err(DecodeError::new(
-                codes::STREAM_BACKWARD_JUMP,
-                format!("backward jump to {} in streaming program", goto_text(t)),
-            ));
-        }
-        top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
-        return Ok(());
-    }
-    // A file frame: the label index, built over several ticks; the line waits for it.
-    let Some(index) = rd.label_index() else {
-        return Ok(());
-    };
-    let found = match index.find(t) {
-        Some(at) => Some(at),
-        None if index.overflowed => match rd.searched(ScanGoal::Label(goto_label(t))) {
-            Some(ScanFound::Label(at)) => at,
-            _ => return Ok(()),
-        },
-        None => None,
-    };
-    let Some((at, depth)) = found else {
-        return Err(DecodeError::new(
-            codes::LABEL_NOT_FOUND,
-            format!("label {} not found", goto_text(t)),
-        ));
-    };
-    rd.top().jump_to((at, depth));
-    Ok(())
 }
 
 pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {

@@ -5,89 +5,17 @@
 //! stream segment and pulls the next segment from the stream buffer only when it has decoded
 //! the last line of the previous one (ISG FCT-C19 Data streaming §2.2: one read extracts all data present).
 
-use std::collections::BTreeSet;
 use std::sync::Arc;
 
-use crate::lang::block::{GotoTarget, Label};
 use crate::source::loader::PendingRead;
 use crate::source::store::ProgramText;
 use crate::source::stream::StreamBuffer;
 
+use super::flow::Flow;
 use super::labels::LabelIndex;
 pub(crate) use super::line::LinePos;
 pub use super::line::MAX_LINE_BYTES;
 use super::line::{cut_line, LineMeta, LineRead, LineTooLong};
-use super::vars::VarSlot;
-
-/// One open control structure of a frame.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum FlowEntry {
-    /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
-    If { taken: bool },
-    /// `$SWITCH`: the value cases compare against.
-    Switch { value: f64 },
-    /// `$FOR var = start, end, step`: the body starts at `body`.
-    For {
-        var: VarSlot,
-        end: f64,
-        step: f64,
-        body: LinePos,
-    },
-    /// `$WHILE`: `head` is the `$WHILE` line itself (the condition is evaluated there).
-    While { head: LinePos },
-    /// `$DO` … `$ENDDO cond`.
-    Do { body: LinePos },
-    /// `$REPEAT` … `$UNTIL cond`.
-    Repeat { body: LinePos },
-}
-
-impl FlowEntry {
-    pub(crate) fn is_loop(&self) -> bool {
-        matches!(
-            self,
-            FlowEntry::For { .. }
-                | FlowEntry::While { .. }
-                | FlowEntry::Do { .. }
-                | FlowEntry::Repeat { .. }
-        )
-    }
-}
-
-/// What the skip machine is looking for.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum SkipUntil {
-    /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
-    IfBranch,
-    /// A branch has run: the `$ENDIF`.
-    IfEnd,
-    /// `$SWITCH` looking for its case: a matching `$CASE`, `$DEFAULT` or `$ENDSWITCH`.
-    Case,
-    /// After `$BREAK` in a switch: the `$ENDSWITCH`.
-    SwitchEnd,
-    /// A false `$WHILE` or a `$BREAK` in a loop: past the loop's end statement.
-    LoopExit,
-    /// `$CONTINUE`: the loop's end statement, which is then evaluated.
-    LoopContinue,
-    /// A forward `$GOTO` (streams): the line with this label.
-    Label(GotoTarget),
-    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
-    /// next `%name` head when it has none.
-    LocalSubroutine,
-}
-
-/// Skip state: what we look for and how deep inside skipped structures we are.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Skip {
-    pub(crate) until: SkipUntil,
-    /// Structures opened inside the skipped region and not yet closed.
-    pub(crate) depth: u32,
-}
-
-impl Skip {
-    pub(crate) fn new(until: SkipUntil) -> Self {
-        Skip { until, depth: 0 }
-    }
-}
 
 /// What kind of program level a frame is; decides which end blocks are allowed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -120,28 +48,19 @@ pub(crate) struct Frame {
     pub(crate) pos: usize,
     /// File frames: lines read so far.
     pub(crate) line_no: u32,
-    /// Open control structures, innermost last.
-    pub(crate) flow: Vec<FlowEntry>,
-    /// Set while lines are being skipped (false branch, forward jump, …).
-    pub(crate) skip: Option<Skip>,
+    /// Its control flow: open structures, what is skipped, labels passed (`flow.rs`).
+    pub(crate) flow: Flow,
     /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
     pub(crate) comment_block: bool,
     /// Inside `#VAR` … `#ENDVAR`.
     pub(crate) var_block: bool,
-    /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
-    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`; a B-tree
-    /// for the reason `LabelIndex` is one.
-    pub(crate) seen_labels: BTreeSet<Label>,
     /// File frames: label → position and structural depth, built on the first jump.
     pub(crate) label_index: Option<Arc<LabelIndex>>,
 }
 
-/// How many stream labels a frame remembers. A stream may run for days; a label passed more
-/// than this many labels ago is treated as unknown (a jump to it waits forward for it).
-pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
-
 /// A frame that held the last reference to a large file text lets the loader thread free it,
-/// and its label tables with it: tens of thousands of labels take milliseconds to free.
+/// and its label index with it (its flow's labels follow, `Flow`'s `Drop`): tens of
+/// thousands of labels take milliseconds to free.
 impl Drop for Frame {
     fn drop(&mut self) {
         use crate::source::loader;
@@ -152,8 +71,6 @@ impl Drop for Frame {
             let items = index.len();
             loader::release_table(index, items);
         }
-        let seen = self.seen_labels.len();
-        loader::release_table(std::mem::take(&mut self.seen_labels), seen);
     }
 }
 
@@ -165,11 +82,9 @@ impl Frame {
             prog,
             pos: 0,
             line_no: 0,
-            flow: Vec::new(),
-            skip: None,
+            flow: Flow::default(),
             comment_block: false,
             var_block: false,
-            seen_labels: BTreeSet::new(),
             label_index: None,
         }
     }

@@ -14,6 +14,7 @@ mod search;
 mod words;
 
 use super::error::{var_error, Res};
+use super::flow::Env;
 use super::io::DecoderIo;
 use super::line::BlockAt;
 use super::modal::Modal;
@@ -208,5 +209,21 @@ impl Interpreter {
             action,
             silent,
         });
+    }
+}
+
+/// The skip machine's expressions and `$FOR` variable, as the running program sees them.
+impl Env for Interpreter {
+    fn eval(&self, e: &Expr) -> Res<f64> {
+        Interpreter::eval(self, e)
+    }
+    fn resolve(&self, v: &VarRef) -> Res<VarSlot> {
+        Interpreter::resolve(self, v)
+    }
+    fn var(&self, k: &VarSlot) -> Option<f64> {
+        Interpreter::var(self, k)
+    }
+    fn set_var(&mut self, k: VarSlot, v: f64) -> Res {
+        Interpreter::set_var(self, k, v)
     }
 }

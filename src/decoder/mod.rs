@@ -29,7 +29,8 @@ use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
 
 use crate::lang::control::{goto_text, is_loop_statement};
-use frame::{Frame, FrameKind, Skip, SkipUntil, Source};
+use flow::{FlowStep, SkipUntil};
+use frame::{Frame, FrameKind, Source};
 use interp::Interpreter;
 use line::{BlockAt, LineMeta, LineRead, LineTooLong};
 use modal::Modal;
@@ -487,23 +488,25 @@ impl Decoder {
             }
             return Ok(());
         }
-        let skipping = top.skip.is_some();
+        let skipping = top.flow.skipping();
         let block = match parse_block(text) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error.
             Err(_) if skipping => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        if self.reader.current().is_stream() {
+        let stream = self.reader.current().is_stream();
+        if stream {
             stream_allows(&block)?;
         }
         if skipping {
-            let run_it = self.reader.top().skip_line(&block, &self.interp)?;
+            let flow = &mut self.reader.top().flow;
+            let run_it = flow.skip_line(&block, stream, &self.interp)?;
             if !run_it {
                 return Ok(());
             }
         } else if let Some(l) = &block.label {
-            self.reader.top().note_label(l)?;
+            self.reader.top().flow.note_label(l, stream)?;
         }
         let at = BlockAt {
             block: &block,
@@ -523,21 +526,29 @@ impl Decoder {
         match &block.body {
             Body::Items(items) if items.is_empty() => Ok(()),
             Body::Items(items) => ip.exec_items(items, at, rd, notes, io),
-            Body::Control(c) => match rd.top().exec_control(c, meta, ip)? {
-                Some(target) => flow::goto(rd, target),
-                None => Ok(()),
-            },
+            Body::Control(c) => {
+                let top = rd.top();
+                let next = top.line_pos();
+                match top.flow.exec_control(c, meta, next, ip)? {
+                    FlowStep::Next => Ok(()),
+                    FlowStep::Seek(at) => {
+                        top.seek(at);
+                        Ok(())
+                    }
+                    FlowStep::Goto(target) => rd.goto(target),
+                }
+            }
             Body::Command(c) => ip.exec_command(c, at, rd, notes, io),
             Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
             Body::ProgramHead { .. } if rd.current().kind == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                rd.top().check_open_flow()?;
+                rd.top().flow.check_open_flow()?;
                 ip.return_from_subroutine(rd, notes);
                 ip.resume_held_end(rd, notes, io)
             }
             Body::ProgramHead { local: true, .. } => {
                 // A local subroutine section met while running: it runs only when called.
-                rd.top().begin_skip(SkipUntil::LocalSubroutine);
+                rd.top().flow.begin_skip(SkipUntil::LocalSubroutine);
                 Ok(())
             }
             Body::ProgramHead { local: false, .. } => Ok(()),
@@ -547,11 +558,7 @@ impl Decoder {
     fn end_of_file(&mut self, _io: &mut DecoderIo<'_>) -> Res {
         let searching = self.interp.searching();
         let top = self.reader.top();
-        if let Some(Skip {
-            until: SkipUntil::Label(t),
-            ..
-        }) = &top.skip
-        {
+        if let Some(t) = top.flow.skipping_to() {
             return Err(DecodeError::new(
                 codes::LABEL_NOT_FOUND,
                 format!("label {} not found", goto_text(t)),

@@ -5,12 +5,15 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::error::DecodeError;
+use super::error::{DecodeError, Res};
 use super::frame::{read_file_line, Frame, Source, StreamNote, StreamReader};
 use super::labels::{LabelIndex, LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
 use super::line::{LineMeta, LinePos, LineRead};
 use super::note::Note;
 use super::settings::{DECLARED_VALUES_PER_TICK, LINE_BYTES_PER_TICK};
+use crate::lang::block::GotoTarget;
+use crate::lang::codes;
+use crate::lang::control::{goto_label, goto_text};
 use crate::lang::Joiner;
 use crate::source::loader::PendingRead;
 use crate::source::store::{ProgramStore, ProgramText, StoreError};
@@ -441,6 +444,37 @@ impl Reader {
                 Err((e, meta))
             }
         }
+    }
+
+    /// `$GOTO`: in a stream a forward skip to the label; in a file a jump by the label index of
+    /// the top frame's text, which the reader builds over several ticks.
+    pub(super) fn goto(&mut self, t: &GotoTarget) -> Res {
+        let top = self.top();
+        if top.is_stream() {
+            return top.flow.skip_to(t);
+        }
+        // A file frame: the label index, built over several ticks; the line waits for it.
+        let Some(index) = self.label_index() else {
+            return Ok(());
+        };
+        let found = match index.find(t) {
+            Some(at) => Some(at),
+            None if index.overflowed => match self.searched(ScanGoal::Label(goto_label(t))) {
+                Some(ScanFound::Label(at)) => at,
+                _ => return Ok(()),
+            },
+            None => None,
+        };
+        let Some((at, depth)) = found else {
+            return Err(DecodeError::new(
+                codes::LABEL_NOT_FOUND,
+                format!("label {} not found", goto_text(t)),
+            ));
+        };
+        let top = self.top();
+        top.seek(at);
+        top.flow.leave_to_depth(depth);
+        Ok(())
     }
 
     /// The label index of the top frame's text, once built. `None`: its scan has begun (or

@@ -223,7 +223,7 @@ impl Interpreter {
         };
         match h.m {
             17 | 29 => {
-                rd.top().check_open_flow()?;
+                rd.top().flow.check_open_flow()?;
                 self.return_from_subroutine(rd, notes);
                 self.resume_held_end(rd, notes, io)
             }

@@ -519,7 +519,7 @@ impl Interpreter {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            rd.top().check_open_flow()?;
+            rd.top().flow.check_open_flow()?;
             self.return_from_subroutine(rd, notes);
             return self.resume_held_end(rd, notes, io);
         }
@@ -578,7 +578,7 @@ impl Interpreter {
             });
             Ok(())
         } else {
-            rd.top().check_open_flow()
+            rd.top().flow.check_open_flow()
         }
     }
 }
