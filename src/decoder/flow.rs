@@ -78,9 +78,9 @@ pub(crate) enum SkipUntil {
 /// Skip state: what we look for and how deep inside skipped structures we are.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Skip {
-    pub(crate) until: SkipUntil,
+    until: SkipUntil,
     /// Structures opened inside the skipped region and not yet closed.
-    pub(crate) depth: u32,
+    depth: u32,
 }
 
 impl Skip {
@@ -627,7 +627,7 @@ impl Flow {
         }
     }
 
-    pub(super) fn check_open_flow(&mut self) -> Res {
+    pub(super) fn check_open_flow(&self) -> Res {
         if !self.stack.is_empty() {
             return Err(DecodeError::new(
                 codes::OPEN_CONTROL_BLOCK,

@@ -41,21 +41,24 @@ pub(crate) enum Source {
 /// One program level.
 #[derive(Debug)]
 pub(crate) struct Frame {
-    pub(crate) kind: FrameKind,
-    pub(crate) source: Source,
-    pub(crate) prog: Arc<str>,
+    /// Main program, subroutine, cycle or local subroutine: which end blocks it allows.
+    kind: FrameKind,
+    /// Its text, the loader's read of it, or the stream.
+    source: Source,
+    /// The program's name.
+    prog: Arc<str>,
     /// File frames: byte offset of the next line.
-    pub(crate) pos: usize,
+    pos: usize,
     /// File frames: lines read so far.
-    pub(crate) line_no: u32,
+    line_no: u32,
     /// Its control flow: open structures, what is skipped, labels passed (`flow.rs`).
-    pub(crate) flow: Flow,
+    flow: Flow,
     /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
-    pub(crate) comment_block: bool,
+    comment_block: bool,
     /// Inside `#VAR` … `#ENDVAR`.
-    pub(crate) var_block: bool,
+    var_block: bool,
     /// File frames: label → position and structural depth, built on the first jump.
-    pub(crate) label_index: Option<Arc<LabelIndex>>,
+    label_index: Option<Arc<LabelIndex>>,
 }
 
 /// A frame that held the last reference to a large file text lets the loader thread free it,
@@ -103,6 +106,76 @@ impl Frame {
     pub(crate) fn seek(&mut self, at: LinePos) {
         self.pos = at.pos;
         self.line_no = at.line_no;
+    }
+
+    pub(crate) fn kind(&self) -> FrameKind {
+        self.kind
+    }
+
+    /// The program's name.
+    pub(crate) fn prog(&self) -> &Arc<str> {
+        &self.prog
+    }
+
+    /// Lines read so far (file frames).
+    pub(crate) fn line_no(&self) -> u32 {
+        self.line_no
+    }
+
+    /// Its text, when it is a file whose text is there.
+    pub(crate) fn file(&self) -> Option<&ProgramText> {
+        match &self.source {
+            Source::File(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The loader's read of its file, while it is not done.
+    pub(crate) fn loading(&self) -> Option<&PendingRead> {
+        match &self.source {
+            Source::Loading(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The loader's read is done: the frame reads `text`.
+    pub(crate) fn loaded(&mut self, text: ProgramText) {
+        self.source = Source::File(text);
+    }
+
+    pub(crate) fn flow(&self) -> &Flow {
+        &self.flow
+    }
+
+    pub(crate) fn flow_mut(&mut self) -> &mut Flow {
+        &mut self.flow
+    }
+
+    /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
+    pub(crate) fn in_comment_block(&self) -> bool {
+        self.comment_block
+    }
+
+    pub(crate) fn set_comment_block(&mut self, on: bool) {
+        self.comment_block = on;
+    }
+
+    /// Inside `#VAR` … `#ENDVAR`.
+    pub(crate) fn in_var_block(&self) -> bool {
+        self.var_block
+    }
+
+    pub(crate) fn set_var_block(&mut self, on: bool) {
+        self.var_block = on;
+    }
+
+    /// The label index of its text, once built.
+    pub(crate) fn label_index(&self) -> Option<&Arc<LabelIndex>> {
+        self.label_index.as_ref()
+    }
+
+    pub(crate) fn set_label_index(&mut self, index: Arc<LabelIndex>) {
+        self.label_index = Some(index);
     }
 }
 

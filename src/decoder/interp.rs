@@ -179,7 +179,7 @@ impl Interpreter {
     pub(super) fn info(&self, rd: &Reader, at: BlockAt<'_>, io: &DecoderIo<'_>) -> BlockInfo {
         let top = rd.current();
         BlockInfo {
-            prog: top.prog.clone(),
+            prog: top.prog().clone(),
             line: at.meta.line,
             offset: at.meta.offset,
             counter: self.counter,

@@ -351,7 +351,7 @@ impl Decoder {
                     budget -= 1;
                     if let Err(e) = self.end_of_file(io) {
                         let meta = LineMeta {
-                            line: self.reader.last().map_or(0, |f| f.line_no),
+                            line: self.reader.last().map_or(0, |f| f.line_no()),
                             offset: 0,
                         };
                         self.fail(e, meta);
@@ -361,7 +361,8 @@ impl Decoder {
                     budget -= 1;
                     self.stats.lines += 1;
                     if self.reader.joining()
-                        || (continuation(&line).is_some() && !self.reader.current().comment_block)
+                        || (continuation(&line).is_some()
+                            && !self.reader.current().in_comment_block())
                     {
                         if self.reader.join(&line, meta) {
                             self.run_joined(io);
@@ -424,7 +425,7 @@ impl Decoder {
         let prog = self
             .reader
             .last()
-            .map(|f| f.prog.clone())
+            .map(|f| f.prog().clone())
             .unwrap_or_else(|| Arc::from(""));
         let msg = match self
             .interp
@@ -449,7 +450,7 @@ impl Decoder {
 
     /// Raise an error from outside the decoder's own lines (e.g. stream data without CR LF).
     pub fn abort(&mut self, code: u32, msg: impl Into<String>) {
-        let line = self.reader.last().map_or(0, |f| f.line_no);
+        let line = self.reader.last().map_or(0, |f| f.line_no());
         self.fail(DecodeError::new(code, msg), LineMeta { line, offset: 0 });
     }
 
@@ -467,20 +468,20 @@ impl Decoder {
     /// labels, block search, `/n` skipping, then the block's body.
     fn run_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
         let top = self.reader.top();
-        if top.comment_block {
+        if top.in_comment_block() {
             if is_comment_end(text) {
-                top.comment_block = false;
+                top.set_comment_block(false);
             }
             return Ok(());
         }
-        if top.var_block {
+        if top.in_var_block() {
             // The lines of a `#VAR` block are declarations, read exactly as `check` reads
             // them (`V.P.TABLE[10]` is no ordinary block).
             match parse_var_line(text)? {
                 VarLine::Blank => {}
-                VarLine::End => top.var_block = false,
+                VarLine::End => top.set_var_block(false),
                 // The comment block ends inside the `#VAR` block: both flags hold.
-                VarLine::CommentBegin => top.comment_block = true,
+                VarLine::CommentBegin => top.set_comment_block(true),
                 VarLine::Decl(d) => {
                     let made = self.interp.declare(&d)?;
                     self.reader.count_declared(made);
@@ -488,7 +489,7 @@ impl Decoder {
             }
             return Ok(());
         }
-        let skipping = top.flow.skipping();
+        let skipping = top.flow().skipping();
         let block = match parse_block(text) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error.
@@ -500,13 +501,13 @@ impl Decoder {
             stream_allows(&block)?;
         }
         if skipping {
-            let flow = &mut self.reader.top().flow;
+            let flow = self.reader.top().flow_mut();
             let run_it = flow.skip_line(&block, stream, &self.interp)?;
             if !run_it {
                 return Ok(());
             }
         } else if let Some(l) = &block.label {
-            self.reader.top().flow.note_label(l, stream)?;
+            self.reader.top().flow_mut().note_label(l, stream)?;
         }
         let at = BlockAt {
             block: &block,
@@ -529,7 +530,7 @@ impl Decoder {
             Body::Control(c) => {
                 let top = rd.top();
                 let next = top.line_pos();
-                match top.flow.exec_control(c, meta, next, ip)? {
+                match top.flow_mut().exec_control(c, meta, next, ip)? {
                     FlowStep::Next => Ok(()),
                     FlowStep::Seek(at) => {
                         top.seek(at);
@@ -540,15 +541,15 @@ impl Decoder {
             }
             Body::Command(c) => ip.exec_command(c, at, rd, notes, io),
             Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
-            Body::ProgramHead { .. } if rd.current().kind == FrameKind::Local => {
+            Body::ProgramHead { .. } if rd.current().kind() == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                rd.top().flow.check_open_flow()?;
+                rd.top().flow().check_open_flow()?;
                 ip.return_from_subroutine(rd, notes);
                 ip.resume_held_end(rd, notes, io)
             }
             Body::ProgramHead { local: true, .. } => {
                 // A local subroutine section met while running: it runs only when called.
-                rd.top().flow.begin_skip(SkipUntil::LocalSubroutine);
+                rd.top().flow_mut().begin_skip(SkipUntil::LocalSubroutine);
                 Ok(())
             }
             Body::ProgramHead { local: false, .. } => Ok(()),
@@ -558,7 +559,7 @@ impl Decoder {
     fn end_of_file(&mut self, _io: &mut DecoderIo<'_>) -> Res {
         let searching = self.interp.searching();
         let top = self.reader.top();
-        if let Some(t) = top.flow.skipping_to() {
+        if let Some(t) = top.flow().skipping_to() {
             return Err(DecodeError::new(
                 codes::LABEL_NOT_FOUND,
                 format!("label {} not found", goto_text(t)),
@@ -570,7 +571,7 @@ impl Decoder {
                 "block search target not found",
             ));
         }
-        match top.kind {
+        match top.kind() {
             FrameKind::Main => Err(DecodeError::new(
                 codes::MAIN_END_MISSING,
                 "end of main program without M30/M02",

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::error::{DecodeError, Res};
-use super::frame::{read_file_line, Frame, Source, StreamNote, StreamReader};
+use super::frame::{read_file_line, Frame, StreamNote, StreamReader};
 use super::labels::{LabelIndex, LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
 use super::line::{LineMeta, LinePos, LineRead};
 use super::note::Note;
@@ -196,8 +196,8 @@ impl Reader {
 
     /// The text of the file program `prog` while a frame of it is open.
     pub(super) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
-        self.frames.iter().rev().find_map(|f| match &f.source {
-            Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
+        self.frames.iter().rev().find_map(|f| match f.file() {
+            Some(t) if **f.prog() == *prog => Some(Arc::clone(&t.text)),
             _ => None,
         })
     }
@@ -385,13 +385,13 @@ impl Reader {
         let Some(top) = self.frames.last_mut() else {
             return FileArrival::Ready;
         };
-        let Source::Loading(p) = &top.source else {
+        let Some(p) = top.loading() else {
             return FileArrival::Ready;
         };
         match store.finish_read(p) {
             None => FileArrival::Waiting,
             Some(Ok(text)) => {
-                top.source = Source::File(text);
+                top.loaded(text);
                 FileArrival::Arrived
             }
             Some(Err(e)) => FileArrival::Failed(e.into()),
@@ -429,17 +429,17 @@ impl Reader {
             Ok(ScanStep::Done(found)) => {
                 self.scan = None;
                 match found {
-                    ScanFound::Index(index) => self.top().label_index = Some(Arc::new(index)),
+                    ScanFound::Index(index) => self.top().set_label_index(Arc::new(index)),
                     other => self.scan_found = Some((goal, other)),
                 }
                 Ok(true)
             }
             Err(e) => {
                 self.scan = None;
-                let top = self.top();
+                let at = self.top().line_pos();
                 let meta = LineMeta {
-                    line: top.line_no + 1,
-                    offset: top.pos as u64,
+                    line: at.line_no + 1,
+                    offset: at.pos as u64,
                 };
                 Err((e, meta))
             }
@@ -451,7 +451,7 @@ impl Reader {
     pub(super) fn goto(&mut self, t: &GotoTarget) -> Res {
         let top = self.top();
         if top.is_stream() {
-            return top.flow.skip_to(t);
+            return top.flow_mut().skip_to(t);
         }
         // A file frame: the label index, built over several ticks; the line waits for it.
         let Some(index) = self.label_index() else {
@@ -473,7 +473,7 @@ impl Reader {
         };
         let top = self.top();
         top.seek(at);
-        top.flow.leave_to_depth(depth);
+        top.flow_mut().leave_to_depth(depth);
         Ok(())
     }
 
@@ -482,10 +482,10 @@ impl Reader {
     /// done. A stream frame has none (its jumps go forward, line by line).
     pub(super) fn label_index(&mut self) -> Option<Arc<LabelIndex>> {
         let top = self.top();
-        if let Some(i) = &top.label_index {
+        if let Some(i) = top.label_index() {
             return Some(i.clone());
         }
-        let Source::File(p) = &top.source else {
+        let Some(p) = top.file() else {
             return Some(Arc::new(LabelIndex::default()));
         };
         let scan = LabelScan::new(p.text.clone(), ScanGoal::Index);
@@ -500,7 +500,7 @@ impl Reader {
                 return self.scan_found.take().map(|(_, found)| found);
             }
         }
-        if let Source::File(p) = &self.top().source {
+        if let Some(p) = self.top().file() {
             let scan = LabelScan::new(p.text.clone(), goal);
             self.begin_scan(scan);
         }

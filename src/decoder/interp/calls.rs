@@ -192,7 +192,7 @@ impl Interpreter {
         notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let main = rd.top().kind == FrameKind::Main;
+        let main = rd.top().kind() == FrameKind::Main;
         if main && !self.implicit.end_called {
             if let Some(name) = self.settings.implicit.at_end.clone() {
                 self.implicit.end_called = true;
@@ -223,7 +223,7 @@ impl Interpreter {
         };
         match h.m {
             17 | 29 => {
-                rd.top().flow.check_open_flow()?;
+                rd.top().flow().check_open_flow()?;
                 self.return_from_subroutine(rd, notes);
                 self.resume_held_end(rd, notes, io)
             }
@@ -262,7 +262,7 @@ impl Interpreter {
                     self.emit(info, Action::None, false, io);
                 }
             }
-            Command::CommentBegin => rd.top().comment_block = true,
+            Command::CommentBegin => rd.top().set_comment_block(true),
             // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
             Command::CommentEnd => {}
             Command::Spline(s) => {
@@ -291,7 +291,7 @@ impl Interpreter {
                 self.modal.contouring = *on;
                 self.emit(info, Action::None, false, io)
             }
-            Command::Var => rd.top().var_block = true,
+            Command::Var => rd.top().set_var_block(true),
             Command::EndVar => {}
             Command::Msg(m) => {
                 let text = self.format_message(m)?;

@@ -83,14 +83,18 @@ impl Interpreter {
             ));
         };
         let top = rd.top();
-        let Source::File(p) = &top.source else {
+        let Some(p) = top.file() else {
             return Err(DecodeError::new(
                 codes::STREAM_LOCAL_CALL,
                 format!("{what} in streaming program"),
             ));
         };
-        let mut frame = Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
-        frame.label_index = Some(index);
+        let mut frame = Frame::new(
+            FrameKind::Local,
+            Source::File(p.clone()),
+            top.prog().clone(),
+        );
+        frame.set_label_index(index);
         frame.seek(at);
         Ok(Some(frame))
     }

@@ -489,7 +489,7 @@ impl Interpreter {
             .copied()
             .find(|m| matches!(m, 2 | 30 | 17 | 29));
         if let Some(m @ (17 | 29)) = end_m {
-            if rd.top().kind == FrameKind::Main {
+            if rd.top().kind() == FrameKind::Main {
                 return Err(DecodeError::new(
                     codes::UNEXPECTED_SUB_END,
                     format!("unexpected M{m} in main program"),
@@ -519,7 +519,7 @@ impl Interpreter {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            rd.top().flow.check_open_flow()?;
+            rd.top().flow().check_open_flow()?;
             self.return_from_subroutine(rd, notes);
             return self.resume_held_end(rd, notes, io);
         }
@@ -571,14 +571,14 @@ impl Interpreter {
                 format!("block search target {} not found", s.target),
             ));
         }
-        if rd.top().kind != FrameKind::Main {
+        if rd.top().kind() != FrameKind::Main {
             notes.push(Note::Warning {
                 code: codes::UNEXPECTED_PROGRAM_END,
                 msg: format!("M{m} in a subroutine: the program ends"),
             });
             Ok(())
         } else {
-            rd.top().flow.check_open_flow()
+            rd.top().flow().check_open_flow()
         }
     }
 }
