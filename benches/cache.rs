@@ -63,6 +63,7 @@ fn machine(dir: &Path) -> (Machine, Duration) {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     assert_eq!(
         m.apply(&t0, 1, Op::Start("main.nc".into())),
@@ -87,10 +88,10 @@ fn run(m: Machine, period: Duration) -> Outcome {
     let sim = rt.time();
     let (m, _) = rt.into_inner();
     let c = &m.channels()[0];
-    assert!(c.errors().is_empty(), "{:?}", c.errors());
+    assert!(c.report().errors.is_empty(), "{:?}", c.report().errors);
     Outcome {
-        opens: c.store_stats().opens,
-        hits: c.cache().hits,
+        opens: c.report().store.opens,
+        hits: c.report().cache.hits,
         sim,
         wall,
     }

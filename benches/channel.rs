@@ -48,6 +48,7 @@ impl Setup {
             index: 0,
             period,
             time: Duration::ZERO,
+            clock: ncchannel::runtime::Clock::Virtual,
         };
         assert_eq!(
             m.apply(&t0, 1, Op::Start(program.to_string())),
@@ -60,7 +61,7 @@ impl Setup {
         (
             stats.work.quantile_us(0.5),
             stats.work.quantile_us(0.99),
-            m.channels()[0].stats().blocks,
+            m.channels()[0].report().stats.blocks,
         )
     }
 }

@@ -19,6 +19,7 @@ fn soak(c: &mut Criterion) {
                     index,
                     period,
                     time: period.saturating_mul(u32::try_from(index).unwrap_or(u32::MAX)),
+                    clock: ncchannel::runtime::Clock::Virtual,
                 };
                 index += 1;
                 black_box(cycle.step(&tick));

@@ -36,6 +36,7 @@ fn stream(c: &mut Criterion) {
                 index,
                 period,
                 time: Duration::from_millis(index),
+                clock: ncchannel::runtime::Clock::Virtual,
             };
             index += 1;
             black_box(load.step(&tick));

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
 use crate::vocab::stats::{CycleStats, Histogram, LiveCycleStats};
-pub use crate::vocab::tick::Tick;
+pub use crate::vocab::tick::{Clock, Tick};
 
 /// Requests served per tick at most. A flood of requests (say a client hammering the stream
 /// object from many connections) then delays its own answers, never the tick: the rest wait
@@ -42,16 +42,14 @@ pub trait Cycle {
 
     /// Do one tick's work.
     fn step(&mut self, tick: &Tick) -> Flow;
-}
 
-/// How time passes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Clock {
-    /// Ticks run back to back; channel time advances one period per tick. Deterministic and
-    /// faster than real time, for soak tests and the demo.
-    Virtual,
-    /// Tick `k` starts at `start + k × period`, waited for with spin_sleep.
-    RealTime,
+    /// The wall time the ticks since the last call stood still waiting for the program
+    /// loader with the clock stopped (virtual time), and zero from now on. The runtime takes
+    /// it after every tick: that wait is the simulated machine's file system, not the tick's
+    /// work, and is reported apart. A cycle that reads no program files keeps the default.
+    fn take_clock_stopped(&mut self) -> Duration {
+        Duration::ZERO
+    }
 }
 
 /// Why [`Runtime::run`] returned.
@@ -217,10 +215,6 @@ impl<C: Cycle> Runtime<C> {
     /// were, so a hiccup is caught up by ticks running back to back, and channel time stays
     /// `index × period`.
     pub fn run(&mut self, max_ticks: Option<u64>) -> RunSummary {
-        crate::source::loader::set_load_wait(match self.clock {
-            Clock::Virtual => crate::source::loader::LoadWait::StopTheClock,
-            Clock::RealTime => crate::source::loader::LoadWait::Ticks,
-        });
         let wall_start = Instant::now();
         let base = self.resume_at.take().unwrap_or(wall_start);
         let first = self.next_index;
@@ -242,6 +236,7 @@ impl<C: Cycle> Runtime<C> {
                 index: self.next_index,
                 period: self.period,
                 time: channel_time(self.period, self.next_index),
+                clock: self.clock,
             };
             let (started, late) = match self.clock {
                 Clock::Virtual => (Instant::now(), None),
@@ -257,7 +252,7 @@ impl<C: Cycle> Runtime<C> {
             let flow = self.cycle.step(&tick);
             // Virtual time: a wait for the program loader stops the clock; it is the
             // simulated file system's time, counted apart, not the tick's work.
-            let stopped = crate::source::loader::take_clock_stopped();
+            let stopped = self.cycle.take_clock_stopped();
             self.stats.clock_stopped += stopped;
             let work = started.elapsed().saturating_sub(stopped);
             self.stats.work.record(work);

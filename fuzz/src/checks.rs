@@ -345,6 +345,7 @@ pub fn channel_program(data: &[u8]) {
         index,
         period,
         time: period * u32::try_from(index).unwrap_or(u32::MAX),
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     // Whole lines with CR LF, cut into packets of at most 992 bytes; longer lines are left out
     // (the stream interface refuses them whole, which the stream_buffer target covers).
@@ -619,6 +620,7 @@ fn tick_at(period: std::time::Duration, index: u64) -> ncchannel::runtime::Tick 
         index,
         period,
         time: period * u32::try_from(index).unwrap_or(u32::MAX),
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -674,7 +676,7 @@ fn serve_request(
 ) -> (Option<ncchannel::machine::Reply>, bool) {
     use ncchannel::runtime::Cycle;
     let write = matches!(op, ncchannel::machine::Op::WriteStream(_));
-    let before = machine.channels()[0].stream_fill();
+    let before = machine.channels()[0].report().stream_fill;
     let (req, caller) = ncchannel::machine::Request::new(1, op, tx.clone());
     let gave_up = give_up && caller.take();
     machine.serve(req, tick);
@@ -684,7 +686,7 @@ fn serve_request(
         assert!(reply.is_none(), "answered after its caller gave up");
         if write {
             assert_eq!(
-                machine.channels()[0].stream_fill(),
+                machine.channels()[0].report().stream_fill,
                 before,
                 "a write applied after its caller gave up"
             );

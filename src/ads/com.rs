@@ -305,11 +305,7 @@ struct PlatformAxis {
 fn platform_axes(backend: &dyn CncBackend) -> Result<Vec<PlatformAxis>, AdsResult> {
     let mut out = Vec::new();
     for ch in 1..=backend.channel_count() {
-        let n = backend
-            .status(ch)
-            .map_err(DeviceError::result)?
-            .positions
-            .len();
+        let n = backend.status(ch).map_err(AdsResult::from)?.positions.len();
         out.extend((0..n).map(|index| PlatformAxis { ch, index }));
     }
     Ok(out)
@@ -388,7 +384,7 @@ fn resolve(
 /// platform axes), names unique. `ch` 0 lists channel 1.
 pub fn objects(backend: &dyn CncBackend, ch: u16) -> Result<Vec<ObjectInfo>, AdsResult> {
     let ch = ch.max(1);
-    let view = backend.status(ch).map_err(DeviceError::result)?;
+    let view = backend.status(ch).map_err(AdsResult::from)?;
     let group = GROUP_CHANNEL + u32::from(ch);
     let axes = platform_axes(backend)?;
     let mut out = Vec::with_capacity(TABLE.len() + 16 * axes.len());
@@ -436,7 +432,7 @@ pub fn objects(backend: &dyn CncBackend, ch: u16) -> Result<Vec<ObjectInfo>, Ads
 }
 
 fn dev(e: DeviceError) -> AdsResult {
-    e.result()
+    e.into()
 }
 
 /// A fixed-size value: at least its size must be asked for; exactly its size is answered.
@@ -801,7 +797,7 @@ fn unit(r: Result<(), DeviceError>) -> Result<(), AdsResult> {
 
 /// Write step: stream bytes go to the channel's stream; its refusal is the answer.
 fn write_stream(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
-    let r = backend.write_stream(ch, data);
+    let r = super::backend::write_stream(backend, ch, data);
     if r.is_ok() {
         Ok(())
     } else {

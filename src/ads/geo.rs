@@ -12,7 +12,7 @@
 //! The HLD's mode-and-state unit (0x21–0x2F) mirrors the PLC's HLI unit
 //! (`gpCh[i]^.channel_mc_control.mode_and_state`, see [`super::hli`]): one store, two views.
 
-use super::backend::{CncBackend, DeviceError, Status};
+use super::backend::{CncBackend, Status};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::hli::{Hli, Unit};
 use super::result::AdsResult;
@@ -269,15 +269,11 @@ pub fn read(
         let bytes = hli.unit_bytes(ch, unit, at as usize, def.size as usize)?;
         return fixed(bytes, length);
     }
-    let v = backend.status(ch).map_err(DeviceError::result)?;
+    let v = backend.status(ch).map_err(AdsResult::from)?;
     if def.field == Field::PlatformAxes {
         let mut n = 0usize;
         for c in 1..=backend.channel_count() {
-            n += backend
-                .status(c)
-                .map_err(DeviceError::result)?
-                .positions
-                .len();
+            n += backend.status(c).map_err(AdsResult::from)?.positions.len();
         }
         return fixed((n as u16).to_le_bytes().to_vec(), length);
     }

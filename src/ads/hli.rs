@@ -572,7 +572,7 @@ impl Hli {
             axes.push(
                 self.backend
                     .status(ch)
-                    .map_err(DeviceError::result)?
+                    .map_err(AdsResult::from)?
                     .positions
                     .len(),
             );
@@ -631,7 +631,7 @@ impl Hli {
         let s = &img.symbols[i];
         match img.roles[s.root] {
             Role::ModeState(ch) => {
-                let st = self.backend.status(ch).map_err(DeviceError::result)?;
+                let st = self.backend.status(ch).map_err(AdsResult::from)?;
                 let mut mem = img.memory();
                 mem[s.root][0..4].copy_from_slice(&(st.mode as u32).to_le_bytes());
                 mem[s.root][4..8].copy_from_slice(&(st.state as u32).to_le_bytes());
@@ -725,7 +725,7 @@ impl Hli {
         let i = usize::from(ch) - 1;
         let refusal = img.refused.lock().unwrap_or_else(|p| p.into_inner())[i].pop_front();
         if let Some(code) = refusal {
-            let tick = self.backend.status(ch).map_err(DeviceError::result)?.tick;
+            let tick = self.backend.status(ch).map_err(AdsResult::from)?.tick;
             let mut mem = img.memory();
             mem[areas.error_record].copy_from_slice(&error_record(code, ch, tick));
             mem[areas.error_semaphore][0] = 1;
@@ -735,7 +735,7 @@ impl Hli {
         let mut rec = self
             .backend
             .error_record(ch, next)
-            .map_err(DeviceError::result)?;
+            .map_err(AdsResult::from)?;
         if next >= rec.total {
             return Ok(());
         }
@@ -746,9 +746,9 @@ impl Hli {
             rec = self
                 .backend
                 .error_record(ch, index)
-                .map_err(DeviceError::result)?;
+                .map_err(AdsResult::from)?;
         }
-        let tick = self.backend.status(ch).map_err(DeviceError::result)?.tick;
+        let tick = self.backend.status(ch).map_err(AdsResult::from)?.tick;
         let code = rec.error.as_ref().map_or(0, |(c, _)| *c);
         let record = error_record(code, ch, tick);
         let mut mem = img.memory();
@@ -786,7 +786,7 @@ impl Hli {
                 }
                 let (mode, state) = match self.backend.status(ch) {
                     Ok(st) => (st.mode as u32, st.state as u32),
-                    Err(e) => return Some(Err(e.result())),
+                    Err(e) => return Some(Err(e.into())),
                 };
                 let mut mem = img.memory();
                 let r = &mut mem[areas.request];
@@ -1162,7 +1162,10 @@ mod tests {
             "no error yet"
         );
         // A line without CR LF while no program runs: the channel raises error 21476.
-        assert_eq!(b.write_stream(1, b"N10 X1\n"), AdsResult::INVALID_DATA);
+        assert_eq!(
+            crate::ads::backend::write_stream(b, 1, b"N10 X1\n"),
+            AdsResult::INVALID_DATA
+        );
         assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, sem, 1).unwrap(), [1]);
         let r = hli.read(GROUP_VALUE_BY_HANDLE, rec, 942).unwrap();
         assert_eq!(r.len(), ERROR_RECORD_BYTES);

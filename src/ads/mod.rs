@@ -4,11 +4,11 @@
 //!
 //! The object table reaches the channels only through [`backend::CncBackend`], one door:
 //! `call(channel, Op) → Reply`, the channel's own vocabulary (`crate::machine`). The runtime
-//! implements it ([`channel_backend::ChannelBackend`]); the tests drive real channels through
-//! it too, so there is no stand-in channel to drift from the real one.
+//! implements it beside the machine (`crate::machine::remote::ChannelBackend`); the tests
+//! drive real channels through it too, so there is no stand-in channel to drift from the
+//! real one.
 
 pub mod backend;
-pub mod channel_backend;
 pub mod client;
 pub mod com;
 pub(crate) mod description;

@@ -17,7 +17,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::backend::{CncBackend, DeviceError};
+use super::backend::CncBackend;
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
 use crate::vocab::axis::slot_of;
@@ -183,7 +183,7 @@ impl Sda {
     fn handle(&self, ch: u16, name: Var) -> Result<u32, AdsResult> {
         // Only a variable that exists gets a handle (zero offsets 1…6 always do).
         if let Var::External(n) = &name {
-            self.backend.read_ve(ch, n).map_err(DeviceError::result)?;
+            self.backend.read_ve(ch, n).map_err(AdsResult::from)?;
         }
         let mut names = self.names.lock().unwrap_or_else(|p| p.into_inner());
         let i = match names.iter().position(|n| *n == name) {
@@ -202,7 +202,7 @@ impl Sda {
             Var::External(name) => self
                 .backend
                 .read_ve(ch, name)
-                .map_err(DeviceError::result)?
+                .map_err(AdsResult::from)?
                 .to_le_bytes()
                 .to_vec(),
             Var::ZeroOffset(i) => self.zero_offset(ch, *i)?,
@@ -216,7 +216,7 @@ impl Sda {
     /// `V.G.NP[i].V`: one DINT (0.1 µm, saturating) per configured axis of the channel, in
     /// the channel's axis order.
     fn zero_offset(&self, ch: u16, i: usize) -> Result<Vec<u8>, AdsResult> {
-        let v = self.backend.status(ch).map_err(DeviceError::result)?;
+        let v = self.backend.status(ch).map_err(AdsResult::from)?;
         let table = v.zero_offsets.get(i - 1).ok_or(AdsResult::NOT_FOUND)?;
         Ok(v.positions
             .iter()
@@ -235,7 +235,7 @@ impl Sda {
             Var::External(name) => self
                 .backend
                 .write_ve(ch, name, value_arg(data)?)
-                .map_err(DeviceError::result),
+                .map_err(AdsResult::from),
             Var::ZeroOffset(_) => Err(AdsResult::ACCESS_DENIED),
         }
     }

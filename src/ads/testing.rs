@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use super::backend::CncBackend;
-use super::channel_backend::Ticking;
+use crate::machine::remote::Ticking;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 

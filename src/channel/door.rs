@@ -7,11 +7,17 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use super::{
-    ActiveBlock, Channel, CommandError, ErrorRecord, ExecutedBlock, HmiCommands, Mode,
-    SearchCommand, State,
+    ActiveBlock, Channel, ChannelStats, CommandError, ErrorRecord, ExecutedBlock, HmiCommands,
+    Mode, SearchCommand, State,
 };
-use crate::decoder::SearchTarget;
-use crate::source::stream::StreamWriteError;
+use crate::decoder::modal::Modal;
+use crate::decoder::vars::VarClass;
+use crate::decoder::{DecoderStats, SearchTarget};
+use crate::lang::block::AxisName;
+use crate::motion::trace::Trace;
+use crate::source::store::StoreStats;
+use crate::source::stream::{StreamCounters, StreamWriteError};
+use crate::vocab::axis::Position;
 
 /// What a client asks of a channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -166,6 +172,85 @@ pub struct Status {
     pub distance_to_go_mm: f64,
 }
 
+/// What a channel tells after a run (and what tests read between ticks): its counters and
+/// those of the parts it owns, the errors, the position, the motion trace. Built on demand by
+/// [`Channel::report`], never by the tick.
+#[derive(Debug, Clone)]
+pub struct ChannelReport {
+    /// 1-based channel number.
+    pub number: u32,
+    pub mode: Mode,
+    pub state: State,
+    pub stats: ChannelStats,
+    /// Program files opened and read, by the program store.
+    pub store: StoreStats,
+    pub cache: CacheStats,
+    /// What passed through the stream interface.
+    pub stream: StreamCounters,
+    /// Stream fill level: (used, free) bytes.
+    pub stream_fill: (usize, usize),
+    pub decoder: DecoderStats,
+    /// The decoder's modal state (it runs ahead of execution by the lookahead).
+    pub modal: Modal,
+    /// The decoder reads the stream interface (a streaming program runs).
+    pub reads_stream: bool,
+    /// Block counter of the running program (ISG: every decoded line).
+    pub block_counter: u64,
+    /// Machine position of every axis slot, mm / degrees.
+    pub position: Position,
+    /// The configured axes' positions under their configured names (`X`, `X1`), in
+    /// `AXIS_LETTERS` order, mm / degrees.
+    pub named_positions: Vec<(AxisName, f64)>,
+    /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first.
+    pub errors: Vec<ErrorRecord>,
+    pub last_error: Option<ErrorRecord>,
+    /// The latest operator message an NC program sent with `#MSG` (`mc_message_r`).
+    pub message: Option<String>,
+    /// Command parameter (0x108): the program `ACTIVE` starts.
+    pub program: Option<String>,
+    /// Blocks the lookahead window holds and may not release yet (the memory effect): what
+    /// the axes wait for during an interrupt.
+    pub held_blocks: usize,
+    /// The motion trace `run --plot` asked for ([`TraceOp::Plot`]), if on.
+    pub trace: Option<Trace>,
+    /// Bytes of variables by class, in [`VarClass`] order.
+    var_bytes: [usize; VAR_CLASSES.len()],
+}
+
+/// The variable classes a report counts, in the order of `ChannelReport::var_bytes`.
+const VAR_CLASSES: [VarClass; 5] = [
+    VarClass::P,
+    VarClass::Program,
+    VarClass::Local,
+    VarClass::SelfRetaining,
+    VarClass::External,
+];
+
+impl ChannelReport {
+    /// Bytes the decoder's variables of `class` take (what the class's limit counts).
+    pub fn var_bytes(&self, class: VarClass) -> usize {
+        // Exhaustive: a new class must find its place in `VAR_CLASSES`.
+        let i = match class {
+            VarClass::P => 0,
+            VarClass::Program => 1,
+            VarClass::Local => 2,
+            VarClass::SelfRetaining => 3,
+            VarClass::External => 4,
+        };
+        debug_assert_eq!(VAR_CLASSES[i], class);
+        self.var_bytes[i]
+    }
+}
+
+/// The file cache's counters and contents.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct CacheStats {
+    /// Calls served from the cache.
+    pub hits: u64,
+    /// Names of the cached files, in the cache's order.
+    pub files: Vec<String>,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Reply {
     Done,
@@ -202,43 +287,72 @@ fn wire(e: &ErrorRecord) -> (u32, String) {
 /// last error when it is the newest one.
 pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
     let i = usize::try_from(index).ok()?;
-    if let Some(e) = c.errors().get(i) {
+    if let Some(e) = c.log.errors().get(i) {
         return Some(wire(e));
     }
-    if index + 1 == c.stats().errors {
-        return c.last_error().map(wire);
+    if index + 1 == c.log.stats().errors {
+        return c.log.last_error().map(wire);
     }
     None
 }
 
 pub(crate) fn status_of(c: &Channel) -> Status {
-    let (used, free) = c.stream_fill();
+    let stats = c.log.stats();
     Status {
-        mode: c.mode(),
-        state: c.state(),
-        block_counter: c.block_counter(),
-        stream_used: used,
-        stream_free: free,
+        mode: c.isg.mode(),
+        state: c.isg.state(),
+        block_counter: c.decoder.counter(),
+        stream_used: c.stream.used(),
+        stream_free: c.stream.free(),
         positions: c.axis_positions(),
-        last_error: c.last_error().map(wire),
-        override_pct: c.motion().override_pct(),
-        blocks: c.stats().blocks,
+        last_error: c.log.last_error().map(wire),
+        override_pct: c.motion.override_pct(),
+        blocks: stats.blocks,
         tick: 0,
         period: Duration::ZERO,
         cycle_times: CycleTimes::default(),
-        program: c.running_program().map(String::from),
-        active_block: c.active_block().cloned(),
-        feed_mm_per_min: c.decoder().modal().feed_mm_per_min,
-        velocity_mm_per_s: c.motion().velocity_mm_per_s(),
-        hmi: c.hmi(),
-        searching: c.decoder().searching(),
+        program: c.run.running().map(String::from),
+        active_block: c.run.active_block().cloned(),
+        feed_mm_per_min: c.decoder.modal().feed_mm_per_min,
+        velocity_mm_per_s: c.motion.velocity_mm_per_s(),
+        hmi: c.hmi.commands(),
+        searching: c.decoder.searching(),
         ipo_blocks: c.ipo_blocks(),
-        errors_total: c.stats().errors,
+        errors_total: stats.errors,
         pcs_positions: c.pcs_positions(),
-        message: c.message().map(str::to_string),
-        queued_blocks: c.queued_blocks(),
-        programs_ended: c.stats().programs_ended,
-        zero_offsets: *c.zero_offsets(),
-        distance_to_go_mm: c.motion().distance_to_go_mm(),
+        message: c.log.message().map(str::to_string),
+        queued_blocks: c.queue.len(),
+        programs_ended: stats.programs_ended,
+        zero_offsets: c.zero_offsets,
+        distance_to_go_mm: c.motion.distance_to_go_mm(),
+    }
+}
+
+pub(crate) fn report_of(c: &Channel) -> ChannelReport {
+    ChannelReport {
+        number: c.log.number(),
+        mode: c.isg.mode(),
+        state: c.isg.state(),
+        stats: c.log.stats(),
+        store: c.store.stats(),
+        cache: CacheStats {
+            hits: c.cache.hits,
+            files: c.cache.names().map(String::from).collect(),
+        },
+        stream: *c.stream.counters(),
+        stream_fill: (c.stream.used(), c.stream.free()),
+        decoder: c.decoder.stats(),
+        modal: c.decoder.modal().clone(),
+        reads_stream: c.decoder.reads_stream(),
+        block_counter: c.decoder.counter(),
+        position: c.motion.position(),
+        named_positions: c.named_positions(),
+        errors: c.log.errors().to_vec(),
+        last_error: c.log.last_error().cloned(),
+        message: c.log.message().map(String::from),
+        program: c.hmi.program().map(String::from),
+        held_blocks: c.motion.held_blocks(),
+        trace: c.motion.trace().cloned(),
+        var_bytes: VAR_CLASSES.map(|class| c.decoder.vars().bytes(class)),
     }
 }

@@ -107,7 +107,7 @@ fn start_list(args: &BenchArgs, default: &str) -> Result<PathBuf, String> {
 }
 
 /// A usage error of `bench`: said on stderr, exit 2.
-pub(super) fn usage(msg: String) -> ExitCode {
+fn usage(msg: String) -> ExitCode {
     eprintln!("ncchannel bench: {msg}");
     ExitCode::from(super::exit::USAGE)
 }
@@ -136,7 +136,8 @@ pub fn execute(args: BenchArgs) -> ExitCode {
             params: &params,
             seconds: args.seconds,
             pages: args.pages as usize,
-        }),
+        })
+        .unwrap_or_else(usage),
     }
 }
 
@@ -186,8 +187,7 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     ));
     let blocks = cycle.total_blocks;
     let (mut ok, mut rejected, mut bytes) = (0, 0, 0);
-    for s in &cycle.slots {
-        let c = s.feeder.counters();
+    for c in cycle.feed_counters() {
         ok += c.writes_ok;
         rejected += c.writes_rejected;
         bytes += c.bytes;

@@ -15,12 +15,12 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::out::{say, Stdout};
-use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::client::{self, AdsClient, ClientError};
 use crate::ads::frame::AmsAddr;
 use crate::ads::objects::{offset, GROUP_CHANNEL, PORT_CNC_COM};
 use crate::ads::result::AdsResult;
 use crate::ads::ServerConfig;
+use crate::machine::remote::ChannelBackend;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, Runtime};
@@ -156,7 +156,7 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
     };
     let ticks = rt.ticks();
     let (machine, stats) = rt.into_inner();
-    let blocks = machine.channels().first().map_or(0, |c| c.stats().blocks);
+    let blocks = machine.channels().first().map_or(0, |c| c.report().stats.blocks);
     let code = report(b, period, &measured);
     // The cycle under this load: on a shared machine a starved runtime shows here.
     say(format_args!(

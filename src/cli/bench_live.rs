@@ -18,8 +18,8 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::out::Stdout;
-use crate::ads::channel_backend::ChannelBackend;
 use crate::http::{ControlAccess, HttpConfig, HttpHandle};
+use crate::machine::remote::ChannelBackend;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, Runtime};
@@ -130,24 +130,21 @@ fn settle(rt: &mut Runtime<Machine>, done: impl Fn() -> bool) -> bool {
     }
 }
 
-pub fn execute(b: &LiveBench<'_>) -> ExitCode {
-    let usage = super::bench::usage;
+/// Runs the bench; `Err` is a usage error (the parameter lists), which `bench` reports as such.
+pub fn execute(b: &LiveBench<'_>) -> Result<ExitCode, String> {
     let fail = |msg: String| {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::CHANNEL_ERROR)
     };
     let folder = match tempfile::tempdir() {
         Ok(d) => d,
-        Err(e) => return fail(format!("a folder for the generated program: {e}")),
+        Err(e) => return Ok(fail(format!("a folder for the generated program: {e}"))),
     };
     let blocks = (b.seconds * 2.0 * BLOCKS_PER_S * BLOCK_MARGIN).ceil() as u64;
     if let Err(e) = std::fs::write(folder.path().join(PROGRAM), contour(blocks)) {
-        return fail(format!("writing the generated program: {e}"));
+        return Ok(fail(format!("writing the generated program: {e}")));
     }
-    let mut config = match super::run::load_config(b.params) {
-        Ok(c) => c,
-        Err(e) => return usage(e),
-    };
+    let mut config = super::run::load_config(b.params)?;
     super::run::search_first(
         &mut config,
         0,
@@ -156,13 +153,13 @@ pub fn execute(b: &LiveBench<'_>) -> ExitCode {
     );
     let channels = match crate::setup::channels(&config, false) {
         Ok(c) => c,
-        Err(e) => return usage(e.to_string()),
+        Err(e) => return Err(e.to_string()),
     };
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
     if let Err(e) = super::serve::start_at_first_tick(&mut machine, period, PROGRAM) {
-        return fail(format!("starting the generated program: {e}"));
+        return Ok(fail(format!("starting the generated program: {e}")));
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
     let view = HttpConfig {
@@ -173,20 +170,20 @@ pub fn execute(b: &LiveBench<'_>) -> ExitCode {
     let backend = Arc::new(ChannelBackend::new(requests, nch));
     let web = match crate::http::spawn(&view, backend, Some(rt.live_stats())) {
         Ok(h) => h,
-        Err(e) => return fail(format!("the web view: {e}")),
+        Err(e) => return Ok(fail(format!("the web view: {e}"))),
     };
     let measured = alternate(&mut rt, &web, b);
     web.shutdown();
     let (without, with, updates) = match measured {
         Ok(m) => m,
-        Err(e) => return fail(e),
+        Err(e) => return Ok(fail(e)),
     };
     let executed = rt
         .cycle()
         .channels()
         .first()
-        .map_or(0, |c| c.stats().blocks);
-    report(b, period, &without, &with, updates, executed)
+        .map_or(0, |c| c.report().stats.blocks);
+    Ok(report(b, period, &without, &with, updates, executed))
 }
 
 /// Slices of about a second, without and with the pages in turn, so a change of load on a

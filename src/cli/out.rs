@@ -1,4 +1,4 @@
-//! Standard output for the commands' results.
+//! Standard output for the commands' results, and their report files.
 //!
 //! `println!` panics when the reader of standard output has gone (`ncchannel check FILE |
 //! head`: a panic message and exit 101). [`Stdout`] writes through one locked handle and
@@ -9,6 +9,7 @@
 
 use std::fmt::Display;
 use std::io::{self, Write};
+use std::path::Path;
 
 /// Is this the error of a write whose reader went away (a closed pipe)?
 pub(crate) fn reader_gone(e: &io::Error) -> bool {
@@ -87,4 +88,16 @@ pub(crate) fn say(msg: std::fmt::Arguments<'_>) {
 pub(crate) fn log(msg: std::fmt::Arguments<'_>) {
     let time = humantime::format_rfc3339_millis(std::time::SystemTime::now());
     say(format_args!("{time} {msg}"));
+}
+
+/// Write a report file; false (after saying why) when it could not be written.
+pub(crate) fn write_report(command: &str, path: &Path, json: &str) -> bool {
+    let text = format!("{json}\n");
+    match crate::destination::write(path, text.as_bytes()) {
+        Err(e) if !reader_gone(&e) => {
+            eprintln!("ncchannel {command}: --report {}: {e}", path.display());
+            false
+        }
+        _ => true,
+    }
 }

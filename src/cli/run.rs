@@ -155,19 +155,12 @@ fn program_exists(
     args: &RunArgs,
     program: &str,
 ) -> Result<(), String> {
-    use crate::source::store::ProgramKind;
     let Some(c) = channels.get((args.channel as usize).wrapping_sub(1)) else {
         return Ok(());
     };
-    let store = c.store();
-    if store.is_streaming_program(program) || store.find(program, ProgramKind::Main).is_ok() {
+    let Err(dirs) = c.find_program(program) else {
         return Ok(());
-    }
-    let dirs: Vec<String> = store
-        .search_dirs()
-        .iter()
-        .map(|d| d.dir.display().to_string())
-        .collect();
+    };
     Err(format!(
         "program {program} not found in the current folder nor in channel {}'s search paths ({})",
         args.channel,
@@ -342,14 +335,7 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
         .copied()
         .flatten();
     let outcome = outcome_of(summary.as_ref().map(|s| s.end), finish);
-    let end = Tick {
-        index: ticks,
-        period,
-        time: end_time,
-    };
-    if let Reply::Trace(Err(e)) = machine.apply(&end, args.channel, Op::Trace(TraceOp::FinishCsv)) {
-        eprintln!("ncchannel run: --trace: {e}");
-    }
+    finish_trace(&mut machine, args.channel, ticks, end_time, period);
     let report = build_report(
         &machine,
         &args,
@@ -359,9 +345,9 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
         &stats,
         period,
     );
-    let c = &machine.channels()[args.channel as usize - 1];
+    let c = machine.channels()[args.channel as usize - 1].report();
     let mut written = true;
-    if let (Some(p), Some(trace)) = (&args.plot, c.motion().trace()) {
+    if let (Some(p), Some(trace)) = (&args.plot, &c.trace) {
         let title = format!("ncchannel run {program}");
         if let Err(e) = crate::report::plot::write(p, trace, &title) {
             eprintln!("ncchannel run: --plot {e}");
@@ -388,11 +374,7 @@ fn run_program(
     program: &str,
     period: Duration,
 ) -> (Runtime<Machine>, Option<crate::runtime::RunSummary>) {
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
+    let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
     machine.apply(&tick0, ch, Op::SearchAt(args.search));
     machine.apply(&tick0, ch, Op::SkipMask(args.skip_mask));
@@ -423,13 +405,28 @@ fn run_program(
     (rt, summary)
 }
 
+/// `--trace`: the CSV file's last rows written out, at the tick the run ended.
+fn finish_trace(
+    machine: &mut Machine,
+    channel: u32,
+    ticks: u64,
+    end_time: Duration,
+    period: Duration,
+) {
+    let end = Tick {
+        index: ticks,
+        period,
+        time: end_time,
+        clock: Clock::Virtual,
+    };
+    if let Reply::Trace(Err(e)) = machine.apply(&end, channel, Op::Trace(TraceOp::FinishCsv)) {
+        eprintln!("ncchannel run: --trace: {e}");
+    }
+}
+
 /// `--plot` and `--trace`: the motion trace of the channel that runs the program.
 fn enable_traces(machine: &mut Machine, args: &RunArgs, period: Duration) -> Result<(), String> {
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
+    let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
     if args.plot.is_some() {
         let op = Op::Trace(TraceOp::Plot {
@@ -502,22 +499,22 @@ fn build_report(
     stats: &crate::vocab::stats::CycleStats,
     period: Duration,
 ) -> Report {
-    let c = &machine.channels()[args.channel as usize - 1];
+    let c = machine.channels()[args.channel as usize - 1].report();
     Report {
         outcome,
         ticks,
         time_s,
         wall_s: summary.map_or(0.0, |s| s.wall.as_secs_f64()),
-        blocks: c.stats().blocks,
+        blocks: c.stats.blocks,
         position: c
-            .named_positions()
+            .named_positions
             .into_iter()
             .map(|(a, v)| (a.to_string(), v))
             .collect::<BTreeMap<_, _>>(),
-        stream: StreamReport::from(c.stream().counters()),
-        interrupts: c.stats().interrupts,
+        stream: StreamReport::from(&c.stream),
+        interrupts: c.stats.interrupts,
         errors: c
-            .errors()
+            .errors
             .iter()
             .map(|e| ErrorReport {
                 code: e.code,
@@ -528,10 +525,10 @@ fn build_report(
             .collect(),
         cycle: CycleReport::new(period, stats),
         files: FilesReport {
-            opens: c.store_stats().opens,
-            bytes_read: c.store_stats().bytes_read,
-            cache_hits: c.cache().hits,
-            latency_s: c.store_stats().latency.as_secs_f64(),
+            opens: c.store.opens,
+            bytes_read: c.store.bytes_read,
+            cache_hits: c.cache.hits,
+            latency_s: c.store.latency.as_secs_f64(),
         },
     }
 }

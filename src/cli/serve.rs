@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::{AmsNetId, ServerConfig};
+use crate::machine::remote::ChannelBackend;
 use crate::machine::{Machine, Op, Reply, StopWhen};
 use crate::report::event::{Backlog, EventLog};
 use crate::runtime::{Clock, Runtime, Tick};
@@ -149,11 +149,7 @@ pub(super) fn start_at_first_tick(
     period: Duration,
     program: &str,
 ) -> Result<(), String> {
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-    };
+    let tick0 = Tick::first(period, Clock::RealTime);
     match machine.apply(&tick0, 1, Op::Start(program.to_string())) {
         Reply::Command(Err(e)) => Err(e.to_string()),
         _ => Ok(()),
@@ -292,7 +288,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
 fn stopped(rt: Runtime<Machine>, summary: &crate::runtime::RunSummary, events: bool) -> ExitCode {
     let (mut machine, stats) = rt.into_inner();
     let log = machine.finish_log();
-    let blocks: u64 = machine.channels().iter().map(|c| c.stats().blocks).sum();
+    let blocks: u64 = machine
+        .channels()
+        .iter()
+        .map(|c| c.report().stats.blocks)
+        .sum();
     super::logger::line(format_args!(
         "stopped after {} ticks ({:.1} s), {blocks} blocks; {}",
         summary.ticks,

@@ -8,8 +8,8 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::ads::channel_backend::ChannelBackend;
 use crate::ads::ServerConfig;
+use crate::machine::remote::ChannelBackend;
 use crate::runtime::{Clock, RunEnd, Runtime};
 use crate::soak::external::{resident, Supervised};
 use crate::soak::report::{CycleFigures, MemoryReport, RunFigures, SoakReport};

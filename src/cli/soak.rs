@@ -75,18 +75,6 @@ fn human_out(report: Option<&Path>) -> Box<dyn std::io::Write> {
     }
 }
 
-/// Write a report file; false (after saying why) when it could not be written.
-pub(crate) fn write_report(command: &str, path: &Path, json: &str) -> bool {
-    let text = format!("{json}\n");
-    match crate::destination::write(path, text.as_bytes()) {
-        Err(e) if !super::out::reader_gone(&e) => {
-            eprintln!("ncchannel {command}: --report {}: {e}", path.display());
-            false
-        }
-        _ => true,
-    }
-}
-
 pub fn execute(args: SoakArgs) -> ExitCode {
     if let Some(SoakCommand::Merge(m)) = args.merge {
         return super::soak_merge::execute(m);
@@ -148,7 +136,7 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         };
         let _ = report.print_human(&mut *human_out(args.report.as_deref()));
         if let Some(p) = &args.report {
-            if !write_report("soak", p, &report.to_json()) {
+            if !super::out::write_report("soak", p, &report.to_json()) {
                 return ExitCode::from(exit::USAGE);
             }
         }
@@ -196,7 +184,7 @@ fn run_campaign(
     let report = CampaignReport::new(spec, shard, plan.len(), runs);
     let _ = report.print_human(&mut *out);
     if let Some(p) = &args.report {
-        if !write_report("soak", p, &report.to_json()) {
+        if !super::out::write_report("soak", p, &report.to_json()) {
             return Err(ExitCode::from(exit::USAGE));
         }
     }

@@ -62,7 +62,7 @@ pub fn execute(args: MergeArgs) -> ExitCode {
         merged.print_human(&mut std::io::stdout())
     };
     if let Some(p) = &args.report {
-        if !super::soak::write_report("soak merge", p, &merged.to_json()) {
+        if !super::out::write_report("soak merge", p, &merged.to_json()) {
             return ExitCode::from(exit::USAGE);
         }
     }

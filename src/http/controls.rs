@@ -7,7 +7,7 @@
 //! protocol"), so that site cannot command the channels through a user's browser.
 
 use super::{Backend, ControlAccess};
-use crate::ads::backend::DeviceError;
+use crate::machine::remote::DeviceError;
 use crate::machine::{Op, Reply};
 use crate::vocab::mode::State;
 

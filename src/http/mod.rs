@@ -21,7 +21,7 @@ use std::time::Duration;
 
 pub use server::{spawn, HttpHandle};
 
-use crate::ads::backend::CncBackend;
+use crate::machine::remote::CncBackend;
 
 /// Pages connected to the event stream at once; more are answered 503. Each costs one
 /// thread and one bounded queue.

@@ -370,7 +370,7 @@ impl EventLog {
                     note_dropped(&mut out);
                     // After a write error the sink only counts: the tick is never held up.
                     for ev in batch.drain(..) {
-                        out.event(&ev);
+                        out.line(&ev);
                     }
                     // Hand the empty Vec back; if the tick has enough spares, let it go.
                     let _ = recycle_tx.try_send(batch);
@@ -514,6 +514,7 @@ mod tests {
             index: 3,
             period: Duration::from_millis(1),
             time: Duration::from_millis(3),
+            clock: crate::vocab::tick::Clock::Virtual,
         };
         let e = Event::new(
             &tick,
@@ -571,6 +572,7 @@ mod tests {
             index: 0,
             period: Duration::from_millis(1),
             time: Duration::ZERO,
+            clock: crate::vocab::tick::Clock::Virtual,
         };
         let batches = MAX_QUEUED_BATCHES * 3;
         for _ in 0..batches {

@@ -10,8 +10,6 @@
 use std::fs::File;
 use std::io::{self, Write};
 
-use super::event::Event;
-
 /// The buffer of whole lines is written out when it holds this many bytes, whatever the
 /// flush policy (bounded memory, large writes).
 const FLUSH_BYTES: usize = 64 * 1024;
@@ -51,8 +49,9 @@ impl LineSink {
         }
     }
 
-    /// One event as one line.
-    pub(crate) fn event(&mut self, ev: &Event) {
+    /// One value (an event) as one line of JSON. Generic over what it writes, so the writer
+    /// needs nothing of the event vocabulary that uses it.
+    pub(crate) fn line<T: serde::Serialize>(&mut self, value: &T) {
         if self.failed.is_some() {
             self.lost += 1;
             return;
@@ -60,7 +59,7 @@ impl LineSink {
         let start = self.pending.len();
         // Serialising plain strings, numbers and options into a Vec cannot fail; if it did,
         // the half line is taken back.
-        if serde_json::to_writer(&mut self.pending, ev).is_err() {
+        if serde_json::to_writer(&mut self.pending, value).is_err() {
             self.pending.truncate(start);
             return;
         }
@@ -169,7 +168,7 @@ fn write_counted(out: &mut dyn Write, buf: &[u8]) -> Result<(), (usize, io::Erro
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::event::EventKind;
+    use crate::report::event::{Event, EventKind};
     use crate::vocab::tick::Tick;
     use std::sync::{Arc, Mutex};
     use std::time::Duration;
@@ -202,6 +201,7 @@ mod tests {
             index: i,
             period: Duration::from_millis(1),
             time: Duration::from_millis(i),
+            clock: crate::vocab::tick::Clock::Virtual,
         };
         Event::new(
             &tick,
@@ -227,7 +227,7 @@ mod tests {
         let mut sink = LineSink::new(Box::new(out), None, "test".into());
         // Far more than one flush's worth, so the size-triggered flushes happen too.
         for i in 0..5000 {
-            sink.event(&block(i));
+            sink.line(&block(i));
             if i % 700 == 0 {
                 sink.flush();
             }
@@ -252,7 +252,7 @@ mod tests {
         };
         let mut sink = LineSink::new(Box::new(out), None, "test".into());
         for i in 0..3000 {
-            sink.event(&block(i));
+            sink.line(&block(i));
         }
         let e = sink.finish().expect_err("the disk filled");
         assert_eq!(e.kind(), io::ErrorKind::StorageFull);

@@ -11,17 +11,19 @@
 
 use std::collections::{BTreeMap, VecDeque};
 use std::convert::Infallible;
+use std::sync::Arc;
+use std::time::Duration;
 
 use serde::Serialize;
 
-use super::feed::{Owed, SoakFeeder};
+use super::feed::{FeedCounters, Owed, SoakFeeder};
 use super::invariants::{check_blocks, Checksum, Tally, Verdict};
 use super::rng::SplitMix64;
 use super::scenario::Faults;
 use crate::channel::{Channel, State};
 use crate::machine::{Machine, Op, Reply};
 use crate::motion::AxisLimits;
-use crate::runtime::{Cycle, Flow, Tick};
+use crate::runtime::{Clock, Cycle, Flow, Tick};
 
 /// The one way the soak commands a channel, and reads it.
 pub trait Door {
@@ -29,15 +31,6 @@ pub trait Door {
     fn apply(&mut self, tick: &Tick, op: Op) -> Reply;
     /// The channel, read-only (state, position, errors for the checks).
     fn channel(&self) -> &Channel;
-}
-
-impl Door for Channel {
-    fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
-        Channel::apply(self, tick, op)
-    }
-    fn channel(&self) -> &Channel {
-        self
-    }
 }
 
 /// One channel of a [`Machine`] as a door: ops go through [`Machine::apply`].
@@ -427,7 +420,7 @@ impl SoakChannel {
 
     /// The counters for the report, with the channel's own figures and the checksum.
     pub fn report(&self, c: &Channel) -> SoakCounters {
-        let st = c.stats();
+        let st = c.report().stats;
         SoakCounters {
             interrupts: st.interrupts,
             warnings: st.warnings,
@@ -437,41 +430,51 @@ impl SoakChannel {
     }
 }
 
-/// One channel soaked by its own built-in client.
+/// One channel soaked by its own built-in client: the channel itself lives in the machine.
 pub struct Slot {
-    pub channel: Channel,
+    /// 1-based channel number in the machine.
+    number: u32,
     pub feeder: SoakFeeder,
     pub core: SoakChannel,
     rng: SplitMix64,
+    /// The packet on offer, shared with each write attempt until the channel takes it: the
+    /// feeder offers the same packet again after a refusal, so a refused packet is not
+    /// copied again (a full buffer refuses most attempts).
+    pending: Option<Arc<[u8]>>,
 }
 
 impl Slot {
+    /// The soak's client of channel `number` of `machine`; `None` when the machine has no
+    /// such channel.
     pub fn new(
-        mut channel: Channel,
+        machine: &mut Machine,
+        number: u32,
         program: String,
         feeder: SoakFeeder,
         axes: &[AxisLimits],
         rng: SplitMix64,
-    ) -> Self {
+    ) -> Option<Self> {
         // Turning observation on emits nothing, so the tick does not matter.
-        let tick0 = Tick {
-            index: 0,
-            period: std::time::Duration::ZERO,
-            time: std::time::Duration::ZERO,
-        };
-        channel.apply(&tick0, Op::ObserveStreamBlocks(true));
-        let core = SoakChannel::new(channel.number(), Some(program), axes);
-        Slot {
-            channel,
+        let tick0 = Tick::first(Duration::ZERO, Clock::Virtual);
+        let mut door = MachineDoor::new(machine, number)?;
+        door.apply(&tick0, Op::ObserveStreamBlocks(true));
+        Some(Slot {
+            number,
             feeder,
-            core,
+            core: SoakChannel::new(number, Some(program), axes),
             rng,
-        }
+            pending: None,
+        })
     }
 
-    /// The counters for the report, the client's writes included.
-    pub fn report(&self) -> SoakCounters {
+    /// The counters for the report, the client's writes and the channel's own figures
+    /// included.
+    fn report(&self, machine: &Machine) -> SoakCounters {
         let f = self.feeder.counters();
+        let own = (self.number as usize)
+            .checked_sub(1)
+            .and_then(|i| machine.channels().get(i))
+            .map_or_else(|| self.core.counters.clone(), |c| self.core.report(c));
         SoakCounters {
             writes_ok: f.writes_ok,
             writes_rejected: f.writes_rejected,
@@ -479,14 +482,17 @@ impl Slot {
             bytes: f.bytes,
             lines_accepted: f.lines,
             pauses: f.pauses,
-            ..self.core.report(&self.channel)
+            ..own
         }
     }
 }
 
-/// The in-process soak as a runtime [`Cycle`].
+/// The in-process soak as a runtime [`Cycle`]: the shipped [`Machine`] with a built-in
+/// client and a fault plan per soaked channel around it, as `serve --soak` wraps it for
+/// external clients. The machine's tick is the one `run` and `serve` tick.
 pub struct SoakCycle {
-    pub slots: Vec<Slot>,
+    machine: Machine,
+    slots: Vec<Slot>,
     faults: Faults,
     expected_errors: Vec<u32>,
     /// Stop when this many stream blocks ran, all channels together.
@@ -498,12 +504,14 @@ pub struct SoakCycle {
 
 impl SoakCycle {
     pub fn new(
+        machine: Machine,
         slots: Vec<Slot>,
         faults: Faults,
         expected_errors: Vec<u32>,
         target_blocks: Option<u64>,
     ) -> Self {
         SoakCycle {
+            machine,
             slots,
             faults,
             expected_errors,
@@ -512,6 +520,16 @@ impl SoakCycle {
             tallies: Tallies::default(),
             planned: false,
         }
+    }
+
+    /// Each soaked channel's counters, in the order of the scenario.
+    pub fn reports(&self) -> Vec<SoakCounters> {
+        self.slots.iter().map(|s| s.report(&self.machine)).collect()
+    }
+
+    /// The built-in clients' write counters, in the order of the scenario.
+    pub fn feed_counters(&self) -> impl Iterator<Item = &FeedCounters> {
+        self.slots.iter().map(|s| s.feeder.counters())
     }
 }
 
@@ -523,6 +541,9 @@ impl Cycle for SoakCycle {
         match req {}
     }
 
+    /// One tick, per soaked channel: faults due, then the client's write; the machine's tick;
+    /// then per channel the checks. Channels do not share state, so each sees the same
+    /// sequence as when they took turns.
     fn step(&mut self, tick: &Tick) -> Flow {
         let t = tick.index;
         if !self.planned {
@@ -532,27 +553,37 @@ impl Cycle for SoakCycle {
             }
         }
         for slot in &mut self.slots {
-            let feeder = &mut slot.feeder;
-            slot.core.faults(
-                &mut slot.rng,
-                &self.faults,
-                tick,
-                &mut slot.channel,
-                &mut |t| feeder.new_epoch(t),
-            );
+            let Some(mut door) = MachineDoor::new(&mut self.machine, slot.number) else {
+                continue;
+            };
+            let (feeder, pending) = (&mut slot.feeder, &mut slot.pending);
+            slot.core
+                .faults(&mut slot.rng, &self.faults, tick, &mut door, &mut |t| {
+                    *pending = None;
+                    feeder.new_epoch(t);
+                });
             if slot.core.rejecting(t) {
                 slot.feeder.skip(t);
             } else if let Some(packet) = slot.feeder.poll(t) {
-                let reply = slot
-                    .channel
-                    .apply(tick, Op::WriteStream(std::sync::Arc::from(packet)));
-                slot.feeder
-                    .result(t, matches!(reply, Reply::Stream(Ok(()))));
+                let data = slot.pending.get_or_insert_with(|| Arc::from(packet));
+                let reply = door.apply(tick, Op::WriteStream(Arc::clone(data)));
+                let accepted = matches!(reply, Reply::Stream(Ok(())));
+                if accepted {
+                    slot.pending = None;
+                }
+                slot.feeder.result(t, accepted);
             }
-            slot.channel.step(tick);
+        }
+        // The machine decides nothing here (it never stops by itself): the soak stops at
+        // its block target.
+        let _ = self.machine.step(tick);
+        for slot in &mut self.slots {
+            let Some(mut door) = MachineDoor::new(&mut self.machine, slot.number) else {
+                continue;
+            };
             self.total_blocks += slot.core.check(
                 tick,
-                &mut slot.channel,
+                &mut door,
                 slot.feeder.owed_mut(),
                 &mut self.tallies,
                 &self.expected_errors,
@@ -562,5 +593,9 @@ impl Cycle for SoakCycle {
             Some(b) if self.total_blocks >= b => Flow::Stop,
             _ => Flow::Continue,
         }
+    }
+
+    fn take_clock_stopped(&mut self) -> Duration {
+        self.machine.take_clock_stopped()
     }
 }

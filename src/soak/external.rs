@@ -14,7 +14,7 @@ use super::rng::SplitMix64;
 use super::scenario::{Faults, Scenario};
 use crate::machine::{Machine, Op, Reply, Request};
 use crate::motion::AxisLimits;
-use crate::runtime::{Cycle, Flow, Tick};
+use crate::runtime::{Clock, Cycle, Flow, Tick};
 
 /// How long a channel stays READY after an injected reset before its streaming program
 /// restarts: longer than the 200 ms default cycle of an on-change notification in
@@ -124,11 +124,7 @@ impl Supervised {
         programs: Vec<Option<String>>,
     ) -> Self {
         let n = machine.channels().len() as u32;
-        let tick0 = Tick {
-            index: 0,
-            period: Duration::ZERO,
-            time: Duration::ZERO,
-        };
+        let tick0 = Tick::first(Duration::ZERO, Clock::RealTime);
         for ch in 1..=n {
             machine.apply(&tick0, ch, Op::ObserveStreamBlocks(true));
         }
@@ -313,6 +309,10 @@ impl Cycle for Supervised {
             );
         }
         flow
+    }
+
+    fn take_clock_stopped(&mut self) -> Duration {
+        self.machine.take_clock_stopped()
     }
 }
 

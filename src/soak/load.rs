@@ -9,6 +9,8 @@ use super::feed::{FeederSpec, SoakFeeder, Source};
 use super::generator::{Generator, ProgramSpec};
 use super::rng::SplitMix64;
 use super::scenario::Faults;
+use crate::machine::{Machine, StopWhen};
+use crate::report::event::EventLog;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 /// `n` channels built from the start-up list, each fed its own endless generated program by
@@ -25,7 +27,8 @@ pub fn streaming_channels(
     }
     let axes = crate::setup::axes(&config).map_err(|e| e.to_string())?;
     let mut rng = SplitMix64::new(seed);
-    let mut slots = Vec::new();
+    let mut channels = Vec::new();
+    let mut clients = Vec::new();
     for i in 0..n {
         let cc = &config.channels[i as usize % config.channels.len()];
         let mut settings =
@@ -44,12 +47,19 @@ pub fn streaming_channels(
             r.fork(2),
             Source::Generated(Generator::new(ProgramSpec::default(), r.fork(1))),
         );
-        let channel = crate::channel::Channel::new(settings, false);
-        slots.push(Slot::new(channel, program, feeder, &axes, r.fork(3)));
+        channels.push(crate::channel::Channel::new(settings, false));
+        clients.push((i + 1, program, feeder, r.fork(3)));
+    }
+    let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
+    let mut slots = Vec::new();
+    for (number, program, feeder, r) in clients {
+        let slot = Slot::new(&mut machine, number, program, feeder, &axes, r)
+            .ok_or_else(|| format!("channel {number}: not built"))?;
+        slots.push(slot);
     }
     let period = Duration::from_micros(config.runtime.cycle_period_us.max(1));
     Ok((
-        SoakCycle::new(slots, Faults::default(), Vec::new(), None),
+        SoakCycle::new(machine, slots, Faults::default(), Vec::new(), None),
         period,
     ))
 }

@@ -18,6 +18,8 @@ use std::time::{Duration, Instant};
 use indicatif::ProgressBar;
 use thiserror::Error;
 
+use crate::machine::{Machine, StopWhen};
+use crate::report::event::EventLog;
 use crate::runtime::{Clock, RunEnd, Runtime};
 use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
@@ -78,6 +80,16 @@ pub fn build(
     } else {
         scenario.channels.clone()
     };
+    // The machine has the start-up list's channels up to the highest one soaked, so channel
+    // n is at its number as in `run` and `serve`; a channel no spec names stays READY.
+    let highest = specs.iter().map(|s| s.number).max().unwrap_or(0) as usize;
+    let mut channels = Vec::new();
+    for cc in config.channels.iter().take(highest) {
+        let settings = crate::setup::channel_settings(&config, cc)
+            .map_err(|e| SoakError::Setup(e.to_string()))?;
+        channels.push(crate::channel::Channel::new(settings, false));
+    }
+    let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
     let mut rng = SplitMix64::new(seed);
     let mut slots = Vec::new();
     for spec in &specs {
@@ -88,8 +100,6 @@ pub fn build(
                 config.channels.len()
             )));
         };
-        let settings = crate::setup::channel_settings(&config, cc)
-            .map_err(|e| SoakError::Setup(e.to_string()))?;
         let program = match (&spec.program, &cc.streaming_prog_file) {
             (Some(p), _) | (None, Some(p)) => p.clone(),
             (None, None) => {
@@ -123,10 +133,19 @@ pub fn build(
             ch_rng.fork(2),
             source,
         );
-        let channel = crate::channel::Channel::new(settings, false);
-        slots.push(Slot::new(channel, program, feeder, &axes, ch_rng.fork(3)));
+        let slot = Slot::new(
+            &mut machine,
+            spec.number,
+            program,
+            feeder,
+            &axes,
+            ch_rng.fork(3),
+        )
+        .ok_or_else(|| SoakError::Setup(format!("channel {}: not built", spec.number)))?;
+        slots.push(slot);
     }
     let cycle = SoakCycle::new(
+        machine,
         slots,
         scenario.faults.clone(),
         scenario.invariants.expected_errors.clone(),
@@ -260,7 +279,7 @@ fn report_of(
         &scenario.path,
         run,
         invariants,
-        cycle.slots.iter().map(Slot::report).collect(),
+        cycle.reports(),
         memory,
         CycleFigures::new(period.as_secs_f64() * 1e6, stats),
     )

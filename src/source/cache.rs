@@ -100,14 +100,12 @@ impl Cache {
         }
     }
 
-    pub fn limits(&self) -> CacheLimits {
-        self.limits
-    }
-
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.entries.len()
     }
 
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }

@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
 
 use crate::bounded::BoundedReadError;
+use crate::vocab::tick::Clock;
 
 /// Bytes of program files one tick reads itself at most; a file that does not fit in what is
 /// left goes to the loader thread.
@@ -51,58 +52,32 @@ pub(crate) enum Poll {
     Done(ReadResult),
 }
 
-/// How a tick on this thread meets a read the loader has not finished.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LoadWait {
-    /// Real time: the tick goes on and the decoder waits ticks for the text.
-    Ticks,
-    /// Virtual time: the clock stops until the text is there, so a run takes the same ticks
-    /// on every machine (the simulated file-system latency is still charged in ticks).
-    StopTheClock,
-}
-
-thread_local! {
-    /// Set by the runtime for the thread its ticks run on ([`set_load_wait`]).
-    static LOAD_WAIT: std::cell::Cell<LoadWait> = const { std::cell::Cell::new(LoadWait::Ticks) };
-    /// Wall time this thread's ticks stood still waiting for the loader since the runtime last
-    /// took it ([`take_clock_stopped`]).
-    static CLOCK_STOPPED: std::cell::Cell<Duration> = const { std::cell::Cell::new(Duration::ZERO) };
-}
-
-/// The wall time the calling thread's ticks waited for the loader with the clock stopped
-/// since the last call, and zero from now on. The runtime takes it after every tick: that
-/// wait is the simulated machine's file system, not the tick's work, and is reported apart.
-pub fn take_clock_stopped() -> Duration {
-    CLOCK_STOPPED.with(|c| c.replace(Duration::ZERO))
-}
-
-/// How ticks on the calling thread wait for the loader: the runtime sets this from its clock.
-/// A thread-local, not a parameter, because the choice belongs to the clock, which the
-/// decoder and the file cache that poll reads do not (and should not) know.
-pub fn set_load_wait(wait: LoadWait) {
-    LOAD_WAIT.with(|w| w.set(wait));
-}
-
 impl PendingRead {
-    /// Whether the loader has finished: never waits in real time; in virtual time waits
-    /// for the read to end (the clock stands still meanwhile).
-    pub(crate) fn poll(&self) -> Poll {
-        let r = match LOAD_WAIT.with(std::cell::Cell::get) {
-            LoadWait::Ticks => self.reply.try_recv().map_err(|e| e == TryRecvError::Empty),
-            LoadWait::StopTheClock => {
+    /// Whether the loader has finished, and the wall time this call waited for it. In real
+    /// time it never waits: the tick goes on and the decoder waits ticks for the text. In
+    /// virtual time it waits for the read to end, the clock standing still meanwhile, so a
+    /// run takes the same ticks on every machine (the simulated file-system latency is still
+    /// charged in ticks); the caller reports that wait apart from the tick's work.
+    pub(crate) fn poll(&self, clock: Clock) -> (Poll, Duration) {
+        let (r, waited) = match clock {
+            Clock::RealTime => (
+                self.reply.try_recv().map_err(|e| e == TryRecvError::Empty),
+                Duration::ZERO,
+            ),
+            Clock::Virtual => {
                 let waiting = Instant::now();
                 let r = self.reply.recv().map_err(|_| false);
-                CLOCK_STOPPED.with(|c| c.set(c.get() + waiting.elapsed()));
-                r
+                (r, waiting.elapsed())
             }
         };
-        match r {
+        let poll = match r {
             Ok(r) => Poll::Done(r),
             Err(true) => Poll::Waiting,
             Err(false) => Poll::Done(Err(BoundedReadError::Io(std::io::Error::other(
                 "the program loader stopped",
             )))),
-        }
+        };
+        (poll, waited)
     }
 }
 

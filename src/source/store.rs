@@ -21,6 +21,7 @@ use std::time::Duration;
 use thiserror::Error;
 
 use crate::bounded::BoundedReadError;
+use crate::vocab::tick::Clock;
 
 use super::loader::{self, PendingRead, Poll, INLINE_READ_BYTES_PER_TICK};
 
@@ -57,6 +58,11 @@ pub struct ProgramText {
     /// The name as the program called it.
     pub name: Arc<str>,
     /// Where it was found. Shared like the text: a cache hit copies no path.
+    #[allow(
+        dead_code,
+        reason = "read by nothing in the crate since the channel keeps its parts to itself; \
+                  the loader (src/source/loader.rs) still sets it"
+    )]
     pub path: Arc<Path>,
     /// The file's bytes, as read (shared without a copy: a `Vec` read to its exact size).
     pub text: Arc<Vec<u8>>,
@@ -165,6 +171,11 @@ pub struct ProgramStore {
     owed: Duration,
     /// Bytes read inside the current tick.
     read_this_tick: u64,
+    /// The clock of the current tick ([`ProgramStore::begin_tick`]): whether a read the
+    /// loader has not finished is waited for (virtual time) or polled again next tick.
+    clock: Clock,
+    /// Wall time this tick waited for the loader with the clock stopped (virtual time).
+    clock_stopped: Duration,
 }
 
 impl ProgramStore {
@@ -179,17 +190,27 @@ impl ProgramStore {
             latency: FsLatency::default(),
             owed: Duration::ZERO,
             read_this_tick: 0,
+            clock: Clock::Virtual,
+            clock_stopped: Duration::ZERO,
         }
+    }
+
+    /// The start of a tick: reads the loader has not finished meet this tick's clock.
+    pub(crate) fn begin_tick(&mut self, clock: Clock) {
+        self.clock = clock;
+    }
+
+    /// The wall time the reads of the tick waited for the loader with the clock stopped, and
+    /// zero from now on (the channel hands it to the cycle, which reports it apart from the
+    /// tick's work).
+    pub(crate) fn take_clock_stopped(&mut self) -> Duration {
+        std::mem::take(&mut self.clock_stopped)
     }
 
     /// Charge every file-system read with this simulated latency.
     pub(crate) fn with_latency(mut self, latency: FsLatency) -> Self {
         self.latency = latency;
         self
-    }
-
-    pub fn latency(&self) -> FsLatency {
-        self.latency
     }
 
     pub fn stats(&self) -> StoreStats {
@@ -266,7 +287,9 @@ impl ProgramStore {
         &mut self,
         pending: &PendingRead,
     ) -> Option<Result<ProgramText, StoreError>> {
-        match pending.poll() {
+        let (poll, waited) = pending.poll(self.clock);
+        self.clock_stopped += waited;
+        match poll {
             Poll::Waiting => None,
             Poll::Done(Ok(text)) => {
                 self.stats.loaded_off_tick += 1;

@@ -36,7 +36,9 @@ impl Cycle for StallOnce {
 
     fn step(&mut self, tick: &Tick) -> Flow {
         let mut stalled = self.stalled.lock().unwrap();
-        if stalled.is_none() && self.machine.channels()[0].stats().blocks >= STALL_AFTER_BLOCKS {
+        if stalled.is_none()
+            && self.machine.channels()[0].report().stats.blocks >= STALL_AFTER_BLOCKS
+        {
             let began = Instant::now();
             std::thread::sleep(STALL);
             *stalled = Some(began.elapsed());
@@ -69,7 +71,7 @@ fn ads_node_stall_longer_than_the_client_timeout_answers_busy_and_loses_no_line(
         rt.into_inner().0.machine
     });
     // The server as `serve` builds it, with the default reply timeout.
-    let backend = ncchannel::ads::channel_backend::ChannelBackend::new(tx, 1);
+    let backend = ncchannel::machine::remote::ChannelBackend::new(tx, 1);
     let config = ncchannel::ads::ServerConfig {
         bind: "127.0.0.1:0".parse().unwrap(),
         ..Default::default()

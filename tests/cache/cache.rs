@@ -64,7 +64,7 @@ fn run_program(c: &mut Channel, t: &mut Tick, program: &str) {
         Reply::Command(Ok(()))
     );
     for _ in 0..1_000_000 {
-        if !matches!(c.state(), State::Active | State::Hold) {
+        if !matches!(c.status().state, State::Active | State::Hold) {
             return;
         }
         c.step(t);
@@ -113,9 +113,9 @@ fn seed_002_example_runs_with_its_calls_served_from_the_cache() {
     let c = &r.machine.channels()[0];
     // Main program + five loads + the one uncached call (Laser_on.cyc); the three cached
     // calls open nothing.
-    assert_eq!(c.store_stats().opens, 7);
-    assert_eq!(c.cache().hits, 3);
-    let cached: Vec<&str> = c.cache().names().collect();
+    assert_eq!(c.report().store.opens, 7);
+    assert_eq!(c.report().cache.hits, 3);
+    let cached = c.report().cache.files;
     assert_eq!(cached, ["Macro.cyc", "Laser_off.cyc", "Global.sub"]);
     // Every called program ran, from its start to its M17.
     let b = blocks(&r.events);
@@ -132,7 +132,7 @@ fn seed_002_example_runs_with_its_calls_served_from_the_cache() {
     }
     assert!(b.contains(&("cache_example.nc".into(), "N3050 M30".into())));
     // Laser_off.cyc retracted to Z5; the rectangle of Macro.cyc closed at X47 Y0.
-    let pos = c.position();
+    let pos = c.report().position;
     assert!((pos[0] - 47.0).abs() < 1e-6 && pos[1].abs() < 1e-6 && (pos[2] - 5.0).abs() < 1e-6);
 }
 
@@ -149,16 +149,16 @@ fn calls_after_the_load_never_touch_the_file_system() {
     let r = rig.run("main.nc", None, 100_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
     let c = &r.machine.channels()[0];
-    assert_eq!(c.store_stats().opens, 2, "main program + the load");
-    assert_eq!(c.cache().hits, 50);
-    assert_eq!(c.position()[0], 0.0, "each call ran: P1 = 50 × 2");
+    assert_eq!(c.report().store.opens, 2, "main program + the load");
+    assert_eq!(c.report().cache.hits, 50);
+    assert_eq!(c.report().position[0], 0.0, "each call ran: P1 = 50 × 2");
 }
 
 fn failing(rig: &Rig, main: &str) -> (u64, String, common::RunResult) {
     rig.program("main.nc", main);
     let r = rig.run("main.nc", None, 100_000);
     assert_eq!(r.finish, Some(Finish::Error), "{}", r.log);
-    assert_eq!(r.machine.channels()[0].state(), State::Error);
+    assert_eq!(r.machine.channels()[0].status().state, State::Error);
     let e = r.of("error")[0].clone();
     assert!(
         !r.block_texts().iter().any(|t| t == "G1 X10 F1000"),
@@ -189,7 +189,7 @@ fn cache_full_is_21562_and_a_refresh_needs_no_room() {
     );
     assert_eq!(code, 21562);
     assert_eq!(r.of("error")[0]["line"], 3);
-    assert_eq!(r.machine.channels()[0].cache().len(), 2);
+    assert_eq!(r.machine.channels()[0].report().cache.files.len(), 2);
 }
 
 #[test]
@@ -222,11 +222,11 @@ fn file_larger_than_max_cache_size_is_21564_and_is_not_read() {
     assert!(msg.contains("big.cyc") && msg.contains("200"), "{msg}");
     let c = &r.machine.channels()[0];
     assert_eq!(
-        c.store_stats().opens,
+        c.report().store.opens,
         2,
         "main + fits.cyc; big.cyc is refused unread"
     );
-    assert_eq!(c.cache().names().collect::<Vec<_>>(), ["fits.cyc"]);
+    assert_eq!(c.report().cache.files, ["fits.cyc"]);
 }
 
 #[test]
@@ -263,7 +263,7 @@ fn invalid_cache_programming_is_21560() {
         let (code, _, r) = failing(&rig, &format!("N10 {cmd}\nG1 X10 F1000\nM30\n"));
         assert_eq!(code, 21560, "{cmd}");
         assert_eq!(r.of("error")[0]["line"], 1);
-        assert!(r.machine.channels()[0].cache().is_empty());
+        assert!(r.machine.channels()[0].report().cache.files.is_empty());
     }
 }
 
@@ -279,7 +279,10 @@ fn double_cache_programming_is_21561() {
     ] {
         let (code, _, r) = failing(&rig, &format!("{cmd}\nG1 X10 F1000\nM30\n"));
         assert_eq!(code, 21561, "{cmd}");
-        assert!(r.machine.channels()[0].cache().is_empty(), "{cmd}");
+        assert!(
+            r.machine.channels()[0].report().cache.files.is_empty(),
+            "{cmd}"
+        );
     }
 }
 
@@ -293,25 +296,28 @@ fn the_cache_lasts_across_programs_until_a_reset() {
     let mut t = tick0(period);
     let c = &mut channel;
     run_program(c, &mut t, "load.nc");
-    assert_eq!(c.cache().len(), 1);
+    assert_eq!(c.report().cache.files.len(), 1);
     run_program(c, &mut t, "call.nc");
-    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.status().state, State::Ready);
     assert_eq!(
-        c.store_stats().opens,
+        c.report().store.opens,
         3,
         "load.nc, the load, call.nc: the call is a hit"
     );
-    assert_eq!(c.cache().hits, 1);
+    assert_eq!(c.report().cache.hits, 1);
     c.apply(&t, Op::Reset);
-    assert!(c.cache().is_empty(), "a channel reset clears the cache");
+    assert!(
+        c.report().cache.files.is_empty(),
+        "a channel reset clears the cache"
+    );
     run_program(c, &mut t, "call.nc");
-    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.status().state, State::Ready);
     assert_eq!(
-        c.store_stats().opens,
+        c.report().store.opens,
         5,
         "call.nc and c.cyc from the file system"
     );
-    assert_eq!(c.cache().hits, 1);
+    assert_eq!(c.report().cache.hits, 1);
 }
 
 #[test]
@@ -337,10 +343,10 @@ fn names_are_case_insensitive() {
         ])
     );
     let c = &r.machine.channels()[0];
-    assert!(c.cache().is_empty());
+    assert!(c.report().cache.files.is_empty());
     // main, load, refresh, and the last call from the file system.
-    assert_eq!(c.store_stats().opens, 4);
-    assert_eq!(c.position()[0], 0.0, "all three calls ran");
+    assert_eq!(c.report().store.opens, 4);
+    assert_eq!(c.report().position[0], 0.0, "all three calls ran");
 }
 
 #[test]
@@ -356,10 +362,10 @@ fn cached_text_stays_until_refreshed_and_a_refresh_picks_up_the_changed_file() {
     std::fs::write(rig.nc().join("c.cyc"), "G1 X2 F6000\nM17\n").unwrap();
     // The cache holds what was loaded: the change on disk is not seen yet.
     run_program(c, &mut t, "call.nc");
-    assert!((c.position()[0] - 1.0).abs() < 1e-9);
+    assert!((c.report().position[0] - 1.0).abs() < 1e-9);
     run_program(c, &mut t, "load.nc");
     run_program(c, &mut t, "call.nc");
-    assert!((c.position()[0] - 2.0).abs() < 1e-9, "refreshed");
+    assert!((c.report().position[0] - 2.0).abs() < 1e-9, "refreshed");
     let ev = channel_events(c);
     assert_eq!(
         cache_ops(&ev),
@@ -370,7 +376,7 @@ fn cached_text_stays_until_refreshed_and_a_refresh_picks_up_the_changed_file() {
             ("hit", "c.cyc"),
         ])
     );
-    assert_eq!(c.store_stats().opens, 6, "four main programs, two loads");
+    assert_eq!(c.report().store.opens, 6, "four main programs, two loads");
 }
 
 #[test]
@@ -394,16 +400,16 @@ fn a_refresh_while_the_cycle_runs_leaves_the_running_call_on_the_old_text() {
         c.step(&t);
         next(&mut t);
     }
-    assert!(c.position()[0] > 0.0 && c.position()[0] < 10.0);
+    assert!(c.report().position[0] > 0.0 && c.report().position[0] < 10.0);
     std::fs::write(rig.nc().join("c.cyc"), "G1 X20 F6000\nG1 Y2\nM17\n").unwrap();
     for _ in 0..100_000 {
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
         c.step(&t);
         next(&mut t);
     }
-    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.status().state, State::Ready);
     let ev = channel_events(c);
     let cyc: Vec<String> = blocks(&ev)
         .into_iter()
@@ -455,8 +461,8 @@ fn a_streamed_program_calls_from_the_cache() {
         ops(&[("load", "c.cyc"), ("hit", "c.cyc"), ("hit", "C.CYC")])
     );
     let c = &r.machine.channels()[0];
-    assert_eq!(c.store_stats().opens, 1, "only the load reads a file");
-    assert!((c.position()[0] - 7.0).abs() < 1e-9);
+    assert_eq!(c.report().store.opens, 1, "only the load reads a file");
+    assert!((c.report().position[0] - 7.0).abs() < 1e-9);
 }
 
 #[test]
@@ -471,9 +477,9 @@ fn a_stream_called_from_a_file_program_uses_the_cache_the_file_loaded() {
     );
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
     let c = &r.machine.channels()[0];
-    assert_eq!(c.store_stats().opens, 2, "main.nc and the load");
-    assert_eq!(c.cache().hits, 1);
-    let pos = c.position();
+    assert_eq!(c.report().store.opens, 2, "main.nc and the load");
+    assert_eq!(c.report().cache.hits, 1);
+    let pos = c.report().position;
     assert!((pos[0] - 3.0).abs() < 1e-9 && (pos[1] - 5.0).abs() < 1e-9);
 }
 
@@ -492,7 +498,7 @@ fn latency_run(runtime: &str, cached: bool, calls: usize) -> (u64, Duration, u64
     rig.program("main.nc", &main);
     let r = rig.run("main.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
-    let s = r.machine.channels()[0].store_stats();
+    let s = r.machine.channels()[0].report().store;
     (s.opens, s.latency, r.ticks)
 }
 
@@ -567,7 +573,7 @@ fn the_channel_list_can_switch_caching_on() {
     let r = rig.run("main.nc", None, 10_000);
     // One file allowed by the channel list: the second load is 21562.
     assert_eq!(r.error_codes(), [21562], "{}", r.log);
-    assert_eq!(r.machine.channels()[0].cache().hits, 1);
+    assert_eq!(r.machine.channels()[0].report().cache.hits, 1);
 }
 
 #[test]

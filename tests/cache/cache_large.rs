@@ -38,7 +38,7 @@ fn a_large_file_is_cached_off_the_tick_and_runs_from_the_cache() {
     );
     assert_eq!(texts.iter().filter(|t| *t == "M17").count(), 2);
     assert_eq!((r.position('X'), r.position('Y')), (4.0, 2.0));
-    let files = r.machine.channels()[0].store_stats();
+    let files = r.machine.channels()[0].report().store;
     assert_eq!((files.opens, files.loaded_off_tick), (2, 1), "{files:?}");
     assert!(files.max_tick_read_bytes <= INLINE_READ_BYTES_PER_TICK);
 }

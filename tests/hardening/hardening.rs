@@ -19,6 +19,7 @@ fn tick(period: Duration, k: u64) -> Tick {
         index: k,
         period,
         time: period * k as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -79,7 +80,7 @@ impl Hand {
     }
 
     fn error_code(&mut self) -> Option<u32> {
-        self.channel().last_error().map(|e| e.code)
+        self.channel().report().last_error.map(|e| e.code)
     }
 
     fn reset(&mut self) {
@@ -122,7 +123,7 @@ fn var_declarations_are_spread_over_ticks_and_bounded_in_bytes() {
     let mut h = Hand::new(&rig);
     h.start("decl.nc");
     h.step();
-    let after_one = h.channel().decoder().vars().bytes(VarClass::Local);
+    let after_one = h.channel().report().var_bytes(VarClass::Local);
     assert!(
         after_one <= 2 * (DECLARED_VALUES_PER_TICK * 8 + 4_000 + 64),
         "one tick made {after_one} bytes of variables"
@@ -130,7 +131,7 @@ fn var_declarations_are_spread_over_ticks_and_bounded_in_bytes() {
     let (finish, _) = h.run(100_000);
     assert_eq!(finish, Some(Finish::Ended), "{:?}", h.error_code());
     // All ten were made by the program's end — in their name once each.
-    let made = h.channel().decoder().vars().bytes(VarClass::Local);
+    let made = h.channel().report().var_bytes(VarClass::Local);
     assert!((10 * 800_000..=CLASS_BYTES).contains(&made), "{made}");
 }
 
@@ -159,11 +160,11 @@ fn self_retaining_variables_stay_bounded_across_resets() {
     h.start("fill.nc");
     assert_eq!(h.run(100_000).0, Some(Finish::Error));
     assert_eq!(h.error_code(), Some(20967));
-    let full = h.channel().decoder().vars().bytes(VarClass::SelfRetaining);
+    let full = h.channel().report().var_bytes(VarClass::SelfRetaining);
     assert!(full <= CLASS_BYTES && full > CLASS_BYTES / 2, "{full}");
     h.reset();
     assert_eq!(
-        h.channel().decoder().vars().bytes(VarClass::SelfRetaining),
+        h.channel().report().var_bytes(VarClass::SelfRetaining),
         full
     );
     h.start("more.nc");
@@ -174,7 +175,7 @@ fn self_retaining_variables_stay_bounded_across_resets() {
     h.start("again.nc");
     assert_eq!(h.run(100_000).0, Some(Finish::Ended));
     assert_eq!(
-        h.channel().decoder().vars().bytes(VarClass::SelfRetaining),
+        h.channel().report().var_bytes(VarClass::SelfRetaining),
         full
     );
 }
@@ -311,11 +312,11 @@ fn soft_limits_refuse_the_block_before_it_moves() {
     h.start("far.nc");
     assert_eq!(h.run(200_000).0, Some(Finish::Error));
     assert_eq!(h.error_code(), Some(21897));
-    let msg = h.channel().last_error().unwrap().msg.clone();
+    let msg = h.channel().report().last_error.unwrap().msg.clone();
     assert!(msg.contains("axis X") && msg.contains("5000"), "{msg}");
-    let p = h.channel().position();
+    let p = h.channel().report().position;
     assert!(p[0] <= 10.0 + 1e-9 && p[1] <= 10.0 + 1e-9, "{p:?}");
-    assert_eq!(h.channel().state(), State::Error);
+    assert_eq!(h.channel().status().state, State::Error);
     // An arc whose end points are inside but whose circle passes X -1200 is refused too.
     assert_eq!(
         run_file("G01 X0 Y0 F6000\nG02 X0 Y0 I-600 J0\nM30\n"),
@@ -338,9 +339,9 @@ fn soft_limits_refuse_the_block_before_it_moves() {
     assert_eq!(h.error_code(), Some(21897));
     // The error stops the axes wherever the earlier block had brought them: never past 50.
     assert!(
-        h.channel().position()[0] <= 50.0,
+        h.channel().report().position[0] <= 50.0,
         "{:?}",
-        h.channel().position()
+        h.channel().report().position
     );
 }
 
@@ -363,7 +364,7 @@ fn a_bad_stream_write_does_not_abort_a_running_file_program() {
     assert_eq!(e.isg_code(), Some(21476));
     let (finish, _) = h.run(200_000);
     assert_eq!(finish, Some(Finish::Ended), "{:?}", h.error_code());
-    assert!(h.channel().errors().is_empty());
+    assert!(h.channel().report().errors.is_empty());
 
     let mut h = Hand::new(&rig);
     h.start("streaming.nc");

@@ -251,7 +251,7 @@ fn each_dwell_form_dwells_its_time() {
         assert!((t - 2.5).abs() < 0.01, "{form}: dwelled {t} s");
         // The time word is no feed: the modal feed stays unset.
         let c = &r.machine.channels()[0];
-        assert_eq!(c.decoder().modal().feed_mm_per_min, 0.0, "{form}");
+        assert_eq!(c.status().feed_mm_per_min, 0.0, "{form}");
     }
 }
 
@@ -361,7 +361,10 @@ fn msg_is_an_event_and_the_channel_keeps_the_latest() {
         .map(|e| (e["text"].as_str().unwrap(), e["save"].as_bool().unwrap()))
         .collect();
     assert_eq!(m, [("tool 1 in", false), ("second", true)]);
-    assert_eq!(r.machine.channels()[0].message(), Some("second"));
+    assert_eq!(
+        r.machine.channels()[0].status().message.as_deref(),
+        Some("second")
+    );
 }
 
 /// A program in the style of a TwinCAT CAM post: `%`, comments, the modal header, a tool

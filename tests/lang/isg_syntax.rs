@@ -170,7 +170,7 @@ fn an_address_takes_a_parameter_expression_without_brackets() {
         &rig,
         "#VAR\n  V.P.TOOLNR = 7\n  V.L.x = 4\n#ENDVAR\nM6 TV.P.TOOLNR\nG01 XV.L.x Y-V.L.X F100\nM30\n",
     );
-    assert_eq!(r.machine.channels()[0].decoder().modal().tool, 7);
+    assert_eq!(r.machine.channels()[0].report().modal.tool, 7);
     assert_eq!((r.position('X'), r.position('Y')), (4.0, -4.0));
     // The value ends at the blank: what follows is the next word.
     let b = parse_block("XP1 +2").unwrap_err();
@@ -748,7 +748,8 @@ fn axes_named_with_digits_take_an_equals_sign() {
     );
     assert_eq!(
         r.machine.channels()[0]
-            .named_positions()
+            .report()
+            .named_positions
             .into_iter()
             .map(|(n, v)| (n.to_string(), v))
             .collect::<Vec<_>>(),

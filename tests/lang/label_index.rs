@@ -33,7 +33,7 @@ fn run_many(labels: usize, call: bool) -> RunResult {
 /// No tick's label scan read more than the budget: the scan of a file of any size is spread
 /// over ticks (before, the whole file was scanned in the tick of the `$GOTO`).
 fn assert_scan_bounded(r: &RunResult, lines: usize) {
-    let stats = r.machine.channels()[0].decoder().stats();
+    let stats = r.machine.channels()[0].report().decoder;
     assert!(
         stats.max_scan_lines_per_tick <= LABEL_SCAN_LINES_PER_TICK,
         "{stats:?}"
@@ -62,7 +62,7 @@ fn a_jump_over_many_labels_is_indexed_over_many_ticks_and_lands() {
     );
     assert_eq!(r.position('X'), 5.0);
     assert_scan_bounded(&r, labels);
-    assert_eq!(r.machine.channels()[0].decoder().stats().label_scans, 1);
+    assert_eq!(r.machine.channels()[0].report().decoder.label_scans, 1);
 }
 
 #[test]
@@ -83,7 +83,7 @@ fn more_labels_than_the_index_holds_warn_once_and_are_searched_at_the_jump() {
     assert_eq!(r.block_texts(), ["N1 G01 X0 F6000", "[LAST] X5", "M30"]);
     assert_scan_bounded(&r, labels);
     // The index, then a targeted search for the label that found no room.
-    assert_eq!(r.machine.channels()[0].decoder().stats().label_scans, 2);
+    assert_eq!(r.machine.channels()[0].report().decoder.label_scans, 2);
 }
 
 #[test]

@@ -69,7 +69,10 @@ fn msg_formats_its_values_as_printf_does_in_file_and_stream() {
                 ("no quotes %d".to_string(), false),
             ]
         );
-        assert_eq!(r.machine.channels()[0].message(), Some("no quotes %d"));
+        assert_eq!(
+            r.machine.channels()[0].status().message.as_deref(),
+            Some("no quotes %d")
+        );
     }
     assert_eq!(check_program(text), []);
 }

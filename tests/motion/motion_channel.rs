@@ -61,6 +61,7 @@ fn tick(k: u64) -> Tick {
         index: k,
         period: PERIOD,
         time: PERIOD * k as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -83,7 +84,7 @@ fn run_stream(
             }
         }
         c.step(&t);
-        velocity.push(c.motion().velocity_mm_per_s());
+        velocity.push(c.status().velocity_mm_per_s);
         events.extend(
             c.events_mut()
                 .events()
@@ -91,7 +92,7 @@ fn run_stream(
                 .map(|e| (e.tick, e.kind.clone())),
         );
         c.events_mut().flush_to(&mut EventLog::disabled());
-        if c.state() != State::Active && c.state() != State::Hold {
+        if c.status().state != State::Active && c.status().state != State::Hold {
             break;
         }
     }
@@ -141,8 +142,8 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
         min_v > 16.0,
         "slowed to {min_v} mm/s at the N10/N20 junction"
     );
-    assert_eq!(c.position()[0], 20.0);
-    assert_eq!(c.stats().interrupts, 1);
+    assert_eq!(c.report().position[0], 20.0);
+    assert_eq!(c.report().stats.interrupts, 1);
 
     // Late: N20 arrives at 1.0 s, after N10 has stopped: an interrupt, then a resume.
     let (c, ev, _) = run_stream(&s, &[(1, first), (1000, next), (2500, end)], 6000);
@@ -156,7 +157,7 @@ fn flush_continue_next_block_in_time_no_stop_late_one_interrupt() {
     assert!((600..1000).contains(&first_interrupt), "{first_interrupt}");
     let resume = ev.iter().find(|e| e.1 == EventKind::Resume).unwrap().0;
     assert_eq!(resume, 1000, "resumes when N20 starts");
-    assert_eq!(c.position()[0], 20.0);
+    assert_eq!(c.report().position[0], 20.0);
     assert!(ev.iter().any(|e| e.1
         == EventKind::ProgramEnd {
             prog: "streaming.nc".into(),
@@ -183,7 +184,7 @@ fn without_flush_blocks_wait_in_the_window_and_the_program_end_releases_them() {
         })
         .collect();
     assert_eq!(held, vec![3]);
-    assert_eq!(c.position()[0], 15.0);
+    assert_eq!(c.report().position[0], 15.0);
 }
 
 #[test]
@@ -203,8 +204,8 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
         }
         c.step(&t);
         if k == 790 {
-            assert_eq!(c.state(), State::Hold);
-            assert_eq!(c.motion().velocity_mm_per_s(), 0.0);
+            assert_eq!(c.status().state, State::Hold);
+            assert_eq!(c.status().velocity_mm_per_s, 0.0);
         }
         events.extend(c.events_mut().events().iter().map(|e| e.kind.clone()));
         c.events_mut().flush_to(&mut EventLog::disabled());
@@ -212,8 +213,8 @@ fn hold_is_not_an_interrupt_and_program_end_is_not_one_either() {
     assert!(!events
         .iter()
         .any(|e| matches!(e, EventKind::Interrupt { .. })));
-    assert_eq!(c.state(), State::Ready);
-    assert_eq!(c.position()[0], 100.0);
+    assert_eq!(c.status().state, State::Ready);
+    assert_eq!(c.report().position[0], 100.0);
 }
 
 #[test]
@@ -232,12 +233,12 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
     start(&mut c, &tick(0), "arcs.nc");
     for k in 1..20_000 {
         c.step(&tick(k));
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
-    let p = c.position();
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
+    let p = c.report().position;
     assert_eq!((p[0], p[1], p[2]), (0.0, -5.0, 20.0));
 
     s.write(
@@ -249,8 +250,8 @@ fn arcs_in_nc_text_end_exactly_and_inconsistent_ones_are_errors() {
     for k in 1..5000 {
         c.step(&tick(k));
     }
-    assert_eq!(c.state(), State::Error);
-    assert_eq!(c.last_error().unwrap().code, 900130);
+    assert_eq!(c.status().state, State::Error);
+    assert_eq!(c.report().last_error.unwrap().code, 900130);
 }
 
 #[test]
@@ -280,16 +281,16 @@ fn zero_offsets_from_the_list_named_in_the_startup_list() {
             .collect();
         c.events_mut().flush_to(&mut EventLog::disabled());
         if ev.iter().any(|e| matches!(e, EventKind::Flush { .. })) {
-            after_n10 = Some(c.position());
+            after_n10 = Some(c.report().position);
         }
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
     let p = after_n10.unwrap();
     assert_eq!((p[0], p[1]), (10.0, -2.5));
-    let p = c.position();
+    let p = c.report().position;
     assert_eq!((p[0], p[1], p[2]), (1.0, 7.0, 1.0));
 
     // A list that cannot be read is refused at start-up, pointing at the start-up entry.
@@ -439,7 +440,7 @@ fn m5_after_the_last_motion_of_a_paused_stream_takes_effect_when_the_motion_ends
         held[0].0 as usize > t8 + 150,
         "not during the dwell: {held:?}"
     );
-    assert_eq!(c.position()[0], 30.0);
+    assert_eq!(c.report().position[0], 30.0);
 }
 
 /// Run a program file to its end; every tick's position and path velocity.
@@ -450,14 +451,14 @@ fn run_file(s: &Setup, name: &str, text: &str, max_ticks: u64) -> (Vec<[f64; 6]>
     let (mut pos, mut vel) = (Vec::new(), Vec::new());
     for k in 1..max_ticks {
         c.step(&tick(k));
-        pos.push(c.position());
-        vel.push(c.motion().velocity_mm_per_s());
+        pos.push(c.report().position);
+        vel.push(c.status().velocity_mm_per_s);
         c.events_mut().flush_to(&mut EventLog::disabled());
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
     (pos, vel)
 }
 
@@ -613,7 +614,7 @@ fn streaming_spline_example_in_packets_passes_its_points_without_stopping() {
         .collect();
     let refs: Vec<(u64, &str)> = writes.iter().map(|(t, w)| (*t, w.as_str())).collect();
     let (c, ev, v) = run_stream(&s, &refs, 20_000);
-    assert!(c.errors().is_empty(), "{:?}", c.errors());
+    assert!(c.report().errors.is_empty(), "{:?}", c.report().errors);
     let b = blocks(&ev);
     let first = b.iter().find(|x| x.1 == Some(36338)).unwrap().0 as usize;
     let last = b.iter().find(|x| x.1 == Some(36355)).unwrap().0 as usize;
@@ -622,7 +623,7 @@ fn streaming_spline_example_in_packets_passes_its_points_without_stopping() {
         slowest > 1.0,
         "stopped at a programmed point: {slowest} mm/s"
     );
-    assert!((c.position()[2] - 1.8353).abs() < 1e-9);
+    assert!((c.report().position[2] - 1.8353).abs() < 1e-9);
 }
 
 #[test]
@@ -632,10 +633,10 @@ fn flush_inside_the_streaming_spline_is_120102() {
     let (head, tail) = text.split_at(text.find("N36340").unwrap());
     let (c, _, _) = run_stream(&s, &[(1, head), (2, tail)], 20_000);
     assert_eq!(
-        c.last_error().map(|e| e.code),
+        c.report().last_error.map(|e| e.code),
         Some(120102),
         "{:?}",
-        c.errors()
+        c.report().errors
     );
 }
 
@@ -663,13 +664,13 @@ fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
         }
         c.events_mut().flush_to(&mut EventLog::disabled());
         if inside {
-            out.push(c.position());
+            out.push(c.report().position);
         }
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    assert_eq!(c.state(), State::Ready, "{:?}", c.errors());
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
     out
 }
 
@@ -725,16 +726,16 @@ fn trc_radius_larger_than_an_inner_arc_is_error_900140() {
     for k in 1..20_000u64 {
         c.step(&tick(k));
         c.events_mut().flush_to(&mut EventLog::disabled());
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    assert_eq!(c.state(), State::Error);
+    assert_eq!(c.status().state, State::Error);
     assert_eq!(
-        c.last_error().map(|e| e.code),
+        c.report().last_error.map(|e| e.code),
         Some(900140),
         "{:?}",
-        c.errors()
+        c.report().errors
     );
 }
 
@@ -749,13 +750,13 @@ fn run_to_error(runtime: &str, program: &str) -> (Vec<ncchannel::channel::ErrorR
     let mut x_max: f64 = 0.0;
     for k in 1..200_000u64 {
         c.step(&tick(k));
-        x_max = x_max.max(c.position()[0].abs());
+        x_max = x_max.max(c.report().position[0].abs());
         c.events_mut().flush_to(&mut EventLog::disabled());
-        if c.state() != State::Active {
+        if c.status().state != State::Active {
             break;
         }
     }
-    (c.errors().to_vec(), x_max)
+    (c.report().errors.to_vec(), x_max)
 }
 
 #[test]

@@ -114,6 +114,7 @@ fn tick(k: u64) -> Tick {
         index: k,
         period: PERIOD,
         time: PERIOD * k as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -136,7 +137,7 @@ fn run(c: &mut Channel, writes: &[(u64, &str)], max_ticks: u64) -> Vec<(u64, Eve
                 .map(|e| (e.tick, e.kind.clone())),
         );
         c.events_mut().flush_to(&mut EventLog::disabled());
-        if c.state() != State::Active && c.state() != State::Hold {
+        if c.status().state != State::Active && c.status().state != State::Hold {
             break;
         }
     }
@@ -196,7 +197,7 @@ fn a_move_runs_at_the_axis_lists_velocity_and_acceleration() {
             (measured - analytic).abs() <= 0.01 * analytic,
             "{prog}: {measured} s against the analytic {analytic} s"
         );
-        assert_eq!(c.position()[0], 200.0);
+        assert_eq!(c.report().position[0], 200.0);
     }
 }
 
@@ -210,7 +211,7 @@ fn beyond_swe_pos_is_refused_with_21897_and_the_kernels_text() {
     start(&mut c, &tick(0), "edge.nc");
     let ev = run(&mut c, &[], 40_000);
     assert!(!ev.iter().any(|(_, e)| matches!(e, EventKind::Error { .. })));
-    assert_eq!(c.position()[0], 1500.0);
+    assert_eq!(c.report().position[0], 1500.0);
 
     let mut c = i.channel();
     start(&mut c, &tick(0), "far.nc");
@@ -228,7 +229,7 @@ fn beyond_swe_pos_is_refused_with_21897_and_the_kernels_text() {
         "{msg}"
     );
     assert!(msg.contains("1500"), "{msg}");
-    assert_eq!(c.position()[0], 0.0, "nothing moved");
+    assert_eq!(c.report().position[0], 0.0, "nothing moved");
 }
 
 const IMPLICIT: &str = "start_init_prog_file init.nc ( P-CHAN-00119\n\
@@ -283,7 +284,7 @@ fn implicit_subroutines_run_at_program_start_m6_and_program_end() {
             .all(|(t, _)| *t <= end),
         "{ev:#?}"
     );
-    let p = c.position();
+    let p = c.report().position;
     assert_eq!((p[0], p[1], p[2]), (3.0, 2.0, 5.0));
     assert!(ev.iter().any(|(_, e)| *e
         == EventKind::ProgramEnd {
@@ -326,7 +327,7 @@ fn implicit_subroutines_run_in_a_stream_started_under_the_channel_lists_name() {
     .map(|(p, n)| (p.to_string(), *n))
     .collect();
     assert_eq!(got, want);
-    let p = c.position();
+    let p = c.report().position;
     assert_eq!((p[0], p[1], p[2]), (3.0, 2.0, 5.0));
     assert!(ev.iter().any(|(_, e)| *e
         == EventKind::ProgramStart {
@@ -348,8 +349,8 @@ fn without_implicit_subroutines_m6_is_an_ordinary_m_function_and_streams_work_as
     );
     let progs: Vec<String> = blocks(&ev).into_iter().map(|(p, _)| p).collect();
     assert_eq!(progs, vec!["streaming.nc"; 3]);
-    assert_eq!(c.position()[0], 2.0);
-    assert_eq!(c.position()[2], 0.0);
+    assert_eq!(c.report().position[0], 2.0);
+    assert_eq!(c.report().position[2], 0.0);
 }
 
 #[test]
@@ -367,7 +368,7 @@ fn a_missing_implicit_subroutine_is_the_program_not_found_error() {
         })
         .expect("an error");
     assert!(msg.contains("missing.nc"), "{msg}");
-    assert_eq!(c.position()[0], 0.0);
+    assert_eq!(c.report().position[0], 0.0);
 }
 
 #[test]
@@ -389,7 +390,7 @@ fn the_shipped_example_installation_runs_its_part() {
     assert_eq!(progs.first().map(String::as_str), Some("init.nc"));
     assert!(progs.iter().any(|p| p == "toolchange.nc"));
     assert_eq!(progs.last().map(String::as_str), Some("final.nc"));
-    assert_eq!(c.position()[2], 100.0, "final.nc retracts to Z100");
+    assert_eq!(c.report().position[2], 100.0, "final.nc retracts to Z100");
 }
 
 #[test]
@@ -425,7 +426,7 @@ fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
     .map(|(p, n)| (p.to_string(), *n))
     .collect();
     assert_eq!(got, want);
-    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.status().state, State::Ready);
     assert!(ev.iter().any(|(_, e)| *e
         == EventKind::ProgramEnd {
             prog: "part.nc".into(),
@@ -452,7 +453,8 @@ fn an_axis_named_x1_in_the_channel_list_is_programmed_as_x1_equals() {
     let ev = run(&mut c, &[], 20_000);
     end_tick(&ev);
     let named: Vec<(String, f64)> = c
-        .named_positions()
+        .report()
+        .named_positions
         .into_iter()
         .map(|(n, v)| (n.to_string(), v))
         .collect();

@@ -41,7 +41,7 @@ fn a_large_subprogram_is_read_off_the_tick_and_runs_whole() {
         Some(&*format!("P1={}", lines - 1))
     );
     assert_eq!((r.position('X'), r.position('Y')), (7.0, 2.0));
-    let files = r.machine.channels()[0].store_stats();
+    let files = r.machine.channels()[0].report().store;
     assert_eq!(files.opens, 2);
     assert_eq!(files.bytes_read, (main.len() + sub.len()) as u64);
     assert_eq!(files.loaded_off_tick, 1, "{files:?}");
@@ -60,7 +60,7 @@ fn a_large_main_program_is_read_off_the_tick() {
     assert!(r.error_codes().is_empty(), "{:?}", r.error_codes());
     assert_eq!(r.position('X'), 3.0);
     assert_eq!(r.of("program_start").len(), 1);
-    let files = r.machine.channels()[0].store_stats();
+    let files = r.machine.channels()[0].report().store;
     assert_eq!((files.opens, files.loaded_off_tick), (1, 1), "{files:?}");
     assert!(files.max_tick_read_bytes <= INLINE_READ_BYTES_PER_TICK);
     // Virtual time waited for the loader with the clock stopped: that wait is counted apart,
@@ -83,7 +83,7 @@ M30
     );
     let r = rig.run("small.nc", None, 100_000);
     assert_eq!(r.position('X'), 3.0);
-    assert_eq!(r.machine.channels()[0].store_stats().loaded_off_tick, 0);
+    assert_eq!(r.machine.channels()[0].report().store.loaded_off_tick, 0);
     assert_eq!(r.stats.clock_stopped, std::time::Duration::ZERO);
 }
 
@@ -112,7 +112,7 @@ fn long_lines_are_decoded_a_bounded_number_of_bytes_per_tick() {
     let r = rig.run("long_lines.nc", None, 100_000);
     assert!(r.error_codes().is_empty(), "{:?}", r.error_codes());
     assert_eq!(r.block_texts(), ["N1 G01 X1 F6000", "X2", "M30"]);
-    let stats = r.machine.channels()[0].decoder().stats();
+    let stats = r.machine.channels()[0].report().decoder;
     assert!(
         stats.max_line_bytes_per_tick
             <= ncchannel::LINE_BYTES_PER_TICK + ncchannel::MAX_LINE_BYTES + 2,

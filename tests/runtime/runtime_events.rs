@@ -41,6 +41,7 @@ fn every_event_kind_has_the_documented_fields() {
         index: 1500,
         period: Duration::from_millis(1),
         time: Duration::from_millis(1500),
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     let mut cases = program_event_cases();
     cases.extend(message_event_cases());
@@ -218,6 +219,7 @@ fn a_disabled_log_takes_events_and_writes_nothing() {
         index: 0,
         period: Duration::from_millis(1),
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     buf.push(&tick, 1, EventKind::Interrupt { held: 0 });
     assert!(buf.is_empty());
@@ -350,6 +352,7 @@ fn typed_fields_serialise_to_the_documented_words() {
         index: 1,
         period: Duration::from_millis(1),
         time: Duration::from_millis(1),
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     let json = |kind: EventKind| -> Value {
         serde_json::from_str(&Event::new(&tick, 1, kind).to_json()).unwrap()

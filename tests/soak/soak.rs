@@ -170,6 +170,7 @@ fn machine_ticks_four_channels_each_with_its_own_stream() {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     for ch in 1..=4u32 {
         let mut text = String::from("N1 G90 G01 F30000\n");
@@ -189,8 +190,8 @@ fn machine_ticks_four_channels_each_with_its_own_stream() {
     let (m, _) = rt.into_inner();
     for (i, c) in m.channels().iter().enumerate() {
         let ch = i as f64 + 1.0;
-        assert_eq!(c.stats().blocks, 203, "channel {}", i + 1);
-        let p = c.position();
+        assert_eq!(c.report().stats.blocks, 203, "channel {}", i + 1);
+        let p = c.report().position;
         assert_eq!((p[0], p[1]), (ch * 100.0, ch * 2.0), "channel {}", i + 1);
         assert_eq!(m.finishes()[i], Some(ncchannel::channel::Finish::Ended));
     }

@@ -29,7 +29,7 @@ fn stream_as_main_program_runs_every_block_and_ends() {
     assert_eq!(start[0]["stream"], true);
     let end = r.of("program_end");
     assert_eq!(end[0]["end"], "M30");
-    let pos = r.machine.channels()[0].position();
+    let pos = r.machine.channels()[0].report().position;
     assert!((pos[0] - 10.0).abs() < 1e-9 && (pos[1] - 10.0).abs() < 1e-9);
 }
 
@@ -87,7 +87,7 @@ fn packets_written_before_the_read_merge_into_one_segment() {
         common::write(c, &t, &crlf("N2 P2=2\nN3 P3=3\n")),
         common::WRITTEN
     );
-    assert_eq!(c.stream_fill().0, 9 + 18);
+    assert_eq!(c.report().stream_fill.0, 9 + 18);
     common::start(c, &t, "streaming.nc");
     c.step(&t);
     let ev = common::channel_events(c);
@@ -113,14 +113,14 @@ fn m30_mid_segment_discards_the_rest_of_the_segment_but_not_later_data() {
     for _ in 0..5 {
         c.step(&t);
     }
-    assert_eq!(c.state(), State::Ready);
+    assert_eq!(c.status().state, State::Ready);
     let ev = common::channel_events(c);
     let discard = common::of(&ev, "discard");
     assert_eq!(discard.len(), 1);
     assert_eq!(discard[0]["bytes"], 9, "'N2 P2=2\\r\\n' dropped");
     let texts = common::block_texts(&ev);
     assert_eq!(texts, ["N1 P1=1", "M30"]);
-    assert_eq!(c.stream_fill().0, 9);
+    assert_eq!(c.report().stream_fill.0, 9);
     // The next start runs it.
     common::start(c, &t, "streaming.nc");
     assert_eq!(common::write(c, &t, &crlf("M30\n")), common::WRITTEN);
@@ -185,7 +185,7 @@ fn a_line_without_cr_lf_raises_21476_and_stops_the_channel() {
     let r = rig.run("streaming.nc", Some(f), 1000);
     assert_eq!(r.finish, Some(Finish::Error));
     assert_eq!(r.error_codes(), [21476]);
-    assert_eq!(r.machine.channels()[0].state(), State::Error);
+    assert_eq!(r.machine.channels()[0].status().state, State::Error);
     // The kernel's text once, then where in the packet: no second number, no second text.
     let msg = r.of("error")[0]["msg"].as_str().unwrap_or("").to_string();
     assert_eq!(
@@ -212,7 +212,7 @@ fn a_starved_stream_interrupts_and_resumes() {
         kinds,
         ["block", "block", "interrupt", "resume", "block", "block"]
     );
-    assert_eq!(r.machine.channels()[0].stats().interrupts, 1);
+    assert_eq!(r.machine.channels()[0].report().stats.interrupts, 1);
 }
 
 #[test]
@@ -240,13 +240,13 @@ fn reset_empties_buffer_and_state() {
     common::start(c, &t, "streaming.nc");
     c.step(&t);
     assert_eq!(common::write(c, &t, &crlf("N3 X5\n")), common::WRITTEN);
-    assert!(c.decoder().reads_stream());
+    assert!(c.report().reads_stream);
     c.apply(&t, Op::Reset);
-    assert_eq!(c.state(), State::Ready);
-    assert_eq!(c.stream_fill(), (0, 4094));
-    assert!(!c.decoder().reads_stream());
-    assert_eq!(c.block_counter(), 0);
-    assert!(c.last_error().is_none());
+    assert_eq!(c.status().state, State::Ready);
+    assert_eq!(c.report().stream_fill, (0, 4094));
+    assert!(!c.report().reads_stream);
+    assert_eq!(c.status().block_counter, 0);
+    assert!(c.report().last_error.is_none());
 }
 
 #[test]
@@ -283,7 +283,10 @@ fn the_error_list_is_bounded_and_counts_the_rest() {
         let _ = c.apply(&t, Op::WriteStream(b"N1 X1\n".as_slice().into()));
         c.apply(&t, Op::Reset);
     }
-    assert_eq!(c.stats().errors, 1000);
-    assert_eq!(c.errors().len(), ncchannel::channel::MAX_LISTED_ERRORS);
-    assert!(c.errors().iter().all(|e| e.code == 21476));
+    assert_eq!(c.report().stats.errors, 1000);
+    assert_eq!(
+        c.report().errors.len(),
+        ncchannel::channel::MAX_LISTED_ERRORS
+    );
+    assert!(c.report().errors.iter().all(|e| e.code == 21476));
 }

@@ -185,7 +185,7 @@ fn file_programs_may_loop_and_jump_back() {
     );
     let r = rig.run("loops.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{:?}", r.of("error"));
-    assert!((r.machine.channels()[0].position()[0] - 11.0).abs() < 1e-9);
+    assert!((r.machine.channels()[0].report().position[0] - 11.0).abs() < 1e-9);
     // The block counter counts every decoded line, each loop pass included.
     let last = r.of("block").last().unwrap()["counter"].as_u64().unwrap();
     assert!(last > 20, "{last}");
@@ -224,7 +224,7 @@ fn subroutines_cycles_locals_and_variables() {
     );
     let r = rig.run("main.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{:?}", r.of("error"));
-    let p = r.machine.channels()[0].position();
+    let p = r.machine.channels()[0].report().position;
     assert_eq!((p[0], p[1]), (2.0, 7.0));
 }
 
@@ -305,7 +305,7 @@ fn block_search_by_number_counter_and_offset_restores_the_state_of_a_full_run() 
     let cut = cut_at_n70();
     for stream in [false, true] {
         let full = run_search(&rig, &cut, stream, None);
-        let full_modal = full.machine.channels()[0].decoder().modal().clone();
+        let full_modal = full.machine.channels()[0].report().modal;
         assert_eq!(
             (
                 full_modal.tool,
@@ -322,14 +322,14 @@ fn block_search_by_number_counter_and_offset_restores_the_state_of_a_full_run() 
             // Snapshot: the state collected by the search equals the full run's at N70 …
             let s = run_search(&rig, &cut, stream, Some(target));
             assert_eq!(
-                s.machine.channels()[0].decoder().modal(),
+                &s.machine.channels()[0].report().modal,
                 &full_modal,
                 "{target} stream={stream}"
             );
             // … the positioning move brought the axes where the full run had them …
             assert_eq!(
-                s.machine.channels()[0].position(),
-                full.machine.channels()[0].position(),
+                s.machine.channels()[0].report().position,
+                full.machine.channels()[0].report().position,
                 "{target}"
             );
             let ev = s.of("search");

@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 
 use ads::{AmsAddr, AmsNetId, Client, Source, Timeouts};
 use common::{of, Rig};
-use ncchannel::ads::channel_backend::ChannelBackend;
 use ncchannel::ads::objects::offset;
+use ncchannel::machine::remote::ChannelBackend;
 use ncchannel::machine::{Machine, Op, Reply, Request, StopWhen};
 use ncchannel::runtime::{Clock, Cycle, Flow, Runtime, Tick};
 use serde_json::Value;

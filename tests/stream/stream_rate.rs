@@ -36,6 +36,7 @@ fn stream_for(startup: &Path, ticks: u64) -> (u64, Vec<Option<u32>>) {
         index,
         period,
         time: period * index as u32,
+        clock: ncchannel::runtime::Clock::Virtual,
     };
     assert_eq!(
         ch.apply(&tick(0), Op::Start("streaming.nc".into())),
@@ -53,7 +54,7 @@ fn stream_for(startup: &Path, ticks: u64) -> (u64, Vec<Option<u32>>) {
             pending = packet(next);
         }
         ch.step(&tick(t));
-        assert_eq!(ch.state(), State::Active);
+        assert_eq!(ch.status().state, State::Active);
         if let Reply::Executed(e) = ch.apply(&tick(t), Op::DrainExecuted) {
             executed.extend(e.into_iter().map(|b| b.n));
         }

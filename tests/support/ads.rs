@@ -10,9 +10,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ncchannel::ads::backend::{CncBackend, Op, Status};
-use ncchannel::ads::channel_backend::Ticking;
 use ncchannel::ads::frame::{self, AmsAddr, AmsHeader, CommandId, Frame};
 use ncchannel::ads::{spawn, ServerConfig, ServerHandle};
+use ncchannel::machine::remote::Ticking;
 use ncchannel::machine::{Machine, StopWhen};
 use ncchannel::report::event::EventLog;
 use ncchannel::vocab::ams::AmsNetId;

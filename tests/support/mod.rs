@@ -83,7 +83,8 @@ impl RunResult {
     /// Where channel 1's `axis` stands at the end, mm.
     pub fn position(&self, axis: char) -> f64 {
         self.machine.channels()[0]
-            .axis_positions()
+            .status()
+            .positions
             .into_iter()
             .find(|(a, _)| *a == axis)
             .map(|(_, v)| v)
@@ -252,6 +253,7 @@ pub fn tick0(period: Duration) -> Tick {
         index: 0,
         period,
         time: Duration::ZERO,
+        clock: ncchannel::runtime::Clock::Virtual,
     }
 }
 
@@ -287,7 +289,7 @@ impl Served {
             rt.run(None);
             rt.into_inner().0
         });
-        let backend = ncchannel::ads::channel_backend::ChannelBackend::new(tx, n);
+        let backend = ncchannel::machine::remote::ChannelBackend::new(tx, n);
         let config = ncchannel::ads::ServerConfig {
             bind: "127.0.0.1:0".parse().unwrap(),
             ..Default::default()

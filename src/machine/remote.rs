@@ -1,5 +1,14 @@
-//! The object table's backend over the real channels: each call becomes a request into the
-//! runtime's fixed-cycle loop and waits for the answer of the tick that serves it.
+//! The channels seen from other threads: one door, `call(channel, Op) → Reply`
+//! ([`CncBackend`]), shared by the ADS object table and the web view, and its runtime
+//! implementation ([`ChannelBackend`]): each call becomes a request into the fixed-cycle loop
+//! and waits for the answer of the tick that serves it, answered exactly once — applied, or
+//! busy and not applied (the claim, docs/exactly-once.md). [`Ticking`] runs a machine so on a
+//! thread of its own.
+//!
+//! Channel numbers are 1-based everywhere here (`1..=channel_count()`). The `impl dyn
+//! CncBackend` block holds the few translations of a [`Reply`] that callers share (a status,
+//! a command's result); they are not part of the door, so a backend implements only the two
+//! methods.
 
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -8,8 +17,8 @@ use std::time::Duration;
 
 use crossbeam_channel::{RecvTimeoutError, Sender};
 
-use super::backend::{CncBackend, DeviceError};
-use crate::machine::{Machine, Op, Reply, Request};
+use super::{Machine, Op, Reply, Request, Status};
+use crate::channel::CommandError;
 use crate::runtime::{Clock, Runtime, StopHandle};
 
 /// How long a connection thread waits for the runtime by default (runtime.toml
@@ -137,5 +146,100 @@ impl Ticking {
 impl Drop for Ticking {
     fn drop(&mut self) {
         self.stop_and_join();
+    }
+}
+
+/// Why a channel request failed (the ADS server maps each to one ADS result code).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum DeviceError {
+    /// The channel cannot do that in its current mode/state (0x707).
+    #[error("device not ready")]
+    NotReady,
+    /// Try again shortly (0x708).
+    #[error("device busy")]
+    Busy,
+    /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
+    #[error("invalid parameter value")]
+    InvalidValue,
+    /// A named thing does not exist, e.g. an unknown V.E. variable (0x70C).
+    #[error("not found")]
+    NotFound,
+}
+
+/// The remote handle of the channels, shared by the ADS object table and the web view.
+/// `ch` is 1-based.
+pub trait CncBackend: Send + Sync + 'static {
+    /// Number of channels; index groups exist for `1..=channel_count()`.
+    fn channel_count(&self) -> u16;
+    /// Apply `op` to channel `ch` and return the channel's answer. `Err` only when the
+    /// request never reached the channel: [`DeviceError::Busy`] when it was not applied in
+    /// time and never will be (docs/exactly-once.md), [`DeviceError::NotReady`] when the
+    /// runtime is gone, [`DeviceError::NotFound`] for a channel that does not exist.
+    fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError>;
+}
+
+/// One entry of a channel's error history and how many errors it raised in all.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ErrorRecord {
+    pub total: u64,
+    /// ISG error number and text; `None` when that error is no longer kept.
+    pub error: Option<(u32, String)>,
+}
+
+/// How a refused command maps onto a device error: a value the channel does not know is
+/// invalid (ADS 0x706), a command its mode/state does not allow now is busy (0x708: the same
+/// command succeeds once the state changes), a start without a program or that failed is not
+/// ready (0x707).
+fn command_error(e: &CommandError) -> DeviceError {
+    match e {
+        CommandError::InvalidValue(_) | CommandError::BadOverride(_) => DeviceError::InvalidValue,
+        CommandError::Busy { .. } => DeviceError::Busy,
+        CommandError::NoProgram | CommandError::StartFailed { .. } => DeviceError::NotReady,
+    }
+}
+
+impl dyn CncBackend {
+    /// Everything the COM, GEO and HLI objects show of a channel, in one snapshot.
+    pub fn status(&self, ch: u16) -> Result<Status, DeviceError> {
+        match self.call(ch, Op::Status)? {
+            Reply::Status(s) => Ok(*s),
+            _ => Err(DeviceError::NotReady),
+        }
+    }
+
+    /// A command whose answer is only "done" or why not.
+    pub fn command(&self, ch: u16, op: Op) -> Result<(), DeviceError> {
+        match self.call(ch, op)? {
+            Reply::Command(Ok(())) | Reply::Done => Ok(()),
+            Reply::Command(Err(e)) => Err(command_error(&e)),
+            _ => Err(DeviceError::NotReady),
+        }
+    }
+
+    /// Read an external variable `V.E.<name>` (name given without the `V.E.` prefix).
+    pub(crate) fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError> {
+        match self.call(ch, Op::ReadExternal(name.to_string()))? {
+            Reply::Value(Some(v)) => Ok(v),
+            _ => Err(DeviceError::NotFound),
+        }
+    }
+
+    /// Write an external variable `V.E.<name>`.
+    pub fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError> {
+        match self.call(ch, Op::WriteExternal(name.to_string(), value))? {
+            Reply::Value(Some(_)) => Ok(()),
+            _ => Err(DeviceError::InvalidValue),
+        }
+    }
+
+    /// The `index`-th error the channel raised (0 = first), if still kept.
+    pub(crate) fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+        match self.call(ch, Op::ErrorRecord(index))? {
+            Reply::ErrorRecord { total, record } => Ok(ErrorRecord {
+                total,
+                error: record,
+            }),
+            _ => Err(DeviceError::NotReady),
+        }
     }
 }

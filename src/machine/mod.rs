@@ -4,9 +4,11 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+pub mod remote;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::Sender;
 
@@ -84,6 +86,9 @@ pub struct Machine {
     /// Per channel: how its last program finished.
     finishes: Vec<Option<Finish>>,
     cycle_times: CycleTimes,
+    /// Wall time the channels' ticks waited for the program loader with the clock stopped,
+    /// not yet taken by the runtime ([`Cycle::take_clock_stopped`]).
+    clock_stopped: Duration,
 }
 
 impl Machine {
@@ -96,6 +101,7 @@ impl Machine {
             stop_when,
             finishes: vec![None; n],
             cycle_times: CycleTimes::default(),
+            clock_stopped: Duration::ZERO,
         }
     }
 
@@ -201,7 +207,7 @@ impl Cycle for Machine {
             }
         }
         for (i, c) in self.channels.iter_mut().enumerate() {
-            c.step(tick);
+            self.clock_stopped += c.step(tick);
             if let Some(f) = c.take_finish() {
                 self.finishes[i] = Some(f);
             }
@@ -223,5 +229,9 @@ impl Cycle for Machine {
                 }
             }
         }
+    }
+
+    fn take_clock_stopped(&mut self) -> Duration {
+        std::mem::take(&mut self.clock_stopped)
     }
 }

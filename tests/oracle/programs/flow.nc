@@ -1,0 +1,65 @@
+(every control-flow statement, with motion between them)
+%L SQUARE
+G91 G01 X[P10] F3000
+Y[P10]
+X-[P10]
+Y-[P10]
+G90
+M17
+%L LOOPS
+$FOR P1 = 1, 4
+  $IF P1 == 2
+    $CONTINUE
+  $ELSEIF P1 == 4
+    $BREAK
+  $ELSE
+    G01 X[P1 * 5] F2000
+  $ENDIF
+$ENDFOR
+M17
+%main
+#VAR
+  V.L.COUNT = 3
+  V.P.TABLE[4]
+#ENDVAR
+N10 G90 G17 G54 G01 X0 Y0 Z0 F6000
+N20 LL LOOPS
+N30 P2 = 0
+$WHILE P2 < 3
+  P2 = P2 + 1
+  G01 Y[P2 * 2]
+$ENDWHILE
+$DO
+  P2 = P2 + 1
+  V.P.TABLE[1] = P2
+$ENDDO P2 < 6
+$REPEAT
+  P2 = P2 + 1
+  G01 Z[-P2 / 10]
+$UNTIL P2 >= 8
+$SWITCH V.L.COUNT
+$CASE 1
+  G01 X1
+$BREAK
+$CASE 3
+  G01 X3
+  P10 = 4
+  LL SQUARE
+$BREAK
+$DEFAULT
+  G01 X9
+$ENDSWITCH
+N40 P3 = 0
+N50: P3 = P3 + 1
+$IF P3 < 3 $GOTO N50
+$IF P3 == 3 $GOTO [ARC]
+G01 X100
+[ARC] G01 X0 Y0
+G02 X10 Y0 I5 J0 F1500
+G03 X0 Y0 I-5 J0
+/ G01 X77
+#MSG ["pass %d done", P3]
+#FLUSH
+L subprogram.nc
+N90 G00 Z20
+M30
