@@ -156,7 +156,10 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
     };
     let ticks = rt.ticks();
     let (machine, stats) = rt.into_inner();
-    let blocks = machine.channels().first().map_or(0, |c| c.report().stats.blocks);
+    let blocks = machine
+        .channels()
+        .first()
+        .map_or(0, |c| c.report().stats.blocks);
     let code = report(b, period, &measured);
     // The cycle under this load: on a shared machine a starved runtime shows here.
     say(format_args!(
