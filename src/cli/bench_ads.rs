@@ -99,7 +99,8 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::USAGE)
     };
-    let (config, channels) = match super::run::load_channels(b.params, false) {
+    let loader = crate::source::loader::Loader::start();
+    let (config, channels) = match super::run::load_channels(b.params, false, &loader) {
         Ok(c) => c,
         Err(e) => return usage(e),
     };

@@ -107,15 +107,6 @@ pub(crate) struct Flow {
     seen_labels: BTreeSet<Label>,
 }
 
-/// A large set of labels passed is freed by the loader thread, as the frame's text is
-/// (`Frame`'s `Drop`).
-impl Drop for Flow {
-    fn drop(&mut self) {
-        let seen = self.seen_labels.len();
-        crate::source::loader::release_table(std::mem::take(&mut self.seen_labels), seen);
-    }
-}
-
 /// Where a frame goes on after a `$` statement.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum FlowStep<'c> {
@@ -149,6 +140,12 @@ pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
 }
 
 impl Flow {
+    /// Whether freeing the labels passed could cost a tick (then the frame is freed by the
+    /// loader thread, `Frame::is_heavy`).
+    pub(crate) fn is_heavy(&self) -> bool {
+        crate::source::loader::is_heavy_table(self.seen_labels.len())
+    }
+
     /// Record a label passed in a stream: a label seen twice is codes::LABEL_TWICE; a later `$GOTO` to a
     /// seen label is a backward jump.
     pub(super) fn note_label(&mut self, l: &Label, stream: bool) -> Res {

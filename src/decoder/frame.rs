@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use crate::source::loader::PendingRead;
+use crate::source::loader::{self, PendingRead};
 use crate::source::store::ProgramText;
 use crate::source::stream::StreamBuffer;
 
@@ -61,23 +61,19 @@ pub(crate) struct Frame {
     label_index: Option<Arc<LabelIndex>>,
 }
 
-/// A frame that held the last reference to a large file text lets the loader thread free it,
-/// and its label index with it (its flow's labels follow, `Flow`'s `Drop`): tens of
-/// thousands of labels take milliseconds to free.
-impl Drop for Frame {
-    fn drop(&mut self) {
-        use crate::source::loader;
-        if let Source::File(p) = &mut self.source {
-            loader::release(std::mem::take(&mut p.text));
-        }
-        if let Some(index) = self.label_index.take() {
-            let items = index.len();
-            loader::release_table(index, items);
-        }
-    }
-}
-
 impl Frame {
+    /// Whether dropping this frame could cost a tick milliseconds: it holds the last
+    /// reference to a large file text, a large label index, or many labels passed. The reader
+    /// that owns it then lets the loader thread free it (`Reader::release`).
+    pub(crate) fn is_heavy(&self) -> bool {
+        matches!(&self.source, Source::File(p) if loader::is_heavy_text(&p.text))
+            || self
+                .label_index
+                .as_ref()
+                .is_some_and(|i| loader::is_heavy_table(i.len()))
+            || self.flow.is_heavy()
+    }
+
     pub(crate) fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
         Frame {
             kind,

@@ -25,6 +25,7 @@ use super::settings::DecoderSettings;
 use super::vars::{VarSlot, VarStore};
 use crate::lang::block::{Expr, VarRef};
 use crate::queue::{Action, BlockInfo, QueuedBlock};
+use crate::source::loader::Loader;
 use crate::vocab::axis::{Position, MAX_AXES};
 use block_words::Words;
 use implicit::ImplicitState;
@@ -56,14 +57,14 @@ pub(super) struct Interpreter {
 }
 
 impl Interpreter {
-    pub(super) fn new(settings: DecoderSettings) -> Self {
+    pub(super) fn new(settings: DecoderSettings, loader: Loader) -> Self {
         let renamed_slots = (0..MAX_AXES)
             .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
             .fold(0u8, |m, i| m | 1 << i);
         Interpreter {
             settings,
             renamed_slots,
-            vars: VarStore::new(),
+            vars: VarStore::new(loader),
             modal: Modal::defaults([0.0; MAX_AXES]),
             tool_radii: Vec::new(),
             counter: 0,

@@ -158,18 +158,15 @@ pub(crate) struct LabelScan {
     warned_other: bool,
 }
 
-/// A scan that outlives its frame (a reset during the scan) lets the loader free the text and
-/// the index built so far.
-impl Drop for LabelScan {
-    fn drop(&mut self) {
-        use crate::source::loader;
-        loader::release(std::mem::take(&mut self.text));
-        let items = self.index.len();
-        loader::release_table(std::mem::take(&mut self.index), items);
-    }
-}
-
 impl LabelScan {
+    /// Whether dropping the scan could cost a tick: it outlived its frame (a reset during the
+    /// scan) holding the last reference to a large text, or its index grew large. The reader
+    /// then lets the loader thread free it.
+    pub(crate) fn is_heavy(&self) -> bool {
+        crate::source::loader::is_heavy_text(&self.text)
+            || crate::source::loader::is_heavy_table(self.index.len())
+    }
+
     pub(crate) fn new(text: Arc<Vec<u8>>, goal: ScanGoal) -> Self {
         LabelScan {
             text,

@@ -25,6 +25,7 @@ use std::time::Duration;
 use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, VarLine};
+use crate::source::loader::Loader;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
 
@@ -101,10 +102,11 @@ enum Ready {
 }
 
 impl Decoder {
-    pub fn new(settings: DecoderSettings) -> Self {
+    /// A decoder whose reader and variables free what could cost a tick through `loader`.
+    pub fn new(settings: DecoderSettings, loader: Loader) -> Self {
         Decoder {
-            reader: Reader::default(),
-            interp: Interpreter::new(settings),
+            reader: Reader::new(loader.clone()),
+            interp: Interpreter::new(settings, loader),
             state: DecoderState::Idle,
             notes: Vec::new(),
             stats: DecoderStats::default(),
@@ -163,9 +165,6 @@ impl Decoder {
     /// listing); `None` for the stream and for a program no frame runs.
     pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
         self.reader.program_text(prog)
-    }
-    pub fn depth(&self) -> usize {
-        self.reader.depth()
     }
     /// The message reported for error `code`: the kernel's text for it (error text file,
     /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.

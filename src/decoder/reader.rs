@@ -15,7 +15,7 @@ use crate::lang::block::GotoTarget;
 use crate::lang::codes;
 use crate::lang::control::{goto_label, goto_text};
 use crate::lang::Joiner;
-use crate::source::loader::PendingRead;
+use crate::source::loader::{Loader, PendingRead};
 use crate::source::store::{ProgramStore, ProgramText, StoreError};
 use crate::source::stream::StreamBuffer;
 
@@ -80,11 +80,15 @@ pub(super) struct Reader {
     /// where its first line stands.
     joiner: Joiner,
     join_meta: LineMeta,
+    /// Frees the frames and label scans the reader lets go of when that could cost a tick
+    /// (a large text, a large label table).
+    loader: Loader,
 }
 
-impl Default for Reader {
-    fn default() -> Self {
+impl Reader {
+    pub(super) fn new(loader: Loader) -> Self {
         Reader {
+            loader,
             frames: Vec::new(),
             stream: StreamReader::default(),
             stream_active: false,
@@ -106,10 +110,33 @@ impl Default for Reader {
     }
 }
 
+/// Whatever the reader still holds when the decoder goes is freed as a frame popped is.
+impl Drop for Reader {
+    fn drop(&mut self) {
+        self.release_frames();
+        self.release_scan();
+    }
+}
+
 impl Reader {
+    /// Let go of every frame, each through [`Reader::release`].
+    fn release_frames(&mut self) {
+        let loader = &self.loader;
+        for f in self.frames.drain(..) {
+            loader.free_if(f.is_heavy(), f);
+        }
+    }
+
+    /// Let go of the label scan under way, if any: a large one through the loader thread.
+    fn release_scan(&mut self) {
+        if let Some(scan) = self.scan.take() {
+            self.loader.free_if(scan.is_heavy(), scan);
+        }
+    }
+
     /// A new program starts: no frames, nothing waited for.
     pub(super) fn start(&mut self) {
-        self.frames.clear();
+        self.release_frames();
         self.joiner = Joiner::default();
         self.wait_idle = false;
         self.starved = false;
@@ -120,7 +147,7 @@ impl Reader {
 
     /// Channel reset: frames and the stream position go.
     pub(super) fn reset(&mut self) {
-        self.frames.clear();
+        self.release_frames();
         self.joiner = Joiner::default();
         self.stream.restart();
         self.stream_active = false;
@@ -132,7 +159,7 @@ impl Reader {
 
     /// No label scan under way or waited for.
     fn forget_scan(&mut self) {
-        self.scan = None;
+        self.release_scan();
         self.scan_found = None;
         self.cache_read = None;
         self.wait_line = false;
@@ -145,14 +172,17 @@ impl Reader {
     }
 
     /// The running frame leaves the stack (a return); a stream frame ends its stream, the
-    /// rest of its segment going (reported as a discard).
-    pub(super) fn pop(&mut self, notes: &mut Vec<Note>) -> Option<Frame> {
-        let f = self.frames.pop()?;
+    /// rest of its segment going (reported as a discard). False: no frame was running.
+    pub(super) fn pop(&mut self, notes: &mut Vec<Note>) -> bool {
+        let Some(f) = self.frames.pop() else {
+            return false;
+        };
         if f.is_stream() {
             self.discard_stream_rest(notes);
             self.stream_active = false;
         }
-        Some(f)
+        self.loader.free_if(f.is_heavy(), f);
+        true
     }
 
     /// M30/M2: every frame goes; in a stream the rest of the current segment goes.
@@ -161,7 +191,7 @@ impl Reader {
             self.discard_stream_rest(notes);
             self.stream_active = false;
         }
-        self.frames.clear();
+        self.release_frames();
         self.starved = false;
     }
 
@@ -427,7 +457,7 @@ impl Reader {
         match step {
             Ok(ScanStep::Pending) => Ok(false),
             Ok(ScanStep::Done(found)) => {
-                self.scan = None;
+                self.release_scan();
                 match found {
                     ScanFound::Index(index) => self.top().set_label_index(Arc::new(index)),
                     other => self.scan_found = Some((goal, other)),
@@ -435,7 +465,7 @@ impl Reader {
                 Ok(true)
             }
             Err(e) => {
-                self.scan = None;
+                self.release_scan();
                 let at = self.top().line_pos();
                 let meta = LineMeta {
                     line: at.line_no + 1,

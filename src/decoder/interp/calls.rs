@@ -61,7 +61,7 @@ impl Interpreter {
         rd: &mut Reader,
         notes: &mut Vec<Note>,
     ) {
-        if rd.pop(notes).is_some() {
+        if rd.pop(notes) {
             self.vars.pop_level();
         }
         if self.implicit.m6_depth.is_some_and(|d| rd.depth() < d) {
