@@ -56,7 +56,7 @@ fn write_case(dir: &Path, cached: bool, fs_latency_us: u64, body: &str) {
 /// A machine with main.nc started, ready to run.
 fn machine(dir: &Path) -> (Machine, Duration) {
     let config = ncchannel::params::load(&dir.join("params/startup.lis")).unwrap();
-    let channels = ncchannel::channels(&config, false).unwrap();
+    let channels = ncchannel::channels(&config, false, &ncchannel::Loader::start()).unwrap();
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
     let t0 = Tick {

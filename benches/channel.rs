@@ -38,7 +38,7 @@ impl Setup {
     /// Run `program` (fed from `stream` if given) to its end; returns the tick work p99 in µs.
     fn run(&self, program: &str, stream: Option<&[u8]>) -> (f64, f64, u64) {
         let config = ncchannel::params::load(&self.dir.path().join("p/startup.lis")).unwrap();
-        let channels = ncchannel::channels(&config, false).unwrap();
+        let channels = ncchannel::channels(&config, false, &ncchannel::Loader::start()).unwrap();
         let period = Duration::from_micros(config.runtime.cycle_period_us);
         let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
         if let Some(s) = stream {

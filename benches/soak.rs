@@ -11,7 +11,8 @@ use ncchannel::soak::load::streaming_channels;
 fn soak(c: &mut Criterion) {
     let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
     for n in [1u32, 4] {
-        let (mut cycle, period) = streaming_channels(&params, n, 1).unwrap();
+        let (mut cycle, period) =
+            streaming_channels(&params, n, 1, &ncchannel::Loader::start()).unwrap();
         let mut index = 0u64;
         c.bench_function(&format!("soak_tick_{n}_channels"), |b| {
             b.iter(|| {

@@ -43,11 +43,6 @@ pub mod ads;
 pub(crate) mod bounded;
 pub mod channel;
 pub mod cli;
-#[allow(
-    dead_code,
-    reason = "Decoder::depth, VarStore::is_string and VarStore::string_max were reached only \
-              through the channel's former decoder() accessor; removing them is the decoder's"
-)]
 pub(crate) mod decoder;
 pub(crate) mod destination;
 pub(crate) mod diag;
@@ -96,7 +91,7 @@ pub use decoder::{
     SearchTarget, DECLARED_VALUES_PER_TICK, LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK,
     LINE_BYTES_PER_TICK, MAX_INDEXED_LABELS,
 };
-pub use source::loader::INLINE_READ_BYTES_PER_TICK;
+pub use source::loader::{Loader, INLINE_READ_BYTES_PER_TICK};
 
 /// Findings of a parameter-list check.
 pub use diag::{Diagnostic, Severity};

@@ -10,6 +10,7 @@ use crate::motion::{AxisLimits, PlannerSettings};
 use crate::params::runtime::axis_index;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
 use crate::source::cache::CacheLimits;
+use crate::source::loader::Loader;
 use crate::source::store::{FsLatency, SearchDir, PATH_MAIN, PATH_SUB};
 use crate::vocab::axis::MAX_AXES;
 
@@ -125,11 +126,21 @@ pub fn channel_settings(
     })
 }
 
-/// Every channel of the configuration.
-pub fn channels(config: &Config, events: bool) -> Result<Vec<Channel>, SetupError> {
+/// Every channel of the configuration, reading and freeing large programs through `loader`.
+pub fn channels(
+    config: &Config,
+    events: bool,
+    loader: &Loader,
+) -> Result<Vec<Channel>, SetupError> {
     config
         .channels
         .iter()
-        .map(|ch| Ok(Channel::new(channel_settings(config, ch)?, events)))
+        .map(|ch| {
+            Ok(Channel::new(
+                channel_settings(config, ch)?,
+                events,
+                loader.clone(),
+            ))
+        })
         .collect()
 }

@@ -331,7 +331,7 @@ pub fn channel_program(data: &[u8]) {
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
     };
-    let Ok(mut channels) = ncchannel::channels(config, false) else {
+    let Ok(mut channels) = ncchannel::channels(config, false, &ncchannel::Loader::start()) else {
         panic!("the shipped parameter lists give no channel")
     };
     let Some(channel) = channels.first_mut() else {
@@ -422,7 +422,7 @@ pub fn param_folder(data: &[u8]) {
         }
     }
     if let Ok(config) = ncchannel::params::config::load(&dir.path().join("startup.lis")) {
-        let _ = ncchannel::channels(&config, false);
+        let _ = ncchannel::channels(&config, false, &ncchannel::Loader::start());
     }
 }
 
@@ -537,7 +537,7 @@ pub fn machine_steps(steps: Vec<ClientStep>) -> usize {
     let Some(config) = shipped_config() else {
         panic!("params/startup.lis not found or refused")
     };
-    let Ok(channels) = ncchannel::channels(config, false) else {
+    let Ok(channels) = ncchannel::channels(config, false, &ncchannel::Loader::start()) else {
         panic!("the shipped parameter lists give no channel")
     };
     let Some(stream_prog) = config.channels[0].streaming_prog_file.clone() else {

@@ -38,7 +38,8 @@ pub(crate) fn channels(n: u16) -> TestChannels {
     }
     std::fs::write(params.join("startup.lis"), startup).expect("start-up list");
     let config = crate::params::load(&params.join("startup.lis")).expect("valid lists");
-    let chans = crate::setup::channels(&config, false).expect("channels");
+    let loader = crate::source::loader::Loader::start();
+    let chans = crate::setup::channels(&config, false, &loader).expect("channels");
     let period = std::time::Duration::from_micros(config.runtime.cycle_period_us);
     let machine = Machine::new(chans, EventLog::disabled(), StopWhen::Never);
     let (backend, ticking) = Ticking::start(machine, period).expect("runtime thread");

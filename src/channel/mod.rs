@@ -16,6 +16,7 @@ use crate::queue::BlockQueue;
 use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
+use crate::source::loader::Loader;
 use crate::source::store::{FsLatency, ProgramStore, SearchDir};
 use crate::source::stream::{StreamBuffer, StreamWriteError};
 use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
@@ -101,6 +102,9 @@ pub struct Channel {
     cache: Cache,
     queue: BlockQueue,
     decoder: Decoder,
+    /// Frees the kept main program text off the tick (the store and the decoder hold their
+    /// own handles to the same loader thread).
+    loader: Loader,
     motion: Motion,
     /// G54…G59 offsets (mm), for positions in the programming coordinate system.
     zero_offsets: ZeroOffsets,
@@ -204,7 +208,9 @@ impl Channel {
         }
     }
 
-    pub fn new(s: ChannelSettings, events_enabled: bool) -> Self {
+    /// A channel built from its settings; `loader` (started by whoever runs the channels)
+    /// reads its large program files and frees its large texts and tables off the tick.
+    pub fn new(s: ChannelSettings, events_enabled: bool, loader: Loader) -> Self {
         let zero_offsets = s.decoder.zero_offsets;
         Channel {
             isg: Isg::new(),
@@ -213,11 +219,12 @@ impl Channel {
             log: ChannelLog::new(s.number, events_enabled),
             stream: StreamBuffer::new(),
             store: ProgramStore::new(s.search_dirs, s.streaming_prog.as_deref())
-                .with_latency(s.fs_latency),
+                .with_latency(s.fs_latency)
+                .with_loader(loader.clone()),
             cache: Cache::new(s.cache),
             queue: BlockQueue::new(s.queue_capacity),
             decoder: {
-                let mut d = Decoder::new(s.decoder);
+                let mut d = Decoder::new(s.decoder, loader.clone());
                 d.set_tool_radii(s.tools.clone());
                 d
             },
@@ -227,6 +234,7 @@ impl Channel {
                 m
             },
             zero_offsets,
+            loader,
             notes: Vec::new(),
             decoder_notes: Vec::new(),
         }
@@ -446,7 +454,7 @@ impl Channel {
             .decoder
             .program_text(name)
             .map(|t| (std::sync::Arc::from(name), t));
-        self.run.keep_main_text(kept);
+        self.run.keep_main_text(kept, &self.loader);
         self.set_state(tick, State::Active);
         self.drain_decoder_notes(tick);
         Ok(())

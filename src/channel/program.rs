@@ -1,6 +1,7 @@
 //! The main program run: which program runs, the block that took effect last, whether motion
 //! waits for stream data, how the run finished, and the program text the live view lists.
 
+use crate::source::loader::Loader;
 use std::sync::Arc;
 
 use crate::queue::BlockInfo;
@@ -62,11 +63,15 @@ impl ProgramRun {
     }
 
     /// Keep the started main program's text for the live view.
-    pub(super) fn keep_main_text(&mut self, kept: Option<(Arc<str>, Arc<Vec<u8>>)>) {
+    pub(super) fn keep_main_text(
+        &mut self,
+        kept: Option<(Arc<str>, Arc<Vec<u8>>)>,
+        loader: &Loader,
+    ) {
         // The last program's text may be the only hold on hundreds of MB: the loader thread
         // frees it, not this tick (the decoder's frames release theirs the same way).
         if let Some((_, old)) = std::mem::replace(&mut self.main_text, kept) {
-            crate::source::loader::release(old);
+            loader.release(old);
         }
     }
 

@@ -143,7 +143,8 @@ pub fn execute(args: BenchArgs) -> ExitCode {
 
 /// `--load cycle`: the runtime with channels streaming in-process against a bare loop.
 fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
-    let (cycle, _) = match streaming_channels(params, args.channels, args.seed) {
+    let loader = crate::source::loader::Loader::start();
+    let (cycle, _) = match streaming_channels(params, args.channels, args.seed, &loader) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),
     };

@@ -99,7 +99,8 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
         eprintln!("ncchannel bench: {msg}");
         ExitCode::from(super::exit::USAGE)
     };
-    let (config, channels) = match super::run::load_channels(b.params, false) {
+    let loader = crate::source::loader::Loader::start();
+    let (config, channels) = match super::run::load_channels(b.params, false, &loader) {
         Ok(c) => c,
         Err(e) => return usage(e),
     };
@@ -156,7 +157,10 @@ pub fn execute(b: &AdsBench<'_>) -> ExitCode {
     };
     let ticks = rt.ticks();
     let (machine, stats) = rt.into_inner();
-    let blocks = machine.channels().first().map_or(0, |c| c.report().stats.blocks);
+    let blocks = machine
+        .channels()
+        .first()
+        .map_or(0, |c| c.report().stats.blocks);
     let code = report(b, period, &measured);
     // The cycle under this load: on a shared machine a starved runtime shows here.
     say(format_args!(

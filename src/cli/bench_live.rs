@@ -151,7 +151,8 @@ pub fn execute(b: &LiveBench<'_>) -> Result<ExitCode, String> {
         folder.path().to_path_buf(),
         "ncchannel bench --load live-view",
     );
-    let channels = match crate::setup::channels(&config, false) {
+    let loader = crate::source::loader::Loader::start();
+    let channels = match crate::setup::channels(&config, false, &loader) {
         Ok(c) => c,
         Err(e) => return Err(e.to_string()),
     };

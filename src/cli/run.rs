@@ -15,6 +15,7 @@ use crate::report::summary::{
     CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
 };
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
+use crate::source::loader::Loader;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 use super::exit;
@@ -211,9 +212,10 @@ pub(crate) fn search_first(
 pub(crate) fn load_channels(
     params: &Path,
     events: bool,
+    loader: &Loader,
 ) -> Result<(crate::params::Config, Vec<crate::channel::Channel>), String> {
     let config = load_config(params)?;
-    let channels = crate::setup::channels(&config, events).map_err(|e| e.to_string())?;
+    let channels = crate::setup::channels(&config, events, loader).map_err(|e| e.to_string())?;
     Ok((config, channels))
 }
 
@@ -287,7 +289,10 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
             "ncchannel run PROGRAM",
         );
     }
-    let channels = match crate::setup::channels(&config, args.events.is_some()) {
+    // The program loader of this run: it reads large program files and frees large texts off
+    // the tick, for the channels built here.
+    let loader = Loader::start();
+    let channels = match crate::setup::channels(&config, args.events.is_some(), &loader) {
         Ok(c) => c,
         Err(e) => return usage(e),
     };

@@ -214,9 +214,13 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         Ok(p) => p,
         Err(e) => return usage(e.to_string()),
     };
+    // The program loader of the served channels: large program files are read, and large
+    // texts freed, off the runtime thread.
+    let loader = crate::source::loader::Loader::start();
     let (config, channels) = match super::run::load_channels(
         &args.params,
         args.events.is_some() || scenario.is_some(),
+        &loader,
     ) {
         Ok(c) => c,
         Err(msg) => return usage(msg),

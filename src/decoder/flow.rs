@@ -4,56 +4,128 @@
 //! or a forward jump only sets a skip state, and the lines that follow are examined one by one
 //! as they arrive — which is what makes these statements work across stream packets.
 
-use std::sync::Arc;
+use std::collections::BTreeSet;
 
-use crate::lang::block::{Block, Body, Control, GotoTarget, Item, Label, Value};
+use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
-use super::frame::{FlowEntry, LineMeta, LinePos, Skip, SkipUntil, Source, MAX_SEEN_LABELS};
-use super::labels::{LabelAt, LabelIndex, LabelScan, ScanFound, ScanGoal};
-use super::{whole, DecodeError, Decoder, Res};
+use super::error::{DecodeError, Res};
+use super::line::{LineMeta, LinePos};
+use super::vars::VarSlot;
 use crate::lang::codes;
+use crate::lang::control::{
+    block_ends_program, control_name, goto_label, goto_text, items_have_m, label_matches,
+    label_text, nesting, Nesting,
+};
 use crate::lang::eval::is_true;
 
-/// How a `$` statement changes nesting, for skipping and for the label index.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Nesting {
-    Open,
-    Close,
-    Neither,
+/// One open control structure of a frame.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum FlowEntry {
+    /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
+    If { taken: bool },
+    /// `$SWITCH`: the value cases compare against.
+    Switch { value: f64 },
+    /// `$FOR var = start, end, step`: the body starts at `body`.
+    For {
+        var: VarSlot,
+        end: f64,
+        step: f64,
+        body: LinePos,
+    },
+    /// `$WHILE`: `head` is the `$WHILE` line itself (the condition is evaluated there).
+    While { head: LinePos },
+    /// `$DO` … `$ENDDO cond`.
+    Do { body: LinePos },
+    /// `$REPEAT` … `$UNTIL cond`.
+    Repeat { body: LinePos },
 }
 
-pub(crate) fn nesting(c: &Control) -> Nesting {
-    match c {
-        Control::If(_)
-        | Control::Switch(_)
-        | Control::For { .. }
-        | Control::While(_)
-        | Control::Do
-        | Control::Repeat => Nesting::Open,
-        Control::EndIf
-        | Control::EndSwitch
-        | Control::EndFor
-        | Control::EndWhile
-        | Control::EndDo(_)
-        | Control::Until(_) => Nesting::Close,
-        _ => Nesting::Neither,
+impl FlowEntry {
+    pub(crate) fn is_loop(&self) -> bool {
+        matches!(
+            self,
+            FlowEntry::For { .. }
+                | FlowEntry::While { .. }
+                | FlowEntry::Do { .. }
+                | FlowEntry::Repeat { .. }
+        )
     }
 }
 
-/// Statements that are loops: not allowed in a stream (codes::STREAM_LOOP).
-pub(crate) fn is_loop_statement(c: &Control) -> bool {
-    matches!(
-        c,
-        Control::For { .. }
-            | Control::EndFor
-            | Control::While(_)
-            | Control::EndWhile
-            | Control::Do
-            | Control::EndDo(_)
-            | Control::Repeat
-            | Control::Until(_)
-    )
+/// What the skip machine is looking for.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum SkipUntil {
+    /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
+    IfBranch,
+    /// A branch has run: the `$ENDIF`.
+    IfEnd,
+    /// `$SWITCH` looking for its case: a matching `$CASE`, `$DEFAULT` or `$ENDSWITCH`.
+    Case,
+    /// After `$BREAK` in a switch: the `$ENDSWITCH`.
+    SwitchEnd,
+    /// A false `$WHILE` or a `$BREAK` in a loop: past the loop's end statement.
+    LoopExit,
+    /// `$CONTINUE`: the loop's end statement, which is then evaluated.
+    LoopContinue,
+    /// A forward `$GOTO` (streams): the line with this label.
+    Label(GotoTarget),
+    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
+    /// next `%name` head when it has none.
+    LocalSubroutine,
+}
+
+/// Skip state: what we look for and how deep inside skipped structures we are.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Skip {
+    until: SkipUntil,
+    /// Structures opened inside the skipped region and not yet closed.
+    depth: u32,
+}
+
+impl Skip {
+    pub(crate) fn new(until: SkipUntil) -> Self {
+        Skip { until, depth: 0 }
+    }
+}
+
+/// How many stream labels a frame remembers. A stream may run for days; a label passed more
+/// than this many labels ago is treated as unknown (a jump to it waits forward for it).
+pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
+
+/// A frame's control flow: the structures open in it, what the skip machine looks for, and
+/// (streams) the labels passed.
+#[derive(Debug, Default)]
+pub(crate) struct Flow {
+    /// Open control structures, innermost last.
+    stack: Vec<FlowEntry>,
+    /// Set while lines are being skipped (false branch, forward jump, …).
+    skip: Option<Skip>,
+    /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
+    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`; a B-tree
+    /// for the reason `LabelIndex` is one.
+    seen_labels: BTreeSet<Label>,
+}
+
+/// Where a frame goes on after a `$` statement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum FlowStep<'c> {
+    /// The next line.
+    Next,
+    /// Back to a loop's head or body.
+    Seek(LinePos),
+    /// To a label (`$GOTO`).
+    Goto(&'c GotoTarget),
+}
+
+/// What the skip machine asks of the interpreter: expressions evaluated, the `$FOR`
+/// variable resolved, read and set.
+pub(super) trait Env {
+    fn eval(&self, e: &Expr) -> Res<f64>;
+    fn resolve(&self, v: &VarRef) -> Res<VarSlot>;
+    /// A variable's value (`None`: not defined).
+    fn var(&self, k: &VarSlot) -> Option<f64>;
+    fn set_var(&mut self, k: VarSlot, v: f64) -> Res;
 }
 
 /// Whether `c` closes the loop `e`.
@@ -67,12 +139,18 @@ pub(crate) fn closes_loop(e: &FlowEntry, c: &Control) -> bool {
     )
 }
 
-impl Decoder {
+impl Flow {
+    /// Whether freeing the labels passed could cost a tick (then the frame is freed by the
+    /// loader thread, `Frame::is_heavy`).
+    pub(crate) fn is_heavy(&self) -> bool {
+        crate::source::loader::is_heavy_table(self.seen_labels.len())
+    }
+
     /// Record a label passed in a stream: a label seen twice is codes::LABEL_TWICE; a later `$GOTO` to a
     /// seen label is a backward jump.
-    pub(super) fn note_label(&mut self, l: &Label) -> Res {
-        let top = self.top();
-        if !top.is_stream() {
+    pub(super) fn note_label(&mut self, l: &Label, stream: bool) -> Res {
+        let top = self;
+        if !stream {
             return Ok(());
         }
         if top.seen_labels.contains(l) {
@@ -89,19 +167,19 @@ impl Decoder {
 
     /// One line while skipping. Returns whether the line is to be executed after all (the
     /// label line a forward jump was looking for).
-    pub(super) fn skip_line(&mut self, block: &Block) -> Res<bool> {
-        let Some(skip) = self.top().skip.clone() else {
+    pub(super) fn skip_line(&mut self, block: &Block, stream: bool, ip: &impl Env) -> Res<bool> {
+        let Some(skip) = self.skip.clone() else {
             return Ok(true);
         };
         if let SkipUntil::Label(t) = &skip.until {
-            return self.skip_to_label(block, t);
+            return self.skip_to_label(block, t, stream);
         }
         if skip.until == SkipUntil::LocalSubroutine {
             match &block.body {
-                Body::Items(items) if items_have_m(items, &[17, 29]) => self.top().skip = None,
+                Body::Items(items) if items_have_m(items, &[17, 29]) => self.skip = None,
                 // A section without M17/M29 ends at the next main program head, which runs.
                 Body::ProgramHead { local: false, .. } => {
-                    self.top().skip = None;
+                    self.skip = None;
                     return Ok(true);
                 }
                 _ => {}
@@ -114,31 +192,32 @@ impl Decoder {
         if self.skip_nested(c, skip.depth) {
             return Ok(false);
         }
-        self.skip_reaches(&skip.until, c)
+        self.skip_reaches(&skip.until, c, ip)
     }
 
     /// A forward jump (streams): the line with the label runs; structures passed on the way
     /// keep the flow stack right; a program end before the label is 20840.
-    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget) -> Res<bool> {
-        let is_stream = self.top().is_stream();
+    fn skip_to_label(&mut self, block: &Block, t: &GotoTarget, is_stream: bool) -> Res<bool> {
         if let Some(l) = &block.label {
-            self.note_label(l)?;
+            self.note_label(l, is_stream)?;
             if label_matches(l, t) {
-                self.top().skip = None;
+                self.skip = None;
                 return Ok(true);
             }
         }
         if let Body::Control(c) = &block.body {
             // Structures opened or closed between jump and label keep the stack right.
-            let top = self.top();
+            let top = self;
             match c {
-                Control::If(_) => top.flow.push(FlowEntry::If { taken: true }),
-                Control::Switch(_) => top.flow.push(FlowEntry::Switch { value: f64::NAN }),
-                Control::EndIf if matches!(top.flow.last(), Some(FlowEntry::If { .. })) => {
-                    top.flow.pop();
+                Control::If(_) => top.stack.push(FlowEntry::If { taken: true }),
+                Control::Switch(_) => top.stack.push(FlowEntry::Switch { value: f64::NAN }),
+                Control::EndIf if matches!(top.stack.last(), Some(FlowEntry::If { .. })) => {
+                    top.stack.pop();
                 }
-                Control::EndSwitch if matches!(top.flow.last(), Some(FlowEntry::Switch { .. })) => {
-                    top.flow.pop();
+                Control::EndSwitch
+                    if matches!(top.stack.last(), Some(FlowEntry::Switch { .. })) =>
+                {
+                    top.stack.pop();
                 }
                 _ => {}
             }
@@ -157,13 +236,13 @@ impl Decoder {
     fn skip_nested(&mut self, c: &Control, depth: u32) -> bool {
         match nesting(c) {
             Nesting::Open => {
-                if let Some(s) = self.top().skip.as_mut() {
+                if let Some(s) = self.skip.as_mut() {
                     s.depth += 1;
                 }
                 true
             }
             Nesting::Close if depth > 0 => {
-                if let Some(s) = self.top().skip.as_mut() {
+                if let Some(s) = self.skip.as_mut() {
                     s.depth -= 1;
                 }
                 true
@@ -174,45 +253,45 @@ impl Decoder {
 
     /// A statement at the skipped structure's own level: does it end the skip? `true` when
     /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
-    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control) -> Res<bool> {
+    fn skip_reaches(&mut self, until: &SkipUntil, c: &Control, ip: &impl Env) -> Res<bool> {
         match (until, c) {
-            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(self.eval(e)?) => {
-                self.top().skip = None;
+            (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(ip.eval(e)?) => {
+                self.skip = None;
                 self.set_if_taken();
             }
             (SkipUntil::IfBranch, Control::Else) => {
-                self.top().skip = None;
+                self.skip = None;
                 self.set_if_taken();
             }
             (SkipUntil::IfBranch | SkipUntil::IfEnd, Control::EndIf) => {
-                let top = self.top();
+                let top = self;
                 top.skip = None;
-                top.flow.pop();
+                top.stack.pop();
             }
             (SkipUntil::Case, Control::Case(e)) => {
-                let v = self.eval(e)?;
-                if let Some(FlowEntry::Switch { value }) = self.top().flow.last() {
+                let v = ip.eval(e)?;
+                if let Some(FlowEntry::Switch { value }) = self.stack.last() {
                     if crate::lang::eval::case_matches(*value, v) {
-                        self.top().skip = None;
+                        self.skip = None;
                     }
                 }
             }
-            (SkipUntil::Case, Control::Default) => self.top().skip = None,
+            (SkipUntil::Case, Control::Default) => self.skip = None,
             (SkipUntil::Case | SkipUntil::SwitchEnd, Control::EndSwitch) => {
-                let top = self.top();
+                let top = self;
                 top.skip = None;
-                top.flow.pop();
+                top.stack.pop();
             }
             (SkipUntil::LoopExit, c) => {
-                let top = self.top();
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                let top = self;
+                if top.stack.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
-                    top.flow.pop();
+                    top.stack.pop();
                 }
             }
             (SkipUntil::LoopContinue, c) => {
-                let top = self.top();
-                if top.flow.last().is_some_and(|e| closes_loop(e, c)) {
+                let top = self;
+                if top.stack.last().is_some_and(|e| closes_loop(e, c)) {
                     top.skip = None;
                     return Ok(true);
                 }
@@ -223,53 +302,100 @@ impl Decoder {
     }
 
     pub(super) fn set_if_taken(&mut self) {
-        if let Some(FlowEntry::If { taken }) = self.top().flow.last_mut() {
+        if let Some(FlowEntry::If { taken }) = self.stack.last_mut() {
             *taken = true;
         }
     }
 
-    pub(super) fn skip(&mut self, until: SkipUntil) {
-        self.top().skip = Some(Skip::new(until));
+    pub(super) fn begin_skip(&mut self, until: SkipUntil) {
+        self.skip = Some(Skip::new(until));
     }
 
-    pub(super) fn stray(&self, c: &Control) -> DecodeError {
-        use crate::lang::codes::StrayKind as K;
-        let kind = match c {
-            Control::Else => Some(K::Else),
-            Control::ElseIf(_) => Some(K::ElseIf),
-            Control::EndIf => Some(K::EndIf),
-            Control::Case(_) => Some(K::Case),
-            Control::Default => Some(K::Default),
-            Control::Break => Some(K::Break),
-            Control::EndSwitch => Some(K::EndSwitch),
-            Control::EndFor => Some(K::EndFor),
-            Control::EndWhile => Some(K::EndWhile),
-            Control::EndDo(_) => Some(K::EndDo),
-            Control::Until(_) => Some(K::Until),
-            Control::Continue => Some(K::Continue),
+    /// Lines are being skipped (a false branch, a forward jump, …).
+    pub(super) fn skipping(&self) -> bool {
+        self.skip.is_some()
+    }
+
+    /// The label a forward jump is skipping to, if it is one.
+    pub(super) fn skipping_to(&self) -> Option<&GotoTarget> {
+        match &self.skip {
+            Some(Skip {
+                until: SkipUntil::Label(t),
+                ..
+            }) => Some(t),
             _ => None,
-        };
-        let code = kind.map_or(codes::SYNTAX, K::code);
-        DecodeError::new(code, format!("unexpected {}", control_name(c)))
+        }
     }
 
-    pub(super) fn exec_control(&mut self, c: &Control, meta: LineMeta) -> Res {
+    /// A `$GOTO` in a stream: a jump to a label already passed is a backward jump (21477);
+    /// to another, the lines are skipped up to the label.
+    pub(super) fn skip_to(&mut self, t: &GotoTarget) -> Res {
+        let key = goto_label(t);
+        if self.seen_labels.contains(&key) {
+            return Err(DecodeError::new(
+                codes::STREAM_BACKWARD_JUMP,
+                format!("backward jump to {} in streaming program", goto_text(t)),
+            ));
+        }
+        self.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
+        Ok(())
+    }
+}
+
+/// The error for a `$` statement met outside its structure.
+pub(super) fn stray(c: &Control) -> DecodeError {
+    use crate::lang::codes::StrayKind as K;
+    let kind = match c {
+        Control::Else => Some(K::Else),
+        Control::ElseIf(_) => Some(K::ElseIf),
+        Control::EndIf => Some(K::EndIf),
+        Control::Case(_) => Some(K::Case),
+        Control::Default => Some(K::Default),
+        Control::Break => Some(K::Break),
+        Control::EndSwitch => Some(K::EndSwitch),
+        Control::EndFor => Some(K::EndFor),
+        Control::EndWhile => Some(K::EndWhile),
+        Control::EndDo(_) => Some(K::EndDo),
+        Control::Until(_) => Some(K::Until),
+        Control::Continue => Some(K::Continue),
+        _ => None,
+    };
+    let code = kind.map_or(codes::SYNTAX, K::code);
+    DecodeError::new(code, format!("unexpected {}", control_name(c)))
+}
+
+impl Flow {
+    /// Run a `$` statement of the line at `meta`, `next` being where the line after it
+    /// starts. Where the frame goes on is returned: a loop's way back for the frame to seek,
+    /// a jump for the reader to make with its label index (`Reader::goto`).
+    pub(super) fn exec_control<'c>(
+        &mut self,
+        c: &'c Control,
+        meta: LineMeta,
+        next: LinePos,
+        ip: &mut impl Env,
+    ) -> Res<FlowStep<'c>> {
+        let back = |at: Option<LinePos>| at.map_or(FlowStep::Next, FlowStep::Seek);
         match c {
-            Control::Break | Control::Continue => self.exec_leave(c),
+            Control::Break | Control::Continue => self.exec_leave(c).map(|()| FlowStep::Next),
             Control::For {
                 var,
                 start,
                 end,
                 step,
-            } => self.exec_for(var, start, end, step.as_deref()),
-            Control::EndFor => self.exec_end_for(c),
+            } => self
+                .exec_for(var, start, end, step.as_deref(), next, ip)
+                .map(|()| FlowStep::Next),
+            Control::EndFor => self.exec_end_for(c, ip).map(back),
             Control::While(_)
             | Control::EndWhile
             | Control::Do
             | Control::EndDo(_)
             | Control::Repeat
-            | Control::Until(_) => self.exec_loop(c, meta),
-            _ => self.exec_branch(c),
+            | Control::Until(_) => self.exec_loop(c, meta, next, ip).map(back),
+            _ => self
+                .exec_branch(c, ip)
+                .map(|t| t.map_or(FlowStep::Next, FlowStep::Goto)),
         }
     }
 
@@ -280,52 +406,53 @@ impl Decoder {
         e: &crate::lang::block::Expr,
         entry: impl FnOnce(bool) -> FlowEntry,
         or_skip: SkipUntil,
+        ip: &impl Env,
     ) -> Res {
-        let v = is_true(self.eval(e)?);
-        self.top().flow.push(entry(v));
+        let v = is_true(ip.eval(e)?);
+        self.stack.push(entry(v));
         if !v {
-            self.skip(or_skip);
+            self.begin_skip(or_skip);
         }
         Ok(())
     }
 
     /// `$IF`, `$SWITCH` and their parts, `$GOTO`.
-    fn exec_branch(&mut self, c: &Control) -> Res {
+    fn exec_branch<'c>(&mut self, c: &'c Control, ip: &impl Env) -> Res<Option<&'c GotoTarget>> {
         match c {
             Control::If(e) => {
-                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch)?
+                self.open_conditional(e, |v| FlowEntry::If { taken: v }, SkipUntil::IfBranch, ip)?
             }
-            Control::IfGoto(e, t) if is_true(self.eval(e)?) => self.goto(t)?,
-            Control::ElseIf(_) | Control::Else => match self.top().flow.last() {
-                Some(FlowEntry::If { .. }) => self.skip(SkipUntil::IfEnd),
-                _ => return Err(self.stray(c)),
+            Control::IfGoto(e, t) if is_true(ip.eval(e)?) => return Ok(Some(t)),
+            Control::ElseIf(_) | Control::Else => match self.stack.last() {
+                Some(FlowEntry::If { .. }) => self.begin_skip(SkipUntil::IfEnd),
+                _ => return Err(stray(c)),
             },
-            Control::EndIf => match self.top().flow.last() {
+            Control::EndIf => match self.stack.last() {
                 Some(FlowEntry::If { .. }) => {
-                    self.top().flow.pop();
+                    self.stack.pop();
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
             Control::Switch(e) => {
-                let value = self.eval(e)?;
-                self.top().flow.push(FlowEntry::Switch { value });
-                self.skip(SkipUntil::Case);
+                let value = ip.eval(e)?;
+                self.stack.push(FlowEntry::Switch { value });
+                self.begin_skip(SkipUntil::Case);
             }
             // Executing into a later case: fall through (no `$BREAK` before it).
-            Control::Case(_) | Control::Default => match self.top().flow.last() {
+            Control::Case(_) | Control::Default => match self.stack.last() {
                 Some(FlowEntry::Switch { .. }) => {}
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
-            Control::EndSwitch => match self.top().flow.last() {
+            Control::EndSwitch => match self.stack.last() {
                 Some(FlowEntry::Switch { .. }) => {
-                    self.top().flow.pop();
+                    self.stack.pop();
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
-            Control::Goto(t) => self.goto(t)?,
+            Control::Goto(t) => return Ok(Some(t)),
             _ => {}
         }
-        Ok(())
+        Ok(None)
     }
 
     /// `$BREAK` and `$CONTINUE`: close the structures they leave, skip to the end.
@@ -333,8 +460,7 @@ impl Decoder {
         match c {
             Control::Break => {
                 let inner = self
-                    .top()
-                    .flow
+                    .stack
                     .iter()
                     .rev()
                     .find(|e| e.is_loop() || matches!(e, FlowEntry::Switch { .. }))
@@ -342,34 +468,34 @@ impl Decoder {
                 match inner {
                     Some(FlowEntry::Switch { .. }) => {
                         // Close inner $IFs between the $BREAK and its switch.
-                        while matches!(self.top().flow.last(), Some(FlowEntry::If { .. })) {
-                            self.top().flow.pop();
+                        while matches!(self.stack.last(), Some(FlowEntry::If { .. })) {
+                            self.stack.pop();
                         }
-                        self.skip(SkipUntil::SwitchEnd);
+                        self.begin_skip(SkipUntil::SwitchEnd);
                     }
                     Some(_) => {
                         while matches!(
-                            self.top().flow.last(),
+                            self.stack.last(),
                             Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                         ) {
-                            self.top().flow.pop();
+                            self.stack.pop();
                         }
-                        self.skip(SkipUntil::LoopExit);
+                        self.begin_skip(SkipUntil::LoopExit);
                     }
-                    None => return Err(self.stray(c)),
+                    None => return Err(stray(c)),
                 }
             }
             Control::Continue => {
-                if !self.top().flow.iter().any(FlowEntry::is_loop) {
-                    return Err(self.stray(c));
+                if !self.stack.iter().any(FlowEntry::is_loop) {
+                    return Err(stray(c));
                 }
                 while matches!(
-                    self.top().flow.last(),
+                    self.stack.last(),
                     Some(FlowEntry::If { .. } | FlowEntry::Switch { .. })
                 ) {
-                    self.top().flow.pop();
+                    self.stack.pop();
                 }
-                self.skip(SkipUntil::LoopContinue);
+                self.begin_skip(SkipUntil::LoopContinue);
             }
             _ => {}
         }
@@ -377,12 +503,20 @@ impl Decoder {
     }
 
     /// `$FOR`: set the variable to its start and enter the body, or skip it.
-    fn exec_for(&mut self, var: &VarRef, start: &Expr, end: &Expr, step: Option<&Expr>) -> Res {
-        let key = self.resolve(var)?;
-        let start = self.eval(start)?;
-        let end = self.eval(end)?;
+    fn exec_for(
+        &mut self,
+        var: &VarRef,
+        start: &Expr,
+        end: &Expr,
+        step: Option<&Expr>,
+        next: LinePos,
+        ip: &mut impl Env,
+    ) -> Res {
+        let key = ip.resolve(var)?;
+        let start = ip.eval(start)?;
+        let end = ip.eval(end)?;
         let step = match step {
-            Some(s) => self.eval(s)?,
+            Some(s) => ip.eval(s)?,
             None => 1.0,
         };
         if step == 0.0 || !step.is_finite() {
@@ -391,170 +525,107 @@ impl Decoder {
                 "$FOR step must not be 0",
             ));
         }
-        self.set_var(key.clone(), start)?;
-        let body = self.top().line_pos();
-        self.top().flow.push(FlowEntry::For {
+        ip.set_var(key.clone(), start)?;
+        let body = next;
+        self.stack.push(FlowEntry::For {
             var: key,
             end,
             step,
             body,
         });
         if !for_continues(start, end, step) {
-            self.skip(SkipUntil::LoopExit);
+            self.begin_skip(SkipUntil::LoopExit);
         }
         Ok(())
     }
 
     /// `$ENDFOR`: step the variable and go round again, or leave the loop.
-    fn exec_end_for(&mut self, c: &Control) -> Res {
-        match self.top().flow.last().cloned() {
+    fn exec_end_for(&mut self, c: &Control, ip: &mut impl Env) -> Res<Option<LinePos>> {
+        match self.stack.last().cloned() {
             Some(FlowEntry::For {
                 var,
                 end,
                 step,
                 body,
             }) => {
-                let v = self.vars.get(&var).unwrap_or(0.0) + step;
-                self.set_var(var, v)?;
+                let v = ip.var(&var).unwrap_or(0.0) + step;
+                ip.set_var(var, v)?;
                 if for_continues(v, end, step) {
-                    self.top().seek(body);
+                    return Ok(Some(body));
                 } else {
-                    self.top().flow.pop();
+                    self.stack.pop();
                 }
             }
-            _ => return Err(self.stray(c)),
+            _ => return Err(stray(c)),
         }
-        Ok(())
+        Ok(None)
     }
 
     /// `$WHILE`, `$DO` and `$REPEAT` loops.
-    fn exec_loop(&mut self, c: &Control, meta: LineMeta) -> Res {
+    fn exec_loop(
+        &mut self,
+        c: &Control,
+        meta: LineMeta,
+        next: LinePos,
+        ip: &impl Env,
+    ) -> Res<Option<LinePos>> {
         let here = LinePos {
             pos: meta.offset as usize,
             line_no: meta.line - 1,
         };
         match c {
-            Control::While(e) => {
-                self.open_conditional(e, |_| FlowEntry::While { head: here }, SkipUntil::LoopExit)?
-            }
-            Control::EndWhile => match self.top().flow.last().cloned() {
+            Control::While(e) => self.open_conditional(
+                e,
+                |_| FlowEntry::While { head: here },
+                SkipUntil::LoopExit,
+                ip,
+            )?,
+            Control::EndWhile => match self.stack.last().cloned() {
                 Some(FlowEntry::While { head }) => {
                     // Back to the $WHILE line, which evaluates and pushes again.
-                    self.top().flow.pop();
-                    self.top().seek(head);
+                    self.stack.pop();
+                    return Ok(Some(head));
                 }
-                _ => return Err(self.stray(c)),
+                _ => return Err(stray(c)),
             },
             Control::Do | Control::Repeat => {
-                let body = self.top().line_pos();
+                let body = next;
                 let entry = match c {
                     Control::Do => FlowEntry::Do { body },
                     _ => FlowEntry::Repeat { body },
                 };
-                self.top().flow.push(entry);
+                self.stack.push(entry);
             }
             // `$ENDDO cond` loops while cond holds, `$UNTIL cond` until it holds.
             Control::EndDo(e) | Control::Until(e) => {
-                let (body, again_if) = match (c, self.top().flow.last()) {
+                let (body, again_if) = match (c, self.stack.last()) {
                     (Control::EndDo(_), Some(FlowEntry::Do { body })) => (*body, true),
                     (Control::Until(_), Some(FlowEntry::Repeat { body })) => (*body, false),
-                    _ => return Err(self.stray(c)),
+                    _ => return Err(stray(c)),
                 };
-                if is_true(self.eval(e)?) == again_if {
-                    self.top().seek(body);
+                if is_true(ip.eval(e)?) == again_if {
+                    return Ok(Some(body));
                 } else {
-                    self.top().flow.pop();
+                    self.stack.pop();
                 }
             }
             _ => {}
         }
-        Ok(())
-    }
-
-    pub(super) fn goto(&mut self, t: &GotoTarget) -> Res {
-        let top = self.top();
-        if top.is_stream() {
-            let key = goto_label(t);
-            if top.seen_labels.contains(&key) {
-                return Err(DecodeError::new(
-                    codes::STREAM_BACKWARD_JUMP,
-                    format!("backward jump to {} in streaming program", goto_text(t)),
-                ));
-            }
-            top.skip = Some(Skip::new(SkipUntil::Label(t.clone())));
-            return Ok(());
-        }
-        // A file frame: the label index, built over several ticks; the line waits for it.
-        let Some(index) = self.label_index() else {
-            return Ok(());
-        };
-        let found = match index.find(t) {
-            Some(at) => Some(at),
-            None if index.overflowed => match self.searched(ScanGoal::Label(goto_label(t))) {
-                Some(ScanFound::Label(at)) => at,
-                _ => return Ok(()),
-            },
-            None => None,
-        };
-        let Some((at, depth)) = found else {
-            return Err(DecodeError::new(
-                codes::LABEL_NOT_FOUND,
-                format!("label {} not found", goto_text(t)),
-            ));
-        };
-        self.jump_to((at, depth));
-        Ok(())
+        Ok(None)
     }
 
     /// Continue at a label: its structural depth decides which open structures the jump
     /// leaves.
-    fn jump_to(&mut self, (at, depth): LabelAt) {
-        let top = self.top();
-        top.seek(at);
-        top.flow.truncate(depth);
-        while top.flow.len() < depth {
-            top.flow.push(FlowEntry::If { taken: true });
+    pub(super) fn leave_to_depth(&mut self, depth: usize) {
+        let top = self;
+        top.stack.truncate(depth);
+        while top.stack.len() < depth {
+            top.stack.push(FlowEntry::If { taken: true });
         }
     }
 
-    /// The label index of the top frame's text, once built. `None`: its scan has begun (or
-    /// goes on) and the line asking waits (`wait_line`); it is read again when the scan is
-    /// done. A stream frame has none (its jumps go forward, line by line).
-    pub(super) fn label_index(&mut self) -> Option<Arc<LabelIndex>> {
-        let top = self.top();
-        if let Some(i) = &top.label_index {
-            return Some(i.clone());
-        }
-        let Source::File(p) = &top.source else {
-            return Some(Arc::new(LabelIndex::default()));
-        };
-        let scan = LabelScan::new(p.text.clone(), ScanGoal::Index);
-        self.begin_scan(scan);
-        None
-    }
-
-    /// What a targeted scan for `goal` found: `None` while it runs (the line waits).
-    pub(super) fn searched(&mut self, goal: ScanGoal) -> Option<ScanFound> {
-        if let Some((g, _)) = &self.scan_found {
-            if *g == goal {
-                return self.scan_found.take().map(|(_, found)| found);
-            }
-        }
-        if let Source::File(p) = &self.top().source {
-            let scan = LabelScan::new(p.text.clone(), goal);
-            self.begin_scan(scan);
-        }
-        None
-    }
-
-    fn begin_scan(&mut self, scan: LabelScan) {
-        self.stats.label_scans += 1;
-        self.scan = Some(scan);
-        self.wait_line = true;
-    }
-
-    pub(super) fn check_open_flow(&mut self) -> Res {
-        if !self.top().flow.is_empty() {
+    pub(super) fn check_open_flow(&self) -> Res {
+        if !self.stack.is_empty() {
             return Err(DecodeError::new(
                 codes::OPEN_CONTROL_BLOCK,
                 "open control blocks at program end",
@@ -569,66 +640,5 @@ pub(super) fn for_continues(v: f64, end: f64, step: f64) -> bool {
         v <= end + 1e-9
     } else {
         v >= end - 1e-9
-    }
-}
-
-pub(super) fn items_have_m(items: &[Item], codes: &[u32]) -> bool {
-    items.iter().any(|i| match i {
-        Item::Word(w) if w.letter == b'M' => match w.value {
-            Value::Num(v) => whole(v).is_some_and(|m| codes.contains(&m)),
-            Value::Expr(_) => false,
-        },
-        _ => false,
-    })
-}
-
-pub(super) fn block_ends_program(b: &Block) -> bool {
-    matches!(&b.body, Body::Items(items) if items_have_m(items, &[2, 30]))
-}
-
-pub(super) fn goto_label(t: &GotoTarget) -> Label {
-    match t {
-        GotoTarget::Number(n) => Label::Number(*n),
-        GotoTarget::Name(s) => Label::Name(s.clone()),
-    }
-}
-
-pub(super) fn label_matches(l: &Label, t: &GotoTarget) -> bool {
-    *l == goto_label(t)
-}
-
-pub(super) fn label_text(l: &Label) -> String {
-    match l {
-        Label::Number(n) => format!("N{n}"),
-        Label::Name(s) => format!("[{s}]"),
-    }
-}
-
-pub(super) fn goto_text(t: &GotoTarget) -> String {
-    label_text(&goto_label(t))
-}
-
-pub(super) fn control_name(c: &Control) -> &'static str {
-    match c {
-        Control::If(_) => "$IF",
-        Control::IfGoto(..) => "$IF … $GOTO",
-        Control::ElseIf(_) => "$ELSEIF",
-        Control::Else => "$ELSE",
-        Control::EndIf => "$ENDIF",
-        Control::Switch(_) => "$SWITCH",
-        Control::Case(_) => "$CASE",
-        Control::Default => "$DEFAULT",
-        Control::Break => "$BREAK",
-        Control::EndSwitch => "$ENDSWITCH",
-        Control::For { .. } => "$FOR",
-        Control::EndFor => "$ENDFOR",
-        Control::While(_) => "$WHILE",
-        Control::EndWhile => "$ENDWHILE",
-        Control::Do => "$DO",
-        Control::EndDo(_) => "$ENDDO",
-        Control::Repeat => "$REPEAT",
-        Control::Until(_) => "$UNTIL",
-        Control::Continue => "$CONTINUE",
-        Control::Goto(_) => "$GOTO",
     }
 }

@@ -5,85 +5,17 @@
 //! stream segment and pulls the next segment from the stream buffer only when it has decoded
 //! the last line of the previous one (ISG FCT-C19 Data streaming §2.2: one read extracts all data present).
 
-use std::collections::BTreeSet;
 use std::sync::Arc;
 
-use crate::lang::block::{GotoTarget, Label};
-use crate::source::loader::PendingRead;
+use crate::source::loader::{self, PendingRead};
 use crate::source::store::ProgramText;
 use crate::source::stream::StreamBuffer;
 
-use super::vars::VarSlot;
-
-/// One open control structure of a frame.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum FlowEntry {
-    /// `$IF`: `taken` once a branch has run, so later `$ELSEIF`/`$ELSE` branches are skipped.
-    If { taken: bool },
-    /// `$SWITCH`: the value cases compare against.
-    Switch { value: f64 },
-    /// `$FOR var = start, end, step`: the body starts at `body`.
-    For {
-        var: VarSlot,
-        end: f64,
-        step: f64,
-        body: LinePos,
-    },
-    /// `$WHILE`: `head` is the `$WHILE` line itself (the condition is evaluated there).
-    While { head: LinePos },
-    /// `$DO` … `$ENDDO cond`.
-    Do { body: LinePos },
-    /// `$REPEAT` … `$UNTIL cond`.
-    Repeat { body: LinePos },
-}
-
-impl FlowEntry {
-    pub(crate) fn is_loop(&self) -> bool {
-        matches!(
-            self,
-            FlowEntry::For { .. }
-                | FlowEntry::While { .. }
-                | FlowEntry::Do { .. }
-                | FlowEntry::Repeat { .. }
-        )
-    }
-}
-
-/// What the skip machine is looking for.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum SkipUntil {
-    /// A false `$IF`/`$ELSEIF`: the next `$ELSEIF` (evaluated), `$ELSE` or `$ENDIF`.
-    IfBranch,
-    /// A branch has run: the `$ENDIF`.
-    IfEnd,
-    /// `$SWITCH` looking for its case: a matching `$CASE`, `$DEFAULT` or `$ENDSWITCH`.
-    Case,
-    /// After `$BREAK` in a switch: the `$ENDSWITCH`.
-    SwitchEnd,
-    /// A false `$WHILE` or a `$BREAK` in a loop: past the loop's end statement.
-    LoopExit,
-    /// `$CONTINUE`: the loop's end statement, which is then evaluated.
-    LoopContinue,
-    /// A forward `$GOTO` (streams): the line with this label.
-    Label(GotoTarget),
-    /// A `%L name` section met while running the main program: up to its M17/M29, or to the
-    /// next `%name` head when it has none.
-    LocalSubroutine,
-}
-
-/// Skip state: what we look for and how deep inside skipped structures we are.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct Skip {
-    pub(crate) until: SkipUntil,
-    /// Structures opened inside the skipped region and not yet closed.
-    pub(crate) depth: u32,
-}
-
-impl Skip {
-    pub(crate) fn new(until: SkipUntil) -> Self {
-        Skip { until, depth: 0 }
-    }
-}
+use super::flow::Flow;
+use super::labels::LabelIndex;
+pub(crate) use super::line::LinePos;
+pub use super::line::MAX_LINE_BYTES;
+use super::line::{cut_line, LineMeta, LineRead, LineTooLong};
 
 /// What kind of program level a frame is; decides which end blocks are allowed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -106,63 +38,42 @@ pub(crate) enum Source {
     Stream,
 }
 
-/// Where a line starts, so loops and backward jumps in files can return to it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LinePos {
-    /// Byte offset of the line's first byte.
-    pub(crate) pos: usize,
-    /// Number of lines before it (the line's own number is `line_no + 1`).
-    pub(crate) line_no: u32,
-}
-
 /// One program level.
 #[derive(Debug)]
 pub(crate) struct Frame {
-    pub(crate) kind: FrameKind,
-    pub(crate) source: Source,
-    pub(crate) prog: Arc<str>,
+    /// Main program, subroutine, cycle or local subroutine: which end blocks it allows.
+    kind: FrameKind,
+    /// Its text, the loader's read of it, or the stream.
+    source: Source,
+    /// The program's name.
+    prog: Arc<str>,
     /// File frames: byte offset of the next line.
-    pub(crate) pos: usize,
+    pos: usize,
     /// File frames: lines read so far.
-    pub(crate) line_no: u32,
-    /// Open control structures, innermost last.
-    pub(crate) flow: Vec<FlowEntry>,
-    /// Set while lines are being skipped (false branch, forward jump, …).
-    pub(crate) skip: Option<Skip>,
+    line_no: u32,
+    /// Its control flow: open structures, what is skipped, labels passed (`flow.rs`).
+    flow: Flow,
     /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
-    pub(crate) comment_block: bool,
+    comment_block: bool,
     /// Inside `#VAR` … `#ENDVAR`.
-    pub(crate) var_block: bool,
-    /// Stream frames: labels already passed, to tell a backward jump (21477) from a forward
-    /// one and to find labels defined twice (20836). Bounded by `MAX_SEEN_LABELS`; a B-tree
-    /// for the reason `LabelIndex` is one.
-    pub(crate) seen_labels: BTreeSet<Label>,
+    var_block: bool,
     /// File frames: label → position and structural depth, built on the first jump.
-    pub(crate) label_index: Option<Arc<super::labels::LabelIndex>>,
-}
-
-/// How many stream labels a frame remembers. A stream may run for days; a label passed more
-/// than this many labels ago is treated as unknown (a jump to it waits forward for it).
-pub(crate) const MAX_SEEN_LABELS: usize = 65_536;
-
-/// A frame that held the last reference to a large file text lets the loader thread free it,
-/// and its label tables with it: tens of thousands of labels take milliseconds to free.
-impl Drop for Frame {
-    fn drop(&mut self) {
-        use crate::source::loader;
-        if let Source::File(p) = &mut self.source {
-            loader::release(std::mem::take(&mut p.text));
-        }
-        if let Some(index) = self.label_index.take() {
-            let items = index.len();
-            loader::release_table(index, items);
-        }
-        let seen = self.seen_labels.len();
-        loader::release_table(std::mem::take(&mut self.seen_labels), seen);
-    }
+    label_index: Option<Arc<LabelIndex>>,
 }
 
 impl Frame {
+    /// Whether dropping this frame could cost a tick milliseconds: it holds the last
+    /// reference to a large file text, a large label index, or many labels passed. The reader
+    /// that owns it then lets the loader thread free it (`Reader::release`).
+    pub(crate) fn is_heavy(&self) -> bool {
+        matches!(&self.source, Source::File(p) if loader::is_heavy_text(&p.text))
+            || self
+                .label_index
+                .as_ref()
+                .is_some_and(|i| loader::is_heavy_table(i.len()))
+            || self.flow.is_heavy()
+    }
+
     pub(crate) fn new(kind: FrameKind, source: Source, prog: Arc<str>) -> Self {
         Frame {
             kind,
@@ -170,11 +81,9 @@ impl Frame {
             prog,
             pos: 0,
             line_no: 0,
-            flow: Vec::new(),
-            skip: None,
+            flow: Flow::default(),
             comment_block: false,
             var_block: false,
-            seen_labels: BTreeSet::new(),
             label_index: None,
         }
     }
@@ -194,77 +103,76 @@ impl Frame {
         self.pos = at.pos;
         self.line_no = at.line_no;
     }
-}
 
-/// One line handed to the interpreter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LineMeta {
-    /// 1-based line number in its program (stream: since stream start).
-    pub(crate) line: u32,
-    /// Byte offset of the line (stream: since stream start).
-    pub(crate) offset: u64,
-}
-
-/// The result of asking a frame for its next line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum LineRead {
-    Line(LineMeta),
-    /// A stream frame with no complete line available yet: try again next tick.
-    Pending,
-    /// A file frame at its end.
-    Eof,
-    /// A file frame's next line is longer than [`MAX_LINE_BYTES`].
-    TooLong(LineMeta),
-}
-
-/// Longest line of a program file, bytes. A block is at most `MAX_BLOCK_CHARS` (4000)
-/// characters, so no useful line comes near it; the bound keeps the search for a line end, and
-/// the copy of the line, from growing with a file that has no line ends.
-pub const MAX_LINE_BYTES: usize = 16 * 1024;
-
-/// A line longer than [`MAX_LINE_BYTES`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct LineTooLong;
-
-impl LineTooLong {
-    /// The error at 1-based line `line` of a file.
-    pub(crate) fn error(self, line: u32) -> super::DecodeError {
-        super::DecodeError::new(
-            crate::lang::codes::SYNTAX,
-            format!("line {line} is longer than {MAX_LINE_BYTES} bytes"),
-        )
+    pub(crate) fn kind(&self) -> FrameKind {
+        self.kind
     }
-}
 
-/// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
-/// offset after the line end, or `None` when no complete line is there. Looks at most
-/// [`MAX_LINE_BYTES`] bytes ahead.
-pub(super) fn cut_line(
-    text: &[u8],
-    pos: usize,
-    out: &mut String,
-    at_eof_ok: bool,
-) -> Result<Option<usize>, LineTooLong> {
-    let Some(rest) = text.get(pos..) else {
-        return Ok(None);
-    };
-    if rest.is_empty() {
-        return Ok(None);
+    /// The program's name.
+    pub(crate) fn prog(&self) -> &Arc<str> {
+        &self.prog
     }
-    let window = &rest[..rest.len().min(MAX_LINE_BYTES + 1)];
-    let (line, next) = match memchr::memchr(b'\n', window) {
-        Some(i) => (&rest[..i], pos + i + 1),
-        None if window.len() > MAX_LINE_BYTES => return Err(LineTooLong),
-        None if at_eof_ok => (rest, text.len()),
-        None => return Ok(None),
-    };
-    let line = line.strip_suffix(b"\r").unwrap_or(line);
-    out.clear();
-    match std::str::from_utf8(line) {
-        Ok(s) => out.push_str(s),
-        Err(_) => out.push_str(&String::from_utf8_lossy(line)),
+
+    /// Lines read so far (file frames).
+    pub(crate) fn line_no(&self) -> u32 {
+        self.line_no
     }
-    Ok(Some(next))
+
+    /// Its text, when it is a file whose text is there.
+    pub(crate) fn file(&self) -> Option<&ProgramText> {
+        match &self.source {
+            Source::File(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The loader's read of its file, while it is not done.
+    pub(crate) fn loading(&self) -> Option<&PendingRead> {
+        match &self.source {
+            Source::Loading(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// The loader's read is done: the frame reads `text`.
+    pub(crate) fn loaded(&mut self, text: ProgramText) {
+        self.source = Source::File(text);
+    }
+
+    pub(crate) fn flow(&self) -> &Flow {
+        &self.flow
+    }
+
+    pub(crate) fn flow_mut(&mut self) -> &mut Flow {
+        &mut self.flow
+    }
+
+    /// Inside `#COMMENT BEGIN` … `#COMMENT END`.
+    pub(crate) fn in_comment_block(&self) -> bool {
+        self.comment_block
+    }
+
+    pub(crate) fn set_comment_block(&mut self, on: bool) {
+        self.comment_block = on;
+    }
+
+    /// Inside `#VAR` … `#ENDVAR`.
+    pub(crate) fn in_var_block(&self) -> bool {
+        self.var_block
+    }
+
+    pub(crate) fn set_var_block(&mut self, on: bool) {
+        self.var_block = on;
+    }
+
+    /// The label index of its text, once built.
+    pub(crate) fn label_index(&self) -> Option<&Arc<LabelIndex>> {
+        self.label_index.as_ref()
+    }
+
+    pub(crate) fn set_label_index(&mut self, index: Arc<LabelIndex>) {
+        self.label_index = Some(index);
+    }
 }
 
 /// Next line of a file frame.

@@ -18,10 +18,10 @@ use std::sync::Arc;
 use crate::lang::block::{Body, Command, GotoTarget, Label};
 use crate::lang::{continuation, is_comment_end, parse_block, Joiner};
 
-use super::flow::{label_text, nesting, Nesting};
-use super::frame::{cut_line, LinePos};
-use super::DecodeError;
+use super::error::DecodeError;
+use super::line::{cut_line, LinePos};
 use crate::lang::codes;
+use crate::lang::control::{goto_label, label_text, nesting, Nesting};
 
 /// Labels of one kind (block-number labels `N10:`, string labels `[NAME]`) the index holds;
 /// `%L` sections likewise. Memory stays proportional to this, not to the file: a label
@@ -62,7 +62,7 @@ impl LabelIndex {
     }
 
     pub(crate) fn find(&self, t: &GotoTarget) -> Option<LabelAt> {
-        self.labels.get(&super::flow::goto_label(t)).copied()
+        self.labels.get(&goto_label(t)).copied()
     }
 
     pub(crate) fn local_sub(&self, name: &str) -> Option<LinePos> {
@@ -158,18 +158,15 @@ pub(crate) struct LabelScan {
     warned_other: bool,
 }
 
-/// A scan that outlives its frame (a reset during the scan) lets the loader free the text and
-/// the index built so far.
-impl Drop for LabelScan {
-    fn drop(&mut self) {
-        use crate::source::loader;
-        loader::release(std::mem::take(&mut self.text));
-        let items = self.index.len();
-        loader::release_table(std::mem::take(&mut self.index), items);
-    }
-}
-
 impl LabelScan {
+    /// Whether dropping the scan could cost a tick: it outlived its frame (a reset during the
+    /// scan) holding the last reference to a large text, or its index grew large. The reader
+    /// then lets the loader thread free it.
+    pub(crate) fn is_heavy(&self) -> bool {
+        crate::source::loader::is_heavy_text(&self.text)
+            || crate::source::loader::is_heavy_table(self.index.len())
+    }
+
     pub(crate) fn new(text: Arc<Vec<u8>>, goal: ScanGoal) -> Self {
         LabelScan {
             text,

@@ -5,205 +5,48 @@
 //! pulls a new stream segment only when it has decoded the previous one: that is the whole of
 //! the channel's back-pressure.
 
-mod axis_vars;
-mod calls;
-mod cycles;
-mod expr;
+mod error;
 pub mod flow;
 pub mod frame;
+mod interp;
+mod io;
 mod labels;
+mod line;
 pub mod modal;
-mod search;
+mod note;
+mod reader;
+mod search_target;
+mod settings;
 pub mod vars;
-mod words;
 
-use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::geometry::{arc, SoftLimits};
-use crate::lang::block::{AxisName, Block, Body, Call, Command, Item, SplineCommand, Value};
+use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
-use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, Joiner, VarLine};
-use crate::queue::{Action, BlockInfo, BlockQueue, Move, MoveKind, QueuedBlock};
-use crate::source::cache::Cache;
+use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, VarLine};
+use crate::source::loader::Loader;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
-use crate::source::stream::StreamBuffer;
-use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
-use crate::vocab::flush::FlushKind;
+use crate::vocab::axis::{Position, MAX_AXES};
 
-use flow::{goto_text, is_loop_statement};
-use frame::{
-    read_file_line, Frame, FrameKind, LineMeta, LineRead, Skip, SkipUntil, Source, StreamNote,
-    StreamReader,
-};
-use modal::{apply_g, apply_m, BlockGs, Modal, MotionMode, ZeroOffsets};
-use vars::{VarSlot, VarStore};
+use crate::lang::control::{goto_text, is_loop_statement};
+use flow::{FlowStep, SkipUntil};
+use frame::{Frame, FrameKind, Source};
+use interp::Interpreter;
+use line::{BlockAt, LineMeta, LineRead, LineTooLong};
+use modal::Modal;
+use reader::{FileArrival, Reader};
+use vars::VarStore;
 
-use labels::{LabelScan, ScanFound, ScanGoal, ScanStep, ScanWork};
 pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
-use search::Search;
-pub use search::SearchTarget;
+pub use search_target::SearchTarget;
 
-/// What the decoder needs from the configuration.
-#[derive(Debug, Clone)]
-pub struct DecoderSettings {
-    /// Lines decoded per tick at most (runtime.toml `decoder.blocks_per_tick`).
-    pub blocks_per_tick: usize,
-    /// Subroutine nesting depth at most (main program = level 0).
-    pub(crate) max_depth: usize,
-    /// Axes the channel has, by letter index of `AXIS_LETTERS`.
-    pub axes: [bool; MAX_AXES],
-    /// The name of the axis in each slot (`X`, or `X1` for an axis list's `X1`): a program
-    /// writes `X10` for a one-letter name, `X1=10` for a longer one. Resolved once at set-up.
-    pub(crate) axis_names: [AxisName; MAX_AXES],
-    pub(crate) zero_offsets: ZeroOffsets,
-    /// How far the end point may lie off the circle, mm.
-    pub(crate) arc_tolerance_mm: f64,
-    /// Software limits per axis (runtime.toml `soft_limit_min_mm` / `soft_limit_max_mm`),
-    /// mm in machine coordinates, by `AXIS_LETTERS` index: a block whose end point or arc
-    /// lies outside is refused before it moves (21897).
-    pub(crate) soft_limits_mm: [SoftLimits; MAX_AXES],
-    /// Global subroutines the channel calls by itself: at program start (P-CHAN-00119), before
-    /// the main program's M02/M30 (P-CHAN-00252) and for M6 (P-CHAN-00118).
-    pub implicit: crate::params::channel::ImplicitSubroutines,
-    /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
-    /// is reported with it, ncchannel's detail after it in parentheses.
-    pub(crate) error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
-}
-
-/// Each slot named by its letter, `X` to `C`.
-pub(crate) fn letter_names() -> [AxisName; MAX_AXES] {
-    AXIS_LETTERS.map(|l| AxisName::new(std::str::from_utf8(&[l]).unwrap_or("X")).expect("a letter"))
-}
-
-/// Values `#VAR` declarations may make in one tick before decoding waits for the next: a
-/// 100,000-element declaration costs ~0.1 ms to fill, so a tick does at most about two
-/// such, whatever the NC text (a line of ten took 15 s in one tick before).
-pub const DECLARED_VALUES_PER_TICK: usize = 100_000;
-
-/// Bytes of NC text the decoder reads per tick at most (files and stream alike; one line may
-/// end beyond it). Real blocks are tens of bytes, so `blocks_per_tick` lines stay far inside
-/// it; lines thousands of bytes long (comments in a `#COMMENT` block) no longer make a tick's
-/// work grow with them (64 lines of 60 KB took 30 ms a tick before).
-pub const LINE_BYTES_PER_TICK: usize = 64 * 1024;
-
-impl Default for DecoderSettings {
-    fn default() -> Self {
-        DecoderSettings {
-            blocks_per_tick: 64,
-            max_depth: 20,
-            axes: [true, true, true, false, false, false],
-            axis_names: letter_names(),
-            zero_offsets: [[0.0; MAX_AXES]; 6],
-            arc_tolerance_mm: 0.01,
-            soft_limits_mm: [SoftLimits::default(); MAX_AXES],
-            implicit: Default::default(),
-            error_texts: None,
-        }
-    }
-}
-
-/// A decoding error: the ISG number, the message and the column when the parser knows it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DecodeError {
-    pub code: u32,
-    pub msg: String,
-    pub col: Option<u32>,
-}
-
-impl DecodeError {
-    pub fn new(code: u32, msg: impl Into<String>) -> Self {
-        DecodeError {
-            code,
-            msg: msg.into(),
-            col: None,
-        }
-    }
-    fn at(mut self, col: u32) -> Self {
-        self.col = Some(col);
-        self
-    }
-}
-
-/// A parser error keeps its number, message and column.
-impl From<crate::lang::SyntaxError> for DecodeError {
-    fn from(e: crate::lang::SyntaxError) -> Self {
-        DecodeError::new(e.code, e.message).at(e.col)
-    }
-}
-
-/// Each error type that carries an ISG (or our) number converts with its number and text.
-macro_rules! numbered_error {
-    ($($t:ty),*) => {$(
-        impl From<$t> for DecodeError {
-            fn from(e: $t) -> Self {
-                DecodeError::new(e.code(), e.to_string())
-            }
-        }
-    )*};
-}
-numbered_error!(
-    crate::source::store::StoreError,
-    crate::source::cache::CacheError,
-    crate::lang::EvalError
-);
-
-impl fmt::Display for DecodeError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} {}", self.code, self.msg)
-    }
-}
-
-/// What the decoder reports besides queued blocks; the channel turns these into events.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Note {
-    ProgramStart {
-        prog: Arc<str>,
-        stream: bool,
-    },
-    Segment {
-        bytes: usize,
-    },
-    Discard {
-        bytes: usize,
-    },
-    Warning {
-        code: u32,
-        msg: String,
-    },
-    Error {
-        code: u32,
-        msg: String,
-        prog: Arc<str>,
-        line: u32,
-        col: Option<u32>,
-    },
-    Search {
-        target: SearchTarget,
-        found: bool,
-    },
-    Cache {
-        op: crate::vocab::event::CacheOp,
-        file: String,
-    },
-    /// `#MSG`: an operator message (`save`: `#MSG SAVE`, also to be written to a file).
-    Message {
-        text: String,
-        save: bool,
-    },
-    /// An H function (0..=65535) decoded: handed to the PLC side, with its value when
-    /// programmed with one (`H20=5`).
-    HFunction {
-        h: u32,
-        value: Option<f64>,
-    },
-    /// An M function programmed with a value (`M200=1200`): handed to the PLC side.
-    MFunction {
-        m: u32,
-        value: f64,
-    },
-}
+pub use error::DecodeError;
+use error::Res;
+pub use io::DecoderIo;
+pub(crate) use note::Note;
+pub(crate) use settings::letter_names;
+pub use settings::{DecoderSettings, DECLARED_VALUES_PER_TICK, LINE_BYTES_PER_TICK};
 
 /// Where the decoder stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -215,23 +58,6 @@ pub enum DecoderState {
     Ended,
     /// An error stopped decoding; only a reset clears it.
     Failed,
-}
-
-/// The channel's parts the decoder reads from and writes to during one step.
-pub struct DecoderIo<'a> {
-    pub stream: &'a mut StreamBuffer,
-    pub store: &'a mut ProgramStore,
-    pub cache: &'a mut Cache,
-    pub queue: &'a mut BlockQueue,
-    /// Motion has nothing left to do (for `#FLUSH WAIT`).
-    pub(crate) motion_idle: bool,
-    /// Keep each block's text for the event log (and report cache hits: events are on).
-    pub(crate) want_text: bool,
-    /// Channel time at the start of this tick.
-    pub now: Duration,
-    /// Length of this tick: decoding stops for the tick once simulated file-system latency
-    /// has used it up.
-    pub period: Duration,
 }
 
 /// Counters for the report.
@@ -254,61 +80,16 @@ pub struct DecoderStats {
 }
 
 pub struct Decoder {
-    settings: DecoderSettings,
-    /// Bit i: the configured axis in slot i has a name longer than its letter (`X1`), so the
-    /// letter alone names no axis. Read for every axis word; built once from the settings.
-    renamed_slots: u8,
-    frames: Vec<Frame>,
-    stream: StreamReader,
-    /// A stream frame is on the frame stack.
-    stream_active: bool,
-    vars: VarStore,
-    modal: Modal,
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
-    tool_radii: Vec<(u32, f64)>,
-    /// ISG block counter of the current program.
-    counter: u64,
+    /// The frame stack, the line joiner and what a line waits for.
+    reader: Reader,
+    /// Modal state, variables, calls: what a block does.
+    interp: Interpreter,
     state: DecoderState,
-    search: Option<Search>,
-    /// Bit n set: blocks with `/n` are skipped (`/` is `/1`).
-    skip_mask: u16,
-    /// `#FLUSH WAIT`: decoding waits until motion is empty.
-    wait_idle: bool,
-    /// The top frame is a stream that has no complete line: motion may starve.
-    starved: bool,
-    /// Channel time when the last simulated file-system read completes (runtime.toml
-    /// `fs_latency_us`). Decoding does nothing before it; motion runs on meanwhile.
-    ready_at: Duration,
-    /// Values made by `#VAR` declarations in this tick ([`DECLARED_VALUES_PER_TICK`]).
-    declared_this_tick: usize,
-    /// A label scan of the top frame's text under way (module `labels`): the line that
-    /// needs it waits, rewound, and runs again when the scan is done.
-    scan: Option<LabelScan>,
-    /// What a finished targeted scan found, for the line that asked for it.
-    scan_found: Option<(ScanGoal, ScanFound)>,
-    /// What label scans read in this tick.
-    scanned_this_tick: ScanWork,
-    /// Bytes of NC text decoded in this tick ([`LINE_BYTES_PER_TICK`]).
-    line_bytes_this_tick: usize,
-    /// A `#CACHE LOAD` waiting for the loader.
-    cache_read: Option<calls::CacheRead>,
-    /// The line being run has to wait (for a label scan, a `#CACHE LOAD` read): it is read
-    /// again later.
-    wait_line: bool,
-    line: String,
-    /// A block written over several lines (`\` at the end of a line) being collected, and
-    /// where its first line stands.
-    joiner: Joiner,
-    join_meta: LineMeta,
+    /// What happened besides queued blocks, since the channel last took them.
     notes: Vec<Note>,
+    /// Counters for the report (blocks and label scans are counted by the parts).
     stats: DecoderStats,
-    /// The word collection of the block being executed, kept between blocks.
-    words: Option<Box<words::Words>>,
-    /// The implicit subroutine calls' state in the running program.
-    implicit: calls::ImplicitState,
 }
-
-type Res<T = ()> = Result<T, DecodeError>;
 
 /// Whether the decoder may read its next line in this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -321,40 +102,14 @@ enum Ready {
 }
 
 impl Decoder {
-    pub fn new(settings: DecoderSettings) -> Self {
-        let renamed_slots = (0..MAX_AXES)
-            .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
-            .fold(0u8, |m, i| m | 1 << i);
+    /// A decoder whose reader and variables free what could cost a tick through `loader`.
+    pub fn new(settings: DecoderSettings, loader: Loader) -> Self {
         Decoder {
-            settings,
-            renamed_slots,
-            frames: Vec::new(),
-            stream: StreamReader::default(),
-            stream_active: false,
-            vars: VarStore::new(),
-            modal: Modal::defaults([0.0; MAX_AXES]),
-            tool_radii: Vec::new(),
-            counter: 0,
+            reader: Reader::new(loader.clone()),
+            interp: Interpreter::new(settings, loader),
             state: DecoderState::Idle,
-            search: None,
-            skip_mask: 0,
-            wait_idle: false,
-            starved: false,
-            ready_at: Duration::ZERO,
-            declared_this_tick: 0,
-            scan: None,
-            scan_found: None,
-            scanned_this_tick: ScanWork::default(),
-            line_bytes_this_tick: 0,
-            cache_read: None,
-            wait_line: false,
-            line: String::new(),
-            joiner: Joiner::default(),
-            join_meta: LineMeta { line: 0, offset: 0 },
             notes: Vec::new(),
             stats: DecoderStats::default(),
-            words: None,
-            implicit: calls::ImplicitState::default(),
         }
     }
 
@@ -363,57 +118,60 @@ impl Decoder {
     }
     /// The running program reads the stream interface (a stream frame is on the stack).
     pub fn reads_stream(&self) -> bool {
-        self.stream_active
+        self.reader.stream_active()
     }
     /// Axes the channel has, by `AXIS_LETTERS` index.
     pub fn axes(&self) -> [bool; MAX_AXES] {
-        self.settings.axes
+        self.interp.settings().axes
     }
     /// The name of the axis in each slot (`X`, `X1`, …), by `AXIS_LETTERS` index.
     pub(crate) fn axis_names(&self) -> &[AxisName; MAX_AXES] {
-        &self.settings.axis_names
+        &self.interp.settings().axis_names
     }
     pub fn modal(&self) -> &Modal {
-        &self.modal
+        self.interp.modal()
     }
     pub fn vars(&self) -> &VarStore {
-        &self.vars
+        self.interp.vars()
     }
     pub(crate) fn vars_mut(&mut self) -> &mut VarStore {
-        &mut self.vars
+        self.interp.vars_mut()
     }
     pub fn stats(&self) -> DecoderStats {
-        self.stats
+        DecoderStats {
+            blocks: self.interp.blocks(),
+            label_scans: self.reader.label_scans(),
+            ..self.stats
+        }
     }
     pub fn counter(&self) -> u64 {
-        self.counter
+        self.interp.counter()
     }
     /// Waiting for stream data that has not arrived.
     pub(crate) fn starved(&self) -> bool {
-        self.starved && self.state == DecoderState::Running
+        self.reader.starved() && self.state == DecoderState::Running
     }
     pub(crate) fn searching(&self) -> bool {
-        self.search.is_some()
+        self.interp.searching()
     }
     pub(crate) fn set_skip_mask(&mut self, mask: u16) {
-        self.skip_mask = mask;
+        self.interp.set_skip_mask(mask);
+    }
+    /// The tool list's radii by D number, mm (`V.G.WZ[j].R` and `V.G.WZ_AKT.R`).
+    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
+        self.interp.set_tool_radii(radii);
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
     pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {
-        self.frames.iter().rev().find_map(|f| match &f.source {
-            frame::Source::File(t) if &*f.prog == prog => Some(Arc::clone(&t.text)),
-            _ => None,
-        })
-    }
-    pub fn depth(&self) -> usize {
-        self.frames.len()
+        self.reader.program_text(prog)
     }
     /// The message reported for error `code`: the kernel's text for it (error text file,
     /// P-STUP-00168) followed by ncchannel's `detail` in parentheses, or `detail` alone.
     pub(crate) fn reported_message(&self, code: u32, detail: String) -> String {
         match self
-            .settings
+            .interp
+            .settings()
             .error_texts
             .as_deref()
             .and_then(|t| t.get(code))
@@ -439,28 +197,15 @@ impl Decoder {
         machine_pos: Position,
         search: Option<SearchTarget>,
     ) -> Res {
-        self.frames.clear();
-        self.joiner = Joiner::default();
-        self.modal = Modal::defaults(machine_pos);
-        self.vars.start_program();
-        self.counter = 0;
-        self.wait_idle = false;
-        self.starved = false;
-        self.ready_at = Duration::ZERO;
-        self.forget_scan();
+        self.reader.start();
+        self.interp.start(machine_pos, search);
         // A read charged to an earlier program is not this one's to wait for.
         store.take_owed();
-        self.stream_active = false;
-        self.implicit = calls::ImplicitState::at_start(&self.settings.implicit);
-        self.search = search.map(|target| Search {
-            target,
-            from: machine_pos,
-        });
         let opened = store.open(name, ProgramKind::Main)?;
         match opened {
             Opened::File(p) => {
                 let prog = p.name.clone();
-                self.frames
+                self.reader
                     .push(Frame::new(FrameKind::Main, Source::File(p), prog.clone()));
                 self.notes.push(Note::ProgramStart {
                     prog,
@@ -469,7 +214,7 @@ impl Decoder {
             }
             Opened::Loading(p) => {
                 let prog = p.name.clone();
-                self.frames.push(Frame::new(
+                self.reader.push(Frame::new(
                     FrameKind::Main,
                     Source::Loading(p),
                     prog.clone(),
@@ -480,8 +225,8 @@ impl Decoder {
                 });
             }
             Opened::Stream { name } => {
-                self.begin_stream();
-                self.frames
+                self.reader.begin_stream();
+                self.reader
                     .push(Frame::new(FrameKind::Main, Source::Stream, name.clone()));
                 self.notes.push(Note::ProgramStart {
                     prog: name,
@@ -495,33 +240,9 @@ impl Decoder {
 
     /// Channel reset: frames, stream position, parameters and modal state go; V.S. stays.
     pub fn reset(&mut self, machine_pos: Position) {
-        self.frames.clear();
-        self.joiner = Joiner::default();
-        self.stream.restart();
-        self.stream_active = false;
-        self.vars.reset();
-        self.modal = Modal::defaults(machine_pos);
-        self.counter = 0;
+        self.reader.reset();
+        self.interp.reset(machine_pos);
         self.state = DecoderState::Idle;
-        self.search = None;
-        self.implicit = calls::ImplicitState::default();
-        self.wait_idle = false;
-        self.starved = false;
-        self.ready_at = Duration::ZERO;
-        self.forget_scan();
-    }
-
-    /// No label scan under way or waited for.
-    fn forget_scan(&mut self) {
-        self.scan = None;
-        self.scan_found = None;
-        self.cache_read = None;
-        self.wait_line = false;
-    }
-
-    fn begin_stream(&mut self) {
-        self.stream.restart();
-        self.stream_active = true;
     }
 
     /// Decode up to the per-tick budget.
@@ -532,18 +253,10 @@ impl Decoder {
     /// 200 µs in 1 ms ticks give five per tick, and a 5 ms read pauses decoding for five ticks.
     pub fn step(&mut self, io: &mut DecoderIo<'_>) {
         self.decode(io);
-        self.stats.max_scan_lines_per_tick = self
-            .stats
-            .max_scan_lines_per_tick
-            .max(self.scanned_this_tick.lines);
-        self.stats.max_scan_bytes_per_tick = self
-            .stats
-            .max_scan_bytes_per_tick
-            .max(self.scanned_this_tick.bytes);
-        self.stats.max_line_bytes_per_tick = self
-            .stats
-            .max_line_bytes_per_tick
-            .max(self.line_bytes_this_tick);
+        let (scanned, line_bytes) = self.reader.tick_work();
+        self.stats.max_scan_lines_per_tick = self.stats.max_scan_lines_per_tick.max(scanned.lines);
+        self.stats.max_scan_bytes_per_tick = self.stats.max_scan_bytes_per_tick.max(scanned.bytes);
+        self.stats.max_line_bytes_per_tick = self.stats.max_line_bytes_per_tick.max(line_bytes);
         io.store.end_tick();
     }
 
@@ -551,42 +264,37 @@ impl Decoder {
     /// file-system latency, a label scan, the loader, `#FLUSH WAIT`, room in the queue, the
     /// start subroutine, a frame's file.
     fn ready_to_read(&mut self, io: &mut DecoderIo<'_>, tick_end: Duration) -> Ready {
-        if self.declared_this_tick >= DECLARED_VALUES_PER_TICK
-            || self.line_bytes_this_tick >= LINE_BYTES_PER_TICK
-        {
+        if self.reader.budget_spent() {
             return Ready::Stop;
         }
         let owed = io.store.take_owed();
-        if !owed.is_zero() {
-            self.ready_at = self.ready_at.max(io.now) + owed;
-        }
-        if self.ready_at >= tick_end {
+        if self.reader.busy(owed, io.now, tick_end) {
             return Ready::Stop;
         }
-        if self.scan.is_some() && !self.advance_scan() {
+        if self.reader.scanning() && !self.advance_scan() {
             return Ready::Stop;
         }
-        match self.cache_read_arrived(io.store) {
+        match self.reader.cache_read_arrived(io.store) {
             Some(false) => return Ready::Stop,
             // The read's simulated latency is waited for first (top of the loop).
             Some(true) => return Ready::Again,
             None => {}
         }
-        if self.wait_idle {
-            if io.queue.is_empty() && io.motion_idle {
-                self.wait_idle = false;
-            } else {
-                return Ready::Stop;
-            }
+        if self
+            .reader
+            .waits_for_idle(io.queue.is_empty() && io.motion_idle)
+        {
+            return Ready::Stop;
         }
         if !io.queue.has_room() {
             return Ready::Stop;
         }
-        if self.implicit.start_pending {
-            if let Err(e) = self.start_subroutine(io) {
-                self.fail(e, LineMeta { line: 0, offset: 0 });
-                return Ready::Stop;
-            }
+        if let Err(e) = self
+            .interp
+            .start_subroutine(&mut self.reader, &mut self.notes, io)
+        {
+            self.fail(e, LineMeta { line: 0, offset: 0 });
+            return Ready::Stop;
         }
         self.frame_file_arrived(io.store)
     }
@@ -594,103 +302,76 @@ impl Decoder {
     /// A top frame whose file the loader reads: `Again` when the text has just arrived (its
     /// simulated latency is waited for first), `Stop` while it has not or could not be read.
     fn frame_file_arrived(&mut self, store: &mut ProgramStore) -> Ready {
-        let Some(top) = self.frames.last_mut() else {
-            return Ready::Go;
-        };
-        let Source::Loading(p) = &top.source else {
-            return Ready::Go;
-        };
-        match store.finish_read(p) {
-            None => Ready::Stop,
-            Some(Ok(text)) => {
-                top.source = Source::File(text);
-                Ready::Again
-            }
-            Some(Err(e)) => {
-                self.fail(e.into(), LineMeta { line: 0, offset: 0 });
+        match self.reader.frame_file_arrived(store) {
+            FileArrival::Ready => Ready::Go,
+            FileArrival::Arrived => Ready::Again,
+            FileArrival::Waiting => Ready::Stop,
+            FileArrival::Failed(e) => {
+                self.fail(e, LineMeta { line: 0, offset: 0 });
                 Ready::Stop
             }
         }
     }
 
-    /// The decoding loop of [`Decoder::step`].
+    /// The decoding loop of [`Decoder::step`]: read a line, then join, run or end the frame.
     fn decode(&mut self, io: &mut DecoderIo<'_>) {
-        let mut budget = self.settings.blocks_per_tick;
+        let mut budget = self.interp.settings().blocks_per_tick;
         let tick_end = io.now + io.period;
-        self.declared_this_tick = 0;
-        self.scanned_this_tick = ScanWork::default();
-        self.line_bytes_this_tick = 0;
+        self.reader.begin_tick();
         while budget > 0 && self.state == DecoderState::Running {
             match self.ready_to_read(io, tick_end) {
                 Ready::Stop => break,
                 Ready::Again => continue,
                 Ready::Go => {}
             }
-            let Some(top) = self.frames.last_mut() else {
+            if self.reader.last().is_none() {
                 self.state = DecoderState::Idle;
                 break;
-            };
-            let mut line = std::mem::take(&mut self.line);
-            let read = if top.is_stream() {
-                let mut note = None;
-                let r = self.stream.next_line(io.stream, &mut line, &mut note);
-                if let Some(StreamNote::Segment { bytes }) = note {
-                    self.notes.push(Note::Segment { bytes });
-                }
-                r
-            } else {
-                read_file_line(top, &mut line)
-            };
-            if let LineRead::Line(_) = read {
-                // The line and its end (CR LF at most).
-                self.line_bytes_this_tick += line.len() + 2;
             }
+            let mut line = self.reader.take_line();
+            let read = self.reader.read_line(io.stream, &mut line, &mut self.notes);
             match read {
                 LineRead::Pending => {
-                    self.starved = true;
-                    self.line = line;
+                    self.reader.put_line(line);
                     break;
                 }
-                LineRead::Eof if self.joiner.is_open() => {
+                LineRead::Eof if self.reader.joining() => {
                     // The file ends in a continued line: the block is what there is.
-                    self.line = line;
+                    self.reader.put_line(line);
                     budget -= 1;
                     self.run_joined(io);
                 }
                 LineRead::TooLong(meta) => {
-                    self.line = line;
-                    self.fail(frame::LineTooLong.error(meta.line), meta);
+                    self.reader.put_line(line);
+                    self.fail(LineTooLong.error(meta.line), meta);
                 }
                 LineRead::Eof => {
-                    self.line = line;
+                    self.reader.put_line(line);
                     budget -= 1;
                     if let Err(e) = self.end_of_file(io) {
                         let meta = LineMeta {
-                            line: self.frames.last().map_or(0, |f| f.line_no),
+                            line: self.reader.last().map_or(0, |f| f.line_no()),
                             offset: 0,
                         };
                         self.fail(e, meta);
                     }
                 }
                 LineRead::Line(meta) => {
-                    self.starved = false;
                     budget -= 1;
                     self.stats.lines += 1;
-                    if self.joiner.is_open()
-                        || (continuation(&line).is_some() && !self.top().comment_block)
+                    if self.reader.joining()
+                        || (continuation(&line).is_some()
+                            && !self.reader.current().in_comment_block())
                     {
-                        if !self.joiner.is_open() {
-                            self.join_meta = meta;
-                        }
-                        if self.joiner.push(&line) {
+                        if self.reader.join(&line, meta) {
                             self.run_joined(io);
                         }
-                        self.line = line;
+                        self.reader.put_line(line);
                         continue;
                     }
-                    self.counter += 1;
+                    self.interp.count_line();
                     let r = self.process_line(&line, meta, io);
-                    self.line = line;
+                    self.reader.put_line(line);
                     if let Err(e) = r {
                         self.fail(e, meta);
                     }
@@ -703,9 +384,8 @@ impl Decoder {
     /// Run the block collected from several lines; an error's column names the line it
     /// was written in.
     fn run_joined(&mut self, io: &mut DecoderIo<'_>) {
-        let joiner = std::mem::take(&mut self.joiner);
-        let meta = self.join_meta;
-        self.counter += 1;
+        let (joiner, meta) = self.reader.take_joined();
+        self.interp.count_line();
         let r = self.process_line(joiner.text(), meta, io);
         if let Err(mut e) = r {
             let mut at = meta;
@@ -716,67 +396,24 @@ impl Decoder {
             }
             self.fail(e, at);
         }
-        self.joiner = joiner;
-        self.joiner.close();
+        self.reader.put_joined(joiner);
         self.rewind_if_waiting(meta);
     }
 
     /// A line that has to wait (for a label scan) did nothing: it is read again, and its
     /// block counter given back.
     fn rewind_if_waiting(&mut self, meta: LineMeta) {
-        if !std::mem::take(&mut self.wait_line) {
-            return;
+        if self.reader.rewind_if_waiting(meta) {
+            self.interp.give_back_line();
         }
-        self.counter -= 1;
-        let at = frame::LinePos {
-            pos: usize::try_from(meta.offset).unwrap_or(usize::MAX),
-            line_no: meta.line.saturating_sub(1),
-        };
-        self.top().seek(at);
-    }
-
-    /// A `#CACHE LOAD` waiting for the loader: `Some(true)` when its text has just arrived,
-    /// `Some(false)` while it has not, `None` when no load waits.
-    fn cache_read_arrived(&mut self, store: &mut ProgramStore) -> Option<bool> {
-        let r = self.cache_read.as_mut().filter(|r| r.read.is_none())?;
-        let read = store.finish_read(&r.pending);
-        let arrived = read.is_some();
-        r.read = read;
-        Some(arrived)
     }
 
     /// Go on with the label scan under way, within what is left of this tick's scan budget.
     /// `true` when it is done (its result installed) and decoding may go on.
     fn advance_scan(&mut self) -> bool {
-        let Some(scan) = self.scan.as_mut() else {
-            return true;
-        };
-        let step = scan.advance(&mut self.scanned_this_tick);
-        let warnings = scan.take_warnings();
-        let goal = scan.goal().clone();
-        for w in warnings {
-            self.notes.push(Note::Warning {
-                code: w.code,
-                msg: w.msg,
-            });
-        }
-        match step {
-            Ok(ScanStep::Pending) => false,
-            Ok(ScanStep::Done(found)) => {
-                self.scan = None;
-                match found {
-                    ScanFound::Index(index) => self.top().label_index = Some(Arc::new(index)),
-                    other => self.scan_found = Some((goal, other)),
-                }
-                true
-            }
-            Err(e) => {
-                self.scan = None;
-                let top = self.top();
-                let meta = LineMeta {
-                    line: top.line_no + 1,
-                    offset: top.pos as u64,
-                };
+        match self.reader.advance_scan(&mut self.notes) {
+            Ok(done) => done,
+            Err((e, meta)) => {
                 self.fail(e, meta);
                 false
             }
@@ -785,12 +422,13 @@ impl Decoder {
 
     fn fail(&mut self, e: DecodeError, meta: LineMeta) {
         let prog = self
-            .frames
+            .reader
             .last()
-            .map(|f| f.prog.clone())
+            .map(|f| f.prog().clone())
             .unwrap_or_else(|| Arc::from(""));
         let msg = match self
-            .settings
+            .interp
+            .settings()
             .error_texts
             .as_deref()
             .and_then(|t| t.get(e.code))
@@ -806,148 +444,121 @@ impl Decoder {
             col: e.col,
         });
         self.state = DecoderState::Failed;
-        self.search = None;
+        self.interp.end_search();
     }
 
     /// Raise an error from outside the decoder's own lines (e.g. stream data without CR LF).
     pub fn abort(&mut self, code: u32, msg: impl Into<String>) {
-        let line = self.frames.last().map_or(0, |f| f.line_no);
+        let line = self.reader.last().map_or(0, |f| f.line_no());
         self.fail(DecodeError::new(code, msg), LineMeta { line, offset: 0 });
     }
 
-    fn top(&mut self) -> &mut Frame {
-        // process_line and friends run only with a frame on the stack (checked in step).
-        let i = self.frames.len() - 1;
-        &mut self.frames[i]
+    /// Run one line (a block, or a line of a `#COMMENT`/`#VAR` block); the main program's
+    /// end decoded in it ends decoding.
+    fn process_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
+        let r = self.run_line(text, meta, io);
+        if self.interp.take_ended() {
+            self.state = DecoderState::Ended;
+        }
+        r
     }
 
-    fn process_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
-        let top = self.top();
-        if top.comment_block {
+    /// The steps of one line: comment and `#VAR` blocks, parse, the flow's skipping and
+    /// labels, block search, `/n` skipping, then the block's body.
+    fn run_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
+        let top = self.reader.top();
+        if top.in_comment_block() {
             if is_comment_end(text) {
-                top.comment_block = false;
+                top.set_comment_block(false);
             }
             return Ok(());
         }
-        if top.var_block {
+        if top.in_var_block() {
             // The lines of a `#VAR` block are declarations, read exactly as `check` reads
             // them (`V.P.TABLE[10]` is no ordinary block).
             match parse_var_line(text)? {
                 VarLine::Blank => {}
-                VarLine::End => top.var_block = false,
+                VarLine::End => top.set_var_block(false),
                 // The comment block ends inside the `#VAR` block: both flags hold.
-                VarLine::CommentBegin => top.comment_block = true,
-                VarLine::Decl(d) => self.declare(&d)?,
+                VarLine::CommentBegin => top.set_comment_block(true),
+                VarLine::Decl(d) => {
+                    let made = self.interp.declare(&d)?;
+                    self.reader.count_declared(made);
+                }
             }
             return Ok(());
         }
-        let skipping = top.skip.is_some();
+        let skipping = top.flow().skipping();
         let block = match parse_block(text) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error.
             Err(_) if skipping => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        if self.top().is_stream() {
+        let stream = self.reader.current().is_stream();
+        if stream {
             stream_allows(&block)?;
         }
         if skipping {
-            let run_it = self.skip_line(&block)?;
+            let flow = self.reader.top().flow_mut();
+            let run_it = flow.skip_line(&block, stream, &self.interp)?;
             if !run_it {
                 return Ok(());
             }
         } else if let Some(l) = &block.label {
-            self.note_label(l)?;
+            self.reader.top().flow_mut().note_label(l, stream)?;
         }
-        if self.search.is_some() {
-            self.search_block(&block, text, meta, io);
+        let at = BlockAt {
+            block: &block,
+            text,
+            meta,
+        };
+        if self.interp.searching() {
+            self.interp
+                .search_block(at, &mut self.reader, &mut self.notes, io);
         }
         if let Some(level) = block.skip_level {
-            if self.skip_mask & (1u16 << level.min(15)) != 0 {
+            if self.interp.skips_level(level) {
                 return Ok(());
             }
         }
+        let (ip, rd, notes) = (&mut self.interp, &mut self.reader, &mut self.notes);
         match &block.body {
             Body::Items(items) if items.is_empty() => Ok(()),
-            Body::Items(items) => self.exec_items(items, &block, text, meta, io),
-            Body::Control(c) => self.exec_control(c, meta),
-            Body::Command(c) => self.exec_command(c, &block, text, meta, io),
-            Body::Call(c) => self.exec_call(c, &block, text, meta, io),
-            Body::ProgramHead { .. } if self.top().kind == FrameKind::Local => {
+            Body::Items(items) => ip.exec_items(items, at, rd, notes, io),
+            Body::Control(c) => {
+                let top = rd.top();
+                let next = top.line_pos();
+                match top.flow_mut().exec_control(c, meta, next, ip)? {
+                    FlowStep::Next => Ok(()),
+                    FlowStep::Seek(at) => {
+                        top.seek(at);
+                        Ok(())
+                    }
+                    FlowStep::Goto(target) => rd.goto(target),
+                }
+            }
+            Body::Command(c) => ip.exec_command(c, at, rd, notes, io),
+            Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
+            Body::ProgramHead { .. } if rd.current().kind() == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                self.check_open_flow()?;
-                self.return_from_subroutine();
-                self.resume_held_end(io)
+                rd.top().flow().check_open_flow()?;
+                ip.return_from_subroutine(rd, notes);
+                ip.resume_held_end(rd, notes, io)
             }
             Body::ProgramHead { local: true, .. } => {
                 // A local subroutine section met while running: it runs only when called.
-                let top = self.top();
-                top.skip = Some(Skip::new(SkipUntil::LocalSubroutine));
+                rd.top().flow_mut().begin_skip(SkipUntil::LocalSubroutine);
                 Ok(())
             }
             Body::ProgramHead { local: false, .. } => Ok(()),
         }
     }
 
-    fn set_var(&mut self, k: VarSlot, v: f64) -> Res {
-        self.vars.set(k, v).map_err(var_error)
-    }
-
-    fn info(&self, block: &Block, text: &str, meta: LineMeta, io: &DecoderIo<'_>) -> BlockInfo {
-        let top = &self.frames[self.frames.len() - 1];
-        BlockInfo {
-            prog: top.prog.clone(),
-            line: meta.line,
-            offset: meta.offset,
-            counter: self.counter,
-            n: block.n,
-            text: io.want_text.then(|| text.into()),
-            stream: top.is_stream(),
-        }
-    }
-
-    /// Queue a block that takes effect. During block search nothing is queued: the block
-    /// was evaluated, its state collected.
-    fn emit(&mut self, info: BlockInfo, action: Action, silent: bool, io: &mut DecoderIo<'_>) {
-        if self.search.is_some() {
-            return;
-        }
-        if !silent {
-            self.stats.blocks += 1;
-        }
-        io.queue.push(QueuedBlock {
-            info,
-            action,
-            silent,
-        });
-    }
-
-    /// M30/M2: the program ends; in a stream the rest of the current segment goes.
-    fn end_program(&mut self) {
-        if self.stream_active {
-            self.discard_stream_rest();
-            self.stream_active = false;
-        }
-        self.frames.clear();
-        self.state = DecoderState::Ended;
-        self.starved = false;
-    }
-
-    fn discard_stream_rest(&mut self) {
-        let bytes = self.stream.discard_rest();
-        if bytes > 0 {
-            self.notes.push(Note::Discard { bytes });
-        }
-    }
-
     fn end_of_file(&mut self, _io: &mut DecoderIo<'_>) -> Res {
-        let searching = self.search.is_some();
-        let top = self.top();
-        if let Some(Skip {
-            until: SkipUntil::Label(t),
-            ..
-        }) = &top.skip
-        {
+        let searching = self.interp.searching();
+        let top = self.reader.top();
+        if let Some(t) = top.flow().skipping_to() {
             return Err(DecodeError::new(
                 codes::LABEL_NOT_FOUND,
                 format!("label {} not found", goto_text(t)),
@@ -959,7 +570,7 @@ impl Decoder {
                 "block search target not found",
             ));
         }
-        match top.kind {
+        match top.kind() {
             FrameKind::Main => Err(DecodeError::new(
                 codes::MAIN_END_MISSING,
                 "end of main program without M30/M02",
@@ -970,22 +581,6 @@ impl Decoder {
             )),
         }
     }
-
-    fn eval(&self, e: &crate::lang::block::Expr) -> Res<f64> {
-        expr::eval(e, &expr::Env(self))
-    }
-
-    fn resolve(&self, v: &crate::lang::block::VarRef) -> Res<VarSlot> {
-        expr::resolve(v, &expr::Env(self))
-    }
-}
-
-/// A whole number written as a float (`G01` parses as 1.0).
-pub(crate) use crate::lang::range::whole_u32 as whole;
-
-/// The variable store's refusal with its number (20967, 21928, 20974, `codes::EVAL_UNDEFINED`).
-fn var_error(e: vars::VarError) -> DecodeError {
-    DecodeError::new(e.code(), e.to_string())
 }
 
 /// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).

@@ -21,6 +21,7 @@ use crate::lang::codes::{
     MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, STRING_TOO_LONG_FOR_VARIABLE, TOO_MANY_INDICES,
     VARIABLE_MEMORY_FULL,
 };
+use crate::source::loader::Loader;
 
 /// Array indices of a variable, evaluated. At most three dimensions, as ISG arrays have.
 pub(crate) type Indices = [i64; 3];
@@ -199,17 +200,17 @@ struct Scope {
     bytes: usize,
 }
 
-impl Drop for Scope {
-    fn drop(&mut self) {
-        free_large(std::mem::take(&mut self.vars));
-    }
-}
-
 /// Let go of a table: a large one is freed by the loader thread (freeing 100,000 entries
 /// costs a tick milliseconds).
-fn free_large<K: Send + 'static, V: Send + 'static>(table: BTreeMap<K, V>) {
+fn free_large<K: Send + 'static, V: Send + 'static>(loader: &Loader, table: BTreeMap<K, V>) {
     let items = table.len();
-    crate::source::loader::release_table(table, items);
+    loader.release_table(table, items);
+}
+
+/// Let go of a scope as of a table.
+fn free_scope(loader: &Loader, scope: Scope) {
+    let items = scope.vars.len();
+    loader.release_table(scope, items);
 }
 
 impl Scope {
@@ -234,14 +235,16 @@ impl Scope {
         }
     }
 
-    fn clear(&mut self) {
-        free_large(std::mem::take(&mut self.vars));
+    fn clear(&mut self, loader: &Loader) {
+        free_large(loader, std::mem::take(&mut self.vars));
         self.bytes = 0;
     }
 }
 
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct VarStore {
+    /// Frees the scopes and tables that end when that could cost a tick.
+    loader: Loader,
     /// P1..P1023 without indices; NaN = never assigned.
     p_flat: Vec<f64>,
     p_other: BTreeMap<VarSlot, f64>,
@@ -256,23 +259,47 @@ pub struct VarStore {
     cycle_text: Vec<Vec<(u32, Box<str>)>>,
 }
 
+/// The scopes still held when the decoder goes are freed as a scope that ends is.
+impl Drop for VarStore {
+    fn drop(&mut self) {
+        let loader = &self.loader;
+        for s in self.local.drain(..) {
+            free_scope(loader, s);
+        }
+        for s in [
+            std::mem::take(&mut self.program),
+            std::mem::take(&mut self.self_retaining),
+            std::mem::take(&mut self.external),
+        ] {
+            free_scope(loader, s);
+        }
+        free_large(loader, std::mem::take(&mut self.p_other));
+    }
+}
+
 impl VarStore {
-    pub fn new() -> Self {
+    pub fn new(loader: Loader) -> Self {
         VarStore {
+            loader,
             p_flat: vec![f64::NAN; FLAT_P],
+            p_other: BTreeMap::new(),
+            program: Scope::default(),
             local: vec![Scope::default()],
+            self_retaining: Scope::default(),
+            external: Scope::default(),
             cycle: vec![Vec::new()],
             cycle_text: vec![Vec::new()],
-            ..Default::default()
         }
     }
 
     /// Program (or stream) start: P and V.P. start empty, one level of V.L.
     pub fn start_program(&mut self) {
         self.p_flat.iter_mut().for_each(|v| *v = f64::NAN);
-        free_large(std::mem::take(&mut self.p_other));
-        self.program.clear();
-        self.local.clear();
+        free_large(&self.loader, std::mem::take(&mut self.p_other));
+        self.program.clear(&self.loader);
+        for s in self.local.drain(..) {
+            free_scope(&self.loader, s);
+        }
         self.local.push(Scope::default());
         self.cycle.clear();
         self.cycle.push(Vec::new());
@@ -303,7 +330,9 @@ impl VarStore {
 
     pub(crate) fn pop_level(&mut self) {
         if self.local.len() > 1 {
-            self.local.pop();
+            if let Some(s) = self.local.pop() {
+                free_scope(&self.loader, s);
+            }
             self.cycle.pop();
             self.cycle_text.pop();
         }
@@ -314,11 +343,6 @@ impl VarStore {
         (0..self.cycle.len()).rev().find(|&k| {
             !self.cycle[k].is_empty() || self.cycle_text.get(k).is_some_and(|t| !t.is_empty())
         })
-    }
-
-    /// Whether `k` holds a string: a `STRING[n]` variable, a cycle parameter `@P1="text"`.
-    pub fn is_string(&self, k: &VarSlot) -> bool {
-        self.get_str(k).is_some()
     }
 
     /// The string `k` holds, if it holds one.
@@ -340,6 +364,7 @@ impl VarStore {
     }
 
     /// The declared length of the `STRING[n]` variable `k` names, if it names one.
+    #[cfg(test)]
     pub fn string_max(&self, k: &VarSlot) -> Option<u8> {
         let VarSlot::V { scope, name, .. } = k else {
             return None;
@@ -764,7 +789,7 @@ mod tests {
 
     #[test]
     fn lifetimes_follow_isg() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         s.set(p(1), 10.0).unwrap();
         s.set(p(5000), 1.0).unwrap();
         s.set(v(VScope::SelfRetaining, "KEEP"), 7.0).unwrap();
@@ -780,7 +805,7 @@ mod tests {
 
     #[test]
     fn locals_are_seen_by_callees_and_die_with_their_level() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         s.set(v(VScope::Local, "A"), 1.0).unwrap();
         s.push_level(vec![(1, 5.0)]);
         assert_eq!(s.get(&v(VScope::Local, "A")), Some(1.0));
@@ -800,7 +825,7 @@ mod tests {
 
     #[test]
     fn an_array_is_one_entry_with_its_name_once() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         let name = "N".repeat(3900);
         assert_eq!(
             s.declare(VScope::Local, &name, &[100_000], 0.5),
@@ -826,7 +851,7 @@ mod tests {
 
     #[test]
     fn row_major_elements_of_a_matrix() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         s.declare(VScope::Program, "GRID", &[3, 4], 0.0).unwrap();
         for i in 0..3 {
             for j in 0..4 {
@@ -841,7 +866,7 @@ mod tests {
 
     #[test]
     fn string_variables_hold_bounded_strings() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         assert_eq!(s.declare_str(VScope::Local, "ROW", &[3], 4, "ab"), Ok(3));
         assert_eq!(s.bytes(VarClass::Local), text_cost("ROW", 3, 4));
         assert_eq!(s.get_str(&el(VScope::Local, "ROW", &[2])), Some("ab"));
@@ -884,14 +909,14 @@ mod tests {
 
     #[test]
     fn an_element_of_an_undeclared_array_is_refused() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         let e = s.set(el(VScope::Local, "NOPE", &[2]), 1.0).unwrap_err();
         assert_eq!(e.code(), EVAL_UNDEFINED);
     }
 
     #[test]
     fn each_class_is_bounded_in_bytes_and_redeclaring_does_not_grow() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         // Redeclaring one name a thousand times replaces it: the bytes stay.
         for _ in 0..1000 {
             s.declare(VScope::SelfRetaining, "A", &[100_000], 0.0)
@@ -919,7 +944,7 @@ mod tests {
 
     #[test]
     fn scalars_and_p_parameters_are_bounded_too() {
-        let mut s = VarStore::new();
+        let mut s = VarStore::new(Loader::inline());
         let long = "L".repeat(3900);
         let mut refused = None;
         for k in 0..10_000 {

@@ -9,6 +9,7 @@ pub(crate) mod block;
 mod bytes;
 pub mod check;
 pub mod codes;
+pub(crate) mod control;
 pub mod dialect;
 mod display;
 pub(crate) mod error;

@@ -11,6 +11,7 @@ use super::rng::SplitMix64;
 use super::scenario::Faults;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
+use crate::source::loader::Loader;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
 /// `n` channels built from the start-up list, each fed its own endless generated program by
@@ -19,6 +20,7 @@ pub fn streaming_channels(
     params: &Path,
     n: u32,
     seed: u64,
+    loader: &Loader,
 ) -> Result<(SoakCycle, Duration), String> {
     // `ParamError` displays every diagnostic, rendered, one a line.
     let config = crate::params::load(params).map_err(|e| e.to_string())?;
@@ -47,7 +49,11 @@ pub fn streaming_channels(
             r.fork(2),
             Source::Generated(Generator::new(ProgramSpec::default(), r.fork(1))),
         );
-        channels.push(crate::channel::Channel::new(settings, false));
+        channels.push(crate::channel::Channel::new(
+            settings,
+            false,
+            loader.clone(),
+        ));
         clients.push((i + 1, program, feeder, r.fork(3)));
     }
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);

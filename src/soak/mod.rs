@@ -21,6 +21,7 @@ use thiserror::Error;
 use crate::machine::{Machine, StopWhen};
 use crate::report::event::EventLog;
 use crate::runtime::{Clock, RunEnd, Runtime};
+use crate::source::loader::Loader;
 use driver::{Slot, SoakCycle};
 use feed::{SoakFeeder, Source};
 use generator::Generator;
@@ -62,6 +63,7 @@ pub fn build(
     scenario: &Scenario,
     seed: u64,
     target_blocks: Option<u64>,
+    loader: &Loader,
 ) -> Result<(SoakCycle, Duration), SoakError> {
     let params = scenario.params_path();
     let config = crate::params::load(&params).map_err(|e| SoakError::Params {
@@ -87,7 +89,11 @@ pub fn build(
     for cc in config.channels.iter().take(highest) {
         let settings = crate::setup::channel_settings(&config, cc)
             .map_err(|e| SoakError::Setup(e.to_string()))?;
-        channels.push(crate::channel::Channel::new(settings, false));
+        channels.push(crate::channel::Channel::new(
+            settings,
+            false,
+            loader.clone(),
+        ));
     }
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
     let mut rng = SplitMix64::new(seed);
@@ -173,7 +179,9 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         .clone()
         .unwrap_or_else(|| scenario.length.clone());
     let seed = opts.seed.unwrap_or(scenario.seed);
-    let (cycle, period) = build(scenario, seed, length.blocks)?;
+    // The soak's program loader: the channels' large files are read off the tick.
+    let loader = Loader::start();
+    let (cycle, period) = build(scenario, seed, length.blocks, &loader)?;
     let realtime = opts.realtime || scenario.clock == ClockSpec::Realtime;
     let clock = if realtime {
         Clock::RealTime

@@ -6,9 +6,13 @@
 //! programs and subroutines, read in the tick as before, keep virtual-time runs exact — and
 //! hands anything larger to the loader. Memory stays bounded by `MAX_PROGRAM_BYTES` per file:
 //! the file is read into one buffer of its size, which becomes the program text without a copy.
+//!
+//! The same thread frees what a tick must not: a program text of hundreds of MB, tens of
+//! thousands of labels or variables. Whoever runs the channels starts it and hands a
+//! [`Loader`] to each; nothing reaches it but through that handle.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use crossbeam_channel::{Receiver, Sender, TryRecvError};
@@ -41,7 +45,6 @@ enum Job {
 pub struct PendingRead {
     /// The name as the program called it.
     pub(crate) name: Arc<str>,
-    pub(crate) path: Arc<Path>,
     reply: Receiver<ReadResult>,
 }
 
@@ -81,78 +84,112 @@ impl PendingRead {
     }
 }
 
-/// The process's loader thread, started at its first use; `None` when it could not start.
-fn loader() -> Option<&'static Sender<Job>> {
-    static LOADER: OnceLock<Option<Sender<Job>>> = OnceLock::new();
-    LOADER
-        .get_or_init(|| {
-            let (tx, rx) = crossbeam_channel::unbounded::<Job>();
-            std::thread::Builder::new()
-                .name("ncchannel-loader".into())
-                .spawn(move || {
-                    for job in rx {
-                        match job {
-                            Job::Read { path, limit, reply } => {
-                                let r = crate::bounded::read_file(&path, limit);
-                                // The decoder may have gone (reset): nobody waits for the text.
-                                let _ = reply.send(r);
-                            }
-                            Job::Free(garbage) => drop(garbage),
+/// The program loader: a thread that reads large program files and frees large texts and
+/// tables, so neither costs a tick milliseconds. Whoever owns the runtime starts it
+/// ([`Loader::start`]) and hands it to each channel it builds; the parts that read files or
+/// let go of large tables (the program store, the decoder's reader and variables, the
+/// channel's kept program text) hold a handle and name it where they use it. The thread ends
+/// when the last handle is dropped.
+#[derive(Clone)]
+pub struct Loader {
+    /// The thread's queue; `None`: no thread (it could not start, or [`Loader::inline`]), so
+    /// files are read and tables freed where they are asked for.
+    jobs: Option<Sender<Job>>,
+}
+
+impl std::fmt::Debug for Loader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Loader")
+            .field("thread", &self.jobs.is_some())
+            .finish()
+    }
+}
+
+impl Loader {
+    /// Start the loader thread (`ncchannel-loader`). If it cannot start, the loader works
+    /// inline: a tick then reads a large file and frees a large table itself.
+    pub fn start() -> Loader {
+        let (tx, rx) = crossbeam_channel::unbounded::<Job>();
+        let started = std::thread::Builder::new()
+            .name("ncchannel-loader".into())
+            .spawn(move || {
+                for job in rx {
+                    match job {
+                        Job::Read { path, limit, reply } => {
+                            let r = crate::bounded::read_file(&path, limit);
+                            // The decoder may have gone (reset): nobody waits for the text.
+                            let _ = reply.send(r);
                         }
+                        Job::Free(garbage) => drop(garbage),
                     }
-                })
-                .ok()
-                .map(|_| tx)
-        })
-        .as_ref()
-}
+                }
+            });
+        Loader {
+            jobs: started.ok().map(|_| tx),
+        }
+    }
 
-/// Hand the read of `path` (at most `limit` bytes) to the loader thread. Without one (it could
-/// not be started) the file is read here, the one case where a tick reads a large file.
-pub(crate) fn spawn_read(name: &str, path: &Path, limit: u64) -> PendingRead {
-    let (tx, rx) = crossbeam_channel::bounded(1);
-    let job = Job::Read {
-        path: path.to_path_buf(),
-        limit,
-        reply: tx,
-    };
-    let unsent = match loader() {
-        Some(loader) => loader.send(job).err().map(|e| e.into_inner()),
-        None => Some(job),
-    };
-    if let Some(Job::Read { path, limit, reply }) = unsent {
-        let _ = reply.send(crate::bounded::read_file(&path, limit));
+    /// A loader without a thread: every read and every free happens where it is asked for
+    /// (unit tests of the parts that hold one).
+    pub fn inline() -> Loader {
+        Loader { jobs: None }
     }
-    PendingRead {
-        name: name.into(),
-        path: path.into(),
-        reply: rx,
-    }
-}
 
-/// Let go of a program text: a large one held nowhere else is freed by the loader thread
-/// (freeing it here could cost the tick milliseconds); anything else is dropped here.
-pub(crate) fn release(text: Arc<Vec<u8>>) {
-    if text.len() as u64 <= INLINE_READ_BYTES_PER_TICK || Arc::strong_count(&text) > 1 {
-        return;
+    /// Hand the read of `path` (at most `limit` bytes) to the loader thread. Without one the
+    /// file is read here, the one case where a tick reads a large file.
+    pub(crate) fn read(&self, name: &str, path: &Path, limit: u64) -> PendingRead {
+        let (tx, rx) = crossbeam_channel::bounded(1);
+        let job = Job::Read {
+            path: path.to_path_buf(),
+            limit,
+            reply: tx,
+        };
+        let unsent = match &self.jobs {
+            Some(jobs) => jobs.send(job).err().map(|e| e.into_inner()),
+            None => Some(job),
+        };
+        if let Some(Job::Read { path, limit, reply }) = unsent {
+            let _ = reply.send(crate::bounded::read_file(&path, limit));
+        }
+        PendingRead {
+            name: name.into(),
+            reply: rx,
+        }
     }
-    if let Some(loader) = loader() {
-        // A loader that has stopped hands the job back: it is dropped here after all.
-        let _ = loader.send(Job::Free(Box::new(text)));
+
+    /// Let go of a program text: a large one held nowhere else is freed by the loader thread
+    /// (freeing it here could cost the tick milliseconds); anything else is dropped here.
+    pub(crate) fn release(&self, text: Arc<Vec<u8>>) {
+        let heavy = is_heavy_text(&text);
+        self.free_if(heavy, text);
+    }
+
+    /// Let go of a table of `items` entries: a large one is dropped by the loader thread, so
+    /// the tick does not pay for freeing it; a small one is dropped here.
+    pub(crate) fn release_table<T: Send + 'static>(&self, table: T, items: usize) {
+        self.free_if(is_heavy_table(items), table);
+    }
+
+    /// Drop `garbage` on the loader thread when `heavy`, here otherwise (and when there is no
+    /// thread: a loader that has stopped hands the job back, dropped here after all).
+    pub(crate) fn free_if<T: Send + 'static>(&self, heavy: bool, garbage: T) {
+        if let (true, Some(jobs)) = (heavy, &self.jobs) {
+            let _ = jobs.send(Job::Free(Box::new(garbage)));
+        }
     }
 }
 
 /// Tables of at most this many items are freed where they are dropped (microseconds); larger
-/// ones go to the loader thread ([`release_table`]).
+/// ones go to the loader thread ([`Loader::release_table`]).
 const FREE_HERE_ITEMS: usize = 1024;
 
-/// Let go of a table of `items` entries: a large one is dropped by the loader thread, so the
-/// tick does not pay for freeing it; a small one (or any, without a loader) is dropped here.
-pub(crate) fn release_table<T: Send + 'static>(table: T, items: usize) {
-    if items <= FREE_HERE_ITEMS {
-        return;
-    }
-    if let Some(loader) = loader() {
-        let _ = loader.send(Job::Free(Box::new(table)));
-    }
+/// Whether dropping this text could cost a tick: larger than a tick reads itself, and held
+/// nowhere else (dropping a shared one only counts down).
+pub(crate) fn is_heavy_text(text: &Arc<Vec<u8>>) -> bool {
+    text.len() as u64 > INLINE_READ_BYTES_PER_TICK && Arc::strong_count(text) == 1
+}
+
+/// Whether freeing a table of `items` entries could cost a tick.
+pub(crate) fn is_heavy_table(items: usize) -> bool {
+    items > FREE_HERE_ITEMS
 }

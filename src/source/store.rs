@@ -23,7 +23,7 @@ use thiserror::Error;
 use crate::bounded::BoundedReadError;
 use crate::vocab::tick::Clock;
 
-use super::loader::{self, PendingRead, Poll, INLINE_READ_BYTES_PER_TICK};
+use super::loader::{Loader, PendingRead, Poll, INLINE_READ_BYTES_PER_TICK};
 
 /// Largest program the store reads into memory (900110 beyond it). A bound, so a mistaken
 /// path to a huge file cannot exhaust memory; real NC programs that large are streamed instead.
@@ -57,13 +57,6 @@ pub enum ProgramKind {
 pub struct ProgramText {
     /// The name as the program called it.
     pub name: Arc<str>,
-    /// Where it was found. Shared like the text: a cache hit copies no path.
-    #[allow(
-        dead_code,
-        reason = "read by nothing in the crate since the channel keeps its parts to itself; \
-                  the loader (src/source/loader.rs) still sets it"
-    )]
-    pub path: Arc<Path>,
     /// The file's bytes, as read (shared without a copy: a `Vec` read to its exact size).
     pub text: Arc<Vec<u8>>,
 }
@@ -176,6 +169,8 @@ pub struct ProgramStore {
     clock: Clock,
     /// Wall time this tick waited for the loader with the clock stopped (virtual time).
     clock_stopped: Duration,
+    /// Reads the files too large for the tick's inline budget.
+    loader: Loader,
 }
 
 impl ProgramStore {
@@ -192,7 +187,15 @@ impl ProgramStore {
             read_this_tick: 0,
             clock: Clock::Virtual,
             clock_stopped: Duration::ZERO,
+            loader: Loader::inline(),
         }
+    }
+
+    /// Read files too large for a tick's inline budget through `loader` (without one they
+    /// are read in the tick).
+    pub(crate) fn with_loader(mut self, loader: Loader) -> Self {
+        self.loader = loader;
+        self
     }
 
     /// The start of a tick: reads the loader has not finished meet this tick's clock.
@@ -271,7 +274,7 @@ impl ProgramStore {
             });
         }
         if self.read_this_tick + bytes > INLINE_READ_BYTES_PER_TICK {
-            return Ok(Opened::Loading(loader::spawn_read(
+            return Ok(Opened::Loading(self.loader.read(
                 name,
                 &path,
                 MAX_PROGRAM_BYTES,
@@ -279,7 +282,7 @@ impl ProgramStore {
         }
         let text = read_bounded(&path, name)?;
         self.read_this_tick += text.len() as u64;
-        Ok(Opened::File(self.opened(name, path.into(), text)))
+        Ok(Opened::File(self.opened(name, text)))
     }
 
     /// The text of a read handed to the loader, once it is there (`None`: not yet).
@@ -293,7 +296,7 @@ impl ProgramStore {
             Poll::Waiting => None,
             Poll::Done(Ok(text)) => {
                 self.stats.loaded_off_tick += 1;
-                Some(Ok(self.opened(&pending.name, pending.path.clone(), text)))
+                Some(Ok(self.opened(&pending.name, text)))
             }
             Poll::Done(Err(e)) => Some(Err(read_error(e, &pending.name))),
         }
@@ -306,7 +309,7 @@ impl ProgramStore {
     }
 
     /// A file read: counted, its latency charged.
-    fn opened(&mut self, name: &str, path: Arc<Path>, text: Vec<u8>) -> ProgramText {
+    fn opened(&mut self, name: &str, text: Vec<u8>) -> ProgramText {
         self.stats.opens += 1;
         self.stats.bytes_read += text.len() as u64;
         if !self.latency.is_zero() {
@@ -316,7 +319,6 @@ impl ProgramStore {
         }
         ProgramText {
             name: name.into(),
-            path,
             text: Arc::new(text),
         }
     }

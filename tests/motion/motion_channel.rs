@@ -52,7 +52,9 @@ impl Setup {
     }
     fn channel(&self) -> Channel {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        ncchannel::channels(&config, true).unwrap().remove(0)
+        ncchannel::channels(&config, true, &ncchannel::Loader::start())
+            .unwrap()
+            .remove(0)
     }
 }
 

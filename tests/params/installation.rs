@@ -105,7 +105,9 @@ impl Installation {
 
     fn channel(&self) -> Channel {
         let config = ncchannel::params::load(&self.startup()).unwrap_or_else(|e| panic!("{e}"));
-        ncchannel::channels(&config, true).unwrap().remove(0)
+        ncchannel::channels(&config, true, &ncchannel::Loader::start())
+            .unwrap()
+            .remove(0)
     }
 }
 
@@ -383,7 +385,9 @@ fn the_shipped_example_installation_runs_its_part() {
     // achsmds3.lis: vb_max 250000 µm/s = 15000 mm/min, swe_neg -3000000 × 0.1 µm = -300 mm.
     assert_eq!(ch.axes[2].max_velocity_mm_per_min, 15000.0);
     assert_eq!(ch.axes[2].soft_limit_min_mm, -300.0);
-    let mut c = ncchannel::channels(&config, true).unwrap().remove(0);
+    let mut c = ncchannel::channels(&config, true, &ncchannel::Loader::start())
+        .unwrap()
+        .remove(0);
     start(&mut c, &tick(0), "part.nc");
     let ev = run(&mut c, &[], 60_000);
     let progs: Vec<String> = blocks(&ev).into_iter().map(|(p, _)| p).collect();

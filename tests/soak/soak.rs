@@ -162,7 +162,7 @@ fn four_channels_stream_independently_in_one_cycle() {
 #[test]
 fn machine_ticks_four_channels_each_with_its_own_stream() {
     let config = ncchannel::params::load(&soak_dir().join("startup4.lis")).unwrap();
-    let channels = ncchannel::channels(&config, false).unwrap();
+    let channels = ncchannel::channels(&config, false, &ncchannel::Loader::start()).unwrap();
     assert_eq!(channels.len(), 4);
     let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
     let period = Duration::from_millis(1);

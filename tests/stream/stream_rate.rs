@@ -30,7 +30,9 @@ fn packet(k: u64) -> Vec<u8> {
 /// writes until the channel answers busy.
 fn stream_for(startup: &Path, ticks: u64) -> (u64, Vec<Option<u32>>) {
     let config = ncchannel::params::load(startup).unwrap();
-    let mut ch = ncchannel::channels(&config, false).unwrap().remove(0);
+    let mut ch = ncchannel::channels(&config, false, &ncchannel::Loader::start())
+        .unwrap()
+        .remove(0);
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let tick = |index: u64| Tick {
         index,

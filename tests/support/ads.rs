@@ -95,7 +95,7 @@ impl Channels {
 
     pub fn from_params(params: Params) -> Channels {
         let config = ncchannel::params::load(&params.startup()).unwrap();
-        let channels = ncchannel::channels(&config, true).unwrap();
+        let channels = ncchannel::channels(&config, true, &ncchannel::Loader::start()).unwrap();
         let log = LogBytes::default();
         let machine = Machine::new(
             channels,

@@ -178,7 +178,7 @@ impl Rig {
 
     pub fn machine(&self) -> (Machine, Duration, Shared2) {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        let channels = ncchannel::channels(&config, true).unwrap();
+        let channels = ncchannel::channels(&config, true, &ncchannel::Loader::start()).unwrap();
         let shared = Shared::default();
         let log = EventLog::to_writer(Box::new(shared.clone()));
         let period = Duration::from_micros(config.runtime.cycle_period_us);
@@ -192,7 +192,7 @@ impl Rig {
     /// Channel 1 of the rig on its own (its events kept in its buffer), and the cycle time.
     pub fn channel(&self) -> (Channel, Duration) {
         let config = ncchannel::params::load(&self.startup()).unwrap();
-        let mut channels = ncchannel::channels(&config, true).unwrap();
+        let mut channels = ncchannel::channels(&config, true, &ncchannel::Loader::start()).unwrap();
         let period = Duration::from_micros(config.runtime.cycle_period_us);
         (channels.remove(0), period)
     }

@@ -8,116 +8,41 @@
 //! The parser has already refused what a block may not hold (a letter twice, a dwell with
 //! company, unknown or unsupported G/M/H numbers), so the steps need not check it again.
 
-use super::modal::FeedMode;
-use super::*;
+use super::block_words::{Words, MAX_FUNCTIONS};
+use super::{expr, Interpreter};
+use crate::decoder::error::{var_error, DecodeError, Res};
+use crate::decoder::frame::FrameKind;
+use crate::decoder::io::DecoderIo;
+use crate::decoder::line::BlockAt;
+use crate::decoder::modal::FeedMode;
+use crate::decoder::modal::{apply_g, apply_m, BlockGs, MotionMode};
+use crate::decoder::note::Note;
+use crate::decoder::reader::Reader;
+use crate::decoder::vars;
+use crate::geometry::arc;
 use crate::lang::block::VarRef;
+use crate::lang::block::{Item, Value};
+use crate::lang::codes;
 use crate::lang::eval::Val;
+use crate::lang::range::whole_u32 as whole;
+use crate::queue::{Action, BlockInfo, Move, MoveKind};
 use crate::vocab::axis::slot_of;
+use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 
-/// M or H functions one block may hold.
-const MAX_FUNCTIONS: usize = 8;
-/// G functions one block may hold (a CAM header writes six or seven).
-const MAX_GS: usize = 16;
-
-/// Step 1's result: the block's words by meaning, values evaluated, not yet applied.
-#[derive(Debug, Default)]
-pub(super) struct Words {
-    /// G numbers in written order, with their columns.
-    gs: [(u32, u32); MAX_GS],
-    n_gs: usize,
-    /// Axis values as programmed (program units), by `AXIS_LETTERS` index.
-    /// Plain values and a bit mask rather than `Option`s: this struct is built for every
-    /// block, and reading `Option<f64>`s back showed as store-forwarding stalls in a profile.
-    axes: [f64; MAX_AXES],
-    /// Bit i: axis i is programmed.
-    axes_set: u8,
-    /// Column of an X word on a channel without X: an error unless X is a dwell time.
-    unconfigured_x_col: Option<u32>,
-    /// I, J, K as programmed (program units).
-    ijk: [Option<f64>; 3],
-    /// R as programmed (program units).
-    radius: Option<f64>,
-    /// F as programmed, with its column.
-    feed: Option<(f64, u32)>,
-    /// S, rpm.
-    spindle_rpm: Option<f64>,
-    tool: Option<u32>,
-    tool_offset: Option<u32>,
-    /// `G04 <t>` / `G04 P<t>`: the dwell time in seconds.
-    dwell_s: Option<f64>,
-    ms: [u32; MAX_FUNCTIONS],
-    /// The value of each M programmed with one (`M200=1200`), by its place in `ms`.
-    m_values: [Option<f64>; MAX_FUNCTIONS],
-    n_ms: usize,
-    hs: [u32; MAX_FUNCTIONS],
-    h_values: [Option<f64>; MAX_FUNCTIONS],
-    n_hs: usize,
-    /// G800–G819 (number, column): an implicit subroutine call at the end of the block.
-    call: Option<(u32, u32)>,
-    /// Its transfer parameters as `@P` number and value (gaps left out).
-    call_params: Vec<(u32, f64)>,
-}
-
-impl Words {
-    /// Empty again for the next block. The fixed arrays keep their stale entries: only the
-    /// first `n_*` count, so clearing them would be a memset per block for nothing.
-    fn clear(&mut self) {
-        self.n_gs = 0;
-        self.axes_set = 0;
-        self.unconfigured_x_col = None;
-        self.ijk = [None; 3];
-        self.radius = None;
-        self.feed = None;
-        self.spindle_rpm = None;
-        self.tool = None;
-        self.tool_offset = None;
-        self.dwell_s = None;
-        self.n_ms = 0;
-        self.n_hs = 0;
-        // `call_params` count only with `call`, and are cleared when it is set.
-        self.call = None;
-    }
-
-    fn gs(&self) -> &[(u32, u32)] {
-        &self.gs[..self.n_gs]
-    }
-
-    fn push_g(&mut self, g: u32, col: u32) -> Res {
-        if self.n_gs == MAX_GS {
-            return Err(DecodeError::new(
-                codes::SYNTAX,
-                "too many G functions in one block",
-            ));
-        }
-        self.gs[self.n_gs] = (g, col);
-        self.n_gs += 1;
-        Ok(())
-    }
-    fn ms(&self) -> &[u32] {
-        &self.ms[..self.n_ms]
-    }
-    pub(super) fn has_m(&self, m: u32) -> bool {
-        self.ms().contains(&m)
-    }
-    fn hs(&self) -> &[u32] {
-        &self.hs[..self.n_hs]
-    }
-}
-
-impl Decoder {
-    pub(super) fn exec_items(
+impl Interpreter {
+    pub(in crate::decoder) fn exec_items(
         &mut self,
         items: &[Item],
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         // One `Words` reused from block to block (see `Words::clear`), boxed so taking it
         // out of the decoder moves a pointer.
         let mut w = self.words.take().unwrap_or_default();
         w.clear();
-        let r = self.exec_words(items, block, text, meta, io, &mut w);
+        let r = self.exec_words(items, at, rd, notes, io, &mut w);
         self.words = Some(w);
         r
     }
@@ -126,9 +51,9 @@ impl Decoder {
     fn exec_words(
         &mut self,
         items: &[Item],
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
         w: &mut Words,
     ) -> Res {
@@ -136,7 +61,7 @@ impl Decoder {
             self.collect(it, w)?;
         }
         let gs = self.modal_changes(w)?;
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         let mut queued = false;
         if gs.dwell {
             let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
@@ -152,7 +77,7 @@ impl Decoder {
             self.emit(info.clone(), Action::Move(mv), false, io);
             queued = true;
         }
-        self.end_of_block(w, info, queued, io)
+        self.end_of_block(w, info, queued, rd, notes, io)
     }
 
     /// Step 1: one item. Assignments take effect at once, in written order, so a later word
@@ -534,14 +459,16 @@ impl Decoder {
         w: &Words,
         info: BlockInfo,
         queued: bool,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         for (&h, &value) in w.hs().iter().zip(&w.h_values) {
-            self.notes.push(Note::HFunction { h, value });
+            notes.push(Note::HFunction { h, value });
         }
         for (&m, &value) in w.ms().iter().zip(&w.m_values) {
             if let Some(value) = value {
-                self.notes.push(Note::MFunction { m, value });
+                notes.push(Note::MFunction { m, value });
             }
         }
         let stop = w.ms().iter().copied().find(|m| matches!(m, 0 | 1));
@@ -562,7 +489,7 @@ impl Decoder {
             .copied()
             .find(|m| matches!(m, 2 | 30 | 17 | 29));
         if let Some(m @ (17 | 29)) = end_m {
-            if self.top().kind == FrameKind::Main {
+            if rd.top().kind() == FrameKind::Main {
                 return Err(DecodeError::new(
                     codes::UNEXPECTED_SUB_END,
                     format!("unexpected M{m} in main program"),
@@ -580,21 +507,21 @@ impl Decoder {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
             }
-            return self.call_g800(g, &w.call_params, end_m, info, io);
+            return self.call_g800(g, &w.call_params, end_m.map(|m| (m, info)), rd, notes, io);
         }
         if let Some(name) = self.m6_subroutine(w) {
             if !queued {
                 self.emit(info.clone(), Action::None, false, io);
             }
-            return self.call_m6(&name, end_m, info, io);
+            return self.call_m6(&name, end_m, info, rd, notes, io);
         }
         if let Some(17 | 29) = end_m {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            self.check_open_flow()?;
-            self.return_from_subroutine();
-            return self.resume_held_end(io);
+            rd.top().flow().check_open_flow()?;
+            self.return_from_subroutine(rd, notes);
+            return self.resume_held_end(rd, notes, io);
         }
         let Some(m) = end_m else {
             if !queued {
@@ -602,11 +529,11 @@ impl Decoder {
             }
             return Ok(());
         };
-        self.program_end_checks(m)?;
+        self.program_end_checks(m, rd, notes)?;
         if !queued {
             self.emit(info.clone(), Action::None, false, io);
         }
-        self.program_end(m, info, io)
+        self.program_end(m, info, rd, notes, io)
     }
 
     /// G800–G819 in this block (`col` its column): its subroutine must be configured
@@ -632,21 +559,26 @@ impl Decoder {
 
     /// M2/M30: a block search that reaches it failed; in a subroutine it is a warning; in
     /// the main program every control block must be closed.
-    pub(super) fn program_end_checks(&mut self, m: u32) -> Res {
+    pub(super) fn program_end_checks(
+        &mut self,
+        m: u32,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+    ) -> Res {
         if let Some(s) = self.search {
             return Err(DecodeError::new(
                 codes::SEARCH_NOT_FOUND,
                 format!("block search target {} not found", s.target),
             ));
         }
-        if self.top().kind != FrameKind::Main {
-            self.notes.push(Note::Warning {
+        if rd.top().kind() != FrameKind::Main {
+            notes.push(Note::Warning {
                 code: codes::UNEXPECTED_PROGRAM_END,
                 msg: format!("M{m} in a subroutine: the program ends"),
             });
             Ok(())
         } else {
-            self.check_open_flow()
+            rd.top().flow().check_open_flow()
         }
     }
 }

@@ -1,57 +1,29 @@
 //! Subroutine and cycle calls, their return, and the `#` commands (`#FLUSH`, `#CACHE`,
 //! `#SPLINE`, `#HSC`, `#CONTOUR MODE`, `#VAR`, `#COMMENT`, `#MSG`, `#TIME`).
 
-use super::*;
+use std::sync::Arc;
+
+use super::implicit::HeldEnd;
+use super::{block_words, expr, Interpreter};
+use crate::decoder::error::{var_error, DecodeError, Res};
+use crate::decoder::frame::{Frame, FrameKind, Source};
+use crate::decoder::io::DecoderIo;
+use crate::decoder::line::BlockAt;
+use crate::decoder::note::Note;
+use crate::decoder::reader::CacheRead;
+use crate::decoder::reader::Reader;
+use crate::lang::block::{Call, Command, SplineCommand, Value};
+use crate::lang::codes;
+use crate::queue::{Action, BlockInfo};
 use crate::source::cache::LoadStep;
-use crate::source::loader::PendingRead;
-use crate::source::store::{ProgramText, StoreError};
+use crate::source::store::{Opened, ProgramKind};
 use crate::vocab::event::CacheOp;
+use crate::vocab::flush::FlushKind;
 
-/// A `#CACHE LOAD` whose file the loader reads: the line waits, and runs again with the text.
-#[derive(Debug)]
-pub(super) struct CacheRead {
-    pub(crate) file: String,
-    pub(crate) pending: PendingRead,
-    /// The loader's answer, once there.
-    pub(crate) read: Option<Result<ProgramText, StoreError>>,
-}
-
-/// A program end (M02/M30) or return (M17/M29) held back while an implicit subroutine runs
-/// before it: applied when the frame stack is back at `depth`.
-#[derive(Debug, Clone)]
-pub(super) struct HeldEnd {
-    pub(crate) m: u32,
-    pub(crate) info: BlockInfo,
-    pub(crate) depth: usize,
-}
-
-/// Where the running program stands with its implicit subroutine calls.
-#[derive(Debug, Clone, Default)]
-pub(super) struct ImplicitState {
-    /// The start subroutine (P-CHAN-00119) is still to be called.
-    pub(crate) start_pending: bool,
-    /// The end subroutine (P-CHAN-00252) has been called.
-    pub(crate) end_called: bool,
-    /// Depth of the running M6 subroutine's frame: an M6 inside it is an ordinary M function,
-    /// as the kernel does not call the tool change from the tool change.
-    pub(crate) m6_depth: Option<usize>,
-    /// Ends held back, innermost last (at most one per frame).
-    pub(crate) held: Vec<HeldEnd>,
-}
-
-impl ImplicitState {
-    pub(crate) fn at_start(calls: &crate::params::channel::ImplicitSubroutines) -> Self {
-        ImplicitState {
-            start_pending: calls.at_start.is_some(),
-            ..Default::default()
-        }
-    }
-}
-
-impl Decoder {
+impl Interpreter {
     /// One `#VAR` declaration, already validated by the parser (sizes, element count). The
     /// values it made count against this tick's declaration budget.
-    pub(super) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res {
+    pub(in crate::decoder) fn declare(&mut self, d: &crate::lang::block::VarDecl) -> Res<usize> {
         if let Some(crate::lang::block::VarType::String(max)) = d.ty {
             // A string variable: its start value (checked by the parser) or "" in every
             // element (docs/nc-language.md, "Strings").
@@ -65,8 +37,7 @@ impl Decoder {
                     d.text.as_deref().unwrap_or(""),
                 )
                 .map_err(var_error)?;
-            self.declared_this_tick += made;
-            return Ok(());
+            return Ok(made);
         }
         let init = match &d.init {
             Some(e) => self.eval(e)?,
@@ -81,32 +52,33 @@ impl Decoder {
             .declare(d.scope, &d.name, &d.dims, init)
             .map_err(var_error)?;
         self.vars.fill(d.scope, &d.name, &values);
-        self.declared_this_tick += made;
-        Ok(())
+        Ok(made)
     }
 
     /// M17/M29: back to the caller, past the call line.
-    pub(super) fn return_from_subroutine(&mut self) {
-        if let Some(f) = self.frames.pop() {
-            if f.is_stream() {
-                self.discard_stream_rest();
-                self.stream_active = false;
-            }
+    pub(in crate::decoder) fn return_from_subroutine(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+    ) {
+        if rd.pop(notes) {
             self.vars.pop_level();
         }
-        if self
-            .implicit
-            .m6_depth
-            .is_some_and(|d| self.frames.len() < d)
-        {
+        if self.implicit.m6_depth.is_some_and(|d| rd.depth() < d) {
             self.implicit.m6_depth = None;
         }
     }
 
     /// A global subroutine call without a call line (an implicit call): the frame is pushed,
     /// its blocks run as those of `L name` would.
-    pub(super) fn call_global(&mut self, name: &str, io: &mut DecoderIo<'_>) -> Res {
-        self.call_implicit(name, FrameKind::Global, Vec::new(), io)
+    pub(super) fn call_global(
+        &mut self,
+        name: &str,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        self.call_implicit(name, FrameKind::Global, Vec::new(), rd, notes, io)
     }
 
     /// An implicit call of `name` as `kind`, with `params` as its `@P` values.
@@ -115,17 +87,19 @@ impl Decoder {
         name: &str,
         kind: FrameKind,
         params: Vec<(u32, f64)>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.frames.len() > self.settings.max_depth {
+        if rd.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
             ));
         }
-        let frame = self.open_subroutine(name, kind, io)?;
+        let frame = self.open_subroutine(name, kind, rd, notes, io)?;
         self.vars.push_level(params);
-        self.frames.push(frame);
+        rd.push(frame);
         Ok(())
     }
 
@@ -142,8 +116,9 @@ impl Decoder {
         &mut self,
         g: u32,
         params: &[(u32, f64)],
-        end_m: Option<u32>,
-        info: BlockInfo,
+        end: Option<(u32, BlockInfo)>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
         let Some(name) = self.g800_subroutine(g).map(str::to_string) else {
@@ -152,32 +127,37 @@ impl Decoder {
                 format!("unknown G function G{g}"),
             ));
         };
-        let depth = self.frames.len();
+        let depth = rd.depth();
         let kind = if params.is_empty() {
             FrameKind::Global
         } else {
             FrameKind::Cycle
         };
-        self.call_implicit(&name, kind, params.to_vec(), io)?;
-        if let Some(m) = end_m {
+        self.call_implicit(&name, kind, params.to_vec(), rd, notes, io)?;
+        if let Some((m, info)) = end {
             self.implicit.held.push(HeldEnd { m, info, depth });
         }
         Ok(())
     }
 
     /// Program start: `start_init_prog_file` (P-CHAN-00119) is called as the first action.
-    pub(super) fn start_subroutine(&mut self, io: &mut DecoderIo<'_>) -> Res {
+    pub(in crate::decoder) fn start_subroutine(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         if !std::mem::take(&mut self.implicit.start_pending) {
             return Ok(());
         }
         match self.settings.implicit.at_start.clone() {
-            Some(name) => self.call_global(&name, io),
+            Some(name) => self.call_global(&name, rd, notes, io),
             None => Ok(()),
         }
     }
 
     /// M6 with `m6_prog_file` (P-CHAN-00118) set, outside the M6 subroutine itself: its name.
-    pub(super) fn m6_subroutine(&self, w: &words::Words) -> Option<String> {
+    pub(super) fn m6_subroutine(&self, w: &block_words::Words) -> Option<String> {
         let name = self.settings.implicit.at_m6.as_ref()?;
         (self.implicit.m6_depth.is_none() && w.has_m(6)).then(|| name.clone())
     }
@@ -189,11 +169,13 @@ impl Decoder {
         name: &str,
         end_m: Option<u32>,
         info: BlockInfo,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let depth = self.frames.len();
-        self.call_global(name, io)?;
-        self.implicit.m6_depth = Some(self.frames.len());
+        let depth = rd.depth();
+        self.call_global(name, rd, notes, io)?;
+        self.implicit.m6_depth = Some(rd.depth());
         if let Some(m) = end_m {
             self.implicit.held.push(HeldEnd { m, info, depth });
         }
@@ -202,26 +184,38 @@ impl Decoder {
 
     /// M02/M30 of the main program: first the end subroutine (P-CHAN-00252), once; then the
     /// end itself.
-    pub(super) fn program_end(&mut self, m: u32, info: BlockInfo, io: &mut DecoderIo<'_>) -> Res {
-        let main = self.top().kind == FrameKind::Main;
+    pub(super) fn program_end(
+        &mut self,
+        m: u32,
+        info: BlockInfo,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let main = rd.top().kind() == FrameKind::Main;
         if main && !self.implicit.end_called {
             if let Some(name) = self.settings.implicit.at_end.clone() {
                 self.implicit.end_called = true;
-                let depth = self.frames.len();
-                self.call_global(&name, io)?;
+                let depth = rd.depth();
+                self.call_global(&name, rd, notes, io)?;
                 self.implicit.held.push(HeldEnd { m, info, depth });
                 return Ok(());
             }
         }
         self.emit(info, Action::End { m }, true, io);
-        self.end_program();
+        self.end_program(rd, notes);
         Ok(())
     }
 
     /// After a return: an end held back for the frame now on top is applied.
-    pub(super) fn resume_held_end(&mut self, io: &mut DecoderIo<'_>) -> Res {
+    pub(in crate::decoder) fn resume_held_end(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         let held = match self.implicit.held.last() {
-            Some(h) if h.depth == self.frames.len() => self.implicit.held.pop(),
+            Some(h) if h.depth == rd.depth() => self.implicit.held.pop(),
             _ => None,
         };
         let Some(h) = held else {
@@ -229,26 +223,26 @@ impl Decoder {
         };
         match h.m {
             17 | 29 => {
-                self.check_open_flow()?;
-                self.return_from_subroutine();
-                self.resume_held_end(io)
+                rd.top().flow().check_open_flow()?;
+                self.return_from_subroutine(rd, notes);
+                self.resume_held_end(rd, notes, io)
             }
             m => {
-                self.program_end_checks(m)?;
-                self.program_end(m, h.info, io)
+                self.program_end_checks(m, rd, notes)?;
+                self.program_end(m, h.info, rd, notes, io)
             }
         }
     }
 
-    pub(super) fn exec_command(
+    pub(in crate::decoder) fn exec_command(
         &mut self,
         c: &Command,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         match c {
             Command::Flush(kind) => {
                 if let Some((code, what)) = self.modal.flush_refusal() {
@@ -259,16 +253,16 @@ impl Decoder {
                 }
                 self.emit(info, Action::Flush(*kind), false, io);
                 if *kind == FlushKind::Wait && self.search.is_none() {
-                    self.wait_idle = true;
+                    rd.wait_for_idle();
                 }
             }
             Command::CacheLoad { .. } | Command::CacheClear { .. } | Command::CacheClearAll => {
-                self.exec_cache(c, io)?;
-                if !self.wait_line {
+                self.exec_cache(c, rd, notes, io)?;
+                if !rd.line_waits() {
                     self.emit(info, Action::None, false, io);
                 }
             }
-            Command::CommentBegin => self.top().comment_block = true,
+            Command::CommentBegin => rd.top().set_comment_block(true),
             // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
             Command::CommentEnd => {}
             Command::Spline(s) => {
@@ -284,24 +278,24 @@ impl Decoder {
                 self.emit(info, Action::None, false, io);
             }
             Command::ContourMode { options } => {
-                if let Some(dev) = super::modal::path_dev_mm(options) {
+                if let Some(dev) = crate::decoder::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.emit(info, Action::None, false, io)
             }
             // `ON [...]`: the parameters, then G261; `OFF`: G260.
             Command::ContourSwitch { on, options } => {
-                if let Some(dev) = super::modal::path_dev_mm(options) {
+                if let Some(dev) = crate::decoder::modal::path_dev_mm(options) {
                     self.modal.contour_dev_mm = dev;
                 }
                 self.modal.contouring = *on;
                 self.emit(info, Action::None, false, io)
             }
-            Command::Var => self.top().var_block = true,
+            Command::Var => rd.top().set_var_block(true),
             Command::EndVar => {}
             Command::Msg(m) => {
                 let text = self.format_message(m)?;
-                self.notes.push(Note::Message {
+                notes.push(Note::Message {
                     text,
                     save: m.save(),
                 });
@@ -333,10 +327,16 @@ impl Decoder {
     }
 
     /// `#CACHE LOAD`, `#CACHE CLEAR`, `#CACHE CLEAR ALL` (TF5200 File Caching).
-    fn exec_cache(&mut self, c: &Command, io: &mut DecoderIo<'_>) -> Res {
+    fn exec_cache(
+        &mut self,
+        c: &Command,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         match c {
             Command::CacheLoad { file } => {
-                let loaded = match self.cache_read.take() {
+                let loaded = match rd.take_cache_read() {
                     // The line again, after the loader read the file.
                     Some(CacheRead {
                         file: f,
@@ -346,31 +346,30 @@ impl Decoder {
                     _ => match io.cache.load(file, io.store)? {
                         LoadStep::Done(loaded) => loaded,
                         LoadStep::Reading(pending) => {
-                            self.cache_read = Some(CacheRead {
+                            rd.wait_for_cache_read(CacheRead {
                                 file: file.clone(),
                                 pending,
                                 read: None,
                             });
-                            self.wait_line = true;
                             return Ok(());
                         }
                     },
                 };
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: loaded.op(),
                     file: file.clone(),
                 });
             }
             Command::CacheClear { file } => {
                 io.cache.clear(file)?;
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::Clear,
                     file: file.clone(),
                 });
             }
             Command::CacheClearAll => {
                 io.cache.clear_all()?;
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::ClearAll,
                     file: String::new(),
                 });
@@ -380,38 +379,42 @@ impl Decoder {
         Ok(())
     }
 
-    pub(super) fn exec_call(
+    pub(in crate::decoder) fn exec_call(
         &mut self,
         c: &Call,
-        block: &Block,
-        text: &str,
-        meta: LineMeta,
+        at: BlockAt<'_>,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        if self.frames.len() > self.settings.max_depth {
+        if rd.depth() > self.settings.max_depth {
             return Err(DecodeError::new(
                 codes::NESTING_TOO_DEEP,
                 format!("subroutine nesting deeper than {}", self.settings.max_depth),
             ));
         }
-        let info = self.info(block, text, meta, io);
+        let info = self.info(rd, at, io);
         match c {
             Call::Global { file } => {
-                self.call_global(file, io)?;
+                self.call_global(file, rd, notes, io)?;
                 self.emit(info, Action::None, false, io);
             }
             Call::Cycle {
                 name,
                 local,
                 params,
-            } => self.call_cycle(name, *local, params, info, io)?,
+            } => {
+                if self.call_cycle(name, *local, params, rd, notes, io)? {
+                    self.emit(info, Action::None, false, io);
+                }
+            }
             Call::Local { name } => {
-                let Some(frame) = self.local_frame(name, "local subroutine call (LL)")? else {
+                let Some(frame) = self.local_frame(rd, name, "local subroutine call (LL)")? else {
                     return Ok(());
                 };
                 self.emit(info, Action::None, false, io);
                 self.vars.push_level(Vec::new());
-                self.frames.push(frame);
+                rd.push(frame);
             }
         }
         Ok(())
@@ -422,12 +425,14 @@ impl Decoder {
         &mut self,
         name: &str,
         kind: FrameKind,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res<Frame> {
         if let Some(p) = io.cache.get(name) {
             if io.want_text {
                 // Only with events on: the hot call path stays free of the allocation.
-                self.notes.push(Note::Cache {
+                notes.push(Note::Cache {
                     op: CacheOp::Hit,
                     file: name.to_string(),
                 });
@@ -446,14 +451,14 @@ impl Decoder {
                 Ok(Frame::new(kind, Source::Loading(p), prog))
             }
             Opened::Stream { name } => {
-                if self.stream_active {
+                if rd.stream_active() {
                     return Err(DecodeError::new(
                         codes::STREAM_ALREADY_ACTIVE,
                         "the streaming program is already running",
                     ));
                 }
-                self.begin_stream();
-                self.notes.push(Note::ProgramStart {
+                rd.begin_stream();
+                notes.push(Note::ProgramStart {
                     prog: name.clone(),
                     stream: true,
                 });

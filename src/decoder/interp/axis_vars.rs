@@ -5,9 +5,11 @@
 //! refuses the manual's other V.A. and V.G. variables by name (docs/nc-language.md,
 //! "Constructs of real programs").
 
-use super::*;
+use super::Interpreter;
+use crate::decoder::modal;
+use crate::vocab::axis::AXIS_LETTERS;
 
-impl Decoder {
+impl Interpreter {
     /// `V.A.ABS.<axis>`: the axis' end point of the previous block in program coordinates
     /// (zero offset and G92 taken off, in inch under G70); `None` for an axis the channel
     /// does not have.
@@ -25,12 +27,7 @@ impl Decoder {
     }
 }
 
-impl Decoder {
-    /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
-    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
-        self.tool_radii = radii;
-    }
-
+impl Interpreter {
     /// Radius of tool data set `d` (`None`: the active D), mm; D0 is radius 0; `None` for a
     /// D the tool list does not have.
     pub(super) fn tool_radius(&self, d: Option<u32>) -> Option<f64> {

@@ -5,19 +5,29 @@
 //! it, and using it as a number is 900008 (docs/nc-language.md, "Constructs of real
 //! programs").
 
-use super::*;
+use super::{expr, Interpreter};
+use crate::decoder::error::{DecodeError, Res};
+use crate::decoder::frame::{Frame, FrameKind, Source};
+use crate::decoder::io::DecoderIo;
+use crate::decoder::labels;
+use crate::decoder::note::Note;
+use crate::decoder::reader::Reader;
 use crate::lang::block::CycleArg;
+use crate::lang::codes;
 use crate::lang::eval::Val;
 
-impl Decoder {
+impl Interpreter {
+    /// The cycle's frame is pushed, its parameters evaluated into the new level. `Ok(false)`:
+    /// the call line waits (the label index for `LL CYCLE` is being built) and did nothing.
     pub(super) fn call_cycle(
         &mut self,
         name: &str,
         local: bool,
         params: &[(u32, CycleArg)],
-        info: BlockInfo,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
-    ) -> Res {
+    ) -> Res<bool> {
         let mut numbers = Vec::with_capacity(params.len());
         let mut texts = Vec::new();
         for (n, a) in params {
@@ -31,31 +41,35 @@ impl Decoder {
             }
         }
         let frame = if local {
-            match self.local_frame(name, "local cycle call (LL CYCLE)")? {
+            match self.local_frame(rd, name, "local cycle call (LL CYCLE)")? {
                 Some(f) => f,
-                None => return Ok(()),
+                None => return Ok(false),
             }
         } else {
-            self.open_subroutine(name, FrameKind::Cycle, io)?
+            self.open_subroutine(name, FrameKind::Cycle, rd, notes, io)?
         };
-        self.emit(info, Action::None, false, io);
         self.vars.push_cycle_level(numbers, texts);
-        self.frames.push(frame);
-        Ok(())
+        rd.push(frame);
+        Ok(true)
     }
 
     /// The frame of `%L name` in the running file, for `LL name` and `LL CYCLE` (`what`
     /// names the call in the streaming error): not in a streaming program, where it is 21479.
     /// `Ok(None)`: the label index (or a search for the section) is still being built; the
     /// call line waits and runs again.
-    pub(super) fn local_frame(&mut self, name: &str, what: &str) -> Res<Option<Frame>> {
-        let Some(index) = self.label_index() else {
+    pub(super) fn local_frame(
+        &mut self,
+        rd: &mut Reader,
+        name: &str,
+        what: &str,
+    ) -> Res<Option<Frame>> {
+        let Some(index) = rd.label_index() else {
             return Ok(None);
         };
         let found = match index.local_sub(name) {
             Some(at) => Some(at),
             None if index.overflowed => {
-                match self.searched(labels::ScanGoal::LocalSub(name.to_ascii_uppercase())) {
+                match rd.searched(labels::ScanGoal::LocalSub(name.to_ascii_uppercase())) {
                     Some(labels::ScanFound::LocalSub(at)) => at,
                     _ => return Ok(None),
                 }
@@ -68,15 +82,19 @@ impl Decoder {
                 format!("local subroutine {name} not found"),
             ));
         };
-        let top = self.top();
-        let Source::File(p) = &top.source else {
+        let top = rd.top();
+        let Some(p) = top.file() else {
             return Err(DecodeError::new(
                 codes::STREAM_LOCAL_CALL,
                 format!("{what} in streaming program"),
             ));
         };
-        let mut frame = Frame::new(FrameKind::Local, Source::File(p.clone()), top.prog.clone());
-        frame.label_index = Some(index);
+        let mut frame = Frame::new(
+            FrameKind::Local,
+            Source::File(p.clone()),
+            top.prog().clone(),
+        );
+        frame.set_label_index(index);
         frame.seek(at);
         Ok(Some(frame))
     }

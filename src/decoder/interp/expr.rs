@@ -3,8 +3,8 @@
 use crate::lang::block::{Expr, VarRef};
 use crate::lang::eval::{self, VarKey, Vars};
 
-use super::vars::{VarSlot, VarStore};
-use super::DecodeError;
+use crate::decoder::error::DecodeError;
+use crate::decoder::vars::{VarSlot, VarStore};
 use crate::lang::codes;
 
 /// Index bound of the store's keys: ISG arrays have at most three dimensions.
@@ -49,7 +49,7 @@ pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
 
 /// What an expression in a running program sees: the variable store and, for `V.A.ABS`,
 /// the decoder's position.
-pub(super) struct Env<'d>(pub &'d super::Decoder);
+pub(super) struct Env<'d>(pub &'d super::Interpreter);
 
 impl Vars for Env<'_> {
     fn get(&self, key: &VarKey<'_>) -> Option<f64> {
