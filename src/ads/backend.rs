@@ -8,8 +8,8 @@
 
 use super::result::AdsResult;
 pub use crate::machine::remote::{CncBackend, DeviceError, ErrorRecord};
+use crate::machine::StreamWriteError;
 pub use crate::machine::{HmiOp, Op, Reply, Status};
-use crate::source::stream::StreamWriteError;
 
 impl From<DeviceError> for AdsResult {
     fn from(e: DeviceError) -> Self {

@@ -11,14 +11,14 @@ use thiserror::Error;
 
 use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note};
-use crate::motion::{AxisLimits, Motion, MotionNote, PlannerSettings};
+use crate::motion::{Motion, MotionNote, PlannerSettings};
 use crate::queue::BlockQueue;
 use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::cache::{Cache, CacheLimits};
 use crate::source::loader::Loader;
 use crate::source::store::{FsLatency, ProgramStore, SearchDir};
-use crate::source::stream::{StreamBuffer, StreamWriteError};
+use crate::source::stream::StreamBuffer;
 use crate::vocab::axis::{Position, AXIS_LETTERS, MAX_AXES};
 
 pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
@@ -33,9 +33,13 @@ mod refusals;
 pub use crate::decoder::modal::Modal;
 pub use crate::decoder::vars::VarClass;
 pub use crate::decoder::DecoderStats;
+/// The words of the door and the settings that callers outside the channel name.
+pub use crate::decoder::SearchTarget;
 pub use crate::motion::trace::Trace;
+pub use crate::motion::AxisLimits;
 pub use crate::source::store::StoreStats;
 pub use crate::source::stream::StreamCounters;
+pub use crate::source::stream::StreamWriteError;
 pub use crate::vocab::mode::{Mode, State};
 pub use door::{CacheStats, ChannelReport, Status};
 pub(crate) use hmi::HmiCommands;

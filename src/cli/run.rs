@@ -7,8 +7,8 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use crate::channel::Finish;
-use crate::decoder::SearchTarget;
 use crate::feeder::Feeder;
+use crate::machine::SearchTarget;
 use crate::machine::{Machine, Op, Reply, StopWhen, TraceOp};
 use crate::report::event::EventLog;
 use crate::report::summary::{

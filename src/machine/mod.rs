@@ -14,6 +14,7 @@ use crossbeam_channel::Sender;
 
 pub use crate::channel::door::{CycleTimes, HmiOp, Op, Reply, Status, TraceOp};
 use crate::channel::{Channel, Finish, State};
+pub use crate::channel::{SearchTarget, StreamWriteError};
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
 use crate::runtime::{Cycle, Flow, Tick};

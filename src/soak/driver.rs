@@ -20,9 +20,9 @@ use super::feed::{FeedCounters, Owed, SoakFeeder};
 use super::invariants::{check_blocks, Checksum, Tally, Verdict};
 use super::rng::SplitMix64;
 use super::scenario::Faults;
+use crate::channel::AxisLimits;
 use crate::channel::{Channel, State};
 use crate::machine::{Machine, Op, Reply};
-use crate::motion::AxisLimits;
 use crate::runtime::{Clock, Cycle, Flow, Tick};
 
 /// The one way the soak commands a channel, and reads it.

@@ -12,8 +12,8 @@ use super::feed::Owed;
 use super::invariants::{resident_kib, Verdict};
 use super::rng::SplitMix64;
 use super::scenario::{Faults, Scenario};
+use crate::channel::AxisLimits;
 use crate::machine::{Machine, Op, Reply, Request};
-use crate::motion::AxisLimits;
 use crate::runtime::{Clock, Cycle, Flow, Tick};
 
 /// How long a channel stays READY after an injected reset before its streaming program
@@ -216,9 +216,7 @@ impl Cycle for Supervised {
         let reply = match req.op {
             Op::WriteStream(_) if watch.core.rejecting(tick.index) => {
                 watch.core.counters.writes_skipped += 1;
-                Reply::Stream(Err(crate::source::stream::StreamWriteError::Full {
-                    free: 0,
-                }))
+                Reply::Stream(Err(crate::machine::StreamWriteError::Full { free: 0 }))
             }
             Op::WriteStream(data) => {
                 let len = data.len() as u64;
