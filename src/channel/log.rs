@@ -251,6 +251,7 @@ impl ChannelLog {
 
     /// One note of the decoder as events; an error note is handed back for the channel to
     /// raise (it stops the channel).
+    #[inline]
     pub(super) fn decoder_note(&mut self, tick: &Tick, note: Note) -> Option<ErrorRecord> {
         match note {
             Note::ProgramStart { prog, stream } => self.emit(
@@ -330,6 +331,7 @@ impl ChannelLog {
     /// One note of the motion as events, in order: block events and the active block,
     /// flushes, programmed stops, a planning error, the program end. What the channel's
     /// state machine must do about it comes back.
+    #[inline]
     pub(super) fn motion_note(
         &mut self,
         tick: &Tick,

@@ -220,6 +220,7 @@ impl Reader {
     }
 
     /// The running frame, if any.
+    #[inline]
     pub(super) fn last(&self) -> Option<&Frame> {
         self.frames.last()
     }
@@ -253,6 +254,7 @@ impl Reader {
     // --- Reading lines ---
 
     /// The top frame's next line into `line`: a new stream segment pulled is noted.
+    #[inline]
     pub(super) fn read_line(
         &mut self,
         stream: &mut StreamBuffer,
@@ -284,15 +286,18 @@ impl Reader {
     }
 
     /// The line buffer, lent out while its line runs ([`Reader::put_line`] gives it back).
+    #[inline]
     pub(super) fn take_line(&mut self) -> String {
         std::mem::take(&mut self.line)
     }
 
+    #[inline]
     pub(super) fn put_line(&mut self, line: String) {
         self.line = line;
     }
 
     /// A block written over several lines is being collected.
+    #[inline]
     pub(super) fn joining(&self) -> bool {
         self.joiner.is_open()
     }
@@ -335,6 +340,7 @@ impl Reader {
     // --- Budgets and waits ---
 
     /// A tick begins: its budgets are full.
+    #[inline]
     pub(super) fn begin_tick(&mut self) {
         self.declared_this_tick = 0;
         self.scanned_this_tick = ScanWork::default();
@@ -342,6 +348,7 @@ impl Reader {
     }
 
     /// The tick's byte or `#VAR` budget is used up.
+    #[inline]
     pub(super) fn budget_spent(&self) -> bool {
         self.declared_this_tick >= DECLARED_VALUES_PER_TICK
             || self.line_bytes_this_tick >= LINE_BYTES_PER_TICK
@@ -353,6 +360,7 @@ impl Reader {
     }
 
     /// Lines and bytes label scans read in this tick, and bytes of NC text decoded.
+    #[inline]
     pub(super) fn tick_work(&self) -> (ScanWork, usize) {
         (self.scanned_this_tick, self.line_bytes_this_tick)
     }
@@ -364,6 +372,7 @@ impl Reader {
 
     /// Simulated file-system latency `owed` moves the time decoding may go on by its cost,
     /// counted from when the decoder was free; `true` while that time lies past `tick_end`.
+    #[inline]
     pub(super) fn busy(&mut self, owed: Duration, now: Duration, tick_end: Duration) -> bool {
         if !owed.is_zero() {
             self.ready_at = self.ready_at.max(now) + owed;
@@ -377,6 +386,7 @@ impl Reader {
     }
 
     /// Still waiting for motion to be empty (`idle`: queue and motion have nothing left).
+    #[inline]
     pub(super) fn waits_for_idle(&mut self, idle: bool) -> bool {
         if self.wait_idle && idle {
             self.wait_idle = false;
@@ -402,6 +412,7 @@ impl Reader {
 
     /// A `#CACHE LOAD` waiting for the loader: `Some(true)` when its text has just arrived,
     /// `Some(false)` while it has not, `None` when no load waits.
+    #[inline]
     pub(super) fn cache_read_arrived(&mut self, store: &mut ProgramStore) -> Option<bool> {
         let r = self.cache_read.as_mut().filter(|r| r.read.is_none())?;
         let read = store.finish_read(&r.pending);
@@ -411,6 +422,7 @@ impl Reader {
     }
 
     /// A top frame whose file the loader reads: has its text arrived?
+    #[inline]
     pub(super) fn frame_file_arrived(&mut self, store: &mut ProgramStore) -> FileArrival {
         let Some(top) = self.frames.last_mut() else {
             return FileArrival::Ready;
@@ -431,6 +443,7 @@ impl Reader {
     // --- Label scans ---
 
     /// A label scan is under way.
+    #[inline]
     pub(super) fn scanning(&self) -> bool {
         self.scan.is_some()
     }

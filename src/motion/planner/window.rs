@@ -129,6 +129,7 @@ impl Window {
     }
 
     /// The window holds `lookahead` motion blocks or its most entries.
+    #[inline]
     pub(super) fn full(&self) -> bool {
         self.moves >= self.lookahead || self.entries.len() >= self.max_entries
     }
@@ -145,6 +146,7 @@ impl Window {
 
     /// Whether an entry of `kind` entering now is released with everything before it:
     /// `nothing_held` says no block is held before it (in the window or waiting outside it).
+    #[inline]
     pub(super) fn releases(&self, kind: &EntryKind, nothing_held: bool) -> bool {
         match kind {
             EntryKind::Flush(_) | EntryKind::Stop { .. } | EntryKind::End { .. } => true,
@@ -156,6 +158,7 @@ impl Window {
     }
 
     /// Append one entry at the back; its index.
+    #[inline]
     pub(super) fn push_back(&mut self, entry: Entry) -> usize {
         self.entries.push_back(entry);
         self.entries.len() - 1
@@ -163,6 +166,7 @@ impl Window {
 
     /// Count a motion entry that entered (`counted`: towards the lookahead); it was the next
     /// motion block `#FLUSH CONTINUE` waited for, if any.
+    #[inline]
     pub(super) fn moved_in(&mut self, counted: bool) {
         if counted {
             self.moves += 1;
@@ -178,6 +182,7 @@ impl Window {
     }
 
     /// Release every block in the window.
+    #[inline]
     pub(super) fn release_all(&mut self) {
         if self.released != self.entries.len() {
             self.released = self.entries.len();
