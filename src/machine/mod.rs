@@ -61,13 +61,39 @@ impl Claim {
     }
 }
 
+/// The packet a built-in client keeps offering until the channel takes it, shared with each
+/// write attempt: a client offers the same packet again after a refusal, so a refused packet
+/// (a full buffer refuses most attempts) is not copied again.
+#[derive(Debug, Default)]
+pub(crate) struct Offer(Option<Arc<[u8]>>);
+
+impl Offer {
+    /// The stream write of `packet`, copied at its first attempt only.
+    pub(crate) fn write(&mut self, packet: &[u8]) -> Op {
+        Op::WriteStream(Arc::clone(self.0.get_or_insert_with(|| Arc::from(packet))))
+    }
+
+    /// The channel's answer to the write: true when it took the packet (the next offer is a
+    /// new packet).
+    pub(crate) fn answered(&mut self, reply: &Reply) -> bool {
+        let accepted = matches!(reply, Reply::Stream(Ok(())));
+        if accepted {
+            self.0 = None;
+        }
+        accepted
+    }
+
+    /// The client starts over (a reset): nothing is on offer.
+    pub(crate) fn withdraw(&mut self) {
+        self.0 = None;
+    }
+}
+
 /// A built-in client streaming a file into one channel.
 pub struct Attached {
     pub channel: u32,
     pub feeder: Feeder,
-    /// The packet on offer, shared with each write attempt until the channel takes it (the
-    /// feeder offers the same packet again after a refusal).
-    pending: Option<Arc<[u8]>>,
+    offer: Offer,
 }
 
 /// When `run` is over.
@@ -114,7 +140,7 @@ impl Machine {
         self.feeders.push(Attached {
             channel,
             feeder,
-            pending: None,
+            offer: Offer::default(),
         });
     }
 
@@ -198,13 +224,8 @@ impl Cycle for Machine {
             if let Some(packet) = a.feeder.poll(tick.index) {
                 // Through the door like any client's write; a write the channel cannot take
                 // (ERROR, no streaming program) is a refusal the feeder retries.
-                let data = a.pending.get_or_insert_with(|| Arc::from(packet));
-                let reply = c.apply(tick, Op::WriteStream(Arc::clone(data)));
-                let accepted = matches!(reply, Reply::Stream(Ok(())));
-                if accepted {
-                    a.pending = None;
-                }
-                a.feeder.result(accepted);
+                let reply = c.apply(tick, a.offer.write(packet));
+                a.feeder.result(a.offer.answered(&reply));
             }
         }
         for (i, c) in self.channels.iter_mut().enumerate() {

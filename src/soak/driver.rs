@@ -11,7 +11,6 @@
 
 use std::collections::{BTreeMap, VecDeque};
 use std::convert::Infallible;
-use std::sync::Arc;
 use std::time::Duration;
 
 use serde::Serialize;
@@ -22,7 +21,7 @@ use super::rng::SplitMix64;
 use super::scenario::Faults;
 use crate::channel::AxisLimits;
 use crate::channel::{Channel, State};
-use crate::machine::{Machine, Op, Reply};
+use crate::machine::{Machine, Offer, Op, Reply};
 use crate::runtime::{Clock, Cycle, Flow, Tick};
 
 /// The one way the soak commands a channel, and reads it.
@@ -437,10 +436,8 @@ pub struct Slot {
     pub feeder: SoakFeeder,
     pub core: SoakChannel,
     rng: SplitMix64,
-    /// The packet on offer, shared with each write attempt until the channel takes it: the
-    /// feeder offers the same packet again after a refusal, so a refused packet is not
-    /// copied again (a full buffer refuses most attempts).
-    pending: Option<Arc<[u8]>>,
+    /// The packet on offer until the channel takes it.
+    offer: Offer,
 }
 
 impl Slot {
@@ -463,7 +460,7 @@ impl Slot {
             feeder,
             core: SoakChannel::new(number, Some(program), axes),
             rng,
-            pending: None,
+            offer: Offer::default(),
         })
     }
 
@@ -556,22 +553,17 @@ impl Cycle for SoakCycle {
             let Some(mut door) = MachineDoor::new(&mut self.machine, slot.number) else {
                 continue;
             };
-            let (feeder, pending) = (&mut slot.feeder, &mut slot.pending);
+            let (feeder, offer) = (&mut slot.feeder, &mut slot.offer);
             slot.core
                 .faults(&mut slot.rng, &self.faults, tick, &mut door, &mut |t| {
-                    *pending = None;
+                    offer.withdraw();
                     feeder.new_epoch(t);
                 });
             if slot.core.rejecting(t) {
                 slot.feeder.skip(t);
             } else if let Some(packet) = slot.feeder.poll(t) {
-                let data = slot.pending.get_or_insert_with(|| Arc::from(packet));
-                let reply = door.apply(tick, Op::WriteStream(Arc::clone(data)));
-                let accepted = matches!(reply, Reply::Stream(Ok(())));
-                if accepted {
-                    slot.pending = None;
-                }
-                slot.feeder.result(t, accepted);
+                let reply = door.apply(tick, slot.offer.write(packet));
+                slot.feeder.result(t, slot.offer.answered(&reply));
             }
         }
         // The machine decides nothing here (it never stops by itself): the soak stops at
