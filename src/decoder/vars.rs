@@ -207,12 +207,6 @@ fn free_large<K: Send + 'static, V: Send + 'static>(loader: &Loader, table: BTre
     loader.release_table(table, items);
 }
 
-/// Let go of a scope as of a table.
-fn free_scope(loader: &Loader, scope: Scope) {
-    let items = scope.vars.len();
-    loader.release_table(scope, items);
-}
-
 impl Scope {
     fn get(&self, name: &str, indices: &Indices, dims: u8) -> Option<f64> {
         let var = self.vars.get(name)?;
@@ -264,14 +258,14 @@ impl Drop for VarStore {
     fn drop(&mut self) {
         let loader = &self.loader;
         for s in self.local.drain(..) {
-            free_scope(loader, s);
+            free_large(loader, s.vars);
         }
         for s in [
             std::mem::take(&mut self.program),
             std::mem::take(&mut self.self_retaining),
             std::mem::take(&mut self.external),
         ] {
-            free_scope(loader, s);
+            free_large(loader, s.vars);
         }
         free_large(loader, std::mem::take(&mut self.p_other));
     }
@@ -298,7 +292,7 @@ impl VarStore {
         free_large(&self.loader, std::mem::take(&mut self.p_other));
         self.program.clear(&self.loader);
         for s in self.local.drain(..) {
-            free_scope(&self.loader, s);
+            free_large(&self.loader, s.vars);
         }
         self.local.push(Scope::default());
         self.cycle.clear();
@@ -331,7 +325,7 @@ impl VarStore {
     pub(crate) fn pop_level(&mut self) {
         if self.local.len() > 1 {
             if let Some(s) = self.local.pop() {
-                free_scope(&self.loader, s);
+                free_large(&self.loader, s.vars);
             }
             self.cycle.pop();
             self.cycle_text.pop();
