@@ -59,12 +59,7 @@ fn machine(dir: &Path) -> (Machine, Duration) {
     let channels = ncchannel::channels(&config, false, &ncchannel::Loader::start()).unwrap();
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
-    let t0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-        clock: ncchannel::runtime::Clock::Virtual,
-    };
+    let t0 = Tick::first(period, ncchannel::runtime::Clock::Virtual);
     assert_eq!(
         m.apply(&t0, 1, Op::Start("main.nc".into())),
         Reply::Command(Ok(()))

@@ -44,12 +44,7 @@ impl Setup {
         if let Some(s) = stream {
             m.attach_feeder(1, Feeder::new(s.to_vec(), 992, 1, false).unwrap());
         }
-        let t0 = Tick {
-            index: 0,
-            period,
-            time: Duration::ZERO,
-            clock: ncchannel::runtime::Clock::Virtual,
-        };
+        let t0 = Tick::first(period, ncchannel::runtime::Clock::Virtual);
         assert_eq!(
             m.apply(&t0, 1, Op::Start(program.to_string())),
             Reply::Command(Ok(()))

@@ -215,12 +215,7 @@ fn a_disabled_log_takes_events_and_writes_nothing() {
     assert!(!log.enabled());
     let mut buf = log.buffer();
     assert!(!buf.enabled());
-    let tick = Tick {
-        index: 0,
-        period: Duration::from_millis(1),
-        time: Duration::ZERO,
-        clock: ncchannel::runtime::Clock::Virtual,
-    };
+    let tick = Tick::first(Duration::from_millis(1), ncchannel::runtime::Clock::Virtual);
     buf.push(&tick, 1, EventKind::Interrupt { held: 0 });
     assert!(buf.is_empty());
     buf.flush_to(&mut log);

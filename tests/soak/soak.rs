@@ -166,12 +166,7 @@ fn machine_ticks_four_channels_each_with_its_own_stream() {
     assert_eq!(channels.len(), 4);
     let mut m = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
     let period = Duration::from_millis(1);
-    let tick0 = Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-        clock: ncchannel::runtime::Clock::Virtual,
-    };
+    let tick0 = Tick::first(period, ncchannel::runtime::Clock::Virtual);
     for ch in 1..=4u32 {
         let mut text = String::from("N1 G90 G01 F30000\n");
         for k in 0..200 {

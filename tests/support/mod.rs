@@ -249,12 +249,7 @@ impl Shared2 {
 }
 
 pub fn tick0(period: Duration) -> Tick {
-    Tick {
-        index: 0,
-        period,
-        time: Duration::ZERO,
-        clock: ncchannel::runtime::Clock::Virtual,
-    }
+    Tick::first(period, ncchannel::runtime::Clock::Virtual)
 }
 
 pub fn feeder(text: &str, packet: usize, every: u64) -> Feeder {
