@@ -50,6 +50,12 @@ pub trait Cycle {
     fn take_clock_stopped(&mut self) -> Duration {
         Duration::ZERO
     }
+
+    /// The tick's work as the runtime measured it (the requests it served and `step`, without
+    /// the clock-stopped wait), handed over after every tick. A cycle that shows its own
+    /// cycle-time statistics (the machine's, read through the CNC's time objects) records it
+    /// here instead of reading the clock a second time; the default ignores it.
+    fn record_work(&mut self, _work: Duration) {}
 }
 
 /// Why [`Runtime::run`] returned.
@@ -256,6 +262,7 @@ impl<C: Cycle> Runtime<C> {
             self.stats.clock_stopped += stopped;
             let work = started.elapsed().saturating_sub(stopped);
             self.stats.work.record(work);
+            self.cycle.record_work(work);
             let overrun = late.is_some_and(|late| late + work > self.period);
             if let Some(late) = late {
                 self.stats.lateness.record(late);

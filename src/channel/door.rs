@@ -90,8 +90,9 @@ pub enum HmiOp {
     FeedHold(bool),
 }
 
-/// Work time of the machine's ticks (decode, plan, interpolate every channel), as the
-/// kernel's `cnc_time_*` runtime statistics show their tasks' times.
+/// Work time of the machine's ticks (serve the tick's requests, decode, plan, interpolate
+/// every channel), as the kernel's `cnc_time_*` runtime statistics show their tasks' times.
+/// The runtime measures it and hands it to the machine (the runtime's `Cycle::record_work`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct CycleTimes {
     pub min: Duration,

@@ -590,4 +590,8 @@ impl Cycle for SoakCycle {
     fn take_clock_stopped(&mut self) -> Duration {
         self.machine.take_clock_stopped()
     }
+
+    fn record_work(&mut self, work: Duration) {
+        self.machine.record_work(work);
+    }
 }

@@ -312,6 +312,10 @@ impl Cycle for Supervised {
     fn take_clock_stopped(&mut self) -> Duration {
         self.machine.take_clock_stopped()
     }
+
+    fn record_work(&mut self, work: Duration) {
+        self.machine.record_work(work);
+    }
 }
 
 /// Resident set now, KiB (for the memory invariant of `serve --soak`).

@@ -179,6 +179,7 @@ impl Planner {
     }
 
     /// Put one decoded block into the window (held unless a rule releases it).
+    #[inline]
     pub(crate) fn push(&mut self, b: QueuedBlock) {
         let QueuedBlock {
             info,
