@@ -14,6 +14,7 @@ use super::search_path::{PathCollector, PathField, SearchPath};
 use super::startup::{shape, warn_duplicates};
 use super::value::{string_value, uint_value};
 use crate::diag::Diagnostic;
+use crate::vocab::techno::TechnoTable;
 
 /// Longest `streaming_prog_file` (ISG FCT-C19 Data streaming: a string of up to 83 characters);
 /// the implicit subroutine names have the same limit (P-CHAN-00118/-00119/-00252: at most 83
@@ -60,6 +61,8 @@ pub(crate) struct ChannelList {
     /// `Some` when the list names any `path[j].*`: these replace the start-up list's paths.
     pub search_paths: Option<Vec<SearchPath>>,
     pub decoder: DecoderParams,
+    /// M/H/S/T synchronisation types, process times and pre-outputs (`params/techno.rs`).
+    pub techno: TechnoTable,
     /// Entries used, inert and unknown.
     pub summary: ListSummary,
 }
@@ -180,6 +183,7 @@ pub(crate) fn interpret_channel(
         axes,
         search_paths,
         decoder,
+        techno: TechnoTable::kernel_defaults(),
         summary,
     }
 }

@@ -25,6 +25,7 @@ use super::zero_offsets::{
     interpret_zero_offsets, is_zero_offset_list, read_zero_offsets, ZeroOffsetTable,
 };
 use crate::diag::{Diagnostic, Severity};
+use crate::vocab::techno::TechnoTable;
 
 /// The file name runtime settings are read from, in the start-up list's folder.
 pub const RUNTIME_FILE: &str = "runtime.toml";
@@ -81,6 +82,8 @@ pub struct ChannelConfig {
     pub zero_offset_list: Option<PathBuf>,
     /// G54 … G59 offsets by group and axis, mm.
     pub(crate) zero_offsets: ZeroOffsetTable,
+    /// M/H/S/T functions: synchronisation types, process times, pre-outputs.
+    pub techno: TechnoTable,
     /// The channel list's entries, unknown ones included.
     pub list: ParamList,
 }
@@ -452,6 +455,7 @@ fn combine(
         decoder: decoder.finish(diags),
         zero_offset_list: None,
         zero_offsets: Default::default(),
+        techno: chan.techno,
         list: chan.list,
     }
 }

@@ -8,4 +8,5 @@ pub mod event;
 pub mod flush;
 pub mod mode;
 pub mod stats;
+pub mod techno;
 pub(crate) mod tick;
