@@ -29,6 +29,7 @@ mod isg;
 mod log;
 mod program;
 mod refusals;
+pub mod techno;
 
 pub use crate::decoder::modal::Modal;
 pub use crate::decoder::vars::VarClass;

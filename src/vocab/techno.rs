@@ -295,6 +295,17 @@ pub struct TechnoFn {
     pub def: FunctionDef,
 }
 
+/// The functions a block hands to the PLC at one point of its execution, with the block's
+/// data the unit shows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputGroup {
+    pub fns: Vec<TechnoFn>,
+    /// The block's N number (0 = none).
+    pub block_nr: u32,
+    /// Its line in its program, 1-based.
+    pub line: u32,
+}
+
 /// Which acknowledgements a part that waits can see (the channel's technology units answer;
 /// the interpolator asks at a wait entry).
 pub trait Acknowledgements {
