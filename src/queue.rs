@@ -7,6 +7,8 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
+use crate::vocab::techno::{OutputGroup, TechnoSeq};
+
 use crate::vocab::axis::{Position, MAX_AXES};
 use crate::vocab::flush::FlushKind;
 
@@ -233,6 +235,17 @@ pub enum Action {
     End {
         m: u32,
     },
+    /// A technology function step around the block's motion (always a silent part).
+    Techno(TechnoStep),
+}
+
+/// Where a block's technology functions meet its motion (TF5200 "Synchronisation types").
+#[derive(Debug, Clone, PartialEq)]
+pub enum TechnoStep {
+    /// Hand these functions to the PLC when execution reaches this point.
+    Output(Box<OutputGroup>),
+    /// The axes stand until these functions are acknowledged.
+    Wait(Box<[TechnoSeq]>),
 }
 
 #[derive(Debug, Clone, PartialEq)]

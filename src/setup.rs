@@ -85,6 +85,7 @@ pub fn channel_settings(
         soft_limits_mm,
         implicit: ch.implicit.clone(),
         error_texts: config.error_texts.clone(),
+        techno: ch.techno.clone(),
         ..DecoderSettings::default()
     };
     let search_dirs = ch

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
+use super::techno::{TechnoRefusal, TechnoStatus, TechnoWrite};
 use super::{
     ActiveBlock, Channel, ChannelStats, CommandError, ErrorRecord, ExecutedBlock, HmiCommands,
     Mode, SearchCommand, State,
@@ -59,6 +60,9 @@ pub enum Op {
     /// The text of this file program while the decoder runs it ([`Reply::ProgramText`]): the
     /// live view's listing. A shared handle to the decoder's copy, so the tick copies nothing.
     ProgramText(Arc<str>),
+    /// A PLC's write into the technology interface (`plc_present_w`, a unit's `please_rw`
+    /// or `done_w`).
+    Techno(TechnoWrite),
 }
 
 /// What `run` asks of the motion trace.
@@ -171,6 +175,8 @@ pub struct Status {
     pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
     /// Path length left in the executing move, mm (the DRO's distance to go).
     pub distance_to_go_mm: f64,
+    /// The HLI technology interface: PLC present, the units and what they hold.
+    pub techno: TechnoStatus,
 }
 
 /// What a channel tells after a run (and what tests read between ticks): its counters and
@@ -277,6 +283,8 @@ pub enum Reply {
     Trace(Result<(), String>),
     /// The program text [`Op::ProgramText`] asked for; `None` when no frame runs it.
     ProgramText(Option<Arc<Vec<u8>>>),
+    /// A technology write taken, or refused without a change.
+    Techno(Result<(), TechnoRefusal>),
 }
 
 /// An error as the ADS objects carry it: number and text.
@@ -326,6 +334,7 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         programs_ended: stats.programs_ended,
         zero_offsets: c.zero_offsets,
         distance_to_go_mm: c.motion.distance_to_go_mm(),
+        techno: c.techno.status(),
     }
 }
 

@@ -4,6 +4,7 @@
 use super::hmi::Hmi;
 use super::program::ProgramRun;
 use super::refusals::RefusalStretch;
+use super::techno::{TechnoNote, UnitSet};
 use crate::decoder::Note;
 use crate::motion::MotionNote;
 use crate::queue::BlockInfo;
@@ -309,14 +310,6 @@ impl ChannelLog {
                 );
                 self.message = Some(text);
             }
-            Note::HFunction { h, value } => self.emit(tick, EventKind::HFunction { h, value }),
-            Note::MFunction { m, value } => self.emit(
-                tick,
-                EventKind::MFunction {
-                    m,
-                    value: Some(value),
-                },
-            ),
             Note::Cache { op, file } => self.emit(
                 tick,
                 EventKind::Cache {
@@ -350,6 +343,8 @@ impl ChannelLog {
                 // The flush the single-block gate added: no program event.
             }
             MotionNote::Flush(kind) => self.emit(tick, EventKind::Flush { kind }),
+            // The channel hands it to its technology units (channel/techno.rs).
+            MotionNote::TechnoOutput(_) => {}
             MotionNote::ProgramStop { optional } => {
                 let m = u32::from(optional);
                 self.emit(tick, EventKind::ProgramStop { m });
@@ -378,6 +373,34 @@ impl ChannelLog {
             }
         }
         AfterMotionNote::Go
+    }
+
+    /// What the technology units did: one event per function output and per function
+    /// acknowledged.
+    pub(super) fn techno_notes(&mut self, tick: &Tick, notes: impl Iterator<Item = TechnoNote>) {
+        for n in notes {
+            let kind = match n {
+                TechnoNote::Output {
+                    unit,
+                    set,
+                    function: f,
+                } => EventKind::TechnoOutput {
+                    kind: f.kind,
+                    number: f.number,
+                    value: (f.add_value != 0).then_some(f.add_value),
+                    sync: f.sync,
+                    unit,
+                    late: set == UnitSet::Late,
+                    line: f.line,
+                },
+                TechnoNote::Acknowledged { function: f, at } => EventKind::TechnoAcknowledged {
+                    kind: f.kind,
+                    number: f.number,
+                    waited_s: at.saturating_sub(f.output_at).as_secs_f64(),
+                },
+            };
+            self.emit(tick, kind);
+        }
     }
 
     /// A block took effect: counted, recorded for the soak when observed, one `block` event.

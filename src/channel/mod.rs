@@ -54,6 +54,7 @@ use hmi::Hmi;
 use isg::{Isg, StateCommand};
 use log::{AfterMotionNote, ChannelLog};
 use program::ProgramRun;
+use techno::TechnoUnits;
 
 /// Why a command was refused.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -111,6 +112,8 @@ pub struct Channel {
     /// own handles to the same loader thread).
     loader: Loader,
     motion: Motion,
+    /// The HLI technology units: M/H/S/T functions handed to the PLC and acknowledged.
+    techno: TechnoUnits,
     /// G54…G59 offsets (mm), for positions in the programming coordinate system.
     zero_offsets: ZeroOffsets,
     /// Reused buffer for the motion's notes of a tick.
@@ -210,6 +213,7 @@ impl Channel {
                 TraceOp::FinishCsv => self.motion.finish_csv_trace().map_err(|e| e.to_string()),
             }),
             Op::ProgramText(prog) => Reply::ProgramText(self.program_text(&prog)),
+            Op::Techno(w) => Reply::Techno(self.techno.write(w)),
         }
     }
 
@@ -238,6 +242,7 @@ impl Channel {
                 m.set_tool_radii(s.tools);
                 m
             },
+            techno: TechnoUnits::new(),
             zero_offsets,
             loader,
             notes: Vec::new(),
@@ -371,6 +376,7 @@ impl Channel {
         self.log.record_error(tick, error);
         // An error stops decoding and motion; only a reset leaves ERROR.
         self.motion.reset();
+        self.techno.reset();
         self.queue.clear();
         self.hmi.close_gate();
         self.run.failed();
@@ -570,6 +576,10 @@ impl Channel {
     /// program end (READY).
     fn apply_motion_notes(&mut self, tick: &Tick, notes: &mut Vec<MotionNote>) {
         for n in notes.drain(..) {
+            if let MotionNote::TechnoOutput(group) = n {
+                self.techno.output(*group, tick.time);
+                continue;
+            }
             match self.log.motion_note(tick, n, &mut self.run, &mut self.hmi) {
                 AfterMotionNote::Go => {}
                 AfterMotionNote::ProgramStop => {
@@ -600,6 +610,7 @@ impl Channel {
     /// The tick's named steps: decode, execute, hold after a single block, note an interrupt.
     fn run_tick(&mut self, tick: &Tick) {
         self.log.seen(tick);
+        self.techno_units(tick);
         if !self.isg.running() {
             return;
         }
@@ -610,6 +621,16 @@ impl Channel {
         self.execute(tick);
         self.hold_after_single_block(tick);
         self.note_interrupt(tick);
+    }
+
+    /// The technology units' share: acknowledgements that came in (or, without a PLC, process
+    /// times that passed) finish their functions; waiting ones are output.
+    fn techno_units(&mut self, tick: &Tick) {
+        if self.techno.idle() {
+            return;
+        }
+        self.techno.tick(tick.time);
+        self.log.techno_notes(tick, self.techno.drain_notes());
     }
 
     /// The decoder's share of the tick: stream or file lines into the block queue.
@@ -634,8 +655,11 @@ impl Channel {
         let dt = tick.period.as_secs_f64();
         let mut notes = std::mem::take(&mut self.notes);
         let blocks = self.hmi.blocks_for_motion(&mut self.queue, &self.motion);
-        self.motion.step(dt, blocks, &mut notes);
+        self.motion.step(dt, blocks, &mut notes, &self.techno);
         self.apply_motion_notes(tick, &mut notes);
+        if !self.techno.idle() {
+            self.log.techno_notes(tick, self.techno.drain_notes());
+        }
         self.notes = notes;
     }
 

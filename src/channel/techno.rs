@@ -119,6 +119,8 @@ pub struct TechnoStats {
     pub acknowledged: u64,
     /// Functions dropped by a reset while output or waiting to be.
     pub dropped_by_reset: u64,
+    /// Channel time from output to acknowledgement, summed over the acknowledged functions.
+    pub waited: Duration,
 }
 
 /// A snapshot of the interface for clients.
@@ -332,24 +334,27 @@ impl TechnoUnits {
 
     /// Step: units whose function is finished give it up.
     fn finish(&mut self, now: Duration) {
-        let finished = |u: &mut Unit, open: &mut Vec<TechnoSeq>, notes: &mut Vec<TechnoNote>| {
-            let Some(f) = &u.function else { return false };
-            if !open.contains(&f.seq) {
-                return false;
-            }
-            let fetched = !u.please;
-            let done = u.done || (!f.waited && fetched);
-            if !done {
-                return false;
-            }
-            u.please = false;
-            open.retain(|s| *s != f.seq);
-            notes.push(TechnoNote::Acknowledged {
-                function: f.clone(),
-                at: now,
-            });
-            true
-        };
+        let mut waited = Duration::ZERO;
+        let mut finished =
+            |u: &mut Unit, open: &mut Vec<TechnoSeq>, notes: &mut Vec<TechnoNote>| {
+                let Some(f) = &u.function else { return false };
+                if !open.contains(&f.seq) {
+                    return false;
+                }
+                let fetched = !u.please;
+                let done = u.done || (!f.waited && fetched);
+                if !done {
+                    return false;
+                }
+                u.please = false;
+                open.retain(|s| *s != f.seq);
+                waited += now.saturating_sub(f.output_at);
+                notes.push(TechnoNote::Acknowledged {
+                    function: f.clone(),
+                    at: now,
+                });
+                true
+            };
         let mut acked = 0u64;
         for u in &mut self.late {
             if finished(u, &mut self.open, &mut self.notes) {
@@ -362,6 +367,7 @@ impl TechnoUnits {
             }
         }
         self.stats.acknowledged += acked;
+        self.stats.waited += waited;
         let std_busy = self.std[..self.used_std].iter().any(|u| {
             u.function
                 .as_ref()

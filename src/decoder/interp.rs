@@ -11,6 +11,7 @@ mod cycles;
 mod expr;
 mod implicit;
 mod search;
+mod techno;
 mod words;
 
 use super::error::{var_error, Res};
@@ -29,6 +30,7 @@ use crate::source::loader::Loader;
 use crate::vocab::axis::{Position, MAX_AXES};
 use block_words::Words;
 use implicit::ImplicitState;
+use techno::TechnoState;
 
 /// Modal state, variables and the running program's calls.
 #[derive(Debug)]
@@ -54,6 +56,8 @@ pub(super) struct Interpreter {
     words: Option<Box<Words>>,
     /// The implicit subroutine calls' state in the running program.
     implicit: ImplicitState,
+    /// M/H/S/T functions: the channel's table, sequence numbers, late synchronisations.
+    techno: TechnoState,
 }
 
 impl Interpreter {
@@ -61,7 +65,9 @@ impl Interpreter {
         let renamed_slots = (0..MAX_AXES)
             .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
             .fold(0u8, |m, i| m | 1 << i);
+        let techno = TechnoState::new(settings.techno.clone(), settings.implicit.at_m6.is_some());
         Interpreter {
+            techno,
             settings,
             renamed_slots,
             vars: VarStore::new(loader),
@@ -97,6 +103,7 @@ impl Interpreter {
         self.counter = 0;
         self.search = None;
         self.implicit = ImplicitState::default();
+        self.techno.reset();
     }
 
     pub(super) fn settings(&self) -> &DecoderSettings {

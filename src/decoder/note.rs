@@ -41,15 +41,4 @@ pub(crate) enum Note {
         text: String,
         save: bool,
     },
-    /// An H function (0..=65535) decoded: handed to the PLC side, with its value when
-    /// programmed with one (`H20=5`).
-    HFunction {
-        h: u32,
-        value: Option<f64>,
-    },
-    /// An M function programmed with a value (`M200=1200`): handed to the PLC side.
-    MFunction {
-        m: u32,
-        value: f64,
-    },
 }

@@ -7,6 +7,7 @@ use super::modal::ZeroOffsets;
 use crate::geometry::SoftLimits;
 use crate::lang::block::AxisName;
 use crate::vocab::axis::{AXIS_LETTERS, MAX_AXES};
+use crate::vocab::techno::TechnoTable;
 
 /// What the decoder needs from the configuration.
 #[derive(Debug, Clone)]
@@ -33,6 +34,9 @@ pub struct DecoderSettings {
     /// The kernel's error texts by id (start-up list P-STUP-00168): an error with a text there
     /// is reported with it, ncchannel's detail after it in parentheses.
     pub(crate) error_texts: Option<Arc<crate::params::error_texts::ErrorTexts>>,
+    /// M/H/S/T functions: synchronisation types, process times (the channel list's
+    /// `m_synch[i]`, `h_synch[i]`, `spindel[0].*`, `tool.*`).
+    pub techno: TechnoTable,
 }
 
 /// Each slot named by its letter, `X` to `C`.
@@ -63,6 +67,7 @@ impl Default for DecoderSettings {
             soft_limits_mm: [SoftLimits::default(); MAX_AXES],
             implicit: Default::default(),
             error_texts: None,
+            techno: TechnoTable::kernel_defaults(),
         }
     }
 }

@@ -31,6 +31,8 @@ pub const ARC_RADIUS_RANGE: u32 = 20054;
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function (TF5200 diagnosis ID 20157).
 pub const UNKNOWN_M: u32 = 20157;
+/// Unknown H function (the kernel's id for an H function the channel list does not define).
+pub const UNKNOWN_H: u32 = 20162;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
 /// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",

@@ -21,6 +21,7 @@ use std::sync::Arc;
 use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind};
 use crate::vocab::axis::{Position, MAX_AXES};
 use crate::vocab::flush::FlushKind;
+use crate::vocab::techno::{Acknowledgements, OutputGroup};
 
 use filter::{jerk_window_s, AxisFilter};
 use interpolator::{advance, advance_swing, point_at, Profile, Swing};
@@ -68,6 +69,8 @@ pub enum MotionNote {
         m: u32,
         prog: Arc<str>,
     },
+    /// Execution reached the point where these technology functions go to the PLC.
+    TechnoOutput(Box<OutputGroup>),
 }
 
 /// What happens to the front entry after its share of a tick.
@@ -369,7 +372,15 @@ impl Motion {
     }
 
     /// Advance channel time by `dt_s`: take blocks into the window, plan, interpolate.
-    pub fn step(&mut self, dt_s: f64, queue: &mut BlockQueue, notes: &mut Vec<MotionNote>) {
+    /// One tick: take blocks from `queue`, plan, interpolate. A technology wait asks `acks`
+    /// whether its functions are acknowledged.
+    pub fn step(
+        &mut self,
+        dt_s: f64,
+        queue: &mut BlockQueue,
+        notes: &mut Vec<MotionNote>,
+        acks: &impl Acknowledgements,
+    ) {
         let dt_s = if dt_s.is_finite() { dt_s.max(0.0) } else { 0.0 };
         if dt_s > 0.0 {
             self.dt_s = dt_s;
@@ -391,7 +402,7 @@ impl Motion {
                 self.v_mm_per_s = 0.0;
             } else {
                 self.planner.plan_if_needed(self.override_pct, self.dt_s);
-                self.execute(dt_s, notes);
+                self.execute(dt_s, notes, acks);
             }
         } else {
             self.v_mm_per_s = 0.0;
@@ -427,7 +438,7 @@ impl Motion {
     }
 
     /// Run released entries for `dt_s` seconds.
-    fn execute(&mut self, dt_s: f64, notes: &mut Vec<MotionNote>) {
+    fn execute(&mut self, dt_s: f64, notes: &mut Vec<MotionNote>, acks: &impl Acknowledgements) {
         let cruise_pct = if self.hold { 0.0 } else { self.override_pct };
         let mut left = dt_s;
         // Each pass pops an entry or ends the tick, so the window length bounds the loop.
@@ -451,7 +462,7 @@ impl Motion {
             if !self.front_started && !self.start_front(left, notes) {
                 break;
             }
-            let Some(next) = self.run_front(cruise_pct, &mut left, notes) else {
+            let Some(next) = self.run_front(cruise_pct, &mut left, notes, acks) else {
                 break;
             };
             match next {
@@ -594,6 +605,7 @@ impl Motion {
         cruise_pct: f64,
         left: &mut f64,
         notes: &mut Vec<MotionNote>,
+        acks: &impl Acknowledgements,
     ) -> Option<Next> {
         let front = self.planner.front()?;
         Some(match &front.kind {
@@ -624,6 +636,21 @@ impl Motion {
                 }
             }
             EntryKind::Plain => Next::Pop,
+            EntryKind::TechnoOutput(g) => {
+                notes.push(MotionNote::TechnoOutput(g.clone()));
+                Next::Pop
+            }
+            EntryKind::TechnoWait(seqs) => {
+                self.v_mm_per_s = 0.0;
+                if seqs.iter().all(|s| acks.is_acknowledged(*s)) {
+                    Next::Pop
+                } else {
+                    // Channel time passes while the PLC works: the rest of the tick is
+                    // spent standing.
+                    *left = 0.0;
+                    Next::Stay
+                }
+            }
             EntryKind::Stop { optional } => {
                 if *optional && !self.optional_stop {
                     Next::Pop

@@ -28,6 +28,7 @@ use super::event_writer::LineSink;
 use crate::vocab::event::CacheOp;
 use crate::vocab::flush::FlushKind;
 use crate::vocab::mode::{Mode, State};
+use crate::vocab::techno::{SyncType, TechnoKind};
 use crate::vocab::tick::Tick;
 
 /// One event: when, where, what. Serialises as `{"tick":…,"t":…,"ch":…,"ev":"…",…fields}`.
@@ -129,20 +130,27 @@ pub enum EventKind {
         text: String,
         save: bool,
     },
-    /// An H function decoded (0..=65535), for the PLC side; `value` only when programmed
-    /// with one (`H20=5`).
-    HFunction {
-        h: u32,
+    /// A technology function (M, H, S, T) handed to the PLC: it entered technology unit
+    /// `unit` (`late`: a late-synchronisation unit) when execution reached its output point
+    /// (TF5200 "Synchronisation types"). `value`: `M200=1200`'s 1200, an S word's speed.
+    TechnoOutput {
+        kind: TechnoKind,
+        number: u32,
         #[serde(skip_serializing_if = "Option::is_none")]
-        value: Option<f64>,
+        value: Option<i32>,
+        sync: SyncType,
+        unit: usize,
+        #[serde(skip_serializing_if = "std::ops::Not::not")]
+        late: bool,
+        /// The block's line in its program.
+        line: u32,
     },
-    /// An M function programmed with a value (`M200=1200`, TF5200 "User-specific technology
-    /// functions"), for the PLC side. M functions without a value have no event of their own
-    /// (their block's `block` event shows them); `value` is optional so that they may.
-    MFunction {
-        m: u32,
-        #[serde(skip_serializing_if = "Option::is_none")]
-        value: Option<f64>,
+    /// The PLC acknowledged it (or, without a PLC, its process time passed): `waited_s`
+    /// since its output, channel time.
+    TechnoAcknowledged {
+        kind: TechnoKind,
+        number: u32,
+        waited_s: f64,
     },
     /// M00 (`m` 0) or M01 (`m` 1, M01 switch on) reached: the channel holds until the next
     /// start.

@@ -62,20 +62,51 @@ impl Interpreter {
         }
         let gs = self.modal_changes(w)?;
         let info = self.info(rd, at, io);
-        let mut queued = false;
-        if gs.dwell {
+        // Step 4: the block's action (a dwell or a move), not yet queued.
+        let action = if gs.dwell {
             let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
-            self.emit(info.clone(), Action::Dwell { seconds }, false, io);
-            queued = true;
+            Some(Action::Dwell { seconds })
         } else if gs.set_reference {
             self.set_reference(w);
+            None
         } else if let Some(end) = self.target(w, gs) {
             let mut mv = self.motion(w, end)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
-            self.modal.pos = end;
-            self.emit(info.clone(), Action::Move(mv), false, io);
+            Some(Action::Move(mv))
+        } else {
+            None
+        };
+        // Step 4½: its technology functions around it (decoder/interp/techno.rs).
+        let feed_move = matches!(&action, Some(Action::Move(mv)) if mv.kind != MoveKind::Rapid);
+        let mut techno = if self.techno.concerns(w, feed_move) {
+            Some(self.techno.plan(w, feed_move)?)
+        } else {
+            None
+        };
+        let (block_nr, line) = (info.n.unwrap_or(0), info.line);
+        let mut queued = false;
+        if let Some(t) = techno.as_mut() {
+            if action.is_none() {
+                // A block without motion takes effect, then hands its functions over.
+                self.emit(info.clone(), Action::None, false, io);
+                queued = true;
+            }
+            for a in t.actions_before(block_nr, line) {
+                self.emit(info.clone(), a, true, io);
+            }
+        }
+        if let Some(a) = action {
+            if let Action::Move(mv) = &a {
+                self.modal.pos = mv.end;
+            }
+            self.emit(info.clone(), a, false, io);
             queued = true;
+        }
+        if let Some(t) = techno.as_mut() {
+            for a in t.actions_after(block_nr, line) {
+                self.emit(info.clone(), a, true, io);
+            }
         }
         self.end_of_block(w, info, queued, rd, notes, io)
     }
@@ -463,14 +494,6 @@ impl Interpreter {
         notes: &mut Vec<Note>,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        for (&h, &value) in w.hs().iter().zip(&w.h_values) {
-            notes.push(Note::HFunction { h, value });
-        }
-        for (&m, &value) in w.ms().iter().zip(&w.m_values) {
-            if let Some(value) = value {
-                notes.push(Note::MFunction { m, value });
-            }
-        }
         let stop = w.ms().iter().copied().find(|m| matches!(m, 0 | 1));
         let queued = match stop {
             Some(m) => {

@@ -4,6 +4,7 @@
 use crate::queue::{BlockInfo, Move};
 use crate::vocab::axis::MAX_AXES;
 use crate::vocab::flush::FlushKind;
+use crate::vocab::techno::{OutputGroup, TechnoSeq};
 
 /// A motion block with what the plan needs of it.
 #[derive(Debug, Clone)]
@@ -74,6 +75,10 @@ pub(crate) enum EntryKind {
         optional: bool,
     },
     Flush(FlushKind),
+    /// Hand technology functions to the PLC (no stop of its own).
+    TechnoOutput(Box<OutputGroup>),
+    /// Stand until these technology functions are acknowledged.
+    TechnoWait(Box<[TechnoSeq]>),
     End {
         m: u32,
         prog: std::sync::Arc<str>,
@@ -86,6 +91,7 @@ impl EntryKind {
         matches!(
             self,
             EntryKind::Dwell { .. }
+                | EntryKind::TechnoWait(_)
                 | EntryKind::Stop { .. }
                 | EntryKind::End { .. }
                 | EntryKind::Flush(FlushKind::Stop | FlushKind::Wait)

@@ -28,7 +28,9 @@ mod spline_feed;
 mod velocity;
 mod window;
 
-use crate::queue::{Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind};
+use crate::queue::{
+    Action, BlockInfo, CompSide, Move, MoveKind, QueuedBlock, SplineKind, TechnoStep,
+};
 use crate::vocab::flush::FlushKind;
 
 use super::spline;
@@ -233,6 +235,8 @@ impl Planner {
                 },
             },
             Action::Flush(k) => EntryKind::Flush(k),
+            Action::Techno(TechnoStep::Output(g)) => EntryKind::TechnoOutput(g),
+            Action::Techno(TechnoStep::Wait(w)) => EntryKind::TechnoWait(w),
             Action::Stop { optional } => EntryKind::Stop { optional },
             Action::End { m } => EntryKind::End {
                 m,

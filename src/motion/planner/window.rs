@@ -153,7 +153,10 @@ impl Window {
             EntryKind::Move(_) => self.release_next_move,
             // Nothing held before it: it takes no part in cross-block planning, so it runs
             // when interpolation reaches it, not when more motion arrives.
-            EntryKind::Plain | EntryKind::Dwell { .. } => nothing_held,
+            EntryKind::Plain
+            | EntryKind::Dwell { .. }
+            | EntryKind::TechnoOutput(_)
+            | EntryKind::TechnoWait(_) => nothing_held,
         }
     }
 

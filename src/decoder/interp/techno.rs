@@ -1,0 +1,201 @@
+//! A block's technology functions (M, H, S, T) against the channel's table: which are
+//! defined (else the kernel's 20157 / 20162), which go to the PLC, and where they meet the
+//! block's motion (TF5200 "M and H functions", "Synchronisation types" and their examples).
+
+use super::block_words::Words;
+use crate::decoder::error::{DecodeError, Res};
+use crate::lang::codes;
+use crate::queue::{Action, TechnoStep};
+use crate::vocab::techno::{
+    FunctionDef, OutputGroup, SyncType, TechnoFn, TechnoKind, TechnoSeq, TechnoTable,
+};
+
+/// The decoder's technology state: the table (which `V.G.M_FCT[n].SYNCH` may change), the
+/// next sequence number and the late-synchronised functions not yet synchronised.
+#[derive(Debug)]
+pub(in crate::decoder) struct TechnoState {
+    table: TechnoTable,
+    /// M6 calls the tool-change subroutine (P-CHAN-00118) instead of going to the PLC.
+    m6_calls_subroutine: bool,
+    next_seq: TechnoSeq,
+    /// MVS_SLM functions output and waiting for the next feed motion block.
+    late_at_feed: Vec<TechnoSeq>,
+    /// MVS_SLP functions output and waiting for `#EXPL SYN`.
+    late_explicit: Vec<TechnoSeq>,
+}
+
+/// What a block adds around its motion, in execution order: outputs and waits before it,
+/// outputs and waits after it.
+#[derive(Debug, Default)]
+pub(in crate::decoder) struct BlockTechno {
+    before: Vec<TechnoFn>,
+    wait_before: Vec<TechnoSeq>,
+    after: Vec<TechnoFn>,
+    wait_after: Vec<TechnoSeq>,
+}
+
+impl BlockTechno {
+    /// The queue actions before the block's motion.
+    pub(in crate::decoder) fn actions_before(
+        &mut self,
+        block_nr: u32,
+        line: u32,
+    ) -> impl Iterator<Item = Action> {
+        steps(
+            std::mem::take(&mut self.before),
+            std::mem::take(&mut self.wait_before),
+            block_nr,
+            line,
+        )
+    }
+
+    /// The queue actions after the block's motion.
+    pub(in crate::decoder) fn actions_after(
+        &mut self,
+        block_nr: u32,
+        line: u32,
+    ) -> impl Iterator<Item = Action> {
+        steps(
+            std::mem::take(&mut self.after),
+            std::mem::take(&mut self.wait_after),
+            block_nr,
+            line,
+        )
+    }
+}
+
+fn steps(
+    fns: Vec<TechnoFn>,
+    waits: Vec<TechnoSeq>,
+    block_nr: u32,
+    line: u32,
+) -> impl Iterator<Item = Action> {
+    let output = (!fns.is_empty()).then(|| {
+        Action::Techno(TechnoStep::Output(Box::new(OutputGroup {
+            fns,
+            block_nr,
+            line,
+        })))
+    });
+    let wait =
+        (!waits.is_empty()).then(|| Action::Techno(TechnoStep::Wait(waits.into_boxed_slice())));
+    output.into_iter().chain(wait)
+}
+
+impl TechnoState {
+    pub(in crate::decoder) fn new(table: TechnoTable, m6_calls_subroutine: bool) -> Self {
+        TechnoState {
+            table,
+            m6_calls_subroutine,
+            next_seq: 0,
+            late_at_feed: Vec::new(),
+            late_explicit: Vec::new(),
+        }
+    }
+
+    /// Channel reset: late functions waiting are dropped with everything else.
+    pub(in crate::decoder) fn reset(&mut self) {
+        self.late_at_feed.clear();
+        self.late_explicit.clear();
+    }
+
+    #[allow(dead_code)] // V.G.M_FCT[n].SYNCH writes it (next commit)
+    pub(in crate::decoder) fn table_mut(&mut self) -> &mut TechnoTable {
+        &mut self.table
+    }
+
+    #[allow(dead_code)]
+    pub(in crate::decoder) fn table(&self) -> &TechnoTable {
+        &self.table
+    }
+
+    /// Does the block program anything this step looks at? (Most blocks do not: one test.)
+    #[inline]
+    pub(in crate::decoder) fn concerns(&self, w: &Words, feed_move: bool) -> bool {
+        !w.ms().is_empty()
+            || !w.hs().is_empty()
+            || w.spindle_rpm.is_some()
+            || w.tool.is_some()
+            || (feed_move && !self.late_at_feed.is_empty())
+    }
+
+    /// STEP 1–3 for one block: check every function against the table, give the output ones
+    /// their sequence numbers, and place them and their waits around the motion.
+    /// `feed_move`: the block moves at feed (G01/G02/G03), which synchronises MVS_SLM.
+    pub(in crate::decoder) fn plan(&mut self, w: &Words, feed_move: bool) -> Res<BlockTechno> {
+        let mut out = BlockTechno::default();
+        // STEP 1: the late functions a feed move synchronises wait before its motion.
+        if feed_move {
+            out.wait_before.append(&mut self.late_at_feed);
+        }
+        // STEP 2: each function with its definition, in the order M, H, S, T.
+        for (&m, &value) in w.ms().iter().zip(&w.m_values) {
+            if m == 6 && self.m6_calls_subroutine {
+                continue;
+            }
+            let def = self.table.m_def(m).ok_or_else(|| {
+                DecodeError::new(
+                    codes::UNKNOWN_M,
+                    format!("M{m} is not defined in the channel parameters (m_synch[{m}])"),
+                )
+            })?;
+            self.place(&mut out, TechnoKind::M, m, value, def);
+        }
+        for (&h, &value) in w.hs().iter().zip(&w.h_values) {
+            let def = self.table.h_def(h).ok_or_else(|| {
+                DecodeError::new(
+                    codes::UNKNOWN_H,
+                    format!("H{h} is not defined in the channel parameters (h_synch[{h}])"),
+                )
+            })?;
+            self.place(&mut out, TechnoKind::H, h, value, def);
+        }
+        if let Some(rpm) = w.spindle_rpm {
+            let number = rpm.abs().round().min(f64::from(u32::MAX)) as u32;
+            self.place(&mut out, TechnoKind::S, number, Some(rpm), self.table.s);
+        }
+        if let Some(t) = w.tool {
+            self.place(&mut out, TechnoKind::T, t, None, self.table.t);
+        }
+        Ok(out)
+    }
+
+    /// STEP 3: one function's place: output before or after the motion, waited for before,
+    /// after, or late.
+    fn place(
+        &mut self,
+        out: &mut BlockTechno,
+        kind: TechnoKind,
+        number: u32,
+        value: Option<f64>,
+        def: FunctionDef,
+    ) {
+        if !def.sync.outputs() {
+            return;
+        }
+        let seq = self.next_seq;
+        self.next_seq += 1;
+        let f = TechnoFn {
+            seq,
+            kind,
+            number,
+            value,
+            def,
+        };
+        let timing = def.sync.timing();
+        if timing.outputs_before_motion() {
+            out.before.push(f);
+        } else {
+            out.after.push(f);
+        }
+        if timing.waits_before_motion() {
+            out.wait_before.push(seq);
+        } else if timing.waits_after_motion() {
+            out.wait_after.push(seq);
+        } else if timing == SyncType::MvsSlm {
+            self.late_at_feed.push(seq);
+        } else if timing == SyncType::MvsSlp {
+            self.late_explicit.push(seq);
+        }
+    }
+}
