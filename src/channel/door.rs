@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::techno::{TechnoRefusal, TechnoStatus, TechnoWrite};
+use super::techno::{TechnoRefusal, TechnoStats, TechnoStatus, TechnoWrite};
 use super::{
     ActiveBlock, Channel, ChannelStats, CommandError, ErrorRecord, ExecutedBlock, HmiCommands,
     Mode, SearchCommand, State,
@@ -186,6 +186,8 @@ pub struct Status {
 pub struct ChannelReport {
     /// 1-based channel number.
     pub number: u32,
+    /// Technology functions output, acknowledged, waited for.
+    pub techno: TechnoStats,
     pub mode: Mode,
     pub state: State,
     pub stats: ChannelStats,
@@ -341,6 +343,7 @@ pub(crate) fn status_of(c: &Channel) -> Status {
 pub(crate) fn report_of(c: &Channel) -> ChannelReport {
     ChannelReport {
         number: c.log.number(),
+        techno: c.techno.stats(),
         mode: c.isg.mode(),
         state: c.isg.state(),
         stats: c.log.stats(),

@@ -12,7 +12,7 @@ use crate::machine::SearchTarget;
 use crate::machine::{Machine, Op, Reply, StopWhen, TraceOp};
 use crate::report::event::EventLog;
 use crate::report::summary::{
-    CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport,
+    CycleReport, ErrorReport, FilesReport, TechnoReport, Outcome, Report, StreamReport,
 };
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
 use crate::source::loader::Loader;
@@ -534,6 +534,12 @@ fn build_report(
             bytes_read: c.store.bytes_read,
             cache_hits: c.cache.hits,
             latency_s: c.store.latency.as_secs_f64(),
+        },
+        techno: TechnoReport {
+            output: c.techno.output,
+            acknowledged: c.techno.acknowledged,
+            waited_s: c.techno.waited.as_secs_f64(),
+            dropped_by_reset: c.techno.dropped_by_reset,
         },
     }
 }

@@ -43,6 +43,19 @@ impl From<&StreamCounters> for StreamReport {
     }
 }
 
+/// Technology functions (M, H, S, T) handed to the PLC through the HLI units.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TechnoReport {
+    /// Functions output to the PLC.
+    pub output: u64,
+    /// Functions acknowledged (by the PLC, or without one after their process time).
+    pub acknowledged: u64,
+    /// Channel time from output to acknowledgement, summed, seconds.
+    pub waited_s: f64,
+    /// Functions a reset dropped while output or waiting to be.
+    pub dropped_by_reset: u64,
+}
+
 /// Program file accesses: what the file cache (`#CACHE`) saves.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct FilesReport {
@@ -121,6 +134,10 @@ pub struct Report {
     /// File-system opens, bytes read and cache hits (absent in reports of versions without the file cache).
     #[serde(default)]
     pub files: FilesReport,
+    /// Technology functions output and acknowledged (absent in reports of versions without
+    /// the technology units).
+    #[serde(default)]
+    pub techno: TechnoReport,
 }
 
 impl Report {
@@ -179,6 +196,13 @@ impl Report {
             "files:      {} opens, {} bytes read, {} cache hits, {:.6} s simulated latency",
             self.files.opens, self.files.bytes_read, self.files.cache_hits, self.files.latency_s
         )?;
+        if self.techno.output > 0 {
+            writeln!(
+                w,
+                "techno:     {} functions output, {} acknowledged, {:.3} s waiting for the PLC",
+                self.techno.output, self.techno.acknowledged, self.techno.waited_s
+            )?;
+        }
         writeln!(
             w,
             "cycle:      {:.0} µs period, work p50 {:.1} µs p99 {:.1} µs max {:.1} µs, late p99 {:.1} µs, {} overruns",

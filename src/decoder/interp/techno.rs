@@ -99,7 +99,7 @@ impl TechnoState {
         self.late_explicit.clear();
     }
 
-    #[allow(dead_code)] // V.G.M_FCT[n].SYNCH writes it (next commit)
+    #[allow(dead_code)]
     pub(in crate::decoder) fn table_mut(&mut self) -> &mut TechnoTable {
         &mut self.table
     }
