@@ -29,7 +29,7 @@ impl Setup {
         .unwrap();
         std::fs::write(
             dir.path().join("p/ch.lis"),
-            "streaming_prog_file streaming.nc\n",
+            "streaming_prog_file streaming.nc\nm_synch[8] NO_SYNCH\n",
         )
         .unwrap();
         Setup { dir }

@@ -14,6 +14,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
 use ncchannel::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, QueuedBlock, SplineKind,
@@ -178,7 +179,8 @@ impl Bench {
         if self.queue.has_room() {
             self.push();
         }
-        self.motion.step(DT, &mut self.queue, &mut self.notes);
+        self.motion
+            .step(DT, &mut self.queue, &mut self.notes, &NoUnits);
         self.notes.clear();
     }
 }

@@ -8,3 +8,4 @@ mod motion;
 mod motion_channel;
 mod motion_jerk;
 mod motion_pace;
+mod techno;

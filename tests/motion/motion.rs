@@ -6,6 +6,7 @@ use crate::support::queued::block;
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
 use ncchannel::vocab::flush::FlushKind;
 use ncchannel::JUNCTION_ACCEL_SHARE;
@@ -79,7 +80,7 @@ fn run(
     let mut all = Vec::new();
     let mut positions = Vec::new();
     for k in 1..=max {
-        m.step(DT, q, &mut notes);
+        m.step(DT, q, &mut notes, &NoUnits);
         positions.push(m.position());
         let ended = notes.iter().any(|n| matches!(n, MotionNote::End { .. }));
         all.extend(notes.drain(..).map(|n| (k, n)));
@@ -249,7 +250,7 @@ fn blocks_are_held_until_the_window_is_full_then_run_without_stopping() {
         push(&mut q, n);
     }
     for _ in 0..50 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     // Three of four: held, nothing runs, and motion says it waits for data.
     assert!(notes.is_empty());
@@ -259,7 +260,7 @@ fn blocks_are_held_until_the_window_is_full_then_run_without_stopping() {
     assert!(!m.idle());
     // The fourth fills the window: all four run.
     push(&mut q, 4);
-    m.step(DT, &mut q, &mut notes);
+    m.step(DT, &mut q, &mut notes, &NoUnits);
     assert_eq!(m.held_blocks(), 0);
     assert!(m.position()[0] > 0.0);
     // Feed one block per tick while they run: the window stays full, the motion never stops.
@@ -270,7 +271,7 @@ fn blocks_are_held_until_the_window_is_full_then_run_without_stopping() {
             push(&mut q, n);
             n += 1;
         }
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         if m.position()[0] > 1.0 && m.position()[0] < 150.0 {
             min_v_after_start = min_v_after_start.min(m.velocity_mm_per_s());
         }
@@ -301,7 +302,7 @@ fn flush_continue_releases_and_the_next_block_in_time_continues_without_stop() {
                 q.push(block(3, line(p(10.0, 0.0, 0.0), p(20.0, 0.0, 0.0), 1000.0)));
                 q.push(block(4, Action::End { m: 30 }));
             }
-            m.step(DT, &mut q, &mut notes);
+            m.step(DT, &mut q, &mut notes, &NoUnits);
             let x = m.position()[0];
             if x > 1.0 && x < 19.0 && m.velocity_mm_per_s() == 0.0 {
                 stopped_between = true;
@@ -325,7 +326,7 @@ fn plain_flush_stops_at_the_last_block_even_with_the_next_in_time() {
     // The stop falls inside a tick; the tick-end velocities around it are at most a·dt.
     let mut v_min_near_10 = f64::INFINITY;
     for _ in 0..3000 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         let x = m.position()[0];
         if (9.9..=10.1).contains(&x) {
             v_min_near_10 = v_min_near_10.min(m.velocity_mm_per_s());
@@ -349,7 +350,7 @@ fn dwell_stops_and_waits_and_m_functions_do_not_stop() {
     let mut v_at_10 = None;
     let mut ticks_at_20 = 0;
     for _ in 0..5000 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         let x = m.position()[0];
         if (x - 10.0).abs() < 0.06 && v_at_10.is_none() {
             v_at_10 = Some(m.velocity_mm_per_s());
@@ -383,14 +384,14 @@ fn hold_brakes_on_the_path_and_resume_reaches_the_end() {
     let mut notes = Vec::new();
     let mut check = LimitCheck::new(&axes(30000.0, a_axis), DT, DEFAULT_EPS);
     for _ in 0..300 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         check.record(m.position());
     }
     assert!(m.velocity_mm_per_s() > 99.0);
     m.set_hold(true);
     let mut ticks = 0;
     while m.velocity_mm_per_s() > 0.0 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         check.record(m.position());
         ticks += 1;
         assert!(ticks < 1000);
@@ -401,13 +402,13 @@ fn hold_brakes_on_the_path_and_resume_reaches_the_end() {
     let held_at = m.position();
     assert!((held_at[1] - held_at[0] / 2.0).abs() < 1e-9, "on the path");
     for _ in 0..100 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert_eq!(m.position(), held_at);
     assert!(!m.waiting_for_data(), "a hold is not a lack of data");
     m.set_hold(false);
     for _ in 0..5000 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         check.record(m.position());
     }
     assert_eq!(m.position(), end);
@@ -422,26 +423,26 @@ fn override_scales_the_feed_and_zero_stops_on_the_path() {
     q.push(block(2, Action::End { m: 30 }));
     let mut notes = Vec::new();
     for _ in 0..500 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert!((m.velocity_mm_per_s() - 100.0).abs() < 1e-9);
     m.set_override(50.0);
     for _ in 0..500 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert!((m.velocity_mm_per_s() - 50.0).abs() < 1e-9);
     m.set_override(200.0);
     for _ in 0..500 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert!((m.velocity_mm_per_s() - 200.0).abs() < 1e-9);
     m.set_override(0.0);
     for _ in 0..500 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert_eq!(m.velocity_mm_per_s(), 0.0);
     let x = m.position()[0];
-    m.step(DT, &mut q, &mut notes);
+    m.step(DT, &mut q, &mut notes, &NoUnits);
     assert_eq!(m.position()[0], x);
     assert!(!m.waiting_for_data(), "override 0 is not a lack of data");
 }
@@ -455,7 +456,7 @@ fn override_above_100_never_exceeds_the_axis_limit() {
     m.set_override(200.0);
     let mut notes = Vec::new();
     for _ in 0..1000 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     assert!((m.velocity_mm_per_s() - 100.0).abs() < 1e-9);
 }
@@ -468,13 +469,13 @@ fn reset_stops_at_once_and_forgets_the_window() {
     q.push(block(2, Action::End { m: 30 }));
     let mut notes = Vec::new();
     for _ in 0..100 {
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
     }
     let x = m.position()[0];
     m.reset();
     assert_eq!(m.velocity_mm_per_s(), 0.0);
     assert!(m.idle());
-    m.step(DT, &mut q, &mut notes);
+    m.step(DT, &mut q, &mut notes, &NoUnits);
     assert_eq!(m.position()[0], x);
 }
 
@@ -566,7 +567,7 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
             50_000 => m.set_override(100.0),
             _ => {}
         }
-        m.step(DT, &mut q, &mut notes);
+        m.step(DT, &mut q, &mut notes, &NoUnits);
         check.record(m.position());
         ended = notes.iter().any(|n| matches!(n, MotionNote::End { .. }));
         notes.clear();

@@ -7,6 +7,7 @@ use crate::support::queued::{block, r50_circle};
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, FILTERED_EPS};
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
 use ncchannel::{Action, BlockQueue, CompSide, Move, MoveKind, PathMode, SplineKind};
 use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
@@ -62,7 +63,7 @@ fn run_to_end(
         c.record(m.position());
     }
     for k in 1..=max_ticks {
-        m.step(DT, q, &mut notes);
+        m.step(DT, q, &mut notes, &NoUnits);
         positions.push(m.position());
         if let Some(c) = check.as_deref_mut() {
             c.record(m.position());
@@ -227,7 +228,7 @@ fn a_lone_move_keeps_its_limits_through_holds_and_override_changes() {
                     _ if k == hold_at + 300 => m.set_override(100.0),
                     _ => {}
                 }
-                m.step(DT, &mut q, &mut notes);
+                m.step(DT, &mut q, &mut notes, &NoUnits);
                 check.record(m.position());
                 if notes.iter().any(|n| matches!(n, MotionNote::End { .. })) {
                     ended = true;

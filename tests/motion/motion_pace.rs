@@ -7,6 +7,7 @@ use std::path::Path;
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
 use crate::support::queued::{block, r50_circle};
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
 use ncchannel::DEFAULT_PATH_DEV_MM;
 use ncchannel::{Action, BlockQueue, Move, MoveKind, PathMode};
@@ -53,7 +54,7 @@ fn run(q: &mut BlockQueue, start: Position) -> Run {
     let (mut positions, mut velocities) = (Vec::new(), Vec::new());
     let mut notes = Vec::new();
     for k in 1..=200_000 {
-        m.step(DT, q, &mut notes);
+        m.step(DT, q, &mut notes, &NoUnits);
         positions.push(m.position());
         velocities.push(m.velocity_mm_per_s());
         check.record(m.position());

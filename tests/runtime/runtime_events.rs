@@ -263,6 +263,7 @@ fn sample_report() -> Report {
             cache_hits: 5,
             latency_s: 0.0006,
         },
+        techno: Default::default(),
     }
 }
 

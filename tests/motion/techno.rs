@@ -1,0 +1,181 @@
+//! Technology functions against the TF5200 examples of the synchronisation types ("Examples of
+//! the synchronisation methods in connection with motions"): the block times prove when the
+//! motion started relative to the output and the acknowledgement. No PLC is present, so the
+//! channel acknowledges each unit after the function's process time (`m_prozess_zeit`).
+
+use serde_json::Value;
+
+use super::support::{Rig, RunResult};
+
+/// The manual's program: M25 in N40, a rapid move between two others.
+const EXAMPLE: &str = "N20 G00 X25\nN30 X50\nN40 X75 M25\nN50 G01 X100 F2000\nN60 X125 Z100\nM30\n";
+
+/// Process time of M25 in these tests, s.
+const PROCESS_S: f64 = 0.5;
+
+fn rig_with(m_synch: &str) -> Rig {
+    let rig = Rig::new();
+    let list = format!(
+        "streaming_prog_file streaming.nc\nm_synch[25] {m_synch}\nm_prozess_zeit[25] {}\n",
+        (PROCESS_S * 1e6) as u64
+    );
+    std::fs::write(rig.startup().with_file_name("channel1.lis"), list).unwrap();
+    rig
+}
+
+fn run(m_synch: &str) -> RunResult {
+    let rig = rig_with(m_synch);
+    rig.program("example.nc", EXAMPLE);
+    let r = rig.run("example.nc", None, 200_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    r
+}
+
+/// Channel time of the `block` event of the block numbered `n`.
+fn block_t(r: &RunResult, n: u64) -> f64 {
+    r.of("block")
+        .into_iter()
+        .find(|e| e["n"] == n)
+        .and_then(|e| e["t"].as_f64())
+        .unwrap_or_else(|| panic!("no block N{n}: {}", r.log))
+}
+
+fn only<'a>(r: &'a RunResult, ev: &str) -> &'a Value {
+    let v = r.of(ev);
+    assert_eq!(v.len(), 1, "one {ev}: {}", r.log);
+    v[0]
+}
+
+fn t(e: &Value) -> f64 {
+    e["t"].as_f64().unwrap()
+}
+
+/// Channel time the program took.
+fn end_t(r: &RunResult) -> f64 {
+    t(only(r, "program_end"))
+}
+
+#[test]
+fn mvs_svs_the_motion_of_its_block_starts_only_after_the_acknowledgement() {
+    let r = run("MVS_SVS");
+    let out = only(&r, "techno_output");
+    assert_eq!(out["kind"], "m");
+    assert_eq!(out["number"], 25);
+    assert_eq!(out["sync"], "MVS_SVS");
+    assert_eq!(out["unit"], 0);
+    let ack = only(&r, "techno_acknowledged");
+    let waited = ack["waited_s"].as_f64().unwrap();
+    assert!((waited - PROCESS_S).abs() < 0.002, "{waited}");
+    // Output when N40 is reached (N30 done, the axes at rest), motion of N40 after the
+    // acknowledgement.
+    assert!(t(out) >= block_t(&r, 30));
+    assert!(block_t(&r, 40) >= t(ack) - 1e-9, "{}", r.log);
+    assert!(block_t(&r, 40) - t(out) >= PROCESS_S - 1e-9);
+}
+
+#[test]
+fn mvs_sns_outputs_before_the_motion_and_waits_at_the_block_end() {
+    let r = run("MVS_SNS");
+    let out = only(&r, "techno_output");
+    let ack = only(&r, "techno_acknowledged");
+    // The motion of N40 does not wait: it starts when the function goes out.
+    assert!((block_t(&r, 40) - t(out)).abs() < 0.002, "{}", r.log);
+    // N50 waits for the acknowledgement (the rapid N40 takes less than the process time).
+    assert!(block_t(&r, 50) >= t(ack) - 1e-9, "{}", r.log);
+    assert!(block_t(&r, 50) - block_t(&r, 40) >= PROCESS_S - 1e-9);
+}
+
+#[test]
+fn mns_sns_outputs_after_the_motion_and_waits_then() {
+    let r = run("MNS_SNS");
+    let out = only(&r, "techno_output");
+    let ack = only(&r, "techno_acknowledged");
+    // Output only once N40's 25 mm are done: later than N40's start by its motion time.
+    let n40_motion = t(out) - block_t(&r, 40);
+    assert!(n40_motion > 0.01, "{}", r.log);
+    assert!(block_t(&r, 50) >= t(ack) - 1e-9);
+    assert!((block_t(&r, 50) - t(out) - PROCESS_S).abs() < 0.005, "{}", r.log);
+}
+
+#[test]
+fn mos_is_output_and_the_motion_goes_on_without_waiting() {
+    let with = run("MOS");
+    let out = only(&with, "techno_output");
+    assert!((block_t(&with, 40) - t(out)).abs() < 0.002);
+    // The program runs exactly as without the function: no wait anywhere.
+    let rig = rig_with("NO_SYNCH");
+    rig.program("example.nc", EXAMPLE);
+    let without = rig.run("example.nc", None, 200_000);
+    assert_eq!(without.of("techno_output").len(), 0, "NO_SYNCH: not output");
+    assert!((end_t(&with) - end_t(&without)).abs() < 1e-9);
+}
+
+#[test]
+fn a_wait_costs_channel_time_the_program_takes_longer_by_the_wait() {
+    let svs = run("MVS_SVS");
+    let rig = rig_with("NO_SYNCH");
+    rig.program("example.nc", EXAMPLE);
+    let none = rig.run("example.nc", None, 200_000);
+    let extra = end_t(&svs) - end_t(&none);
+    // At least the process time; N30 now ends at rest and N40 starts from rest.
+    assert!(extra >= PROCESS_S, "{extra}");
+    assert!(extra < PROCESS_S + 0.5, "{extra}");
+}
+
+#[test]
+fn an_m_function_the_channel_list_does_not_define_is_20157_and_an_h_20162() {
+    let rig = rig_with("MVS_SVS");
+    rig.program("m.nc", "N10 G01 X1 F1000\nN20 M26\nM30\n");
+    let r = rig.run("m.nc", None, 10_000);
+    assert_eq!(r.error_codes(), vec![20157], "{}", r.log);
+    rig.program("h.nc", "N10 H7=2\nM30\n");
+    let r = rig.run("h.nc", None, 10_000);
+    assert_eq!(r.error_codes(), vec![20162], "{}", r.log);
+}
+
+#[test]
+fn the_kernels_internal_m_functions_need_no_entry_and_are_not_output() {
+    let rig = rig_with("MVS_SVS");
+    rig.program("i.nc", "N10 M3 S1000\nN20 G01 X1 F1000\nN30 M5\nM30\n");
+    let r = rig.run("i.nc", None, 10_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    assert_eq!(r.of("techno_output").len(), 0, "{}", r.log);
+}
+
+#[test]
+fn a_value_goes_with_its_function_and_several_functions_share_the_units_of_their_block() {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "streaming_prog_file streaming.nc\nm_synch[200] MVS_SVS\nm_synch[8] MVS_SVS\nh_synch[7] MOS\n\
+         m_prozess_zeit[200] 100000\nm_prozess_zeit[8] 200000\n",
+    )
+    .unwrap();
+    rig.program("v.nc", "N10 M200=1200 M8 H7=2\nN20 G01 X1 F1000\nM30\n");
+    let r = rig.run("v.nc", None, 10_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    let outs = r.of("techno_output");
+    let got: Vec<(String, u64, Option<i64>, u64)> = outs
+        .iter()
+        .map(|e| {
+            (
+                e["kind"].as_str().unwrap().to_string(),
+                e["number"].as_u64().unwrap(),
+                e["value"].as_i64(),
+                e["unit"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            ("m".into(), 200, Some(1200), 0),
+            ("m".into(), 8, None, 1),
+            ("h".into(), 7, Some(2), 2)
+        ]
+    );
+    // One group: all output in the same tick; N20 moves after the slower of the two waits.
+    assert!(outs.iter().all(|e| t(e) == t(outs[0])));
+    assert!(block_t(&r, 20) - t(outs[0]) >= 0.2 - 1e-9, "{}", r.log);
+    assert_eq!(r.of("techno_acknowledged").len(), 3);
+}
