@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use crate::diag::{Diagnostic, Severity};
+use crate::vocab::techno::TechnoTable;
 
 #[derive(Debug, clap::Args)]
 pub struct CheckArgs {
@@ -18,6 +19,15 @@ pub struct CheckArgs {
     /// `.toml`) or directories holding them.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// Check the M and H functions the NC programs use against a channel's parameters: a
+    /// start-up list (its channel --channel) or a channel list. Each M/H number the channel
+    /// does not define (`m_synch[i]` P-CHAN-00041, `h_synch[i]` P-CHAN-00027, the spindle's
+    /// M3/M4/M5/M19, the kernel's internal M functions) is an error, 20157 (M) / 20162 (H).
+    #[arg(long, value_name = "LIST")]
+    pub params: Option<PathBuf>,
+    /// Channel (1-based) of the --params start-up list whose functions the programs use.
+    #[arg(long, default_value_t = 1, requires = "params")]
+    pub channel: u32,
 }
 
 /// Extensions picked up when walking a directory. Files named explicitly are checked
@@ -34,11 +44,28 @@ pub fn execute(args: CheckArgs) -> ExitCode {
     for path in &args.files {
         collect(path, true, &mut files, &mut diags);
     }
+    // Without the channel's table the programs are checked as before; a list that does not
+    // load is reported and the M/H check left out.
+    let techno = args
+        .params
+        .as_deref()
+        .and_then(|p| match channel_techno(p, args.channel) {
+            Ok(t) => Some(t),
+            Err(found) => {
+                diags.extend(found);
+                None
+            }
+        });
     // Each list's counts once, also when a start-up list and a folder walk both reach it.
     let mut summaries: Vec<crate::params::catalog::ListSummary> = Vec::new();
     for file in &files {
         let (found, lists) = check_file_summarized(file);
         diags.extend(found);
+        if let Some(t) = &techno {
+            if !PARAM_EXTENSIONS.contains(&extension(file).as_str()) {
+                diags.extend(check_functions_file(file, t));
+            }
+        }
         for l in lists {
             if !summaries.iter().any(|s| s.file == l.file) {
                 summaries.push(l);
@@ -259,4 +286,199 @@ pub(crate) fn check_params_file(path: &Path) -> Vec<Diagnostic> {
             .unwrap_or_default();
     }
     crate::params::check_list_file(path)
+}
+
+/// The technology table of `--params`: a start-up list's channel `channel` (1-based), or a
+/// channel list read alone. Its errors, when it is refused.
+fn channel_techno(path: &Path, channel: u32) -> Result<TechnoTable, Vec<Diagnostic>> {
+    use crate::params::list::read_list;
+    let (list, mut diags) = read_list(path).map_err(|d| vec![d])?;
+    if crate::params::startup::is_startup_list(&list) {
+        let config = crate::params::load(path).map_err(|e| e.errors())?;
+        let index = usize::try_from(channel.saturating_sub(1)).unwrap_or(usize::MAX);
+        return match config.channels.get(index) {
+            Some(c) if channel > 0 => Ok(c.techno.clone()),
+            _ => Err(vec![Diagnostic::error(
+                path,
+                0,
+                0,
+                None,
+                format!(
+                    "--channel {channel}: the start-up list has {} channel(s)",
+                    config.channels.len()
+                ),
+            )]),
+        };
+    }
+    let folder = crate::params::search_path::list_folder(path);
+    let channel = crate::params::channel::interpret_channel(list, &folder, &mut diags);
+    diags.retain(|d| d.severity == Severity::Error);
+    if diags.is_empty() {
+        Ok(channel.techno)
+    } else {
+        Err(diags)
+    }
+}
+
+/// The M and H functions of an NC program that `techno` does not define: one error per
+/// number, at its first use (the kernel's 20157 / 20162 when the block is decoded).
+fn check_functions_file(path: &Path, techno: &TechnoTable) -> Vec<Diagnostic> {
+    // An unreadable file was reported by the program check already.
+    let Ok(text) = read_text(path) else {
+        return Vec::new();
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let mut diags = Vec::new();
+    for f in undefined_functions(&text, techno) {
+        let (code, what) = match f.letter {
+            b'M' => (crate::lang::codes::UNKNOWN_M, "m_synch"),
+            _ => (crate::lang::codes::UNKNOWN_H, "h_synch"),
+        };
+        let letter = char::from(f.letter);
+        let again = match f.uses {
+            1 => String::new(),
+            n => format!(" (used {n} times, first here)"),
+        };
+        let diag = Diagnostic::error(
+            path,
+            f.line,
+            f.col,
+            Some(code),
+            format!(
+                "{letter}{n} is not defined in the channel's parameters ({what}[{n}] missing){again}",
+                n = f.number
+            ),
+        );
+        diags.push(match lines.get(f.line.wrapping_sub(1)) {
+            Some(src) => diag.with_source(src),
+            None => diag,
+        });
+    }
+    diags
+}
+
+/// An M or H number a program uses that its channel does not define.
+struct UndefinedFunction {
+    letter: u8,
+    number: u32,
+    line: usize,
+    col: usize,
+    uses: usize,
+}
+
+/// Walk the program's blocks as the checker does (`\` continuations joined, `#COMMENT` and
+/// `#VAR` sections skipped) and gather the M and H words `techno` does not define, by first use.
+fn undefined_functions(text: &str, techno: &TechnoTable) -> Vec<UndefinedFunction> {
+    use crate::lang::{continuation, is_comment_end, parse_var_line, Joiner, VarLine};
+    let mut found: Vec<UndefinedFunction> = Vec::new();
+    let mut note = |letter: u8, number: u32, line: usize, col: usize| {
+        let defined = match letter {
+            b'M' => techno.m_def(number).is_some(),
+            _ => techno.h_def(number).is_some(),
+        };
+        if defined {
+            return;
+        }
+        match found
+            .iter_mut()
+            .find(|f| f.letter == letter && f.number == number)
+        {
+            Some(f) => f.uses += 1,
+            None => found.push(UndefinedFunction {
+                letter,
+                number,
+                line,
+                col,
+                uses: 1,
+            }),
+        }
+    };
+    let mut state = Sections::default();
+    let mut joiner = Joiner::default();
+    let mut first = 0;
+    for (idx, raw) in text.lines().enumerate() {
+        let line = idx + 1;
+        if state.in_comment {
+            if is_comment_end(raw) {
+                state.in_comment = false;
+            }
+            continue;
+        }
+        if state.in_var {
+            match parse_var_line(raw) {
+                Ok(VarLine::End) => state.in_var = false,
+                Ok(VarLine::CommentBegin) => state.in_comment = true,
+                _ => {}
+            }
+            continue;
+        }
+        if joiner.is_open() || continuation(raw).is_some() {
+            // A block written over several lines: read once it is complete.
+            if !joiner.is_open() {
+                first = line;
+            }
+            if joiner.push(raw) {
+                block_functions(joiner.text(), first, Some(&joiner), &mut state, &mut note);
+            }
+            continue;
+        }
+        block_functions(raw, line, None, &mut state, &mut note);
+    }
+    if joiner.is_open() {
+        block_functions(joiner.text(), first, Some(&joiner), &mut state, &mut note);
+    }
+    found
+}
+
+/// Whether the lines that follow are inside `#COMMENT BEGIN … END` or `#VAR … #ENDVAR`.
+#[derive(Default)]
+struct Sections {
+    in_comment: bool,
+    in_var: bool,
+}
+
+/// The M and H words of one block (`line` is its first line), handed to `note` with their
+/// line and column; a `#COMMENT BEGIN` or `#VAR` block opens its section.
+fn block_functions(
+    text: &str,
+    line: usize,
+    joined: Option<&crate::lang::Joiner>,
+    state: &mut Sections,
+    note: &mut impl FnMut(u8, u32, usize, usize),
+) {
+    use crate::lang::{parse_block, Body, Command, Item, Value, Word};
+    // A block that does not parse is the program check's finding.
+    let Ok(block) = parse_block(text) else {
+        return;
+    };
+    let items = match block.body {
+        Body::Command(Command::CommentBegin) => {
+            state.in_comment = true;
+            return;
+        }
+        Body::Command(Command::Var) => {
+            state.in_var = true;
+            return;
+        }
+        Body::Items(items) => items,
+        _ => return,
+    };
+    for item in items {
+        let (letter, number, col) = match item {
+            Item::Word(Word {
+                letter: l @ (b'M' | b'H'),
+                value: Value::Num(v),
+                col,
+            }) if v >= 0.0 && v.fract() == 0.0 && v <= f64::from(u32::MAX) => (l, v as u32, col),
+            Item::FunctionValue {
+                letter: l @ (b'M' | b'H'),
+                number,
+                col,
+                ..
+            } => (l, number, col),
+            _ => continue,
+        };
+        let (d, c) = joined.map_or((0, col), |j| j.position(col));
+        note(letter, number, line + d as usize, c as usize);
+    }
 }

@@ -31,7 +31,8 @@ pub const ARC_RADIUS_RANGE: u32 = 20054;
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function (TF5200 diagnosis ID 20157).
 pub const UNKNOWN_M: u32 = 20157;
-/// Unknown H function (the kernel's id for an H function the channel list does not define).
+/// H function the channel parameters do not define (kernel id 20162; its TF5200 page was not
+/// read, see [`KERNEL_UNREAD`]).
 pub const UNKNOWN_H: u32 = 20162;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
@@ -267,6 +268,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (ARC_RADIUS_RANGE, "centre from R outside the data format"),
     (UNKNOWN_G, "unknown G function"),
     (UNKNOWN_M, "unknown M function"),
+    (UNKNOWN_H, "unknown H function"),
     (F_TWICE, "F twice in a block"),
     (S_TWICE, "S twice in a block"),
     (SYNTAX, "syntax"),
@@ -503,6 +505,9 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
 /// [`KERNEL_TITLES`] (or, if it means something else, to our range).
 pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     (20157, "unknown M function"),
+    // The kernel's id for an H function the channel does not define, as reported for the
+    // TwinCAT CNC; its TF5200 diagnosis page was not read.
+    (20162, "unknown H function"),
     (20200, "NC command or axis name expected"),
     (20209, "unknown # command or $ statement"),
     (20240, "unexpected $ENDDO"),
@@ -746,8 +751,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840, 21469, 21560,
-                21561, 21562, 21563, 21564, 21897
+                20157, 20162, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840, 21469,
+                21560, 21561, 21562, 21563, 21564, 21897
             ]
         );
     }

@@ -1,8 +1,10 @@
 //! A channel list: the streaming program name (P-CHAN-00158), the implicitly called
 //! subroutines (at program start P-CHAN-00119, at program end P-CHAN-00252, at M6
 //! P-CHAN-00118, for G800–G819 P-CHAN-00187), the channel's axes (`gruppe[0].achse[j].*`, P-CHAN-00006 / -00035), the
-//! channel's own program search paths (`path[j].*`, replacing the start-up list's) and
-//! decoder overrides.
+//! channel's own program search paths (`path[j].*`, replacing the start-up list's),
+//! decoder overrides, and the technology functions' synchronisation types, process times and
+//! pre-outputs (`m_synch[i]` P-CHAN-00041, `h_synch[i]` P-CHAN-00027, `spindel[0].*_synch`,
+//! `tool.synch` P-CHAN-00086 …; read by `techno.rs`, TF5200 "M and H functions").
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,6 +14,7 @@ use super::decoder::{DecoderField, DecoderParams};
 use super::list::{Entry, ParamList};
 use super::search_path::{PathCollector, PathField, SearchPath};
 use super::startup::{shape, warn_duplicates};
+use super::techno::TechnoCollector;
 use super::value::{string_value, uint_value};
 use crate::diag::Diagnostic;
 use crate::vocab::techno::TechnoTable;
@@ -93,6 +96,7 @@ pub(crate) fn interpret_channel(
     let mut decoder = DecoderParams::default();
     let mut paths = PathCollector::default();
     let mut tally = Tally::new(ListKind::Channel);
+    let mut techno = TechnoCollector::default();
     let (mut start_mode, mut final_mode) = (CallMode::Automatic, CallMode::Automatic);
 
     for e in &list.entries {
@@ -159,9 +163,11 @@ pub(crate) fn interpret_channel(
                 };
                 decoder.set(&list, e, field, diags);
             }
+            _ if techno.add(&list, e, diags) => {}
             _ => tally.not_read(&list, e, diags),
         }
     }
+    let techno = techno.finish(&list, diags);
 
     let search_paths = if paths.is_empty() {
         None
@@ -183,7 +189,7 @@ pub(crate) fn interpret_channel(
         axes,
         search_paths,
         decoder,
-        techno: TechnoTable::kernel_defaults(),
+        techno,
         summary,
     }
 }

@@ -15,6 +15,7 @@ pub(crate) mod runtime;
 pub(crate) mod search_path;
 pub mod shipped;
 pub(crate) mod startup;
+pub(crate) mod techno;
 pub(crate) mod tools;
 pub(crate) mod value;
 pub(crate) mod zero_offsets;

@@ -7,3 +7,4 @@ mod support;
 mod check_params;
 mod installation;
 mod params;
+mod techno;
