@@ -14,8 +14,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::{
     Action, BlockInfo, BlockQueue, CompSide, Move, MoveKind, PathMode, QueuedBlock, SplineKind,
 };

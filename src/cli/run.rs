@@ -12,7 +12,7 @@ use crate::machine::SearchTarget;
 use crate::machine::{Machine, Op, Reply, StopWhen, TraceOp};
 use crate::report::event::EventLog;
 use crate::report::summary::{
-    CycleReport, ErrorReport, FilesReport, TechnoReport, Outcome, Report, StreamReport,
+    CycleReport, ErrorReport, FilesReport, Outcome, Report, StreamReport, TechnoReport,
 };
 use crate::runtime::{Clock, RunEnd, Runtime, Tick};
 use crate::source::loader::Loader;

@@ -407,6 +407,9 @@ fn parse_symbols(text: &str) -> Result<SyncSpec, SyncError> {
             .iter()
             .find(|(_, n, _)| word.eq_ignore_ascii_case(n))
         {
+            if !t.is_modelled() {
+                return Err(err(unmodelled(t.name())));
+            }
             match sync {
                 Some(first) if first != *t => {
                     return Err(err(format!(
@@ -437,14 +440,20 @@ fn parse_symbols(text: &str) -> Result<SyncSpec, SyncError> {
 /// `0x00020002`: a type's value, `PLC_INFO` (0x20000) added or not.
 fn parse_number(v: u32) -> Result<SyncSpec, SyncError> {
     let rest = v & !PLC_INFO;
-    if let Some(sync) = SyncType::from_value(rest) {
+    if let Some(sync) = SyncType::from_value(rest).filter(|t| t.is_modelled()) {
         return Ok(SyncSpec {
             sync,
             plc_info: v & PLC_INFO != 0,
         });
     }
-    let message = match UNMODELLED_SYNC.iter().find(|(_, x)| *x == Some(rest)) {
-        Some((n, _)) => unmodelled(n),
+    let unmodelled_type = SyncType::from_value(rest).map(SyncType::name);
+    let message = match UNMODELLED_SYNC
+        .iter()
+        .find(|(_, x)| *x == Some(rest))
+        .map(|(n, _)| *n)
+        .or(unmodelled_type)
+    {
+        Some(n) => unmodelled(n),
         None => format!(
             "0x{v:08X} is not a synchronisation type ncchannel models ({})",
             SyncType::ALL

@@ -6,9 +6,9 @@ use crate::support::queued::block;
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
-use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
 use ncchannel::vocab::flush::FlushKind;
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::JUNCTION_ACCEL_SHARE;
 use ncchannel::{Action, BlockQueue, Move, MoveKind, PathMode, Plane};
 use ncchannel::{ArcError, ArcSpec};

@@ -7,8 +7,8 @@ use crate::support::queued::{block, r50_circle};
 use crate::support::random_path::{self, Rng};
 
 use crate::support::limit_check::{LimitCheck, FILTERED_EPS};
-use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::{Action, BlockQueue, CompSide, Move, MoveKind, PathMode, SplineKind};
 use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};
 

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use crate::support::limit_check::{LimitCheck, DEFAULT_EPS};
 use crate::support::queued::{block, r50_circle};
-use ncchannel::vocab::techno::NoUnits;
 use ncchannel::vocab::axis::Position;
+use ncchannel::vocab::techno::NoUnits;
 use ncchannel::DEFAULT_PATH_DEV_MM;
 use ncchannel::{Action, BlockQueue, Move, MoveKind, PathMode};
 use ncchannel::{AxisLimits, Motion, MotionNote, PlannerSettings};

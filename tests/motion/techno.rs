@@ -94,7 +94,11 @@ fn mns_sns_outputs_after_the_motion_and_waits_then() {
     let n40_motion = t(out) - block_t(&r, 40);
     assert!(n40_motion > 0.01, "{}", r.log);
     assert!(block_t(&r, 50) >= t(ack) - 1e-9);
-    assert!((block_t(&r, 50) - t(out) - PROCESS_S).abs() < 0.005, "{}", r.log);
+    assert!(
+        (block_t(&r, 50) - t(out) - PROCESS_S).abs() < 0.005,
+        "{}",
+        r.log
+    );
 }
 
 #[test]

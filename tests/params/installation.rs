@@ -340,7 +340,8 @@ fn implicit_subroutines_run_in_a_stream_started_under_the_channel_lists_name() {
 
 #[test]
 fn without_implicit_subroutines_m6_is_an_ordinary_m_function_and_streams_work_as_before() {
-    let i = Installation::new("");
+    // Without m6_prog_file, M6 is an M function the channel list defines like any other.
+    let i = Installation::new("m_synch[6] MOS\n");
     i.write("prg/tool.nc", "N4 G01 Z5 F6000\nN6 M17\n");
     let mut c = i.channel();
     start(&mut c, &tick(0), "streaming.nc");
