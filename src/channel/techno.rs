@@ -455,4 +455,9 @@ impl Acknowledgements for TechnoUnits {
     fn is_acknowledged(&self, seq: TechnoSeq) -> bool {
         seq < self.next_seq && !self.open.contains(&seq)
     }
+
+    #[inline]
+    fn all_acknowledged(&self) -> bool {
+        self.open.is_empty()
+    }
 }

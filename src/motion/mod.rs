@@ -101,6 +101,9 @@ enum Run {
 /// The executor of one channel.
 #[derive(Debug)]
 pub struct Motion {
+    /// A technology output was handed over this step: the channel takes it into its units
+    /// only after the step, so the program end waits a step for it.
+    output_this_step: bool,
     axes: Vec<AxisLimits>,
     planner: Planner,
     /// Axis positions after the axis filter: where the axes are, mm (rotary: degrees).
@@ -152,6 +155,7 @@ impl Motion {
             [0.0; MAX_AXES],
         );
         Motion {
+            output_this_step: false,
             planner: Planner::new(&axes, settings),
             axes,
             pos: [0.0; MAX_AXES],
@@ -386,6 +390,7 @@ impl Motion {
             self.dt_s = dt_s;
         }
         self.time_s += dt_s;
+        self.output_this_step = false;
         self.filter.configure(self.dt_s);
         if !self.ended {
             self.planner.set_front_busy(self.front_started);
@@ -637,6 +642,7 @@ impl Motion {
             }
             EntryKind::Plain => Next::Pop,
             EntryKind::TechnoOutput(g) => {
+                self.output_this_step = true;
                 notes.push(MotionNote::TechnoOutput(g.clone()));
                 Next::Pop
             }
@@ -664,6 +670,11 @@ impl Motion {
             EntryKind::Flush(k) => {
                 notes.push(MotionNote::Flush(*k));
                 Next::Pop
+            }
+            // The program ends when its technology functions are finished too.
+            EntryKind::End { .. } if self.output_this_step || !acks.all_acknowledged() => {
+                *left = 0.0;
+                Next::Stay
             }
             EntryKind::End { m, prog } => {
                 notes.push(MotionNote::End {

@@ -320,6 +320,10 @@ pub struct OutputGroup {
 pub trait Acknowledgements {
     /// Has function `seq` been acknowledged (or was it never waited for)?
     fn is_acknowledged(&self, seq: TechnoSeq) -> bool;
+
+    /// Is every function output so far finished (nothing waits to be output either)? The
+    /// program end waits for it: no function is left behind in a unit.
+    fn all_acknowledged(&self) -> bool;
 }
 
 /// No technology units: every wait passes at once. For a motion driven without a channel
@@ -329,6 +333,10 @@ pub struct NoUnits;
 
 impl Acknowledgements for NoUnits {
     fn is_acknowledged(&self, _seq: TechnoSeq) -> bool {
+        true
+    }
+
+    fn all_acknowledged(&self) -> bool {
         true
     }
 }

@@ -209,13 +209,19 @@ fn m_and_h_run_from_0_to_65535_and_h_functions_are_events() {
         assert_eq!(parse_block(l).unwrap_err().code, codes::UNKNOWN_M, "{l}");
     }
     let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "m_synch[100] MOS\nm_synch[65535] MOS\nh_synch[7] MOS\nh_synch[65535] MOS\n",
+    )
+    .unwrap();
     rig.program("h.nc", "M100 H7\nH65535 M65535\nM30\n");
     let r = rig.run("h.nc", None, 100_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
     let hs: Vec<u64> = r
-        .of("h_function")
+        .of("techno_output")
         .iter()
-        .map(|e| e["h"].as_u64().unwrap())
+        .filter(|e| e["kind"] == "h")
+        .map(|e| e["number"].as_u64().unwrap())
         .collect();
     assert_eq!(hs, [7, 65535]);
 }

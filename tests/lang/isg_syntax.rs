@@ -192,25 +192,28 @@ fn an_address_takes_a_parameter_expression_without_brackets() {
 #[test]
 fn an_m_function_takes_a_value_carried_with_its_event() {
     let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "streaming_prog_file streaming.nc\nm_synch[200] MOS\nm_synch[201] MOS\n\
+         h_synch[20] MOS\nh_synch[21] MOS\n",
+    )
+    .unwrap();
     let r = runs_clean(
         &rig,
         "P1=3\nG01 X1 F100 M200=1200\nM201 = P1*2 H20=5 H21\nM30\n",
     );
-    let ms: Vec<(u64, f64)> = r
-        .of("m_function")
-        .iter()
-        .map(|e| (e["m"].as_u64().unwrap(), e["value"].as_f64().unwrap()))
-        .collect();
-    assert_eq!(ms, [(200, 1200.0), (201, 6.0)]);
-    let hs: Vec<(u64, Option<f64>)> = r
-        .of("h_function")
-        .iter()
-        .map(|e| (e["h"].as_u64().unwrap(), e["value"].as_f64()))
-        .collect();
-    assert_eq!(hs, [(20, Some(5.0)), (21, None)]);
-    // An M function without a value has no event of its own, as before.
+    let of = |kind: &str| -> Vec<(u64, Option<i64>)> {
+        r.of("techno_output")
+            .iter()
+            .filter(|e| e["kind"] == kind)
+            .map(|e| (e["number"].as_u64().unwrap(), e["value"].as_i64()))
+            .collect()
+    };
+    assert_eq!(of("m"), [(200, Some(1200)), (201, Some(6))]);
+    assert_eq!(of("h"), [(20, Some(5)), (21, None)]);
+    // The kernel's own M3 and an S the channel list does not hand to the PLC: no output.
     let r = runs_clean(&rig, "M3 S1000\nM30\n");
-    assert_eq!(r.of("m_function").len(), 0);
+    assert_eq!(r.of("techno_output").len(), 0);
     // The number is still checked; an undefined value is the run's error at the M.
     fails_at(&rig, "G01 X1 F100\nM70000=1\nM30\n", 20157, 2, 1, true);
     fails_at(&rig, "G01 X1 F100\nX2 M200=P9\nM30\n", 900005, 2, 4, false);

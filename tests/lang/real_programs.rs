@@ -177,7 +177,8 @@ fn g800_rig() -> Rig {
         rig.startup().with_file_name("channel1.lis"),
         "streaming_prog_file streaming.nc\n\
          g800_prog_file[0] g800.nc ( P-CHAN-00187\n\
-         g800_prog_file[5] g805.nc\n",
+         g800_prog_file[5] g805.nc\n\
+         m_synch[200] MOS\nm_synch[201] MOS\n",
     )
     .unwrap();
     rig.program("g800.nc", "N5 G01 Z4 F6000\nN6 M17\n");
@@ -422,12 +423,12 @@ fn a_printer_post_processor_program_runs_to_m30_with_its_own_g80x_subroutines() 
         .map(|(p, n)| (p.to_string(), *n))
         .collect();
         assert_eq!(calls, want, "{}", r.log);
-        let m_values: Vec<(u64, f64)> = r
-            .of("m_function")
+        let m_values: Vec<(u64, Option<i64>)> = r
+            .of("techno_output")
             .iter()
-            .map(|e| (e["m"].as_u64().unwrap(), e["value"].as_f64().unwrap()))
+            .map(|e| (e["number"].as_u64().unwrap(), e["value"].as_i64()))
             .collect();
-        assert_eq!(m_values, [(200, 1200.0), (201, 0.0)], "{}", r.log);
+        assert_eq!(m_values, [(200, Some(1200)), (201, None)], "{}", r.log);
         assert_eq!(messages(r), [("layer 1 of 1".to_string(), false)]);
         // The square closed at the origin at the layer height, then G800 lifted Z to 4.
         assert_eq!(

@@ -92,6 +92,12 @@ impl RunResult {
     }
 }
 
+/// The M functions the shipped and the tests' programs use (tool change, coolant, laser, the
+/// printer's M200/M201), defined as MOS: handed to the units and acknowledged without a wait,
+/// so the tests of motion and streaming see the program's pace unchanged.
+pub const RIG_M_FUNCTIONS: &str = "m_synch[6] MOS\nm_synch[7] MOS\nm_synch[8] MOS\n\
+    m_synch[9] MOS\nm_synch[10] MOS\nm_synch[11] MOS\nm_synch[200] MOS\nm_synch[201] MOS\n";
+
 impl Rig {
     /// One channel, streaming program `streaming.nc`, programs in `nc/`, caching on (2 × 200 B).
     pub fn new() -> Rig {
@@ -121,7 +127,7 @@ impl Rig {
         std::fs::write(dir.path().join("params/startup.lis"), startup).unwrap();
         std::fs::write(
             dir.path().join("params/channel1.lis"),
-            "streaming_prog_file streaming.nc\n",
+            format!("streaming_prog_file streaming.nc\n{RIG_M_FUNCTIONS}"),
         )
         .unwrap();
         if !runtime_toml.is_empty() {
