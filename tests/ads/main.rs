@@ -17,3 +17,4 @@ mod ads_symbols;
 mod ads_techno;
 mod ads_twinsharp;
 mod ads_unholdable;
+mod techno_rig;
