@@ -8,6 +8,8 @@
 //! acknowledgement. Ignored by default (needs the client installed):
 //!
 //! `NCCHANNEL_PYTHON=/path/to/venv/bin/python cargo test --test ads_clients -- --ignored techno`
+//! (pyads, tests/python/techno_with_pyads.py; Node `ads-client` after `npm install --prefix
+//! tests/node`, tests/node/techno_plc_test.js).
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -25,16 +27,13 @@ struct Seen {
 
 /// Run `program script` against a fresh rig, watching the channel until the client exits;
 /// the client's JSON line and what was seen.
-fn run_watching(program: &str, script: &str, cwd: Option<&str>) -> (serde_json::Value, Vec<Seen>) {
+fn run_watching(program: &str, script: &str) -> (serde_json::Value, Vec<Seen>) {
     let rig = TechnoRig::start();
     let mut cmd = Command::new(program);
     cmd.arg(script)
         .env("NCCHANNEL_ADS_ADDR", rig.server.local_addr().to_string())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
-    if let Some(dir) = cwd {
-        cmd.current_dir(dir);
-    }
     let mut child = cmd
         .spawn()
         .unwrap_or_else(|e| panic!("{program} runs: {e}"));
@@ -117,7 +116,19 @@ fn pyads_as_the_plc_acknowledges_m25_and_the_motion_waits() {
         env!("CARGO_MANIFEST_DIR"),
         "/tests/python/techno_with_pyads.py"
     );
-    let (json, seen) = run_watching(&python, script, None);
+    let (json, seen) = run_watching(&python, script);
+    assert_m25(&json["unit"]);
+    assert_m25(&json["notified"]);
+    assert_eq!(json["used_after"], 0);
+    assert_waited(&seen, Duration::from_millis(150));
+}
+
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_ads_client_as_the_plc_acknowledges_m25_and_the_motion_waits() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/techno_plc_test.js");
+    let (json, seen) = run_watching(&node, script);
     assert_m25(&json["unit"]);
     assert_m25(&json["notified"]);
     assert_eq!(json["used_after"], 0);
