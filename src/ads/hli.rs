@@ -1452,6 +1452,53 @@ mod tests {
     }
 
     #[test]
+    fn units_encode_as_techno_unit_ch_with_hli_m_h_prozess() {
+        use crate::channel::techno::UnitFunction;
+        use crate::vocab::techno::{SyncType, TechnoKind};
+        let f = |kind, number, add_value| UnitFunction {
+            seq: 0,
+            kind,
+            number,
+            process_time_us: 1500,
+            block_nr: 20,
+            line: 2,
+            add_value,
+            synch_mode: 2,
+            sync: SyncType::MvsSvs,
+            output_at: std::time::Duration::ZERO,
+            waited: true,
+        };
+        let units = [
+            TechnoUnit {
+                please: true,
+                done: false,
+                function: Some(f(TechnoKind::M, 200, 1200)),
+            },
+            TechnoUnit {
+                please: false,
+                done: true,
+                function: Some(f(TechnoKind::S, 1000, 1000)),
+            },
+            TechnoUnit::default(),
+        ];
+        let b = encode_units(&units, TECHNO_UNITS);
+        assert_eq!(b.len(), 940);
+        let word = |at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+        assert_eq!(&b[0..4], &[1, 0, 1, 0], "please, done, type M");
+        assert_eq!(
+            (word(8), word(12), word(16), word(20), word(24), word(32)),
+            (200, 1500, 20, 2, 1200, 2),
+            "nr, time µs, block_nr, prg_line, add_value, synch_mode"
+        );
+        assert!(b[36..47].iter().all(|&x| x == 0));
+        let s = &b[47..94];
+        assert_eq!(&s[0..4], &[0, 1, 3, 0], "done, type S");
+        assert_eq!(&s[8..12], &1000u32.to_le_bytes(), "S: the speed in nr");
+        assert_eq!(&s[24..28], &1000i32.to_le_bytes(), "and in add_value");
+        assert!(b[94..].iter().all(|&x| x == 0), "never filled: zero");
+    }
+
+    #[test]
     fn record_is_942_bytes_with_the_error_id_first() {
         let r = error_record(21476, 1, 5);
         assert_eq!(r.len(), 942);
