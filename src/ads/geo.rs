@@ -11,11 +11,15 @@
 //!
 //! The HLD's mode-and-state unit (0x21–0x2F) mirrors the PLC's HLI unit
 //! (`gpCh[i]^.channel_mc_control.mode_and_state`, see [`super::hli`]): one store, two views.
+//! The technology elements 0x02–0x07 (`used_units_*_sync_r`, the first standard and late
+//! unit's please/done) and 0x0E (`head.plc_present_w`) read the channel's technology units
+//! (`Status.techno`, src/channel/techno.rs), as the HLI symbols do; they are read-only here.
 
 use super::backend::{CncBackend, Status};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::hli::{Hli, Unit};
 use super::result::AdsResult;
+use crate::channel::techno::UnitSet;
 
 pub const PORT: u16 = 551;
 /// Position controller, platform instance (ISG sample client `cnc_demo_samples.c` waits
@@ -56,6 +60,10 @@ enum Field {
     InputBlockCount,
     OverrideFactor,
     PlcPresent,
+    /// `used_units_std_sync_r` / `used_units_late_sync_r`.
+    UsedUnits(UnitSet),
+    /// `techno_std_sync[0]` / `techno_late_sync[0]`: `please` or `done`.
+    TechnoFlag(UnitSet, bool),
     OverrideEnable,
     OverrideCommand,
     OverrideRequest,
@@ -120,6 +128,12 @@ static TABLE: &[Def] = &[
     d(Ipo, 0x2F, "latest_input_block_clount", Dint, 4, "block counter", SRC_DUMP, F::InputBlockCount),
     d(Ipo, 0x70, "override feed factor", Lreal, 8, "1 = 100 %", SRC_DUMP, F::OverrideFactor),
     d(Hld, 0x00, "HLD : elements", Dword, 4, "element types served", SRC_DUMP, F::Elements),
+    d(Hld, 0x02, "used_units_late_sync_r", Word, 2, "units", SRC_DUMP, F::UsedUnits(UnitSet::Late)),
+    d(Hld, 0x03, "used_units_std_sync_r", Word, 2, "units", SRC_DUMP, F::UsedUnits(UnitSet::Std)),
+    d(Hld, 0x04, "techno_std_sync[0]::please", Bool, 1, "", SRC_DUMP, F::TechnoFlag(UnitSet::Std, true)),
+    d(Hld, 0x05, "techno_std_sync[0]::done", Bool, 1, "", SRC_DUMP, F::TechnoFlag(UnitSet::Std, false)),
+    d(Hld, 0x06, "techno_late_sync[0]::please", Bool, 1, "", SRC_DUMP, F::TechnoFlag(UnitSet::Late, true)),
+    d(Hld, 0x07, "techno_late_sync[0]::done", Bool, 1, "", SRC_DUMP, F::TechnoFlag(UnitSet::Late, false)),
     d(Hld, 0x0E, "head.plc_present_w", Bool, 1, "", SRC_DUMP, F::PlcPresent),
     d(Hld, 0x1B, "override_feedrate.enable_w", Bool, 1, "", SRC_DUMP, F::OverrideEnable),
     d(Hld, 0x1C, "override_feedrate.command_w", Word, 2, "0.1 %", SRC_DUMP, F::OverrideCommand),
@@ -277,10 +291,10 @@ pub fn read(
         }
         return fixed((n as u16).to_le_bytes().to_vec(), length);
     }
-    fixed(value(&v, hli, ch, class, def.field)?, length)
+    fixed(value(&v, class, def.field)?, length)
 }
 
-fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
+fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
     let feed_um_s = v.feed_mm_per_min * 1000.0 / 60.0;
     let active = v.active_block.as_ref();
     let tenths = (v.override_pct * 10.0).round().clamp(0.0, 2000.0) as u16;
@@ -317,7 +331,22 @@ fn value(v: &Status, hli: &Hli, ch: u16, class: Class, field: Field) -> Result<V
         }
         Field::State => (v.state as u32).to_le_bytes().to_vec(),
         Field::Mode => (v.mode as u32).to_le_bytes().to_vec(),
-        Field::PlcPresent => hli.plc_present(ch)?,
+        Field::PlcPresent => vec![u8::from(v.techno.plc_present)],
+        Field::UsedUnits(set) => match set {
+            UnitSet::Std => v.techno.used_std,
+            UnitSet::Late => v.techno.used_late,
+        }
+        .to_le_bytes()
+        .to_vec(),
+        Field::TechnoFlag(set, please) => {
+            let units = match set {
+                UnitSet::Std => &v.techno.std,
+                UnitSet::Late => &v.techno.late,
+            };
+            vec![units
+                .first()
+                .map_or(0, |u| u8::from(if please { u.please } else { u.done }))]
+        }
         Field::Unit(..) | Field::PlatformAxes => return Err(AdsResult::ACCESS_DENIED),
     })
 }

@@ -11,9 +11,16 @@
 //! semaphore reads FALSE afterwards. Errors (`mc_error`, infosys `174914699.html`): one record
 //! is posted with `semaphor_rw` TRUE; the next only after the client wrote it FALSE.
 //!
-//! Symbols without behaviour in ncchannel (backward motion, manual mode keys, technology
-//! units, external axis commands …) are plain memory: they resolve, read back what was
-//! written and act on nothing (listed as inert in docs/ads.md).
+//! Technology units (TF5200 HLI "Technology functions", "Data of the M/H function"; the PLC's
+//! side as `kimblad/TwinSharp` `TwinSharp/CNC/TechnologyProcesses.cs` runs it):
+//! `techno_unit_std_sync`, `techno_unit_late_sync`, their `used_units_*_r` and
+//! `head.plc_present_w` are live views of the channel's units (`Status.techno`, see
+//! `src/channel/techno.rs`), encoded on every read; `please_rw`, `done_w` and `plc_present_w`
+//! writes go to the channel as `Op::Techno`; every other part of them is read-only.
+//!
+//! Symbols without behaviour in ncchannel (backward motion, manual mode keys, external axis
+//! commands …) are plain memory: they resolve, read back what was written and act on nothing
+//! (listed as inert in docs/ads.md).
 //!
 //! Services (ADS index groups of the TwinCAT PLC runtime): 0xF003 handle by name
 //! (ReadWrite), 0xF004 value by name (ReadWrite), 0xF005 value by handle (Read/Write, offset =
@@ -27,7 +34,7 @@
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
-use super::backend::{CncBackend, DeviceError, Op};
+use super::backend::{CncBackend, DeviceError, Op, Reply};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::plc_types::DataType;
 use super::result::AdsResult;
@@ -35,6 +42,9 @@ use super::symbols::{
     self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_LOCATION_BY_NAME,
     GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
     GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
+};
+use crate::channel::techno::{
+    TechnoStatus, TechnoWrite, Unit as TechnoUnit, UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS,
 };
 use crate::vocab::mode::Mode;
 
@@ -56,9 +66,15 @@ const PARAMETER_AT: usize = 24;
 const PARAMETER_BYTES: usize = 299;
 /// `HLI_ERROR_SATZ` (TwinSharp `Structs.cs`): 104-byte head + 838-byte body.
 pub(crate) const ERROR_RECORD_BYTES: usize = 942;
-/// `TECHNO_UNIT_CH` bytes and `techno_unit_std_sync` entries (`[0..19]`).
-const TECHNO_UNIT_BYTES: usize = 47;
-const TECHNO_UNITS: usize = 20;
+/// `TECHNO_UNIT_CH` bytes (TwinSharp `Structs.cs`, Pack = 1): please_rw BOOL @0, done_w BOOL
+/// @1, type UINT @2, fill_up_1 DINT @4, the function's data byte[39] @8.
+pub(crate) const TECHNO_UNIT_BYTES: usize = 47;
+/// Where the function's data (`attribut_r.data`) starts in a unit.
+const TECHNO_DATA_AT: usize = 8;
+const TECHNO_DATA_BYTES: usize = 39;
+/// `techno_unit_std_sync` entries (`[0..19]`) and `techno_unit_late_sync` entries (`[0..9]`).
+const TECHNO_UNITS: usize = STD_SYNC_UNITS;
+const TECHNO_UNITS_LATE: usize = LATE_SYNC_UNITS;
 /// TwinSharp `Constants.cs`: keys `[0..10]`; the kernel dump lists handwheels `[0..5]`.
 const KEYS: usize = 11;
 const HANDWHEELS: usize = 6;
@@ -97,6 +113,23 @@ enum Role {
     /// `mc_error.satz_r` / `semaphor_rw`: posts the next error when the semaphore is FALSE.
     ErrorRecord(u16),
     ErrorSemaphore(u16),
+    /// `techno_unit_std_sync` / `techno_unit_late_sync`: the channel's units, read live;
+    /// `please_rw` and `done_w` written through.
+    TechnoUnits(u16, UnitSet),
+    /// `used_units_std_sync_r` / `used_units_late_sync_r`, read live, read-only.
+    TechnoUsed(u16, UnitSet),
+    /// `head.plc_present_w`: the channel's flag, read live and written through.
+    PlcPresent(u16),
+}
+
+impl Role {
+    /// Live symbols whose every byte is the CNC's: a write is refused.
+    fn read_only(self) -> bool {
+        matches!(
+            self,
+            Role::ModeState(_) | Role::ErrorRecord(_) | Role::TechnoUsed(..)
+        )
+    }
 }
 
 /// One symbol: a window `[at, at + size)` of a root area.
@@ -118,7 +151,6 @@ struct ChannelAreas {
     request_semaphore: usize,
     command: usize,
     command_semaphore: usize,
-    plc_present: usize,
     error_record: usize,
     error_semaphore: usize,
 }
@@ -262,7 +294,7 @@ impl Builder {
     fn channel(&mut self, i: usize, ch: u16, axes: usize) -> ChannelAreas {
         let p = format!("HLI_Global_Variables.gpCh[{i}]^");
         let areas = self.channel_control(&p, ch);
-        self.techno_units(&p);
+        self.techno_units(&p, ch);
         self.path_control_units(&p);
         self.manual_mode_units(&p, axes);
         areas
@@ -295,19 +327,30 @@ impl Builder {
             "UDINT",
             ADST_UINT32,
         );
+        let request = self.transition(format!("{ms}.request_r"), Role::Plain);
+        let enable = self.bool(format!("{ms}.enable_w"));
+        let command = self.transition(format!("{ms}.command_w"), Role::Plain);
+        let request_semaphore = self.bool(format!("{ms}.request_semaphor_rw"));
+        let command_semaphore = self.root(
+            format!("{ms}.command_semaphor_rw"),
+            1,
+            "BOOL",
+            ADST_BIT,
+            Role::CommandSemaphore(ch),
+        );
+        self.root(
+            format!("{p}.head.plc_present_w"),
+            1,
+            "BOOL",
+            ADST_BIT,
+            Role::PlcPresent(ch),
+        );
         let areas = ChannelAreas {
-            request: self.transition(format!("{ms}.request_r"), Role::Plain),
-            enable: self.bool(format!("{ms}.enable_w")),
-            command: self.transition(format!("{ms}.command_w"), Role::Plain),
-            request_semaphore: self.bool(format!("{ms}.request_semaphor_rw")),
-            command_semaphore: self.root(
-                format!("{ms}.command_semaphor_rw"),
-                1,
-                "BOOL",
-                ADST_BIT,
-                Role::CommandSemaphore(ch),
-            ),
-            plc_present: self.bool(format!("{p}.head.plc_present_w")),
+            request,
+            enable,
+            command,
+            request_semaphore,
+            command_semaphore,
             error_record: self.root(
                 format!("{p}.mc_error.satz_r"),
                 ERROR_RECORD_BYTES,
@@ -334,49 +377,67 @@ impl Builder {
         areas
     }
 
-    /// Channel step 2: technology units (M/H/S/T handshakes): ncchannel raises none; plain
-    /// memory.
-    fn techno_units(&mut self, p: &str) {
-        let tu = self.root(
-            format!("{p}.techno_unit_std_sync"),
-            TECHNO_UNITS * TECHNO_UNIT_BYTES,
-            "ARRAY [0..19] OF TECHNO_UNIT_CH",
-            ADST_BIGTYPE,
-            Role::Plain,
-        );
-        for k in 0..TECHNO_UNITS {
-            self.sub(
-                format!("{p}.techno_unit_std_sync[{k}]"),
-                tu,
-                k * TECHNO_UNIT_BYTES,
-                TECHNO_UNIT_BYTES,
-                "TECHNO_UNIT_CH",
+    /// Channel step 2: technology units (TF5200 HLI "Technology functions"), live views of
+    /// the channel's units: the arrays, each unit, its `please_rw`, `done_w`, `type` and
+    /// `attribut_r.data` (the function's data, `HLI_M_H_PROZESS` for M and H), and the
+    /// `used_units_*_r` counts.
+    fn techno_units(&mut self, p: &str, ch: u16) {
+        for (set, name, n, used) in [
+            (
+                UnitSet::Std,
+                "techno_unit_std_sync",
+                TECHNO_UNITS,
+                "used_units_std_sync_r",
+            ),
+            (
+                UnitSet::Late,
+                "techno_unit_late_sync",
+                TECHNO_UNITS_LATE,
+                "used_units_late_sync_r",
+            ),
+        ] {
+            let ty: &'static str = match set {
+                UnitSet::Std => "ARRAY [0..19] OF TECHNO_UNIT_CH",
+                UnitSet::Late => "ARRAY [0..9] OF TECHNO_UNIT_CH",
+            };
+            let tu = self.root(
+                format!("{p}.{name}"),
+                n * TECHNO_UNIT_BYTES,
+                ty,
                 ADST_BIGTYPE,
+                Role::TechnoUnits(ch, set),
             );
-            self.sub(
-                format!("{p}.techno_unit_std_sync[{k}].please_rw"),
-                tu,
-                k * TECHNO_UNIT_BYTES,
-                1,
-                "BOOL",
-                ADST_BIT,
-            );
-            self.sub(
-                format!("{p}.techno_unit_std_sync[{k}].done_w"),
-                tu,
-                k * TECHNO_UNIT_BYTES + 1,
-                1,
-                "BOOL",
-                ADST_BIT,
+            for k in 0..n {
+                let u = format!("{p}.{name}[{k}]");
+                let at = k * TECHNO_UNIT_BYTES;
+                self.sub(
+                    u.clone(),
+                    tu,
+                    at,
+                    TECHNO_UNIT_BYTES,
+                    "TECHNO_UNIT_CH",
+                    ADST_BIGTYPE,
+                );
+                self.sub(format!("{u}.please_rw"), tu, at, 1, "BOOL", ADST_BIT);
+                self.sub(format!("{u}.done_w"), tu, at + 1, 1, "BOOL", ADST_BIT);
+                self.sub(format!("{u}.type"), tu, at + 2, 2, "UINT", ADST_UINT16);
+                self.sub(
+                    format!("{u}.attribut_r.data"),
+                    tu,
+                    at + TECHNO_DATA_AT,
+                    TECHNO_DATA_BYTES,
+                    "ARRAY [0..38] OF BYTE",
+                    ADST_BIGTYPE,
+                );
+            }
+            self.root(
+                format!("{p}.{used}"),
+                2,
+                "UINT",
+                ADST_UINT16,
+                Role::TechnoUsed(ch, set),
             );
         }
-        self.root(
-            format!("{p}.used_units_std_sync_r"),
-            2,
-            "UINT",
-            ADST_UINT16,
-            Role::Plain,
-        );
     }
 
     /// Channel step 3: path control units (TwinSharp BackwardsOnPath.cs,
@@ -629,6 +690,13 @@ impl Hli {
     fn read_symbol(&self, i: usize, length: u32) -> Result<Vec<u8>, AdsResult> {
         let img = self.image()?;
         let s = &img.symbols[i];
+        let n = s.size.min(length as usize);
+        if let Some(bytes) = self.techno_root(img.roles[s.root])? {
+            return bytes
+                .get(s.at..s.at + n)
+                .map(<[u8]>::to_vec)
+                .ok_or(AdsResult::INVALID_SIZE);
+        }
         match img.roles[s.root] {
             Role::ModeState(ch) => {
                 let st = self.backend.status(ch).map_err(AdsResult::from)?;
@@ -640,8 +708,49 @@ impl Hli {
             _ => {}
         }
         let mem = img.memory();
-        let n = s.size.min(length as usize);
         Ok(mem[s.root][s.at..s.at + n].to_vec())
+    }
+
+    /// A technology root's bytes, encoded from the channel's status now; `None` for the
+    /// other roles.
+    fn techno_root(&self, role: Role) -> Result<Option<Vec<u8>>, AdsResult> {
+        let (ch, f): (u16, fn(&TechnoStatus) -> Vec<u8>) = match role {
+            Role::TechnoUnits(ch, UnitSet::Std) => (ch, |t| encode_units(&t.std, TECHNO_UNITS)),
+            Role::TechnoUnits(ch, UnitSet::Late) => {
+                (ch, |t| encode_units(&t.late, TECHNO_UNITS_LATE))
+            }
+            Role::TechnoUsed(ch, UnitSet::Std) => (ch, |t| t.used_std.to_le_bytes().to_vec()),
+            Role::TechnoUsed(ch, UnitSet::Late) => (ch, |t| t.used_late.to_le_bytes().to_vec()),
+            Role::PlcPresent(ch) => (ch, |t| vec![u8::from(t.plc_present)]),
+            _ => return Ok(None),
+        };
+        let st = self.backend.status(ch).map_err(AdsResult::from)?;
+        Ok(Some(f(&st.techno)))
+    }
+
+    /// A write into a technology symbol: one byte on a unit's `please_rw` or `done_w`, or
+    /// `head.plc_present_w`; any other part (type, data, a whole unit or array) is
+    /// read-only.
+    fn write_techno(&self, role: Role, s: &Symbol, data: &[u8]) -> Result<(), AdsResult> {
+        let (ch, w) = match (role, data) {
+            (Role::PlcPresent(ch), [v]) => (ch, TechnoWrite::PlcPresent(*v != 0)),
+            (Role::TechnoUnits(ch, set), [v]) if s.size == 1 => {
+                let unit = s.at / TECHNO_UNIT_BYTES;
+                let value = *v != 0;
+                match s.at % TECHNO_UNIT_BYTES {
+                    0 => (ch, TechnoWrite::Please { set, unit, value }),
+                    1 => (ch, TechnoWrite::Done { set, unit, value }),
+                    _ => return Err(AdsResult::ACCESS_DENIED),
+                }
+            }
+            _ => return Err(AdsResult::ACCESS_DENIED),
+        };
+        match self.backend.call(ch, Op::Techno(w)) {
+            Ok(Reply::Techno(Ok(()))) => Ok(()),
+            Ok(Reply::Techno(Err(_))) => Err(AdsResult::INVALID_OFFSET),
+            Ok(_) => Err(AdsResult::NOT_READY),
+            Err(e) => Err(e.into()),
+        }
     }
 
     fn write_symbol(&self, i: usize, data: &[u8]) -> Result<(), AdsResult> {
@@ -651,8 +760,11 @@ impl Hli {
             return Err(AdsResult::INVALID_SIZE);
         }
         let role = img.roles[s.root];
-        if matches!(role, Role::ModeState(_) | Role::ErrorRecord(_)) {
+        if role.read_only() {
             return Err(AdsResult::ACCESS_DENIED);
+        }
+        if matches!(role, Role::TechnoUnits(..) | Role::PlcPresent(_)) {
+            return self.write_techno(role, s, data);
         }
         img.memory()[s.root][s.at..s.at + data.len()].copy_from_slice(data);
         if let (Role::CommandSemaphore(ch), [1, ..]) = (role, data) {
@@ -848,13 +960,6 @@ impl Hli {
         Ok(())
     }
 
-    /// `gpCh[ch-1]^.head.plc_present_w` as one byte.
-    pub(crate) fn plc_present(&self, ch: u16) -> Result<Vec<u8>, AdsResult> {
-        let img = self.image()?;
-        let a = img.areas(ch)?;
-        Ok(img.memory()[a.plc_present].clone())
-    }
-
     /// What the symbol entry of symbol `i` says: its address is value-by-handle.
     fn info<'i>(&self, img: &'i Image, i: usize) -> SymbolInfo<'i> {
         let s = &img.symbols[i];
@@ -865,7 +970,7 @@ impl Hli {
             offset: i as u32 + 1,
             size_bytes: s.size as u32,
             adst: s.adst,
-            read_only: matches!(img.roles[s.root], Role::ModeState(_) | Role::ErrorRecord(_)),
+            read_only: img.roles[s.root].read_only(),
         }
     }
 
@@ -1014,6 +1119,32 @@ fn role_source(role: Role) -> &'static str {
         Role::Plain => "TwinSharp; inert",
         _ => "TwinSharp; HLI docs",
     }
+}
+
+/// `count` units as `TECHNO_UNIT_CH` (47 bytes each, Pack = 1, little-endian; TwinSharp
+/// `Structs.cs`): please_rw, done_w, type (1 M, 2 H, 3 S, 4 T; 0 = never filled), fill, then
+/// the function's data. For every kind the data is `HLI_M_H_PROZESS` (TF5200 HLI "Data of the
+/// M/H function"): nr UDINT @0, time DINT @4 [µs], block_nr UDINT @8, prg_line UDINT @12,
+/// add_value DINT @16, nr_late_sync UINT @20, fill UINT @22, synch_mode UDINT @24, fill DINT
+/// @28; the last 7 bytes are zero. S and T have no public layout: S carries its speed (rpm,
+/// rounded) in nr and add_value, T its tool number in nr.
+pub(crate) fn encode_units(units: &[TechnoUnit], count: usize) -> Vec<u8> {
+    let mut out = vec![0u8; count * TECHNO_UNIT_BYTES];
+    for (u, b) in units.iter().zip(out.chunks_exact_mut(TECHNO_UNIT_BYTES)) {
+        b[0] = u8::from(u.please);
+        b[1] = u8::from(u.done);
+        let Some(f) = &u.function else { continue };
+        b[2..4].copy_from_slice(&(f.kind as u16).to_le_bytes());
+        let d = &mut b[TECHNO_DATA_AT..];
+        d[0..4].copy_from_slice(&f.number.to_le_bytes());
+        let time = i32::try_from(f.process_time_us).unwrap_or(i32::MAX);
+        d[4..8].copy_from_slice(&time.to_le_bytes());
+        d[8..12].copy_from_slice(&f.block_nr.to_le_bytes());
+        d[12..16].copy_from_slice(&f.line.to_le_bytes());
+        d[16..20].copy_from_slice(&f.add_value.to_le_bytes());
+        d[24..28].copy_from_slice(&f.synch_mode.to_le_bytes());
+    }
+    out
 }
 
 /// `HLI_ERROR_SATZ` for error `code` of channel `ch` (TwinSharp `Structs.cs`,
@@ -1318,6 +1449,53 @@ mod tests {
             hli.read_write(GROUP_TYPE_BY_NAME, 0, u32::MAX, b"NO_SUCH_TYPE\0"),
             Err(SYMBOL_NOT_FOUND)
         );
+    }
+
+    #[test]
+    fn units_encode_as_techno_unit_ch_with_hli_m_h_prozess() {
+        use crate::channel::techno::UnitFunction;
+        use crate::vocab::techno::{SyncType, TechnoKind};
+        let f = |kind, number, add_value| UnitFunction {
+            seq: 0,
+            kind,
+            number,
+            process_time_us: 1500,
+            block_nr: 20,
+            line: 2,
+            add_value,
+            synch_mode: 2,
+            sync: SyncType::MvsSvs,
+            output_at: std::time::Duration::ZERO,
+            waited: true,
+        };
+        let units = [
+            TechnoUnit {
+                please: true,
+                done: false,
+                function: Some(f(TechnoKind::M, 200, 1200)),
+            },
+            TechnoUnit {
+                please: false,
+                done: true,
+                function: Some(f(TechnoKind::S, 1000, 1000)),
+            },
+            TechnoUnit::default(),
+        ];
+        let b = encode_units(&units, TECHNO_UNITS);
+        assert_eq!(b.len(), 940);
+        let word = |at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+        assert_eq!(&b[0..4], &[1, 0, 1, 0], "please, done, type M");
+        assert_eq!(
+            (word(8), word(12), word(16), word(20), word(24), word(32)),
+            (200, 1500, 20, 2, 1200, 2),
+            "nr, time µs, block_nr, prg_line, add_value, synch_mode"
+        );
+        assert!(b[36..47].iter().all(|&x| x == 0));
+        let s = &b[47..94];
+        assert_eq!(&s[0..4], &[0, 1, 3, 0], "done, type S");
+        assert_eq!(&s[8..12], &1000u32.to_le_bytes(), "S: the speed in nr");
+        assert_eq!(&s[24..28], &1000i32.to_le_bytes(), "and in add_value");
+        assert!(b[94..].iter().all(|&x| x == 0), "never filled: zero");
     }
 
     #[test]

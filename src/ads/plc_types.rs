@@ -122,15 +122,41 @@ pub(crate) static STRUCTS: &[Struct] = &[
             m("cycle_counter", "UDINT", 4),
         ],
     },
+    // TwinSharp `Structs.cs` `TECHNO_UNIT_CH` (please_rw, done_w, TechnologyType, fill_up_1,
+    // MSTH_PROCESS_CH byte[39]); the data's HLI path is `attribut_r.data` (TF5200 HLI "Data
+    // of the M/H function": `techno_unit_std_sync[k].attribut_r.data[0]`). The name of
+    // attribut_r's type is not public: ncchannel calls it TECHNO_UNIT_CH_ATTRIBUT.
     Struct {
         name: "TECHNO_UNIT_CH",
         size_bytes: 47,
         members: &[
             m("please_rw", "BOOL", 0),
             m("done_w", "BOOL", 1),
-            m("technology_type", "UINT", 2),
+            m("type", "UINT", 2),
             m("fill_up_1", "DINT", 4),
-            m("msth_process_ch", "ARRAY [0..38] OF BYTE", 8),
+            m("attribut_r", "TECHNO_UNIT_CH_ATTRIBUT", 8),
+        ],
+    },
+    Struct {
+        name: "TECHNO_UNIT_CH_ATTRIBUT",
+        size_bytes: 39,
+        members: &[m("data", "ARRAY [0..38] OF BYTE", 0)],
+    },
+    // TF5200 HLI "Data of the M/H function" (the first 32 bytes of `attribut_r.data` for M
+    // and H); TwinSharp `Structs.cs` `HLI_M_H_PROZESS`. Served by name (0xF011).
+    Struct {
+        name: "HLI_M_H_PROZESS",
+        size_bytes: 32,
+        members: &[
+            m("nr", "UDINT", 0),
+            m("time", "DINT", 4),
+            m("block_nr", "UDINT", 8),
+            m("prg_line", "UDINT", 12),
+            m("add_value", "DINT", 16),
+            m("nr_late_sync", "UINT", 20),
+            m("fill_up_1", "UINT", 22),
+            m("synch_mode", "UDINT", 24),
+            m("fill_up_2", "DINT", 28),
         ],
     },
     Struct {
@@ -539,6 +565,13 @@ mod tests {
         assert_eq!(t.size_bytes(), Some(940));
         assert_eq!(t.member_at("[2].done_w"), Some((95, 1, "BOOL")));
         assert_eq!(t.member_at("[20]"), None);
+        assert_eq!(t.member_at("[1].type"), Some((49, 2, "UINT")));
+        assert_eq!(
+            t.member_at("[1].attribut_r.data"),
+            Some((55, 39, "ARRAY [0..38] OF BYTE"))
+        );
+        let mh = DataType::lookup("HLI_M_H_PROZESS").unwrap();
+        assert_eq!(mh.member_at(".synch_mode"), Some((24, 4, "UDINT")));
         let e = DataType::lookup("hli_error_satz").unwrap();
         assert_eq!(e.member_at(".kopf.error_id"), Some((0, 4, "UDINT")));
         assert_eq!(

@@ -14,5 +14,7 @@ mod ads_serve;
 mod ads_server;
 mod ads_stream;
 mod ads_symbols;
+mod ads_techno;
 mod ads_twinsharp;
 mod ads_unholdable;
+mod techno_rig;

@@ -7,3 +7,6 @@ mod support;
 mod ads_node;
 mod ads_node_stall;
 mod ads_pyads;
+mod ads_techno_clients;
+#[path = "../ads/techno_rig.rs"]
+mod techno_rig;
