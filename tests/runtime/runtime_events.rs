@@ -285,12 +285,17 @@ fn report_json_has_the_documented_shape() {
             "interrupts",
             "errors",
             "cycle",
-            "files"
+            "files",
+            "techno"
         ])
     );
     assert_eq!(
         keys(&v["files"].to_string()),
         sorted(&["opens", "bytes_read", "cache_hits", "latency_s"])
+    );
+    assert_eq!(
+        keys(&v["techno"].to_string()),
+        sorted(&["output", "acknowledged", "waited_s", "dropped_by_reset"])
     );
     assert_eq!(v["position"]["Y"], -2.5);
     assert_eq!(
