@@ -404,6 +404,7 @@ impl ChannelLog {
     }
 
     /// A block took effect: counted, recorded for the soak when observed, one `block` event.
+    #[inline]
     fn block(&mut self, tick: &Tick, info: BlockInfo) {
         self.stats.blocks += 1;
         if self.observe && info.stream {

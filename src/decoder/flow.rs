@@ -167,6 +167,7 @@ impl Flow {
 
     /// One line while skipping. Returns whether the line is to be executed after all (the
     /// label line a forward jump was looking for).
+    #[inline]
     pub(super) fn skip_line(&mut self, block: &Block, stream: bool, ip: &impl Env) -> Res<bool> {
         let Some(skip) = self.skip.clone() else {
             return Ok(true);

@@ -141,6 +141,9 @@ impl Interpreter {
     }
 
     /// Program start: `start_init_prog_file` (P-CHAN-00119) is called as the first action.
+    /// Asked before every line: inline, so the answer for all lines but the first is one
+    /// test (the call itself is out of line).
+    #[inline]
     pub(in crate::decoder) fn start_subroutine(
         &mut self,
         rd: &mut Reader,
@@ -150,6 +153,16 @@ impl Interpreter {
         if !std::mem::take(&mut self.implicit.start_pending) {
             return Ok(());
         }
+        self.call_start_subroutine(rd, notes, io)
+    }
+
+    #[inline(never)]
+    fn call_start_subroutine(
+        &mut self,
+        rd: &mut Reader,
+        notes: &mut Vec<Note>,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
         match self.settings.implicit.at_start.clone() {
             Some(name) => self.call_global(&name, rd, notes, io),
             None => Ok(()),
