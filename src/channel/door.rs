@@ -19,6 +19,7 @@ use crate::motion::trace::Trace;
 use crate::source::store::StoreStats;
 use crate::source::stream::{StreamCounters, StreamWriteError};
 use crate::vocab::axis::Position;
+use crate::vocab::techno::Acknowledgements;
 
 /// What a client asks of a channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -177,6 +178,17 @@ pub struct Status {
     pub distance_to_go_mm: f64,
     /// The HLI technology interface: PLC present, the units and what they hold.
     pub techno: TechnoStatus,
+    /// Technology functions output and acknowledged so far, and which units hold a function
+    /// still open (not yet acknowledged): `techno.std` then `techno.late`, by index.
+    pub techno_open: TechnoOpen,
+}
+
+/// The technology counters and open units a [`Status`] carries for the live view.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TechnoOpen {
+    pub stats: TechnoStats,
+    /// `(late, unit)`: `false` for `techno.std[unit]`, `true` for `techno.late[unit]`.
+    pub units: Vec<(bool, usize)>,
 }
 
 /// What a channel tells after a run (and what tests read between ticks): its counters and
@@ -309,6 +321,8 @@ pub(crate) fn error_record(c: &Channel, index: u64) -> Option<(u32, String)> {
 
 pub(crate) fn status_of(c: &Channel) -> Status {
     let stats = c.log.stats();
+    let techno = c.techno.status();
+    let techno_open = techno_open(c, &techno);
     Status {
         mode: c.isg.mode(),
         state: c.isg.state(),
@@ -336,7 +350,39 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         programs_ended: stats.programs_ended,
         zero_offsets: c.zero_offsets,
         distance_to_go_mm: c.motion.distance_to_go_mm(),
-        techno: c.techno.status(),
+        techno,
+        techno_open,
+    }
+}
+
+/// Units holding an open function: none while the units are idle (no allocation).
+fn techno_open(c: &Channel, s: &TechnoStatus) -> TechnoOpen {
+    let t = &c.techno;
+    let open = |u: &super::techno::Unit| {
+        u.function
+            .as_ref()
+            .is_some_and(|f| !t.is_acknowledged(f.seq))
+    };
+    let units = if t.idle() {
+        Vec::new()
+    } else {
+        let std = s
+            .std
+            .iter()
+            .enumerate()
+            .filter(|(_, u)| open(u))
+            .map(|(i, _)| (false, i));
+        let late = s
+            .late
+            .iter()
+            .enumerate()
+            .filter(|(_, u)| open(u))
+            .map(|(i, _)| (true, i));
+        std.chain(late).collect()
+    };
+    TechnoOpen {
+        stats: t.stats(),
+        units,
     }
 }
 

@@ -8,6 +8,7 @@ use serde::Serialize;
 use crate::machine::Status;
 use crate::vocab::mode::{Mode, State};
 use crate::vocab::stats::LiveCycleReading;
+use crate::vocab::techno::TechnoKind;
 
 /// One axis of the DRO.
 #[derive(Debug, Clone, Serialize)]
@@ -54,6 +55,96 @@ pub struct ChannelView {
     pub errors_total: u64,
     pub last_error: Option<ErrorView>,
     pub message: Option<String>,
+    pub techno: TechnoView,
+}
+
+/// The HLI technology interface of one channel (README "Technology functions: the PLC half").
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TechnoView {
+    /// A PLC has set `plc_present_w`; else the channel acknowledges its own units once the
+    /// function's process time has passed.
+    pub plc_present: bool,
+    /// Functions output to the units and acknowledged since the channel was built.
+    pub output: u64,
+    pub acknowledged: u64,
+    /// The units holding a function the PLC has not acknowledged yet, oldest output first.
+    pub waiting: Vec<WaitingUnit>,
+}
+
+/// One unit waiting for the PLC.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WaitingUnit {
+    /// As programmed: `M25`, `M200=1200`, `H7=2`, `S12000`, `T2`.
+    pub function: String,
+    /// The synchronisation type (`MVS_SVS`, …).
+    pub sync: &'static str,
+    /// `std` (`techno_unit_std_sync`) or `late` (`techno_unit_late_sync`).
+    pub set: &'static str,
+    pub unit: usize,
+    /// `please_rw` still TRUE: the PLC has not fetched it.
+    pub please: bool,
+    /// Channel time of the output, s, and how long it has waited since, s.
+    pub output_at_s: f64,
+    pub waited_s: f64,
+    /// The process time the channel list gives it, µs (what the channel waits without a PLC).
+    pub process_time_us: u32,
+    /// Program line of the block that output it.
+    pub line: u32,
+}
+
+/// The function as programmed (README "Technology functions": the value of `M200=1200` is
+/// the unit's `add_value`; S carries the speed, T the tool number).
+fn function_text(kind: TechnoKind, number: u32, add_value: i32) -> String {
+    match kind {
+        TechnoKind::S => format!("S{add_value}"),
+        TechnoKind::T => format!("T{number}"),
+        TechnoKind::M | TechnoKind::H if add_value != 0 => {
+            format!("{}{number}={add_value}", kind.letter())
+        }
+        TechnoKind::M | TechnoKind::H => format!("{}{number}", kind.letter()),
+    }
+}
+
+/// The technology panel: only the units the status marks open are encoded (none while the
+/// channel has nothing out to the PLC).
+pub fn techno_view(s: &Status) -> TechnoView {
+    // Channel time of the tick that served the status: `index × period` (src/vocab/tick.rs).
+    let now_ns = s.period.as_nanos().saturating_mul(u128::from(s.tick));
+    let now = std::time::Duration::from_nanos(u64::try_from(now_ns).unwrap_or(u64::MAX));
+    let unit = |late: bool, i: usize| {
+        if late {
+            s.techno.late.get(i).map(|u| (u, "late"))
+        } else {
+            s.techno.std.get(i).map(|u| (u, "std"))
+        }
+    };
+    let mut waiting: Vec<WaitingUnit> = s
+        .techno_open
+        .units
+        .iter()
+        .filter_map(|&(late, i)| {
+            let (u, set) = unit(late, i)?;
+            let f = u.function.as_ref()?;
+            Some(WaitingUnit {
+                function: function_text(f.kind, f.number, f.add_value),
+                sync: f.sync.name(),
+                set,
+                unit: i,
+                please: u.please,
+                output_at_s: f.output_at.as_secs_f64(),
+                waited_s: now.saturating_sub(f.output_at).as_secs_f64(),
+                process_time_us: f.process_time_us,
+                line: f.line,
+            })
+        })
+        .collect();
+    waiting.sort_by(|a, b| a.output_at_s.total_cmp(&b.output_at_s));
+    TechnoView {
+        plc_present: s.techno.plc_present,
+        output: s.techno_open.stats.output,
+        acknowledged: s.techno_open.stats.acknowledged,
+        waiting,
+    }
 }
 
 /// The runtime's cycle statistics in one update.
@@ -208,6 +299,7 @@ pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>) -> ChannelVi
             text: text.clone(),
         }),
         message: s.message.clone(),
+        techno: techno_view(s),
     }
 }
 
@@ -227,5 +319,14 @@ mod tests {
         let v = l.view(1);
         assert_eq!(v.lines, ["N10 G01 X1", "N20 X2", "N30 M30"]);
         assert_eq!(v.lines_left_out, 0);
+    }
+
+    #[test]
+    fn functions_read_as_programmed() {
+        assert_eq!(function_text(TechnoKind::M, 25, 0), "M25");
+        assert_eq!(function_text(TechnoKind::M, 200, 1200), "M200=1200");
+        assert_eq!(function_text(TechnoKind::H, 7, 2), "H7=2");
+        assert_eq!(function_text(TechnoKind::S, 12000, 12000), "S12000");
+        assert_eq!(function_text(TechnoKind::T, 2, 0), "T2");
     }
 }

@@ -1,6 +1,6 @@
 //! The live web view of `serve --http`: the page and its event stream over real sockets
-//! (`feed`), the operator controls (`controls`), what it costs the runtime (`bench`), and the
-//! page in a real headless browser (`browser`, run by `.ci/run`; ignored here only when no
+//! (`feed`), the operator controls (`controls`), the technology units waiting for the PLC
+//! (`techno`), what it costs the runtime (`bench`), and the page in a real headless browser (`browser`, run by `.ci/run`; ignored here only when no
 //! chromium is installed).
 
 #[path = "../support/mod.rs"]
@@ -11,6 +11,7 @@ mod browser;
 mod client;
 mod controls;
 mod feed;
+mod techno;
 
 use std::sync::Arc;
 

@@ -1,5 +1,6 @@
 // ncchannel live view: reads the server's event stream (/events) and draws each channel's
-// DRO, state, listing, stream fill, errors, cycle statistics and backplot; sends the operator
+// DRO, state, listing, stream fill, errors, the technology units waiting for the PLC, cycle
+// statistics and backplot; sends the operator
 // controls to /control/<channel>/<action>. Hand-written, no libraries.
 "use strict";
 
@@ -80,7 +81,47 @@ function showChannel(v, c) {
   $(n, ".errors-total").textContent = c.errors_total ? "(" + c.errors_total + " raised)" : "";
   if (c.last_error) onError(Object.assign({ ch: c.ch }, c.last_error));
   showLine(v, c);
+  showTechno(v, c.techno);
   addPoint(v, c.axes);
+}
+
+// ---- technology units waiting for the PLC ----
+
+function showTechno(v, t) {
+  const n = v.node;
+  const plc = $(n, ".techno-plc");
+  plc.textContent = t.plc_present
+    ? "· PLC present: waits for done_w"
+    : "· no PLC: the channel acknowledges after the process time";
+  plc.className = "techno-plc " + (t.plc_present ? "present" : "absent");
+  $(n, ".techno-counts").textContent = "· output " + t.output + " / acknowledged " + t.acknowledged;
+  const body = $(n, ".techno tbody");
+  // Few rows (at most one per unit): rebuilt on every update.
+  body.textContent = "";
+  for (const w of t.waiting) {
+    const row = document.createElement("tr");
+    row.dataset.function = w.function;
+    row.dataset.set = w.set;
+    row.dataset.unit = w.unit;
+    if (!t.plc_present && w.waited_s * 1e6 > w.process_time_us) row.className = "overdue";
+    const cells = [
+      ["function", w.function],
+      ["sync", w.sync],
+      ["unit", w.set + " " + w.unit],
+      ["fetched", w.please ? "no" : "yes"],
+      ["since", fmt(w.output_at_s, 3) + " s"],
+      ["waited", fmt(w.waited_s, 1) + " s of " + fmt(w.process_time_us / 1e6, 1) + " s"],
+      ["line", w.line],
+    ];
+    for (const [cls, text] of cells) {
+      const td = document.createElement("td");
+      td.className = cls;
+      td.textContent = text;
+      row.appendChild(td);
+    }
+    body.appendChild(row);
+  }
+  $(n, ".techno-none").hidden = t.waiting.length > 0;
 }
 
 function showDro(v, c) {
