@@ -254,6 +254,7 @@ impl Flow {
 
     /// A statement at the skipped structure's own level: does it end the skip? `true` when
     /// the line is then to be executed (the loop end a `$CONTINUE` looked for).
+    #[inline]
     fn skip_reaches(&mut self, until: &SkipUntil, c: &Control, ip: &impl Env) -> Res<bool> {
         match (until, c) {
             (SkipUntil::IfBranch, Control::ElseIf(e)) if is_true(ip.eval(e)?) => {
