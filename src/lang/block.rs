@@ -209,6 +209,10 @@ pub enum VarRef {
     /// j's), mm, from the tool list (TF5200 programming manual, "Global variables (V.G.)").
     /// Read-only.
     ToolRadius(Option<Box<Expr>>),
+    /// `V.G.M_FCT[n].SYNCH` / `V.G.H_FCT[n].SYNCH`: the synchronisation type of M or H
+    /// function n, as the kernel's value (TF5200 "Parameterising the synchronisation
+    /// methods": the program may change what `m_synch` / `h_synch` configured).
+    FunctionSync { h: bool, number: Box<Expr> },
 }
 
 /// The axis of a `V.A.` variable: by name (`.X`) or by index in the channel's axis list.

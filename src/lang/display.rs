@@ -304,6 +304,10 @@ impl Display for VarRef {
             VarRef::AxisAbs(AxisSel::Index(e)) => return write!(f, "V.A.ABS{}", Bracketed(e)),
             VarRef::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
             VarRef::ToolRadius(Some(e)) => return write!(f, "V.G.WZ{}.R", Bracketed(e)),
+            VarRef::FunctionSync { h, number } => {
+                let letter = if *h { 'H' } else { 'M' };
+                return write!(f, "V.G.{letter}_FCT{}.SYNCH", Bracketed(number));
+            }
         };
         for e in indices {
             Bracketed(e).fmt(f)?;

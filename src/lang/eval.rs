@@ -31,6 +31,8 @@ pub enum VarKey<'e> {
     AxisAbs(AxisId),
     /// `V.G.WZ_AKT.R` (`None`: the active tool) or `V.G.WZ[j].R`: a tool radius.
     ToolRadius(Option<u32>),
+    /// `V.G.M_FCT[n].SYNCH` (`h` false) / `V.G.H_FCT[n].SYNCH`.
+    FunctionSync { h: bool, number: u32 },
 }
 
 /// The axis of a `V.A.` variable, its index evaluated: which axis a letter or index names
@@ -60,6 +62,9 @@ impl std::fmt::Display for VarKey<'_> {
             VarKey::AxisAbs(AxisId::Letter(l)) => return write!(f, "V.A.ABS.{}", char::from(*l)),
             VarKey::AxisAbs(AxisId::Index(i)) => return write!(f, "V.A.ABS[{i}]"),
             VarKey::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
+            VarKey::FunctionSync { h, number } => {
+                return write!(f, "V.G.{}_FCT[{number}].SYNCH", if *h { 'H' } else { 'M' })
+            }
             VarKey::ToolRadius(Some(j)) => return write!(f, "V.G.WZ[{j}].R"),
         };
         for i in indices {
@@ -426,6 +431,10 @@ pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalE
         }
         VarRef::ToolRadius(None) => VarKey::ToolRadius(None),
         VarRef::ToolRadius(Some(e)) => VarKey::ToolRadius(Some(index(eval(e, vars)?)?)),
+        VarRef::FunctionSync { h, number } => VarKey::FunctionSync {
+            h: *h,
+            number: index(eval(number, vars)?)?,
+        },
     })
 }
 

@@ -673,6 +673,9 @@ impl<'a> Ctx<'a> {
         self.height.set(0);
         let f = &i[4..];
         let (rest, name) = name_or(f, "global variable name expected")?;
+        if let ("M_FCT" | "H_FCT", true) = (name.as_str(), rest.starts_with('[')) {
+            return self.function_sync(name.as_str() == "H_FCT", rest, i);
+        }
         let (rest, tool) = match name.as_str() {
             "WZ_AKT" => (rest, None),
             "WZ" if rest.starts_with('[') => {
@@ -705,6 +708,31 @@ impl<'a> Ctx<'a> {
         }
         self.set_height(self.height.get() + 1, i)?;
         Ok((rest, VarRef::ToolRadius(tool)))
+    }
+
+    /// `V.G.M_FCT[<n>].SYNCH` / `V.G.H_FCT[<n>].SYNCH` from the `[` on; `i` at the `V`.
+    #[cold]
+    fn function_sync(&self, h: bool, rest: &'a str, i: &'a str) -> PResult<'a, VarRef> {
+        let (r, number) = self.bracketed(rest)?;
+        let (r, field) = match r.strip_prefix('.') {
+            Some(r) => name_or(r, "function data field expected")?,
+            None => return fail(r, SYNTAX, "`.SYNCH` expected after the function number"),
+        };
+        if field != "SYNCH" {
+            return fail(
+                r,
+                UNSUPPORTED,
+                format!("{field}: ncchannel models the SYNCH field of V.G.M_FCT / V.G.H_FCT only"),
+            );
+        }
+        self.set_height(self.height.get() + 1, i)?;
+        Ok((
+            r,
+            VarRef::FunctionSync {
+                h,
+                number: Box::new(number),
+            },
+        ))
     }
 
     /// Array indices written directly after a variable: `[i]`, `[i][j]`.

@@ -183,3 +183,22 @@ fn a_value_goes_with_its_function_and_several_functions_share_the_units_of_their
     assert!(block_t(&r, 20) - t(outs[0]) >= 0.2 - 1e-9, "{}", r.log);
     assert_eq!(r.of("techno_acknowledged").len(), 3);
 }
+
+#[test]
+fn a_program_changes_a_functions_type_through_v_g_m_fct_synch() {
+    let rig = rig_with("MVS_SVS");
+    let prog = "V.G.M_FCT[25].SYNCH = 1\n\
+                $IF V.G.M_FCT[25].SYNCH == 1\n#MSG [\"M25 is MOS now\"]\n$ENDIF\n\
+                N20 G00 X25\nN30 X50\nN40 X75 M25\nN50 G01 X100 F2000\nM30\n";
+    rig.program("v.nc", prog);
+    let r = rig.run("v.nc", None, 200_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    assert_eq!(only(&r, "techno_output")["sync"], "MOS");
+    assert_eq!(only(&r, "message")["text"], "M25 is MOS now");
+    // MOS does not wait: N40's motion starts with the output.
+    assert!((block_t(&r, 40) - t(only(&r, "techno_output"))).abs() < 0.002);
+    // A value that is no modelled type is refused at the assignment.
+    rig.program("bad.nc", "G01 X1 F1000\nV.G.H_FCT[7].SYNCH = 3\nM30\n");
+    let r = rig.run("bad.nc", None, 10_000);
+    assert_eq!(r.error_codes(), vec![900132], "{}", r.log);
+}

@@ -1,7 +1,9 @@
 //! Machine data a program reads: `V.A.ABS.<axis>` / `V.A.ABS[<index>]`, the axis'
 //! coordinate at the end of the previous block in the active coordinate system (TF5200
 //! programming manual, "Axis-specific variables (V.A.)"), and `V.G.WZ_AKT.R` /
-//! `V.G.WZ[j].R`, tool radii from the tool list ("Global variables (V.G.)"). The parser
+//! `V.G.WZ[j].R`, tool radii from the tool list ("Global variables (V.G.)"), and
+//! `V.G.M_FCT[n].SYNCH` / `V.G.H_FCT[n].SYNCH`, a technology function's synchronisation
+//! type (TF5200 "Parameterising the synchronisation methods"). The parser
 //! refuses the manual's other V.A. and V.G. variables by name (docs/nc-language.md,
 //! "Constructs of real programs").
 
@@ -39,5 +41,13 @@ impl Interpreter {
             .iter()
             .find(|(n, _)| *n == d)
             .map(|(_, r)| *r)
+    }
+}
+
+impl Interpreter {
+    /// `V.G.M_FCT[n].SYNCH` / `V.G.H_FCT[n].SYNCH` (`h`): the function's synchronisation
+    /// value from the channel's table (decoder/interp/techno.rs).
+    pub(super) fn function_sync(&self, h: bool, n: u32) -> Option<f64> {
+        self.techno.sync_value(h, n)
     }
 }

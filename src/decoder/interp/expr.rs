@@ -43,7 +43,7 @@ pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
         }
         VarKey::CycleParam(n) => VarSlot::CycleParam(*n),
         // Read from the decoder's position, never stored (`Env`).
-        VarKey::AxisAbs(_) | VarKey::ToolRadius(_) => return None,
+        VarKey::AxisAbs(_) | VarKey::ToolRadius(_) | VarKey::FunctionSync { .. } => return None,
     })
 }
 
@@ -56,6 +56,7 @@ impl Vars for Env<'_> {
         match key {
             VarKey::AxisAbs(id) => self.0.axis_abs(*id),
             VarKey::ToolRadius(d) => self.0.tool_radius(*d),
+            VarKey::FunctionSync { h, number } => self.0.function_sync(*h, *number),
             _ => VarStore::get(&self.0.vars, &slot(key)?),
         }
     }

@@ -5,9 +5,11 @@
 use super::block_words::Words;
 use crate::decoder::error::{DecodeError, Res};
 use crate::lang::codes;
+use crate::lang::range::whole_u32 as whole;
 use crate::queue::{Action, TechnoStep};
 use crate::vocab::techno::{
-    FunctionDef, OutputGroup, SyncType, TechnoFn, TechnoKind, TechnoSeq, TechnoTable,
+    FunctionDef, OutputGroup, SyncSpec, SyncType, TechnoFn, TechnoKind, TechnoSeq, TechnoTable,
+    PLC_INFO,
 };
 
 /// The decoder's technology state: the table (which `V.G.M_FCT[n].SYNCH` may change), the
@@ -99,14 +101,54 @@ impl TechnoState {
         self.late_explicit.clear();
     }
 
-    #[allow(dead_code)]
-    pub(in crate::decoder) fn table_mut(&mut self) -> &mut TechnoTable {
-        &mut self.table
+    /// `V.G.M_FCT[n].SYNCH` (`h` false) / `V.G.H_FCT[n].SYNCH` read: the kernel's value of
+    /// the function's synchronisation type; `None` for a function the table does not define.
+    pub(in crate::decoder) fn sync_value(&self, h: bool, n: u32) -> Option<f64> {
+        let def = if h {
+            self.table.h_def(n)
+        } else {
+            self.table.m_def(n)
+        }?;
+        Some(f64::from(def.sync.value()))
     }
 
-    #[allow(dead_code)]
-    pub(in crate::decoder) fn table(&self) -> &TechnoTable {
-        &self.table
+    /// `V.G.M_FCT[n].SYNCH = v`: from the next block on, function n has the type of value
+    /// `v` (a modelled type's value, `PLC_INFO` added or not); anything else is refused.
+    pub(in crate::decoder) fn set_sync(&mut self, h: bool, n: f64, v: f64) -> Res {
+        let letter = if h { 'H' } else { 'M' };
+        let number = whole(n).filter(|n| *n <= codes::MAX_M_H).ok_or_else(|| {
+            DecodeError::new(
+                codes::BAD_VALUE,
+                format!(
+                    "V.G.{letter}_FCT[{n}]: a function number is 0 … {}",
+                    codes::MAX_M_H
+                ),
+            )
+        })?;
+        let spec = whole(v)
+            .and_then(|v| {
+                let sync = SyncType::from_value(v & !PLC_INFO).filter(|t| t.is_modelled())?;
+                Some(SyncSpec {
+                    sync,
+                    plc_info: v & PLC_INFO != 0,
+                })
+            })
+            .ok_or_else(|| {
+                DecodeError::new(
+                    codes::BAD_VALUE,
+                    format!(
+                        "V.G.{letter}_FCT[{number}].SYNCH = {v}: not a synchronisation type \
+                         ncchannel models (NO_SYNCH 0, MOS 1, MVS_SVS 2, MVS_SNS 4, MNS_SNS 8, \
+                         MVS_SLM 0x4000, with PLC_INFO 0x20000 or not)"
+                    ),
+                )
+            })?;
+        if h {
+            self.table.set_h_sync(number, spec);
+        } else {
+            self.table.set_m_sync(number, spec);
+        }
+        Ok(())
     }
 
     /// Does the block program anything this step looks at? (Most blocks do not: one test.)

@@ -185,6 +185,11 @@ impl Interpreter {
     /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
     /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
     fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
+        if let VarRef::FunctionSync { h, number } = target {
+            let n = self.eval(number).map_err(|e| e.at(col))?;
+            let v = self.eval(value).map_err(|e| e.at(col))?;
+            return self.techno.set_sync(*h, n, v).map_err(|e| e.at(col));
+        }
         let key = self.resolve(target).map_err(|e| e.at(col))?;
         if matches!(target, VarRef::P { .. }) {
             let v = self.eval(value).map_err(|e| e.at(col))?;
