@@ -318,6 +318,15 @@ impl Flow {
         self.skip.is_some()
     }
 
+    /// A skip that only `$` statements can end or nest (not a jump to a label, not a local
+    /// subroutine's section).
+    #[inline]
+    pub(super) fn skips_structure(&self) -> bool {
+        self.skip
+            .as_ref()
+            .is_some_and(|s| !matches!(s.until, SkipUntil::Label(_) | SkipUntil::LocalSubroutine))
+    }
+
     /// The label a forward jump is skipping to, if it is one.
     pub(super) fn skipping_to(&self) -> Option<&GotoTarget> {
         match &self.skip {

@@ -489,13 +489,19 @@ impl Decoder {
             return Ok(());
         }
         let skipping = top.flow().skipping();
+        let stream = self.reader.current().is_stream();
+        if skipping
+            && self.reader.top().flow().skips_structure()
+            && !may_matter_when_skipped(text, stream)
+        {
+            return Ok(());
+        }
         let block = match parse_block(text) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error.
             Err(_) if skipping => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        let stream = self.reader.current().is_stream();
         if stream {
             stream_allows(&block)?;
         }
@@ -584,6 +590,17 @@ impl Decoder {
 }
 
 /// What a streaming program may not hold: loops (21478) and local subroutine calls (21479).
+/// Can a line matter while a structure (`$IF` branch, `$SWITCH` case, loop) is skipped? Only
+/// a `$` statement nests or ends the skip, and in a stream an `LL` call is refused even
+/// there ([`stream_allows`]); any other line is skipped unparsed — a syntax error in it never
+/// runs, as for a parsed one. A `$` or (streams) an `L` anywhere, in a comment too, sends the
+/// line through the parser: the test may say yes too often, never too seldom.
+#[inline]
+fn may_matter_when_skipped(text: &str, stream: bool) -> bool {
+    let b = text.as_bytes();
+    memchr::memchr(b'$', b).is_some() || (stream && memchr::memchr2(b'L', b'l', b).is_some())
+}
+
 fn stream_allows(block: &Block) -> Res {
     match &block.body {
         Body::Control(c) if is_loop_statement(c) => Err(DecodeError::new(

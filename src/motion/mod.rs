@@ -572,6 +572,7 @@ impl Motion {
     /// STEP 1 of an entry: start the front entry if it may start now — a move only with time
     /// left in the tick, nothing while held at rest, a stop only once the axes stand. Emits
     /// its `Started` note. Returns whether it started.
+    #[inline]
     fn start_front(&mut self, left: f64, notes: &mut Vec<MotionNote>) -> bool {
         let Some(front) = self.planner.front_mut() else {
             return false;

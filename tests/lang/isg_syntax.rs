@@ -786,3 +786,30 @@ fn axes_named_with_digits_take_an_equals_sign() {
     // An ordinary channel: `X1=5` names an axis it does not have.
     fails_at(&Rig::new(), "G01 X1=5 F1000\nM30\n", 20200, 1, 5, false);
 }
+
+#[test]
+fn a_skipped_branch_runs_nothing_of_its_lines_and_a_streamed_ll_in_it_is_still_refused() {
+    let rig = Rig::new();
+    // The false branch holds a line that would not parse and a `$` inside a comment; the
+    // nested `$IF` in it keeps the structure right. Neither runs, as the kernel skips them.
+    let text = "P1=1\n$IF P1 == 2\nG01 X*** F\n( cost in $ )\n$IF P1 == 1\nG01 Y5 F100\n\
+                $ENDIF\n$ELSE\nG01 X1 F100\n$ENDIF\nM30\n";
+    let r = runs_clean_unchecked(&rig, text);
+    assert_eq!((r.position('X'), r.position('Y')), (1.0, 0.0));
+    // A stream refuses an LL call even in a branch it skips (the kernel's 21479), as a
+    // file runs it only when it is taken.
+    let s = rig.run(
+        "streaming.nc",
+        Some(feeder("P1=1\n$IF P1 == 2\nLL SUB1\n$ENDIF\nM30\n", 992, 1)),
+        100_000,
+    );
+    assert_eq!(s.error_codes(), vec![21479], "{}", s.log);
+}
+
+/// A program that must run to its end in a file and streamed (`check` is not asked: the
+/// program may hold lines only a skip makes harmless).
+fn runs_clean_unchecked(rig: &Rig, text: &str) -> RunResult {
+    let r = run_everywhere(rig, text);
+    assert_eq!(r.finish, Some(Finish::Ended), "{text}\n{}", r.log);
+    r
+}

@@ -37,6 +37,14 @@ pub(in crate::decoder) struct BlockTechno {
 }
 
 impl BlockTechno {
+    /// Nothing to output and nothing to wait for (only NO_SYNCH functions).
+    pub(in crate::decoder) fn is_empty(&self) -> bool {
+        self.before.is_empty()
+            && self.wait_before.is_empty()
+            && self.after.is_empty()
+            && self.wait_after.is_empty()
+    }
+
     /// The queue actions before the block's motion.
     pub(in crate::decoder) fn actions_before(
         &mut self,

@@ -62,32 +62,28 @@ impl Interpreter {
         }
         let gs = self.modal_changes(w)?;
         let info = self.info(rd, at, io);
-        // Step 4: the block's action (a dwell or a move), not yet queued.
-        let action = if gs.dwell {
-            let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
-            Some(Action::Dwell { seconds })
-        } else if gs.set_reference {
-            self.set_reference(w);
+        // Step 4: the block's move (not yet queued), if it has one.
+        let mv = if gs.dwell || gs.set_reference {
             None
         } else if let Some(end) = self.target(w, gs) {
             let mut mv = self.motion(w, end)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
-            Some(Action::Move(mv))
+            Some(mv)
         } else {
             None
         };
-        // Step 4½: its technology functions around it (decoder/interp/techno.rs).
-        let feed_move = matches!(&action, Some(Action::Move(mv)) if mv.kind != MoveKind::Rapid);
-        let mut techno = if self.techno.concerns(w, feed_move) {
-            Some(self.techno.plan(w, feed_move)?)
-        } else {
-            None
-        };
+        // Step 4½: its technology functions around it (decoder/interp/techno.rs); most
+        // blocks have none and go straight on.
+        let feed_move = mv.as_ref().is_some_and(|mv| mv.kind != MoveKind::Rapid);
+        let mut techno = None;
+        if self.techno.concerns(w, feed_move) {
+            techno = Some(self.techno.plan(w, feed_move)?).filter(|t| !t.is_empty());
+        }
         let (block_nr, line) = (info.n.unwrap_or(0), info.line);
         let mut queued = false;
         if let Some(t) = techno.as_mut() {
-            if action.is_none() {
+            if mv.is_none() && !gs.dwell {
                 // A block without motion takes effect, then hands its functions over.
                 self.emit(info.clone(), Action::None, false, io);
                 queued = true;
@@ -96,11 +92,16 @@ impl Interpreter {
                 self.emit(info.clone(), a, true, io);
             }
         }
-        if let Some(a) = action {
-            if let Action::Move(mv) = &a {
-                self.modal.pos = mv.end;
-            }
-            self.emit(info.clone(), a, false, io);
+        // Step 4 queued: the dwell or the move.
+        if gs.dwell {
+            let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
+            self.emit(info.clone(), Action::Dwell { seconds }, false, io);
+            queued = true;
+        } else if gs.set_reference {
+            self.set_reference(w);
+        } else if let Some(mv) = mv {
+            self.modal.pos = mv.end;
+            self.emit(info.clone(), Action::Move(mv), false, io);
             queued = true;
         }
         if let Some(t) = techno.as_mut() {
