@@ -407,6 +407,9 @@ pub enum GotoTarget {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     Flush(FlushKind),
+    /// `#EXPL SYN`: the explicit synchronisation point of MVS_SLP technology functions
+    /// (TF5200 "Example of MVS_SLP").
+    ExplicitSync,
     /// `#CACHE LOAD [FILE=name]`.
     CacheLoad {
         file: String,

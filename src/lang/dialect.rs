@@ -151,7 +151,7 @@ pub fn g_support(g: u32) -> Option<(Support, &'static str)> {
 
 /// The `#` commands of the reference list by their first keyword, and ours. Commands
 /// handled by the parser itself (`#FLUSH`, `#CACHE`, `#COMMENT`, `#SPLINE`, `#HSC`,
-/// `#CONTOUR`, `#VAR`/`#ENDVAR`, `#MSG`, `#TIME`) are listed as implemented.
+/// `#CONTOUR`, `#VAR`/`#ENDVAR`, `#MSG`, `#TIME`, `#EXPL SYN`) are listed as implemented.
 const COMMAND_TABLE: &[(&str, Support)] = &[
     ("ACS", R),
     ("ADD", R),
@@ -189,7 +189,7 @@ const COMMAND_TABLE: &[(&str, Support)] = &[
     ("ENABLE", R),
     ("ENDVAR", I),
     ("ERROR", R),
-    ("EXPL", R),
+    ("EXPL", I),
     ("EXPORT", R),
     ("EXTCOMP", N),
     ("FACE", R),

@@ -402,6 +402,7 @@ impl Display for Command {
             Command::CacheClearAll => f.write_str("#CACHE CLEAR ALL"),
             Command::CommentBegin => f.write_str("#COMMENT BEGIN"),
             Command::CommentEnd => f.write_str("#COMMENT END"),
+            Command::ExplicitSync => f.write_str("#EXPL SYN"),
             Command::Spline(SplineCommand::On) => f.write_str("#SPLINE ON"),
             Command::Spline(SplineCommand::Off) => f.write_str("#SPLINE OFF"),
             Command::Spline(SplineCommand::TypeAkima) => f.write_str("#SPLINE TYPE AKIMA"),

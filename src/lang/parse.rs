@@ -955,6 +955,10 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             }
         }
         b"CACHE" => cache(r),
+        b"EXPL" => match keyword(r, "SYN") {
+            Some(r) if gap(r).is_empty() => Ok((r, Command::ExplicitSync)),
+            _ => fail(r, UNSUPPORTED, "#EXPL: ncchannel has #EXPL SYN only"),
+        },
         b"COMMENT" => {
             if let Some(r) = keyword(r, "BEGIN") {
                 Ok((r, Command::CommentBegin))

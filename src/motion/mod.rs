@@ -507,6 +507,7 @@ impl Motion {
         if !moving && !continues {
             self.v_mm_per_s = 0.0;
         }
+        self.pre_output(notes);
     }
 
     /// A run starts with the front move, at rest with the filter settled: a straight move
@@ -566,6 +567,26 @@ impl Motion {
             };
             self.planner.set_corner_window_s(corner_s);
             self.planner.plan_if_needed(self.override_pct, self.dt_s);
+        }
+    }
+
+    /// MEP_SVS / MET_SVS: a group whose pre-output point the moving front block has passed
+    /// goes to the PLC now (planner/pre_output.rs); measured from where the front move is.
+    fn pre_output(&mut self, notes: &mut Vec<MotionNote>) {
+        if !self.front_started {
+            return;
+        }
+        let Some(EntryKind::Move(seg)) = self.planner.front().map(|e| &e.kind) else {
+            return;
+        };
+        let to_go_mm = (seg.length_mm - self.s_mm).max(0.0);
+        let to_go_s = to_go_mm / seg.cruise_mm_per_s(self.override_pct).max(1e-9);
+        while let Some(g) = self
+            .planner
+            .take_due_pre_output(to_go_mm, to_go_s, self.override_pct)
+        {
+            self.output_this_step = true;
+            notes.push(MotionNote::TechnoOutput(g));
         }
     }
 

@@ -407,9 +407,6 @@ fn parse_symbols(text: &str) -> Result<SyncSpec, SyncError> {
             .iter()
             .find(|(_, n, _)| word.eq_ignore_ascii_case(n))
         {
-            if !t.is_modelled() {
-                return Err(err(unmodelled(t.name())));
-            }
             match sync {
                 Some(first) if first != *t => {
                     return Err(err(format!(
@@ -440,20 +437,14 @@ fn parse_symbols(text: &str) -> Result<SyncSpec, SyncError> {
 /// `0x00020002`: a type's value, `PLC_INFO` (0x20000) added or not.
 fn parse_number(v: u32) -> Result<SyncSpec, SyncError> {
     let rest = v & !PLC_INFO;
-    if let Some(sync) = SyncType::from_value(rest).filter(|t| t.is_modelled()) {
+    if let Some(sync) = SyncType::from_value(rest) {
         return Ok(SyncSpec {
             sync,
             plc_info: v & PLC_INFO != 0,
         });
     }
-    let unmodelled_type = SyncType::from_value(rest).map(SyncType::name);
-    let message = match UNMODELLED_SYNC
-        .iter()
-        .find(|(_, x)| *x == Some(rest))
-        .map(|(n, _)| *n)
-        .or(unmodelled_type)
-    {
-        Some(n) => unmodelled(n),
+    let message = match UNMODELLED_SYNC.iter().find(|(_, x)| *x == Some(rest)) {
+        Some((n, _)) => unmodelled(n),
         None => format!(
             "0x{v:08X} is not a synchronisation type ncchannel models ({})",
             SyncType::ALL

@@ -113,14 +113,6 @@ impl SyncType {
         matches!(self, SyncType::MvsSns | SyncType::MnsSns)
     }
 
-    /// Does ncchannel run this type as the kernel does? MVS_SLP synchronises at `#EXPL SYN`,
-    /// a command ncchannel does not have; MEP_SVS and MET_SVS output a path or a time before
-    /// the synchronisation point, which the interpolator does not model. They are refused at
-    /// start-up like the types of [`UNMODELLED_SYNC`], never run as another type.
-    pub fn is_modelled(self) -> bool {
-        !matches!(self, SyncType::MvsSlp | SyncType::MepSvs | SyncType::MetSvs)
-    }
-
     /// Synchronised later (the late-sync units): MVS_SLM before the next feed block, MVS_SLP
     /// at `#EXPL SYN`.
     pub fn is_late(self) -> bool {

@@ -202,3 +202,111 @@ fn a_program_changes_a_functions_type_through_v_g_m_fct_synch() {
     let r = rig.run("bad.nc", None, 10_000);
     assert_eq!(r.error_codes(), vec![900132], "{}", r.log);
 }
+
+/// The late-synchronisation examples: two functions with a 2 s process time, output early,
+/// synchronised only where the manual's program says.
+fn late_rig(m_synch: &str) -> Rig {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        format!(
+            "streaming_prog_file streaming.nc\nm_synch[24] {m_synch}\nm_synch[25] {m_synch}\n\
+             m_prozess_zeit[24] 2000000\nm_prozess_zeit[25] 2000000\n"
+        ),
+    )
+    .unwrap();
+    rig
+}
+
+#[test]
+fn mvs_slm_synchronises_before_the_next_feed_motion_block() {
+    let rig = late_rig("MVS_SLM");
+    rig.program(
+        "slm.nc",
+        "N05 M24\nN10 M25 G00 X25\nN20 X50\nN30 X75\nN40 X100\nN50 G01 X125 F2000\nN60 Z100\nM30\n",
+    );
+    let r = rig.run("slm.nc", None, 200_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    let outs = r.of("techno_output");
+    assert_eq!(outs.len(), 2);
+    assert!(outs
+        .iter()
+        .all(|e| e["late"] == true && e["sync"] == "MVS_SLM"));
+    let last_ack = r
+        .of("techno_acknowledged")
+        .iter()
+        .map(|e| t(e))
+        .fold(0.0, f64::max);
+    // The rapid blocks run on while the PLC works; the feed block N50 waits for both.
+    assert!(block_t(&r, 40) < last_ack, "{}", r.log);
+    assert!(block_t(&r, 50) >= last_ack - 1e-9, "{}", r.log);
+}
+
+#[test]
+fn mvs_slp_synchronises_at_expl_syn() {
+    let rig = late_rig("MVS_SLP");
+    rig.program(
+        "slp.nc",
+        "N05 M24 G00 X25\nN10 M25\nN20 X50\nN30 X75\nN40 X100\nN50 G01 X125 F2000\n\
+         N60 #EXPL SYN\nN70 G00 X0\nN80 X0 Y0\nM30\n",
+    );
+    let r = rig.run("slp.nc", None, 200_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    let last_ack = r
+        .of("techno_acknowledged")
+        .iter()
+        .map(|e| t(e))
+        .fold(0.0, f64::max);
+    assert_eq!(r.of("techno_acknowledged").len(), 2);
+    // Even the feed block N50 does not wait (that is MVS_SLM's point); N70 after #EXPL SYN does.
+    assert!(block_t(&r, 50) < last_ack, "{}", r.log);
+    assert!(block_t(&r, 70) >= last_ack - 1e-9, "{}", r.log);
+}
+
+/// The TwinCAT CNC example of "Synchronization types MET_SVS, MEP_SVS": M96 in N45 is output
+/// 25 mm (MEP_SVS, `m_pre_outp` 250000 × 0.1 µm) or 0.3 s (MET_SVS, 300000 µs) before the
+/// synchronisation point X40, while N20 still moves.
+fn pre_output_run(m_synch: &str, pre: u32) -> RunResult {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        format!(
+            "streaming_prog_file streaming.nc\nm_synch[96] {m_synch}\nm_pre_outp[96] {pre}\n\
+             m_prozess_zeit[96] 300000\n"
+        ),
+    )
+    .unwrap();
+    rig.program(
+        "pre.nc",
+        "N10 G01 X10 G90 F5000\nN20 X20\nN30 X30\nN40 X40\nN45 M96\nN50 X80\nM30\n",
+    );
+    let r = rig.run("pre.nc", None, 200_000);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{}", r.log);
+    r
+}
+
+#[test]
+fn mep_svs_and_met_svs_go_out_before_the_synchronisation_point_while_the_axes_still_move() {
+    let svs = pre_output_run("MVS_SVS", 0);
+    for (sync, pre) in [("MEP_SVS", 250_000), ("MET_SVS", 300_000)] {
+        let r = pre_output_run(sync, pre);
+        let out = only(&r, "techno_output");
+        let ack = only(&r, "techno_acknowledged");
+        assert_eq!(out["sync"], sync);
+        // Out while N20 moves (25 mm or about 0.3 s before X40 is X15), not at N45.
+        assert!(
+            t(out) > block_t(&r, 20) && t(out) < block_t(&r, 30),
+            "{sync}: {}",
+            r.log
+        );
+        // N50 still starts only after the acknowledgement ...
+        assert!(block_t(&r, 50) >= t(ack) - 1e-9, "{sync}: {}", r.log);
+        // ... which the PLC's time, overlapping the motion, made sooner than MVS_SVS's.
+        assert!(
+            end_t(&r) < end_t(&svs) - 0.2,
+            "{sync}: {} vs {}",
+            end_t(&r),
+            end_t(&svs)
+        );
+    }
+}

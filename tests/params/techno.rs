@@ -79,7 +79,7 @@ fn symbols_values_and_bar_combinations_define_the_functions_sorted_by_number() {
          m_synch[12]  PLC_INFO | MNS_SNS\n\
          m_synch[13]  mvs_slm\n\
          h_synch[7]   MOS\n\
-         h_synch[2]   PLC_INFO|MVS_SVS\n\
+         h_synch[2]   PLC_INFO|MVS_SLP\n\
          h_synch[65535] 0x00020000\n",
     );
     assert!(warnings.is_empty(), "{warnings:#?}");
@@ -92,7 +92,7 @@ fn symbols_values_and_bar_combinations_define_the_functions_sorted_by_number() {
     assert_eq!(t.m_def(12), Some(def(SyncType::MnsSns, true, 0, 0)));
     assert_eq!(t.m_def(13), Some(def(SyncType::MvsSlm, false, 0, 0)));
     assert_eq!(t.m_def(20), Some(def(SyncType::MvsSvs, false, 0, 0)));
-    assert_eq!(t.h_def(2), Some(def(SyncType::MvsSvs, true, 0, 0)));
+    assert_eq!(t.h_def(2), Some(def(SyncType::MvsSlp, true, 0, 0)));
     assert_eq!(t.h_def(7), Some(def(SyncType::Mos, false, 0, 0)));
     // PLC_INFO alone: reported to the PLC without a type of its own.
     assert_eq!(t.h_def(65535), Some(def(SyncType::NoSynch, true, 0, 0)));
@@ -107,13 +107,14 @@ fn a_second_column_must_say_the_same_as_the_first() {
     // The kernel's own lists: the symbol then the value, or the value then the symbol.
     let (t, warnings) = table(
         "spindel[0].m3_synch     PLC_INFO | MVS_SVS    0x00020002\n\
-         m_synch[96]             0x00000008  MNS_SNS\n\
+         m_synch[96]             0x01000000  MEP_SVS\n\
+         m_pre_outp[96]          100000     in 0.1 um\n\
          m_synch[8]              MVS_SVS    (coolant on) 0x1\n\
          m_synch[9]              0x00000004 coolant off\n",
     );
     assert!(warnings.is_empty(), "{warnings:#?}");
     assert_eq!(t.m_def(3), Some(def(SyncType::MvsSvs, true, 0, 0)));
-    assert_eq!(t.m_def(96), Some(def(SyncType::MnsSns, false, 0, 0)));
+    assert_eq!(t.m_def(96), Some(def(SyncType::MepSvs, false, 0, 100_000)));
     // After `(` and after words that are no second column: a comment.
     assert_eq!(t.m_def(8), Some(def(SyncType::MvsSvs, false, 0, 0)));
     assert_eq!(t.m_def(9), Some(def(SyncType::MvsSns, false, 0, 0)));
@@ -212,18 +213,28 @@ fn process_times_and_pre_outputs_join_their_functions() {
          m_prozess_zeit[8]   100000\n\
          h_synch[3]          MVS_SNS\n\
          h_prozess_zeit[3]   0x10\n\
+         m_synch[97]         MET_SVS\n\
+         m_pre_outp[97]      40000\n\
+         m_prozess_zeit[97]  5000\n\
          m_prozess_zeit[7]   2000\n\
          m_synch[11]         MVS_SVS\n\
-         m_pre_outp[11]      250000\n",
+         m_pre_outp[11]      250000\n\
+         m_synch[95]         MEP_SVS\n",
     );
     assert_eq!(t.m_def(8), Some(def(SyncType::MvsSvs, false, 100_000, 0)));
     assert_eq!(t.h_def(3), Some(def(SyncType::MvsSns, false, 16, 0)));
+    assert_eq!(
+        t.m_def(97),
+        Some(def(SyncType::MetSvs, false, 5000, 40_000))
+    );
     // A process time without a type: the function stays undefined.
     assert!(t.m_def(7).is_none());
     // A pre-output for a type that does not pre-output: not used.
     assert_eq!(t.m_def(11), Some(def(SyncType::MvsSvs, false, 0, 0)));
+    // MEP_SVS without one: output at the synchronisation point (P-CHAN-00070's default 0).
+    assert_eq!(t.m_def(95), Some(def(SyncType::MepSvs, false, 0, 0)));
     let lines: Vec<(usize, usize)> = warnings.iter().map(|w| (w.line, w.col)).collect();
-    assert_eq!(warnings.len(), 2, "{warnings:#?}");
+    assert_eq!(warnings.len(), 3, "{warnings:#?}");
     assert!(warnings.iter().all(|w| w.severity == Severity::Warning));
     let find = |line: usize| {
         warnings
@@ -232,12 +243,15 @@ fn process_times_and_pre_outputs_join_their_functions() {
             .unwrap_or_else(|| panic!("no warning on line {line}: {lines:?}"))
     };
     assert_eq!(
-        find(5).message,
+        find(8).message,
         "m_prozess_zeit[7] without m_synch[7]: M7 stays undefined; not used"
     );
-    assert!(find(7)
+    assert!(find(10)
         .message
         .starts_with("m_pre_outp[11]: M11 is MVS_SVS;"));
+    assert!(find(11)
+        .message
+        .starts_with("m_synch[95]: MEP_SVS without a pre-output"));
 
     let (errs, file) = refused("m_synch[8] MOS\nm_prozess_zeit[8] -5\n");
     assert_eq!(errs.len(), 1, "{errs:#?}");
@@ -426,27 +440,4 @@ fn check_reports_an_undefined_m_and_h_with_their_ids_and_places() {
         out.contains("--channel 2: the start-up list has 1 channel(s)"),
         "{out}"
     );
-}
-
-#[test]
-fn the_types_ncchannel_does_not_run_as_the_kernel_are_refused_by_name_and_by_value() {
-    // MVS_SLP synchronises at `#EXPL SYN`, MEP_SVS / MET_SVS pre-output: not modelled, so
-    // refused rather than run as another type.
-    for (entry, name) in [
-        ("m_synch[26] MVS_SLP\n", "MVS_SLP"),
-        ("m_synch[26] 0x8000\n", "MVS_SLP"),
-        ("m_synch[96] MEP_SVS\n", "MEP_SVS"),
-        ("m_synch[96] 0x01000000\n", "MEP_SVS"),
-        ("h_synch[97] PLC_INFO | MET_SVS\n", "MET_SVS"),
-    ] {
-        let (errs, _) = refused(entry);
-        assert_eq!(errs.len(), 1, "{entry}: {errs:#?}");
-        assert!(
-            errs[0].message.ends_with(&format!(
-                "{name} is a synchronisation type ncchannel does not model"
-            )),
-            "{entry}: {}",
-            errs[0].message
-        );
-    }
 }

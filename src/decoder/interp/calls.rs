@@ -278,6 +278,14 @@ impl Interpreter {
             Command::CommentBegin => rd.top().set_comment_block(true),
             // Outside a comment block `#COMMENT END` closes nothing; accepted silently.
             Command::CommentEnd => {}
+            // MVS_SLP functions output earlier wait here, before the next block
+            // (decoder/interp/techno.rs).
+            Command::ExplicitSync => {
+                self.emit(info.clone(), Action::None, false, io);
+                if let Some(wait) = self.techno.explicit_sync() {
+                    self.emit(info, wait, true, io);
+                }
+            }
             Command::Spline(s) => {
                 match s {
                     SplineCommand::On => self.modal.spline = true,

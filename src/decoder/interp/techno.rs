@@ -135,7 +135,7 @@ impl TechnoState {
         })?;
         let spec = whole(v)
             .and_then(|v| {
-                let sync = SyncType::from_value(v & !PLC_INFO).filter(|t| t.is_modelled())?;
+                let sync = SyncType::from_value(v & !PLC_INFO)?;
                 Some(SyncSpec {
                     sync,
                     plc_info: v & PLC_INFO != 0,
@@ -147,7 +147,8 @@ impl TechnoState {
                     format!(
                         "V.G.{letter}_FCT[{number}].SYNCH = {v}: not a synchronisation type \
                          ncchannel models (NO_SYNCH 0, MOS 1, MVS_SVS 2, MVS_SNS 4, MNS_SNS 8, \
-                         MVS_SLM 0x4000, with PLC_INFO 0x20000 or not)"
+                         MVS_SLM 0x4000, MVS_SLP 0x8000, MEP_SVS 0x1000000, MET_SVS 0x2000000, \
+                         with PLC_INFO 0x20000 or not)"
                     ),
                 )
             })?;
@@ -157,6 +158,15 @@ impl TechnoState {
             self.table.set_m_sync(number, spec);
         }
         Ok(())
+    }
+
+    /// `#EXPL SYN`: the MVS_SLP functions output since the last one are waited for here.
+    pub(in crate::decoder) fn explicit_sync(&mut self) -> Option<Action> {
+        (!self.late_explicit.is_empty()).then(|| {
+            Action::Techno(TechnoStep::Wait(
+                std::mem::take(&mut self.late_explicit).into_boxed_slice(),
+            ))
+        })
     }
 
     /// Does the block program anything this step looks at? (Most blocks do not: one test.)

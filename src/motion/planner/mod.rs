@@ -23,6 +23,7 @@ mod blend;
 mod entry;
 mod junction;
 mod limits;
+mod pre_output;
 mod radius_comp;
 mod spline_feed;
 mod velocity;
@@ -84,6 +85,9 @@ pub(crate) struct Planner {
     error: Option<PlanError>,
     /// The front entry is executing (its geometry is fixed).
     front_busy: bool,
+    /// Technology outputs with a pre-output in the window (planner/pre_output.rs): none, the
+    /// usual case, costs one comparison a tick.
+    pre_outputs: usize,
 }
 
 impl Planner {
@@ -98,6 +102,7 @@ impl Planner {
             limits,
             error: None,
             front_busy: false,
+            pre_outputs: 0,
             axes,
         }
     }
@@ -266,6 +271,7 @@ impl Planner {
                 self.check_limits(&seg.mv);
             }
         }
+        self.pre_outputs += usize::from(pre_output::has_lead(&kind));
         let release = self.window.releases(&kind, self.held() == 0);
         let continue_after = matches!(kind, EntryKind::Flush(FlushKind::Continue));
         let at = self.window.push_back(Entry {
@@ -467,11 +473,33 @@ impl Planner {
 
     /// Remove the front entry (it has been executed).
     pub(crate) fn pop_front(&mut self) -> Option<Entry> {
-        self.window.pop_front()
+        let e = self.window.pop_front()?;
+        if pre_output::has_lead(&e.kind) {
+            self.pre_outputs -= 1;
+        }
+        Some(e)
+    }
+
+    /// A MEP_SVS / MET_SVS group whose pre-output point the front move has reached
+    /// (`to_go_mm` and `to_go_s` left of it), taken out of the window to go to the PLC now.
+    #[inline]
+    pub(crate) fn take_due_pre_output(
+        &mut self,
+        to_go_mm: f64,
+        to_go_s: f64,
+        override_pct: f64,
+    ) -> Option<Box<crate::vocab::techno::OutputGroup>> {
+        if self.pre_outputs == 0 {
+            return None;
+        }
+        let g = pre_output::take_due(&mut self.window, to_go_mm, to_go_s, override_pct)?;
+        self.pre_outputs -= 1;
+        Some(g)
     }
 
     /// Drop everything (reset, error).
     pub(crate) fn clear(&mut self) {
+        self.pre_outputs = 0;
         self.window.clear();
         self.spline.clear();
         self.comp.clear();

@@ -82,6 +82,9 @@ impl Window {
     pub(super) fn iter(&self) -> std::collections::vec_deque::Iter<'_, Entry> {
         self.entries.iter()
     }
+    pub(super) fn iter_mut(&mut self) -> std::collections::vec_deque::IterMut<'_, Entry> {
+        self.entries.iter_mut()
+    }
     /// The released entries, front first.
     pub(super) fn released_mut(
         &mut self,
