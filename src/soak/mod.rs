@@ -139,6 +139,13 @@ pub fn build(
             ch_rng.fork(2),
             source,
         );
+        if let Some(plc) = &spec.plc {
+            let seed = ch_rng.fork(4).next_u64();
+            machine.attach_plc(crate::machine::plc::SimulatedPlc::new(
+                spec.number,
+                scenario::plc_config(plc, seed ^ plc.seed),
+            ));
+        }
         let slot = Slot::new(
             &mut machine,
             spec.number,
@@ -150,13 +157,17 @@ pub fn build(
         .ok_or_else(|| SoakError::Setup(format!("channel {}: not built", spec.number)))?;
         slots.push(slot);
     }
-    let cycle = SoakCycle::new(
+    let with_plc = !machine.plcs().is_empty();
+    let mut cycle = SoakCycle::new(
         machine,
         slots,
         scenario.faults.clone(),
         scenario.invariants.expected_errors.clone(),
         target_blocks,
     );
+    if with_plc {
+        cycle.report_techno();
+    }
     Ok((
         cycle,
         Duration::from_micros(config.runtime.cycle_period_us.max(1)),
@@ -256,7 +267,8 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         wall_seconds: start.elapsed().as_secs_f64(),
         blocks: rt.cycle().total_blocks,
     };
-    let (cycle, stats) = rt.into_inner();
+    let (mut cycle, stats) = rt.into_inner();
+    cycle.end_checks();
     Ok(report_of(&cycle, &stats, scenario, run, warmup_kib, period))
 }
 
