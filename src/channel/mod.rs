@@ -562,6 +562,10 @@ impl Channel {
             );
         }
         self.motion.reset();
+        // What was output or waits to be is dropped with the program, as the operator's reset
+        // ends a wait for the PLC (README "Technology functions: the PLC half");
+        // `plc_present` stays.
+        self.techno.reset();
         self.queue.clear();
         self.hmi.close_gate();
         self.decoder.reset(self.motion.position());

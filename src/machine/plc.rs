@@ -183,7 +183,7 @@ impl SimulatedPlc {
             if self
                 .config
                 .late_every
-                .is_some_and(|k| k > 0 && self.stats.taken % k == 0)
+                .is_some_and(|k| k > 0 && self.stats.taken.is_multiple_of(k))
             {
                 ms = ms.saturating_add(self.config.late_ms);
                 self.stats.late += 1;

@@ -615,6 +615,10 @@ impl SoakCycle {
         expected_errors: Vec<u32>,
         target_blocks: Option<u64>,
     ) -> Self {
+        let tallies = Tallies {
+            techno_reported: !machine.plcs().is_empty(),
+            ..Tallies::default()
+        };
         SoakCycle {
             machine,
             slots,
@@ -622,7 +626,7 @@ impl SoakCycle {
             expected_errors,
             target_blocks,
             total_blocks: 0,
-            tallies: Tallies::default(),
+            tallies,
             planned: false,
         }
     }
@@ -642,11 +646,6 @@ impl SoakCycle {
                 s.core.end_checks(c, &mut self.tallies);
             }
         }
-    }
-
-    /// Report the technology verdicts (a simulated PLC runs).
-    pub(crate) fn report_techno(&mut self) {
-        self.tallies.techno_reported = true;
     }
 
     /// The built-in clients' write counters, in the order of the scenario.

@@ -139,13 +139,7 @@ pub fn build(
             ch_rng.fork(2),
             source,
         );
-        if let Some(plc) = &spec.plc {
-            let seed = ch_rng.fork(4).next_u64();
-            machine.attach_plc(crate::machine::plc::SimulatedPlc::new(
-                spec.number,
-                scenario::plc_config(plc, seed ^ plc.seed),
-            ));
-        }
+        attach_plc(&mut machine, spec, &mut ch_rng);
         let slot = Slot::new(
             &mut machine,
             spec.number,
@@ -157,21 +151,29 @@ pub fn build(
         .ok_or_else(|| SoakError::Setup(format!("channel {}: not built", spec.number)))?;
         slots.push(slot);
     }
-    let with_plc = !machine.plcs().is_empty();
-    let mut cycle = SoakCycle::new(
+    let cycle = SoakCycle::new(
         machine,
         slots,
         scenario.faults.clone(),
         scenario.invariants.expected_errors.clone(),
         target_blocks,
     );
-    if with_plc {
-        cycle.report_techno();
-    }
     Ok((
         cycle,
         Duration::from_micros(config.runtime.cycle_period_us.max(1)),
     ))
+}
+
+/// The channel's simulated PLC, if its `[channel.plc]` asks for one; its delays drawn from
+/// the channel's random numbers, so the scenario's seed gives the same answers.
+fn attach_plc(machine: &mut Machine, spec: &scenario::ChannelSpec, ch_rng: &mut SplitMix64) {
+    if let Some(plc) = &spec.plc {
+        let seed = ch_rng.fork(4).next_u64() ^ plc.seed;
+        machine.attach_plc(crate::machine::plc::SimulatedPlc::new(
+            spec.number,
+            scenario::plc_config(plc, seed),
+        ));
+    }
 }
 
 /// The progress bar of a run (none when `enabled` is false).
