@@ -181,7 +181,7 @@ fn a_plc_that_stops_answering_leaves_the_program_waiting() {
     assert_eq!(r["techno"]["output"], 2, "{r}");
     assert_eq!(r["techno"]["acknowledged"], 1, "M9 (MOS) waits in its unit");
     let ev = events(dir.path());
-    let last_block = ev.iter().filter(|e| e["ev"] == "block").last().unwrap();
+    let last_block = ev.iter().rfind(|e| e["ev"] == "block").unwrap();
     // The MOS M9 went out and its block's motion ran; the program waits at the next M8,
     // whose output waits for the unit M9 still holds.
     assert_eq!(last_block["text"], "M8", "{last_block}");
