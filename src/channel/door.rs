@@ -6,7 +6,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::techno::{TechnoRefusal, TechnoStats, TechnoStatus, TechnoWrite};
+use super::techno::{TechnoRefusal, TechnoSeen, TechnoStats, TechnoStatus, TechnoWrite};
 use super::{
     ActiveBlock, Channel, ChannelStats, CommandError, ErrorRecord, ExecutedBlock, HmiCommands,
     Mode, SearchCommand, State,
@@ -64,6 +64,11 @@ pub enum Op {
     /// A PLC's write into the technology interface (`plc_present_w`, a unit's `please_rw`
     /// or `done_w`).
     Techno(TechnoWrite),
+    /// Record every technology function's output, acknowledgement or drop, and the block
+    /// starts that waited for functions, for [`Op::DrainTechno`] (the soak's checks).
+    ObserveTechno(bool),
+    /// The technology observations since the last drain ([`Reply::TechnoSeen`]).
+    DrainTechno,
 }
 
 /// What `run` asks of the motion trace.
@@ -299,6 +304,12 @@ pub enum Reply {
     ProgramText(Option<Arc<Vec<u8>>>),
     /// A technology write taken, or refused without a change.
     Techno(Result<(), TechnoRefusal>),
+    /// The observations [`Op::DrainTechno`] asked for, in order, and how many did not fit
+    /// between two drains.
+    TechnoSeen {
+        seen: Vec<TechnoSeen>,
+        lost: u64,
+    },
 }
 
 /// An error as the ADS objects carry it: number and text.

@@ -214,6 +214,14 @@ impl Channel {
             }),
             Op::ProgramText(prog) => Reply::ProgramText(self.program_text(&prog)),
             Op::Techno(w) => Reply::Techno(self.techno.write(w)),
+            Op::ObserveTechno(on) => {
+                self.techno.observe(on);
+                Reply::Done
+            }
+            Op::DrainTechno => {
+                let (seen, lost) = self.techno.drain_seen();
+                Reply::TechnoSeen { seen, lost }
+            }
         }
     }
 
@@ -248,6 +256,12 @@ impl Channel {
             notes: Vec::new(),
             decoder_notes: Vec::new(),
         }
+    }
+
+    /// The technology units, read-only: what a PLC played inside the machine polls
+    /// (`machine::plc`); it writes only through [`Channel::apply`].
+    pub(crate) fn techno(&self) -> &TechnoUnits {
+        &self.techno
     }
 
     /// The live snapshot a client reads (what `Op::Status` answers, without the tick's
@@ -548,6 +562,10 @@ impl Channel {
             );
         }
         self.motion.reset();
+        // What was output or waits to be is dropped with the program, as the operator's reset
+        // ends a wait for the PLC (README "Technology functions: the PLC half");
+        // `plc_present` stays.
+        self.techno.reset();
         self.queue.clear();
         self.hmi.close_gate();
         self.decoder.reset(self.motion.position());
@@ -579,6 +597,9 @@ impl Channel {
             if let MotionNote::TechnoOutput(group) = n {
                 self.techno.output(*group, tick.time);
                 continue;
+            }
+            if matches!(n, MotionNote::Started(_)) && self.techno.observing() {
+                self.techno.block_started(tick.time);
             }
             match self.log.motion_note(tick, n, &mut self.run, &mut self.hmi) {
                 AfterMotionNote::Go => {}

@@ -133,6 +133,53 @@ pub struct TechnoStatus {
     pub late: Vec<Unit>,
 }
 
+/// What [`TechnoUnits`] records for a checker while observed (`Op::ObserveTechno`), in the
+/// order it happened: every function's way through the units, and each block start that had
+/// functions waiting before it (MVS_SVS).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TechnoSeen {
+    /// The function went into a unit at channel time `at`.
+    Output {
+        seq: TechnoSeq,
+        kind: TechnoKind,
+        number: u32,
+        sync: SyncType,
+        at: Duration,
+    },
+    /// The function was finished (acknowledged, or fetched when not waited for).
+    Acknowledged { seq: TechnoSeq, at: Duration },
+    /// A reset or an error dropped it, output or not yet.
+    Dropped { seq: TechnoSeq },
+    /// A block took effect, the first after these functions that must be acknowledged before
+    /// the motion (`waits_before_motion`) were handed to the units.
+    BlockStarted {
+        at: Duration,
+        waited: Vec<TechnoSeq>,
+    },
+}
+
+/// Observations kept between two drains at most; more are counted as lost.
+const MAX_SEEN: usize = 1 << 16;
+
+/// The observation record (off: `None`, one comparison per output, finish and block start).
+#[derive(Debug, Default)]
+struct Observation {
+    seen: Vec<TechnoSeen>,
+    lost: u64,
+    /// Functions waited for before the motion, handed over since the last block start.
+    before_motion: Vec<TechnoSeq>,
+}
+
+impl Observation {
+    fn push(&mut self, s: TechnoSeen) {
+        if self.seen.len() < MAX_SEEN {
+            self.seen.push(s);
+        } else {
+            self.lost += 1;
+        }
+    }
+}
+
 /// The units and everything waiting for them.
 #[derive(Debug)]
 pub struct TechnoUnits {
@@ -152,6 +199,7 @@ pub struct TechnoUnits {
     next_seq: TechnoSeq,
     stats: TechnoStats,
     notes: Vec<TechnoNote>,
+    observation: Option<Box<Observation>>,
 }
 
 impl Default for TechnoUnits {
@@ -173,6 +221,7 @@ impl TechnoUnits {
             next_seq: 0,
             stats: TechnoStats::default(),
             notes: Vec::new(),
+            observation: None,
         }
     }
 
@@ -193,6 +242,58 @@ impl TechnoUnits {
     /// Functions output or waiting to be, not yet finished.
     pub fn open(&self) -> usize {
         self.open.len()
+    }
+
+    /// The units that hold an open function (output, not finished): set, index, the
+    /// function and whether `please_rw` is still set. What a PLC polls.
+    pub fn open_units(&self) -> impl Iterator<Item = (UnitSet, usize, &UnitFunction, bool)> {
+        let std = self.std[..self.used_std]
+            .iter()
+            .enumerate()
+            .map(|(k, u)| (UnitSet::Std, k, u));
+        let late = self
+            .late
+            .iter()
+            .enumerate()
+            .map(|(k, u)| (UnitSet::Late, k, u));
+        std.chain(late).filter_map(|(set, k, u)| {
+            let f = u.function.as_ref()?;
+            self.open.contains(&f.seq).then_some((set, k, f, u.please))
+        })
+    }
+
+    /// Is function `seq` output or waiting to be, and not finished?
+    pub fn is_open(&self, seq: TechnoSeq) -> bool {
+        self.open.contains(&seq)
+    }
+
+    /// Record [`TechnoSeen`] observations (on) or stop and forget them (off).
+    pub fn observe(&mut self, on: bool) {
+        self.observation = on.then(Box::default);
+    }
+
+    /// Is the record on?
+    #[inline]
+    pub fn observing(&self) -> bool {
+        self.observation.is_some()
+    }
+
+    /// The observations since the last drain, and how many did not fit.
+    pub fn drain_seen(&mut self) -> (Vec<TechnoSeen>, u64) {
+        match &mut self.observation {
+            Some(o) => (std::mem::take(&mut o.seen), std::mem::take(&mut o.lost)),
+            None => (Vec::new(), 0),
+        }
+    }
+
+    /// A block took effect at `now` (observed channels only).
+    pub fn block_started(&mut self, now: Duration) {
+        if let Some(o) = &mut self.observation {
+            if !o.before_motion.is_empty() {
+                let waited = std::mem::take(&mut o.before_motion);
+                o.push(TechnoSeen::BlockStarted { at: now, waited });
+            }
+        }
     }
 
     pub fn status(&self) -> TechnoStatus {
@@ -231,6 +332,13 @@ impl TechnoUnits {
     pub fn output(&mut self, group: OutputGroup, now: Duration) {
         if let Some(last) = group.fns.iter().map(|f| f.seq).max() {
             self.next_seq = self.next_seq.max(last + 1);
+        }
+        if let Some(o) = &mut self.observation {
+            for f in &group.fns {
+                if f.def.sync.timing().waits_before_motion() {
+                    o.before_motion.push(f.seq);
+                }
+            }
         }
         let (late, std): (Vec<TechnoFn>, Vec<TechnoFn>) = group
             .fns
@@ -317,6 +425,12 @@ impl TechnoUnits {
     /// commanded); the units are cleared for the next program. `plc_present` stays.
     pub fn reset(&mut self) {
         self.stats.dropped_by_reset += self.open.len() as u64;
+        if let Some(o) = &mut self.observation {
+            o.before_motion.clear();
+            for &seq in &self.open {
+                o.push(TechnoSeen::Dropped { seq });
+            }
+        }
         self.open.clear();
         self.pending.clear();
         self.pending_late.clear();
@@ -335,6 +449,7 @@ impl TechnoUnits {
     /// Step: units whose function is finished give it up.
     fn finish(&mut self, now: Duration) {
         let mut waited = Duration::ZERO;
+        let mut observation = self.observation.as_deref_mut();
         let mut finished =
             |u: &mut Unit, open: &mut Vec<TechnoSeq>, notes: &mut Vec<TechnoNote>| {
                 let Some(f) = &u.function else { return false };
@@ -349,6 +464,12 @@ impl TechnoUnits {
                 u.please = false;
                 open.retain(|s| *s != f.seq);
                 waited += now.saturating_sub(f.output_at);
+                if let Some(o) = observation.as_deref_mut() {
+                    o.push(TechnoSeen::Acknowledged {
+                        seq: f.seq,
+                        at: now,
+                    });
+                }
                 notes.push(TechnoNote::Acknowledged {
                     function: f.clone(),
                     at: now,
@@ -395,6 +516,9 @@ impl TechnoUnits {
                         function: Some(function.clone()),
                     };
                     self.stats.output += 1;
+                    if let Some(o) = &mut self.observation {
+                        o.push(seen_output(&function));
+                    }
                     self.notes.push(TechnoNote::Output {
                         unit: k,
                         set: UnitSet::Std,
@@ -422,12 +546,25 @@ impl TechnoUnits {
                 function: Some(function.clone()),
             };
             self.stats.output += 1;
+            if let Some(o) = &mut self.observation {
+                o.push(seen_output(&function));
+            }
             self.notes.push(TechnoNote::Output {
                 unit: k,
                 set: UnitSet::Late,
                 function,
             });
         }
+    }
+}
+
+fn seen_output(f: &UnitFunction) -> TechnoSeen {
+    TechnoSeen::Output {
+        seq: f.seq,
+        kind: f.kind,
+        number: f.number,
+        sync: f.sync,
+        at: f.output_at,
     }
 }
 

@@ -2,6 +2,7 @@
 //! through the stream interface by the built-in feeder, in virtual or real time.
 
 use std::collections::BTreeMap;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -329,6 +330,9 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
     if let Some(f) = feeder {
         machine.attach_feeder(args.channel, f);
     }
+    if let Err(msg) = attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
+        return usage(msg);
+    }
     let (rt, summary) = run_program(machine, &args, &program, period);
     let ticks = rt.ticks();
     let end_time = rt.time();
@@ -570,11 +574,72 @@ fn write_outputs(machine: &mut Machine, args: &RunArgs, report: &Report) -> bool
     } else {
         report.print_human(&mut std::io::stdout())
     };
+    let plc = plc_line(machine, args.channel);
+    let printed = printed.and_then(|()| match &plc {
+        None => Ok(()),
+        Some(line) if to_stderr => writeln!(std::io::stderr(), "{line}"),
+        Some(line) => writeln!(std::io::stdout(), "{line}"),
+    });
     match printed {
         Err(e) if !super::out::reader_gone(&e) => eprintln!("ncchannel run: summary: {e}"),
         _ => {}
     }
     written
+}
+
+/// runtime.toml's `[plc]`: a simulated PLC for each channel it names (default every channel)
+/// of the machine; an error names a channel the machine does not have.
+pub(crate) fn attach_plcs(
+    machine: &mut Machine,
+    settings: Option<&crate::params::runtime::PlcSettings>,
+) -> Result<(), String> {
+    let Some(s) = settings else { return Ok(()) };
+    let n = machine.channels().len() as u32;
+    let numbers: Vec<u32> = s.channels.clone().unwrap_or_else(|| (1..=n).collect());
+    for number in numbers {
+        if number == 0 || number > n {
+            return Err(format!(
+                "runtime.toml [plc] channels: channel {number} does not exist (the start-up list has {n})"
+            ));
+        }
+        machine.attach_plc(crate::machine::plc::SimulatedPlc::new(
+            number,
+            crate::soak::scenario::plc_config(s, s.seed),
+        ));
+    }
+    Ok(())
+}
+
+/// The summary's line of the simulated PLC of `channel`, if one played.
+fn plc_line(machine: &Machine, channel: u32) -> Option<String> {
+    let p = machine.plcs().iter().find(|p| p.channel() == channel)?;
+    let (c, st) = (p.config(), p.stats());
+    let delay = |[a, b]: [u64; 2]| {
+        if a == b {
+            format!("{a} ms")
+        } else {
+            format!("{a}..{b} ms")
+        }
+    };
+    let mut line = format!(
+        "plc:        simulated, delay {}, {} acknowledged",
+        delay(c.delay_ms),
+        st.acknowledged
+    );
+    for (kind, n, d) in &c.overrides {
+        let n = n.map_or(String::new(), |n| n.to_string());
+        line.push_str(&format!(", {}{n} {}", kind.letter(), delay(*d)));
+    }
+    if st.late > 0 {
+        line.push_str(&format!(", {} late by {} ms", st.late, c.late_ms));
+    }
+    if let Some(n) = c.stop_after {
+        line.push_str(&format!(
+            ", stops after {n}: {} left unanswered",
+            st.unanswered
+        ));
+    }
+    Some(line)
 }
 
 /// `--packet`: 1..=992 bytes (MAX_PROGRAM_STREAM_INPUT_SIZE, ISG FCT-C19 Data streaming);

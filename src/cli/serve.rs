@@ -232,6 +232,9 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, log, StopWhen::Never);
+    if let Err(msg) = super::run::attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
+        return usage(msg);
+    }
     if let Some(p) = &args.start {
         start(&mut machine, period, p);
     }

@@ -4,7 +4,9 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+pub mod plc;
 pub mod remote;
+pub mod rng;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -18,6 +20,7 @@ pub use crate::channel::{SearchTarget, StreamWriteError};
 use crate::feeder::Feeder;
 use crate::report::event::EventLog;
 use crate::runtime::{Cycle, Flow, Tick};
+use plc::SimulatedPlc;
 
 /// A request with its own way back: answered in the tick that serves it.
 #[derive(Debug)]
@@ -108,6 +111,8 @@ pub enum StopWhen {
 pub struct Machine {
     channels: Vec<Channel>,
     feeders: Vec<Attached>,
+    /// Simulated PLCs, at most one per channel (`machine::plc`).
+    plcs: Vec<SimulatedPlc>,
     log: EventLog,
     stop_when: StopWhen,
     /// Per channel: how its last program finished.
@@ -124,6 +129,7 @@ impl Machine {
         Machine {
             channels,
             feeders: Vec::new(),
+            plcs: Vec::new(),
             log,
             stop_when,
             finishes: vec![None; n],
@@ -142,6 +148,16 @@ impl Machine {
             feeder,
             offer: Offer::default(),
         });
+    }
+
+    /// Play a PLC for its channel (one per channel: a second replaces the first).
+    pub fn attach_plc(&mut self, plc: SimulatedPlc) {
+        self.plcs.retain(|p| p.channel() != plc.channel());
+        self.plcs.push(plc);
+    }
+
+    pub fn plcs(&self) -> &[SimulatedPlc] {
+        &self.plcs
     }
 
     pub fn feeders(&self) -> &[Attached] {
@@ -216,6 +232,15 @@ impl Cycle for Machine {
     }
 
     fn step(&mut self, tick: &Tick) -> Flow {
+        // The PLCs answer before the channels step, as the requests of the tick are served.
+        for p in &mut self.plcs {
+            if let Some(c) = self
+                .channels
+                .get_mut((p.channel() as usize).wrapping_sub(1))
+            {
+                p.tick(tick, c);
+            }
+        }
         for a in &mut self.feeders {
             let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
                 continue;

@@ -35,6 +35,9 @@ pub struct RuntimeConfig {
     pub decoder: DecoderRuntime,
     pub planner: PlannerConfig,
     pub ads: AdsConfig,
+    /// A simulated PLC answering the technology functions (`[plc]`); absent = none, the
+    /// channel acknowledges its own units after the functions' process times.
+    pub plc: Option<PlcSettings>,
 }
 
 impl Default for RuntimeConfig {
@@ -51,6 +54,7 @@ impl Default for RuntimeConfig {
             decoder: DecoderRuntime::default(),
             planner: PlannerConfig::default(),
             ads: AdsConfig::default(),
+            plc: None,
         }
     }
 }
@@ -233,6 +237,135 @@ impl Default for AdsConfig {
     }
 }
 
+/// The simulated PLC (`machine::plc`): runtime.toml's `[plc]` and a soak scenario's
+/// `[channel.plc]`. Delays are channel time, ms.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlcSettings {
+    /// The channels it plays for (runtime.toml; default: every channel).
+    #[serde(default)]
+    pub channels: Option<Vec<u32>>,
+    /// Delay of a function `functions` does not name: ms, or `[min, max]` drawn by `seed`.
+    #[serde(default)]
+    pub delay_ms: PlcDelay,
+    /// Delays by function: `"M8"`, `"H7"`, `"M"` (every M), `"S"`, `"T"`, `"T5"`.
+    #[serde(default)]
+    pub functions: std::collections::BTreeMap<String, PlcDelay>,
+    /// Every `late_every`-th acknowledgement comes `late_ms` later.
+    #[serde(default)]
+    pub late_every: Option<u64>,
+    #[serde(default)]
+    pub late_ms: u64,
+    /// After this many acknowledgements the PLC answers no more.
+    #[serde(default)]
+    pub stop_after: Option<u64>,
+    /// Seed of the drawn delays.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// A delay in ms: fixed, or a range drawn from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a delay in ms: a number, or [min, max] with min <= max"
+)]
+pub enum PlcDelay {
+    Fixed(u64),
+    Range([u64; 2]),
+}
+
+impl Default for PlcDelay {
+    fn default() -> Self {
+        PlcDelay::Fixed(0)
+    }
+}
+
+/// Longest PLC delay accepted, ms (an hour).
+const MAX_PLC_DELAY_MS: u64 = 3_600_000;
+
+impl PlcDelay {
+    /// `[min, max]` (a fixed delay is `[n, n]`).
+    pub fn range(self) -> [u64; 2] {
+        match self {
+            PlcDelay::Fixed(n) => [n, n],
+            PlcDelay::Range(r) => r,
+        }
+    }
+
+    fn check(self) -> Result<(), String> {
+        let [a, b] = self.range();
+        if a > b {
+            return Err(format!("[{a}, {b}]: min is above max"));
+        }
+        if b > MAX_PLC_DELAY_MS {
+            return Err(format!("{b} ms is more than {MAX_PLC_DELAY_MS} ms"));
+        }
+        Ok(())
+    }
+}
+
+/// A function key of `[plc] functions`: `M8` → (M, Some(8)), `S` → (S, None).
+pub fn plc_function_key(key: &str) -> Option<(crate::vocab::techno::TechnoKind, Option<u32>)> {
+    use crate::vocab::techno::TechnoKind;
+    let mut chars = key.chars();
+    let kind = match chars.next()?.to_ascii_uppercase() {
+        'M' => TechnoKind::M,
+        'H' => TechnoKind::H,
+        'S' => TechnoKind::S,
+        'T' => TechnoKind::T,
+        _ => return None,
+    };
+    let rest = chars.as_str();
+    if rest.is_empty() {
+        return Some((kind, None));
+    }
+    if kind == TechnoKind::S || !rest.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    rest.parse().ok().map(|n| (kind, Some(n)))
+}
+
+impl PlcSettings {
+    /// Check every key; the error names it (`delay_ms`, `functions.M8`, …) and says why.
+    pub fn check(&self) -> Result<(), (String, String)> {
+        if let Some(ch) = &self.channels {
+            if ch.contains(&0) {
+                return Err(("channels".into(), "channels are numbered from 1".into()));
+            }
+        }
+        self.delay_ms.check().map_err(|e| ("delay_ms".into(), e))?;
+        for (k, d) in &self.functions {
+            if plc_function_key(k).is_none() {
+                return Err((
+                    format!("functions.{k}"),
+                    format!("`{k}` is not a function: M<n>, H<n>, T<n>, or M, H, S, T for all"),
+                ));
+            }
+            d.check().map_err(|e| (format!("functions.{k}"), e))?;
+        }
+        if self.late_every == Some(0) {
+            return Err(("late_every".into(), "must be at least 1".into()));
+        }
+        if self.late_ms > MAX_PLC_DELAY_MS {
+            return Err((
+                "late_ms".into(),
+                format!("{} ms is more than {MAX_PLC_DELAY_MS} ms", self.late_ms),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The per-function delays, kind, number (`None`: the kind's every number) and range;
+    /// keys that are not functions are left out (`check` refuses them).
+    pub fn overrides(&self) -> Vec<(crate::vocab::techno::TechnoKind, Option<u32>, [u64; 2])> {
+        self.functions
+            .iter()
+            .filter_map(|(k, d)| plc_function_key(k).map(|(kind, n)| (kind, n, d.range())))
+            .collect()
+    }
+}
+
 /// A socket address read from a string, with an error message that says what is expected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(try_from = "String")]
@@ -401,6 +534,13 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
     validate_axes(cfg, &mut fail);
     validate_decoder_planner(cfg, &mut fail);
     validate_ads(cfg, &mut fail);
+    if let Some(Err((key, why))) = cfg.plc.as_ref().map(PlcSettings::check) {
+        let (key, sub) = match key.split_once('.') {
+            Some((k, sub)) => (k.to_string(), format!("{sub}: {why}")),
+            None => (key, why),
+        };
+        fail("plc", None, &key, sub);
+    }
     errs
 }
 

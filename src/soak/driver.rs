@@ -16,7 +16,7 @@ use std::time::Duration;
 use serde::Serialize;
 
 use super::feed::{FeedCounters, Owed, SoakFeeder};
-use super::invariants::{check_blocks, Checksum, Tally, Verdict};
+use super::invariants::{check_blocks, Checksum, Tally, TechnoCheck, Verdict};
 use super::rng::SplitMix64;
 use super::scenario::Faults;
 use crate::channel::AxisLimits;
@@ -135,6 +135,25 @@ pub struct SoakCounters {
     pub errors: BTreeMap<u32, u64>,
     /// FNV-1a over (offset, N) of every executed block, hex: equal for equal runs.
     pub checksum: String,
+    /// The technology functions and the simulated PLC, for a channel with one
+    /// (`[channel.plc]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plc: Option<PlcCounters>,
+}
+
+/// A soaked channel's technology functions and what its simulated PLC did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct PlcCounters {
+    /// What the check counted from the channel's observations.
+    pub functions: super::invariants::TechnoFigures,
+    /// Output and not finished when the run ended.
+    pub open_at_end: u64,
+    /// Channel time from output to acknowledgement, summed, seconds (the channel's figure).
+    pub waited_s: f64,
+    /// Acknowledgements the PLC made late (`late_every`).
+    pub late: u64,
+    /// Functions the PLC left unanswered (`stop_after`).
+    pub unanswered: u64,
 }
 
 /// The invariant tallies over all channels.
@@ -143,6 +162,13 @@ pub struct Tallies {
     pub order: Tally,
     pub errors: Tally,
     pub limits: Tally,
+    /// Technology functions output once, finished once (acknowledged or dropped by a reset).
+    pub techno: Tally,
+    /// No block starts before the functions it waits for are acknowledged.
+    pub techno_motion: Tally,
+    /// A simulated PLC runs: the technology verdicts are reported (they are checked always;
+    /// without a PLC they are reported when violated, so the shipped reports keep their shape).
+    pub techno_reported: bool,
 }
 
 impl Tallies {
@@ -163,7 +189,7 @@ impl Tallies {
                 });
             }
         }
-        vec![
+        let mut v = vec![
             self.order.verdict(
                 "every accepted line executed exactly once, in order, between resets",
                 Some(format!("{blocks} blocks checked")),
@@ -178,7 +204,18 @@ impl Tallies {
                 "memory steady",
                 growth.map(|g| format!("growth {g} KiB ≤ {slack_kib} KiB")),
             ),
-        ]
+        ];
+        if self.techno_reported || self.techno.violations + self.techno_motion.violations > 0 {
+            v.push(self.techno.verdict(
+                "every technology function output once, then acknowledged once or dropped by a reset",
+                None,
+            ));
+            v.push(self.techno_motion.verdict(
+                "no block starts before the functions it waits for (MVS_SVS) are acknowledged",
+                None,
+            ));
+        }
+        v
     }
 }
 
@@ -202,6 +239,8 @@ pub struct SoakChannel {
     /// The last N executed this epoch.
     last_n: Option<u32>,
     sum: Checksum,
+    /// The technology check, for a channel whose observations are on (`Op::ObserveTechno`).
+    techno: Option<TechnoCheck>,
     pub counters: SoakCounters,
 }
 
@@ -218,11 +257,47 @@ impl SoakChannel {
             numbers_rise: false,
             last_n: None,
             sum: Checksum::default(),
+            techno: None,
             counters: SoakCounters {
                 number,
                 program: program.unwrap_or_default(),
                 ..Default::default()
             },
+        }
+    }
+
+    /// Also check the technology functions (the channel's observations must be on).
+    pub(crate) fn with_techno_check(mut self) -> Self {
+        self.techno = Some(TechnoCheck::default());
+        self
+    }
+
+    /// The end of the run: the check's counts against the channel's own counters, and the
+    /// balance output = acknowledged + dropped + still open.
+    pub(crate) fn end_checks(&self, c: &Channel, tallies: &mut Tallies) {
+        let Some(tc) = &self.techno else { return };
+        let (f, own, number) = (tc.figures, c.report().techno, self.counters.number);
+        if f.output != f.acknowledged + f.dropped + tc.open() as u64 {
+            tallies.techno.violate(|| {
+                format!(
+                    "channel {number}: {} output ≠ {} acknowledged + {} dropped + {} open",
+                    f.output,
+                    f.acknowledged,
+                    f.dropped,
+                    tc.open()
+                )
+            });
+        }
+        if (own.output, own.acknowledged, own.dropped_by_reset)
+            != (f.output, f.acknowledged, f.dropped + f.dropped_unoutput)
+        {
+            tallies.techno.violate(|| {
+                format!(
+                    "channel {number}: the channel counted {}/{}/{} output/acknowledged/dropped, its observations {}/{}/{}",
+                    own.output, own.acknowledged, own.dropped_by_reset,
+                    f.output, f.acknowledged, f.dropped + f.dropped_unoutput
+                )
+            });
         }
     }
 
@@ -383,6 +458,18 @@ impl SoakChannel {
                 self.last_n = Some(n);
             }
         }
+        if let Some(tc) = &mut self.techno {
+            if let Reply::TechnoSeen { seen, lost } = door.apply(tick, Op::DrainTechno) {
+                for s in seen {
+                    tc.see(number, s, &mut tallies.techno, &mut tallies.techno_motion);
+                }
+                if lost > 0 {
+                    tallies.techno.violate(|| {
+                        format!("channel {number}, tick {t}: {lost} technology observations lost")
+                    });
+                }
+            }
+        }
         let n = check_blocks(
             number,
             owed,
@@ -419,8 +506,15 @@ impl SoakChannel {
 
     /// The counters for the report, with the channel's own figures and the checksum.
     pub fn report(&self, c: &Channel) -> SoakCounters {
-        let st = c.report().stats;
+        let r = c.report();
+        let st = r.stats;
         SoakCounters {
+            plc: self.techno.as_ref().map(|t| PlcCounters {
+                functions: t.figures,
+                open_at_end: t.open() as u64,
+                waited_s: r.techno.waited.as_secs_f64(),
+                ..PlcCounters::default()
+            }),
             interrupts: st.interrupts,
             warnings: st.warnings,
             checksum: format!("{:016x}", self.sum.0),
@@ -455,10 +549,11 @@ impl Slot {
         let tick0 = Tick::first(Duration::ZERO, Clock::Virtual);
         let mut door = MachineDoor::new(machine, number)?;
         door.apply(&tick0, Op::ObserveStreamBlocks(true));
+        door.apply(&tick0, Op::ObserveTechno(true));
         Some(Slot {
             number,
             feeder,
-            core: SoakChannel::new(number, Some(program), axes),
+            core: SoakChannel::new(number, Some(program), axes).with_techno_check(),
             rng,
             offer: Offer::default(),
         })
@@ -472,7 +567,20 @@ impl Slot {
             .checked_sub(1)
             .and_then(|i| machine.channels().get(i))
             .map_or_else(|| self.core.counters.clone(), |c| self.core.report(c));
+        let plc = machine
+            .plcs()
+            .iter()
+            .find(|p| p.channel() == self.number)
+            .map(|p| {
+                let st = p.stats();
+                PlcCounters {
+                    late: st.late,
+                    unanswered: st.unanswered,
+                    ..own.plc.clone().unwrap_or_default()
+                }
+            });
         SoakCounters {
+            plc,
             writes_ok: f.writes_ok,
             writes_rejected: f.writes_rejected,
             writes_skipped: f.writes_skipped,
@@ -507,6 +615,10 @@ impl SoakCycle {
         expected_errors: Vec<u32>,
         target_blocks: Option<u64>,
     ) -> Self {
+        let tallies = Tallies {
+            techno_reported: !machine.plcs().is_empty(),
+            ..Tallies::default()
+        };
         SoakCycle {
             machine,
             slots,
@@ -514,7 +626,7 @@ impl SoakCycle {
             expected_errors,
             target_blocks,
             total_blocks: 0,
-            tallies: Tallies::default(),
+            tallies,
             planned: false,
         }
     }
@@ -522,6 +634,18 @@ impl SoakCycle {
     /// Each soaked channel's counters, in the order of the scenario.
     pub fn reports(&self) -> Vec<SoakCounters> {
         self.slots.iter().map(|s| s.report(&self.machine)).collect()
+    }
+
+    /// The end-of-run checks of every soaked channel (the technology balance).
+    pub(crate) fn end_checks(&mut self) {
+        for s in &self.slots {
+            if let Some(c) = (s.number as usize)
+                .checked_sub(1)
+                .and_then(|i| self.machine.channels().get(i))
+            {
+                s.core.end_checks(c, &mut self.tallies);
+            }
+        }
     }
 
     /// The built-in clients' write counters, in the order of the scenario.

@@ -2,12 +2,15 @@
 //! resets, no channel error but the expected ones, positions within the soft limits, memory
 //! steady. Checked as the run goes, at the cost of a few comparisons per block.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use std::time::Duration;
 
 use serde::Serialize;
 
 use super::feed::Owed;
+use crate::channel::techno::TechnoSeen;
 use crate::channel::ExecutedBlock;
+use crate::vocab::techno::{TechnoKind, TechnoSeq};
 
 /// Violation messages kept per invariant; the count goes on.
 const MAX_DETAILS: usize = 8;
@@ -133,6 +136,161 @@ pub(crate) fn check_blocks(
     count
 }
 
+/// Finished sequence numbers kept for the "output once" check; beyond, the oldest half is
+/// folded into a floor (everything below it counts as seen).
+const MAX_FINISHED: usize = 4096;
+
+/// What the technology check counted of one channel.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
+pub struct TechnoFigures {
+    pub output: u64,
+    pub acknowledged: u64,
+    /// Output, then dropped by a reset or an error.
+    pub dropped: u64,
+    /// Dropped before they were output (waiting for a unit).
+    pub dropped_unoutput: u64,
+    /// Blocks that started after functions they waited for (MVS_SVS).
+    pub waited_starts: u64,
+    /// Longest channel time from a waited-for function's output to its block's start, ms.
+    pub max_output_to_start_ms: u64,
+}
+
+/// A function output and not yet finished, as the check knows it.
+#[derive(Debug, Clone, Copy)]
+struct OpenFn {
+    kind: TechnoKind,
+    number: u32,
+    at: Duration,
+    /// Its block's motion waits for it (MVS_SVS).
+    before_motion: bool,
+}
+
+/// The technology functions of one channel against the rules: each output once, then
+/// acknowledged once or dropped by a reset; a block that waits for its functions (MVS_SVS)
+/// starts only after they are acknowledged. Fed with the channel's observations
+/// ([`TechnoSeen`], `Op::DrainTechno`), in their order.
+#[derive(Debug, Default)]
+pub(crate) struct TechnoCheck {
+    open: BTreeMap<TechnoSeq, OpenFn>,
+    /// Acknowledged, waiting for their block's start: output time.
+    acknowledged: BTreeMap<TechnoSeq, Duration>,
+    finished: BTreeSet<TechnoSeq>,
+    /// Every number below is finished.
+    floor: TechnoSeq,
+    pub figures: TechnoFigures,
+}
+
+impl TechnoCheck {
+    fn seen(&self, seq: TechnoSeq) -> bool {
+        seq < self.floor || self.finished.contains(&seq) || self.open.contains_key(&seq)
+    }
+
+    fn finish(&mut self, seq: TechnoSeq) {
+        self.finished.insert(seq);
+        if self.finished.len() > MAX_FINISHED {
+            let keep = self.finished.split_off(
+                &self
+                    .finished
+                    .iter()
+                    .nth(MAX_FINISHED / 2)
+                    .copied()
+                    .unwrap_or(0),
+            );
+            if let Some(&last) = self.finished.iter().next_back() {
+                self.floor = self.floor.max(last + 1);
+            }
+            self.finished = keep;
+        }
+    }
+
+    /// Check one observation: `order` is the "once" rule's tally, `motion` the wait rule's.
+    pub(crate) fn see(
+        &mut self,
+        channel: u32,
+        s: TechnoSeen,
+        order: &mut Tally,
+        motion: &mut Tally,
+    ) {
+        match s {
+            TechnoSeen::Output {
+                seq,
+                kind,
+                number,
+                at,
+                sync,
+            } => {
+                if self.seen(seq) {
+                    order.violate(|| {
+                        format!("channel {channel}: {}{number} (#{seq}) output twice", kind.letter())
+                    });
+                    return;
+                }
+                self.figures.output += 1;
+                self.open.insert(
+                    seq,
+                    OpenFn {
+                        kind,
+                        number,
+                        at,
+                        before_motion: sync.waits_before_motion(),
+                    },
+                );
+            }
+            TechnoSeen::Acknowledged { seq, .. } => match self.open.remove(&seq) {
+                Some(f) => {
+                    self.figures.acknowledged += 1;
+                    if f.before_motion {
+                        self.acknowledged.insert(seq, f.at);
+                    }
+                    self.finish(seq);
+                }
+                None => order.violate(|| {
+                    format!("channel {channel}: function #{seq} acknowledged but not open (not output, or acknowledged twice)")
+                }),
+            },
+            TechnoSeen::Dropped { seq } => {
+                if self.open.remove(&seq).is_some() {
+                    self.figures.dropped += 1;
+                } else if self.seen(seq) {
+                    order.violate(|| {
+                        format!("channel {channel}: function #{seq} dropped after it was finished")
+                    });
+                    return;
+                } else {
+                    self.figures.dropped_unoutput += 1;
+                }
+                self.finish(seq);
+            }
+            TechnoSeen::BlockStarted { at, waited } => {
+                self.figures.waited_starts += 1;
+                for seq in waited {
+                    if let Some(out) = self.acknowledged.remove(&seq) {
+                        let ms = at.saturating_sub(out).as_millis() as u64;
+                        self.figures.max_output_to_start_ms =
+                            self.figures.max_output_to_start_ms.max(ms);
+                    } else if let Some(f) = self.open.get(&seq) {
+                        let (k, n) = (f.kind.letter(), f.number);
+                        motion.violate(|| {
+                            format!("channel {channel}: a block started at {:.3} s while {k}{n} (#{seq}) waited for its acknowledgement", at.as_secs_f64())
+                        });
+                    } else {
+                        motion.violate(|| {
+                            format!("channel {channel}: a block started at {:.3} s before function #{seq} it waits for was output", at.as_secs_f64())
+                        });
+                    }
+                }
+                // Acknowledged functions whose block never came (a reset) are forgotten.
+                self.acknowledged.clear();
+            }
+        }
+    }
+
+    /// Functions output and not finished.
+    pub(crate) fn open(&self) -> usize {
+        self.open.len()
+    }
+}
+
 /// Resident set size of this process, KiB (`VmRSS` of /proc/self/status); `None` where there
 /// is no /proc.
 pub(crate) fn resident_kib() -> Option<u64> {
@@ -190,6 +348,91 @@ mod tests {
         let mut t = Tally::default();
         check_blocks(1, &mut q, [ex(0, 4)].into_iter(), &mut t, &mut s);
         assert_eq!(t.violations, 1, "wrong N");
+    }
+
+    fn out(seq: u64, ms: u64) -> TechnoSeen {
+        TechnoSeen::Output {
+            seq,
+            kind: TechnoKind::M,
+            number: 8,
+            sync: crate::vocab::techno::SyncType::MvsSvs,
+            at: Duration::from_millis(ms),
+        }
+    }
+    fn ack(seq: u64, ms: u64) -> TechnoSeen {
+        TechnoSeen::Acknowledged {
+            seq,
+            at: Duration::from_millis(ms),
+        }
+    }
+
+    #[test]
+    fn techno_check_holds_for_output_ack_start_and_reset() {
+        let (mut c, mut o, mut m) = (TechnoCheck::default(), Tally::default(), Tally::default());
+        for s in [
+            out(0, 0),
+            ack(0, 300),
+            TechnoSeen::BlockStarted {
+                at: Duration::from_millis(301),
+                waited: vec![0],
+            },
+            out(1, 400),
+            TechnoSeen::Dropped { seq: 1 },
+            TechnoSeen::Dropped { seq: 2 },
+            out(3, 500),
+        ] {
+            c.see(1, s, &mut o, &mut m);
+        }
+        assert_eq!((o.violations, m.violations), (0, 0), "{:?} {:?}", o, m);
+        let f = c.figures;
+        assert_eq!(
+            (
+                f.output,
+                f.acknowledged,
+                f.dropped,
+                f.dropped_unoutput,
+                c.open()
+            ),
+            (3, 1, 1, 1, 1)
+        );
+        assert_eq!(f.max_output_to_start_ms, 301);
+    }
+
+    #[test]
+    fn techno_check_fails_when_a_rule_is_broken() {
+        let (mut c, mut o, mut m) = (TechnoCheck::default(), Tally::default(), Tally::default());
+        for s in [out(0, 0), ack(0, 10), ack(0, 20), out(0, 30)] {
+            c.see(1, s, &mut o, &mut m);
+        }
+        assert_eq!(
+            o.violations, 2,
+            "acknowledged twice, output twice: {:?}",
+            o.details
+        );
+        let (mut c, mut o, mut m) = (TechnoCheck::default(), Tally::default(), Tally::default());
+        for s in [
+            out(5, 0),
+            TechnoSeen::BlockStarted {
+                at: Duration::from_millis(1),
+                waited: vec![5, 6],
+            },
+        ] {
+            c.see(1, s, &mut o, &mut m);
+        }
+        assert_eq!(m.violations, 2, "{:?}", m.details);
+        assert!(m.details[0].contains("M8 (#5) waited"), "{:?}", m.details);
+    }
+
+    #[test]
+    fn techno_check_forgets_old_numbers_but_still_sees_them() {
+        let (mut c, mut o, mut m) = (TechnoCheck::default(), Tally::default(), Tally::default());
+        for seq in 0..10_000u64 {
+            c.see(1, out(seq, seq), &mut o, &mut m);
+            c.see(1, ack(seq, seq), &mut o, &mut m);
+        }
+        assert!(c.finished.len() <= MAX_FINISHED);
+        c.see(1, out(3, 0), &mut o, &mut m);
+        assert_eq!(o.violations, 1);
     }
 
     #[test]

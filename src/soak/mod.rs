@@ -139,6 +139,7 @@ pub fn build(
             ch_rng.fork(2),
             source,
         );
+        attach_plc(&mut machine, spec, &mut ch_rng);
         let slot = Slot::new(
             &mut machine,
             spec.number,
@@ -161,6 +162,18 @@ pub fn build(
         cycle,
         Duration::from_micros(config.runtime.cycle_period_us.max(1)),
     ))
+}
+
+/// The channel's simulated PLC, if its `[channel.plc]` asks for one; its delays drawn from
+/// the channel's random numbers, so the scenario's seed gives the same answers.
+fn attach_plc(machine: &mut Machine, spec: &scenario::ChannelSpec, ch_rng: &mut SplitMix64) {
+    if let Some(plc) = &spec.plc {
+        let seed = ch_rng.fork(4).next_u64() ^ plc.seed;
+        machine.attach_plc(crate::machine::plc::SimulatedPlc::new(
+            spec.number,
+            scenario::plc_config(plc, seed),
+        ));
+    }
 }
 
 /// The progress bar of a run (none when `enabled` is false).
@@ -256,7 +269,8 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         wall_seconds: start.elapsed().as_secs_f64(),
         blocks: rt.cycle().total_blocks,
     };
-    let (cycle, stats) = rt.into_inner();
+    let (mut cycle, stats) = rt.into_inner();
+    cycle.end_checks();
     Ok(report_of(&cycle, &stats, scenario, run, warmup_kib, period))
 }
 

@@ -8,6 +8,8 @@ use serde::Deserialize;
 use thiserror::Error;
 
 use crate::bounded::BoundedReadError;
+use crate::machine::plc::PlcConfig;
+use crate::params::runtime::PlcSettings;
 
 use super::feed::FeederSpec;
 use super::generator::ProgramSpec;
@@ -125,6 +127,22 @@ pub struct ChannelSpec {
     pub feeder: Option<FeederSpec>,
     #[serde(rename = "program_mix")]
     pub(crate) program_mix: Option<ProgramSpec>,
+    /// A simulated PLC answers this channel's technology functions (`[channel.plc]`, the
+    /// keys of runtime.toml's `[plc]` but `channels`); absent = the channel acknowledges its
+    /// own units after the process times.
+    pub plc: Option<PlcSettings>,
+}
+
+/// The machine's PLC configuration of `[plc]` settings, its delays drawn from `seed`.
+pub fn plc_config(s: &PlcSettings, seed: u64) -> PlcConfig {
+    PlcConfig {
+        delay_ms: s.delay_ms.range(),
+        overrides: s.overrides(),
+        late_every: s.late_every,
+        late_ms: s.late_ms,
+        stop_after: s.stop_after,
+        seed,
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -264,6 +282,17 @@ impl Scenario {
             if let Some(ps) = &c.program_mix {
                 ps.check()?;
             }
+            if let Some(plc) = &c.plc {
+                if plc.channels.is_some() {
+                    return Err(format!(
+                        "[[channel]] number {}: plc.channels: not a scenario key (the PLC plays for its [[channel]])",
+                        c.number
+                    ));
+                }
+                plc.check().map_err(|(key, why)| {
+                    format!("[[channel]] number {}: plc.{key}: {why}", c.number)
+                })?;
+            }
         }
         Ok(())
     }
@@ -298,5 +327,39 @@ mod tests {
         )
         .unwrap();
         assert!(s.validate().unwrap_err().contains("packet_bytes"));
+    }
+
+    #[test]
+    fn a_channel_plc_is_read_and_its_bad_keys_named() {
+        let head = "params = \"a\"\n[length]\nticks = 1\n[[channel]]\nnumber = 1\n[channel.plc]\n";
+        let s = Scenario::parse(&format!(
+            "{head}delay_ms = [10, 20]\nfunctions = {{ M8 = 300, S = [1, 2] }}\nlate_every = 3\nlate_ms = 50\nstop_after = 9\n"
+        ))
+        .unwrap();
+        s.validate().unwrap();
+        let c = plc_config(s.channels[0].plc.as_ref().unwrap(), 7);
+        assert_eq!(c.delay_ms, [10, 20]);
+        assert_eq!(
+            c.delay_of(crate::vocab::techno::TechnoKind::M, 8),
+            [300, 300]
+        );
+        assert_eq!(
+            (c.late_every, c.late_ms, c.stop_after, c.seed),
+            (Some(3), 50, Some(9), 7)
+        );
+        for (bad, key) in [
+            ("delay_ms = [20, 10]", "plc.delay_ms"),
+            ("functions = { Q8 = 1 }", "plc.functions.Q8"),
+            ("functions = { M8 = [5, 1] }", "plc.functions.M8"),
+            ("late_every = 0", "plc.late_every"),
+        ] {
+            let s = Scenario::parse(&format!("{head}{bad}\n")).unwrap();
+            let e = s.validate().unwrap_err();
+            assert!(e.contains(key), "{bad}: {e}");
+        }
+        let e = Scenario::parse(&format!("{head}delay = 5\n")).unwrap_err();
+        assert!(e.contains("delay"), "{e}");
+        let e = Scenario::parse(&format!("{head}delay_ms = \"x\"\n")).unwrap_err();
+        assert!(e.contains("a delay in ms"), "{e}");
     }
 }

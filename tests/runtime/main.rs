@@ -9,6 +9,7 @@ mod anywhere;
 mod cli_outputs;
 mod closed_stdout;
 mod event_log_cuts;
+mod plc;
 mod program_loader;
 mod runtime;
 mod runtime_events;

@@ -2,5 +2,6 @@
 //! `cargo test --test soak -- --ignored`).
 
 mod campaign;
+mod plc;
 mod serve_soak;
 mod soak;
