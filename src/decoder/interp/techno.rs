@@ -24,6 +24,38 @@ pub(in crate::decoder) struct TechnoState {
     late_at_feed: Vec<TechnoSeq>,
     /// MVS_SLP functions output and waiting for `#EXPL SYN`.
     late_explicit: Vec<TechnoSeq>,
+    /// Bit n: M n (`quiet_h`: H n) is defined and never goes to the PLC (NO_SYNCH), so a
+    /// block of only such functions needs no step of its own: one bit test per function
+    /// (65,536 bits each, 8 KiB).
+    quiet_m: Box<[u64]>,
+    quiet_h: Box<[u64]>,
+    /// S and T words that do not go to the PLC.
+    quiet_s: bool,
+    quiet_t: bool,
+}
+
+/// Words of the quiet bit sets: one bit per M or H number 0 … 65,535.
+const QUIET_WORDS: usize = (codes::MAX_M_H as usize + 1) / 64;
+
+fn quiet(def: Option<FunctionDef>) -> bool {
+    def.is_some_and(|d| !d.sync.outputs())
+}
+
+fn set_bit(bits: &mut [u64], n: u32, on: bool) {
+    if let Some(w) = bits.get_mut(n as usize / 64) {
+        let b = 1u64 << (n % 64);
+        if on {
+            *w |= b;
+        } else {
+            *w &= !b;
+        }
+    }
+}
+
+#[inline]
+fn bit(bits: &[u64], n: u32) -> bool {
+    bits.get(n as usize / 64)
+        .is_some_and(|w| w & (1u64 << (n % 64)) != 0)
 }
 
 /// What a block adds around its motion, in execution order: outputs and waits before it,
@@ -94,12 +126,30 @@ fn steps(
 
 impl TechnoState {
     pub(in crate::decoder) fn new(table: TechnoTable, m6_calls_subroutine: bool) -> Self {
+        let mut quiet_m = vec![0u64; QUIET_WORDS].into_boxed_slice();
+        let mut quiet_h = vec![0u64; QUIET_WORDS].into_boxed_slice();
+        let ms = table.m.iter().map(|(n, _)| *n);
+        let internal = crate::vocab::techno::INTERNAL_M.iter().copied();
+        let spindle = table.spindle_m.iter().map(|(n, _)| *n);
+        for n in ms.chain(internal).chain(spindle) {
+            set_bit(&mut quiet_m, n, quiet(table.m_def(n)));
+        }
+        if m6_calls_subroutine {
+            set_bit(&mut quiet_m, 6, true);
+        }
+        for (n, d) in &table.h {
+            set_bit(&mut quiet_h, *n, quiet(Some(*d)));
+        }
         TechnoState {
+            quiet_s: quiet(Some(table.s)),
+            quiet_t: quiet(Some(table.t)),
             table,
             m6_calls_subroutine,
             next_seq: 0,
             late_at_feed: Vec::new(),
             late_explicit: Vec::new(),
+            quiet_m,
+            quiet_h,
         }
     }
 
@@ -154,8 +204,15 @@ impl TechnoState {
             })?;
         if h {
             self.table.set_h_sync(number, spec);
+            set_bit(&mut self.quiet_h, number, quiet(self.table.h_def(number)));
         } else {
             self.table.set_m_sync(number, spec);
+            let m6 = number == 6 && self.m6_calls_subroutine;
+            set_bit(
+                &mut self.quiet_m,
+                number,
+                m6 || quiet(self.table.m_def(number)),
+            );
         }
         Ok(())
     }
@@ -172,10 +229,10 @@ impl TechnoState {
     /// Does the block program anything this step looks at? (Most blocks do not: one test.)
     #[inline]
     pub(in crate::decoder) fn concerns(&self, w: &Words, feed_move: bool) -> bool {
-        !w.ms().is_empty()
-            || !w.hs().is_empty()
-            || w.spindle_rpm.is_some()
-            || w.tool.is_some()
+        w.ms().iter().any(|m| !bit(&self.quiet_m, *m))
+            || w.hs().iter().any(|h| !bit(&self.quiet_h, *h))
+            || (w.spindle_rpm.is_some() && !self.quiet_s)
+            || (w.tool.is_some() && !self.quiet_t)
             || (feed_move && !self.late_at_feed.is_empty())
     }
 
