@@ -69,8 +69,10 @@ fn run_watching(program: &str, script: &str) -> (serde_json::Value, Vec<Seen>) {
         .map_or(f64::NAN, |p| p.1);
     assert!((x - 30.0).abs() < 1e-6, "at its end: X{x}");
     assert_eq!(end.techno.used_std, 0);
-    let json = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim())
+    let json: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim())
         .unwrap_or_else(|e| panic!("{script} printed no JSON ({e}): {stderr}"));
+    // What the client saw, for a reader of `--nocapture`.
+    eprintln!("{script} saw: {json}");
     (json, seen)
 }
 
