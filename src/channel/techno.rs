@@ -509,21 +509,7 @@ impl TechnoUnits {
             if let Some(g) = self.pending.pop_front() {
                 let n = g.fns.len().min(STD_SYNC_UNITS);
                 for (k, f) in g.fns.into_iter().take(n).enumerate() {
-                    let function = unit_function(f, g.block_nr, g.line, now);
-                    self.std[k] = Unit {
-                        please: true,
-                        done: false,
-                        function: Some(function.clone()),
-                    };
-                    self.stats.output += 1;
-                    if let Some(o) = &mut self.observation {
-                        o.push(seen_output(&function));
-                    }
-                    self.notes.push(TechnoNote::Output {
-                        unit: k,
-                        set: UnitSet::Std,
-                        function,
-                    });
+                    self.put(UnitSet::Std, k, unit_function(f, g.block_nr, g.line, now));
                 }
                 self.used_std = n;
             }
@@ -539,22 +525,30 @@ impl TechnoUnits {
             let Some((f, block_nr, line)) = self.pending_late.pop_front() else {
                 break;
             };
-            let function = unit_function(f, block_nr, line, now);
-            self.late[k] = Unit {
-                please: true,
-                done: false,
-                function: Some(function.clone()),
-            };
-            self.stats.output += 1;
-            if let Some(o) = &mut self.observation {
-                o.push(seen_output(&function));
-            }
-            self.notes.push(TechnoNote::Output {
-                unit: k,
-                set: UnitSet::Late,
-                function,
-            });
+            self.put(UnitSet::Late, k, unit_function(f, block_nr, line, now));
         }
+    }
+
+    /// Output one function into unit `k` of `set`: `please_rw` TRUE, counted, observed, noted.
+    fn put(&mut self, set: UnitSet, k: usize, function: UnitFunction) {
+        let units = match set {
+            UnitSet::Std => &mut self.std,
+            UnitSet::Late => &mut self.late,
+        };
+        units[k] = Unit {
+            please: true,
+            done: false,
+            function: Some(function.clone()),
+        };
+        self.stats.output += 1;
+        if let Some(o) = &mut self.observation {
+            o.push(seen_output(&function));
+        }
+        self.notes.push(TechnoNote::Output {
+            unit: k,
+            set,
+            function,
+        });
     }
 }
 
