@@ -12,14 +12,15 @@
 //! The HLD's mode-and-state unit (0x21–0x2F) mirrors the PLC's HLI unit
 //! (`gpCh[i]^.channel_mc_control.mode_and_state`, see [`super::hli`]): one store, two views.
 //! The technology elements 0x02–0x07 (`used_units_*_sync_r`, the first standard and late
-//! unit's please/done) and 0x0E (`head.plc_present_w`) read the channel's technology units
+//! unit's please/done), 0x3F–0x138 (every unit's elements) and 0x0E (`head.plc_present_w`)
+//! read the channel's technology units
 //! (`Status.techno`, src/channel/techno.rs), as the HLI symbols do; they are read-only here.
 
 use super::backend::{CncBackend, Status};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::hli::{Hli, Unit};
 use super::result::AdsResult;
-use crate::channel::techno::UnitSet;
+use crate::channel::techno::{UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS};
 
 pub const PORT: u16 = 551;
 /// Position controller, platform instance (ISG sample client `cnc_demo_samples.c` waits
@@ -64,6 +65,8 @@ enum Field {
     UsedUnits(UnitSet),
     /// `techno_std_sync[0]` / `techno_late_sync[0]`: `please` or `done`.
     TechnoFlag(UnitSet, bool),
+    /// One element of one unit, `techno.std_sync[k]` / `techno.late_sync[k]` (0x3F–0x138).
+    TechnoElement(UnitSet, usize, TechnoPart),
     OverrideEnable,
     OverrideCommand,
     OverrideRequest,
@@ -73,10 +76,78 @@ enum Field {
     Unit(Unit, u32),
 }
 
+/// The elements of a unit in the HLD mirror, in the dump's order: `type`, `please`, `done`,
+/// `m_h.nr`, `m_h.time`, `m_h.block_nr`, `m_h.prg_line_nr`, `m_h.add_value`, and for a late
+/// unit `nr_late_sync`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TechnoPart {
+    Type,
+    Please,
+    Done,
+    Nr,
+    Time,
+    BlockNr,
+    PrgLine,
+    AddValue,
+    NrLateSync,
+}
+
+const TECHNO_PARTS: [(TechnoPart, &str, AdsType, u32); 9] = [
+    (TechnoPart::Type, "type", AdsType::Word, 2),
+    (TechnoPart::Please, "please", AdsType::Bool, 1),
+    (TechnoPart::Done, "done", AdsType::Bool, 1),
+    (TechnoPart::Nr, "m_h.nr", AdsType::Dword, 4),
+    (TechnoPart::Time, "m_h.time", AdsType::Dint, 4),
+    (TechnoPart::BlockNr, "m_h.block_nr", AdsType::Dword, 4),
+    (TechnoPart::PrgLine, "m_h.prg_line_nr", AdsType::Dword, 4),
+    (TechnoPart::AddValue, "m_h.add_value", AdsType::Dint, 4),
+    (TechnoPart::NrLateSync, "nr_late_sync", AdsType::Word, 2),
+];
+
+/// The first unit element's offset in the HLD mirror (the ISG object dump: 0x3F–0x138 are
+/// `techno.std_sync[0..19]`, 8 elements each, then `techno.late_sync[0..9]`, 9 each).
+const TECHNO_FIRST: u32 = 0x3F;
+
+/// The unit elements, built once (their names are made from the unit index).
+fn techno_defs() -> &'static [Def] {
+    static DEFS: std::sync::OnceLock<Vec<Def>> = std::sync::OnceLock::new();
+    DEFS.get_or_init(|| {
+        let mut v = Vec::new();
+        let mut element = TECHNO_FIRST;
+        let sets = [
+            (UnitSet::Std, "techno.std_sync", STD_SYNC_UNITS, 8),
+            (UnitSet::Late, "techno.late_sync", LATE_SYNC_UNITS, 9),
+        ];
+        for (set, prefix, units, parts) in sets {
+            for k in 0..units {
+                for &(part, name, ty, size) in &TECHNO_PARTS[..parts] {
+                    v.push(Def {
+                        class: Class::Hld,
+                        element,
+                        name: std::borrow::Cow::Owned(format!("{prefix}[{k}]::{name}")),
+                        ty,
+                        size,
+                        unit: "",
+                        source: SRC_DUMP,
+                        field: Field::TechnoElement(set, k, part),
+                    });
+                    element += 1;
+                }
+            }
+        }
+        v
+    })
+}
+
+/// Every entry: the table and the unit elements.
+fn all_defs() -> impl Iterator<Item = &'static Def> {
+    TABLE.iter().chain(techno_defs())
+}
+
 struct Def {
     class: Class,
     element: u32,
-    name: &'static str,
+    name: std::borrow::Cow<'static, str>,
     ty: AdsType,
     size: u32,
     unit: &'static str,
@@ -98,7 +169,7 @@ const fn d(
     Def {
         class,
         element,
-        name,
+        name: std::borrow::Cow::Borrowed(name),
         ty,
         size,
         unit,
@@ -168,8 +239,9 @@ fn class_group(c: Class) -> u32 {
 
 /// Objects of channel `ch`'s interpolator and HLD, for the object map.
 pub fn objects(ch: u16) -> Vec<ObjectInfo> {
-    TABLE
-        .iter()
+    let mut defs: Vec<&Def> = all_defs().collect();
+    defs.sort_by_key(|d| (d.class as u8, d.element));
+    defs.into_iter()
         .map(|d| ObjectInfo {
             port: PORT,
             group: class_group(d.class)
@@ -179,7 +251,7 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
                     u32::from(ch)
                 },
             offset: d.element,
-            name: d.name.into(),
+            name: d.name.to_string(),
             ty: d.ty,
             size: d.size,
             access: if writable(d.field) {
@@ -225,8 +297,7 @@ fn locate(
     if ch > u32::from(backend.channel_count()) {
         return Err(AdsResult::INVALID_GROUP);
     }
-    let def = TABLE
-        .iter()
+    let def = all_defs()
         .find(|d| d.class == class && d.element == offset)
         .ok_or(AdsResult::INVALID_OFFSET)?;
     Ok((ch as u16, def))
@@ -300,7 +371,7 @@ fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
     let tenths = (v.override_pct * 10.0).round().clamp(0.0, 2000.0) as u16;
     Ok(match field {
         Field::Elements => {
-            let n = TABLE.iter().filter(|d| d.class == class).count() as u32 - 1;
+            let n = all_defs().filter(|d| d.class == class).count() as u32 - 1;
             n.to_le_bytes().to_vec()
         }
         Field::AxisCount => (v.positions.len() as u16).to_le_bytes().to_vec(),
@@ -347,6 +418,7 @@ fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
                 .first()
                 .map_or(0, |u| u8::from(if please { u.please } else { u.done }))]
         }
+        Field::TechnoElement(set, k, part) => techno_element(v, set, k, part),
         Field::Unit(..) | Field::PlatformAxes => return Err(AdsResult::ACCESS_DENIED),
     })
 }
@@ -387,6 +459,33 @@ pub fn read_write(
         (0, 0)
     };
     Ok([group.to_le_bytes(), offset.to_le_bytes()].concat())
+}
+
+/// One element of unit `k` (a unit that never held a function reads zero).
+fn techno_element(v: &Status, set: UnitSet, k: usize, part: TechnoPart) -> Vec<u8> {
+    let units = match set {
+        UnitSet::Std => &v.techno.std,
+        UnitSet::Late => &v.techno.late,
+    };
+    let Some(u) = units.get(k) else {
+        return vec![0; 4];
+    };
+    let f = u.function.as_ref();
+    let dword = |x: u32| x.to_le_bytes().to_vec();
+    match part {
+        TechnoPart::Type => (f.map_or(0, |f| f.kind as u16)).to_le_bytes().to_vec(),
+        TechnoPart::Please => vec![u8::from(u.please)],
+        TechnoPart::Done => vec![u8::from(u.done)],
+        TechnoPart::Nr => dword(f.map_or(0, |f| f.number)),
+        TechnoPart::Time => (f.map_or(0, |f| i32::try_from(f.process_time_us).unwrap_or(i32::MAX)))
+            .to_le_bytes()
+            .to_vec(),
+        TechnoPart::BlockNr => dword(f.map_or(0, |f| f.block_nr)),
+        TechnoPart::PrgLine => dword(f.map_or(0, |f| f.line)),
+        TechnoPart::AddValue => f.map_or(0, |f| f.add_value).to_le_bytes().to_vec(),
+        // ncchannel numbers no late synchronisations apart (the HLI unit's field reads 0 too).
+        TechnoPart::NrLateSync => 0u16.to_le_bytes().to_vec(),
+    }
 }
 
 #[cfg(test)]

@@ -128,12 +128,7 @@ fn m25_waits_for_the_plc_over_the_hli_and_a_notification_shows_the_unit() {
         &format!("{P}.techno_unit_std_sync[0].attribut_r.data"),
     );
     assert_eq!(u32_at(&read(&plc, data, 39), 0), 25);
-    // GEO HLD mirror: used_units_std_sync_r and unit 0's please.
-    let mut w = [0u8; 2];
-    geo.read_exact(0x123301, 0x03, &mut w).unwrap();
-    assert_eq!(w, [1, 0]);
-    geo.read_exact(0x123301, 0x04, &mut b).unwrap();
-    assert_eq!(b, [1]);
+    geo_unit_elements(&geo);
 
     // MVS_SVS: the motion of N20 waits at X10 for the acknowledgement.
     rig.wait_for(Duration::from_secs(5), |s| {
@@ -287,4 +282,28 @@ fn twinsharp_technology_processes_acknowledges_m25() {
     assert_eq!(acknowledged, [25]);
     rig.wait_until_ended();
     plc.delete_notification(notification).unwrap();
+}
+
+/// The HLD mirror while M25 waits: used_units_std_sync_r (0x03) and unit 0's please (0x04);
+/// the unit's elements, techno.std_sync[0] from 0x3F on (type, please, done, m_h.nr,
+/// m_h.time, m_h.block_nr, m_h.prg_line_nr, m_h.add_value); an empty unit; the last element,
+/// late_sync[9]::nr_late_sync at 0x138.
+fn geo_unit_elements(geo: &ads::Device<'_>) {
+    let (mut b, mut w, mut d) = ([0u8; 1], [0u8; 2], [0u8; 4]);
+    geo.read_exact(0x123301, 0x03, &mut w).unwrap();
+    assert_eq!(w, [1, 0]);
+    geo.read_exact(0x123301, 0x04, &mut b).unwrap();
+    assert_eq!(b, [1]);
+    geo.read_exact(0x123301, 0x3F, &mut w).unwrap();
+    assert_eq!(w, [1, 0], "std_sync[0]::type M");
+    geo.read_exact(0x123301, 0x40, &mut b).unwrap();
+    assert_eq!(b, [1], "std_sync[0]::please");
+    for (offset, want) in [(0x42, 25u32), (0x44, 20), (0x45, 2)] {
+        geo.read_exact(0x123301, offset, &mut d).unwrap();
+        assert_eq!(u32::from_le_bytes(d), want, "HLD 0x{offset:X}");
+    }
+    geo.read_exact(0x123301, 0x3F + 8, &mut w).unwrap();
+    assert_eq!(w, [0, 0]);
+    geo.read_exact(0x123301, 0x138, &mut w).unwrap();
+    assert_eq!(w, [0, 0]);
 }
