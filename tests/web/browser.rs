@@ -5,8 +5,6 @@
 //!
 //! `cargo test --test web -- --ignored browser`
 
-use std::io::{BufRead, BufReader, Read};
-use std::process::{Command, Stdio};
 use std::sync::Arc;
 
 use ncchannel::http::{spawn, ControlAccess, HttpConfig};
@@ -14,7 +12,7 @@ use ncchannel::machine::Op;
 use ncchannel::vocab::mode::State;
 use serde_json::Value;
 
-use super::view;
+use super::{run_page_script, view};
 
 /// The N number a listing line or the DRO's block field starts with (`N20 G01 …`, `N20 (#8)`).
 fn n_number(text: &str) -> Option<u32> {
@@ -30,7 +28,6 @@ fn n_number(text: &str) -> Option<u32> {
 #[test]
 #[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
 fn browser_shows_a_running_channel_its_line_and_its_errors() {
-    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
     let (read_only, channels) = view(ControlAccess::Refused);
     let config = HttpConfig {
         bind: "127.0.0.1:0".parse().unwrap(),
@@ -40,36 +37,19 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
     let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
     channels.command(2, Op::Start("streaming.nc".into()));
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/live_view_test.js");
-    let mut child = Command::new(&node)
-        .arg(script)
-        .arg(format!("http://{}/", read_only.local_addr()))
-        .arg(format!("http://{}/", with_controls.local_addr()))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("{node} runs: {e}"));
-    let mut stderr = child.stderr.take().unwrap();
-    let errors = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = stderr.read_to_string(&mut s);
-        s
-    });
-    let mut last = String::new();
-    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
-        let line = line.unwrap();
-        if line == "READY_FOR_ERROR" {
-            // A syntax error on channel 2's stream while the page watches.
-            let bad = Op::WriteStream(b"N10 G01 X1 Y=\r\n"[..].into());
-            channels.backend.call(2, bad).unwrap();
-        } else {
-            last = line;
+    let args = [
+        format!("http://{}/", read_only.local_addr()),
+        format!("http://{}/", with_controls.local_addr()),
+    ];
+    let seen = run_page_script(script, &args, |line| {
+        if line != "READY_FOR_ERROR" {
+            return false;
         }
-    }
-    let status = child.wait().unwrap();
-    let stderr = errors.join().unwrap();
-    assert!(status.success(), "{stderr}");
-    let seen: Value = serde_json::from_str(&last).unwrap_or_else(|e| panic!("{e}: {last}"));
-    eprintln!("browser saw: {seen}");
+        // A syntax error on channel 2's stream while the page watches.
+        let bad = Op::WriteStream(b"N10 G01 X1 Y=\r\n"[..].into());
+        channels.backend.call(2, bad).unwrap();
+        true
+    });
 
     let refused = seen["refused"].as_str().unwrap();
     assert!(

@@ -36,3 +36,43 @@ pub fn view(controls: ControlAccess) -> (HttpHandle, Channels) {
     let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
     (web, channels)
 }
+
+/// Run a page script (playwright-core driving chromium) with `args`; each line it prints goes
+/// to `cue` (which acts on the lines it knows and answers whether it took the line); the last
+/// other line is the JSON of what the page saw, returned once the script succeeded.
+pub fn run_page_script(
+    script: &str,
+    args: &[String],
+    mut cue: impl FnMut(&str) -> bool,
+) -> serde_json::Value {
+    use std::io::{BufRead, BufReader, Read};
+    use std::process::{Command, Stdio};
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let mut child = Command::new(&node)
+        .arg(script)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{node} runs: {e}"));
+    let mut stderr = child.stderr.take().unwrap();
+    let errors = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+        s
+    });
+    let mut last = String::new();
+    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
+        let line = line.unwrap();
+        if !cue(&line) {
+            last = line;
+        }
+    }
+    let status = child.wait().unwrap();
+    let stderr = errors.join().unwrap();
+    assert!(status.success(), "{stderr}");
+    let seen: serde_json::Value =
+        serde_json::from_str(&last).unwrap_or_else(|e| panic!("{e}: {last}"));
+    eprintln!("browser saw: {seen}");
+    seen
+}

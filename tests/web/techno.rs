@@ -3,8 +3,6 @@
 //! half"), acknowledged by a PLC writing `done_w` through the door as ADS does, and in a real
 //! headless browser without a PLC (the channel acknowledges after the 3 s process time).
 
-use std::io::{BufRead, BufReader, Read};
-use std::process::{Command, Stdio};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -14,6 +12,7 @@ use ncchannel::machine::{Op, Reply};
 use serde_json::Value;
 
 use super::client::{self, Events};
+use super::run_page_script;
 use super::support::ads::{Channels, Params};
 
 const WITHIN: Duration = Duration::from_secs(20);
@@ -100,37 +99,17 @@ fn the_status_event_shows_m25_waiting_for_the_plc_until_done_w() {
 #[test]
 #[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
 fn browser_shows_m25_waiting_then_gone_after_its_process_time() {
-    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
     let (web, channels) = techno_view();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/web/techno_view_test.js");
-    let mut child = Command::new(&node)
-        .arg(script)
-        .arg(format!("http://{}/", web.local_addr()))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("{node} runs: {e}"));
-    let mut stderr = child.stderr.take().unwrap();
-    let errors = std::thread::spawn(move || {
-        let mut s = String::new();
-        let _ = stderr.read_to_string(&mut s);
-        s
-    });
-    let mut last = String::new();
-    for line in BufReader::new(child.stdout.take().unwrap()).lines() {
-        let line = line.unwrap();
-        if line == "READY" {
-            // The page is live: start the program now, so its M25 is output while it watches.
-            channels.command(1, Op::Start("techno.nc".into()));
-        } else {
-            last = line;
+    let args = [format!("http://{}/", web.local_addr())];
+    let seen = run_page_script(script, &args, |line| {
+        if line != "READY" {
+            return false;
         }
-    }
-    let status = child.wait().unwrap();
-    let stderr = errors.join().unwrap();
-    assert!(status.success(), "{stderr}");
-    let seen: Value = serde_json::from_str(&last).unwrap_or_else(|e| panic!("{e}: {last}"));
-    eprintln!("browser saw: {seen}");
+        // The page is live: start the program now, so its M25 is output while it watches.
+        channels.command(1, Op::Start("techno.nc".into()));
+        true
+    });
     assert_eq!(seen["function"], "M25");
     assert_eq!(seen["sync"], "MVS_SVS");
     assert_eq!(seen["unit"], "std 0");
