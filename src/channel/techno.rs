@@ -592,3 +592,103 @@ impl Acknowledgements for TechnoUnits {
         self.open.is_empty()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vocab::techno::{FunctionDef, SyncSpec};
+
+    fn m25(seq: TechnoSeq) -> OutputGroup {
+        OutputGroup {
+            fns: vec![TechnoFn {
+                seq,
+                kind: TechnoKind::M,
+                number: 25,
+                value: None,
+                def: FunctionDef::new(SyncSpec {
+                    sync: SyncType::MvsSvs,
+                    plc_info: false,
+                }),
+            }],
+            block_nr: 40,
+            line: 3,
+        }
+    }
+
+    #[test]
+    fn a_plcs_writes_that_would_not_change_the_handshake_change_nothing() {
+        let mut u = TechnoUnits::new();
+        u.write(TechnoWrite::PlcPresent(true)).unwrap();
+        // Nothing waits: done_w and please_rw TRUE are taken and change nothing.
+        let free = u.status();
+        u.write(TechnoWrite::Done {
+            set: UnitSet::Std,
+            unit: 0,
+            value: true,
+        })
+        .unwrap();
+        u.write(TechnoWrite::Please {
+            set: UnitSet::Std,
+            unit: 3,
+            value: true,
+        })
+        .unwrap();
+        assert_eq!(u.status(), free);
+        assert_eq!(
+            u.write(TechnoWrite::Done {
+                set: UnitSet::Late,
+                unit: 10,
+                value: true
+            }),
+            Err(TechnoRefusal::NoSuchUnit(10))
+        );
+        // M25 waits: a please_rw TRUE from the PLC does not ask again, a FALSE fetches, and
+        // only done_w acknowledges.
+        u.output(m25(0), Duration::ZERO);
+        u.write(TechnoWrite::Please {
+            set: UnitSet::Std,
+            unit: 0,
+            value: true,
+        })
+        .unwrap();
+        u.write(TechnoWrite::Please {
+            set: UnitSet::Std,
+            unit: 0,
+            value: false,
+        })
+        .unwrap();
+        u.tick(Duration::from_millis(1));
+        assert!(!u.is_acknowledged(0), "fetched, not acknowledged");
+        assert_eq!(u.status().used_std, 1);
+        u.write(TechnoWrite::Done {
+            set: UnitSet::Std,
+            unit: 0,
+            value: true,
+        })
+        .unwrap();
+        u.tick(Duration::from_millis(2));
+        assert!(u.is_acknowledged(0));
+        assert_eq!((u.stats().output, u.stats().acknowledged), (1, 1));
+        assert_eq!(u.status().used_std, 0);
+    }
+
+    #[test]
+    fn without_a_plc_the_channel_acknowledges_after_the_process_time_and_a_reset_drops() {
+        let mut u = TechnoUnits::new();
+        let mut g = m25(0);
+        g.fns[0].def.process_time_us = 500_000;
+        u.output(g, Duration::ZERO);
+        u.tick(Duration::from_millis(499));
+        assert!(!u.is_acknowledged(0));
+        u.tick(Duration::from_millis(500));
+        assert!(u.is_acknowledged(0));
+        // A function not yet output is not acknowledged; a reset drops what waits.
+        assert!(!u.is_acknowledged(1));
+        let mut g = m25(1);
+        g.fns[0].def.process_time_us = 500_000;
+        u.output(g, Duration::from_secs(1));
+        u.reset();
+        assert_eq!(u.stats().dropped_by_reset, 1);
+        assert!(u.all_acknowledged());
+    }
+}
