@@ -1031,7 +1031,10 @@ pub(crate) fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, Str
             b']' => {
                 depth -= 1;
                 if depth == 0 {
-                    return Ok((&i[k + 1..], i[1..k].trim().to_string()));
+                    // Only the blanks and tabs `ws` skips: a text that began with another
+                    // space character (a vertical tab) must not print as a quoted one.
+                    let text = i[1..k].trim_matches([' ', '\t']);
+                    return Ok((&i[k + 1..], text.to_string()));
                 }
             }
             _ => {}
