@@ -239,11 +239,6 @@ impl TechnoUnits {
         self.open.is_empty()
     }
 
-    /// Functions output or waiting to be, not yet finished.
-    pub fn open(&self) -> usize {
-        self.open.len()
-    }
-
     /// The units that hold an open function (output, not finished): set, index, the
     /// function and whether `please_rw` is still set. What a PLC polls.
     pub fn open_units(&self) -> impl Iterator<Item = (UnitSet, usize, &UnitFunction, bool)> {
@@ -310,17 +305,7 @@ impl TechnoUnits {
         }
     }
 
-    /// The oldest function still open: since when the channel waits for the PLC.
-    pub fn waiting_since(&self) -> Option<(TechnoKind, u32, Duration)> {
-        self.std
-            .iter()
-            .chain(self.late.iter())
-            .filter(|u| self.is_busy(u))
-            .filter_map(|u| u.function.as_ref())
-            .min_by_key(|f| f.output_at)
-            .map(|f| (f.kind, f.number, f.output_at))
-    }
-
+    /// Does `u` hold a function that is output and not yet finished?
     fn is_busy(&self, u: &Unit) -> bool {
         u.function
             .as_ref()
@@ -398,15 +383,12 @@ impl TechnoUnits {
                 (set, unit)
             }
         };
-        let open = match set {
+        let u = match set {
             UnitSet::Std => self.std.get(unit),
             UnitSet::Late => self.late.get(unit),
         }
-        .ok_or(TechnoRefusal::NoSuchUnit(unit))?
-        .function
-        .as_ref()
-        .is_some_and(|f| self.open.contains(&f.seq));
-        if !open {
+        .ok_or(TechnoRefusal::NoSuchUnit(unit))?;
+        if !self.is_busy(u) {
             return Ok(());
         }
         let u = match set {
@@ -489,11 +471,7 @@ impl TechnoUnits {
         }
         self.stats.acknowledged += acked;
         self.stats.waited += waited;
-        let std_busy = self.std[..self.used_std].iter().any(|u| {
-            u.function
-                .as_ref()
-                .is_some_and(|f| self.open.contains(&f.seq))
-        });
+        let std_busy = self.std[..self.used_std].iter().any(|u| self.is_busy(u));
         if !std_busy && self.used_std > 0 {
             for u in &mut self.std[..self.used_std] {
                 u.done = false;
@@ -515,11 +493,7 @@ impl TechnoUnits {
             }
         }
         while !self.pending_late.is_empty() {
-            let Some(k) = self.late.iter().position(|u| {
-                !u.function
-                    .as_ref()
-                    .is_some_and(|f| self.open.contains(&f.seq))
-            }) else {
+            let Some(k) = self.late.iter().position(|u| !self.is_busy(u)) else {
                 break;
             };
             let Some((f, block_nr, line)) = self.pending_late.pop_front() else {
