@@ -263,6 +263,14 @@ impl<'a> Ctx<'a> {
         self.level(0, i)
     }
 
+    /// A word's value written without brackets (`XP1`, `X = P1*2`). Written back it is
+    /// bracketed (`X[P1]`), so it counts one nesting level, or the printed block could nest
+    /// past the limit and not parse again.
+    pub(crate) fn unbracketed_value(&self, i: &'a str) -> PResult<'a, Expr> {
+        let _g = self.enter(i)?;
+        self.expr(i)
+    }
+
     /// `[expr]`: the bracketed form words use (`X[P1*2]`).
     pub(crate) fn bracketed(&self, i: &'a str) -> PResult<'a, Expr> {
         let (i, _) = ch('[')(i)?;

@@ -632,7 +632,7 @@ fn axis_assigned<'a>(
     after: &'a str,
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
-    let (r, e) = ctx.expr(ws(&ws(after)[1..]))?;
+    let (r, e) = ctx.unbracketed_value(ws(&ws(after)[1..]))?;
     items.push(Item::Word(Word {
         letter: up,
         value: expr_value(e),
@@ -692,7 +692,7 @@ fn word_unbracketed<'a>(
         .unwrap_or(after.len());
     let cut = ctx.cut(ctx.line.len() - after.len() + end);
     let text = &cut.line[cut.line.len() - end..];
-    let e = match cut.expr(text) {
+    let e = match cut.unbracketed_value(text) {
         Ok(("", e)) => e,
         Ok((rest, _)) => {
             return Err(ctx.err_at(cut.col(rest), SYNTAX, "operator or blank expected"));
