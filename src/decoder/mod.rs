@@ -426,19 +426,11 @@ impl Decoder {
             .last()
             .map(|f| f.prog().clone())
             .unwrap_or_else(|| Arc::from(""));
-        let msg = match self
-            .interp
-            .settings()
-            .error_texts
-            .as_deref()
-            .and_then(|t| t.get(e.code))
-        {
-            Some(text) => format!("{text} ({})", e.msg),
-            None => e.msg,
-        };
+        // ncchannel's detail only: the channel puts the kernel's text before it, once
+        // (`reported_message`, called by the channel's `fail`).
         self.notes.push(Note::Error {
             code: e.code,
-            msg,
+            msg: e.msg,
             prog,
             line: meta.line,
             col: e.col,

@@ -226,12 +226,19 @@ fn beyond_swe_pos_is_refused_with_21897_and_the_kernels_text() {
         })
         .expect("an error");
     assert_eq!(code, 21897);
-    assert!(
-        msg.starts_with("Axis position is out of permissible range. ("),
-        "{msg}"
+    // The kernel's text once, then ncchannel's detail once in parentheses: in the event,
+    // the channel's last-error record and its list of errors (the run report's).
+    assert_eq!(
+        msg,
+        "Axis position is out of permissible range. (axis X end point 1500.001 mm, \
+         above the upper software limit (limits -1500 to 1500 mm))"
     );
-    assert!(msg.contains("1500"), "{msg}");
-    assert_eq!(c.report().position[0], 0.0, "nothing moved");
+    let report = c.report();
+    let last = report.last_error.as_ref().expect("a last error");
+    assert_eq!((last.code, last.msg.as_str()), (21897, msg.as_str()));
+    assert_eq!(report.errors.len(), 1);
+    assert_eq!(report.errors[0].msg, msg);
+    assert_eq!(report.position[0], 0.0, "nothing moved");
 }
 
 const IMPLICIT: &str = "start_init_prog_file init.nc ( P-CHAN-00119\n\
