@@ -64,7 +64,7 @@ pub enum Item {
         col: u32,
     },
     /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent), and
-    /// the dwell `G04 2.5` / `G04=2.5` / `G04 P2.5` (seconds). `G134 50` and `G134=50` both
+    /// the dwell `G04 2.5` / `G04=2.5` / `G04 P1` (seconds). `G134 50` and `G134=50` both
     /// parse to this item. `col` is the G's column.
     GValue {
         g: u32,

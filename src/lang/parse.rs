@@ -399,8 +399,9 @@ fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
 }
 
 /// A dwell stands alone in its block (TF5200 G04): besides `G04` only its time, as `G04 <t>`,
-/// `G04 P<t>`, `G04 X<t>` or `G04 F<t>`. Anything else — a second G, an M, another axis —
-/// is refused rather than executed as a move or a feed.
+/// `G04 P1` (a parameter's value), `G04 X<t>` or `G04 F<t>`, or its spindle revolutions
+/// `G04 S<n>`. Anything else — a second G, an M, another axis — is refused rather than
+/// executed as a move or a feed.
 fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a>>> {
     let mut time_given = items
         .iter()
@@ -410,7 +411,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             continue;
         }
         let (col, what) = match it {
-            Item::Word(w) if matches!(w.letter, b'X' | b'F') && !time_given => {
+            Item::Word(w) if matches!(w.letter, b'X' | b'F' | b'S') && !time_given => {
                 time_given = true;
                 continue;
             }
@@ -674,6 +675,21 @@ fn word_unbracketed<'a>(
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
     literal_only(i, up)?;
+    let (rest, e) = unbracketed_expr(ctx, after)?;
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
+        col,
+    }));
+    Ok(rest)
+}
+
+/// An expression starting with a parameter or variable, written without brackets, at
+/// `after`: it runs to the next blank or comment outside brackets.
+fn unbracketed_expr<'a>(
+    ctx: &Ctx<'a>,
+    after: &'a str,
+) -> Result<(&'a str, super::block::Expr), nom::Err<PErr<'a>>> {
     let mut depth = 0usize;
     let end = after
         .bytes()
@@ -702,12 +718,7 @@ fn word_unbracketed<'a>(
             return Err(ctx.err_at(e.col, e.code, e.message));
         }
     };
-    items.push(Item::Word(Word {
-        letter: up,
-        value: Value::Expr(e),
-        col,
-    }));
-    Ok(&after[end..])
+    Ok((&after[end..], e))
 }
 
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
@@ -774,15 +785,11 @@ fn g_value<'a>(
         let (r, e) = ctx.expr(ws(r))?;
         return Ok(Some((r, expr_value(e))));
     }
-    if dwell_p {
-        if let Some(p) = j.strip_prefix(['P', 'p']) {
-            if let Some((v, n)) = scan_unsigned(p.as_bytes()) {
-                if !v.is_finite() {
-                    return Err(perr(p, SYNTAX, TOO_LARGE));
-                }
-                return Ok(Some((&p[n..], Value::Num(v))));
-            }
-        }
+    if dwell_p && starts_variable(j.as_bytes()) {
+        // `G04 P1`, `G04 V.L.TIME`: the time is the parameter's or variable's value (TF5200
+        // programming manual, "Dwell time (G04), (#TIME)").
+        let (r, e) = unbracketed_expr(ctx, j)?;
+        return Ok(Some((r, expr_value(e))));
     }
     let jb = j.as_bytes();
     let (neg, k) = match jb.first() {

@@ -243,14 +243,18 @@ fn each_dwell_form_dwells_its_time() {
         "G04 2.5",
         "G4 2.5",
         "G04=2.5",
-        "G04 P2.5",
+        "G04 P2",
+        "G04 V.L.TIME",
         "G04 X2.5",
         "G4 F2.5",
         "G04 X[P1/2]",
         "#TIME 2.5",
         "#TIME [P1/2]",
     ] {
-        rig.program("dwell.nc", &format!("P1=5\nM5\n{form}\nM5\nM30\n"));
+        rig.program(
+            "dwell.nc",
+            &format!("#VAR\nV.L.TIME\n#ENDVAR\nP1=5\nP2=2.5\nV.L.TIME=2.5\nM5\n{form}\nM5\nM30\n"),
+        );
         let r = rig.run("dwell.nc", None, 1_000_000);
         assert_eq!(r.finish, Some(Finish::Ended), "{form}: {}", r.log);
         let t = block_duration(&r, form);
@@ -258,6 +262,35 @@ fn each_dwell_form_dwells_its_time() {
         // The time word is no feed: the modal feed stays unset.
         let c = &r.machine.channels()[0];
         assert_eq!(c.status().feed_mm_per_min, 0.0, "{form}");
+    }
+}
+
+/// `G04 S10` waits ten turns of the main spindle at its programmed speed (TF5200 programming
+/// manual, "Dwell time (G04), (#TIME)": `M3 S200`, `G04 S10` waits 3 s) and leaves the speed
+/// as it was; a spindle that does not turn never completes them: 20752.
+#[test]
+fn g04_s_dwells_spindle_revolutions() {
+    let rig = Rig::new();
+    for (speed, form, seconds) in [("M3 S200", "G04 S10", 3.0), ("M4 S600", "G04 S2.5", 0.25)] {
+        rig.program("rev.nc", &format!("{speed}\n{form}\nM5\nM30\n"));
+        let r = rig.run("rev.nc", None, 1_000_000);
+        assert_eq!(r.finish, Some(Finish::Ended), "{form}: {}", r.log);
+        let t = block_duration(&r, form);
+        assert!((t - seconds).abs() < 0.01, "{form}: dwelled {t} s");
+    }
+    for prog in [
+        "G04 S10\nM30\n",
+        "S200\nG04 S10\nM30\n",
+        "M3 S200\nM5\nG04 S10\nM30\n",
+    ] {
+        rig.program("rev.nc", prog);
+        let r = rig.run("rev.nc", None, 1_000_000);
+        assert_eq!(
+            r.error_codes(),
+            [u64::from(codes::DWELL_RANGE_G04)],
+            "{prog}: {}",
+            r.log
+        );
     }
 }
 

@@ -34,7 +34,7 @@ pub(super) struct Words {
     pub(super) spindle_rpm: Option<f64>,
     pub(super) tool: Option<u32>,
     pub(super) tool_offset: Option<u32>,
-    /// `G04 <t>` / `G04 P<t>`: the dwell time in seconds.
+    /// `G04 <t>` / `G04 P1` / `G04 X<t>` / `G04 S<n>`: the dwell time in seconds.
     pub(super) dwell_s: Option<f64>,
     pub(super) ms: [u32; MAX_FUNCTIONS],
     /// The value of each M programmed with one (`M200=1200`), by its place in `ms`.

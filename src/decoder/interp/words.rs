@@ -15,7 +15,7 @@ use crate::decoder::frame::FrameKind;
 use crate::decoder::io::DecoderIo;
 use crate::decoder::line::BlockAt;
 use crate::decoder::modal::FeedMode;
-use crate::decoder::modal::{apply_g, apply_m, BlockGs, MotionMode};
+use crate::decoder::modal::{apply_g, apply_m, BlockGs, MotionMode, Spindle};
 use crate::decoder::note::Note;
 use crate::decoder::reader::Reader;
 use crate::decoder::vars;
@@ -326,6 +326,10 @@ impl Interpreter {
                 w.dwell_s = Some(w.axes[0]);
             } else if let Some((f, _)) = w.feed.take() {
                 w.dwell_s = Some(f);
+            } else if let Some(revolutions) = w.spindle_rpm.take() {
+                // `G04 S<n>`: n revolutions of the main spindle at its programmed speed, not
+                // a new speed (TF5200 programming manual, "Dwell time (G04), (#TIME)").
+                w.dwell_s = Some(self.revolutions_s(revolutions)?);
             }
         }
         if let Some((f, _)) = w.feed {
@@ -351,6 +355,23 @@ impl Interpreter {
             return Err(unconfigured(b'X').at(col));
         }
         Ok(gs)
+    }
+
+    /// The time of `revolutions` turns of the main spindle at the programmed speed, s. A
+    /// spindle that does not turn (M05, or no S programmed) never completes them: refused as
+    /// a dwell time out of range (20752), since no kernel id names it.
+    fn revolutions_s(&self, revolutions: f64) -> Res<f64> {
+        let rpm = self.modal.spindle_rpm;
+        if self.modal.spindle == Spindle::Off || rpm <= 0.0 {
+            return Err(DecodeError::new(
+                codes::DWELL_RANGE_G04,
+                format!(
+                    "dwell of {revolutions} spindle revolutions with the spindle not turning \
+                     (speed {rpm} rpm, M03 or M04 with an S needed)"
+                ),
+            ));
+        }
+        Ok(revolutions * 60.0 / rpm)
     }
 
     /// The offset from program to machine coordinates of axis `i` (zero offset and G92;
