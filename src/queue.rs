@@ -237,6 +237,18 @@ pub enum Action {
     },
     /// A technology function step around the block's motion (always a silent part).
     Techno(TechnoStep),
+    /// `#MSG SYN` / `#MSG SYN_ACK`: an operator message reported when execution reaches its
+    /// block, not when it is decoded (TF5200 programming manual, "Programming a message
+    /// (#MSG)": "synchronous with processing state in interpolator").
+    Message(Box<SyncMessage>),
+}
+
+/// An operator message that waits for its block's execution, its values already formatted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyncMessage {
+    pub text: String,
+    /// `#MSG SAVE …`: written to the report file as well.
+    pub save: bool,
 }
 
 /// Where a block's technology functions meet its motion (TF5200 "Synchronisation types").

@@ -7,7 +7,7 @@ use super::refusals::RefusalStretch;
 use super::techno::{TechnoNote, UnitSet};
 use crate::decoder::Note;
 use crate::motion::MotionNote;
-use crate::queue::BlockInfo;
+use crate::queue::{BlockInfo, SyncMessage};
 use crate::report::event::{EventBuffer, EventKind, ProgramEndKind};
 use crate::runtime::Tick;
 use crate::source::stream::{StreamWriteError, WARN_WRITE_REJECTED};
@@ -137,6 +137,20 @@ impl ChannelLog {
     /// Mode or state changed.
     pub(super) fn state(&mut self, tick: &Tick, mode: Mode, state: State) {
         self.emit(tick, EventKind::State { mode, state });
+    }
+
+    /// An operator message (`#MSG`): its event, and the channel's latest message
+    /// (`mc_message_r`). A plain one comes when its block is decoded, a `SYN` one when
+    /// execution reaches its block.
+    fn operator_message(&mut self, tick: &Tick, text: String, save: bool) {
+        self.emit(
+            tick,
+            EventKind::Message {
+                text: text.clone(),
+                save,
+            },
+        );
+        self.message = Some(text);
     }
 
     pub(super) fn warn(&mut self, tick: &Tick, code: u32, msg: String) {
@@ -300,16 +314,7 @@ impl ChannelLog {
                     found,
                 },
             ),
-            Note::Message { text, save } => {
-                self.emit(
-                    tick,
-                    EventKind::Message {
-                        text: text.clone(),
-                        save,
-                    },
-                );
-                self.message = Some(text);
-            }
+            Note::Message { text, save } => self.operator_message(tick, text, save),
             Note::Cache { op, file } => self.emit(
                 tick,
                 EventKind::Cache {
@@ -345,6 +350,10 @@ impl ChannelLog {
             MotionNote::Flush(kind) => self.emit(tick, EventKind::Flush { kind }),
             // The channel hands it to its technology units (channel/techno.rs).
             MotionNote::TechnoOutput(_) => {}
+            MotionNote::Message(m) => {
+                let SyncMessage { text, save } = *m;
+                self.operator_message(tick, text, save);
+            }
             MotionNote::ProgramStop { optional } => {
                 let m = u32::from(optional);
                 self.emit(tick, EventKind::ProgramStop { m });

@@ -35,6 +35,14 @@ const RECEIVERS: &[&str] = &["ISG_DIAG_BED", "DIAG", "HMI", "PLC", "EVENT_LOGGER
 
 type Res<'a, T> = Result<(&'a str, T), nom::Err<PErr<'a>>>;
 
+/// `#MSG SYN` and `#MSG SYN_ACK`: output "synchronous with processing state in interpolator",
+/// when execution reaches the block; without a mode, or with `ACK`, right after decoding
+/// (TF5200 programming manual, "Programming a message (#MSG)"). No receiver acknowledges
+/// here, so `SYN_ACK` goes on at once as `SYN` does and `ACK` as the default.
+pub(crate) fn synchronous(m: &Message) -> bool {
+    m.options.iter().any(|o| o.starts_with("SYN"))
+}
+
 /// `#MSG …` after the keyword `MSG` (and its blanks).
 pub(crate) fn parse_msg<'a>(ctx: &Ctx<'a>, i: &'a str) -> Res<'a, Command> {
     let (r, options) = options(i)?;

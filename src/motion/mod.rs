@@ -18,7 +18,7 @@ pub mod trc;
 
 use std::sync::Arc;
 
-use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind};
+use crate::queue::{BlockInfo, BlockQueue, Move, MoveKind, SyncMessage};
 use crate::vocab::axis::{Position, MAX_AXES};
 use crate::vocab::flush::FlushKind;
 use crate::vocab::techno::{Acknowledgements, OutputGroup};
@@ -71,6 +71,8 @@ pub enum MotionNote {
     },
     /// Execution reached the point where these technology functions go to the PLC.
     TechnoOutput(Box<OutputGroup>),
+    /// Execution reached a `#MSG SYN` block: its message is reported now.
+    Message(Box<SyncMessage>),
 }
 
 /// What happens to the front entry after its share of a tick.
@@ -500,7 +502,9 @@ impl Motion {
                 .find(|e| {
                     !matches!(
                         e.kind,
-                        EntryKind::Plain | EntryKind::Flush(FlushKind::Continue)
+                        EntryKind::Plain
+                            | EntryKind::Message(_)
+                            | EntryKind::Flush(FlushKind::Continue)
                     )
                 })
                 .is_some_and(|e| matches!(e.kind, EntryKind::Move(_)));
@@ -663,6 +667,10 @@ impl Motion {
                 }
             }
             EntryKind::Plain => Next::Pop,
+            EntryKind::Message(m) => {
+                notes.push(MotionNote::Message(m.clone()));
+                Next::Pop
+            }
             EntryKind::TechnoOutput(g) => {
                 self.output_this_step = true;
                 notes.push(MotionNote::TechnoOutput(g.clone()));

@@ -406,6 +406,41 @@ fn msg_is_an_event_and_the_channel_keeps_the_latest() {
     );
 }
 
+/// `#MSG SYN` is output "synchronous with processing state in interpolator" (TF5200
+/// programming manual, "Programming a message (#MSG)"): its event comes when the motion
+/// reaches its block, with that block's event, after the 6 s move before it; a message
+/// without a mode comes when its block is decoded, before the move has run.
+#[test]
+fn msg_syn_comes_when_execution_reaches_its_block() {
+    let rig = Rig::new();
+    for (mode, at_block) in [("SYN ", true), ("SYN_ACK HMI ", true), ("", false)] {
+        let text = format!("#MSG {mode}[\"X at %.0f\", P1]");
+        rig.program(
+            "msg.nc",
+            &format!("P1=60\nG01 X60 F600\n{text}\nG01 X0\nM30\n"),
+        );
+        let r = rig.run("msg.nc", None, 1_000_000);
+        assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+        let msg = r.of("message");
+        assert_eq!(msg.len(), 1, "{}", r.log);
+        assert_eq!(msg[0]["text"], "X at 60");
+        let t = msg[0]["t"].as_f64().unwrap();
+        let block = r.of("block");
+        let reached = block.iter().find(|b| b["text"] == text.as_str()).unwrap()["t"]
+            .as_f64()
+            .unwrap();
+        if at_block {
+            assert_eq!(t, reached, "{mode}: {}", r.log);
+            assert!(t >= 6.0, "{mode}: {t}");
+        } else {
+            assert!(t < 1.0, "{mode}: {t}");
+        }
+        // The motion did not stop for it: X60 then X0 is one 12 s path in all.
+        let end = r.of("program_end")[0]["t"].as_f64().unwrap();
+        assert!(end < 12.5, "{mode}: ended at {end}");
+    }
+}
+
 /// A program in the style of a TwinCAT CAM post: `%`, comments, the modal header, a tool
 /// change, spindle, rapid and feed moves, arcs, `M30`. `lines` lines in all.
 fn post_program(lines: usize) -> String {

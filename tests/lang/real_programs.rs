@@ -64,14 +64,15 @@ fn msg_formats_its_values_as_printf_does_in_file_and_stream() {
                 ("P1= 2.500000".to_string(), false),
                 ("tool 7 of 8: -1.25 mm".to_string(), false),
                 ("10%".to_string(), true),
-                ("RED,20,BOLD".to_string(), false),
                 ("plain".to_string(), true),
                 ("no quotes %d".to_string(), false),
+                // SYN: when execution reaches its block, after the later blocks' decoding.
+                ("RED,20,BOLD".to_string(), false),
             ]
         );
         assert_eq!(
             r.machine.channels()[0].status().message.as_deref(),
-            Some("no quotes %d")
+            Some("RED,20,BOLD")
         );
     }
     assert_eq!(check_program(text), []);

@@ -14,7 +14,7 @@ use crate::decoder::reader::CacheRead;
 use crate::decoder::reader::Reader;
 use crate::lang::block::{Call, Command, SplineCommand, Value};
 use crate::lang::codes;
-use crate::queue::{Action, BlockInfo};
+use crate::queue::{Action, BlockInfo, SyncMessage};
 use crate::source::cache::LoadStep;
 use crate::source::store::{Opened, ProgramKind};
 use crate::vocab::event::CacheOp;
@@ -316,11 +316,15 @@ impl Interpreter {
             Command::EndVar => {}
             Command::Msg(m) => {
                 let text = self.format_message(m)?;
-                notes.push(Note::Message {
-                    text,
-                    save: m.save(),
-                });
-                self.emit(info, Action::None, false, io);
+                let save = m.save();
+                if crate::lang::msg::synchronous(m) {
+                    // Reported when execution reaches the block (channel log).
+                    let m = Box::new(SyncMessage { text, save });
+                    self.emit(info, Action::Message(m), false, io);
+                } else {
+                    notes.push(Note::Message { text, save });
+                    self.emit(info, Action::None, false, io);
+                }
             }
             Command::Time(v) => {
                 let seconds = match v {

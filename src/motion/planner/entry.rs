@@ -1,7 +1,7 @@
 //! Window entries and the motion-block data the planner's parts share: `Segment`, `Junction`,
 //! `Entry`, `EntryKind`.
 
-use crate::queue::{BlockInfo, Move};
+use crate::queue::{BlockInfo, Move, SyncMessage};
 use crate::vocab::axis::MAX_AXES;
 use crate::vocab::flush::FlushKind;
 use crate::vocab::techno::{OutputGroup, TechnoSeq};
@@ -79,6 +79,9 @@ pub(crate) enum EntryKind {
     TechnoOutput(Box<OutputGroup>),
     /// Stand until these technology functions are acknowledged.
     TechnoWait(Box<[TechnoSeq]>),
+    /// `#MSG SYN`: report the message when execution reaches it; the motion goes on as over
+    /// a plain block.
+    Message(Box<SyncMessage>),
     End {
         m: u32,
         prog: std::sync::Arc<str>,

@@ -242,6 +242,7 @@ impl Planner {
             Action::Flush(k) => EntryKind::Flush(k),
             Action::Techno(TechnoStep::Output(g)) => EntryKind::TechnoOutput(g),
             Action::Techno(TechnoStep::Wait(w)) => EntryKind::TechnoWait(w),
+            Action::Message(m) => EntryKind::Message(m),
             Action::Stop { optional } => EntryKind::Stop { optional },
             Action::End { m } => EntryKind::End {
                 m,

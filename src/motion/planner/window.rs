@@ -124,7 +124,9 @@ impl Window {
         }
         for e in self.entries.iter().take(self.released).skip(1) {
             match &e.kind {
-                EntryKind::Plain | EntryKind::Flush(FlushKind::Continue) => {}
+                EntryKind::Plain
+                | EntryKind::Message(_)
+                | EntryKind::Flush(FlushKind::Continue) => {}
                 k => return k.is_barrier(),
             }
         }
@@ -157,6 +159,7 @@ impl Window {
             // Nothing held before it: it takes no part in cross-block planning, so it runs
             // when interpolation reaches it, not when more motion arrives.
             EntryKind::Plain
+            | EntryKind::Message(_)
             | EntryKind::Dwell { .. }
             | EntryKind::TechnoOutput(_)
             | EntryKind::TechnoWait(_) => nothing_held,
