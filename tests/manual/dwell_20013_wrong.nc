@@ -1,0 +1,6 @@
+; TF5200 diagnosis, ID 20013 "Dwell time is programmed directly and via coordinate.": the wrong program
+; https://infosys.beckhoff.com/content/1033/tf5200_diagnosis/250532491.html
+; expect: error 20013
+N10 G00 X0 Y0 Z0
+N20 G04 10 X2
+N1000 M30
