@@ -7,6 +7,7 @@
 //! - `end X=10 Y=0` — where the named axes stand when the program has ended, mm;
 //! - `msg "text"` — one operator message (`#MSG`), the `msg` lines in the order they come;
 //! - `error 20xxx` — the run stops with this error id;
+//! - `warning 20xxx` — the run reports this warning id (and goes on);
 //! - `blocks N10 N20 N40` — the numbered blocks that run, in order (unnumbered ones not
 //!   listed);
 //! - `runs N110 46` — the block numbered N110 runs 46 times;
@@ -45,6 +46,7 @@ struct Expect {
     end: Vec<(char, f64)>,
     msgs: Vec<String>,
     error: Option<u64>,
+    warnings: Vec<u64>,
     blocks: Option<Vec<u64>>,
     runs: Vec<(u64, usize)>,
     dwells: Vec<(u64, f64)>,
@@ -109,6 +111,9 @@ fn parse_expect(e: &str, x: &mut Expect) -> Result<(), String> {
             x.msgs.push(t.to_string());
         }
         "error" => x.error = Some(rest.parse().map_err(|_| "error id expected")?),
+        "warning" => x
+            .warnings
+            .push(rest.parse().map_err(|_| "warning id expected")?),
         "blocks" => {
             x.blocks = Some(
                 rest.split_whitespace()
@@ -173,6 +178,16 @@ fn check(name: &str, ex: &Example) -> Result<(), String> {
             diffs.push(format!("did not end: {:?}", r.finish));
         }
         None => {}
+    }
+    let warnings: Vec<u64> = r
+        .of("warning")
+        .iter()
+        .filter_map(|w| w["code"].as_u64())
+        .collect();
+    for w in &ex.expect.warnings {
+        if !warnings.contains(w) {
+            diffs.push(format!("warning {w} expected, got {warnings:?}"));
+        }
     }
     for &(axis, want) in &ex.expect.end {
         let got = position(&r, axis);
