@@ -145,9 +145,11 @@ fn n_number(w: &str) -> Result<u64, String> {
         .ok_or_else(|| format!("block number N.. expected, found {w}"))
 }
 
-/// The channel the corpus runs in: the test rig's, with the fixture's channel and tool lists.
+/// The channel the corpus runs in: the test rig's, file caching for 6 files of 6000 bytes
+/// (TF5200 channel parameters, P-CHAN-00503/-00504: their parameterisation example), with the
+/// fixture's channel and tool lists.
 fn rig() -> Rig {
-    let rig = Rig::new();
+    let rig = Rig::with_cache(Some((6, 6000)), "");
     for f in ["channel1.lis", "tools.lis"] {
         std::fs::copy(
             corpus_dir().join("fixture").join(f),
