@@ -13,7 +13,9 @@
 //! - `runs N110 46` — the block numbered N110 runs 46 times;
 //! - `dwell N40 2.0 s` — the block numbered N40 lasts 2.0 s (to the next block's start).
 //!
-//! Without an `error` line the program must end without one. A line `; --- file <name>`
+//! Without an `error` line the program must end without one. A line `; run: stream` runs the
+//! main program through the data-streaming interface (CR LF lines) instead of as a file, for
+//! the examples of the TF5200 data streaming manual. A line `; --- file <name>`
 //! starts a further program file (a subroutine or cycle the example calls); the lines before
 //! the first such line are the main program.
 //!
@@ -28,7 +30,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use ncchannel::channel::Finish;
-use support::{Rig, RunResult};
+use support::{feeder, Rig, RunResult};
 
 /// Most ticks one example may run (1 ms each: 1000 s of channel time).
 const MAX_TICKS: u64 = 1_000_000;
@@ -55,6 +57,8 @@ struct Expect {
 /// One example: its main program, its further files, what it should do.
 struct Example {
     main: String,
+    /// Fed through the streaming interface rather than started as a file.
+    stream: bool,
     files: Vec<(String, String)>,
     expect: Expect,
 }
@@ -64,7 +68,9 @@ fn parse_example(name: &str, text: &str) -> Result<Example, String> {
     let mut main = String::new();
     let mut files: Vec<(String, String)> = Vec::new();
     let mut cited = false;
+    let mut stream = false;
     for line in text.lines() {
+        stream |= line.trim_end() == "; run: stream";
         if let Some(f) = line.strip_prefix("; --- file ") {
             files.push((f.trim().to_string(), String::new()));
             continue;
@@ -87,6 +93,7 @@ fn parse_example(name: &str, text: &str) -> Result<Example, String> {
     }
     Ok(Example {
         main,
+        stream,
         files,
         expect,
     })
@@ -166,8 +173,13 @@ fn check(name: &str, ex: &Example) -> Result<(), String> {
     for (f, text) in &ex.files {
         rig.program(f, text);
     }
-    rig.program(name, &ex.main);
-    let r = rig.run(name, None, MAX_TICKS);
+    let r = if ex.stream {
+        let crlf = ex.main.replace('\n', "\r\n");
+        rig.run("streaming.nc", Some(feeder(&crlf, 4096, 1)), MAX_TICKS)
+    } else {
+        rig.program(name, &ex.main);
+        rig.run(name, None, MAX_TICKS)
+    };
     let mut diffs = Vec::new();
     let errors = r.error_codes();
     match ex.expect.error {
