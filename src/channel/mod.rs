@@ -156,6 +156,16 @@ impl Channel {
             Op::SetOverride(p) => Reply::Command(self.set_override(p)),
             Op::WriteExternal(name, v) => Reply::Value(self.write_external(&name, v).then_some(v)),
             Op::ReadExternal(name) => Reply::Value(self.read_external(&name)),
+            Op::WriteExternalStr(name, text) => Reply::Value(
+                self.decoder
+                    .vars_mut()
+                    .set_external_str(&name, &text)
+                    .is_ok()
+                    .then_some(0.0),
+            ),
+            Op::ReadExternalTyped(name) => {
+                Reply::External(self.decoder.vars().external_value(&name))
+            }
             Op::Status => {
                 let mut s = self.status();
                 s.tick = tick.index;

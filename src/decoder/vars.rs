@@ -884,22 +884,30 @@ impl VarStore {
         self.get(&external_slot(name).ok()?)
     }
 
-    /// The string a V.E. read from outside holds, if it holds one.
-    pub(crate) fn get_external_str(&self, name: &str) -> Option<&str> {
-        self.get_str(&external_slot(name).ok()?)
-    }
-
-    /// The declared type of a V.E. leaf read from outside: `None` without a list (every
-    /// V.E. is a number then, or a string once one was written).
-    pub(crate) fn external_type(&self, name: &str) -> Option<ExtType> {
+    /// A V.E. read from outside with what the PLC side needs to encode it: a number with its
+    /// declared type (`None` without a list), or a string with the characters it may hold.
+    pub(crate) fn external_value(&self, name: &str) -> Option<ExternalValue> {
         let k = external_slot(name).ok()?;
-        self.ext_leaf(&k).ok().flatten().map(|l| l.ty)
+        let ty = self.ext_leaf(&k).ok().flatten().map(|l| l.ty);
+        if let Some(v) = self.get(&k) {
+            return Some(ExternalValue::Num(v, ty));
+        }
+        let text = self.get_str(&k)?;
+        let max = match ty {
+            Some(ExtType::Str { max_chars }) => max_chars,
+            _ => MAX_STRING as u8,
+        };
+        Some(ExternalValue::Str(text.to_string(), max))
     }
+}
 
-    /// The declared V.E. leaves, when a list was given.
-    pub fn external_table(&self) -> Option<&Arc<ExtVarTable>> {
-        self.ext.as_ref()
-    }
+/// A V.E. value as the PLC side reads it ([`VarStore::external_value`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExternalValue {
+    /// The value and the declared type (`None`: no list, an LREAL).
+    Num(f64, Option<ExtType>),
+    /// The text and the characters the variable may hold.
+    Str(String, u8),
 }
 
 /// Characters of a V.E. name written from outside at most.
