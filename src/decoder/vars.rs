@@ -1121,6 +1121,67 @@ mod tests {
     }
 
     #[test]
+    fn declared_externals_are_typed_and_bind_programs_not_the_plc() {
+        use crate::params::ext_vars::{ExtAccess, ExtType, ExtVar, ExtVarTable};
+        let leaf = |name: &str, sizes: Vec<u32>, ty, access| ExtVar {
+            name: name.into(),
+            sizes,
+            ty,
+            access,
+        };
+        let mut s = VarStore::new(Loader::inline());
+        let table = ExtVarTable {
+            file: "ve.lis".into(),
+            vars: vec![
+                leaf("INFO.X", vec![2], ExtType::Uns08, ExtAccess::ReadOnly),
+                leaf(
+                    "MSG",
+                    vec![],
+                    ExtType::Str { max_chars: 4 },
+                    ExtAccess::ReadWrite,
+                ),
+            ],
+        };
+        s.declare_externals(Arc::new(table)).unwrap();
+        // Members and indices as a program writes them, any case.
+        assert_eq!(
+            external_slot(" info[1].x "),
+            Ok(el(VScope::External, "INFO.X", &[1]))
+        );
+        assert!(external_slot("INFO[1]..X").is_err());
+        assert!(external_slot("A[1][2][3][4]").is_err());
+        // The PLC writes a READ_ONLY leaf, rounded into UNS08; a program may not.
+        s.set_external("Info[1].X", 6.5).unwrap();
+        assert_eq!(s.get_external("INFO[1].X"), Some(7.0));
+        let e = |r: Result<(), VarError>| r.unwrap_err().code();
+        assert_eq!(
+            e(s.set(el(VScope::External, "INFO.X", &[0]), 1.0)),
+            VARIABLE_WRITE_DENIED
+        );
+        assert_eq!(
+            e(s.set_external("INFO[0].X", 256.0)),
+            VARIABLE_OUT_OF_FORMAT
+        );
+        assert_eq!(e(s.set_external("INFO[2].X", 1.0)), ARRAY_INDEX_RANGE);
+        assert_eq!(e(s.set_external("NOPE", 1.0)), VARIABLE_UNKNOWN);
+        s.set_external_str("msg", "abcd").unwrap();
+        assert_eq!(
+            s.external_value("MSG"),
+            Some(ExternalValue::Str("abcd".into(), 4))
+        );
+        assert_eq!(
+            e(s.set_external_str("MSG", "abcde")),
+            STRING_TOO_LONG_FOR_VARIABLE
+        );
+        // A reset keeps them.
+        s.reset();
+        assert_eq!(
+            s.external_value("INFO[1].X"),
+            Some(ExternalValue::Num(7.0, Some(ExtType::Uns08)))
+        );
+    }
+
+    #[test]
     fn an_element_of_an_undeclared_array_is_refused() {
         let mut s = VarStore::new(Loader::inline());
         let e = s.set(el(VScope::Local, "NOPE", &[2]), 1.0).unwrap_err();

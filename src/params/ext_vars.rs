@@ -218,33 +218,40 @@ struct StructDef<'l> {
     elements: BTreeMap<u32, Fields<'l>>,
 }
 
-/// Check a parsed V.E. list.
-pub(crate) fn interpret_ext_vars(
-    list: &ParamList,
-    diags: &mut Vec<Diagnostic>,
-) -> (ExtVarTable, ListSummary) {
-    warn_duplicates(list, diags);
-    let mut tally = Tally::new(ListKind::ExtVars);
-    let mut vars: BTreeMap<u32, Fields<'_>> = BTreeMap::new();
-    let mut structs: BTreeMap<u32, StructDef<'_>> = BTreeMap::new();
-    let mut string_chars = STRING_CHARS;
-    let mut used: Option<u32> = None;
+/// The entries of a V.E. list, by variable and structure index.
+struct Gathered<'l> {
+    vars: BTreeMap<u32, Fields<'l>>,
+    structs: BTreeMap<u32, StructDef<'l>>,
+    string_chars: u8,
+    /// `number_used_variables` (P-EXTV-00010), if given.
+    used: Option<u32>,
+}
+
+/// Step 1: every entry to its variable, structure element or list setting.
+fn gather<'l>(list: &'l ParamList, tally: &mut Tally, diags: &mut Vec<Diagnostic>) -> Gathered<'l> {
+    let mut g = Gathered {
+        vars: BTreeMap::new(),
+        structs: BTreeMap::new(),
+        string_chars: STRING_CHARS,
+        used: None,
+    };
     for e in &list.entries {
         match shape(e).as_slice() {
             [("var", Some(i)), (field, None)] => {
                 if *i >= MAX_VARS {
                     diags.push(index_error(list, e, "variable", MAX_VARS));
-                } else if !vars.entry(*i).or_default().take(field, e) {
+                } else if !g.vars.entry(*i).or_default().take(field, e) {
                     tally.not_read(list, e, diags);
                 }
             }
             [("struct", Some(i)), ("name", None)] if *i < MAX_STRUCTS => {
-                structs.entry(*i).or_default().name = Some(e);
+                g.structs.entry(*i).or_default().name = Some(e);
             }
             [("struct", Some(i)), ("element", Some(j)), (field, None)]
                 if *i < MAX_STRUCTS && *j < MAX_ELEMENTS =>
             {
-                let fields = structs
+                let fields = g
+                    .structs
                     .entry(*i)
                     .or_default()
                     .elements
@@ -265,93 +272,40 @@ pub(crate) fn interpret_ext_vars(
                 ));
             }
             [("use_extended_string_var", None)] => match bool_value(list, e) {
-                Ok(true) => string_chars = EXTENDED_STRING_CHARS,
-                Ok(false) => string_chars = STRING_CHARS,
+                Ok(true) => g.string_chars = EXTENDED_STRING_CHARS,
+                Ok(false) => g.string_chars = STRING_CHARS,
                 Err(d) => diags.push(d),
             },
             [("number_used_variables" | "anzahl_belegt", None)] => {
                 match uint_value(list, e, u64::from(MAX_VARS)) {
-                    Ok(n) => used = Some(n as u32),
+                    Ok(n) => g.used = Some(n as u32),
                     Err(d) => diags.push(d),
                 }
             }
             _ => tally.not_read(list, e, diags),
         }
     }
+    g
+}
+
+/// Check a parsed V.E. list.
+pub(crate) fn interpret_ext_vars(
+    list: &ParamList,
+    diags: &mut Vec<Diagnostic>,
+) -> (ExtVarTable, ListSummary) {
+    warn_duplicates(list, diags);
+    let mut tally = Tally::new(ListKind::ExtVars);
+    let g = gather(list, &mut tally, diags);
     let mut cx = Unfold {
         list,
         structs: HashMap::new(),
-        string_chars,
+        string_chars: g.string_chars,
         out: Vec::new(),
         bytes: 0,
         diags,
     };
-    for (i, s) in &structs {
-        let Some(n) = s.name else {
-            if let Some(e) = s.elements.values().find_map(|f| f.name.or(f.ty)) {
-                cx.diags.push(list.error_at(
-                    e,
-                    e.name_pos,
-                    format!("struct[{i}] has elements but no struct[{i}].name"),
-                ));
-            }
-            continue;
-        };
-        if let Some(name) = cx.name(n) {
-            if ExtType::elementary(&name, string_chars).is_some() || name == "VSTRING" {
-                cx.diags.push(list.error_at(
-                    n,
-                    n.value_pos,
-                    format!("{}: {name} is an elementary type", n.name.text),
-                ));
-            } else if cx.structs.insert(name.clone(), s).is_some() {
-                cx.diags.push(list.error_at(
-                    n,
-                    n.value_pos,
-                    format!("{}: structure type {name} is defined twice", n.name.text),
-                ));
-            }
-        }
-    }
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    for (i, v) in &vars {
-        let Some(n) = v.name else {
-            if let Some(e) = v.ty.or(v.access).or(v.array).or(v.size) {
-                cx.diags.push(list.error_at(
-                    e,
-                    e.name_pos,
-                    format!("var[{i}] has no var[{i}].name"),
-                ));
-            }
-            continue;
-        };
-        if used.is_some_and(|u| *i >= u) {
-            cx.diags.push(list.warning_at(
-                n,
-                n.name_pos,
-                format!(
-                    "{}: not below number_used_variables {}: the kernel leaves it out, so does ncchannel",
-                    n.name.text,
-                    used.unwrap_or(0)
-                ),
-            ));
-            continue;
-        }
-        let Some(name) = cx.name(n) else { continue };
-        if let Some(first) = seen.insert(name.clone(), n.name_pos.line) {
-            // TF5200 diagnosis 21485: the kernel makes the second one unreachable.
-            cx.diags.push(list.error_at(
-                n,
-                n.value_pos,
-                format!(
-                    "{}: {name} is already declared on line {first}",
-                    n.name.text
-                ),
-            ));
-            continue;
-        }
-        cx.leaf_or_struct(&name, v, Vec::new(), ExtAccess::ReadWrite, 0);
-    }
+    cx.register_structs(&g.structs);
+    cx.unfold_vars(&g.vars, g.used);
     let Unfold { mut out, .. } = cx;
     out.sort_by(|a, b| a.name.cmp(&b.name));
     (
@@ -375,6 +329,80 @@ struct Unfold<'l, 'd> {
 }
 
 impl<'l> Unfold<'l, '_> {
+    /// Step 2: the structure types by name.
+    fn register_structs(&mut self, structs: &'l BTreeMap<u32, StructDef<'l>>) {
+        for (i, s) in structs {
+            let Some(n) = s.name else {
+                if let Some(e) = s.elements.values().find_map(|f| f.name.or(f.ty)) {
+                    self.diags.push(self.list.error_at(
+                        e,
+                        e.name_pos,
+                        format!("struct[{i}] has elements but no struct[{i}].name"),
+                    ));
+                }
+                continue;
+            };
+            if let Some(name) = self.name(n) {
+                if ExtType::elementary(&name, self.string_chars).is_some() || name == "VSTRING" {
+                    self.diags.push(self.list.error_at(
+                        n,
+                        n.value_pos,
+                        format!("{}: {name} is an elementary type", n.name.text),
+                    ));
+                } else if self.structs.insert(name.clone(), s).is_some() {
+                    self.diags.push(self.list.error_at(
+                        n,
+                        n.value_pos,
+                        format!("{}: structure type {name} is defined twice", n.name.text),
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Step 3: each variable below `used` unfolded into its leaves, names unique.
+    fn unfold_vars(&mut self, vars: &BTreeMap<u32, Fields<'l>>, used: Option<u32>) {
+        let mut seen: HashMap<String, usize> = HashMap::new();
+        for (i, v) in vars {
+            let Some(n) = v.name else {
+                if let Some(e) = v.ty.or(v.access).or(v.array).or(v.size) {
+                    self.diags.push(self.list.error_at(
+                        e,
+                        e.name_pos,
+                        format!("var[{i}] has no var[{i}].name"),
+                    ));
+                }
+                continue;
+            };
+            if used.is_some_and(|u| *i >= u) {
+                self.diags.push(self.list.warning_at(
+                    n,
+                    n.name_pos,
+                    format!(
+                        "{}: not below number_used_variables {}: the kernel leaves it out, so does ncchannel",
+                        n.name.text,
+                        used.unwrap_or(0)
+                    ),
+                ));
+                continue;
+            }
+            let Some(name) = self.name(n) else { continue };
+            if let Some(first) = seen.insert(name.clone(), n.name_pos.line) {
+                // TF5200 diagnosis 21485: the kernel makes the second one unreachable.
+                self.diags.push(self.list.error_at(
+                    n,
+                    n.value_pos,
+                    format!(
+                        "{}: {name} is already declared on line {first}",
+                        n.name.text
+                    ),
+                ));
+                continue;
+            }
+            self.leaf_or_struct(&name, v, Vec::new(), ExtAccess::ReadWrite, 0);
+        }
+    }
+
     /// The upper-case name `e` gives, if it is a valid one (letters, digits, `_`, not
     /// starting with a digit; TF5200 diagnosis 20788 for a bad character).
     fn name(&mut self, e: &Entry) -> Option<String> {
@@ -398,6 +426,87 @@ impl<'l> Unfold<'l, '_> {
         }
     }
 
+    /// The access right of `f` (P-EXTV-00006 / -00019), `inherited` when it names none;
+    /// `None` after an error.
+    fn access(&mut self, f: &Fields<'l>, inherited: ExtAccess) -> Option<ExtAccess> {
+        let Some(e) = f.access else {
+            return Some(inherited);
+        };
+        Some(match e.value.text.trim().to_ascii_uppercase().as_str() {
+            "READ_WRITE" => ExtAccess::ReadWrite,
+            "READ_ONLY" => ExtAccess::ReadOnly,
+            "WRITE_ONLY" => ExtAccess::WriteOnly,
+            "INHERIT_ACCESS" => inherited,
+            _ => {
+                self.diags.push(self.list.error_at(
+                    e,
+                    e.value_pos,
+                    format!(
+                        "{}: READ_WRITE, READ_ONLY, WRITE_ONLY or INHERIT_ACCESS expected, found `{}`",
+                        e.name.text, e.value.text
+                    ),
+                ));
+                return None;
+            }
+        })
+    }
+
+    /// `f`'s array size (P-EXTV-00007 / -00020; 0 is no array) added to `sizes`; `false`
+    /// after an error.
+    fn array(&mut self, f: &Fields<'l>, path: &str, sizes: &mut Vec<u32>) -> bool {
+        let Some(e) = f.array else {
+            return true;
+        };
+        match uint_value(self.list, e, MAX_ARRAY_ELEMENTS) {
+            Ok(0) => true,
+            Ok(n) if sizes.len() < MAX_ARRAY_DIMS => {
+                sizes.push(n as u32);
+                true
+            }
+            Ok(_) => {
+                self.diags.push(self.list.error_at(
+                    e,
+                    e.name_pos,
+                    format!(
+                        "{}: {path} would have more than {MAX_ARRAY_DIMS} indices",
+                        e.name.text
+                    ),
+                ));
+                false
+            }
+            Err(d) => {
+                self.diags.push(d);
+                false
+            }
+        }
+    }
+
+    /// A VSTRING of `f.size` bytes with the NUL (P-EXTV-00008 / -00021; default 128);
+    /// `None` after an error.
+    fn vstring(&mut self, f: &Fields<'l>) -> Option<ExtType> {
+        let bytes = match f.size {
+            None => DEFAULT_VSTRING_BYTES,
+            Some(e) => match uint_value(self.list, e, MAX_VSTRING_BYTES) {
+                Ok(0) => {
+                    self.diags.push(self.list.error_at(
+                        e,
+                        e.value_pos,
+                        format!("{}: at least 1 byte", e.name.text),
+                    ));
+                    return None;
+                }
+                Ok(n) => n,
+                Err(d) => {
+                    self.diags.push(d);
+                    return None;
+                }
+            },
+        };
+        Some(ExtType::Str {
+            max_chars: (bytes - 1) as u8,
+        })
+    }
+
     /// One variable or element `f` named `path`, under arrays `sizes`, inheriting `access`.
     fn leaf_or_struct(
         &mut self,
@@ -408,47 +517,11 @@ impl<'l> Unfold<'l, '_> {
         depth: usize,
     ) {
         let list = self.list;
-        let access = match f.access {
-            None => access,
-            Some(e) => match e.value.text.trim().to_ascii_uppercase().as_str() {
-                "READ_WRITE" => ExtAccess::ReadWrite,
-                "READ_ONLY" => ExtAccess::ReadOnly,
-                "WRITE_ONLY" => ExtAccess::WriteOnly,
-                "INHERIT_ACCESS" => access,
-                _ => {
-                    self.diags.push(list.error_at(
-                        e,
-                        e.value_pos,
-                        format!(
-                            "{}: READ_WRITE, READ_ONLY, WRITE_ONLY or INHERIT_ACCESS expected, found `{}`",
-                            e.name.text, e.value.text
-                        ),
-                    ));
-                    return;
-                }
-            },
+        let Some(access) = self.access(f, access) else {
+            return;
         };
-        if let Some(e) = f.array {
-            match uint_value(list, e, MAX_ARRAY_ELEMENTS) {
-                // P-EXTV-00007: 0 is no array.
-                Ok(0) => {}
-                Ok(n) if sizes.len() < MAX_ARRAY_DIMS => sizes.push(n as u32),
-                Ok(_) => {
-                    self.diags.push(list.error_at(
-                        e,
-                        e.name_pos,
-                        format!(
-                            "{}: {path} would have more than {MAX_ARRAY_DIMS} indices",
-                            e.name.text
-                        ),
-                    ));
-                    return;
-                }
-                Err(d) => {
-                    self.diags.push(d);
-                    return;
-                }
-            }
+        if !self.array(f, path, &mut sizes) {
+            return;
         }
         let elements: u64 = sizes.iter().map(|&s| u64::from(s)).product();
         if elements > MAX_ARRAY_ELEMENTS {
@@ -467,28 +540,10 @@ impl<'l> Unfold<'l, '_> {
         });
         let ty = match (ExtType::elementary(&word, self.string_chars), word.as_str()) {
             (Some(t), _) => t,
-            (None, "VSTRING") => {
-                match f.size.map(|e| (e, uint_value(list, e, MAX_VSTRING_BYTES))) {
-                    None => ExtType::Str {
-                        max_chars: (DEFAULT_VSTRING_BYTES - 1) as u8,
-                    },
-                    Some((_, Ok(n))) if n >= 1 => ExtType::Str {
-                        max_chars: (n - 1) as u8,
-                    },
-                    Some((e, Ok(_))) => {
-                        self.diags.push(list.error_at(
-                            e,
-                            e.value_pos,
-                            format!("{}: at least 1 byte", e.name.text),
-                        ));
-                        return;
-                    }
-                    Some((_, Err(d))) => {
-                        self.diags.push(d);
-                        return;
-                    }
-                }
-            }
+            (None, "VSTRING") => match self.vstring(f) {
+                Some(t) => t,
+                None => return,
+            },
             (None, _) => {
                 let Some(s) = self.structs.get(&word).copied() else {
                     if let Some(e) = f.ty {
