@@ -86,6 +86,7 @@ pub fn channel_settings(
         implicit: ch.implicit.clone(),
         error_texts: config.error_texts.clone(),
         techno: ch.techno.clone(),
+        ext_vars: ch.ext_vars.clone(),
         ..DecoderSettings::default()
     };
     let search_dirs = ch

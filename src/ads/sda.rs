@@ -8,7 +8,11 @@
 //! also reads and writes a variable with the handle as index offset: `Read/Write(0x1223<ch>,
 //! handle)`; that form is served too.
 //!
-//! Variables served: the external variables `V.E.<name>` (LREAL, 8 bytes, read and write) and
+//! Variables served: the external variables `V.E.<name>` — with members and indices as a
+//! program writes them (`V.E.SCH.PREFLOW`, `V.E.FARBE[2]`) — in the PLC type of their
+//! declared type (TF5200 External variables: BOOLEAN → BOOL, SGN08 … UNS32 → SINT … UDINT,
+//! REAL64 → LREAL, STRING → STRING(n), n + 1 bytes NUL-padded), LREAL when no list declares
+//! them (read and write; a write takes exactly the type's bytes, a string up to n + 1), and
 //! the zero offsets `V.G.NP[i].V`, i = 1…6 for G54…G59 (read only: one DINT per configured
 //! axis of the channel, 0.1 µm, as TwinSharp `ZeroOffsets.cs` reads and decodes them). Other
 //! variable kinds (`V.A.*`, `V.P.*` …) are not modelled and answer "not found" (0x70C).
@@ -17,9 +21,11 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::backend::CncBackend;
+use super::backend::{CncBackend, DeviceError};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
+use crate::decoder::vars::ExternalValue;
+use crate::params::ext_vars::ExtType;
 use crate::vocab::axis::slot_of;
 
 pub const PORT: u16 = 552;
@@ -38,7 +44,7 @@ const MAX_NAME_BYTES: usize = 255;
 /// ADS "insufficient memory": the handle table is full.
 const NO_MEMORY: AdsResult = AdsResult(0x70A);
 const LOGICAL: u32 = 0x100000;
-/// Bytes of a value: ncchannel's V.E. variables are LREAL.
+/// Bytes of a V.E. value no list declares: an LREAL.
 const VALUE_BYTES: usize = 8;
 /// Zero-offset tables `V.G.NP[1]` … `V.G.NP[6]` (G54…G59).
 const ZERO_OFFSETS: std::ops::RangeInclusive<usize> = 1..=6;
@@ -62,7 +68,7 @@ pub fn objects(ch: u16) -> Vec<ObjectInfo> {
         group,
         offset,
         name: name.into(),
-        ty: AdsType::Named("V.E.* LREAL; V.G.NP[i].V DINT[axes]"),
+        ty: AdsType::Named("V.E.* declared type (LREAL without a list); V.G.NP[i].V DINT[axes]"),
         size,
         access,
         unit: "",
@@ -144,6 +150,58 @@ fn value_arg(data: &[u8]) -> Result<f64, AdsResult> {
     }
 }
 
+/// A V.E. value in its PLC type's bytes (little-endian; a STRING(n) NUL-padded to n + 1).
+fn encode(v: &ExternalValue) -> Vec<u8> {
+    match v {
+        ExternalValue::Str(text, max) => {
+            let mut out = text.as_bytes().to_vec();
+            out.resize(usize::from(*max) + 1, 0);
+            out
+        }
+        // The store holds whole numbers in range for an integer type: the casts are exact.
+        ExternalValue::Num(v, ty) => match ty {
+            None | Some(ExtType::Real64) | Some(ExtType::Str { .. }) => v.to_le_bytes().to_vec(),
+            Some(ExtType::Boolean | ExtType::Uns08) => vec![*v as u8],
+            Some(ExtType::Sgn08) => (*v as i8).to_le_bytes().to_vec(),
+            Some(ExtType::Sgn16) => (*v as i16).to_le_bytes().to_vec(),
+            Some(ExtType::Uns16) => (*v as u16).to_le_bytes().to_vec(),
+            Some(ExtType::Sgn32) => (*v as i32).to_le_bytes().to_vec(),
+            Some(ExtType::Uns32) => (*v as u32).to_le_bytes().to_vec(),
+        },
+    }
+}
+
+/// The number a write of `data` to a V.E. of type `ty` carries: exactly the type's bytes.
+fn decode(data: &[u8], ty: Option<ExtType>) -> Result<f64, AdsResult> {
+    let Some(ty) = ty.filter(|t| *t != ExtType::Real64) else {
+        return value_arg(data);
+    };
+    let (_, size) = ty.plc_type();
+    if data.len() != size as usize {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    Ok(match (ty, data) {
+        (ExtType::Sgn08, [b]) => f64::from(*b as i8),
+        (ExtType::Boolean | ExtType::Uns08, [b]) => f64::from(*b),
+        (ExtType::Sgn16, [a, b]) => f64::from(i16::from_le_bytes([*a, *b])),
+        (ExtType::Uns16, [a, b]) => f64::from(u16::from_le_bytes([*a, *b])),
+        (ExtType::Sgn32, [a, b, c, d]) => f64::from(i32::from_le_bytes([*a, *b, *c, *d])),
+        (ExtType::Uns32, [a, b, c, d]) => f64::from(u32::from_le_bytes([*a, *b, *c, *d])),
+        _ => return Err(AdsResult::INVALID_SIZE),
+    })
+}
+
+/// The text of a write to a STRING(max): up to the first NUL, at most `max + 1` bytes.
+fn string_arg(data: &[u8], max: u8) -> Result<String, AdsResult> {
+    if data.len() > usize::from(max) + 1 {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    let end = data.iter().position(|&b| b == 0).unwrap_or(data.len());
+    std::str::from_utf8(&data[..end])
+        .map(str::to_string)
+        .map_err(|_| AdsResult::INVALID_DATA)
+}
+
 fn u32_at(data: &[u8], at: usize) -> Result<u32, AdsResult> {
     data.get(at..at + 4)
         .and_then(|b| b.try_into().ok())
@@ -183,7 +241,7 @@ impl Sda {
     fn handle(&self, ch: u16, name: Var) -> Result<u32, AdsResult> {
         // Only a variable that exists gets a handle (zero offsets 1…6 always do).
         if let Var::External(n) = &name {
-            self.backend.read_ve(ch, n).map_err(AdsResult::from)?;
+            self.backend.read_ve_typed(ch, n).map_err(AdsResult::from)?;
         }
         let mut names = self.names.lock().unwrap_or_else(|p| p.into_inner());
         let i = match names.iter().position(|n| *n == name) {
@@ -199,12 +257,12 @@ impl Sda {
 
     fn value(&self, ch: u16, var: &Var, read_length: u32) -> Result<Vec<u8>, AdsResult> {
         let bytes = match var {
-            Var::External(name) => self
-                .backend
-                .read_ve(ch, name)
-                .map_err(AdsResult::from)?
-                .to_le_bytes()
-                .to_vec(),
+            Var::External(name) => encode(
+                &self
+                    .backend
+                    .read_ve_typed(ch, name)
+                    .map_err(AdsResult::from)?,
+            ),
             Var::ZeroOffset(i) => self.zero_offset(ch, *i)?,
         };
         if (read_length as usize) < bytes.len() {
@@ -232,10 +290,28 @@ impl Sda {
     /// the start and runs ahead of execution by the lookahead (docs/ads.md).
     fn store(&self, ch: u16, var: &Var, data: &[u8]) -> Result<(), AdsResult> {
         match var {
-            Var::External(name) => self
-                .backend
-                .write_ve(ch, name, value_arg(data)?)
-                .map_err(AdsResult::from),
+            Var::External(name) => {
+                let now = match self.backend.read_ve_typed(ch, name) {
+                    Ok(v) => v,
+                    // Not there: without a list the first write makes it (an LREAL); with
+                    // one, the name is not declared.
+                    Err(DeviceError::NotFound) => {
+                        return self
+                            .backend
+                            .write_ve(ch, name, value_arg(data)?)
+                            .map_err(|_| AdsResult::NOT_FOUND)
+                    }
+                    Err(e) => return Err(e.into()),
+                };
+                match now {
+                    ExternalValue::Str(_, max) => {
+                        let text = string_arg(data, max)?;
+                        self.backend.write_ve_str(ch, name, &text)
+                    }
+                    ExternalValue::Num(_, ty) => self.backend.write_ve(ch, name, decode(data, ty)?),
+                }
+                .map_err(AdsResult::from)
+            }
             Var::ZeroOffset(_) => Err(AdsResult::ACCESS_DENIED),
         }
     }

@@ -38,6 +38,10 @@ pub enum Op {
     SetOverride(f64),
     WriteExternal(String, f64),
     ReadExternal(String),
+    /// A string into a V.E. variable (`V.E.USERINTERACTION.MESSAGE`), from outside.
+    WriteExternalStr(String, String),
+    /// A V.E. variable with its declared type ([`Reply::External`]), for the ADS side.
+    ReadExternalTyped(String),
     Status,
     /// An HMI command object (`mc_command_*_w`) of the COM task.
     Hmi(HmiOp),
@@ -283,6 +287,8 @@ pub enum Reply {
     Stream(Result<(), StreamWriteError>),
     Command(Result<(), CommandError>),
     Value(Option<f64>),
+    /// A V.E. variable read with its type; `None` when it does not exist.
+    External(Option<crate::decoder::vars::ExternalValue>),
     Status(Box<Status>),
     /// The error asked for (if still kept) and how many the channel raised.
     ErrorRecord {

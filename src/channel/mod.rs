@@ -156,6 +156,10 @@ impl Channel {
             Op::SetOverride(p) => Reply::Command(self.set_override(p)),
             Op::WriteExternal(name, v) => Reply::Value(self.write_external(&name, v).then_some(v)),
             Op::ReadExternal(name) => Reply::Value(self.read_external(&name)),
+            Op::WriteExternalStr(name, text) => Reply::Value(self.write_external_str(&name, &text)),
+            Op::ReadExternalTyped(name) => {
+                Reply::External(self.decoder.vars().external_value(&name))
+            }
             Op::Status => {
                 let mut s = self.status();
                 s.tick = tick.index;
@@ -534,6 +538,12 @@ impl Channel {
     /// V.E. variable written from outside.
     fn write_external(&mut self, name: &str, v: f64) -> bool {
         self.decoder.vars_mut().set_external(name, v).is_ok()
+    }
+
+    /// A string into a V.E. variable from outside: `Some(0.0)` when taken.
+    fn write_external_str(&mut self, name: &str, text: &str) -> Option<f64> {
+        let vars = self.decoder.vars_mut();
+        vars.set_external_str(name, text).is_ok().then_some(0.0)
     }
 
     fn read_external(&self, name: &str) -> Option<f64> {

@@ -66,11 +66,17 @@ impl Interpreter {
             .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
             .fold(0u8, |m, i| m | 1 << i);
         let techno = TechnoState::new(settings.techno.clone(), settings.implicit.at_m6.is_some());
+        let mut vars = VarStore::new(loader);
+        if let Some(t) = &settings.ext_vars {
+            // The list reader refuses a table larger than the V.E. class budget
+            // (params::ext_vars, `MAX_TABLE_BYTES`), so this cannot run out of memory.
+            let _ = vars.declare_externals(t.clone());
+        }
         Interpreter {
             techno,
             settings,
             renamed_slots,
-            vars: VarStore::new(loader),
+            vars,
             modal: Modal::defaults([0.0; MAX_AXES]),
             tool_radii: Vec::new(),
             counter: 0,

@@ -37,6 +37,9 @@ pub struct DecoderSettings {
     /// M/H/S/T functions: synchronisation types, process times (the channel list's
     /// `m_synch[i]`, `h_synch[i]`, `spindel[0].*`, `tool.*`).
     pub techno: TechnoTable,
+    /// The channel's list of external variables (start-up list `ve_var[i]`, P-STUP-00146):
+    /// `None` leaves V.E. variables free.
+    pub ext_vars: Option<Arc<crate::params::ext_vars::ExtVarTable>>,
 }
 
 /// Each slot named by its letter, `X` to `C`.
@@ -68,6 +71,7 @@ impl Default for DecoderSettings {
             implicit: Default::default(),
             error_texts: None,
             techno: TechnoTable::kernel_defaults(),
+            ext_vars: None,
         }
     }
 }

@@ -13,14 +13,17 @@
 //! long-running channel from filling up over many programs.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use crate::lang::block::VScope;
 use crate::lang::block::MAX_STRING;
 use crate::lang::codes::{
     ARRAY_INDEX_RANGE, EVAL_NUMBER_AS_STRING, EVAL_STRING_AS_NUMBER, EVAL_UNDEFINED,
     MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, STRING_TOO_LONG_FOR_VARIABLE, TOO_MANY_INDICES,
-    VARIABLE_MEMORY_FULL,
+    VARIABLE_MEMORY_FULL, VARIABLE_OUT_OF_FORMAT, VARIABLE_READ_DENIED, VARIABLE_UNKNOWN,
+    VARIABLE_WRITE_DENIED,
 };
+use crate::params::ext_vars::{ExtAccess, ExtType, ExtVar, ExtVarTable};
 use crate::source::loader::Loader;
 
 /// Array indices of a variable, evaluated. At most three dimensions, as ISG arrays have.
@@ -111,6 +114,19 @@ pub enum VarError {
     NumberToString(String),
     #[error("{0} holds numbers: a string cannot be assigned to it")]
     StringToNumber(String),
+    #[error("{0} is not declared in the list of external variables")]
+    UnknownExternal(String),
+    #[error("{0} is READ_ONLY for NC programs (list of external variables)")]
+    WriteDenied(String),
+    #[error("{0} is WRITE_ONLY for NC programs (list of external variables)")]
+    ReadDenied(String),
+    #[error("{name}: {value} is outside {min} … {max}, the range of its type")]
+    OutOfFormat {
+        name: String,
+        value: f64,
+        min: f64,
+        max: f64,
+    },
 }
 
 impl VarError {
@@ -125,6 +141,10 @@ impl VarError {
             VarError::StringTooLong { .. } => STRING_TOO_LONG_FOR_VARIABLE,
             VarError::NumberToString(_) => EVAL_NUMBER_AS_STRING,
             VarError::StringToNumber(_) => EVAL_STRING_AS_NUMBER,
+            VarError::UnknownExternal(_) => VARIABLE_UNKNOWN,
+            VarError::WriteDenied(_) => VARIABLE_WRITE_DENIED,
+            VarError::ReadDenied(_) => VARIABLE_READ_DENIED,
+            VarError::OutOfFormat { .. } => VARIABLE_OUT_OF_FORMAT,
         }
     }
 }
@@ -251,6 +271,9 @@ pub struct VarStore {
     cycle: Vec<Vec<(u32, f64)>>,
     /// String cycle parameters (`@P1="text"`) per level, beside `cycle`: one entry per level.
     cycle_text: Vec<Vec<(u32, Box<str>)>>,
+    /// The V.E. list's leaves, when the start-up list names one (`ve_var[i]`): then only
+    /// they exist, typed; without a list V.E. variables are made by whoever writes first.
+    ext: Option<Arc<ExtVarTable>>,
 }
 
 /// The scopes still held when the decoder goes are freed as a scope that ends is.
@@ -283,7 +306,120 @@ impl VarStore {
             external: Scope::default(),
             cycle: vec![Vec::new()],
             cycle_text: vec![Vec::new()],
+            ext: None,
         }
+    }
+
+    /// Declare the leaves of a V.E. list, every number 0 and every string empty (TF5200
+    /// External variables: the kernel clears the shared memory at start-up). From then on
+    /// only they exist.
+    pub(crate) fn declare_externals(&mut self, table: Arc<ExtVarTable>) -> Result<(), VarError> {
+        for v in &table.vars {
+            match v.ty {
+                ExtType::Str { max_chars } => {
+                    self.declare_str(VScope::External, &v.name, &v.sizes, max_chars, "")?
+                }
+                _ => self.declare(VScope::External, &v.name, &v.sizes, 0.0)?,
+            };
+        }
+        self.ext = Some(table);
+        Ok(())
+    }
+
+    /// With a V.E. list: the leaf a V.E. slot names, or 20196. `Ok(None)`: no list, or not a
+    /// V.E. slot.
+    fn ext_leaf(&self, k: &VarSlot) -> Result<Option<&ExtVar>, VarError> {
+        let (
+            Some(t),
+            VarSlot::V {
+                scope: VScope::External,
+                name,
+                indices,
+                dims,
+            },
+        ) = (&self.ext, k)
+        else {
+            return Ok(None);
+        };
+        t.get(name).map(Some).ok_or_else(|| {
+            VarError::UnknownExternal(element(VScope::External, name, indices, *dims))
+        })
+    }
+
+    /// The value an NC program writing `v` to `k` stores: a declared V.E. leaf takes what
+    /// its type holds (an integer type rounds to the nearest whole number, BOOLEAN holds 0
+    /// or 1; outside: 20847), and refuses a program's write when READ_ONLY (20100; the PLC
+    /// and the HMI may always write, P-EXTV-00006).
+    fn typed(&self, k: &VarSlot, v: f64, from_nc: bool) -> Result<f64, VarError> {
+        let Some(leaf) = self.ext_leaf(k)? else {
+            return Ok(v);
+        };
+        let name = || match k {
+            VarSlot::V {
+                scope,
+                name,
+                indices,
+                dims,
+            } => element(*scope, name, indices, *dims),
+            _ => String::new(),
+        };
+        if from_nc && leaf.access == ExtAccess::ReadOnly {
+            return Err(VarError::WriteDenied(name()));
+        }
+        let Some((min, max)) = leaf.ty.range() else {
+            return Ok(v);
+        };
+        let r = v.round();
+        if !(min..=max).contains(&r) {
+            return Err(VarError::OutOfFormat {
+                name: name(),
+                value: v,
+                min,
+                max,
+            });
+        }
+        Ok(r)
+    }
+
+    /// Why an NC program reading `k` gets nothing: an undeclared V.E. (20196), a WRITE_ONLY
+    /// one (20097), an index outside a declared V.E. array (21928). `None`: no list, or
+    /// nothing to add to "undefined".
+    pub(crate) fn why_missing(&self, k: &VarSlot) -> Option<VarError> {
+        let leaf = match self.ext_leaf(k) {
+            Err(e) => return Some(e),
+            Ok(leaf) => leaf?,
+        };
+        let VarSlot::V {
+            scope,
+            name,
+            indices,
+            dims,
+        } = k
+        else {
+            return None;
+        };
+        if leaf.access == ExtAccess::WriteOnly {
+            return Some(VarError::ReadDenied(element(*scope, name, indices, *dims)));
+        }
+        let var = self.external.vars.get(&**name)?;
+        var.offset(indices, *dims)
+            .is_none()
+            .then(|| VarError::OutOfRange(element(*scope, name, indices, *dims)))
+    }
+
+    /// Whether an NC program may read `k`: not a WRITE_ONLY V.E. leaf.
+    fn readable(&self, k: &VarSlot) -> bool {
+        !matches!(self.ext_leaf(k), Ok(Some(leaf)) if leaf.access == ExtAccess::WriteOnly)
+    }
+
+    /// [`VarStore::get`] as an NC program reads.
+    pub(crate) fn nc_get(&self, k: &VarSlot) -> Option<f64> {
+        self.readable(k).then(|| self.get(k)).flatten()
+    }
+
+    /// [`VarStore::get_str`] as an NC program reads.
+    pub(crate) fn nc_get_str(&self, k: &VarSlot) -> Option<&str> {
+        self.readable(k).then(|| self.get_str(k)).flatten()
     }
 
     /// Program (or stream) start: P and V.P. start empty, one level of V.L.
@@ -452,6 +588,11 @@ impl VarStore {
     /// Assign a value. A V. scalar not yet there is created (in its scope; V.L. in the
     /// current level); an element needs its array declared, and its indices inside it.
     pub fn set(&mut self, k: VarSlot, v: f64) -> Result<(), VarError> {
+        let v = self.typed(&k, v, true)?;
+        self.set_typed(k, v)
+    }
+
+    fn set_typed(&mut self, k: VarSlot, v: f64) -> Result<(), VarError> {
         if let Some(i) = Self::flat_index(&k) {
             self.p_flat[i] = v;
             return Ok(());
@@ -531,6 +672,15 @@ impl VarStore {
     /// scalar not yet there is created as a `STRING[126]`; a variable holding numbers, or a P
     /// parameter, takes none (900008). A cycle parameter becomes a string one.
     pub(crate) fn set_str(&mut self, k: VarSlot, text: &str) -> Result<(), VarError> {
+        self.set_str_from(k, text, true)
+    }
+
+    fn set_str_from(&mut self, k: VarSlot, text: &str, from_nc: bool) -> Result<(), VarError> {
+        if let Some(leaf) = self.ext_leaf(&k)? {
+            if from_nc && leaf.access == ExtAccess::ReadOnly {
+                return Err(VarError::WriteDenied(leaf.name.clone()));
+            }
+        }
         let len = text.chars().count();
         match k {
             VarSlot::P { number, .. } => Err(VarError::StringToNumber(format!("P{number}"))),
@@ -716,27 +866,96 @@ impl VarStore {
         }
     }
 
-    /// V.E. written from outside the channel.
+    /// V.E. written from outside the channel (PLC, HMI, ADS): `name` as a program writes it
+    /// after `V.E.`, with members and indices (`SCH.PREFLOW`, `FARBE[2]`). Typed as a
+    /// program's write is, but access rights do not apply (P-EXTV-00006: they bind the CNC).
     pub(crate) fn set_external(&mut self, name: &str, v: f64) -> Result<(), VarError> {
-        self.set(
-            VarSlot::V {
-                scope: VScope::External,
-                name: name.to_ascii_uppercase().into(),
-                indices: [0; 3],
-                dims: 0,
-            },
-            v,
-        )
+        let k = external_slot(name)?;
+        let v = self.typed(&k, v, false)?;
+        self.set_typed(k, v)
+    }
+
+    /// A string V.E. written from outside the channel, as [`VarStore::set_external`].
+    pub(crate) fn set_external_str(&mut self, name: &str, text: &str) -> Result<(), VarError> {
+        self.set_str_from(external_slot(name)?, text, false)
     }
 
     pub(crate) fn get_external(&self, name: &str) -> Option<f64> {
-        self.get(&VarSlot::V {
-            scope: VScope::External,
-            name: name.to_ascii_uppercase().into(),
-            indices: [0; 3],
-            dims: 0,
-        })
+        self.get(&external_slot(name).ok()?)
     }
+
+    /// A V.E. read from outside with what the PLC side needs to encode it: a number with its
+    /// declared type (`None` without a list), or a string with the characters it may hold.
+    pub(crate) fn external_value(&self, name: &str) -> Option<ExternalValue> {
+        let k = external_slot(name).ok()?;
+        let ty = self.ext_leaf(&k).ok().flatten().map(|l| l.ty);
+        if let Some(v) = self.get(&k) {
+            return Some(ExternalValue::Num(v, ty));
+        }
+        let text = self.get_str(&k)?;
+        let max = match ty {
+            Some(ExtType::Str { max_chars }) => max_chars,
+            _ => MAX_STRING as u8,
+        };
+        Some(ExternalValue::Str(text.to_string(), max))
+    }
+}
+
+/// A V.E. value as the PLC side reads it ([`VarStore::external_value`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExternalValue {
+    /// The value and the declared type (`None`: no list, an LREAL).
+    Num(f64, Option<ExtType>),
+    /// The text and the characters the variable may hold.
+    Str(String, u8),
+}
+
+/// Characters of a V.E. name written from outside at most.
+const MAX_EXTERNAL_NAME: usize = 255;
+
+/// `SCH.PREFLOW`, `FARBE[2]`, `INFO[1].X` (any case, blanks around ignored) as the store's
+/// key: the members joined by `.`, the indices in order. A name that is not one is unknown.
+pub(crate) fn external_slot(text: &str) -> Result<VarSlot, VarError> {
+    let unknown = || VarError::UnknownExternal(format!("V.E.{}", text.trim()));
+    let text = text.trim();
+    if text.is_empty() || text.len() > MAX_EXTERNAL_NAME {
+        return Err(unknown());
+    }
+    let mut name = String::with_capacity(text.len());
+    let mut indices = [0i64; 3];
+    let mut dims = 0usize;
+    let mut rest = text;
+    loop {
+        let end = rest
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(rest.len());
+        if end == 0 {
+            return Err(unknown());
+        }
+        name.push_str(&rest[..end].to_ascii_uppercase());
+        rest = &rest[end..];
+        while let Some(r) = rest.strip_prefix('[') {
+            let close = r.find(']').ok_or_else(unknown)?;
+            let i: i64 = r[..close].trim().parse().map_err(|_| unknown())?;
+            *indices.get_mut(dims).ok_or_else(unknown)? = i;
+            dims += 1;
+            rest = &r[close + 1..];
+        }
+        match rest.strip_prefix('.') {
+            Some(r) => {
+                name.push('.');
+                rest = r;
+            }
+            None if rest.is_empty() => break,
+            None => return Err(unknown()),
+        }
+    }
+    Ok(VarSlot::V {
+        scope: VScope::External,
+        name: name.into(),
+        indices,
+        dims: dims as u8,
+    })
 }
 
 fn v_name(scope: VScope, name: &str) -> String {
@@ -899,6 +1118,67 @@ mod tests {
         s.set_str(VarSlot::CycleParam(1), "t").unwrap();
         assert_eq!(s.get(&VarSlot::CycleParam(1)), None);
         assert_eq!(s.get_str(&VarSlot::CycleParam(1)), Some("t"));
+    }
+
+    #[test]
+    fn declared_externals_are_typed_and_bind_programs_not_the_plc() {
+        use crate::params::ext_vars::{ExtAccess, ExtType, ExtVar, ExtVarTable};
+        let leaf = |name: &str, sizes: Vec<u32>, ty, access| ExtVar {
+            name: name.into(),
+            sizes,
+            ty,
+            access,
+        };
+        let mut s = VarStore::new(Loader::inline());
+        let table = ExtVarTable {
+            file: "ve.lis".into(),
+            vars: vec![
+                leaf("INFO.X", vec![2], ExtType::Uns08, ExtAccess::ReadOnly),
+                leaf(
+                    "MSG",
+                    vec![],
+                    ExtType::Str { max_chars: 4 },
+                    ExtAccess::ReadWrite,
+                ),
+            ],
+        };
+        s.declare_externals(Arc::new(table)).unwrap();
+        // Members and indices as a program writes them, any case.
+        assert_eq!(
+            external_slot(" info[1].x "),
+            Ok(el(VScope::External, "INFO.X", &[1]))
+        );
+        assert!(external_slot("INFO[1]..X").is_err());
+        assert!(external_slot("A[1][2][3][4]").is_err());
+        // The PLC writes a READ_ONLY leaf, rounded into UNS08; a program may not.
+        s.set_external("Info[1].X", 6.5).unwrap();
+        assert_eq!(s.get_external("INFO[1].X"), Some(7.0));
+        let e = |r: Result<(), VarError>| r.unwrap_err().code();
+        assert_eq!(
+            e(s.set(el(VScope::External, "INFO.X", &[0]), 1.0)),
+            VARIABLE_WRITE_DENIED
+        );
+        assert_eq!(
+            e(s.set_external("INFO[0].X", 256.0)),
+            VARIABLE_OUT_OF_FORMAT
+        );
+        assert_eq!(e(s.set_external("INFO[2].X", 1.0)), ARRAY_INDEX_RANGE);
+        assert_eq!(e(s.set_external("NOPE", 1.0)), VARIABLE_UNKNOWN);
+        s.set_external_str("msg", "abcd").unwrap();
+        assert_eq!(
+            s.external_value("MSG"),
+            Some(ExternalValue::Str("abcd".into(), 4))
+        );
+        assert_eq!(
+            e(s.set_external_str("MSG", "abcde")),
+            STRING_TOO_LONG_FOR_VARIABLE
+        );
+        // A reset keeps them.
+        s.reset();
+        assert_eq!(
+            s.external_value("INFO[1].X"),
+            Some(ExternalValue::Num(7.0, Some(ExtType::Uns08)))
+        );
     }
 
     #[test]

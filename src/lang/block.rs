@@ -448,6 +448,11 @@ pub enum Command {
     Msg(Box<Message>),
     /// `#TIME <seconds>`: a dwell (TF5200 "Dwell time").
     Time(Value),
+    /// `#FILENAME [MSG=V.E.NAME]`: the report file of `#MSG SAVE` named by a string variable
+    /// (TF5200 programming manual, "Definition of file names"; ISG's teach programs take it
+    /// from a V.E. string the HMI sets). ncchannel writes no report file, but the variable
+    /// is read, so an undeclared or numeric one is refused as the kernel would.
+    MsgFileName(Box<VarRef>),
     /// A `#` command of ISG's list that ncchannel accepts without effect
     /// (`super::dialect`); the whole command text after `#` is kept verbatim.
     Inert {

@@ -142,6 +142,16 @@ pub const LABEL_NOT_FOUND: u32 = 20840;
 pub const VARIABLE_MEMORY_FULL: u32 = 20967;
 /// An array with more indices than variables have (TF5200 diagnosis ID 20974).
 pub const TOO_MANY_INDICES: u32 = 20974;
+/// A V.E. variable the list of external variables does not declare (the kernel's error list:
+/// "unknown variable"; its TF5200 page was not read).
+pub const VARIABLE_UNKNOWN: u32 = 20196;
+/// A program reads a V.E. variable declared WRITE_ONLY (TF5200 diagnosis ID 20097).
+pub const VARIABLE_READ_DENIED: u32 = 20097;
+/// A program writes a V.E. variable declared READ_ONLY (TF5200 diagnosis ID 20100).
+pub const VARIABLE_WRITE_DENIED: u32 = 20100;
+/// A value outside the range of a V.E. variable's type (TF5200 diagnosis ID 20847, with the
+/// value and both limits).
+pub const VARIABLE_OUT_OF_FORMAT: u32 = 20847;
 /// Streaming data without a correct CR LF line end (TF5200 diagnosis ID 21476).
 pub const NO_LINE_END: u32 = 21476;
 /// Backward jump in a streaming program (TF5200 diagnosis ID 21477).
@@ -296,6 +306,13 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
     (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
+    (VARIABLE_UNKNOWN, "V.E. variable not declared"),
+    (VARIABLE_READ_DENIED, "V.E. variable WRITE_ONLY read"),
+    (VARIABLE_WRITE_DENIED, "V.E. variable READ_ONLY written"),
+    (
+        VARIABLE_OUT_OF_FORMAT,
+        "value outside the V.E. variable's type",
+    ),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
@@ -385,6 +402,8 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         20054,
         "Korrigierter Mittelpunkt außerhalb erlaubtem Datenformat.",
     ), // 1031: 250663051
+    (20097, "Variable lesen nicht erlaubt."), // 1031: 250750091
+    (20100, "Write access to variable denied."), // 250758795
     (20131, "Unknown G function"),       // named so on the page of ID 20107, 250784907
     (20175, "Double-programmed F-word."), // 250998155
     (20181, "Double-programmed spindle."), // 251019915
@@ -456,6 +475,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         "Number of string labels too big for optimised program execution.",
     ), // 252695435
     (20836, "Multiple defined label"),   // 252721547
+    (20847, "Value of variable is out of data format."), // 252765067
     (
         20967,
         "Memory for variables limited, allocation of new variable impossible.",
@@ -508,6 +528,7 @@ pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     // The kernel's id for an H function the channel does not define, as reported for the
     // TwinCAT CNC; its TF5200 diagnosis page was not read.
     (20162, "unknown H function"),
+    (20196, "unknown variable"),
     (20200, "NC command or axis name expected"),
     (20209, "unknown # command or $ statement"),
     (20240, "unexpected $ENDDO"),
@@ -751,8 +772,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20162, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840, 21469,
-                21560, 21561, 21562, 21563, 21564, 21897
+                20157, 20162, 20196, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840,
+                21469, 21560, 21561, 21562, 21563, 21564, 21897
             ]
         );
     }

@@ -441,6 +441,7 @@ impl Display for Command {
             }
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),
+            Command::MsgFileName(v) => write!(f, "#FILENAME [MSG={v}]"),
         }
     }
 }

@@ -90,6 +90,13 @@ pub trait Vars {
     fn is_string(&self, key: &VarKey<'_>) -> bool {
         self.get_str(key).is_some()
     }
+
+    /// Why `key` has no value, when there is more to say than "undefined": a V.E. variable
+    /// the list of external variables does not declare, one the program may not read, an
+    /// index outside a declared V.E. array.
+    fn why_missing(&self, _key: &VarKey<'_>) -> Option<EvalError> {
+        None
+    }
 }
 
 /// A value of an expression that may be a string: `V.L.NAME = "abc" + V.L.S`, the values of
@@ -135,6 +142,10 @@ pub enum EvalError {
         min: usize,
         max: usize,
     },
+    /// A variable the store refuses to give, with the store's id (V.E. variables declared
+    /// by a list: 20196, 20097, 21928).
+    #[error("{1}")]
+    Refused(u32, String),
 }
 
 impl EvalError {
@@ -154,6 +165,7 @@ impl EvalError {
             EvalError::StringOperator(_) => codes::STRING_OPERATOR,
             EvalError::StringTooLong(_) => codes::STRING_TOO_LONG,
             EvalError::StringPosition { .. } => codes::STRING_POSITION,
+            EvalError::Refused(code, _) => *code,
         }
     }
 }
@@ -240,7 +252,9 @@ pub fn eval_value(expr: &Expr, vars: &dyn Vars) -> Result<Val, EvalError> {
             }
             match vars.get_str(&key) {
                 Some(t) => Ok(Val::Str(t.to_string())),
-                None => Err(EvalError::Undefined(key.to_string())),
+                None => Err(vars
+                    .why_missing(&key)
+                    .unwrap_or_else(|| EvalError::Undefined(key.to_string()))),
             }
         }
         Expr::Binary(op, a, b) => match binary_value(*op, a, b, vars)? {
@@ -444,7 +458,8 @@ fn no_number(key: &VarKey<'_>, vars: &dyn Vars) -> EvalError {
     if vars.is_string(key) {
         EvalError::StringAsNumber(key.to_string())
     } else {
-        EvalError::Undefined(key.to_string())
+        vars.why_missing(key)
+            .unwrap_or_else(|| EvalError::Undefined(key.to_string()))
     }
 }
 

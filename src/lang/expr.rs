@@ -617,8 +617,28 @@ impl<'a> Ctx<'a> {
                     );
                 };
                 let rest = &rest[1..];
-                let (rest, name) = name_or(rest, "variable name expected")?;
-                let (rest, indices) = self.indices(rest)?;
+                let (mut rest, mut name) = name_or(rest, "variable name expected")?;
+                let (r, mut indices) = self.indices(rest)?;
+                let mut h = self.height.get();
+                rest = r;
+                // A V.E. structure member, `V.E.SCH.PREFLOW`, `V.E.INFO[1].X` (TF5200
+                // External variables): the members join the name, the indices go in order.
+                while scope == VScope::External
+                    && rest.starts_with('.')
+                    && rest[1..]
+                        .bytes()
+                        .next()
+                        .is_some_and(|b| b.is_ascii_alphabetic() || b == b'_')
+                {
+                    let (r, member) = name_or(&rest[1..], "structure member expected")?;
+                    name.push('.');
+                    name.push_str(&member);
+                    let (r, more) = self.indices(r)?;
+                    h = h.max(self.height.get());
+                    indices.extend(more);
+                    rest = r;
+                }
+                self.height.set(h);
                 self.set_height(self.height.get() + 1, i)?;
                 Ok((
                     rest,

@@ -1019,8 +1019,8 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let (r, options) = verbatim_options(ws(m), m)?;
             Ok((r, Command::ContourMode { options }))
         }
-        b"FILENAME" => file_names(i, r),
-        b"FILE" if keyword(r, "NAME").is_some() => file_names(i, ws(&r[4..])),
+        b"FILENAME" => file_names(ctx, i, r),
+        b"FILE" if keyword(r, "NAME").is_some() => file_names(ctx, i, ws(&r[4..])),
         b"VAR" => Ok((rest, Command::Var)),
         b"ENDVAR" => Ok((rest, Command::EndVar)),
         b"MSG" => super::msg::parse_msg(ctx, r),
@@ -1076,16 +1076,22 @@ fn hsc_parameters<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
 /// German edition, "Definition von Dateinamen (#FILE NAME)"; the older TwinCAT CNC
 /// programming manual's "Definition of file names" writes `#FILENAME`): `MSG` names the file `#MSG SAVE` writes to, and
 /// ncchannel writes none, so it is inert. The other file ids (`M6`, `D`, `G80`–`G89`,
-/// `G800`–`G839`) rename implicit subroutines, which is refused by name (900133).
+/// `G800`–`G839`) rename implicit subroutines, which is refused by name (900133). A file
+/// name held by a string variable, `MSG=V.E.TEACH_FILE_NAME`, is read when the block runs
+/// ([`Command::MsgFileName`]).
 #[cold]
-fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
+fn file_names<'a>(ctx: &Ctx<'a>, i: &'a str, r: &'a str) -> PResult<'a, Command> {
     let Some(mut j) = r.strip_prefix('[') else {
         return fail(r, SYNTAX, "#FILENAME takes [<id>=\"<file name>\" …]");
     };
+    let mut var = None;
     loop {
         j = ws(j);
         if let Some(rest) = j.strip_prefix(']') {
-            return inert_to(i, rest);
+            return match var {
+                Some(v) => Ok((rest, Command::MsgFileName(Box::new(v)))),
+                None => inert_to(i, rest),
+            };
         }
         let (k, id) = name_or(j, "file id (MSG, M6, D, G80…) or `]` expected")?;
         if id != "MSG" {
@@ -1105,6 +1111,12 @@ fn file_names<'a>(i: &'a str, r: &'a str) -> PResult<'a, Command> {
         }
         let k = ws(k);
         let k = ws(k.strip_prefix('=').unwrap_or(k));
+        if matches!(k.as_bytes(), [b'V' | b'v', b'.', ..]) {
+            let (rest, v) = ctx.var_ref(k)?;
+            var = Some(v);
+            j = rest;
+            continue;
+        }
         let Some(body) = k.strip_prefix('"') else {
             return fail(k, SYNTAX, "quoted file name expected in #FILENAME");
         };

@@ -216,17 +216,30 @@ impl dyn CncBackend {
         }
     }
 
-    /// Read an external variable `V.E.<name>` (name given without the `V.E.` prefix).
-    pub(crate) fn read_ve(&self, ch: u16, name: &str) -> Result<f64, DeviceError> {
-        match self.call(ch, Op::ReadExternal(name.to_string()))? {
-            Reply::Value(Some(v)) => Ok(v),
+    /// Write an external variable `V.E.<name>`.
+    pub fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError> {
+        match self.call(ch, Op::WriteExternal(name.to_string(), value))? {
+            Reply::Value(Some(_)) => Ok(()),
+            _ => Err(DeviceError::InvalidValue),
+        }
+    }
+
+    /// Read `V.E.<name>` (given without the `V.E.` prefix) with its declared type (numbers)
+    /// or length (strings).
+    pub(crate) fn read_ve_typed(
+        &self,
+        ch: u16,
+        name: &str,
+    ) -> Result<crate::decoder::vars::ExternalValue, DeviceError> {
+        match self.call(ch, Op::ReadExternalTyped(name.to_string()))? {
+            Reply::External(Some(v)) => Ok(v),
             _ => Err(DeviceError::NotFound),
         }
     }
 
-    /// Write an external variable `V.E.<name>`.
-    pub fn write_ve(&self, ch: u16, name: &str, value: f64) -> Result<(), DeviceError> {
-        match self.call(ch, Op::WriteExternal(name.to_string(), value))? {
+    /// Write a string into `V.E.<name>`.
+    pub(crate) fn write_ve_str(&self, ch: u16, name: &str, text: &str) -> Result<(), DeviceError> {
+        match self.call(ch, Op::WriteExternalStr(name.to_string(), text.to_string()))? {
             Reply::Value(Some(_)) => Ok(()),
             _ => Err(DeviceError::InvalidValue),
         }

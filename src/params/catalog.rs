@@ -22,6 +22,8 @@ pub enum ListKind {
     Tools,
     /// The zero-offset list (`np_grp[i].achse[j].versch`, P-ZERO-00003).
     ZeroOffsets,
+    /// The list of external variables (`var[i].*`, `struct[i].*`; TF5200 External variables).
+    ExtVars,
 }
 
 impl fmt::Display for ListKind {
@@ -32,6 +34,7 @@ impl fmt::Display for ListKind {
             ListKind::Axis => "axis list",
             ListKind::Tools => "tool list",
             ListKind::ZeroOffsets => "zero-offset list",
+            ListKind::ExtVars => "external variable list",
         })
     }
 }
@@ -145,6 +148,7 @@ fn is_inert(kind: ListKind, name: &Name) -> bool {
         ListKind::Axis => INERT_AXIS,
         ListKind::Tools => INERT_TOOLS,
         ListKind::ZeroOffsets => &[],
+        ListKind::ExtVars => INERT_EXT_VARS,
     };
     table.iter().any(|(pat, _)| {
         if pat.ends_with('.') {
@@ -306,6 +310,34 @@ pub(crate) const INERT_TOOLS: &[(&str, &str)] = &[
         "P-TOOL-00003 tool length: no length compensation",
     ),
     ("wz[].param[]", "P-TOOL-00007 free tool parameters"),
+];
+
+/// V.E. list entries known and ignored (TF5200 External variables): they lay out the
+/// kernel's memory shared with the PLC, which ncchannel does not have.
+pub(crate) const INERT_EXT_VARS: &[(&str, &str)] = &[
+    ("var[].byte_offset", "P-EXTV-00002 position in memory"),
+    ("var[].index", "position in 24-byte blocks (older lists)"),
+    (
+        "var[].scope",
+        "P-EXTV-00004 CHANNEL/GLOBAL: each channel keeps its own",
+    ),
+    (
+        "var[].synchronisation",
+        "P-EXTV-00005 synchronisation with the PLC",
+    ),
+    (
+        "var[].create_hmi_interface",
+        "HMI interface: the ADS side serves every leaf",
+    ),
+    (
+        "struct[].element[].synchronisation",
+        "P-EXTV-00018 synchronisation",
+    ),
+    (
+        "check_overlapping_variables",
+        "P-EXTV-00011 memory layout check",
+    ),
+    ("auto_memory_mode", "P-EXTV-00012 automatic memory layout"),
 ];
 
 /// The entries a value may refer to by P number, by list kind: (P number, pattern). The

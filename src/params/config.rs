@@ -17,6 +17,7 @@ use super::channel::{interpret_channel, ChannelList, ImplicitSubroutines};
 use super::decoder::{DecoderParams, DecoderSettings};
 use super::error::ParamError;
 use super::error_texts::{read_error_texts, ErrorTexts};
+use super::ext_vars::{interpret_ext_vars, is_ext_var_list, read_ext_vars, ExtVarTable};
 use super::list::{parse_list, read_list, read_list_text, Entry, ParamList};
 use super::runtime::{read_runtime, AxisConfig, RuntimeConfig};
 use super::search_path::{list_folder, SearchPath};
@@ -84,6 +85,9 @@ pub struct ChannelConfig {
     pub(crate) zero_offsets: ZeroOffsetTable,
     /// M/H/S/T functions: synchronisation types, process times, pre-outputs.
     pub techno: TechnoTable,
+    /// The V.E. list the start-up list names (`ve_var[i]`, P-STUP-00146) and its leaves;
+    /// `None`: V.E. variables are free (made by whoever writes them first).
+    pub ext_vars: Option<Arc<ExtVarTable>>,
     /// The channel list's entries, unknown ones included.
     pub list: ParamList,
 }
@@ -152,6 +156,8 @@ pub(crate) fn check_list_file_summarized(path: &Path) -> (Vec<Diagnostic>, Vec<L
         lists.push(interpret_zero_offsets(&list, &mut diags).1);
     } else if super::tools::is_tool_list(&list) {
         lists.push(super::tools::interpret_tools(&list, &mut diags).1);
+    } else if is_ext_var_list(&list) {
+        lists.push(interpret_ext_vars(&list, &mut diags).1);
     } else if is_axis_list(&list) {
         lists.push(tally_axis_list(&list, &mut diags));
         interpret_axis(None, &list, &mut diags);
@@ -427,6 +433,7 @@ fn channels(
             c.zero_offsets = *t;
         }
     }
+    ext_var_lists(startup, &mut out, diags, lists);
     (out.len() == count as usize).then_some(out)
 }
 
@@ -456,6 +463,43 @@ fn combine(
         zero_offset_list: None,
         zero_offsets: Default::default(),
         techno: chan.techno,
+        ext_vars: None,
         list: chan.list,
+    }
+}
+
+/// Step: each channel's V.E. list (`ve_var[i]`); channels may share one: read and report it
+/// once, and share its table.
+fn ext_var_lists(
+    startup: &StartupList,
+    out: &mut [ChannelConfig],
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+) {
+    let mut tables: HashMap<PathBuf, Option<Arc<ExtVarTable>>> = HashMap::new();
+    for c in out {
+        let Some(r) = startup.ext_var_lists.get(&(c.index as u32)) else {
+            continue;
+        };
+        let table =
+            tables
+                .entry(r.path.clone())
+                .or_insert_with(|| match read_ext_vars(&r.path, diags) {
+                    Ok((t, summary)) => {
+                        lists.push(summary);
+                        Some(Arc::new(t))
+                    }
+                    Err(e) => {
+                        diags.push(cannot_read(
+                            &startup.list,
+                            &r.entry,
+                            "external variable list",
+                            &r.path,
+                            &e,
+                        ));
+                        None
+                    }
+                });
+        c.ext_vars = table.clone();
     }
 }

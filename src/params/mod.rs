@@ -10,6 +10,7 @@ pub mod config;
 pub(crate) mod decoder;
 pub(crate) mod error;
 pub mod error_texts;
+pub mod ext_vars;
 pub mod list;
 pub(crate) mod runtime;
 pub(crate) mod search_path;

@@ -49,6 +49,8 @@ pub(crate) struct StartupList {
     pub(crate) default_axis_list: Option<ListRef>,
     /// `error_text_of_id` (P-STUP-00168): the kernel's error text file.
     pub(crate) error_texts: Option<ListRef>,
+    /// `ve_var[i]` (P-STUP-00146): channel i's list of external variables.
+    pub(crate) ext_var_lists: BTreeMap<u32, ListRef>,
     /// Entries used, inert and unknown.
     pub summary: ListSummary,
 }
@@ -121,6 +123,7 @@ pub(crate) fn interpret_startup(
         axis_lists,
         default_axis_list,
         error_texts,
+        ext_var_lists,
         decoder,
         collectors,
         tally,
@@ -146,6 +149,7 @@ pub(crate) fn interpret_startup(
         axis_lists,
         default_axis_list,
         error_texts,
+        ext_var_lists,
         summary,
     }
 }
@@ -205,7 +209,7 @@ fn channel_out_of_range(
         }
     }
     let channel = match s {
-        [("sda_mds" | "zero_offset_list", Some(i))]
+        [("sda_mds" | "zero_offset_list" | "ve_var", Some(i))]
         | [("pfad", Some(i)), (_, Some(_))]
         | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
         _ => None,
@@ -239,6 +243,7 @@ struct Gathered<'l> {
     axis_lists: BTreeMap<u32, ListRef>,
     default_axis_list: Option<ListRef>,
     error_texts: Option<ListRef>,
+    ext_var_lists: BTreeMap<u32, ListRef>,
     decoder: BTreeMap<u32, DecoderParams>,
     collectors: BTreeMap<u32, PathCollector<'l>>,
     tally: Option<Tally>,
@@ -274,6 +279,13 @@ impl<'l> Gathered<'l> {
             // P-STUP-00168; `error_message_texts` is the name some installations write.
             [("error_text_of_id" | "error_message_texts", None)] => {
                 self.error_texts = file_ref(list, base, e, "error text file", diags);
+            }
+            // P-STUP-00146's default is a blank string: no list, V.E. stay free.
+            [("ve_var", Some(_))] if matches!(e.value.text.trim(), "" | "\"\"") => {}
+            [("ve_var", Some(i))] => {
+                if let Some(r) = file_ref(list, base, e, "external variable list", diags) {
+                    self.ext_var_lists.insert(*i, r);
+                }
             }
             [("pfad", Some(i)), (field, Some(j))] => self.path(list, e, *i, field, *j, diags),
             [("configuration", None), ("channel", Some(i)), ("decoder", None), (field, None)] => {
@@ -414,16 +426,17 @@ impl StartupList {
 fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
     matches!(
         s,
-        [("sda_mds" | "zero_offset_list" | "achs_mds", Some(_))]
-            | [
-                ("pfad", Some(_)),
-                ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))
-            ]
-            | [
-                ("configuration", None),
-                ("channel", Some(_)),
-                ("decoder", None),
-                ("function" | "max_cache_number" | "max_cache_size", None)
-            ]
+        [(
+            "sda_mds" | "zero_offset_list" | "achs_mds" | "ve_var",
+            Some(_)
+        )] | [
+            ("pfad", Some(_)),
+            ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))
+        ] | [
+            ("configuration", None),
+            ("channel", Some(_)),
+            ("decoder", None),
+            ("function" | "max_cache_number" | "max_cache_size", None)
+        ]
     )
 }

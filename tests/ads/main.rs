@@ -8,6 +8,7 @@ mod ads_abuse;
 mod ads_channel_commands;
 mod ads_crate_client;
 mod ads_docs;
+mod ads_ext_vars;
 mod ads_housekeeping;
 mod ads_model_objects;
 mod ads_serve;

@@ -813,3 +813,30 @@ fn runs_clean_unchecked(rig: &Rig, text: &str) -> RunResult {
     assert_eq!(r.finish, Some(Finish::Ended), "{text}\n{}", r.log);
     r
 }
+
+/// V.E. structure members (TF5200 External variables) and `#FILENAME [MSG=V.E.x]` (TF5200
+/// programming manual, "Definition of file names"), which were 20200: they parse, and print
+/// back as text that parses to the same block.
+#[test]
+fn external_variable_members_and_filename_from_a_variable_parse() {
+    for line in [
+        "V.E.UserInteraction.Message = \"Insert tool\"",
+        "V.E.Sch.Preflow = 3",
+        "V.E.INFO[1].X = V.E.INFO[0].X + V.E.A.B.C[2]",
+        "#FILENAME [MSG=V.E.TEACH_FILE_NAME]",
+        "#FILE NAME [MSG = V.E.teach_file_name]",
+    ] {
+        let b = parse_block(line).unwrap_or_else(|e| panic!("{line}: {e}"));
+        assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
+    }
+    let b = parse_block("V.E.INFO[1].X = 2").unwrap();
+    assert_eq!(
+        b.to_string(),
+        "V.E.INFO.X[1]=2",
+        "the members joined, then the index"
+    );
+    // Members are V.E.'s: V.P.A.B stays a syntax error, and a member needs a name.
+    for line in ["V.P.A.B = 1", "V.E.A.[1] = 1"] {
+        assert_eq!(parse_block(line).unwrap_err().code, 20200, "{line}");
+    }
+}

@@ -5,6 +5,7 @@
 mod support;
 
 mod check_params;
+mod ext_vars;
 mod installation;
 mod params;
 mod techno;

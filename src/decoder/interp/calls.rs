@@ -14,6 +14,7 @@ use crate::decoder::reader::CacheRead;
 use crate::decoder::reader::Reader;
 use crate::lang::block::{Call, Command, SplineCommand, Value};
 use crate::lang::codes;
+use crate::lang::eval;
 use crate::queue::{Action, BlockInfo, SyncMessage};
 use crate::source::cache::LoadStep;
 use crate::source::store::{Opened, ProgramKind};
@@ -333,6 +334,15 @@ impl Interpreter {
                 };
                 let seconds = super::words::dwell_seconds(seconds, codes::DWELL_RANGE_TIME)?;
                 self.emit(info, Action::Dwell { seconds }, false, io);
+            }
+            // The report file's name: read (a string, or the refusal the variable gets), not
+            // used, as ncchannel writes no report file (`#MSG SAVE` goes to the event log).
+            Command::MsgFileName(v) => {
+                let var = crate::lang::block::Expr::Var(v.clone());
+                if let eval::Val::Num(_) = expr::eval_value(&var, &expr::Env(self))? {
+                    return Err(eval::EvalError::NumberAsString(v.to_string()).into());
+                }
+                self.emit(info, Action::None, false, io);
             }
             // Accepted without effect (lang::dialect): a block like any other.
             Command::Inert { .. } => self.emit(info, Action::None, false, io),

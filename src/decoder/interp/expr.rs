@@ -57,22 +57,32 @@ impl Vars for Env<'_> {
             VarKey::AxisAbs(id) => self.0.axis_abs(*id),
             VarKey::ToolRadius(d) => self.0.tool_radius(*d),
             VarKey::FunctionSync { h, number } => self.0.function_sync(*h, *number),
-            _ => VarStore::get(&self.0.vars, &slot(key)?),
+            _ => self.0.vars.nc_get(&slot(key)?),
         }
     }
 
     fn get_str(&self, key: &VarKey<'_>) -> Option<&str> {
         Vars::get_str(&self.0.vars, key)
     }
+
+    fn why_missing(&self, key: &VarKey<'_>) -> Option<eval::EvalError> {
+        Vars::why_missing(&self.0.vars, key)
+    }
 }
 
+/// What a program sees of the store: V.E. variables as their list declares them.
 impl Vars for VarStore {
     fn get(&self, key: &VarKey<'_>) -> Option<f64> {
-        VarStore::get(self, &slot(key)?)
+        self.nc_get(&slot(key)?)
     }
 
     fn get_str(&self, key: &VarKey<'_>) -> Option<&str> {
-        VarStore::get_str(self, &slot(key)?)
+        self.nc_get_str(&slot(key)?)
+    }
+
+    fn why_missing(&self, key: &VarKey<'_>) -> Option<eval::EvalError> {
+        let e = VarStore::why_missing(self, &slot(key)?)?;
+        Some(eval::EvalError::Refused(e.code(), e.to_string()))
     }
 }
 
