@@ -123,7 +123,8 @@ pub fn channel_settings(
             max_file_bytes: u64::from(c.max_file_bytes),
         },
         fs_latency: FsLatency::from_us(rt.fs_latency_us, rt.fs_latency_us_per_kib),
-        tools: config.tools.clone(),
+        tools: ch.tools.clone(),
+        t_selects_d: ch.t_selects_d,
     })
 }
 

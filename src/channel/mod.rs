@@ -88,8 +88,10 @@ pub struct ChannelSettings {
     pub cache: CacheLimits,
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
     pub(crate) fs_latency: FsLatency,
-    /// Tool radii by D number for G41/G42, mm (`tools.lis`).
-    pub tools: Vec<(u32, f64)>,
+    /// The tool list's data sets by D number, mm (`werkz_data[i]` or `tools.lis`).
+    pub tools: crate::params::tools::ToolTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
+    pub t_selects_d: bool,
 }
 
 /// One NC channel: its parts (mode and state, HMI commands, program run, log) and what it
@@ -242,12 +244,12 @@ impl Channel {
             queue: BlockQueue::new(s.queue_capacity),
             decoder: {
                 let mut d = Decoder::new(s.decoder, loader.clone());
-                d.set_tool_radii(s.tools.clone());
+                d.set_tools(s.tools.clone(), s.t_selects_d);
                 d
             },
             motion: {
                 let mut m = Motion::with_planner(s.axes, s.planner);
-                m.set_tool_radii(s.tools);
+                m.set_tool_radii(s.tools.iter().map(|t| (t.d, t.radius_mm)).collect());
                 m
             },
             techno: TechnoUnits::new(),

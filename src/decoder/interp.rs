@@ -27,6 +27,7 @@ use super::vars::{VarSlot, VarStore};
 use crate::lang::block::{Expr, VarRef};
 use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::loader::Loader;
+use crate::params::tools::ToolTable;
 use crate::vocab::axis::{Position, MAX_AXES};
 use block_words::Words;
 use implicit::ImplicitState;
@@ -41,8 +42,11 @@ pub(super) struct Interpreter {
     renamed_slots: u8,
     vars: VarStore,
     modal: Modal,
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
-    tool_radii: Vec<(u32, f64)>,
+    /// The tool list's data sets by D number, mm (`V.G.WZ[j].*`, G41/G42, length
+    /// compensation).
+    tools: ToolTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
+    t_selects_d: bool,
     /// ISG block counter of the current program.
     counter: u64,
     search: Option<Search>,
@@ -72,7 +76,8 @@ impl Interpreter {
             renamed_slots,
             vars: VarStore::new(loader),
             modal: Modal::defaults([0.0; MAX_AXES]),
-            tool_radii: Vec::new(),
+            tools: Vec::new(),
+            t_selects_d: false,
             counter: 0,
             search: None,
             skip_mask: 0,
@@ -139,9 +144,11 @@ impl Interpreter {
     pub(super) fn skips_level(&self, level: u8) -> bool {
         self.skip_mask & (1u16 << level.min(15)) != 0
     }
-    /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
-    pub(super) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
-        self.tool_radii = radii;
+    /// The tool list's data sets by D number (mm), and whether T selects D as well
+    /// (`einrechnen_mit_t`, P-CHAN-00014).
+    pub(super) fn set_tools(&mut self, tools: ToolTable, t_selects_d: bool) {
+        self.tools = tools;
+        self.t_selects_d = t_selects_d;
     }
 
     /// A line is run: the ISG block counter counts it.

@@ -157,9 +157,11 @@ impl Decoder {
     pub(crate) fn set_skip_mask(&mut self, mask: u16) {
         self.interp.set_skip_mask(mask);
     }
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R` and `V.G.WZ_AKT.R`).
-    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
-        self.interp.set_tool_radii(radii);
+    /// The tool list's data sets by D number, mm (`V.G.WZ[j].*`, `V.G.WZ_AKT.*`, length
+    /// compensation), and whether a T word selects the D data set of its number
+    /// (`einrechnen_mit_t`, P-CHAN-00014).
+    pub(crate) fn set_tools(&mut self, tools: crate::params::tools::ToolTable, t_selects_d: bool) {
+        self.interp.set_tools(tools, t_selects_d);
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.

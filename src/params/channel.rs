@@ -66,6 +66,8 @@ pub(crate) struct ChannelList {
     pub decoder: DecoderParams,
     /// M/H/S/T synchronisation types, process times and pre-outputs (`params/techno.rs`).
     pub techno: TechnoTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): `T80` also selects `D80`.
+    pub t_selects_d: bool,
     /// Entries used, inert and unknown.
     pub summary: ListSummary,
 }
@@ -98,6 +100,7 @@ pub(crate) fn interpret_channel(
     let mut tally = Tally::new(ListKind::Channel);
     let mut techno = TechnoCollector::default();
     let (mut start_mode, mut final_mode) = (CallMode::Automatic, CallMode::Automatic);
+    let mut t_selects_d = false;
 
     for e in &list.entries {
         match shape(e).as_slice() {
@@ -111,6 +114,11 @@ pub(crate) fn interpret_channel(
                 implicit.g800[*i as usize] = program_name(&list, e, diags);
             }
             [("start_init_prog_file_mode", None)] => start_mode = call_mode(&list, e, diags),
+            // P-CHAN-00014: "T80" then corresponds to "T80 D80" (TF5200 channel parameter).
+            [("einrechnen_mit_t", None)] => match uint_value(&list, e, 1) {
+                Ok(v) => t_selects_d = v == 1,
+                Err(d) => diags.push(d),
+            },
             [("final_prog_file_mode", None)] => final_mode = call_mode(&list, e, diags),
             [("gruppe", Some(0)), ("achse", Some(j)), ("bezeichnung", None)] => {
                 match string_value(&list, e, MAX_AXIS_NAME_CHARS) {
@@ -190,6 +198,7 @@ pub(crate) fn interpret_channel(
         search_paths,
         decoder,
         techno,
+        t_selects_d,
         summary,
     }
 }

@@ -164,7 +164,7 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
     // G54 shifts X by 10 mm (list unit 0.1 µm).
     std::fs::write(
         params.dir.path().join("params/zero.lis"),
-        "np_grp[0].achse[0].versch 100000\n",
+        "np_grp[1].achse[0].versch 100000\n",
     )
     .unwrap();
     params.program("g54.nc", "N10 G54 G01 X5 F6000\nN20 X6\nN30 M30\n");

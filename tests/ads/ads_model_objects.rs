@@ -375,7 +375,7 @@ fn zero_offsets_read_as_twinsharp_reads_them() {
     let list = params.dir.path().join("params/np.lis");
     std::fs::write(
         &list,
-        "np_grp[0].achse[0].versch 100000\nnp_grp[1].achse[2].versch -25000\n",
+        "np_grp[1].achse[0].versch 100000\nnp_grp[2].achse[2].versch -25000\n",
     )
     .unwrap();
     let startup = std::fs::read_to_string(params.startup()).unwrap();

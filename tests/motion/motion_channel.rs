@@ -262,9 +262,9 @@ fn zero_offsets_from_the_list_named_in_the_startup_list() {
     s.write(
         "params/zero.lis",
         "# G54: X 10 mm, Y -2.5 mm; G55: Z 1 mm\n\
-         np_grp[0].achse[0].versch 100000\n\
-         np_grp[0].achse[1].versch -25000\n\
-         np_grp[1].achse[2].versch 10000\n",
+         np_grp[1].achse[0].versch 100000\n\
+         np_grp[1].achse[1].versch -25000\n\
+         np_grp[2].achse[2].versch 10000\n",
     );
     s.write(
         "nc/np.nc",
@@ -397,7 +397,7 @@ fn check_list_file_recognises_a_zero_offset_list() {
     let p = dir.path().join("zero.lis");
     std::fs::write(
         &p,
-        "np_grp[0].achse[0].versch 1.5\nnp_grp[0].achse[1].versch 100\n",
+        "np_grp[1].achse[0].versch 1.5\nnp_grp[1].achse[1].versch 100\n",
     )
     .unwrap();
     let d = ncchannel::params::check_list_file(&p);
