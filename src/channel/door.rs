@@ -179,6 +179,10 @@ pub struct Status {
     /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
     /// set it (`V.G.NP[1..6].V`).
     pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
+    /// The active tool data set, as the decoder has selected it (it runs ahead of execution by
+    /// the lookahead): D number (0: none) and radius, mm (`mc_active_tool_id_*`, IPO "Actual
+    /// tool radius").
+    pub(crate) active_tool: (u32, f64),
     /// Path length left in the executing move, mm (the DRO's distance to go).
     pub distance_to_go_mm: f64,
     /// The HLI technology interface: PLC present, the units and what they hold.
@@ -360,6 +364,7 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         queued_blocks: c.queue.len(),
         programs_ended: stats.programs_ended,
         zero_offsets: c.zero_offsets,
+        active_tool: c.decoder.active_tool(),
         distance_to_go_mm: c.motion.distance_to_go_mm(),
         techno,
         techno_open,

@@ -163,6 +163,10 @@ impl Decoder {
     pub(crate) fn set_tools(&mut self, tools: crate::params::tools::ToolTable, t_selects_d: bool) {
         self.interp.set_tools(tools, t_selects_d);
     }
+    /// The active D and its tool radius, mm (D0 or a D the tool list lacks: radius 0).
+    pub(crate) fn active_tool(&self) -> (u32, f64) {
+        self.interp.active_tool()
+    }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.
     pub(crate) fn program_text(&self, prog: &str) -> Option<Arc<Vec<u8>>> {

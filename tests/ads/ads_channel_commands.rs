@@ -194,6 +194,47 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
 }
 
 #[test]
+fn the_active_tool_objects_read_the_tool_list_of_werkz_data() {
+    let params = ads_common::Params::new(1);
+    let startup = std::fs::read_to_string(params.startup()).unwrap();
+    std::fs::write(params.startup(), startup + "werkz_data[0] werkz_d.lis\n").unwrap();
+    // TF5200 Tool data: wz[2] valid, radius 2.5 mm (0.1 µm).
+    std::fs::write(
+        params.dir.path().join("params/werkz_d.lis"),
+        "wz[2].gueltig 1\nwz[2].radius 25000\n",
+    )
+    .unwrap();
+    params.program("tool.nc", "N10 D2 G01 X5 F6000\nN20 X6\nN30 M30\n");
+    let served = ads_common::Served::start(params);
+    let c = client(&served);
+    let com = com_device(&c);
+    let geo = c.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 551));
+    let radius = || {
+        let mut b = [0u8; 8];
+        geo.read_exact(0x121301, 0x2C, &mut b).unwrap();
+        f64::from_le_bytes(b)
+    };
+    assert_eq!((com.u32(0x1A), radius()), (0, 0.0), "D0 before the start");
+    com.write(0x01, &[1]);
+    com.start("tool.nc");
+    com.wait_state(5);
+    assert_eq!(com.u32(0x0E), 10);
+    assert_eq!(com.u32(0x1A), 2, "mc_active_tool_id_basic_r: the active D");
+    assert_eq!(radius(), 25_000.0, "Actual tool radius, 0.1 µm");
+    let mut id = [0xFFu8; 16];
+    com.0.read_exact(CH, 0x19, &mut id).unwrap();
+    let mut want = [0u8; 16];
+    want[0] = 2;
+    assert_eq!(id, want, "mc_active_tool_id_r: basic 2, no sister or variant");
+    assert_eq!(com.u32(0x1B), 0);
+    com.write(0x01, &[0]);
+    com.write(0x137, &[1]);
+    com.wait_state(3);
+    drop(c);
+    served.finish();
+}
+
+#[test]
 fn the_last_msg_text_is_read_at_mc_message_r() {
     let params = ads_common::Params::new(1);
     params.program(

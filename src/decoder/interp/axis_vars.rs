@@ -42,6 +42,14 @@ impl Interpreter {
         self.tools.iter().find(|t| t.d == d).copied()
     }
 
+    /// The active D and its radius, mm (0 for a D the tool list lacks).
+    pub(in crate::decoder) fn active_tool(&self) -> (u32, f64) {
+        (
+            self.modal.tool_offset,
+            self.tool_radius(None).unwrap_or(0.0),
+        )
+    }
+
     /// Radius of tool data set `d` (`None`: the active D), mm.
     pub(super) fn tool_radius(&self, d: Option<u32>) -> Option<f64> {
         self.tool(d).map(|t| t.radius_mm)
