@@ -35,7 +35,10 @@ pub enum VarKey<'e> {
     /// `V.G.M_FCT[n].SYNCH` (`h` false) / `V.G.H_FCT[n].SYNCH`.
     FunctionSync { h: bool, number: u32 },
     /// `V.G.WZ_AKT.<field>` (`tool` `None`) or `V.G.WZ[j].<field>`.
-    ToolData { tool: Option<u32>, field: ToolFieldId },
+    ToolData {
+        tool: Option<u32>,
+        field: ToolFieldId,
+    },
     /// `V.G.NP[group].V.<axis>`.
     ZeroOffset { group: u32, axis: AxisId },
 }

@@ -309,9 +309,15 @@ pub(crate) const INERT_TOOLS: &[(&str, &str)] = &[
         "wz[].kinematic.",
         "P-TOOL-00009 kinematic offsets: no transformations",
     ),
-    ("wz[].tool_fixed", "tool fixed / alignable: no transformations"),
+    (
+        "wz[].tool_fixed",
+        "tool fixed / alignable: no transformations",
+    ),
     ("wz[].kin_id", "kinematic ID: no transformations"),
-    ("wz[].log_ax_nr_spdl", "spindle of the tool: no spindle model"),
+    (
+        "wz[].log_ax_nr_spdl",
+        "spindle of the tool: no spindle model",
+    ),
     ("wz[].vb_min", "tool speed limits: no spindle model"),
     ("wz[].vb_max", "tool speed limits: no spindle model"),
     ("wz[].a_max", "tool acceleration limit: no spindle model"),

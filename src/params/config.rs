@@ -264,7 +264,14 @@ fn build(
         None => None,
     }
     .map(|mut c| {
-        channel_tools(&startup, &mut c, tools_file.as_deref(), &tools, diags, lists);
+        channel_tools(
+            &startup,
+            &mut c,
+            tools_file.as_deref(),
+            &tools,
+            diags,
+            lists,
+        );
         c
     });
     Some(Config {

@@ -429,16 +429,17 @@ impl StartupList {
 fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
     matches!(
         s,
-        [("sda_mds" | "zero_offset_list" | "nullp_data" | "werkz_data" | "achs_mds", Some(_))]
-            | [
-                ("pfad", Some(_)),
-                ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))
-            ]
-            | [
-                ("configuration", None),
-                ("channel", Some(_)),
-                ("decoder", None),
-                ("function" | "max_cache_number" | "max_cache_size", None)
-            ]
+        [(
+            "sda_mds" | "zero_offset_list" | "nullp_data" | "werkz_data" | "achs_mds",
+            Some(_)
+        )] | [
+            ("pfad", Some(_)),
+            ("prg" | "typ" | "prioritaet" | "log_nr", Some(_))
+        ] | [
+            ("configuration", None),
+            ("channel", Some(_)),
+            ("decoder", None),
+            ("function" | "max_cache_number" | "max_cache_size", None)
+        ]
     )
 }

@@ -149,9 +149,9 @@ pub(crate) fn interpret_tools(
         let tool = &mut out[pos];
         let bad = |what: &str| list.error_at(e, e.value_pos, format!("{}: {what}", e.name.text));
         match field {
-            Field::Radius if v < 0 => diags.push(bad(&format!(
-                "a radius cannot be negative (found {v})"
-            ))),
+            Field::Radius if v < 0 => {
+                diags.push(bad(&format!("a radius cannot be negative (found {v})")))
+            }
             Field::Radius => tool.radius_mm = v as f64 * MM_PER_UNIT,
             Field::Length => tool.length_mm = v as f64 * MM_PER_UNIT,
             Field::Valid => match v {

@@ -225,7 +225,10 @@ fn the_active_tool_objects_read_the_tool_list_of_werkz_data() {
     com.0.read_exact(CH, 0x19, &mut id).unwrap();
     let mut want = [0u8; 16];
     want[0] = 2;
-    assert_eq!(id, want, "mc_active_tool_id_r: basic 2, no sister or variant");
+    assert_eq!(
+        id, want,
+        "mc_active_tool_id_r: basic 2, no sister or variant"
+    );
     assert_eq!(com.u32(0x1B), 0);
     com.write(0x01, &[0]);
     com.write(0x137, &[1]);

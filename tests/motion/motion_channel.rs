@@ -888,7 +888,10 @@ fn g41_d1_offsets_the_path_by_the_radius_of_the_werkz_data_list() {
     assert!(pos.len() > 1000);
     for p in &pos {
         let d = distance_to_polygon(p[0], p[1], &square);
-        assert!((d - 3.0).abs() <= 1e-3, "{p:?}: {d} mm from the contour, not 3");
+        assert!(
+            (d - 3.0).abs() <= 1e-3,
+            "{p:?}: {d} mm from the contour, not 3"
+        );
     }
 }
 
@@ -954,7 +957,10 @@ fn v_g_wz_akt_and_v_g_np_read_the_lists() {
 
 #[test]
 fn einrechnen_mit_t_makes_t_select_the_d_data_set_of_its_number() {
-    let p = ended_at(&kernel_lists("einrechnen_mit_t 1\n"), "T2\nG90 G0 Z0\nM30\n");
+    let p = ended_at(
+        &kernel_lists("einrechnen_mit_t 1\n"),
+        "T2\nG90 G0 Z0\nM30\n",
+    );
     assert_eq!(p[2], 60.0, "T2 is T2 D2");
     let p = ended_at(&kernel_lists(""), "T2\nG90 G0 Z0\nM30\n");
     assert_eq!(p[2], 0.0, "without it T selects no data");

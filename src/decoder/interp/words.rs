@@ -190,7 +190,9 @@ impl Interpreter {
             // The emulator's tool and zero-offset data come from the lists at start-up.
             return Err(DecodeError::new(
                 codes::UNSUPPORTED,
-                format!("{target}: read-only in ncchannel (set it in the tool or zero-offset list)"),
+                format!(
+                    "{target}: read-only in ncchannel (set it in the tool or zero-offset list)"
+                ),
             )
             .at(col));
         }
@@ -350,9 +352,7 @@ impl Interpreter {
             self.modal.tool = t;
         }
         // einrechnen_mit_t (P-CHAN-00014): `T80` is `T80 D80`; a D in the block wins.
-        let d = w
-            .tool_offset
-            .or(w.tool.filter(|_| self.t_selects_d));
+        let d = w.tool_offset.or(w.tool.filter(|_| self.t_selects_d));
         if let Some(d) = d {
             self.select_tool_data(d)?;
         }
