@@ -105,6 +105,12 @@ impl Tally {
         }
     }
 
+    /// A kernel entry the interpreter knows but does not use, which it has warned about
+    /// itself (a zero-offset group beyond G59, the G53 group, an axis beyond C): inert.
+    pub(crate) fn kept_unused(&mut self) {
+        self.inert += 1;
+    }
+
     /// The summary of `list`, every entry not counted as inert or unknown being used.
     pub fn finish(&self, list: &ParamList) -> ListSummary {
         let total = list.entries.len();

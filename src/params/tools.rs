@@ -168,14 +168,18 @@ pub(crate) fn interpret_tools(
             )),
             Field::AxisOffset(j) => match tool.axis_offsets_mm.get_mut(j as usize) {
                 Some(o) => *o = v as f64 * MM_PER_UNIT,
-                None => diags.push(list.warning_at(
-                    e,
-                    e.name_pos,
-                    format!(
-                        "{}: kept, but the emulator's axes are X Y Z A B C (ax_versatz[0..5])",
-                        e.name.text
-                    ),
-                )),
+                None => {
+                    diags.push(list.warning_at(
+                        e,
+                        e.name_pos,
+                        format!(
+                            "{}: kept, but the emulator's axes are X Y Z A B C \
+                             (ax_versatz[0..5])",
+                            e.name.text
+                        ),
+                    ));
+                    tally.kept_unused();
+                }
             },
             // P-TOOL-00008: 0 = the list's unit is 0.1 µm; inch tool data is not modelled.
             Field::Unit if v == 0 => {}
@@ -253,6 +257,7 @@ mod tests {
             "{d:?}"
         );
         assert!(d[0].message.contains("0 or 1"), "{}", d[0].message);
-        assert_eq!(s.counts.unknown, 1);
+        // ax_versatz[9]: known, not used (inert); farbe: unknown.
+        assert_eq!((s.counts.inert, s.counts.unknown), (1, 1));
     }
 }

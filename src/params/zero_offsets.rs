@@ -99,6 +99,7 @@ pub(crate) fn interpret_zero_offsets(
                     e.name.text
                 ),
             ));
+            tally.kept_unused();
             continue;
         }
         if i as usize > GROUPS || j as usize >= MAX_AXES {
@@ -111,6 +112,7 @@ pub(crate) fn interpret_zero_offsets(
                     e.name.text
                 ),
             ));
+            tally.kept_unused();
             continue;
         }
         // The list's group 1 (G54) is row 0.
@@ -180,11 +182,16 @@ mod tests {
     use crate::params::list::parse_list;
 
     fn read(text: &str) -> (ZeroOffsetTable, Vec<Diagnostic>) {
+        let (t, d, _) = read_counted(text);
+        (t, d)
+    }
+
+    fn read_counted(text: &str) -> (ZeroOffsetTable, Vec<Diagnostic>, ListSummary) {
         let (list, errs) = parse_list(Path::new("np.lis"), text);
         assert!(errs.is_empty(), "{errs:?}");
         let mut d = Vec::new();
-        let (t, _) = interpret_zero_offsets(&list, &mut d);
-        (t, d)
+        let (t, s) = interpret_zero_offsets(&list, &mut d);
+        (t, d, s)
     }
 
     #[test]
@@ -214,12 +221,19 @@ mod tests {
 
     #[test]
     fn the_g53_group_unknown_and_unused_entries_warn() {
-        let (t, d) = read("np_grp[0].achse[0].versch 70000\nnp_grp[7].achse[0].versch 1\nfoo 1\n");
+        let (t, d, s) = read_counted(
+            "np_grp[0].achse[0].versch 70000\nnp_grp[7].achse[0].versch 1\nfoo 1\n\
+             np_grp[1].achse[0].versch 5\n",
+        );
+        // Known but not used: inert; `foo`: unknown.
+        assert_eq!((s.counts.used, s.counts.inert, s.counts.unknown), (1, 2, 1));
         assert_eq!(d.len(), 3);
         assert!(d[0].message.contains("G53"), "{}", d[0].message);
         assert!(d
             .iter()
             .all(|x| x.severity == crate::diag::Severity::Warning));
-        assert!(t.iter().flatten().all(|v| *v == 0.0));
+        // Only G54's X (5 × 0.1 µm) is set: group 0 did not become G54.
+        assert_eq!(t[0][0], 0.0005);
+        assert_eq!(t.iter().flatten().filter(|v| **v != 0.0).count(), 1);
     }
 }
