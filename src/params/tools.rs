@@ -60,7 +60,7 @@ impl ToolData {
     }
 }
 
-/// Tool data by D number, sorted by D.
+/// Tool data by D number, sorted by D (looked up by binary search).
 pub type ToolTable = Vec<ToolData>;
 
 /// Which format a tool list is read in: the validity flag's default differs.
@@ -111,7 +111,7 @@ pub(crate) fn interpret_tools(
 ) -> (ToolTable, ListSummary) {
     warn_duplicates(list, diags);
     let mut tally = Tally::new(ListKind::Tools);
-    let mut out: ToolTable = Vec::new();
+    let mut out: std::collections::BTreeMap<u32, ToolData> = Default::default();
     for e in &list.entries {
         let (d, field) = match shape(e).as_slice() {
             [("wz", Some(d)), ("radius", None)] => (*d, Field::Radius),
@@ -139,14 +139,9 @@ pub(crate) fn interpret_tools(
                 continue;
             }
         };
-        let pos = match out.iter().position(|t| t.d == d) {
-            Some(p) => p,
-            None => {
-                out.push(ToolData::new(d, format == ToolFormat::Ncchannel));
-                out.len() - 1
-            }
-        };
-        let tool = &mut out[pos];
+        let tool = out
+            .entry(d)
+            .or_insert_with(|| ToolData::new(d, format == ToolFormat::Ncchannel));
         let bad = |what: &str| list.error_at(e, e.value_pos, format!("{}: {what}", e.name.text));
         match field {
             Field::Radius if v < 0 => {
@@ -188,8 +183,8 @@ pub(crate) fn interpret_tools(
             ))),
         }
     }
-    out.sort_by_key(|t| t.d);
-    (out, tally.finish(list))
+    // Sorted by D: the decoder looks data sets up by binary search.
+    (out.into_values().collect(), tally.finish(list))
 }
 
 #[cfg(test)]

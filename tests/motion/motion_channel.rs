@@ -916,11 +916,18 @@ fn tool_length_lies_on_the_tool_axis_and_axis_offsets_on_their_axes() {
 fn an_invalid_tool_is_refused_with_its_error_where_d_selects_it() {
     let s = kernel_lists("");
     // wz[3] has no `gueltig 1`: the kernel's default 0, invalid.
-    let c = run_program(&s, "G0 X0 Y0\nD3\nG41 G1 X10 F1000\nG40 X20\nM30\n");
+    let c = run_program(&s, "G0 X0 Y0\nG1 X1 D3 F1000\nG41 G1 X10\nG40 X20\nM30\n");
     assert_eq!(c.status().state, State::Error);
     let e = c.report().last_error.unwrap();
     assert_eq!((e.code, e.line), (900140, Some(2)), "{}", e.msg);
     assert!(e.msg.contains("gueltig"), "{}", e.msg);
+    assert!(e.msg.contains("(column 7)"), "at the D word: {}", e.msg);
+    assert_eq!(c.report().position[0], 0.0, "the block does not move");
+    // With einrechnen_mit_t the T word selects it, and is the place named.
+    let c = run_program(&kernel_lists("einrechnen_mit_t 1\n"), "N1 T3 M6\nM30\n");
+    let e = c.report().last_error.unwrap();
+    assert_eq!(e.code, 900140);
+    assert!(e.msg.contains("(column 4)"), "at the T word: {}", e.msg);
 }
 
 #[test]

@@ -273,8 +273,11 @@ impl Interpreter {
             b'F' => w.feed = Some((v, col)),
             b'S' => w.spindle_rpm = Some(v),
             // Whole numbers: the range check above refused anything else.
-            b'T' => w.tool = whole(v),
-            b'D' => w.tool_offset = whole(v),
+            b'T' => {
+                w.tool = whole(v);
+                w.tool_col = col;
+            }
+            b'D' => w.tool_offset = whole(v).map(|d| (d, col)),
             b'I' => w.ijk[0] = Some(v),
             b'J' => w.ijk[1] = Some(v),
             b'K' => w.ijk[2] = Some(v),
@@ -352,9 +355,11 @@ impl Interpreter {
             self.modal.tool = t;
         }
         // einrechnen_mit_t (P-CHAN-00014): `T80` is `T80 D80`; a D in the block wins.
-        let d = w.tool_offset.or(w.tool.filter(|_| self.t_selects_d));
-        if let Some(d) = d {
-            self.select_tool_data(d)?;
+        let d = w
+            .tool_offset
+            .or(w.tool.filter(|_| self.t_selects_d).map(|t| (t, w.tool_col)));
+        if let Some((d, col)) = d {
+            self.select_tool_data(d).map_err(|e| e.at(col))?;
         }
         for &m in w.ms() {
             apply_m(&mut self.modal, m);
