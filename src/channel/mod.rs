@@ -89,7 +89,7 @@ pub struct ChannelSettings {
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
     pub(crate) fs_latency: FsLatency,
     /// The tool list's data sets by D number, mm (`werkz_data[i]` or `tools.lis`).
-    pub tools: crate::params::tools::ToolTable,
+    pub tools: crate::decoder::ToolTable,
     /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
     pub t_selects_d: bool,
 }

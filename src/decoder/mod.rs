@@ -41,6 +41,8 @@ use vars::VarStore;
 pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
 pub use search_target::SearchTarget;
 
+/// The tool list's data sets the decoder selects with D (the channel hands them over).
+pub use crate::params::tools::ToolTable;
 pub use error::DecodeError;
 use error::Res;
 pub use io::DecoderIo;
@@ -160,7 +162,7 @@ impl Decoder {
     /// The tool list's data sets by D number, mm (`V.G.WZ[j].*`, `V.G.WZ_AKT.*`, length
     /// compensation), and whether a T word selects the D data set of its number
     /// (`einrechnen_mit_t`, P-CHAN-00014).
-    pub(crate) fn set_tools(&mut self, tools: crate::params::tools::ToolTable, t_selects_d: bool) {
+    pub(crate) fn set_tools(&mut self, tools: ToolTable, t_selects_d: bool) {
         self.interp.set_tools(tools, t_selects_d);
     }
     /// The active D and its tool radius, mm (D0 or a D the tool list lacks: radius 0).
