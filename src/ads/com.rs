@@ -112,6 +112,10 @@ enum Field {
     ToolBasic,
     ToolSister,
     ToolSisterValid,
+    /// The file names of the channel's zero-offset and tool lists (read only: the lists are
+    /// read at start-up).
+    ZeroOffsetFile,
+    ToolFile,
     ChannelNumber,
     ChannelAxes,
     ExecutionModeCommand,
@@ -238,6 +242,8 @@ static TABLE: &[Def] = &[
     d(CH, 0x26, "mc_error_message_r", String, 1330, R, "", SRC_DUMP, F::ErrorMessage),
     d(CH, 0x2B, "mc_actual_logical_axes_number_r", Dword, 4, R, "", SRC_DUMP, F::ChannelAxes),
     d(CH, 0x2C, "mc_channel_number_r", Word, 2, R, "", SRC_DUMP, F::ChannelNumber),
+    d(CH, 0x2D, "mc_zero_offset_file_r", String, 84, R, "file name, empty: none", SRC_DUMP, F::ZeroOffsetFile),
+    d(CH, 0x2F, "mc_tool_file_r", String, 84, R, "file name, empty: none", SRC_DUMP, F::ToolFile),
     d(CH, 0x3F, "mc_command_execution_mode_w", Dint, 4, W, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x40, "mc_command_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x41, "mc_active_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeActive),
@@ -649,6 +655,20 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
         Field::ToolBasic => active_d(v).to_le_bytes().to_vec(),
         Field::ToolSister => 0i32.to_le_bytes().to_vec(),
         Field::ToolSisterValid => vec![0],
+        Field::ZeroOffsetFile => {
+            return Ok(text(
+                v.list_files.zero_offset.as_deref().unwrap_or(""),
+                def.size,
+                length,
+            ))
+        }
+        Field::ToolFile => {
+            return Ok(text(
+                v.list_files.tool.as_deref().unwrap_or(""),
+                def.size,
+                length,
+            ))
+        }
         Field::ChannelNumber => ch.to_le_bytes().to_vec(),
         Field::ExecutionModeCommand => h.execution_mode.to_le_bytes().to_vec(),
         Field::ExecutionModeActive => i32::from(v.searching).to_le_bytes().to_vec(),

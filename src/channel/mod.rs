@@ -92,6 +92,8 @@ pub struct ChannelSettings {
     pub tools: crate::decoder::ToolTable,
     /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
     pub t_selects_d: bool,
+    /// The names of the tool and zero-offset lists, for ADS.
+    pub list_files: door::ListFiles,
 }
 
 /// One NC channel: its parts (mode and state, HMI commands, program run, log) and what it
@@ -118,6 +120,8 @@ pub struct Channel {
     techno: TechnoUnits,
     /// G54…G59 offsets (mm), for positions in the programming coordinate system.
     zero_offsets: ZeroOffsets,
+    /// The names of the tool and zero-offset lists.
+    list_files: door::ListFiles,
     /// Reused buffer for the motion's notes of a tick.
     notes: Vec<MotionNote>,
     /// Reused buffer for the decoder's notes of a tick.
@@ -254,6 +258,7 @@ impl Channel {
             },
             techno: TechnoUnits::new(),
             zero_offsets,
+            list_files: s.list_files,
             loader,
             notes: Vec::new(),
             decoder_notes: Vec::new(),

@@ -186,6 +186,7 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
     com.0.read_exact(0x120201, 0x30, &mut hr).unwrap();
     assert_eq!(f64::from_le_bytes(hr), 150_000.0);
     assert_eq!(com.string(0x10002, 16), "X", "mc_axis_1_name_r");
+    assert_eq!(com.string(0x2D, 84), "zero.lis", "mc_zero_offset_file_r");
     com.write(0x01, &[0]);
     com.write(0x137, &[1]);
     com.wait_state(3);
@@ -230,6 +231,8 @@ fn the_active_tool_objects_read_the_tool_list_of_werkz_data() {
         "mc_active_tool_id_r: basic 2, no sister or variant"
     );
     assert_eq!(com.u32(0x1B), 0);
+    assert_eq!(com.string(0x2F, 84), "werkz_d.lis", "mc_tool_file_r");
+    assert_eq!(com.string(0x2D, 84), "", "mc_zero_offset_file_r: no list");
     com.write(0x01, &[0]);
     com.write(0x137, &[1]);
     com.wait_state(3);
