@@ -3,6 +3,7 @@
 
 use thiserror::Error;
 
+use crate::channel::door::ListFiles;
 use crate::channel::{Channel, ChannelSettings};
 use crate::decoder::DecoderSettings;
 use crate::geometry::SoftLimits;
@@ -124,8 +125,19 @@ pub fn channel_settings(
             max_file_bytes: u64::from(c.max_file_bytes),
         },
         fs_latency: FsLatency::from_us(rt.fs_latency_us, rt.fs_latency_us_per_kib),
-        tools: config.tools.clone(),
+        tools: ch.tools.clone(),
+        t_selects_d: ch.t_selects_d,
+        list_files: ListFiles {
+            tool: file_name(ch.tool_list.as_deref()),
+            zero_offset: file_name(ch.zero_offset_list.as_deref()),
+        },
     })
+}
+
+/// A list's file name, as the ADS objects `mc_tool_file_r` / `mc_zero_offset_file_r` show it.
+fn file_name(path: Option<&std::path::Path>) -> Option<std::sync::Arc<str>> {
+    path.and_then(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into())
 }
 
 /// Every channel of the configuration, reading and freeing large programs through `loader`.

@@ -105,6 +105,17 @@ enum Field {
     SearchNoHold,
     SearchBreakpoint,
     Message,
+    /// The active tool ID (`mc_active_tool_id_*`): basic = the active D (TF5200 "Programming
+    /// commands and variables": the D word's value is the basic tool number); ncchannel has
+    /// no sister or variant tools.
+    ToolId,
+    ToolBasic,
+    ToolSister,
+    ToolSisterValid,
+    /// The file names of the channel's zero-offset and tool lists (read only: the lists are
+    /// read at start-up).
+    ZeroOffsetFile,
+    ToolFile,
     ChannelNumber,
     ChannelAxes,
     ExecutionModeCommand,
@@ -221,10 +232,18 @@ static TABLE: &[Def] = &[
     d(CH, 0x14, "mc_active_feedrate_r", Lreal, 8, R, "µm/s", SRC_TS, F::ActiveFeed),
     d(CH, 0x15, "mc_command_feedhold_r", Bool, 1, R, "", SRC_DUMP, F::FeedHoldCommand),
     d(CH, 0x16, "mc_feedhold_channel_w", Bool, 1, W, "TRUE holds, FALSE releases", SRC_DUMP, F::FeedHold),
+    d(CH, 0x19, "mc_active_tool_id_r", ToolId, 16, R, "basic = active D", SRC_DUMP, F::ToolId),
+    d(CH, 0x1A, "mc_active_tool_id_basic_r", Dint, 4, R, "active D", SRC_DUMP, F::ToolBasic),
+    d(CH, 0x1B, "mc_active_tool_id_sister_r", Dint, 4, R, "0: no sister tools", SRC_DUMP, F::ToolSister),
+    d(CH, 0x1C, "mc_active_tool_id_variant_r", Dint, 4, R, "0: no variants", SRC_DUMP, F::ToolSister),
+    d(CH, 0x1D, "mc_active_tool_id_sister_val_r", Bool, 1, R, "FALSE", SRC_DUMP, F::ToolSisterValid),
+    d(CH, 0x1E, "mc_active_tool_id_variant_val_r", Bool, 1, R, "FALSE", SRC_DUMP, F::ToolSisterValid),
     d(CH, 0x1F, "mc_message_r", String, 120, R, "last #MSG text", SRC_DUMP, F::Message),
     d(CH, 0x26, "mc_error_message_r", String, 1330, R, "", SRC_DUMP, F::ErrorMessage),
     d(CH, 0x2B, "mc_actual_logical_axes_number_r", Dword, 4, R, "", SRC_DUMP, F::ChannelAxes),
     d(CH, 0x2C, "mc_channel_number_r", Word, 2, R, "", SRC_DUMP, F::ChannelNumber),
+    d(CH, 0x2D, "mc_zero_offset_file_r", String, 84, R, "file name, empty: none", SRC_DUMP, F::ZeroOffsetFile),
+    d(CH, 0x2F, "mc_tool_file_r", String, 84, R, "file name, empty: none", SRC_DUMP, F::ToolFile),
     d(CH, 0x3F, "mc_command_execution_mode_w", Dint, 4, W, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x40, "mc_command_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeCommand),
     d(CH, 0x41, "mc_active_execution_mode_r", Dint, 4, R, "0 standard, 1 block search", SRC_TS, F::ExecutionModeActive),
@@ -546,6 +565,11 @@ pub fn read(
     }
 }
 
+/// The active D as the kernel's DINT tool number.
+fn active_d(v: &Status) -> i32 {
+    i32::try_from(v.active_tool.0).unwrap_or(i32::MAX)
+}
+
 fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec<u8>, AdsResult> {
     let channels = backend.channel_count();
     let v = backend.status(1).map_err(dev)?;
@@ -623,6 +647,28 @@ fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, 
         Field::SearchBreakpoint => h.search.breakpoint_tenth_um.to_le_bytes().to_vec(),
         Field::Message => return Ok(text(v.message.as_deref().unwrap_or(""), def.size, length)),
         Field::ChannelAxes => (v.positions.len() as u32).to_le_bytes().to_vec(),
+        Field::ToolId => {
+            let mut b = vec![0u8; 16];
+            b[..4].copy_from_slice(&active_d(v).to_le_bytes());
+            b
+        }
+        Field::ToolBasic => active_d(v).to_le_bytes().to_vec(),
+        Field::ToolSister => 0i32.to_le_bytes().to_vec(),
+        Field::ToolSisterValid => vec![0],
+        Field::ZeroOffsetFile => {
+            return Ok(text(
+                v.list_files.zero_offset.as_deref().unwrap_or(""),
+                def.size,
+                length,
+            ))
+        }
+        Field::ToolFile => {
+            return Ok(text(
+                v.list_files.tool.as_deref().unwrap_or(""),
+                def.size,
+                length,
+            ))
+        }
         Field::ChannelNumber => ch.to_le_bytes().to_vec(),
         Field::ExecutionModeCommand => h.execution_mode.to_le_bytes().to_vec(),
         Field::ExecutionModeActive => i32::from(v.searching).to_le_bytes().to_vec(),

@@ -32,6 +32,10 @@ pub enum AdsType {
     LrealArray,
     /// `{DINT mode; DINT state}` (`mcm_active_r`).
     ModeState,
+    /// The kernel's tool ID, 16 bytes: basic, sister, variant (DINT), sister_valid,
+    /// variant_valid (BOOL), 2 bytes padding (`mc_active_tool_id_r`; TF5200 HLI "Data of the
+    /// T function", HLI_TOOL_ID).
+    ToolId,
     /// A zero-length write that triggers an action.
     Trigger,
     /// A PLC type by name (HLI symbols).
@@ -48,6 +52,7 @@ impl AdsType {
             AdsType::Dword2
             | AdsType::LrealArray
             | AdsType::ModeState
+            | AdsType::ToolId
             | AdsType::Trigger
             | AdsType::Named(_) => "NONE",
             scalar => scalar.name(),
@@ -69,6 +74,10 @@ impl AdsType {
             AdsType::Dword2 => "ARRAY [0..1] OF DWORD",
             AdsType::LrealArray => "ARRAY [1..axes] OF LREAL",
             AdsType::ModeState => "STRUCT mode : DINT; state : DINT; END_STRUCT",
+            AdsType::ToolId => {
+                "STRUCT basic : DINT; sister : DINT; variant : DINT; sister_valid : BOOL; \
+                 variant_valid : BOOL; END_STRUCT"
+            }
             AdsType::Trigger => "NONE",
             AdsType::Named(n) => n,
         }

@@ -60,6 +60,8 @@ enum Field {
     BlockCount,
     InputBlockCount,
     OverrideFactor,
+    /// The active D's tool radius.
+    ToolRadius,
     PlcPresent,
     /// `used_units_std_sync_r` / `used_units_late_sync_r`.
     UsedUnits(UnitSet),
@@ -195,6 +197,7 @@ static TABLE: &[Def] = &[
     d(Ipo, 0x15, "Actual velocity on path", Lreal, 8, "µm/s", SRC, F::PathVelocity),
     d(Ipo, 0x16, "Programmed velocity on path", Lreal, 8, "µm/s", SRC, F::ProgrammedVelocity),
     d(Ipo, 0x21, "actual_block_nr", Dint, 4, "N number", SRC, F::BlockNumber),
+    d(Ipo, 0x2C, "Actual tool radius", Lreal, 8, "0.1 µm, the active D's", SRC_DUMP, F::ToolRadius),
     d(Ipo, 0x2E, "actual_block_count", Dint, 4, "block counter", SRC_DUMP, F::BlockCount),
     d(Ipo, 0x2F, "latest_input_block_clount", Dint, 4, "block counter", SRC_DUMP, F::InputBlockCount),
     d(Ipo, 0x70, "override feed factor", Lreal, 8, "1 = 100 %", SRC_DUMP, F::OverrideFactor),
@@ -395,6 +398,7 @@ fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
             .to_le_bytes()
             .to_vec(),
         Field::OverrideFactor => (v.override_pct / 100.0).to_le_bytes().to_vec(),
+        Field::ToolRadius => (v.active_tool.1 * 10_000.0).to_le_bytes().to_vec(),
         // ncchannel has no PLC override unit: the HMI's override request is taken directly.
         Field::OverrideEnable => vec![0],
         Field::OverrideCommand | Field::OverrideRequest | Field::OverrideState => {

@@ -13,7 +13,7 @@
 //! declared type (TF5200 External variables: BOOLEAN → BOOL, SGN08 … UNS32 → SINT … UDINT,
 //! REAL64 → LREAL, STRING → STRING(n), n + 1 bytes NUL-padded), LREAL when no list declares
 //! them (read and write; a write takes exactly the type's bytes, a string up to n + 1), and
-//! the zero offsets `V.G.NP[i].V`, i = 1…6 for G54…G59 (read only: one DINT per configured
+//! the zero offsets `V.G.NP[i].V`, i = 1…6 for G54…G59 and 0 for G53, all zero (read only: one DINT per configured
 //! axis of the channel, 0.1 µm, as TwinSharp `ZeroOffsets.cs` reads and decodes them). Other
 //! variable kinds (`V.A.*`, `V.P.*` …) are not modelled and answer "not found" (0x70C).
 //! Handles are `0x2000_0000 + n` for the n-th distinct name asked for (at most
@@ -46,8 +46,10 @@ const NO_MEMORY: AdsResult = AdsResult(0x70A);
 const LOGICAL: u32 = 0x100000;
 /// Bytes of a V.E. value no list declares: an LREAL.
 const VALUE_BYTES: usize = 8;
-/// Zero-offset tables `V.G.NP[1]` … `V.G.NP[6]` (G54…G59).
-const ZERO_OFFSETS: std::ops::RangeInclusive<usize> = 1..=6;
+/// Zero-offset groups `V.G.NP[0]` … `V.G.NP[6]` in the kernel's numbering (TF5200 "Zero
+/// offset group"): 0 is G53 (no offset), 1 … 6 are G54 … G59, as the zero-offset list's
+/// `np_grp[i]` and a program's `V.G.NP[i]` number them.
+const ZERO_OFFSETS: std::ops::RangeInclusive<usize> = 0..=6;
 /// 0.1 µm per mm: zero offsets on the wire.
 const TENTH_UM_PER_MM: f64 = 10_000.0;
 
@@ -275,7 +277,10 @@ impl Sda {
     /// the channel's axis order.
     fn zero_offset(&self, ch: u16, i: usize) -> Result<Vec<u8>, AdsResult> {
         let v = self.backend.status(ch).map_err(AdsResult::from)?;
-        let table = v.zero_offsets.get(i - 1).ok_or(AdsResult::NOT_FOUND)?;
+        let table = match i.checked_sub(1) {
+            None => &[0.0; crate::vocab::axis::MAX_AXES],
+            Some(row) => v.zero_offsets.get(row).ok_or(AdsResult::NOT_FOUND)?,
+        };
         Ok(v.positions
             .iter()
             .filter_map(|(letter, _)| u8::try_from(*letter).ok().and_then(slot_of))

@@ -183,6 +183,13 @@ pub struct Status {
     /// The zero-offset table G54…G59 (mm / degrees per axis slot), as the parameter lists
     /// set it (`V.G.NP[1..6].V`).
     pub(crate) zero_offsets: crate::decoder::modal::ZeroOffsets,
+    /// The active tool data set, as the decoder has selected it (it runs ahead of execution by
+    /// the lookahead): D number (0: none) and radius, mm (`mc_active_tool_id_*`, IPO "Actual
+    /// tool radius").
+    pub(crate) active_tool: (u32, f64),
+    /// The tool and zero-offset lists the channel was set up from (`mc_tool_file_r`,
+    /// `mc_zero_offset_file_r`).
+    pub(crate) list_files: ListFiles,
     /// Path length left in the executing move, mm (the DRO's distance to go).
     pub distance_to_go_mm: f64,
     /// The HLI technology interface: PLC present, the units and what they hold.
@@ -190,6 +197,14 @@ pub struct Status {
     /// Technology functions output and acknowledged so far, and which units hold a function
     /// still open (not yet acknowledged): `techno.std` then `techno.late`, by index.
     pub techno_open: TechnoOpen,
+}
+
+/// The file names of a channel's tool list (`werkz_data[i]` or `tools.lis`) and zero-offset
+/// list (`nullp_data[i]` or `zero_offset_list`); `None`: no such list.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ListFiles {
+    pub tool: Option<Arc<str>>,
+    pub zero_offset: Option<Arc<str>>,
 }
 
 /// The technology counters and open units a [`Status`] carries for the live view.
@@ -365,7 +380,9 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         message: c.log.message().map(str::to_string),
         queued_blocks: c.queue.len(),
         programs_ended: stats.programs_ended,
-        zero_offsets: c.zero_offsets,
+        zero_offsets: *c.decoder.zero_offsets(),
+        active_tool: c.decoder.active_tool(),
+        list_files: c.list_files.clone(),
         distance_to_go_mm: c.motion.distance_to_go_mm(),
         techno,
         techno_open,

@@ -9,7 +9,6 @@
 
 use thiserror::Error;
 
-use crate::decoder::modal::ZeroOffsets;
 use crate::decoder::{Decoder, DecoderIo, DecoderSettings, DecoderState, Note};
 use crate::motion::{Motion, MotionNote, PlannerSettings};
 use crate::queue::BlockQueue;
@@ -88,8 +87,12 @@ pub struct ChannelSettings {
     pub cache: CacheLimits,
     /// Simulated cost of each program file read (runtime.toml `fs_latency_us…`).
     pub(crate) fs_latency: FsLatency,
-    /// Tool radii by D number for G41/G42, mm (`tools.lis`).
-    pub tools: Vec<(u32, f64)>,
+    /// The tool list's data sets by D number, mm (`werkz_data[i]` or `tools.lis`).
+    pub tools: crate::decoder::ToolTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
+    pub t_selects_d: bool,
+    /// The names of the tool and zero-offset lists, for ADS.
+    pub list_files: door::ListFiles,
 }
 
 /// One NC channel: its parts (mode and state, HMI commands, program run, log) and what it
@@ -114,8 +117,8 @@ pub struct Channel {
     motion: Motion,
     /// The HLI technology units: M/H/S/T functions handed to the PLC and acknowledged.
     techno: TechnoUnits,
-    /// G54…G59 offsets (mm), for positions in the programming coordinate system.
-    zero_offsets: ZeroOffsets,
+    /// The names of the tool and zero-offset lists.
+    list_files: door::ListFiles,
     /// Reused buffer for the motion's notes of a tick.
     notes: Vec<MotionNote>,
     /// Reused buffer for the decoder's notes of a tick.
@@ -232,7 +235,6 @@ impl Channel {
     /// A channel built from its settings; `loader` (started by whoever runs the channels)
     /// reads its large program files and frees its large texts and tables off the tick.
     pub fn new(s: ChannelSettings, events_enabled: bool, loader: Loader) -> Self {
-        let zero_offsets = s.decoder.zero_offsets;
         Channel {
             isg: Isg::new(),
             hmi: Hmi::new(),
@@ -246,16 +248,16 @@ impl Channel {
             queue: BlockQueue::new(s.queue_capacity),
             decoder: {
                 let mut d = Decoder::new(s.decoder, loader.clone());
-                d.set_tool_radii(s.tools.clone());
+                d.set_tools(s.tools.clone(), s.t_selects_d);
                 d
             },
             motion: {
                 let mut m = Motion::with_planner(s.axes, s.planner);
-                m.set_tool_radii(s.tools);
+                m.set_tool_radii(s.tools.iter().map(|t| (t.d, t.radius_mm)).collect());
                 m
             },
             techno: TechnoUnits::new(),
-            zero_offsets,
+            list_files: s.list_files,
             loader,
             notes: Vec::new(),
             decoder_notes: Vec::new(),
@@ -361,7 +363,7 @@ impl Channel {
             .modal()
             .zero_offset
             .checked_sub(1)
-            .and_then(|i| self.zero_offsets.get(i))
+            .and_then(|i| self.decoder.zero_offsets().get(i))
             .copied()
             .unwrap_or([0.0; MAX_AXES]);
         self.positions_less(&offset)

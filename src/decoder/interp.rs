@@ -18,13 +18,14 @@ use super::error::{var_error, Res};
 use super::flow::Env;
 use super::io::DecoderIo;
 use super::line::BlockAt;
-use super::modal::Modal;
+use super::modal::{Modal, ZeroOffsets};
 use super::note::Note;
 use super::reader::Reader;
 use super::search_target::{Search, SearchTarget};
 use super::settings::DecoderSettings;
 use super::vars::{VarSlot, VarStore};
 use crate::lang::block::{Expr, VarRef};
+use crate::params::tools::ToolTable;
 use crate::queue::{Action, BlockInfo, QueuedBlock};
 use crate::source::loader::Loader;
 use crate::vocab::axis::{Position, MAX_AXES};
@@ -41,8 +42,14 @@ pub(super) struct Interpreter {
     renamed_slots: u8,
     vars: VarStore,
     modal: Modal,
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R`).
-    tool_radii: Vec<(u32, f64)>,
+    /// The tool list's data sets by D number, mm (`V.G.WZ[j].*`, G41/G42, length
+    /// compensation).
+    tools: ToolTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of its number.
+    t_selects_d: bool,
+    /// Zero-offset groups G54 … G59 by axis, mm: the list's values at start-up, then what
+    /// programs write to `V.G.NP[i]` (kept across resets, as the kernel's table is).
+    zero_offsets: ZeroOffsets,
     /// ISG block counter of the current program.
     counter: u64,
     search: Option<Search>,
@@ -74,11 +81,13 @@ impl Interpreter {
         }
         Interpreter {
             techno,
+            zero_offsets: settings.zero_offsets,
             settings,
             renamed_slots,
             vars,
             modal: Modal::defaults([0.0; MAX_AXES]),
-            tool_radii: Vec::new(),
+            tools: Vec::new(),
+            t_selects_d: false,
             counter: 0,
             search: None,
             skip_mask: 0,
@@ -118,6 +127,10 @@ impl Interpreter {
     pub(super) fn modal(&self) -> &Modal {
         &self.modal
     }
+    /// Zero-offset groups G54 … G59 by axis, mm, as programs have left them.
+    pub(super) fn zero_offsets(&self) -> &ZeroOffsets {
+        &self.zero_offsets
+    }
     pub(super) fn vars(&self) -> &VarStore {
         &self.vars
     }
@@ -145,9 +158,11 @@ impl Interpreter {
     pub(super) fn skips_level(&self, level: u8) -> bool {
         self.skip_mask & (1u16 << level.min(15)) != 0
     }
-    /// The tool list's radii by D number (mm), for `V.G.WZ[j].R` and `V.G.WZ_AKT.R`.
-    pub(super) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
-        self.tool_radii = radii;
+    /// The tool list's data sets by D number (mm), and whether T selects D as well
+    /// (`einrechnen_mit_t`, P-CHAN-00014).
+    pub(super) fn set_tools(&mut self, tools: ToolTable, t_selects_d: bool) {
+        self.tools = tools;
+        self.t_selects_d = t_selects_d;
     }
 
     /// A line is run: the ISG block counter counts it.

@@ -41,6 +41,8 @@ use vars::VarStore;
 pub use labels::{LABEL_SCAN_BYTES_PER_TICK, LABEL_SCAN_LINES_PER_TICK, MAX_INDEXED_LABELS};
 pub use search_target::SearchTarget;
 
+/// The tool list's data sets the decoder selects with D (the channel hands them over).
+pub use crate::params::tools::ToolTable;
 pub use error::DecodeError;
 use error::Res;
 pub use io::DecoderIo;
@@ -131,6 +133,11 @@ impl Decoder {
     pub fn modal(&self) -> &Modal {
         self.interp.modal()
     }
+    /// Zero-offset groups G54 … G59 by axis, mm: the list's, as programs have written them
+    /// (`V.G.NP[i]`), as far as the decoder has run.
+    pub(crate) fn zero_offsets(&self) -> &modal::ZeroOffsets {
+        self.interp.zero_offsets()
+    }
     pub fn vars(&self) -> &VarStore {
         self.interp.vars()
     }
@@ -157,9 +164,15 @@ impl Decoder {
     pub(crate) fn set_skip_mask(&mut self, mask: u16) {
         self.interp.set_skip_mask(mask);
     }
-    /// The tool list's radii by D number, mm (`V.G.WZ[j].R` and `V.G.WZ_AKT.R`).
-    pub(crate) fn set_tool_radii(&mut self, radii: Vec<(u32, f64)>) {
-        self.interp.set_tool_radii(radii);
+    /// The tool list's data sets by D number, mm (`V.G.WZ[j].*`, `V.G.WZ_AKT.*`, length
+    /// compensation), and whether a T word selects the D data set of its number
+    /// (`einrechnen_mit_t`, P-CHAN-00014).
+    pub(crate) fn set_tools(&mut self, tools: ToolTable, t_selects_d: bool) {
+        self.interp.set_tools(tools, t_selects_d);
+    }
+    /// The active D and its tool radius, mm (D0 or a D the tool list lacks: radius 0).
+    pub(crate) fn active_tool(&self) -> (u32, f64) {
+        self.interp.active_tool()
     }
     /// The text of the file program `prog` while a frame of it is open (the live view's
     /// listing); `None` for the stream and for a program no frame runs.

@@ -209,10 +209,32 @@ pub enum VarRef {
     /// j's), mm, from the tool list (TF5200 programming manual, "Global variables (V.G.)").
     /// Read-only.
     ToolRadius(Option<Box<Expr>>),
+    /// `V.G.WZ_AKT.<field>` (`tool` `None`: the active tool) or `V.G.WZ[j].<field>`: the tool
+    /// list's length, validity flag or axis offset (TF5200 "Access to tool data in the NC
+    /// program (V.G.WZ..)"). Read-only.
+    ToolData {
+        tool: Option<Box<Expr>>,
+        field: ToolField,
+    },
+    /// `V.G.NP[i].V.<axis>` / `V.G.NP[i].V[j]`: zero-offset group i's offset on an axis, mm
+    /// (group 0 = G53, none; 1 … 6 = G54 … G59; TF5200 programming manual, "Zero offsets").
+    /// Read-only.
+    ZeroOffset { group: Box<Expr>, axis: AxisSel },
     /// `V.G.M_FCT[n].SYNCH` / `V.G.H_FCT[n].SYNCH`: the synchronisation type of M or H
     /// function n, as the kernel's value (TF5200 "Parameterising the synchronisation
     /// methods": the program may change what `m_synch` / `h_synch` configured).
     FunctionSync { h: bool, number: Box<Expr> },
+}
+
+/// A field of a tool data set besides the radius (`V.G.WZ_AKT.L`, `.OK`, `.V.X`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ToolField {
+    /// `L`: the length, mm.
+    Length,
+    /// `OK`: the validity flag, 1 = valid.
+    Valid,
+    /// `V.<axis>` / `V[i]`: the axis offset, mm.
+    AxisOffset(AxisSel),
 }
 
 /// The axis of a `V.A.` variable: by name (`.X`) or by index in the channel's axis list.

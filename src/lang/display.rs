@@ -16,7 +16,7 @@ use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
     AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Index, Item,
-    Label, SplineCommand, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use crate::vocab::flush::FlushKind;
 
@@ -153,6 +153,18 @@ struct Bracketed<'e>(&'e Expr);
 impl Display for Bracketed<'_> {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
         write!(f, "[{}]", self.0)
+    }
+}
+
+/// `.X` or `[…]`: an axis after a variable name (`V.G.NP[1].V.X`, `V.G.WZ_AKT.V[0]`).
+struct AxisSuffix<'e>(&'e AxisSel);
+
+impl Display for AxisSuffix<'_> {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self.0 {
+            AxisSel::Name(l) => write!(f, ".{}", char::from(*l)),
+            AxisSel::Index(e) => write!(f, "{}", Bracketed(e)),
+        }
     }
 }
 
@@ -304,6 +316,20 @@ impl Display for VarRef {
             VarRef::AxisAbs(AxisSel::Index(e)) => return write!(f, "V.A.ABS{}", Bracketed(e)),
             VarRef::ToolRadius(None) => return f.write_str("V.G.WZ_AKT.R"),
             VarRef::ToolRadius(Some(e)) => return write!(f, "V.G.WZ{}.R", Bracketed(e)),
+            VarRef::ToolData { tool, field } => {
+                match tool {
+                    None => f.write_str("V.G.WZ_AKT.")?,
+                    Some(e) => write!(f, "V.G.WZ{}.", Bracketed(e))?,
+                }
+                return match field {
+                    ToolField::Length => f.write_str("L"),
+                    ToolField::Valid => f.write_str("OK"),
+                    ToolField::AxisOffset(a) => write!(f, "V{}", AxisSuffix(a)),
+                };
+            }
+            VarRef::ZeroOffset { group, axis } => {
+                return write!(f, "V.G.NP{}.V{}", Bracketed(group), AxisSuffix(axis))
+            }
             VarRef::FunctionSync { h, number } => {
                 let letter = if *h { 'H' } else { 'M' };
                 return write!(f, "V.G.{letter}_FCT{}.SYNCH", Bracketed(number));

@@ -11,7 +11,8 @@
 //! otherwise; both are in `super::codes`.
 
 use super::block::{
-    AxisSel, BinOp, Expr, Func, Index, StrFunc, UnOp, VScope, VarRef, VarTest, MAX_STRING,
+    AxisSel, BinOp, Expr, Func, Index, StrFunc, ToolField, UnOp, VScope, VarRef, VarTest,
+    MAX_STRING,
 };
 
 /// A variable with every index evaluated: what the decoder stores values under.
@@ -33,6 +34,21 @@ pub enum VarKey<'e> {
     ToolRadius(Option<u32>),
     /// `V.G.M_FCT[n].SYNCH` (`h` false) / `V.G.H_FCT[n].SYNCH`.
     FunctionSync { h: bool, number: u32 },
+    /// `V.G.WZ_AKT.<field>` (`tool` `None`) or `V.G.WZ[j].<field>`.
+    ToolData {
+        tool: Option<u32>,
+        field: ToolFieldId,
+    },
+    /// `V.G.NP[group].V.<axis>`.
+    ZeroOffset { group: u32, axis: AxisId },
+}
+
+/// [`crate::lang::block::ToolField`], its axis index evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ToolFieldId {
+    Length,
+    Valid,
+    AxisOffset(AxisId),
 }
 
 /// The axis of a `V.A.` variable, its index evaluated: which axis a letter or index names
@@ -66,11 +82,37 @@ impl std::fmt::Display for VarKey<'_> {
                 return write!(f, "V.G.{}_FCT[{number}].SYNCH", if *h { 'H' } else { 'M' })
             }
             VarKey::ToolRadius(Some(j)) => return write!(f, "V.G.WZ[{j}].R"),
+            VarKey::ToolData { tool, field } => {
+                match tool {
+                    None => f.write_str("V.G.WZ_AKT.")?,
+                    Some(j) => write!(f, "V.G.WZ[{j}].")?,
+                }
+                return match field {
+                    ToolFieldId::Length => f.write_str("L"),
+                    ToolFieldId::Valid => f.write_str("OK"),
+                    ToolFieldId::AxisOffset(a) => write!(f, "V{}", AxisSuffix(*a)),
+                };
+            }
+            VarKey::ZeroOffset { group, axis } => {
+                return write!(f, "V.G.NP[{group}].V{}", AxisSuffix(*axis))
+            }
         };
         for i in indices {
             write!(f, "[{i}]")?;
         }
         Ok(())
+    }
+}
+
+/// `.X` or `[i]`: an axis after a variable name.
+struct AxisSuffix(AxisId);
+
+impl std::fmt::Display for AxisSuffix {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            AxisId::Letter(l) => write!(f, ".{}", char::from(l)),
+            AxisId::Index(i) => write!(f, "[{i}]"),
+        }
     }
 }
 
@@ -439,12 +481,24 @@ pub fn resolve<'e>(var: &'e VarRef, vars: &dyn Vars) -> Result<VarKey<'e>, EvalE
             indices: indices_of(indices, vars)?,
         },
         VarRef::CycleParam(n) => VarKey::CycleParam(*n),
-        VarRef::AxisAbs(AxisSel::Name(l)) => VarKey::AxisAbs(AxisId::Letter(*l)),
-        VarRef::AxisAbs(AxisSel::Index(e)) => {
-            VarKey::AxisAbs(AxisId::Index(index(eval(e, vars)?)?))
-        }
+        VarRef::AxisAbs(a) => VarKey::AxisAbs(axis_id(a, vars)?),
         VarRef::ToolRadius(None) => VarKey::ToolRadius(None),
         VarRef::ToolRadius(Some(e)) => VarKey::ToolRadius(Some(index(eval(e, vars)?)?)),
+        VarRef::ToolData { tool, field } => VarKey::ToolData {
+            tool: match tool {
+                None => None,
+                Some(e) => Some(index(eval(e, vars)?)?),
+            },
+            field: match field {
+                ToolField::Length => ToolFieldId::Length,
+                ToolField::Valid => ToolFieldId::Valid,
+                ToolField::AxisOffset(a) => ToolFieldId::AxisOffset(axis_id(a, vars)?),
+            },
+        },
+        VarRef::ZeroOffset { group, axis } => VarKey::ZeroOffset {
+            group: index(eval(group, vars)?)?,
+            axis: axis_id(axis, vars)?,
+        },
         VarRef::FunctionSync { h, number } => VarKey::FunctionSync {
             h: *h,
             number: index(eval(number, vars)?)?,
@@ -465,6 +519,14 @@ fn no_number(key: &VarKey<'_>, vars: &dyn Vars) -> EvalError {
 
 fn indices_of(indices: &[Expr], vars: &dyn Vars) -> Result<Vec<u32>, EvalError> {
     indices.iter().map(|e| index(eval(e, vars)?)).collect()
+}
+
+/// An axis by letter or by its index evaluated.
+fn axis_id(a: &AxisSel, vars: &dyn Vars) -> Result<AxisId, EvalError> {
+    Ok(match a {
+        AxisSel::Name(l) => AxisId::Letter(*l),
+        AxisSel::Index(e) => AxisId::Index(index(eval(e, vars)?)?),
+    })
 }
 
 /// An index or computed parameter number: a whole number ≥ 0 (within 1e-6, so that

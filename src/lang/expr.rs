@@ -29,7 +29,8 @@ use nom::error::{ErrorKind, ParseError};
 use nom::IResult;
 
 use super::block::{
-    AxisSel, BinOp, Expr, Func, Index, StrFunc, UnOp, VScope, VarRef, VarTest, MAX_STRING,
+    AxisSel, BinOp, Expr, Func, Index, StrFunc, ToolField, UnOp, VScope, VarRef, VarTest,
+    MAX_STRING,
 };
 use super::codes::{MAX_EXPR_HEIGHT, MAX_EXPR_NESTING, STRING_TOO_LONG, SYNTAX, UNSUPPORTED};
 use super::error::SyntaxError;
@@ -666,36 +667,42 @@ impl<'a> Ctx<'a> {
                 format!("V.A.{field} is an ISG axis variable ncchannel does not model"),
             );
         }
-        let axis = if let Some(r) = rest.strip_prefix('.') {
+        let (rest, axis) = self.axis_sel(rest, "V.A.ABS")?;
+        self.set_height(self.height.get() + 1, i)?;
+        Ok((rest, VarRef::AxisAbs(axis)))
+    }
+
+    /// `.<axis>` or `[<index>]` after `what` (`V.A.ABS`, `V.G.NP[i].V`, `V.G.WZ_AKT.V`); the
+    /// height is left at the index expression's (0 for a name).
+    fn axis_sel(&self, rest: &'a str, what: &str) -> PResult<'a, AxisSel> {
+        if let Some(r) = rest.strip_prefix('.') {
             match r.as_bytes().first() {
                 Some(&b)
                     if b.is_ascii_alphabetic()
                         && !r.as_bytes().get(1).is_some_and(|&c| is_ident_byte(c)) =>
                 {
-                    self.height.set(1);
-                    return Ok((
-                        &r[1..],
-                        VarRef::AxisAbs(AxisSel::Name(b.to_ascii_uppercase())),
-                    ));
+                    self.height.set(0);
+                    Ok((&r[1..], AxisSel::Name(b.to_ascii_uppercase())))
                 }
-                _ => return fail(r, SYNTAX, "axis name expected after V.A.ABS."),
+                _ => fail(r, SYNTAX, format!("axis name expected after {what}.")),
             }
         } else if rest.starts_with('[') {
             let (r, e) = self.bracketed(rest)?;
-            self.set_height(self.height.get() + 1, i)?;
-            (r, e)
+            Ok((r, AxisSel::Index(Box::new(e))))
         } else {
-            return fail(
+            fail(
                 rest,
                 SYNTAX,
-                "`.<axis>` or `[<index>]` expected after V.A.ABS",
-            );
-        };
-        Ok((axis.0, VarRef::AxisAbs(AxisSel::Index(Box::new(axis.1)))))
+                format!("`.<axis>` or `[<index>]` expected after {what}"),
+            )
+        }
     }
 
-    /// `V.G.WZ_AKT.R` or `V.G.WZ[<j>].R` (`i` at the `V`): the tool radii of the tool list;
-    /// every other V.G. variable or tool field is refused by name (900133).
+    /// `V.G.WZ_AKT.<field>` or `V.G.WZ[<j>].<field>` (`i` at the `V`): the tool list's data,
+    /// fields `R`, `L`, `OK`, `V.<axis>` / `V[<i>]` (TF5200 "Access to tool data in the NC
+    /// program (V.G.WZ..)"); `V.G.NP[<i>].V.<axis>` / `.V[<j>]`, a zero-offset group's offset
+    /// (programming manual, "Zero offsets (G53/G54/...G59)"). Every other V.G. variable or
+    /// tool field is refused by name (900133).
     #[cold]
     fn global_var(&self, i: &'a str) -> PResult<'a, VarRef> {
         self.height.set(0);
@@ -703,6 +710,9 @@ impl<'a> Ctx<'a> {
         let (rest, name) = name_or(f, "global variable name expected")?;
         if let ("M_FCT" | "H_FCT", true) = (name.as_str(), rest.starts_with('[')) {
             return self.function_sync(name.as_str() == "H_FCT", rest, i);
+        }
+        if name == "NP" {
+            return self.zero_offset_var(rest, i);
         }
         let (rest, tool) = match name.as_str() {
             "WZ_AKT" => (rest, None),
@@ -727,15 +737,62 @@ impl<'a> Ctx<'a> {
             );
         };
         let (rest, field) = name_or(r, "tool data field expected")?;
-        if field != "R" {
+        let tool_height = self.height.get();
+        let (rest, field) = match field.as_str() {
+            "R" => {
+                self.set_height(tool_height + 1, i)?;
+                return Ok((rest, VarRef::ToolRadius(tool)));
+            }
+            "L" => (rest, ToolField::Length),
+            "OK" => (rest, ToolField::Valid),
+            "V" => {
+                let (rest, axis) = self.axis_sel(rest, &format!("V.G.{name}.V"))?;
+                self.height.set(self.height.get().max(tool_height));
+                (rest, ToolField::AxisOffset(axis))
+            }
+            _ => {
+                return fail(
+                    r,
+                    UNSUPPORTED,
+                    format!(
+                        "V.G.{name}.{field}: ncchannel's tool list has R, L, OK and V (axis \
+                         offsets) only"
+                    ),
+                )
+            }
+        };
+        self.set_height(self.height.get() + 1, i)?;
+        Ok((rest, VarRef::ToolData { tool, field }))
+    }
+
+    /// `V.G.NP[<i>].V.<axis>` / `V.G.NP[<i>].V[<j>]` from the `[` on (`i` at the `V`).
+    #[cold]
+    fn zero_offset_var(&self, rest: &'a str, i: &'a str) -> PResult<'a, VarRef> {
+        if !rest.starts_with('[') {
+            return fail(rest, SYNTAX, "`[<group>]` expected after V.G.NP");
+        }
+        let (r, group) = self.bracketed(rest)?;
+        let group_height = self.height.get();
+        let (r, field) = match r.strip_prefix('.') {
+            Some(r) => name_or(r, "`.V` expected after V.G.NP[<group>]")?,
+            None => return fail(r, SYNTAX, "`.V` expected after V.G.NP[<group>]"),
+        };
+        if field != "V" {
             return fail(
                 r,
                 UNSUPPORTED,
-                format!("V.G.{name}.{field}: ncchannel's tool list has radii (R) only"),
+                format!("V.G.NP[…].{field}: ncchannel models the offsets (V) only"),
             );
         }
-        self.set_height(self.height.get() + 1, i)?;
-        Ok((rest, VarRef::ToolRadius(tool)))
+        let (r, axis) = self.axis_sel(r, "V.G.NP[<group>].V")?;
+        self.set_height(self.height.get().max(group_height) + 1, i)?;
+        Ok((
+            r,
+            VarRef::ZeroOffset {
+                group: Box::new(group),
+                axis,
+            },
+        ))
     }
 
     /// `V.G.M_FCT[<n>].SYNCH` / `V.G.H_FCT[<n>].SYNCH` from the `[` on; `i` at the `V`.

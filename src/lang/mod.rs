@@ -26,7 +26,8 @@ pub use block::*;
 pub use check::{check_program, check_program_counted, ProgramDiag, MAX_PROGRAM_DIAGS};
 pub use error::SyntaxError;
 pub use eval::{
-    case_matches, eval, eval_value, is_true, resolve, AxisId, EvalError, Val, VarKey, Vars,
+    case_matches, eval, eval_value, is_true, resolve, AxisId, EvalError, ToolFieldId, Val, VarKey,
+    Vars,
 };
 pub use expr::parse_expr;
 pub use join::{continuation, Joiner};

@@ -18,9 +18,10 @@ pub enum ListKind {
     Channel,
     /// `achsmds*.lis`, `default_mds.lis`: one axis (TF5200 "Axis parameter").
     Axis,
-    /// The tool list (`wz[i].radius`, P-TOOL-00004).
+    /// The tool list (`wz[i].*`, TF5200 "Tool data"; start-up entry `werkz_data[i]`).
     Tools,
-    /// The zero-offset list (`np_grp[i].achse[j].versch`, P-ZERO-00003).
+    /// The zero-offset list (`np_grp[i].achse[j].versch`, P-ZERO-00003; start-up entry
+    /// `nullp_data[i]`).
     ZeroOffsets,
     /// The list of external variables (`var[i].*`, `struct[i].*`; TF5200 External variables).
     ExtVars,
@@ -105,6 +106,12 @@ impl Tally {
                 ),
             ));
         }
+    }
+
+    /// A kernel entry the interpreter knows but does not use, which it has warned about
+    /// itself (a zero-offset group beyond G59, the G53 group, an axis beyond C): inert.
+    pub(crate) fn kept_unused(&mut self) {
+        self.inert += 1;
     }
 
     /// The summary of `list`, every entry not counted as inert or unknown being used.
@@ -305,11 +312,25 @@ pub(crate) const INERT_AXIS: &[(&str, &str)] = &[
 
 /// Tool entries known and ignored (TF5200 Tool data).
 pub(crate) const INERT_TOOLS: &[(&str, &str)] = &[
-    (
-        "wz[].laenge",
-        "P-TOOL-00003 tool length: no length compensation",
-    ),
+    ("wz[].typ", "P-TOOL-00001 tool type: milling tools only"),
+    ("wz[].srk_lage", "P-TOOL-00002 cutter position: no turning"),
     ("wz[].param[]", "P-TOOL-00007 free tool parameters"),
+    (
+        "wz[].kinematic.",
+        "P-TOOL-00009 kinematic offsets: no transformations",
+    ),
+    (
+        "wz[].tool_fixed",
+        "tool fixed / alignable: no transformations",
+    ),
+    ("wz[].kin_id", "kinematic ID: no transformations"),
+    (
+        "wz[].log_ax_nr_spdl",
+        "spindle of the tool: no spindle model",
+    ),
+    ("wz[].vb_min", "tool speed limits: no spindle model"),
+    ("wz[].vb_max", "tool speed limits: no spindle model"),
+    ("wz[].a_max", "tool acceleration limit: no spindle model"),
 ];
 
 /// V.E. list entries known and ignored (TF5200 External variables): they lay out the

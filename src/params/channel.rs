@@ -66,6 +66,8 @@ pub(crate) struct ChannelList {
     pub decoder: DecoderParams,
     /// M/H/S/T synchronisation types, process times and pre-outputs (`params/techno.rs`).
     pub techno: TechnoTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): `T80` also selects `D80`.
+    pub t_selects_d: bool,
     /// Entries used, inert and unknown.
     pub summary: ListSummary,
 }
@@ -111,6 +113,7 @@ pub(crate) fn interpret_channel(
                 implicit.g800[*i as usize] = program_name(&list, e, diags);
             }
             [("start_init_prog_file_mode", None)] => start_mode = call_mode(&list, e, diags),
+            [("einrechnen_mit_t", None)] => {} // read below
             [("final_prog_file_mode", None)] => final_mode = call_mode(&list, e, diags),
             [("gruppe", Some(0)), ("achse", Some(j)), ("bezeichnung", None)] => {
                 match string_value(&list, e, MAX_AXIS_NAME_CHARS) {
@@ -119,17 +122,8 @@ pub(crate) fn interpret_channel(
                 }
             }
             [("gruppe", Some(0)), ("achse", Some(j)), ("log_achs_nr", None)] => {
-                match uint_value(&list, e, u64::from(u16::MAX)) {
-                    Ok(0) => diags.push(list.error_at(
-                        e,
-                        e.value_pos,
-                        format!("{}: logical axis number 0 is not allowed", e.name.text),
-                    )),
-                    Ok(n) => {
-                        axes.entry(*j).or_insert_with(empty_axis).logical_number =
-                            Some((n as u16, e.clone()))
-                    }
-                    Err(d) => diags.push(d),
+                if let Some(n) = logical_axis_number(&list, e, diags) {
+                    axes.entry(*j).or_insert_with(empty_axis).logical_number = Some((n, e.clone()));
                 }
             }
             [("path", Some(j)), (field, None)] => {
@@ -183,6 +177,10 @@ pub(crate) fn interpret_channel(
         implicit.at_end = None;
     }
     ChannelList {
+        // P-CHAN-00014: "T80" then corresponds to "T80 D80" (TF5200 channel parameter).
+        t_selects_d: list
+            .get("einrechnen_mit_t")
+            .is_some_and(|e| flag(&list, e, diags)),
         list,
         streaming_prog_file,
         implicit,
@@ -231,6 +229,36 @@ fn call_mode(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) -> CallMo
         CallMode::Automatic
     } else {
         CallMode::MdiOnly
+    }
+}
+
+/// `gruppe[0].achse[j].log_achs_nr` (P-CHAN-00035): 1 … 65535.
+fn logical_axis_number(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) -> Option<u16> {
+    match uint_value(list, e, u64::from(u16::MAX)) {
+        Ok(0) => {
+            diags.push(list.error_at(
+                e,
+                e.value_pos,
+                format!("{}: logical axis number 0 is not allowed", e.name.text),
+            ));
+            None
+        }
+        Ok(n) => Some(n as u16),
+        Err(d) => {
+            diags.push(d);
+            None
+        }
+    }
+}
+
+/// A BOOLEAN entry, 0 or 1 (`false` when it is neither: an error).
+fn flag(list: &ParamList, e: &Entry, diags: &mut Vec<Diagnostic>) -> bool {
+    match uint_value(list, e, 1) {
+        Ok(v) => v == 1,
+        Err(d) => {
+            diags.push(d);
+            false
+        }
     }
 }
 

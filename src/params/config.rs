@@ -22,6 +22,7 @@ use super::list::{parse_list, read_list, read_list_text, Entry, ParamList};
 use super::runtime::{read_runtime, AxisConfig, RuntimeConfig};
 use super::search_path::{list_folder, SearchPath};
 use super::startup::{interpret_startup, is_startup_list, StartupList};
+use super::tools::{read_tools, ToolFormat, ToolTable};
 use super::zero_offsets::{
     interpret_zero_offsets, is_zero_offset_list, read_zero_offsets, ZeroOffsetTable,
 };
@@ -47,10 +48,12 @@ pub struct Config {
     pub runtime: RuntimeConfig,
     /// One per channel, in channel order (index 0 = channel 1).
     pub channels: Vec<ChannelConfig>,
-    /// `tools.lis` next to the start-up list, if present.
+    /// `tools.lis` next to the start-up list, if present and the start-up list names no
+    /// `werkz_data[i]` (ncchannel's older tool file, the fallback).
     pub tools_file: Option<PathBuf>,
-    /// Tool radii by D number, mm (empty without a tool list).
-    pub tools: super::tools::ToolRadii,
+    /// Its tool data by D number (empty without it); every channel without a `werkz_data[i]`
+    /// uses it.
+    pub tools: ToolTable,
     /// The error text file the start-up list names (`error_text_of_id`, P-STUP-00168).
     pub error_text_file: Option<PathBuf>,
     /// Its texts by error id; `None`: ncchannel's own texts.
@@ -83,6 +86,14 @@ pub struct ChannelConfig {
     pub zero_offset_list: Option<PathBuf>,
     /// G54 … G59 offsets by group and axis, mm.
     pub(crate) zero_offsets: ZeroOffsetTable,
+    /// The tool list this channel's D words select from: `werkz_data[i]` (P-STUP-00010), else
+    /// `tools.lis`; `None`: no tool data (only D0).
+    pub tool_list: Option<PathBuf>,
+    /// Its tool data by D number, mm.
+    pub tools: ToolTable,
+    /// `einrechnen_mit_t` (P-CHAN-00014): a T word also selects the D data set of the same
+    /// number.
+    pub t_selects_d: bool,
     /// M/H/S/T functions: synchronisation types, process times, pre-outputs.
     pub techno: TechnoTable,
     /// The V.E. list the start-up list names (`ve_var[i]`, P-STUP-00146) and its leaves;
@@ -155,7 +166,7 @@ pub(crate) fn check_list_file_summarized(path: &Path) -> (Vec<Diagnostic>, Vec<L
     } else if is_zero_offset_list(&list) {
         lists.push(interpret_zero_offsets(&list, &mut diags).1);
     } else if super::tools::is_tool_list(&list) {
-        lists.push(super::tools::interpret_tools(&list, &mut diags).1);
+        lists.push(super::tools::interpret_tools(&list, ToolFormat::Kernel, &mut diags).1);
     } else if is_ext_var_list(&list) {
         lists.push(interpret_ext_vars(&list, &mut diags).1);
     } else if is_axis_list(&list) {
@@ -211,8 +222,8 @@ fn build(
     lists.push(startup.summary.clone());
 
     let tools_path = list_folder(&startup_path).join(super::tools::TOOLS_FILE);
-    let (tools_file, tools) = if tools_path.exists() {
-        match super::tools::read_tools(&tools_path, diags) {
+    let (tools_file, tools) = if startup.tool_lists.is_empty() && tools_path.exists() {
+        match read_tools(&tools_path, ToolFormat::Ncchannel, diags) {
             Ok((t, summary)) => {
                 lists.push(summary);
                 (Some(tools_path), t)
@@ -257,7 +268,18 @@ fn build(
     let channels = match &runtime {
         Some(rt) => channels(&startup, &axis_lists, rt, &cnc_dir, diags, lists),
         None => None,
-    };
+    }
+    .map(|mut c| {
+        channel_tools(
+            &startup,
+            &mut c,
+            tools_file.as_deref(),
+            &tools,
+            diags,
+            lists,
+        );
+        c
+    });
     Some(Config {
         startup_list: startup_path,
         startup: startup.list,
@@ -437,6 +459,48 @@ fn channels(
     (out.len() == count as usize).then_some(out)
 }
 
+/// Step: each channel's tool list, `werkz_data[i]` (channels may share one: read and reported
+/// once), else the `tools.lis` fallback.
+fn channel_tools(
+    startup: &StartupList,
+    channels: &mut [ChannelConfig],
+    fallback_file: Option<&Path>,
+    fallback: &ToolTable,
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+) {
+    let mut tables: HashMap<PathBuf, Option<ToolTable>> = HashMap::new();
+    for c in channels {
+        let Some(r) = startup.tool_lists.get(&(c.index as u32)) else {
+            c.tool_list = fallback_file.map(Path::to_path_buf);
+            c.tools = fallback.clone();
+            continue;
+        };
+        let table = tables.entry(r.path.clone()).or_insert_with(|| {
+            match read_tools(&r.path, ToolFormat::Kernel, diags) {
+                Ok((t, summary)) => {
+                    lists.push(summary);
+                    Some(t)
+                }
+                Err(e) => {
+                    diags.push(cannot_read(
+                        &startup.list,
+                        &r.entry,
+                        "tool list",
+                        &r.path,
+                        &e,
+                    ));
+                    None
+                }
+            }
+        });
+        if let Some(t) = table {
+            c.tool_list = Some(r.path.clone());
+            c.tools = t.clone();
+        }
+    }
+}
+
 fn combine(
     startup: &StartupList,
     i: u32,
@@ -462,6 +526,9 @@ fn combine(
         decoder: decoder.finish(diags),
         zero_offset_list: None,
         zero_offsets: Default::default(),
+        tool_list: None,
+        tools: Vec::new(),
+        t_selects_d: chan.t_selects_d,
         techno: chan.techno,
         ext_vars: None,
         list: chan.list,

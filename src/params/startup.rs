@@ -1,6 +1,7 @@
 //! The start-up list (`startup.lis`, `hochlauf.lis` in German installations): channel count,
-//! each channel's list, the axis lists, program search paths and decoder settings per
-//! channel, and the kernel's error text file.
+//! each channel's list, tool list (`werkz_data[i]`, P-STUP-00010) and zero-offset list
+//! (`nullp_data[i]`, P-STUP-00011), the axis lists, program search paths and decoder settings
+//! per channel, and the kernel's error text file.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -39,8 +40,10 @@ pub(crate) struct StartupList {
     pub search_paths: BTreeMap<u32, Vec<SearchPath>>,
     /// `configuration.channel[i].decoder.*` per channel.
     pub decoder: BTreeMap<u32, DecoderParams>,
-    /// `zero_offset_list[i]`: channel i's zero-offset list.
+    /// `nullp_data[i]` (P-STUP-00011) or `zero_offset_list[i]`: channel i's zero-offset list.
     pub(crate) zero_offset_lists: BTreeMap<u32, ListRef>,
+    /// `werkz_data[i]` (P-STUP-00010): channel i's tool list.
+    pub(crate) tool_lists: BTreeMap<u32, ListRef>,
     /// `zero_offset_list`: the zero-offset list of every channel without its own.
     pub(crate) zero_offset_default: Option<ListRef>,
     /// `achs_mds[i]` (P-STUP-00015): the axis lists, by index.
@@ -120,6 +123,7 @@ pub(crate) fn interpret_startup(
         channel_lists,
         zero_offset_lists,
         zero_offset_default,
+        tool_lists,
         axis_lists,
         default_axis_list,
         error_texts,
@@ -146,6 +150,7 @@ pub(crate) fn interpret_startup(
         decoder,
         zero_offset_lists,
         zero_offset_default,
+        tool_lists,
         axis_lists,
         default_axis_list,
         error_texts,
@@ -209,7 +214,7 @@ fn channel_out_of_range(
         }
     }
     let channel = match s {
-        [("sda_mds" | "zero_offset_list" | "ve_var", Some(i))]
+        [("sda_mds" | "zero_offset_list" | "nullp_data" | "werkz_data" | "ve_var", Some(i))]
         | [("pfad", Some(i)), (_, Some(_))]
         | [("configuration", None), ("channel", Some(i)), ..] => Some(*i),
         _ => None,
@@ -240,6 +245,7 @@ struct Gathered<'l> {
     channel_lists: BTreeMap<u32, ListRef>,
     zero_offset_lists: BTreeMap<u32, ListRef>,
     zero_offset_default: Option<ListRef>,
+    tool_lists: BTreeMap<u32, ListRef>,
     axis_lists: BTreeMap<u32, ListRef>,
     default_axis_list: Option<ListRef>,
     error_texts: Option<ListRef>,
@@ -268,6 +274,14 @@ impl<'l> Gathered<'l> {
                 }
             }
             [("zero_offset_list", index)] => self.zero_offset_list(list, base, e, *index, diags),
+            // P-STUP-00011: "Name of the list file for the zero point data", per channel.
+            [("nullp_data", Some(i))] => self.zero_offset_list(list, base, e, Some(*i), diags),
+            // P-STUP-00010: "Name of the list file for the tool data", per channel.
+            [("werkz_data", Some(i))] => {
+                if let Some(r) = file_ref(list, base, e, "tool list", diags) {
+                    self.tool_lists.insert(*i, r);
+                }
+            }
             [("achs_mds", Some(i))] => {
                 if let Some(r) = file_ref(list, base, e, "axis list", diags) {
                     self.axis_lists.insert(*i, r);
@@ -310,7 +324,8 @@ impl<'l> Gathered<'l> {
         }
     }
 
-    /// `zero_offset_list[i]` (channel i's) or `zero_offset_list` (every other channel's).
+    /// `nullp_data[i]` / `zero_offset_list[i]` (channel i's) or `zero_offset_list` (every
+    /// other channel's).
     fn zero_offset_list(
         &mut self,
         list: &ParamList,
@@ -427,7 +442,7 @@ fn is_known_startup_name(s: &[(&str, Option<u32>)]) -> bool {
     matches!(
         s,
         [(
-            "sda_mds" | "zero_offset_list" | "achs_mds" | "ve_var",
+            "sda_mds" | "zero_offset_list" | "nullp_data" | "werkz_data" | "ve_var" | "achs_mds",
             Some(_)
         )] | [
             ("pfad", Some(_)),

@@ -1,10 +1,14 @@
-//! The zero-offset list: the offsets G54 … G59 select, per axis, in the ISG list format
+//! The zero-offset list: the offsets G54 … G59 select, per axis, in the kernel's list format
 //! (`np_grp[i].achse[j].versch`, P-ZERO-00003; `np_grp[i].achse[j].inaktiv`, P-ZERO-00004).
 //!
-//! Group `i` = 0 … 5 is G54 … G59; axis `j` is the channel axis index in X Y Z A B C order.
-//! Offsets are whole numbers in the kernel's position unit: 0.1 µm for linear axes, 0.0001°
-//! for rotary axes (`100000` = 10 mm). The start-up list names the file with
-//! `zero_offset_list <file>` (every channel) or `zero_offset_list[i] <file>` (channel i).
+//! Group `i` is the kernel's numbering (TF5200 "Zero offset group (np_grp[i].*)"): 0 is the
+//! G53 data set (G159 = 0), 1 … 6 are G54 … G59 (G159 = 1 … 6), as `V.G.NP[i]` numbers them
+//! in a program and over ADS. G53 deselects every offset (the kernel's default,
+//! P-ZERO-00001 `g53_verfuegbar` 0), so group 0's entries are kept with a warning. Axis `j`
+//! is the channel axis index in X Y Z A B C order. Offsets are whole numbers in the kernel's
+//! position unit: 0.1 µm for linear axes, 0.0001° for rotary axes (`100000` = 10 mm). The
+//! start-up list names the file with `nullp_data[i] <file>` (P-STUP-00011, channel i), or
+//! ncchannel's older `zero_offset_list <file>` (every channel) / `zero_offset_list[i] <file>`.
 
 use std::path::Path;
 
@@ -14,7 +18,7 @@ use super::startup::{shape, warn_duplicates};
 use crate::diag::Diagnostic;
 use crate::vocab::axis::MAX_AXES;
 
-/// Zero-offset groups the emulator selects: G54 … G59.
+/// Zero-offset groups the emulator selects: G54 … G59, the list's groups 1 … 6.
 pub(crate) const GROUPS: usize = 6;
 /// Groups and axes the kernel's list may name (more groups exist for G159; 32 axes a channel):
 /// accepted with a warning, not used.
@@ -23,7 +27,7 @@ const MAX_LIST_AXES: u32 = 32;
 /// mm per list unit (0.1 µm).
 pub(crate) const MM_PER_UNIT: f64 = 1e-4;
 
-/// Offsets by group (G54 = 0) and axis, mm (degrees for rotary axes).
+/// Offsets by row (G54 = row 0, the list's group 1) and axis, mm (degrees for rotary axes).
 pub(crate) type ZeroOffsetTable = [[f64; MAX_AXES]; GROUPS];
 
 /// Does this list look like a zero-offset list? (It names `np_grp[…]`.)
@@ -85,19 +89,34 @@ pub(crate) fn interpret_zero_offsets(
                 continue;
             }
         };
-        if i as usize >= GROUPS || j as usize >= MAX_AXES {
+        if i == 0 {
             diags.push(list.warning_at(
                 e,
                 e.name_pos,
                 format!(
-                    "{}: kept, but the emulator selects only np_grp[0..5] (G54 … G59) on the \
+                    "{}: kept, but group 0 is G53, which deselects every offset \
+                     (P-ZERO-00001 g53_verfuegbar 0); G54 is np_grp[1]",
+                    e.name.text
+                ),
+            ));
+            tally.kept_unused();
+            continue;
+        }
+        if i as usize > GROUPS || j as usize >= MAX_AXES {
+            diags.push(list.warning_at(
+                e,
+                e.name_pos,
+                format!(
+                    "{}: kept, but the emulator selects only np_grp[1..6] (G54 … G59) on the \
                      axes X Y Z A B C (achse[0..5])",
                     e.name.text
                 ),
             ));
+            tally.kept_unused();
             continue;
         }
-        let (i, j) = (i as usize, j as usize);
+        // The list's group 1 (G54) is row 0.
+        let (i, j) = (i as usize - 1, j as usize);
         match field {
             "versch" => offsets[i][j] = value as f64 * MM_PER_UNIT,
             _ => match value {
@@ -163,32 +182,37 @@ mod tests {
     use crate::params::list::parse_list;
 
     fn read(text: &str) -> (ZeroOffsetTable, Vec<Diagnostic>) {
+        let (t, d, _) = read_counted(text);
+        (t, d)
+    }
+
+    fn read_counted(text: &str) -> (ZeroOffsetTable, Vec<Diagnostic>, ListSummary) {
         let (list, errs) = parse_list(Path::new("np.lis"), text);
         assert!(errs.is_empty(), "{errs:?}");
         let mut d = Vec::new();
-        let (t, _) = interpret_zero_offsets(&list, &mut d);
-        (t, d)
+        let (t, s) = interpret_zero_offsets(&list, &mut d);
+        (t, d, s)
     }
 
     #[test]
     fn offsets_in_tenths_of_a_micron_by_group_and_axis() {
         let (t, d) = read(
-            "np_grp[0].achse[0].versch 100000\n\
-             np_grp[0].achse[1].versch -25000\n\
-             np_grp[5].achse[2].versch 0x10\n\
-             np_grp[1].achse[0].versch 50000\n\
-             np_grp[1].achse[0].inaktiv 1\n",
+            "np_grp[1].achse[0].versch 100000\n\
+             np_grp[1].achse[1].versch -25000\n\
+             np_grp[6].achse[2].versch 0x10\n\
+             np_grp[2].achse[0].versch 50000\n\
+             np_grp[2].achse[0].inaktiv 1\n",
         );
         assert!(d.is_empty(), "{d:?}");
-        assert_eq!(t[0][0], 10.0);
+        assert_eq!(t[0][0], 10.0, "group 1 is G54");
         assert_eq!(t[0][1], -2.5);
-        assert!((t[5][2] - 0.0016).abs() < 1e-12);
+        assert!((t[5][2] - 0.0016).abs() < 1e-12, "group 6 is G59");
         assert_eq!(t[1][0], 0.0, "inaktiv switches the offset off");
     }
 
     #[test]
     fn bad_values_name_the_parameter_and_column() {
-        let (_, d) = read("np_grp[0].achse[0].versch 1.5\nnp_grp[0].achse[0].inaktiv 2\n");
+        let (_, d) = read("np_grp[1].achse[0].versch 1.5\nnp_grp[1].achse[0].inaktiv 2\n");
         assert_eq!(d.len(), 2, "{d:?}");
         assert!(d[0].message.contains("whole number"), "{}", d[0].message);
         assert_eq!((d[0].line, d[0].col), (1, 27));
@@ -196,11 +220,20 @@ mod tests {
     }
 
     #[test]
-    fn unknown_and_unused_entries_warn() {
-        let (_, d) = read("np_grp[7].achse[0].versch 1\nfoo 1\n");
-        assert_eq!(d.len(), 2);
+    fn the_g53_group_unknown_and_unused_entries_warn() {
+        let (t, d, s) = read_counted(
+            "np_grp[0].achse[0].versch 70000\nnp_grp[7].achse[0].versch 1\nfoo 1\n\
+             np_grp[1].achse[0].versch 5\n",
+        );
+        // Known but not used: inert; `foo`: unknown.
+        assert_eq!((s.counts.used, s.counts.inert, s.counts.unknown), (1, 2, 1));
+        assert_eq!(d.len(), 3);
+        assert!(d[0].message.contains("G53"), "{}", d[0].message);
         assert!(d
             .iter()
             .all(|x| x.severity == crate::diag::Severity::Warning));
+        // Only G54's X (5 × 0.1 µm) is set: group 0 did not become G54.
+        assert_eq!(t[0][0], 0.0005);
+        assert_eq!(t.iter().flatten().filter(|v| **v != 0.0).count(), 1);
     }
 }

@@ -164,7 +164,7 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
     // G54 shifts X by 10 mm (list unit 0.1 µm).
     std::fs::write(
         params.dir.path().join("params/zero.lis"),
-        "np_grp[0].achse[0].versch 100000\n",
+        "np_grp[1].achse[0].versch 100000\n",
     )
     .unwrap();
     params.program("g54.nc", "N10 G54 G01 X5 F6000\nN20 X6\nN30 M30\n");
@@ -186,6 +186,53 @@ fn axis_positions_acs_and_pcs_in_tenth_micrometres() {
     com.0.read_exact(0x120201, 0x30, &mut hr).unwrap();
     assert_eq!(f64::from_le_bytes(hr), 150_000.0);
     assert_eq!(com.string(0x10002, 16), "X", "mc_axis_1_name_r");
+    assert_eq!(com.string(0x2D, 84), "zero.lis", "mc_zero_offset_file_r");
+    com.write(0x01, &[0]);
+    com.write(0x137, &[1]);
+    com.wait_state(3);
+    drop(c);
+    served.finish();
+}
+
+#[test]
+fn the_active_tool_objects_read_the_tool_list_of_werkz_data() {
+    let params = ads_common::Params::new(1);
+    let startup = std::fs::read_to_string(params.startup()).unwrap();
+    std::fs::write(params.startup(), startup + "werkz_data[0] werkz_d.lis\n").unwrap();
+    // TF5200 Tool data: wz[2] valid, radius 2.5 mm (0.1 µm).
+    std::fs::write(
+        params.dir.path().join("params/werkz_d.lis"),
+        "wz[2].gueltig 1\nwz[2].radius 25000\n",
+    )
+    .unwrap();
+    params.program("tool.nc", "N10 D2 G01 X5 F6000\nN20 X6\nN30 M30\n");
+    let served = ads_common::Served::start(params);
+    let c = client(&served);
+    let com = com_device(&c);
+    let geo = c.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 551));
+    let radius = || {
+        let mut b = [0u8; 8];
+        geo.read_exact(0x121301, 0x2C, &mut b).unwrap();
+        f64::from_le_bytes(b)
+    };
+    assert_eq!((com.u32(0x1A), radius()), (0, 0.0), "D0 before the start");
+    com.write(0x01, &[1]);
+    com.start("tool.nc");
+    com.wait_state(5);
+    assert_eq!(com.u32(0x0E), 10);
+    assert_eq!(com.u32(0x1A), 2, "mc_active_tool_id_basic_r: the active D");
+    assert_eq!(radius(), 25_000.0, "Actual tool radius, 0.1 µm");
+    let mut id = [0xFFu8; 16];
+    com.0.read_exact(CH, 0x19, &mut id).unwrap();
+    let mut want = [0u8; 16];
+    want[0] = 2;
+    assert_eq!(
+        id, want,
+        "mc_active_tool_id_r: basic 2, no sister or variant"
+    );
+    assert_eq!(com.u32(0x1B), 0);
+    assert_eq!(com.string(0x2F, 84), "werkz_d.lis", "mc_tool_file_r");
+    assert_eq!(com.string(0x2D, 84), "", "mc_zero_offset_file_r: no list");
     com.write(0x01, &[0]);
     com.write(0x137, &[1]);
     com.wait_state(3);

@@ -375,7 +375,8 @@ fn zero_offsets_read_as_twinsharp_reads_them() {
     let list = params.dir.path().join("params/np.lis");
     std::fs::write(
         &list,
-        "np_grp[0].achse[0].versch 100000\nnp_grp[1].achse[2].versch -25000\n",
+        "np_grp[0].achse[0].versch 70000\nnp_grp[1].achse[0].versch 100000\n\
+         np_grp[2].achse[2].versch -25000\n",
     )
     .unwrap();
     let startup = std::fs::read_to_string(params.startup()).unwrap();
@@ -412,6 +413,9 @@ fn zero_offsets_read_as_twinsharp_reads_them() {
         .read_write(0x122301, 0x48, 12, b"V.G.NP[2].V\0")
         .unwrap();
     assert_eq!(dints(&by_name), [0, 0, -25_000], "read by name");
+    // Group 0 is G53: no offset, whatever the list says (the kernel's numbering).
+    let g53 = handle(&mut sda, "V.G.NP[0].V");
+    assert_eq!(dints(&sda.read(0x122301, g53, 12).unwrap()), [0, 0, 0]);
     let g59 = handle(&mut sda, "V.G.NP[6].V");
     assert_eq!(dints(&sda.read(0x122301, g59, 12).unwrap()), [0, 0, 0]);
     assert_eq!(refused(sda.read(0x122301, g54, 8)), 0x705, "12 bytes");
@@ -421,9 +425,9 @@ fn zero_offsets_read_as_twinsharp_reads_them() {
         "the decoder's table comes from the parameter lists"
     );
     assert_eq!(
-        refused(sda.read_write(0x122301, 0x46, 4, b"V.G.NP[0].V")),
+        refused(sda.read_write(0x122301, 0x46, 4, b"V.G.NP[7].V")),
         0x70C,
-        "G54 is index 1"
+        "G59 is the last group ncchannel has"
     );
 }
 

@@ -703,7 +703,21 @@ fn v_g_tool_radii_come_from_the_tool_list() {
     // A D the tool list does not have; variables and fields not modelled; read-only.
     fails_at(&rig, "G01 X[V.G.WZ[3].R] F100\nM30\n", 900005, 1, 5, false);
     fails_at(&rig, "G01 X[V.G.FEEDRATE] F100\nM30\n", 900133, 1, 11, true);
-    fails_at(&rig, "G01 X[V.G.WZ_AKT.L] F100\nM30\n", 900133, 1, 18, true);
+    fails_at(
+        &rig,
+        "G01 X[V.G.WZ_AKT.KIN_ID] F100\nM30\n",
+        900133,
+        1,
+        18,
+        true,
+    );
+    // The other fields of the tool list and the zero-offset groups print back as written.
+    let b =
+        parse_block("X[v.g.wz_akt.l] Y[V.G.WZ[2].ok] Z[V.G.WZ[P1].V[2] + V.G.NP[1].V.x]").unwrap();
+    assert_eq!(
+        b.to_string(),
+        "X[V.G.WZ_AKT.L] Y[V.G.WZ[2].OK] Z[V.G.WZ[P1].V[2] + V.G.NP[1].V.X]"
+    );
     fails_at(&rig, "V.G.WZ[1].R = 2\nM30\n", 20200, 1, 1, true);
 }
 

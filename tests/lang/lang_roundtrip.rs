@@ -54,14 +54,36 @@ fn var_ref(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
     ]
 }
 
-/// Variables a program only reads: `V.A.ABS.X`, `V.A.ABS[i]`, `V.G.WZ_AKT.R`, `V.G.WZ[j].R`.
+/// Variables a program only reads: `V.A.ABS.X`, `V.A.ABS[i]`, `V.G.WZ_AKT.R`, `V.G.WZ[j].R`,
+/// the other tool fields and `V.G.NP[i].V…`.
 fn read_only_var(e: BoxedStrategy<Expr>) -> impl Strategy<Value = VarRef> {
     prop_oneof![
         prop::sample::select(b"XYZABCUVW".to_vec()).prop_map(|l| VarRef::AxisAbs(AxisSel::Name(l))),
         e.clone()
             .prop_map(|x| VarRef::AxisAbs(AxisSel::Index(Box::new(x)))),
         Just(VarRef::ToolRadius(None)),
-        e.prop_map(|x| VarRef::ToolRadius(Some(Box::new(x)))),
+        e.clone()
+            .prop_map(|x| VarRef::ToolRadius(Some(Box::new(x)))),
+        // `V.G.WZ_AKT.L`, `V.G.WZ[j].OK`, `V.G.WZ_AKT.V.X`, `V.G.NP[i].V[j]`.
+        (
+            prop::option::of(e.clone()),
+            prop_oneof![
+                Just(ToolField::Length),
+                Just(ToolField::Valid),
+                prop::sample::select(b"XYZABC".to_vec())
+                    .prop_map(|l| ToolField::AxisOffset(AxisSel::Name(l))),
+                e.clone()
+                    .prop_map(|x| ToolField::AxisOffset(AxisSel::Index(Box::new(x)))),
+            ]
+        )
+            .prop_map(|(tool, field)| VarRef::ToolData {
+                tool: tool.map(Box::new),
+                field
+            }),
+        (e.clone(), e).prop_map(|(g, j)| VarRef::ZeroOffset {
+            group: Box::new(g),
+            axis: AxisSel::Index(Box::new(j))
+        }),
     ]
 }
 

@@ -261,10 +261,10 @@ fn zero_offsets_from_the_list_named_in_the_startup_list() {
     let s = Setup::new("zero_offset_list zero.lis\n", "");
     s.write(
         "params/zero.lis",
-        "# G54: X 10 mm, Y -2.5 mm; G55: Z 1 mm\n\
-         np_grp[0].achse[0].versch 100000\n\
-         np_grp[0].achse[1].versch -25000\n\
-         np_grp[1].achse[2].versch 10000\n",
+        "# G54 (group 1): X 10 mm, Y -2.5 mm; G55 (group 2): Z 1 mm\n\
+         np_grp[1].achse[0].versch 100000\n\
+         np_grp[1].achse[1].versch -25000\n\
+         np_grp[2].achse[2].versch 10000\n",
     );
     s.write(
         "nc/np.nc",
@@ -397,7 +397,7 @@ fn check_list_file_recognises_a_zero_offset_list() {
     let p = dir.path().join("zero.lis");
     std::fs::write(
         &p,
-        "np_grp[0].achse[0].versch 1.5\nnp_grp[0].achse[1].versch 100\n",
+        "np_grp[1].achse[0].versch 1.5\nnp_grp[1].achse[1].versch 100\n",
     )
     .unwrap();
     let d = ncchannel::params::check_list_file(&p);
@@ -653,6 +653,12 @@ fn distance_to_circle(x: f64, y: f64, cx: f64, cy: f64, r: f64) -> f64 {
 fn trc_run(program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
     let s = Setup::new("", "");
     s.write("params/tools.lis", "wz[1].radius 50000\n");
+    positions_between(&s, program, from, to)
+}
+
+/// Positions of `program` run in the set-up `s`, between the first and the last block whose
+/// `N` lies in `from..=to`; the run must end without error.
+fn positions_between(s: &Setup, program: &str, from: u64, to: u64) -> Vec<[f64; 6]> {
     s.write("nc/trc.nc", program);
     let mut c = s.channel();
     start(&mut c, &tick(0), "trc.nc");
@@ -820,4 +826,197 @@ fn a_negative_dwell_is_refused_with_the_kernels_range_error() {
     // Zero is a dwell of no time.
     let (errors, _) = run_to_error("", "G04 X0\nM30\n");
     assert!(errors.is_empty(), "{errors:?}");
+}
+
+/// A set-up in the kernel's format: the start-up list names the tool list (`werkz_data[0]`,
+/// P-STUP-00010) and the zero-offset list (`nullp_data[0]`, P-STUP-00011); the channel list
+/// gets `channel_extra`.
+fn kernel_lists(channel_extra: &str) -> Setup {
+    let s = Setup::new("werkz_data[0] werkz_d.lis\nnullp_data[0] nullp_d.lis\n", "");
+    s.write(
+        "params/channel1.lis",
+        &format!("streaming_prog_file streaming.nc\n{channel_extra}"),
+    );
+    // A tools.lis next to the start-up list is not read when werkz_data names a list.
+    s.write("params/tools.lis", "wz[1].radius 90000\n");
+    s.write(
+        "params/werkz_d.lis",
+        "# TF5200 Tool data, 0.1 um\n\
+         wz[1].gueltig 1\nwz[1].radius 30000\nwz[1].laenge 0\n\
+         wz[2].gueltig 1\nwz[2].radius 20000\nwz[2].laenge 600000\nwz[2].ax_versatz[0] 15000\n\
+         wz[3].radius 10000\n",
+    );
+    s.write(
+        "params/nullp_d.lis",
+        "# TF5200 Zero offset group: 0 = G53, 1 = G54 ... 6 = G59\n\
+         np_grp[0].achse[0].versch 70000\n\
+         np_grp[1].achse[0].versch 100000\n\
+         np_grp[2].achse[1].versch -30000\n\
+         np_grp[6].achse[2].versch 25000\n",
+    );
+    s
+}
+
+/// Run `program` to its end (or first error); the channel after it.
+fn run_program(s: &Setup, program: &str) -> Channel {
+    s.write("nc/tool.nc", program);
+    let mut c = s.channel();
+    start(&mut c, &tick(0), "tool.nc");
+    for k in 1..200_000u64 {
+        c.step(&tick(k));
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.status().state != State::Active {
+            break;
+        }
+    }
+    c
+}
+
+fn ended_at(s: &Setup, program: &str) -> [f64; 6] {
+    let c = run_program(s, program);
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
+    c.report().position
+}
+
+#[test]
+fn g41_d1_offsets_the_path_by_the_radius_of_the_werkz_data_list() {
+    let s = kernel_lists("");
+    let square = [(0.0, 0.0), (50.0, 0.0), (50.0, 50.0), (0.0, 50.0)];
+    let program = "G0 X-20 Y-20\nN1 G41 D1 G1 X0 Y0 F3000\nN2 X50\nN3 Y50\nN4 X0\nN5 Y0\n\
+                   N6 X10\nN7 G40 X-20 Y-20\nM30\n";
+    let pos = positions_between(&s, program, 3, 5);
+    assert!(pos.len() > 1000);
+    for p in &pos {
+        let d = distance_to_polygon(p[0], p[1], &square);
+        assert!(
+            (d - 3.0).abs() <= 1e-3,
+            "{p:?}: {d} mm from the contour, not 3"
+        );
+    }
+}
+
+#[test]
+fn tool_length_lies_on_the_tool_axis_and_axis_offsets_on_their_axes() {
+    let s = kernel_lists("");
+    // G17: the length (60 mm) on Z; ax_versatz[0] (1.5 mm) on X.
+    let p = ended_at(&s, "G17 G90 D2 G0 X0 Y0 Z0\nM30\n");
+    assert_eq!((p[0], p[1], p[2]), (1.5, 0.0, 60.0));
+    // G18: on Y.
+    let p = ended_at(&s, "G18 G90 D2 G0 X0 Y0 Z0\nM30\n");
+    assert_eq!((p[0], p[1], p[2]), (1.5, 60.0, 0.0));
+    // A new D takes effect at the axis' next absolute position (P-CHAN-00100 default);
+    // D0 takes it off.
+    let p = ended_at(&s, "G90 G0 Z0\nD2\nG91 Z0\nG90 X0\nM30\n");
+    assert_eq!((p[0], p[2]), (1.5, 0.0));
+    let p = ended_at(&s, "G90 D2 G0 Z0\nD0 Z10\nM30\n");
+    assert_eq!(p[2], 10.0);
+}
+
+#[test]
+fn an_invalid_tool_is_refused_with_its_error_where_d_selects_it() {
+    let s = kernel_lists("");
+    // wz[3] has no `gueltig 1`: the kernel's default 0, invalid.
+    let c = run_program(&s, "G0 X0 Y0\nG1 X1 D3 F1000\nG41 G1 X10\nG40 X20\nM30\n");
+    assert_eq!(c.status().state, State::Error);
+    let e = c.report().last_error.unwrap();
+    assert_eq!((e.code, e.line), (900140, Some(2)), "{}", e.msg);
+    assert!(e.msg.contains("gueltig"), "{}", e.msg);
+    assert!(e.msg.contains("(column 7)"), "at the D word: {}", e.msg);
+    assert_eq!(c.report().position[0], 0.0, "the block does not move");
+    // With einrechnen_mit_t the T word selects it, and is the place named.
+    let c = run_program(&kernel_lists("einrechnen_mit_t 1\n"), "N1 T3 M6\nM30\n");
+    let e = c.report().last_error.unwrap();
+    assert_eq!(e.code, 900140);
+    assert!(e.msg.contains("(column 4)"), "at the T word: {}", e.msg);
+}
+
+#[test]
+fn g54_to_g59_take_the_kernel_numbered_groups_of_nullp_data() {
+    let s = kernel_lists("");
+    // np_grp[0] (G53) is not G54: G54 is np_grp[1].
+    let p = ended_at(&s, "G54 G90 G01 X0 F3000\nM30\n");
+    assert_eq!(p[0], 10.0);
+    let p = ended_at(&s, "G55 G90 G0 X0 Y0\nM30\n");
+    assert_eq!((p[0], p[1]), (0.0, -3.0));
+    let p = ended_at(&s, "G59 G90 G0 Z0\nG53 G0 X0\nM30\n");
+    assert_eq!((p[0], p[2]), (0.0, 2.5));
+}
+
+#[test]
+fn v_g_wz_akt_and_v_g_np_read_the_lists() {
+    let s = kernel_lists("");
+    // Each value is read into an axis position under G53 (no offset) and D0.
+    let p = ended_at(
+        &s,
+        "D2\nP1 = V.G.WZ_AKT.R\nP2 = V.G.WZ_AKT.L\nP3 = V.G.WZ_AKT.OK + V.G.WZ[3].OK\n\
+         P4 = V.G.WZ_AKT.V.X + V.G.WZ[2].V[1]\nD0\nG53 G90 G0 X[P1] Y[P2] Z[P3 + P4]\nM30\n",
+    );
+    assert_eq!((p[0], p[1], p[2]), (2.0, 60.0, 2.5));
+    let p = ended_at(
+        &s,
+        "G53 G90 G0 X[V.G.NP[1].V.X] Y[V.G.NP[2].V[1]] Z[V.G.NP[6].V.Z + V.G.NP[0].V.X]\nM30\n",
+    );
+    assert_eq!((p[0], p[1], p[2]), (10.0, -3.0, 2.5));
+}
+
+#[test]
+fn a_program_writes_zero_offsets_through_v_g_np_and_they_outlive_a_reset() {
+    let s = kernel_lists("");
+    // TF5200 "Zero offsets": `V.G.NP[1].V.X=10` then `G54` (group 1).
+    let mut c = run_program(&s, "V.G.NP[1].V.X = 25\nV.G.NP[2].V[1] = -4\nG54 G90 G0 X0\nM30\n");
+    assert_eq!(c.report().position[0], 25.0);
+    // The table is the channel's data: the next program, after a reset, still sees it.
+    c.apply(&tick(200_000), Op::Reset);
+    s.write("nc/next.nc", "G55 G90 G0 X0 Y0\nP1 = V.G.NP[1].V.X\nG53 G0 Z[P1]\nM30\n");
+    start(&mut c, &tick(200_001), "next.nc");
+    for k in 200_002..400_000u64 {
+        c.step(&tick(k));
+        c.events_mut().flush_to(&mut EventLog::disabled());
+        if c.status().state != State::Active {
+            break;
+        }
+    }
+    assert_eq!(c.status().state, State::Ready, "{:?}", c.report().errors);
+    let p = c.report().position;
+    assert_eq!((p[1], p[2]), (-4.0, 25.0));
+    // Group 0 is G53 (no offset) and cannot be written; nor can tool data.
+    for prog in ["V.G.NP[0].V.X = 1\nM30\n", "V.G.WZ_AKT.L = 5\nM30\n"] {
+        let c = run_program(&s, prog);
+        assert_eq!(c.report().last_error.map(|e| e.code), Some(900133), "{prog}");
+    }
+}
+
+#[test]
+fn einrechnen_mit_t_makes_t_select_the_d_data_set_of_its_number() {
+    let p = ended_at(
+        &kernel_lists("einrechnen_mit_t 1\n"),
+        "T2\nG90 G0 Z0\nM30\n",
+    );
+    assert_eq!(p[2], 60.0, "T2 is T2 D2");
+    let p = ended_at(&kernel_lists(""), "T2\nG90 G0 Z0\nM30\n");
+    assert_eq!(p[2], 0.0, "without it T selects no data");
+}
+
+#[test]
+fn bad_tool_and_zero_offset_entries_are_refused_with_file_line_and_column() {
+    let s = kernel_lists("");
+    s.write("params/werkz_d.lis", "wz[1].radius 1\nwz[1].gueltig 2\n");
+    s.write("params/nullp_d.lis", "np_grp[1].achse[0].versch 1.5\n");
+    let e = ncchannel::params::load(&s.startup()).unwrap_err();
+    let at: Vec<(String, usize, usize)> = e
+        .errors()
+        .iter()
+        .filter(|d| d.severity == ncchannel::Severity::Error)
+        .map(|d| {
+            let f = d.file.file_name().unwrap().to_string_lossy().into_owned();
+            (f, d.line, d.col)
+        })
+        .collect();
+    assert_eq!(
+        at,
+        [("nullp_d.lis".into(), 1, 27), ("werkz_d.lis".into(), 2, 15)]
+    );
+    // Each list checks on its own as well (`ncchannel check`).
+    let d = ncchannel::params::check_list_file(&s.dir.path().join("params/werkz_d.lis"));
+    assert_eq!((d.len(), d[0].line, d[0].col), (1, 2, 15), "{d:?}");
 }

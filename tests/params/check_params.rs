@@ -123,12 +123,13 @@ fn check_of_the_example_installation_counts_each_lists_entries() {
     assert!(stdout.is_empty(), "no finding: {stdout}");
     // Each list once, whether reached from hochlauf.lis or by the folder walk.
     for line in [
-        "params/installation/listen/hochlauf.lis: start-up list, 17 entries: 14 used, 3 inert, 0 unknown",
+        "params/installation/listen/hochlauf.lis: start-up list, 19 entries: 16 used, 3 inert, 0 unknown",
         "params/installation/listen/sda_mds1.lis: channel list, 20 entries: 17 used, 3 inert, 0 unknown",
         "params/installation/listen/default_mds.lis: axis list, 15 entries: 9 used, 6 inert, 0 unknown",
         "params/installation/listen/achsmds1.lis: axis list, 4 entries: 4 used, 0 inert, 0 unknown",
         "params/installation/listen/achsmds3.lis: axis list, 7 entries: 7 used, 0 inert, 0 unknown",
-        "params/installation/listen/tools.lis: tool list, 3 entries: 2 used, 1 inert, 0 unknown",
+        "params/installation/listen/werkz_d.lis: tool list, 10 entries: 10 used, 0 inert, 0 unknown",
+        "params/installation/listen/nullp_d.lis: zero-offset list, 6 entries: 6 used, 0 inert, 0 unknown",
         "params/installation/listen/ext_var1.lis: external variable list, 27 entries: 27 used, 0 inert, 0 unknown",
     ] {
         assert_eq!(

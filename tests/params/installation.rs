@@ -402,7 +402,14 @@ fn the_shipped_example_installation_runs_its_part() {
     assert_eq!(progs.first().map(String::as_str), Some("init.nc"));
     assert!(progs.iter().any(|p| p == "toolchange.nc"));
     assert_eq!(progs.last().map(String::as_str), Some("final.nc"));
-    assert_eq!(c.report().position[2], 100.0, "final.nc retracts to Z100");
+    // final.nc retracts the tool tip to Z100: with D1's length of 40 mm (werkz_d.lis) the
+    // axis stands at 140; X and Y end at G54's offset (nullp_d.lis np_grp[1]).
+    let p = c.report().position;
+    assert_eq!((p[0], p[1], p[2]), (10.0, 20.0, 140.0));
+    assert_eq!(
+        config.channels[0].tool_list.as_deref(),
+        Some(Path::new("params/installation/./listen/werkz_d.lis"))
+    );
 }
 
 #[test]

@@ -351,6 +351,15 @@ fn channel_index_not_below_kanal_anzahl_is_an_error() {
         (IN_STARTUP, 3, 1),
         "configuration.channel[1]",
     );
+    // P-STUP-00010 / -00011: the tool and zero-offset lists are per channel as well.
+    for name in ["werkz_data[1]", "nullp_data[1]"] {
+        implausible(
+            &format!("{STARTUP}{name} x.lis\n"),
+            CHANNEL,
+            (IN_STARTUP, 3, 1),
+            name,
+        );
+    }
 }
 
 #[test]

@@ -33,7 +33,10 @@ pub(super) struct Words {
     /// S, rpm.
     pub(super) spindle_rpm: Option<f64>,
     pub(super) tool: Option<u32>,
-    pub(super) tool_offset: Option<u32>,
+    /// The T word's column (valid with `tool`).
+    pub(super) tool_col: u32,
+    /// D, with its column.
+    pub(super) tool_offset: Option<(u32, u32)>,
     /// `G04 <t>` / `G04 P1` / `G04 X<t>` / `G04 S<n>`: the dwell time in seconds.
     pub(super) dwell_s: Option<f64>,
     pub(super) ms: [u32; MAX_FUNCTIONS],

@@ -43,7 +43,11 @@ pub(super) fn slot(k: &VarKey<'_>) -> Option<VarSlot> {
         }
         VarKey::CycleParam(n) => VarSlot::CycleParam(*n),
         // Read from the decoder's position, never stored (`Env`).
-        VarKey::AxisAbs(_) | VarKey::ToolRadius(_) | VarKey::FunctionSync { .. } => return None,
+        VarKey::AxisAbs(_)
+        | VarKey::ToolRadius(_)
+        | VarKey::ToolData { .. }
+        | VarKey::ZeroOffset { .. }
+        | VarKey::FunctionSync { .. } => return None,
     })
 }
 
@@ -56,6 +60,8 @@ impl Vars for Env<'_> {
         match key {
             VarKey::AxisAbs(id) => self.0.axis_abs(*id),
             VarKey::ToolRadius(d) => self.0.tool_radius(*d),
+            VarKey::ToolData { tool, field } => self.0.tool_field(*tool, *field),
+            VarKey::ZeroOffset { group, axis } => self.0.zero_offset_of(*group, *axis),
             VarKey::FunctionSync { h, number } => self.0.function_sync(*h, *number),
             _ => self.0.vars.nc_get(&slot(key)?),
         }

@@ -186,6 +186,21 @@ impl Interpreter {
     /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
     /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
     fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
+        if matches!(target, VarRef::ToolData { .. }) {
+            // The emulator's tool data come from the tool list at start-up.
+            return Err(DecodeError::new(
+                codes::UNSUPPORTED,
+                format!("{target}: read-only in ncchannel (set it in the tool list)"),
+            )
+            .at(col));
+        }
+        if matches!(target, VarRef::ZeroOffset { .. }) {
+            let key = crate::lang::eval::resolve(target, &expr::Env(self))
+                .map_err(expr::err)
+                .map_err(|e| e.at(col))?;
+            let v = self.eval(value).map_err(|e| e.at(col))?;
+            return self.set_zero_offset(&key, v).map_err(|e| e.at(col));
+        }
         if let VarRef::FunctionSync { h, number } = target {
             let n = self.eval(number).map_err(|e| e.at(col))?;
             let v = self.eval(value).map_err(|e| e.at(col))?;
@@ -263,8 +278,11 @@ impl Interpreter {
             b'F' => w.feed = Some((v, col)),
             b'S' => w.spindle_rpm = Some(v),
             // Whole numbers: the range check above refused anything else.
-            b'T' => w.tool = whole(v),
-            b'D' => w.tool_offset = whole(v),
+            b'T' => {
+                w.tool = whole(v);
+                w.tool_col = col;
+            }
+            b'D' => w.tool_offset = whole(v).map(|d| (d, col)),
             b'I' => w.ijk[0] = Some(v),
             b'J' => w.ijk[1] = Some(v),
             b'K' => w.ijk[2] = Some(v),
@@ -345,8 +363,12 @@ impl Interpreter {
         if let Some(t) = w.tool {
             self.modal.tool = t;
         }
-        if let Some(d) = w.tool_offset {
-            self.modal.tool_offset = d;
+        // einrechnen_mit_t (P-CHAN-00014): `T80` is `T80 D80`; a D in the block wins.
+        let d = w
+            .tool_offset
+            .or(w.tool.filter(|_| self.t_selects_d).map(|t| (t, w.tool_col)));
+        if let Some((d, col)) = d {
+            self.select_tool_data(d).map_err(|e| e.at(col))?;
         }
         for &m in w.ms() {
             apply_m(&mut self.modal, m);
@@ -374,18 +396,47 @@ impl Interpreter {
         Ok(revolutions * 60.0 / rpm)
     }
 
-    /// The offset from program to machine coordinates of axis `i` (zero offset and G92;
-    /// none under G53 in this block).
-    pub(super) fn program_offset(&self, gs: BlockGs) -> [f64; MAX_AXES] {
-        if gs.machine_coords {
-            return [0.0; MAX_AXES];
+    /// `D<d>`: select tool data set `d`. A data set the list marks invalid (`wz[d].gueltig 0`,
+    /// P-TOOL-00005) is refused with 900140: the kernel's error list in this repository has no
+    /// id of its own for it, and 900140 is what G41/G42 without usable tool data answers.
+    fn select_tool_data(&mut self, d: u32) -> Res {
+        if self.tool(Some(d)).is_some_and(|t| !t.valid) {
+            return Err(DecodeError::new(
+                codes::TRC_IMPOSSIBLE,
+                format!("D{d}: tool data set {d} is not valid (wz[{d}].gueltig 0, P-TOOL-00005)"),
+            ));
         }
-        let mut off = self.modal.g92_offset;
-        if self.modal.zero_offset > 0 {
-            let zero = self.settings.zero_offsets[self.modal.zero_offset - 1];
+        self.modal.tool_offset = d;
+        Ok(())
+    }
+
+    /// The offset from program to machine coordinates of axis `i`: zero offset and G92 (none
+    /// under G53 in this block), plus the active D's tool length on the tool axis (Z under
+    /// G17, Y under G18, X under G19; TF5200 "#TLAX": "+" orientation) and its axis offsets
+    /// (P-TOOL-00006). Like the kernel's default (P-CHAN-00100 `move_tool_offsets_directly`
+    /// 0), a new D takes effect at an axis' next absolute position.
+    pub(super) fn program_offset(&self, gs: BlockGs) -> [f64; MAX_AXES] {
+        let mut off = if gs.machine_coords {
+            [0.0; MAX_AXES]
+        } else {
+            self.modal.g92_offset
+        };
+        if self.modal.zero_offset > 0 && !gs.machine_coords {
+            let zero = self.zero_offsets[self.modal.zero_offset - 1];
             for (o, z) in off.iter_mut().zip(zero) {
                 *o += z;
             }
+        }
+        if let Some(t) = self.tool(None).filter(|t| t.valid) {
+            for (o, a) in off.iter_mut().zip(t.axis_offsets_mm) {
+                *o += a;
+            }
+            let tool_axis = match self.modal.plane {
+                crate::queue::Plane::Xy => 2,
+                crate::queue::Plane::Zx => 1,
+                crate::queue::Plane::Yz => 0,
+            };
+            off[tool_axis] += t.length_mm;
         }
         off
     }
