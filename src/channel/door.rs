@@ -12,6 +12,7 @@ use super::{
     Mode, SearchCommand, State,
 };
 use crate::decoder::modal::Modal;
+pub use crate::decoder::vars::ExternalValue;
 use crate::decoder::vars::VarClass;
 use crate::decoder::{DecoderStats, SearchTarget};
 use crate::lang::block::AxisName;
@@ -303,7 +304,7 @@ pub enum Reply {
     Command(Result<(), CommandError>),
     Value(Option<f64>),
     /// A V.E. variable read with its type; `None` when it does not exist.
-    External(Option<crate::decoder::vars::ExternalValue>),
+    External(Option<ExternalValue>),
     Status(Box<Status>),
     /// The error asked for (if still kept) and how many the channel raised.
     ErrorRecord {

@@ -41,7 +41,7 @@ pub use crate::source::store::StoreStats;
 pub use crate::source::stream::StreamCounters;
 pub use crate::source::stream::StreamWriteError;
 pub use crate::vocab::mode::{Mode, State};
-pub use door::{CacheStats, ChannelReport, Status};
+pub use door::{CacheStats, ChannelReport, ExternalValue, Status};
 pub(crate) use hmi::HmiCommands;
 pub use hmi::SearchCommand;
 pub use log::{ChannelStats, ErrorRecord, ExecutedBlock, MAX_LISTED_ERRORS};

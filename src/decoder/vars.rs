@@ -49,14 +49,7 @@ pub enum VarSlot {
 /// Most parameters in use are small plain numbers: keep those in a flat table.
 const FLAT_P: usize = 1024;
 
-/// Bytes each variable class may hold: names, values and [`ENTRY_BYTES`] per entry.
-/// 8 MiB is ten of the largest arrays a declaration may make (100,000 values, 0.8 MB);
-/// real programs use a few kilobytes.
-pub const CLASS_BYTES: usize = 8 << 20;
-
-/// Bookkeeping charged per entry besides its name and values: a hash-table slot (key and
-/// value, 56 bytes) and allocator headers, rounded.
-pub(crate) const ENTRY_BYTES: usize = 64;
+pub use crate::vocab::vars::{CLASS_BYTES, ENTRY_BYTES};
 
 /// A variable class: each has its own [`CLASS_BYTES`] budget. ISG counts V.P., V.S., V.E.
 /// and V.L. (diagnosis 20967's class parameter); P parameters outside the flat table are a

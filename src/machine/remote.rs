@@ -230,7 +230,7 @@ impl dyn CncBackend {
         &self,
         ch: u16,
         name: &str,
-    ) -> Result<crate::decoder::vars::ExternalValue, DeviceError> {
+    ) -> Result<crate::channel::ExternalValue, DeviceError> {
         match self.call(ch, Op::ReadExternalTyped(name.to_string()))? {
             Reply::External(Some(v)) => Ok(v),
             _ => Err(DeviceError::NotFound),

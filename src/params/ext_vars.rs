@@ -29,7 +29,7 @@ use super::catalog::{ListKind, ListSummary, Tally};
 use super::list::{read_list, Entry, ParamList, ValueKind};
 use super::startup::{shape, warn_duplicates};
 use super::value::uint_value;
-use crate::decoder::vars::{CLASS_BYTES, ENTRY_BYTES};
+use crate::vocab::vars::{CLASS_BYTES, ENTRY_BYTES};
 use crate::diag::Diagnostic;
 use crate::lang::codes::{MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS};
 

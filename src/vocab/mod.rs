@@ -1,5 +1,6 @@
 //! The ground floor: the words every layer shares — time, modes and states, axes, `#FLUSH`,
-//! cache operations, the ADS endpoint's ids and defaults, cycle statistics. It imports nothing
+//! cache operations, the ADS endpoint's ids and defaults, cycle statistics, the variables'
+//! memory budget. It imports nothing
 //! from the crate but itself; every other room may import it.
 
 pub mod ams;
@@ -10,3 +11,4 @@ pub mod mode;
 pub mod stats;
 pub mod techno;
 pub(crate) mod tick;
+pub mod vars;
