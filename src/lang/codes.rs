@@ -19,6 +19,12 @@ pub const WRITE_REJECTED: u32 = 11012;
 /// G1/G2/G3 with path feed 0: no F programmed, or G95 without a spindle speed (TF5200
 /// diagnosis ID 20008 "Feed rate in motion block is 0.").
 pub const NO_FEED: u32 = 20008;
+/// G04 with its time given both directly and by an axis, `G04 10 X2` (TF5200 diagnosis ID
+/// 20013 "Dwell time is programmed directly and via coordinate.").
+pub const DWELL_DIRECT_AND_AXIS: u32 = 20013;
+/// G04 with its time given by an axis other than the first main axis, `G04 Y2` (TF5200
+/// diagnosis ID 20014 "Dwell time is not programmed with the coordinate of first axis.").
+pub const DWELL_NOT_FIRST_AXIS: u32 = 20014;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
@@ -111,6 +117,10 @@ pub const SEARCH_NOT_FOUND: u32 = 20704;
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
 pub const FLUSH_UNDER_TRC: u32 = 20651;
+/// A warning: G04 with further axes beside the first main axis, `G04 X2 Y3`; the dwell takes
+/// X's time and the other axes do not move (TF5200 diagnosis ID 20685 "Dwell time
+/// programmed with additional axes.", class 1, processing continues).
+pub const DWELL_EXTRA_AXES: u32 = 20685;
 /// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
 /// ID 20721 "Number of parameters and the number of format specifiers do not match.").
 pub const MSG_ARG_COUNT: u32 = 20721;
@@ -243,9 +253,9 @@ pub const BAD_VALUE: u32 = 900132;
 /// of the ISG dialect that ncchannel does not model: refused by name rather than given a
 /// wrong meaning (docs/nc-language.md lists them).
 pub const UNSUPPORTED: u32 = 900133;
-/// A dwell (G04) with any other word in its block: refused. The kernel's TF5200 diagnosis ID
-/// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
-/// which the kernel goes on; ours refuses every word, so it keeps its own id.
+/// A dwell (G04) with a word other than its time and axes in its block (an M, a second G, an
+/// assignment, F or S beside the time): refused. The axes have the kernel's ids
+/// ([`DWELL_DIRECT_AND_AXIS`], [`DWELL_NOT_FIRST_AXIS`], [`DWELL_EXTRA_AXES`]).
 pub const DWELL_NOT_ALONE: u32 = 900134;
 /// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
 /// axis [`AXIS_TWICE`]).
@@ -273,6 +283,11 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
 pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
     (NO_FEED, "feed 0 in a motion block"),
+    (DWELL_DIRECT_AND_AXIS, "dwell time direct and by an axis"),
+    (
+        DWELL_NOT_FIRST_AXIS,
+        "dwell time not by the first main axis",
+    ),
     (ARC_CENTER_RANGE, "circle centre outside the data format"),
     (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
     (ARC_RADIUS_RANGE, "centre from R outside the data format"),
@@ -315,6 +330,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     ),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
+    (
+        DWELL_EXTRA_AXES,
+        "dwell with further axes: they do not move",
+    ),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
     (MSG_TOO_MANY_VALUES, "#MSG with too many format elements"),
     (MSG_NO_VALUE, "#MSG comma without a value"),
@@ -391,6 +410,14 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
     (20008, "Feed rate in motion block is 0."), // 250515083
     (
+        20013,
+        "Dwell time is programmed directly and via coordinate.",
+    ), // 250532491
+    (
+        20014,
+        "Dwell time is not programmed with the coordinate of first axis.",
+    ), // 250536843
+    (
         20020,
         "Circle centre point parameter outside permissible data format.",
     ), // 250558603
@@ -458,6 +485,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20396, "Division by 0."),           // 251507339
     (20399, "Logarithm less than/equal 0."), // 251520395
     (20651, "NC command is not allowed during active TRC."), // 252112267
+    (20685, "Dwell time programmed with additional axes."), // 252216715
     (20704, "program end reached without restart mark found"), // blocksearch/15328482315
     (
         20721,

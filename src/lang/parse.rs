@@ -400,21 +400,56 @@ fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
 
 /// A dwell stands alone in its block (TF5200 G04): besides `G04` only its time, as `G04 <t>`,
 /// `G04 P1` (a parameter's value), `G04 X<t>` or `G04 F<t>`, or its spindle revolutions
-/// `G04 S<n>`. Anything else — a second G, an M, another axis — is refused rather than
-/// executed as a move or a feed.
+/// `G04 S<n>`. Anything else — a second G, an M — is refused rather than executed as a move
+/// or a feed. Axes have the kernel's ids (TF5200 diagnosis): a time given directly and by an
+/// axis is 20013 (`G04 10 X2`), an axis without the first main axis 20014 (`G04 Y2`); further
+/// axes beside X (`G04 X2 Y3`) pass here and are the decoder's warning 20685. A named axis
+/// (`X1=2`) passes too: only the channel knows whether it is the first main axis.
 fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a>>> {
-    let mut time_given = items
+    use super::codes::{DWELL_DIRECT_AND_AXIS, DWELL_NOT_FIRST_AXIS};
+    let direct = items
         .iter()
         .any(|it| matches!(it, Item::GValue { g: 4, .. }));
+    let first_axis = items
+        .iter()
+        .any(|it| matches!(it, Item::Word(w) if w.letter == b'X'));
+    let mut time_given = direct;
     for it in items {
         if is_dwell(it) {
             continue;
+        }
+        let axis_col = match it {
+            Item::Word(w) if crate::vocab::axis::slot_of(w.letter).is_some() => Some(w.col),
+            Item::NamedAxis(a) => Some(a.col),
+            _ => None,
+        };
+        if let Some(col) = axis_col.filter(|_| direct) {
+            return Err(ctx.err_at(
+                col,
+                DWELL_DIRECT_AND_AXIS,
+                "dwell time programmed directly and via coordinate",
+            ));
         }
         let (col, what) = match it {
             Item::Word(w) if matches!(w.letter, b'X' | b'F' | b'S') && !time_given => {
                 time_given = true;
                 continue;
             }
+            Item::Word(w) if w.letter != b'X' && axis_col.is_some() => {
+                if !first_axis {
+                    return Err(ctx.err_at(
+                        w.col,
+                        DWELL_NOT_FIRST_AXIS,
+                        format!(
+                            "dwell time not programmed with the coordinate of the first axis X \
+                             but of {}",
+                            w.letter as char
+                        ),
+                    ));
+                }
+                continue;
+            }
+            Item::NamedAxis(_) => continue,
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
             Item::GValue { g, col, .. } => (*col, format!("G{g}")),
@@ -425,7 +460,6 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
-            Item::NamedAxis(a) => (a.col, a.name.to_string()),
         };
         return Err(ctx.err_at(
             col,

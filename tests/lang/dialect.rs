@@ -265,6 +265,26 @@ fn each_dwell_form_dwells_its_time() {
     }
 }
 
+/// `G04 X2 Y3 Z4`: X's time, one warning 20685 for each further axis, which does not move
+/// (TF5200 diagnosis ID 20685 "Dwell time programmed with additional axes.", class 1:
+/// processing continues).
+#[test]
+fn g04_with_further_axes_dwells_x_time_and_warns_for_each() {
+    let rig = Rig::new();
+    rig.program("dwell.nc", "G0 Y1 Z1\nG04 X2 Y3 Z4\nG0 X1\nM30\n");
+    let r = rig.run("dwell.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    let t = block_duration(&r, "G04 X2 Y3 Z4");
+    assert!((t - 2.0).abs() < 0.01, "dwelled {t} s");
+    let warnings: Vec<u64> = r
+        .of("warning")
+        .iter()
+        .filter_map(|w| w["code"].as_u64())
+        .collect();
+    assert_eq!(warnings, [u64::from(codes::DWELL_EXTRA_AXES); 2]);
+    assert_eq!((r.position('Y'), r.position('Z')), (1.0, 1.0));
+}
+
 /// `G04 S10` waits ten turns of the main spindle at its programmed speed (TF5200 programming
 /// manual, "Dwell time (G04), (#TIME)": `M3 S200`, `G04 S10` waits 3 s) and leaves the speed
 /// as it was; a spindle that does not turn never completes them: 20752.
@@ -302,9 +322,10 @@ const REFUSED_BLOCKS: &[(&str, u32, u32)] = &[
     ("G1 X1 F100 F200", codes::F_TWICE, 12),
     ("T1 D1 T2", codes::WORD_TWICE, 7),
     ("G2 X1 Y1 I1 I2 F100", codes::WORD_TWICE, 13),
-    ("G04 Y2", codes::DWELL_NOT_ALONE, 5),
+    ("G04 Y2", codes::DWELL_NOT_FIRST_AXIS, 5),
     ("G4 F1.5 X2", codes::DWELL_NOT_ALONE, 9),
-    ("G04 2 X1", codes::DWELL_NOT_ALONE, 7),
+    ("G04 2 X1", codes::DWELL_DIRECT_AND_AXIS, 7),
+    ("G04 X1 Y2 M3", codes::DWELL_NOT_ALONE, 11),
     ("G04 X1 M3", codes::DWELL_NOT_ALONE, 8),
     ("G1 G04 X1", codes::DWELL_NOT_ALONE, 1),
     ("G33 Z-10 K1.5", codes::UNSUPPORTED, 1),

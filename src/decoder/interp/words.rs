@@ -94,6 +94,18 @@ impl Interpreter {
         }
         // Step 4 queued: the dwell or the move.
         if gs.dwell {
+            // `G04 X2 Y3`: X's time; each further axis is a warning and does not move
+            // (TF5200 diagnosis ID 20685, class 1: processing continues).
+            for (i, name) in self.settings.axis_names.iter().enumerate() {
+                if w.axes_set & (1 << i) != 0 {
+                    notes.push(Note::Warning {
+                        code: codes::DWELL_EXTRA_AXES,
+                        msg: format!(
+                            "dwell time programmed with additional axes: {name} does not move"
+                        ),
+                    });
+                }
+            }
             let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
             self.emit(info.clone(), Action::Dwell { seconds }, false, io);
             queued = true;
@@ -320,7 +332,16 @@ impl Interpreter {
             w.axes_set = 0;
         }
         if gs.dwell {
-            // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
+            // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed. The
+            // parser refused a lettered axis without X; a named one (`Y1=2`) is known only
+            // here (TF5200 diagnosis ID 20014). Further axes stay in `axes_set` for the
+            // warning 20685 and do not move.
+            if w.axes_set != 0 && w.axes_set & 1 == 0 {
+                return Err(DecodeError::new(
+                    codes::DWELL_NOT_FIRST_AXIS,
+                    "dwell time not programmed with the coordinate of the first main axis",
+                ));
+            }
             if w.axes_set & 1 != 0 {
                 w.axes_set &= !1;
                 w.dwell_s = Some(w.axes[0]);
