@@ -490,8 +490,11 @@ impl Decoder {
         }
         let block = match parse_block(text) {
             Ok(b) => b,
-            // A syntax error in a skipped line never runs, so it is no error.
-            Err(_) if skipping => return Ok(()),
+            // A syntax error in a skipped line never runs, so it is no error; but the skip
+            // reads every `$` statement to find its structure's end, so a malformed one is
+            // an error there too (docs/design-choices.md, "Malformed $ statements in
+            // skipped lines").
+            Err(e) if skipping && !codes::is_control_statement_fault(e.code) => return Ok(()),
             Err(e) => return Err(e.into()),
         };
         if stream {

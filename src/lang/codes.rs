@@ -69,6 +69,9 @@ pub const UNEXPECTED_ELSEIF: u32 = 20216;
 pub const UNEXPECTED_ENDIF: u32 = 20218;
 /// `$CASE` outside `$SWITCH` (TF5200 diagnosis ID 20221).
 pub const UNEXPECTED_CASE: u32 = 20221;
+/// `$CASE` with another word after its condition in its block (TF5200 diagnosis ID 20222
+/// "After 'CASE' only the condition is permissible.").
+pub const CASE_NOT_ALONE: u32 = 20222;
 /// `$DEFAULT` outside `$SWITCH` (TF5200 diagnosis ID 20223).
 pub const UNEXPECTED_DEFAULT: u32 = 20223;
 /// `$ENDSWITCH` without its `$SWITCH` (TF5200 diagnosis ID 20225).
@@ -80,6 +83,9 @@ pub const UNEXPECTED_ENDWHILE: u32 = 20237;
 /// `$ENDDO` without its `$DO` (TF5200 diagnosis ID 20240; page not yet read, see
 /// [`KERNEL_UNREAD`]).
 pub const UNEXPECTED_ENDDO: u32 = 20240;
+/// `$ENDDO` with another word after its condition in its block (TF5200 diagnosis ID 20241
+/// "After 'ENDDO' only the condition is permissible.").
+pub const ENDDO_NOT_ALONE: u32 = 20241;
 /// `$BREAK` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20243).
 pub const UNEXPECTED_BREAK: u32 = 20243;
 /// `$CONTINUE` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20244).
@@ -87,6 +93,9 @@ pub const UNEXPECTED_CONTINUE: u32 = 20244;
 /// `$UNTIL` without its `$REPEAT` (TF5200 diagnosis ID 21469; page not yet read, see
 /// [`KERNEL_UNREAD`]).
 pub const UNEXPECTED_UNTIL: u32 = 21469;
+/// `$UNTIL` with another word after its condition in its block (TF5200 diagnosis ID 21470
+/// "After 'UNTIL' only the condition is permissible.").
+pub const UNTIL_NOT_ALONE: u32 = 21470;
 /// Subroutine calls nested deeper than `decoder.max_subroutine_depth` (TF5200 diagnosis ID
 /// 20360 "Stack overflow for global sub-routines."; ncchannel counts local calls too).
 pub const NESTING_TOO_DEEP: u32 = 20360;
@@ -279,6 +288,16 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
     }
 }
 
+/// Is `code` a `$` statement's own fault ([`UNEXPECTED_ELSEIF`] for a `$ELSEIF` without its
+/// condition, [`CASE_NOT_ALONE`], [`ENDDO_NOT_ALONE`], [`UNTIL_NOT_ALONE`]) rather than a
+/// general syntax error? Such a line is refused even where it is skipped.
+pub(crate) fn is_control_statement_fault(code: u32) -> bool {
+    matches!(
+        code,
+        UNEXPECTED_ELSEIF | CASE_NOT_ALONE | ENDDO_NOT_ALONE | UNTIL_NOT_ALONE
+    )
+}
+
 /// Every error id ncchannel can emit, with a short meaning: the constants above, once each.
 pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
@@ -305,14 +324,17 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNEXPECTED_ELSEIF, "unexpected $ELSEIF"),
     (UNEXPECTED_ENDIF, "unexpected $ENDIF"),
     (UNEXPECTED_CASE, "unexpected $CASE"),
+    (CASE_NOT_ALONE, "words after the $CASE condition"),
     (UNEXPECTED_DEFAULT, "unexpected $DEFAULT"),
     (UNEXPECTED_ENDSWITCH, "unexpected $ENDSWITCH"),
     (UNEXPECTED_ENDFOR, "unexpected $ENDFOR"),
     (UNEXPECTED_ENDWHILE, "unexpected $ENDWHILE"),
     (UNEXPECTED_ENDDO, "unexpected $ENDDO"),
+    (ENDDO_NOT_ALONE, "words after the $ENDDO condition"),
     (UNEXPECTED_BREAK, "unexpected $BREAK"),
     (UNEXPECTED_CONTINUE, "unexpected $CONTINUE"),
     (UNEXPECTED_UNTIL, "unexpected $UNTIL"),
+    (UNTIL_NOT_ALONE, "words after the $UNTIL condition"),
     (NESTING_TOO_DEEP, "subroutine nesting too deep"),
     (MAIN_NOT_FOUND, "main program not found"),
     (SUBROUTINE_NOT_FOUND, "global subroutine not found"),
@@ -459,6 +481,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         20221,
         "Unexpected CASE. Does not match the current control block.",
     ), // 251154827
+    (20222, "After 'CASE' only the condition is permissible."), // 251159179
     (
         20223,
         "Unexpected DEFAULT. Does not match the current control block.",
@@ -475,6 +498,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         20237,
         "Unexpected ENDWHILE. Does not match the current control block.",
     ), // 251224459
+    (20241, "After 'ENDDO' only the condition is permissible."), // 251241867
     (20243, "Unexpected 'BREAK'. No valid/open control blocks."), // 251250571
     (
         20244,
@@ -513,6 +537,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         21476,
         "Streaming data does not contain a correct line end marker",
     ), // tf5200_data_streaming/222589963
+    (21470, "After 'UNTIL' only the condition is permissible."), // 254806155
     (21477, "Backward jump during streaming not allowed."), // 254836619
     (21478, "Loop during streaming not allowed."), // 254840971
     (

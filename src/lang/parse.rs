@@ -866,6 +866,28 @@ fn keyword_after<'a>(i: &'a str, buf: &mut [u8; 16]) -> Option<(&'a str, usize)>
     Some((rest, kw.len()))
 }
 
+/// The condition of `$CASE`, `$ENDDO` or `$UNTIL` and nothing after it: another word in its
+/// block is the kernel's "After 'CASE' (… 'ENDDO', 'UNTIL') only the condition is
+/// permissible." (TF5200 diagnosis IDs 20222, 20241, 21470), at that word.
+fn only_condition<'a>(ctx: &Ctx<'a>, i: &'a str, keyword: &'static str) -> PResult<'a, Expr> {
+    use super::codes::{CASE_NOT_ALONE, ENDDO_NOT_ALONE, UNTIL_NOT_ALONE};
+    let (r, e) = ctx.expr(i)?;
+    let rest = gap(r);
+    if rest.is_empty() {
+        return Ok((r, e));
+    }
+    let code = match keyword {
+        "$CASE" => CASE_NOT_ALONE,
+        "$ENDDO" => ENDDO_NOT_ALONE,
+        _ => UNTIL_NOT_ALONE,
+    };
+    fail(
+        rest,
+        code,
+        format!("only the condition may follow {keyword} in its block"),
+    )
+}
+
 fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     let after = &i[1..];
     let mut buf = [0u8; 16];
@@ -886,12 +908,21 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
             }
             return Ok((r, Control::If(cond)));
         }
+        b"ELSEIF" if gap(r).is_empty() => {
+            // An incomplete `$ELSEIF` (TF5200 diagnosis ID 20216: "A control block statement
+            // was programmed in incomplete syntax", whose wrong program is `$ELSEIF` alone).
+            return fail(
+                i,
+                super::codes::UNEXPECTED_ELSEIF,
+                "$ELSEIF without its condition",
+            );
+        }
         b"ELSEIF" => return ctx.expr(r).map(|(r, e)| (r, Control::ElseIf(e))),
         b"SWITCH" => return ctx.expr(r).map(|(r, e)| (r, Control::Switch(e))),
-        b"CASE" => return ctx.expr(r).map(|(r, e)| (r, Control::Case(e))),
+        b"CASE" => return only_condition(ctx, r, "$CASE").map(|(r, e)| (r, Control::Case(e))),
         b"WHILE" => return ctx.expr(r).map(|(r, e)| (r, Control::While(e))),
-        b"ENDDO" => return ctx.expr(r).map(|(r, e)| (r, Control::EndDo(e))),
-        b"UNTIL" => return ctx.expr(r).map(|(r, e)| (r, Control::Until(e))),
+        b"ENDDO" => return only_condition(ctx, r, "$ENDDO").map(|(r, e)| (r, Control::EndDo(e))),
+        b"UNTIL" => return only_condition(ctx, r, "$UNTIL").map(|(r, e)| (r, Control::Until(e))),
         b"GOTO" => return goto_target(r).map(|(r, t)| (r, Control::Goto(t))),
         b"FOR" => return for_head(ctx, r),
         b"ELSE" => Control::Else,
