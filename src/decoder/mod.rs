@@ -543,7 +543,7 @@ impl Decoder {
             Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
             Body::ProgramHead { .. } if rd.current().kind() == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                rd.top().flow().check_open_flow()?;
+                rd.top().flow().warn_open_flow(notes);
                 ip.return_from_subroutine(rd, notes);
                 ip.resume_held_end(rd, notes, io)
             }
@@ -570,6 +570,9 @@ impl Decoder {
                 codes::SEARCH_NOT_FOUND,
                 "block search target not found",
             ));
+        }
+        if let Some(e) = top.flow().open_invalid_block(top.kind()) {
+            return Err(e);
         }
         match top.kind() {
             FrameKind::Main => Err(DecodeError::new(

@@ -105,7 +105,8 @@ pub const MAIN_NOT_FOUND: u32 = 20368;
 pub const SUBROUTINE_NOT_FOUND: u32 = 20369;
 /// Local subroutine not found (TF5200 diagnosis ID 20373).
 pub const LOCAL_SUB_NOT_FOUND: u32 = 20373;
-/// Control blocks still open at program end (TF5200 diagnosis ID 20375).
+/// A warning: control blocks whose branch ran still open at the program's or a subroutine's
+/// end; it ends as programmed (TF5200 diagnosis ID 20375, class 1: processing continues).
 pub const OPEN_CONTROL_BLOCK: u32 = 20375;
 /// M17/M29 where no subroutine runs (TF5200 diagnosis ID 20376).
 pub const UNEXPECTED_SUB_END: u32 = 20376;
@@ -179,6 +180,14 @@ pub const STREAM_BACKWARD_JUMP: u32 = 21477;
 pub const STREAM_LOOP: u32 = 21478;
 /// Local subroutine call (LL) in a streaming program (TF5200 diagnosis ID 21479).
 pub const STREAM_LOCAL_CALL: u32 = 21479;
+/// A false branch (or a skipped case or loop) still waiting for its end statement when the
+/// file of a local subroutine ends (TF5200 diagnosis ID 21500 "There are pending invalid
+/// control blocks at local subroutine end.").
+pub const OPEN_INVALID_BLOCK_LOCAL: u32 = 21500;
+/// As [`OPEN_INVALID_BLOCK_LOCAL`], at the main program's end (TF5200 diagnosis ID 21501).
+pub const OPEN_INVALID_BLOCK_MAIN: u32 = 21501;
+/// As [`OPEN_INVALID_BLOCK_LOCAL`], at a global subroutine's end (TF5200 diagnosis ID 21502).
+pub const OPEN_INVALID_BLOCK_GLOBAL: u32 = 21502;
 /// Invalid `#CACHE` programming (TF5200 diagnosis ID 21560).
 pub const CACHE_SYNTAX: u32 = 21560;
 /// Double programming inside one `#CACHE` command (TF5200 diagnosis ID 21561).
@@ -339,7 +348,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     (MAIN_NOT_FOUND, "main program not found"),
     (SUBROUTINE_NOT_FOUND, "global subroutine not found"),
     (LOCAL_SUB_NOT_FOUND, "local subroutine not found"),
-    (OPEN_CONTROL_BLOCK, "open control blocks at program end"),
+    (
+        OPEN_CONTROL_BLOCK,
+        "open control blocks at program end: a warning",
+    ),
     (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
     (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
@@ -375,6 +387,18 @@ pub const EMITTED: &[(u32, &str)] = &[
     (STREAM_LOOP, "stream: loop"),
     (STREAM_LOCAL_CALL, "stream: LL call"),
     (SEARCH_NOT_FOUND, "block search target not found"),
+    (
+        OPEN_INVALID_BLOCK_LOCAL,
+        "false branch open at local subroutine end",
+    ),
+    (
+        OPEN_INVALID_BLOCK_MAIN,
+        "false branch open at main program end",
+    ),
+    (
+        OPEN_INVALID_BLOCK_GLOBAL,
+        "false branch open at global subroutine end",
+    ),
     (CACHE_SYNTAX, "#CACHE invalid"),
     (CACHE_DOUBLE, "#CACHE double programming"),
     (CACHE_FULL, "file cache full"),
@@ -538,6 +562,18 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         "Streaming data does not contain a correct line end marker",
     ), // tf5200_data_streaming/222589963
     (21470, "After 'UNTIL' only the condition is permissible."), // 254806155
+    (
+        21500,
+        "There are pending invalid control blocks at local subroutine end.",
+    ), // 254941067
+    (
+        21501,
+        "There are pending invalid control blocks at main program end.",
+    ), // 254945419
+    (
+        21502,
+        "There are pending invalid control blocks at global subroutine end.",
+    ), // 254949771
     (21477, "Backward jump during streaming not allowed."), // 254836619
     (21478, "Loop during streaming not allowed."), // 254840971
     (

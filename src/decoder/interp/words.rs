@@ -590,7 +590,7 @@ impl Interpreter {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            rd.top().flow().check_open_flow()?;
+            rd.top().flow().warn_open_flow(notes);
             self.return_from_subroutine(rd, notes);
             return self.resume_held_end(rd, notes, io);
         }
@@ -649,7 +649,8 @@ impl Interpreter {
             });
             Ok(())
         } else {
-            rd.top().flow().check_open_flow()
+            rd.top().flow().warn_open_flow(notes);
+            Ok(())
         }
     }
 }
