@@ -33,13 +33,23 @@ pub const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
 /// The centre computed from R lies outside the data format (TF5200 diagnosis ID 20054, whose
 /// example is `G02 X1 R1000000`).
 pub const ARC_RADIUS_RANGE: u32 = 20054;
+/// G41 and G42 (or one of them twice) in one block (TF5200 diagnosis ID 20114 "Double
+/// programmed selection of tool radius compensation.", whose example is `G41 X10 Y20 G42`).
+pub const TRC_TWICE: u32 = 20114;
 /// Unknown G function (TF5200 diagnosis ID 20131).
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function (TF5200 diagnosis ID 20157).
 pub const UNKNOWN_M: u32 = 20157;
+/// An M function numbered above the self-defined ones ([`MAX_SELF_DEFINED_M`]) that the
+/// channel parameters do not define and that is no internal M function either (TF5200
+/// diagnosis ID 20160 "Unknown internal M-function.", whose example is `M1001`).
+pub const UNKNOWN_INTERNAL_M: u32 = 20160;
 /// H function the channel parameters do not define (kernel id 20162; its TF5200 page was not
 /// read, see [`KERNEL_UNREAD`]).
 pub const UNKNOWN_H: u32 = 20162;
+/// A second D word in one block (TF5200 diagnosis ID 20170 "Double-programmed
+/// D-function.", whose example is `D1 D2`).
+pub const D_TWICE: u32 = 20170;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
 /// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",
@@ -131,6 +141,10 @@ pub const FLUSH_UNDER_TRC: u32 = 20651;
 /// X's time and the other axes do not move (TF5200 diagnosis ID 20685 "Dwell time
 /// programmed with additional axes.", class 1, processing continues).
 pub const DWELL_EXTRA_AXES: u32 = 20685;
+/// The same technology M function twice in one block, `M10 M10` (TF5200 diagnosis ID 20765
+/// "Double-programmed M-function.", channel-specific). The program-flow M functions
+/// ([`PROGRAM_FLOW_M`]) are not technology functions and are not checked here.
+pub const M_TWICE: u32 = 20765;
 /// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
 /// ID 20721 "Number of parameters and the number of format specifiers do not match.").
 pub const MSG_ARG_COUNT: u32 = 20721;
@@ -275,8 +289,8 @@ pub const UNSUPPORTED: u32 = 900133;
 /// assignment, F or S beside the time): refused. The axes have the kernel's ids
 /// ([`DWELL_DIRECT_AND_AXIS`], [`DWELL_NOT_FIRST_AXIS`], [`DWELL_EXTRA_AXES`]).
 pub const DWELL_NOT_ALONE: u32 = 900134;
-/// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
-/// axis [`AXIS_TWICE`]).
+/// T, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], D
+/// [`D_TWICE`], an axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
 /// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
 pub const MSG_TOO_LONG: u32 = 900136;
@@ -293,6 +307,7 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
     match letter.to_ascii_uppercase() {
         b'F' => F_TWICE,
         b'S' => S_TWICE,
+        b'D' => D_TWICE,
         _ => WORD_TWICE,
     }
 }
@@ -319,9 +334,15 @@ pub const EMITTED: &[(u32, &str)] = &[
     (ARC_CENTER_RANGE, "circle centre outside the data format"),
     (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
     (ARC_RADIUS_RANGE, "centre from R outside the data format"),
+    (TRC_TWICE, "G41/G42 twice in a block"),
     (UNKNOWN_G, "unknown G function"),
     (UNKNOWN_M, "unknown M function"),
+    (
+        UNKNOWN_INTERNAL_M,
+        "M above the self-defined range, not internal",
+    ),
     (UNKNOWN_H, "unknown H function"),
+    (D_TWICE, "D twice in a block"),
     (F_TWICE, "F twice in a block"),
     (S_TWICE, "S twice in a block"),
     (SYNTAX, "syntax"),
@@ -368,6 +389,7 @@ pub const EMITTED: &[(u32, &str)] = &[
         DWELL_EXTRA_AXES,
         "dwell with further axes: they do not move",
     ),
+    (M_TWICE, "the same technology M function twice in a block"),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
     (MSG_TOO_MANY_VALUES, "#MSG with too many format elements"),
     (MSG_NO_VALUE, "#MSG comma without a value"),
@@ -436,7 +458,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (BAD_VALUE, "value out of range"),
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
-    (WORD_TWICE, "T, D, I, J, K, R or E twice in a block"),
+    (WORD_TWICE, "T, I, J, K, R or E twice in a block"),
     (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
@@ -477,7 +499,13 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 1031: 250663051
     (20097, "Variable lesen nicht erlaubt."), // 1031: 250750091
     (20100, "Write access to variable denied."), // 250758795
+    (
+        20114,
+        "Double programmed selection of tool radius compensation.",
+    ), // 250815371
     (20131, "Unknown G function"),       // named so on the page of ID 20107, 250784907
+    (20160, "Unknown internal M-function."), // 250945931
+    (20170, "Double-programmed D-function."), // 250985099
     (20175, "Double-programmed F-word."), // 250998155
     (20181, "Double-programmed spindle."), // 251019915
     (20203, "Double-programmed axis."),  // 251085195
@@ -534,6 +562,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20399, "Logarithm less than/equal 0."), // 251520395
     (20651, "NC command is not allowed during active TRC."), // 252112267
     (20685, "Dwell time programmed with additional axes."), // 252216715
+    (20765, "Double-programmed M-function."), // 252469131
     (20704, "program end reached without restart mark found"), // blocksearch/15328482315
     (
         20721,
@@ -719,6 +748,17 @@ pub(crate) fn is_known_m(m: u32) -> bool {
 
 /// M and H functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)").
 pub(crate) const MAX_M_H: u32 = 65_535;
+
+/// The highest self-defined M function: the kernel's table of them has 1000 entries
+/// (TF5200 channel parameters, P-CHAN-00041: `m_synch[i]` with i = 0 … 999). An undefined M
+/// above it is [`UNKNOWN_INTERNAL_M`], one up to it [`UNKNOWN_M`]; ncchannel's lists may define
+/// M functions above it too (docs/design-choices.md).
+pub(crate) const MAX_SELF_DEFINED_M: u32 = 999;
+
+/// The M functions with the kernel's own meaning for the program's flow: the stops M00/M01,
+/// the program ends M02/M30 and the subroutine ends M17/M29 (TF5200 programming manual,
+/// "User-specific M/H functions": the predefined M functions).
+pub(crate) const PROGRAM_FLOW_M: [u32; 6] = [0, 1, 2, 17, 29, 30];
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

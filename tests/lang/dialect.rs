@@ -226,6 +226,35 @@ fn m_and_h_run_from_0_to_65535_and_h_functions_are_events() {
     assert_eq!(hs, [7, 65535]);
 }
 
+/// Double programming the decoder finds (TF5200 diagnosis): G41 and G42 in one block is
+/// 20114, the same technology M function twice 20765 (`M10 M10`; M30 twice is a program
+/// end, not a technology function); an undefined M above the self-defined M0–M999 is 20160,
+/// one within them 20157.
+#[test]
+fn trc_twice_m_twice_and_unknown_internal_m_have_the_kernels_ids() {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "m_synch[10] MOS\nm_synch[5000] MOS\n",
+    )
+    .unwrap();
+    for (block, code) in [
+        ("G41 X10 Y20 G42", codes::TRC_TWICE),
+        ("G42 G41 X10", codes::TRC_TWICE),
+        ("G0 X10 M10 M10", codes::M_TWICE),
+        ("M1001", codes::UNKNOWN_INTERNAL_M),
+        ("M999", codes::UNKNOWN_M),
+    ] {
+        rig.program("twice.nc", &format!("G0 X0 Y0\n{block}\nM30\n"));
+        let r = rig.run("twice.nc", None, 100_000);
+        assert_eq!(r.error_codes(), [u64::from(code)], "{block}: {}", r.log);
+    }
+    // Defined in the channel's list, an M above M999 runs (docs/design-choices.md).
+    rig.program("ok.nc", "G0 X0 Y0\nM10 M5000\nG41 G40 X1\nM30\n");
+    let r = rig.run("ok.nc", None, 100_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+}
+
 /// Channel time from the start of the block `text` to the start of the next block.
 fn block_duration(r: &common::RunResult, text: &str) -> f64 {
     let blocks = r.of("block");
@@ -321,6 +350,7 @@ const REFUSED_BLOCKS: &[(&str, u32, u32)] = &[
     ("S1000 M3 S1500", codes::S_TWICE, 10),
     ("G1 X1 F100 F200", codes::F_TWICE, 12),
     ("T1 D1 T2", codes::WORD_TWICE, 7),
+    ("T1 D1 D2", codes::D_TWICE, 7),
     ("G2 X1 Y1 I1 I2 F100", codes::WORD_TWICE, 13),
     ("G04 Y2", codes::DWELL_NOT_FIRST_AXIS, 5),
     ("G4 F1.5 X2", codes::DWELL_NOT_ALONE, 9),

@@ -311,7 +311,19 @@ impl Interpreter {
     fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
         let mut gs = BlockGs::default();
         let mut call = None;
+        let mut trc_selected = false;
         for &(g, col) in w.gs() {
+            if matches!(g, 41 | 42) {
+                // `G41 X10 Y20 G42`: TF5200 diagnosis ID 20114 "Double programmed selection
+                // of tool radius compensation.".
+                if std::mem::replace(&mut trc_selected, true) {
+                    return Err(DecodeError::new(
+                        codes::TRC_TWICE,
+                        format!("G{g}: tool radius compensation selected twice in the block"),
+                    )
+                    .at(col));
+                }
+            }
             if !apply_g(&mut self.modal, g, &mut gs) {
                 if crate::lang::gcall::G_CALLS.contains(&g) {
                     if call.replace((g, col)).is_some() {
@@ -685,7 +697,15 @@ fn push_function(
         ));
     }
     // The parser admits only whole numbers 0..=65535 for M and H.
-    list[*n] = whole(v).unwrap_or(0);
+    let number = whole(v).unwrap_or(0);
+    if letter == 'M' && list[..*n].contains(&number) && !codes::PROGRAM_FLOW_M.contains(&number) {
+        // `M10 M10`: TF5200 diagnosis ID 20765 "Double-programmed M-function.".
+        return Err(DecodeError::new(
+            codes::M_TWICE,
+            format!("M{number} programmed twice in the block"),
+        ));
+    }
+    list[*n] = number;
     values[*n] = value;
     *n += 1;
     Ok(())
