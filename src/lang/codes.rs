@@ -133,6 +133,9 @@ pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
 /// its TwinCAT 2 edition quotes the message, "program end reached without restart mark
 /// found". The diagnosis page of ID 20704 itself was not in the index searched.
 pub const SEARCH_NOT_FOUND: u32 = 20704;
+/// The combined assignment `/=` with a divisor of 0, `P2/=P1` (TF5200 diagnosis ID 20574
+/// "Division by 0."); a `/` inside an expression is [`EVAL_DIVISION_BY_ZERO`].
+pub const COMBINED_DIVISION_BY_ZERO: u32 = 20574;
 /// `#FLUSH` while tool radius compensation G41/G42 is active (TF5200 diagnosis ID 20651 "NC
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
@@ -376,6 +379,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
     (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
+    (COMBINED_DIVISION_BY_ZERO, "combined assignment /= by zero"),
     (VARIABLE_UNKNOWN, "V.E. variable not declared"),
     (VARIABLE_READ_DENIED, "V.E. variable WRITE_ONLY read"),
     (VARIABLE_WRITE_DENIED, "V.E. variable READ_ONLY written"),
@@ -560,6 +564,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20375, "There are valid open control blocks at program end."), // 251459467
     (20396, "Division by 0."),           // 251507339
     (20399, "Logarithm less than/equal 0."), // 251520395
+    (20574, "Division by 0."),           // 251868555
     (20651, "NC command is not allowed during active TRC."), // 252112267
     (20685, "Dwell time programmed with additional axes."), // 252216715
     (20765, "Double-programmed M-function."), // 252469131

@@ -338,14 +338,19 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             let (r, target) = ctx.var_ref(i)?;
             writable(&target, i)?;
             let r = ws(r);
-            let Some(r) = r.strip_prefix('=') else {
-                return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
+            let (r, op) = match r.strip_prefix('=') {
+                Some(r) => (r, None),
+                None => match combined_assignment(r) {
+                    Some((r, op)) => (r, Some(op)),
+                    None => return Err(perr(r, SYNTAX, "`=` expected after the parameter")),
+                },
             };
             let (r, value) = ctx.expr(ws(r))?;
             items.push(Item::Assign {
                 target: Box::new(target),
                 value,
                 col,
+                op,
             });
             i = r;
         } else {
@@ -366,6 +371,20 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             return Err(perr(i, code, msg));
         }
     }
+}
+
+/// A combined assignment operator at `i`, `+=` `-=` `*=` `/=` (TF5200 diagnosis ID 20574:
+/// "the combined assignment operator /="), and the rest after it.
+fn combined_assignment(i: &str) -> Option<(&str, super::block::BinOp)> {
+    use super::block::BinOp;
+    let op = match i.as_bytes() {
+        [b'+', b'=', ..] => BinOp::Add,
+        [b'-', b'=', ..] => BinOp::Sub,
+        [b'*', b'=', ..] => BinOp::Mul,
+        [b'/', b'=', ..] => BinOp::Div,
+        _ => return None,
+    };
+    Some((&i[2..], op))
 }
 
 /// Is this item the dwell `G04` (with or without its value)?

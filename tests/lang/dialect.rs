@@ -255,6 +255,41 @@ fn trc_twice_m_twice_and_unknown_internal_m_have_the_kernels_ids() {
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
 }
 
+/// The combined assignments `+=`, `-=`, `*=`, `/=` (TF5200 diagnosis ID 20574 names "the
+/// combined assignment operator /="): the target's value with the operand, printed back as
+/// written; `/=` by 0 is 20574, a `/` by 0 inside an expression stays 20396.
+#[test]
+fn combined_assignments_compute_on_the_old_value_and_divide_by_zero_is_20574() {
+    for line in ["P2/=P1", "P2+=[P1*2]", "V.L.X-=1", "P[3]*=2"] {
+        let text = parse_block(line).unwrap().to_string();
+        let (op, _) = line.split_at(line.find('=').unwrap() + 1);
+        assert!(text.starts_with(op), "{line}: {text}");
+        assert_eq!(parse_block(&text).unwrap().to_string(), text, "{line}");
+    }
+    let rig = Rig::new();
+    rig.program(
+        "comb.nc",
+        "P1=4\nP2=10\nP2+=P1 P2*=3 P2-=2\nP2/=P1\nX[P2] F100\nM30\n",
+    );
+    let r = rig.run("comb.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    assert!((r.position('X') - 10.0).abs() < 1e-9, "{}", r.position('X'));
+    for (prog, code) in [
+        (
+            "P1=0\nP2=1\nP2/=P1\nM30\n",
+            codes::COMBINED_DIVISION_BY_ZERO,
+        ),
+        (
+            "P1=0\nP2=1\nP2/=[1/P1]\nM30\n",
+            codes::EVAL_DIVISION_BY_ZERO,
+        ),
+    ] {
+        rig.program("div.nc", prog);
+        let r = rig.run("div.nc", None, 100_000);
+        assert_eq!(r.error_codes(), [u64::from(code)], "{prog}: {}", r.log);
+    }
+}
+
 /// Channel time from the start of the block `text` to the start of the next block.
 fn block_duration(r: &common::RunResult, text: &str) -> f64 {
     let blocks = r.of("block");

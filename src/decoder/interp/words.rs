@@ -128,7 +128,18 @@ impl Interpreter {
     /// of the block may read them.
     fn collect(&mut self, it: &Item, w: &mut Words) -> Res {
         match it {
-            Item::Assign { target, value, col } => self.assign(target, value, *col),
+            Item::Assign {
+                target,
+                value,
+                col,
+                op: None,
+            } => self.assign(target, value, *col),
+            Item::Assign {
+                target,
+                value,
+                col,
+                op: Some(op),
+            } => self.combined_assign(target, *op, value, *col),
             Item::GValue { g, value, col } => {
                 // G132..G134 weight ramps (no effect here); G04's value is its time.
                 let v = match value {
@@ -232,6 +243,30 @@ impl Interpreter {
                 }
             }),
         }
+    }
+
+    /// `P2/=P1`, `P1+=2`: the target's value with the operand by `op`, assigned as `P2=P2/P1`
+    /// would be. The operand is a number; `/=` by 0 is the kernel's 20574 (TF5200 diagnosis
+    /// ID 20574 "Division by 0.", of "the combined assignment operator /=").
+    fn combined_assign(
+        &mut self,
+        target: &VarRef,
+        op: crate::lang::block::BinOp,
+        value: &crate::lang::block::Expr,
+        col: u32,
+    ) -> Res {
+        use crate::lang::block::{BinOp, Expr};
+        let operand = self.eval(value).map_err(|e| e.at(col))?;
+        if op == BinOp::Div && operand == 0.0 {
+            return Err(DecodeError::new(
+                codes::COMBINED_DIVISION_BY_ZERO,
+                "division by 0 in the combined assignment /=",
+            )
+            .at(col));
+        }
+        let old = Expr::Var(Box::new(target.clone()));
+        let new = Expr::Binary(op, Box::new(old), Box::new(Expr::Num(operand)));
+        self.assign(target, &new, col)
     }
 
     /// `X1=10`: the axis whose configured name it is (resolved at set-up), as its slot's
