@@ -10,7 +10,6 @@ use crate::lang::block::{Block, Body, Control, GotoTarget, Label};
 use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
-use super::frame::FrameKind;
 use super::line::{LineMeta, LinePos};
 use super::note::Note;
 use super::vars::VarSlot;
@@ -667,20 +666,14 @@ impl Flow {
     }
 
     /// The end of a file reached while a false branch (or a skipped case or loop) waits for
-    /// its structure's end: an invalid control block still open (TF5200 diagnosis IDs 21500,
-    /// 21501, 21502: "There are pending invalid control blocks at local subroutine / main
-    /// program / global subroutine end."). `None` when no such skip is under way.
-    pub(super) fn open_invalid_block(&self, kind: FrameKind) -> Option<DecodeError> {
+    /// its structure's end: an invalid control block still open, `code` for the kind of
+    /// program whose `end` it is (TF5200 diagnosis IDs 21500, 21501, 21502: "There are
+    /// pending invalid control blocks at local subroutine / main program / global subroutine
+    /// end."). `None` when no such skip is under way.
+    pub(super) fn open_invalid_block(&self, code: u32, end: &str) -> Option<DecodeError> {
         if !self.skips_structure() {
             return None;
         }
-        let (code, end) = match kind {
-            FrameKind::Main => (codes::OPEN_INVALID_BLOCK_MAIN, "main program"),
-            FrameKind::Local => (codes::OPEN_INVALID_BLOCK_LOCAL, "local subroutine"),
-            FrameKind::Global | FrameKind::Cycle => {
-                (codes::OPEN_INVALID_BLOCK_GLOBAL, "global subroutine")
-            }
-        };
         let (open, close) = self.stack.last().map_or(("$", "end"), FlowEntry::keywords);
         Some(DecodeError::new(
             code,

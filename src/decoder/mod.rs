@@ -571,7 +571,14 @@ impl Decoder {
                 "block search target not found",
             ));
         }
-        if let Some(e) = top.flow().open_invalid_block(top.kind()) {
+        let (code, end) = match top.kind() {
+            FrameKind::Main => (codes::OPEN_INVALID_BLOCK_MAIN, "main program"),
+            FrameKind::Local => (codes::OPEN_INVALID_BLOCK_LOCAL, "local subroutine"),
+            FrameKind::Global | FrameKind::Cycle => {
+                (codes::OPEN_INVALID_BLOCK_GLOBAL, "global subroutine")
+            }
+        };
+        if let Some(e) = top.flow().open_invalid_block(code, end) {
             return Err(e);
         }
         match top.kind() {

@@ -461,6 +461,19 @@ fn feed_per_revolution_is_f_times_s_and_needs_s() {
     assert!(r.log.contains("needs a spindle speed"), "{}", r.log);
 }
 
+/// A G01 block without F that does not move is no motion block and runs (the TF5200 example
+/// of ID 21500 starts its main program with `N010 X0 Y0 Z0`); the first one that moves is
+/// 20008 (TF5200 diagnosis ID 20008 "Feed rate in motion block is 0.").
+#[test]
+fn g01_without_feed_is_20008_only_when_it_moves() {
+    let rig = Rig::new();
+    rig.program("still.nc", "G1 X0 Y0 Z0\nG91 X0\nG90 X5\nM30\n");
+    let r = rig.run("still.nc", None, 100_000);
+    assert_eq!(r.error_codes(), [u64::from(codes::NO_FEED)], "{}", r.log);
+    assert_eq!(r.of("error")[0]["line"].as_u64(), Some(3));
+    assert_eq!(r.position('X'), 0.0);
+}
+
 #[test]
 fn g92_makes_the_current_position_the_programmed_one() {
     let rig = Rig::new();

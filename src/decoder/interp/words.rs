@@ -65,7 +65,7 @@ impl Interpreter {
         // Step 4: the block's move (not yet queued), if it has one.
         let mv = if gs.dwell || gs.set_reference {
             None
-        } else if let Some(end) = self.target(w, gs) {
+        } else if let Some(end) = self.target(w, gs).filter(|&e| !self.stands_without_feed(e)) {
             let mut mv = self.motion(w, end)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
@@ -496,6 +496,16 @@ impl Interpreter {
                 self.modal.g92_offset[i] = here - v * self.length_scale(i);
             }
         }
+    }
+
+    /// A G01 block that ends where it starts while no feed is programmed: it does not move,
+    /// so it is no motion block and needs no F (TF5200 diagnosis ID 20008 "Feed rate in
+    /// motion block is 0." is of a block that moves; the local subroutine example of ID
+    /// 21500 runs `N010 X0 Y0 Z0` at program start without one).
+    fn stands_without_feed(&self, end: Position) -> bool {
+        self.modal.motion == MotionMode::Linear
+            && end == self.modal.pos
+            && self.path_feed().is_err()
     }
 
     /// The path feed for G1/G2/G3, mm/min: F under G94, F × S under G95.
