@@ -11,6 +11,7 @@ use crate::lang::{Expr, VarRef};
 
 use super::error::{DecodeError, Res};
 use super::line::{LineMeta, LinePos};
+use super::note::Note;
 use super::vars::VarSlot;
 use crate::lang::codes;
 use crate::lang::control::{
@@ -42,6 +43,18 @@ pub(crate) enum FlowEntry {
 }
 
 impl FlowEntry {
+    /// The statements that open and close this structure, for messages.
+    fn keywords(&self) -> (&'static str, &'static str) {
+        match self {
+            FlowEntry::If { .. } => ("$IF", "$ENDIF"),
+            FlowEntry::Switch { .. } => ("$SWITCH", "$ENDSWITCH"),
+            FlowEntry::For { .. } => ("$FOR", "$ENDFOR"),
+            FlowEntry::While { .. } => ("$WHILE", "$ENDWHILE"),
+            FlowEntry::Do { .. } => ("$DO", "$ENDDO"),
+            FlowEntry::Repeat { .. } => ("$REPEAT", "$UNTIL"),
+        }
+    }
+
     pub(crate) fn is_loop(&self) -> bool {
         matches!(
             self,
@@ -635,14 +648,41 @@ impl Flow {
         }
     }
 
-    pub(super) fn check_open_flow(&self) -> Res {
-        if !self.stack.is_empty() {
-            return Err(DecodeError::new(
-                codes::OPEN_CONTROL_BLOCK,
-                "open control blocks at program end",
-            ));
+    /// M30/M02 in the main program or M17/M29 in a subroutine with control blocks still open
+    /// whose branch ran (no `$ENDIF` after a true `$IF`): the warning 20375, and the program
+    /// or subroutine ends as programmed (TF5200 diagnosis ID 20375 "There are valid open
+    /// control blocks at program end.", class 1: processing continues).
+    pub(super) fn warn_open_flow(&self, notes: &mut Vec<Note>) {
+        if let Some(innermost) = self.stack.last() {
+            let (open, close) = innermost.keywords();
+            notes.push(Note::Warning {
+                code: codes::OPEN_CONTROL_BLOCK,
+                msg: format!(
+                    "{} open control block(s) at program end: {open} without its {close}",
+                    self.stack.len()
+                ),
+            });
         }
-        Ok(())
+    }
+
+    /// The end of a file reached while a false branch (or a skipped case or loop) waits for
+    /// its structure's end: an invalid control block still open, `code` for the kind of
+    /// program whose `end` it is (TF5200 diagnosis IDs 21500, 21501, 21502: "There are
+    /// pending invalid control blocks at local subroutine / main program / global subroutine
+    /// end."). `None` when no such skip is under way.
+    pub(super) fn open_invalid_block(&self, code: u32, end: &str) -> Option<DecodeError> {
+        if !self.skips_structure() {
+            return None;
+        }
+        let (open, close) = self.stack.last().map_or(("$", "end"), FlowEntry::keywords);
+        Some(DecodeError::new(
+            code,
+            format!(
+                "{} pending invalid control block(s) at {end} end: {open} whose condition is \
+                 false without its {close}",
+                self.stack.len().max(1)
+            ),
+        ))
     }
 }
 

@@ -503,8 +503,11 @@ impl Decoder {
         }
         let block = match parse_block(text) {
             Ok(b) => b,
-            // A syntax error in a skipped line never runs, so it is no error.
-            Err(_) if skipping => return Ok(()),
+            // A syntax error in a skipped line never runs, so it is no error; but the skip
+            // reads every `$` statement to find its structure's end, so a malformed one is
+            // an error there too (docs/design-choices.md, "Malformed $ statements in
+            // skipped lines").
+            Err(e) if skipping && !codes::is_control_statement_fault(e.code) => return Ok(()),
             Err(e) => return Err(e.into()),
         };
         if stream {
@@ -553,7 +556,7 @@ impl Decoder {
             Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
             Body::ProgramHead { .. } if rd.current().kind() == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
-                rd.top().flow().check_open_flow()?;
+                rd.top().flow().warn_open_flow(notes);
                 ip.return_from_subroutine(rd, notes);
                 ip.resume_held_end(rd, notes, io)
             }
@@ -580,6 +583,16 @@ impl Decoder {
                 codes::SEARCH_NOT_FOUND,
                 "block search target not found",
             ));
+        }
+        let (code, end) = match top.kind() {
+            FrameKind::Main => (codes::OPEN_INVALID_BLOCK_MAIN, "main program"),
+            FrameKind::Local => (codes::OPEN_INVALID_BLOCK_LOCAL, "local subroutine"),
+            FrameKind::Global | FrameKind::Cycle => {
+                (codes::OPEN_INVALID_BLOCK_GLOBAL, "global subroutine")
+            }
+        };
+        if let Some(e) = top.flow().open_invalid_block(code, end) {
+            return Err(e);
         }
         match top.kind() {
             FrameKind::Main => Err(DecodeError::new(

@@ -58,10 +58,15 @@ pub enum Item {
     Word(Word),
     /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`. The target is boxed to keep `Item` at 48 bytes:
     /// plain word blocks are the hot path and their item lists are allocated per block.
+    ///
+    /// `op` is the operator of a combined assignment, `P2/=P1` (TF5200 diagnosis ID 20574
+    /// names "the combined assignment operator /="): `+=`, `-=`, `*=` or `/=`; the new value
+    /// is the target's old one with `value` by `op`. `None` for a plain `=`.
     Assign {
         target: Box<VarRef>,
         value: Expr,
         col: u32,
+        op: Option<BinOp>,
     },
     /// A G function with a value: `G133=50`, `G134=50` (ramp time weighting in percent), and
     /// the dwell `G04 2.5` / `G04=2.5` / `G04 P1` (seconds). `G134 50` and `G134=50` both

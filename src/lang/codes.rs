@@ -19,6 +19,12 @@ pub const WRITE_REJECTED: u32 = 11012;
 /// G1/G2/G3 with path feed 0: no F programmed, or G95 without a spindle speed (TF5200
 /// diagnosis ID 20008 "Feed rate in motion block is 0.").
 pub const NO_FEED: u32 = 20008;
+/// G04 with its time given both directly and by an axis, `G04 10 X2` (TF5200 diagnosis ID
+/// 20013 "Dwell time is programmed directly and via coordinate.").
+pub const DWELL_DIRECT_AND_AXIS: u32 = 20013;
+/// G04 with its time given by an axis other than the first main axis, `G04 Y2` (TF5200
+/// diagnosis ID 20014 "Dwell time is not programmed with the coordinate of first axis.").
+pub const DWELL_NOT_FIRST_AXIS: u32 = 20014;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
@@ -27,13 +33,23 @@ pub const ARC_FULL_CIRCLE_BY_RADIUS: u32 = 20034;
 /// The centre computed from R lies outside the data format (TF5200 diagnosis ID 20054, whose
 /// example is `G02 X1 R1000000`).
 pub const ARC_RADIUS_RANGE: u32 = 20054;
+/// G41 and G42 (or one of them twice) in one block (TF5200 diagnosis ID 20114 "Double
+/// programmed selection of tool radius compensation.", whose example is `G41 X10 Y20 G42`).
+pub const TRC_TWICE: u32 = 20114;
 /// Unknown G function (TF5200 diagnosis ID 20131).
 pub const UNKNOWN_G: u32 = 20131;
 /// Unknown M function (TF5200 diagnosis ID 20157).
 pub const UNKNOWN_M: u32 = 20157;
+/// An M function numbered above the self-defined ones ([`MAX_SELF_DEFINED_M`]) that the
+/// channel parameters do not define and that is no internal M function either (TF5200
+/// diagnosis ID 20160 "Unknown internal M-function.", whose example is `M1001`).
+pub const UNKNOWN_INTERNAL_M: u32 = 20160;
 /// H function the channel parameters do not define (kernel id 20162; its TF5200 page was not
 /// read, see [`KERNEL_UNREAD`]).
 pub const UNKNOWN_H: u32 = 20162;
+/// A second D word in one block (TF5200 diagnosis ID 20170 "Double-programmed
+/// D-function.", whose example is `D1 D2`).
+pub const D_TWICE: u32 = 20170;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
 /// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",
@@ -63,6 +79,9 @@ pub const UNEXPECTED_ELSEIF: u32 = 20216;
 pub const UNEXPECTED_ENDIF: u32 = 20218;
 /// `$CASE` outside `$SWITCH` (TF5200 diagnosis ID 20221).
 pub const UNEXPECTED_CASE: u32 = 20221;
+/// `$CASE` with another word after its condition in its block (TF5200 diagnosis ID 20222
+/// "After 'CASE' only the condition is permissible.").
+pub const CASE_NOT_ALONE: u32 = 20222;
 /// `$DEFAULT` outside `$SWITCH` (TF5200 diagnosis ID 20223).
 pub const UNEXPECTED_DEFAULT: u32 = 20223;
 /// `$ENDSWITCH` without its `$SWITCH` (TF5200 diagnosis ID 20225).
@@ -74,6 +93,9 @@ pub const UNEXPECTED_ENDWHILE: u32 = 20237;
 /// `$ENDDO` without its `$DO` (TF5200 diagnosis ID 20240; page not yet read, see
 /// [`KERNEL_UNREAD`]).
 pub const UNEXPECTED_ENDDO: u32 = 20240;
+/// `$ENDDO` with another word after its condition in its block (TF5200 diagnosis ID 20241
+/// "After 'ENDDO' only the condition is permissible.").
+pub const ENDDO_NOT_ALONE: u32 = 20241;
 /// `$BREAK` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20243).
 pub const UNEXPECTED_BREAK: u32 = 20243;
 /// `$CONTINUE` outside a loop or `$SWITCH` (TF5200 diagnosis ID 20244).
@@ -81,6 +103,9 @@ pub const UNEXPECTED_CONTINUE: u32 = 20244;
 /// `$UNTIL` without its `$REPEAT` (TF5200 diagnosis ID 21469; page not yet read, see
 /// [`KERNEL_UNREAD`]).
 pub const UNEXPECTED_UNTIL: u32 = 21469;
+/// `$UNTIL` with another word after its condition in its block (TF5200 diagnosis ID 21470
+/// "After 'UNTIL' only the condition is permissible.").
+pub const UNTIL_NOT_ALONE: u32 = 21470;
 /// Subroutine calls nested deeper than `decoder.max_subroutine_depth` (TF5200 diagnosis ID
 /// 20360 "Stack overflow for global sub-routines."; ncchannel counts local calls too).
 pub const NESTING_TOO_DEEP: u32 = 20360;
@@ -90,7 +115,8 @@ pub const MAIN_NOT_FOUND: u32 = 20368;
 pub const SUBROUTINE_NOT_FOUND: u32 = 20369;
 /// Local subroutine not found (TF5200 diagnosis ID 20373).
 pub const LOCAL_SUB_NOT_FOUND: u32 = 20373;
-/// Control blocks still open at program end (TF5200 diagnosis ID 20375).
+/// A warning: control blocks whose branch ran still open at the program's or a subroutine's
+/// end; it ends as programmed (TF5200 diagnosis ID 20375, class 1: processing continues).
 pub const OPEN_CONTROL_BLOCK: u32 = 20375;
 /// M17/M29 where no subroutine runs (TF5200 diagnosis ID 20376).
 pub const UNEXPECTED_SUB_END: u32 = 20376;
@@ -107,10 +133,21 @@ pub const EVAL_LOG_NON_POSITIVE: u32 = 20399;
 /// its TwinCAT 2 edition quotes the message, "program end reached without restart mark
 /// found". The diagnosis page of ID 20704 itself was not in the index searched.
 pub const SEARCH_NOT_FOUND: u32 = 20704;
+/// The combined assignment `/=` with a divisor of 0, `P2/=P1` (TF5200 diagnosis ID 20574
+/// "Division by 0."); a `/` inside an expression is [`EVAL_DIVISION_BY_ZERO`].
+pub const COMBINED_DIVISION_BY_ZERO: u32 = 20574;
 /// `#FLUSH` while tool radius compensation G41/G42 is active (TF5200 diagnosis ID 20651 "NC
 /// command is not allowed during active TRC.", which lists `#FLUSH`; its sibling ID 90050 is
 /// the flush right after G40 before a motion block, a state ncchannel does not have).
 pub const FLUSH_UNDER_TRC: u32 = 20651;
+/// A warning: G04 with further axes beside the first main axis, `G04 X2 Y3`; the dwell takes
+/// X's time and the other axes do not move (TF5200 diagnosis ID 20685 "Dwell time
+/// programmed with additional axes.", class 1, processing continues).
+pub const DWELL_EXTRA_AXES: u32 = 20685;
+/// The same technology M function twice in one block, `M10 M10` (TF5200 diagnosis ID 20765
+/// "Double-programmed M-function.", channel-specific). The program-flow M functions
+/// ([`PROGRAM_FLOW_M`]) are not technology functions and are not checked here.
+pub const M_TWICE: u32 = 20765;
 /// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
 /// ID 20721 "Number of parameters and the number of format specifiers do not match.").
 pub const MSG_ARG_COUNT: u32 = 20721;
@@ -160,6 +197,14 @@ pub const STREAM_BACKWARD_JUMP: u32 = 21477;
 pub const STREAM_LOOP: u32 = 21478;
 /// Local subroutine call (LL) in a streaming program (TF5200 diagnosis ID 21479).
 pub const STREAM_LOCAL_CALL: u32 = 21479;
+/// A false branch (or a skipped case or loop) still waiting for its end statement when the
+/// file of a local subroutine ends (TF5200 diagnosis ID 21500 "There are pending invalid
+/// control blocks at local subroutine end.").
+pub const OPEN_INVALID_BLOCK_LOCAL: u32 = 21500;
+/// As [`OPEN_INVALID_BLOCK_LOCAL`], at the main program's end (TF5200 diagnosis ID 21501).
+pub const OPEN_INVALID_BLOCK_MAIN: u32 = 21501;
+/// As [`OPEN_INVALID_BLOCK_LOCAL`], at a global subroutine's end (TF5200 diagnosis ID 21502).
+pub const OPEN_INVALID_BLOCK_GLOBAL: u32 = 21502;
 /// Invalid `#CACHE` programming (TF5200 diagnosis ID 21560).
 pub const CACHE_SYNTAX: u32 = 21560;
 /// Double programming inside one `#CACHE` command (TF5200 diagnosis ID 21561).
@@ -243,12 +288,12 @@ pub const BAD_VALUE: u32 = 900132;
 /// of the ISG dialect that ncchannel does not model: refused by name rather than given a
 /// wrong meaning (docs/nc-language.md lists them).
 pub const UNSUPPORTED: u32 = 900133;
-/// A dwell (G04) with any other word in its block: refused. The kernel's TF5200 diagnosis ID
-/// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
-/// which the kernel goes on; ours refuses every word, so it keeps its own id.
+/// A dwell (G04) with a word other than its time and axes in its block (an M, a second G, an
+/// assignment, F or S beside the time): refused. The axes have the kernel's ids
+/// ([`DWELL_DIRECT_AND_AXIS`], [`DWELL_NOT_FIRST_AXIS`], [`DWELL_EXTRA_AXES`]).
 pub const DWELL_NOT_ALONE: u32 = 900134;
-/// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
-/// axis [`AXIS_TWICE`]).
+/// T, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], D
+/// [`D_TWICE`], an axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
 /// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
 pub const MSG_TOO_LONG: u32 = 900136;
@@ -265,20 +310,42 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
     match letter.to_ascii_uppercase() {
         b'F' => F_TWICE,
         b'S' => S_TWICE,
+        b'D' => D_TWICE,
         _ => WORD_TWICE,
     }
+}
+
+/// Is `code` a `$` statement's own fault ([`UNEXPECTED_ELSEIF`] for a `$ELSEIF` without its
+/// condition, [`CASE_NOT_ALONE`], [`ENDDO_NOT_ALONE`], [`UNTIL_NOT_ALONE`]) rather than a
+/// general syntax error? Such a line is refused even where it is skipped.
+pub(crate) fn is_control_statement_fault(code: u32) -> bool {
+    matches!(
+        code,
+        UNEXPECTED_ELSEIF | CASE_NOT_ALONE | ENDDO_NOT_ALONE | UNTIL_NOT_ALONE
+    )
 }
 
 /// Every error id ncchannel can emit, with a short meaning: the constants above, once each.
 pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
     (NO_FEED, "feed 0 in a motion block"),
+    (DWELL_DIRECT_AND_AXIS, "dwell time direct and by an axis"),
+    (
+        DWELL_NOT_FIRST_AXIS,
+        "dwell time not by the first main axis",
+    ),
     (ARC_CENTER_RANGE, "circle centre outside the data format"),
     (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
     (ARC_RADIUS_RANGE, "centre from R outside the data format"),
+    (TRC_TWICE, "G41/G42 twice in a block"),
     (UNKNOWN_G, "unknown G function"),
     (UNKNOWN_M, "unknown M function"),
+    (
+        UNKNOWN_INTERNAL_M,
+        "M above the self-defined range, not internal",
+    ),
     (UNKNOWN_H, "unknown H function"),
+    (D_TWICE, "D twice in a block"),
     (F_TWICE, "F twice in a block"),
     (S_TWICE, "S twice in a block"),
     (SYNTAX, "syntax"),
@@ -290,22 +357,29 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNEXPECTED_ELSEIF, "unexpected $ELSEIF"),
     (UNEXPECTED_ENDIF, "unexpected $ENDIF"),
     (UNEXPECTED_CASE, "unexpected $CASE"),
+    (CASE_NOT_ALONE, "words after the $CASE condition"),
     (UNEXPECTED_DEFAULT, "unexpected $DEFAULT"),
     (UNEXPECTED_ENDSWITCH, "unexpected $ENDSWITCH"),
     (UNEXPECTED_ENDFOR, "unexpected $ENDFOR"),
     (UNEXPECTED_ENDWHILE, "unexpected $ENDWHILE"),
     (UNEXPECTED_ENDDO, "unexpected $ENDDO"),
+    (ENDDO_NOT_ALONE, "words after the $ENDDO condition"),
     (UNEXPECTED_BREAK, "unexpected $BREAK"),
     (UNEXPECTED_CONTINUE, "unexpected $CONTINUE"),
     (UNEXPECTED_UNTIL, "unexpected $UNTIL"),
+    (UNTIL_NOT_ALONE, "words after the $UNTIL condition"),
     (NESTING_TOO_DEEP, "subroutine nesting too deep"),
     (MAIN_NOT_FOUND, "main program not found"),
     (SUBROUTINE_NOT_FOUND, "global subroutine not found"),
     (LOCAL_SUB_NOT_FOUND, "local subroutine not found"),
-    (OPEN_CONTROL_BLOCK, "open control blocks at program end"),
+    (
+        OPEN_CONTROL_BLOCK,
+        "open control blocks at program end: a warning",
+    ),
     (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
     (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
+    (COMBINED_DIVISION_BY_ZERO, "combined assignment /= by zero"),
     (VARIABLE_UNKNOWN, "V.E. variable not declared"),
     (VARIABLE_READ_DENIED, "V.E. variable WRITE_ONLY read"),
     (VARIABLE_WRITE_DENIED, "V.E. variable READ_ONLY written"),
@@ -315,6 +389,11 @@ pub const EMITTED: &[(u32, &str)] = &[
     ),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
+    (
+        DWELL_EXTRA_AXES,
+        "dwell with further axes: they do not move",
+    ),
+    (M_TWICE, "the same technology M function twice in a block"),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
     (MSG_TOO_MANY_VALUES, "#MSG with too many format elements"),
     (MSG_NO_VALUE, "#MSG comma without a value"),
@@ -334,6 +413,18 @@ pub const EMITTED: &[(u32, &str)] = &[
     (STREAM_LOOP, "stream: loop"),
     (STREAM_LOCAL_CALL, "stream: LL call"),
     (SEARCH_NOT_FOUND, "block search target not found"),
+    (
+        OPEN_INVALID_BLOCK_LOCAL,
+        "false branch open at local subroutine end",
+    ),
+    (
+        OPEN_INVALID_BLOCK_MAIN,
+        "false branch open at main program end",
+    ),
+    (
+        OPEN_INVALID_BLOCK_GLOBAL,
+        "false branch open at global subroutine end",
+    ),
     (CACHE_SYNTAX, "#CACHE invalid"),
     (CACHE_DOUBLE, "#CACHE double programming"),
     (CACHE_FULL, "file cache full"),
@@ -371,7 +462,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (BAD_VALUE, "value out of range"),
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
-    (WORD_TWICE, "T, D, I, J, K, R or E twice in a block"),
+    (WORD_TWICE, "T, I, J, K, R or E twice in a block"),
     (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
@@ -391,6 +482,14 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
     (20008, "Feed rate in motion block is 0."), // 250515083
     (
+        20013,
+        "Dwell time is programmed directly and via coordinate.",
+    ), // 250532491
+    (
+        20014,
+        "Dwell time is not programmed with the coordinate of first axis.",
+    ), // 250536843
+    (
         20020,
         "Circle centre point parameter outside permissible data format.",
     ), // 250558603
@@ -404,7 +503,13 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 1031: 250663051
     (20097, "Variable lesen nicht erlaubt."), // 1031: 250750091
     (20100, "Write access to variable denied."), // 250758795
+    (
+        20114,
+        "Double programmed selection of tool radius compensation.",
+    ), // 250815371
     (20131, "Unknown G function"),       // named so on the page of ID 20107, 250784907
+    (20160, "Unknown internal M-function."), // 250945931
+    (20170, "Double-programmed D-function."), // 250985099
     (20175, "Double-programmed F-word."), // 250998155
     (20181, "Double-programmed spindle."), // 251019915
     (20203, "Double-programmed axis."),  // 251085195
@@ -432,6 +537,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         20221,
         "Unexpected CASE. Does not match the current control block.",
     ), // 251154827
+    (20222, "After 'CASE' only the condition is permissible."), // 251159179
     (
         20223,
         "Unexpected DEFAULT. Does not match the current control block.",
@@ -448,6 +554,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         20237,
         "Unexpected ENDWHILE. Does not match the current control block.",
     ), // 251224459
+    (20241, "After 'ENDDO' only the condition is permissible."), // 251241867
     (20243, "Unexpected 'BREAK'. No valid/open control blocks."), // 251250571
     (
         20244,
@@ -457,7 +564,10 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20375, "There are valid open control blocks at program end."), // 251459467
     (20396, "Division by 0."),           // 251507339
     (20399, "Logarithm less than/equal 0."), // 251520395
+    (20574, "Division by 0."),           // 251868555
     (20651, "NC command is not allowed during active TRC."), // 252112267
+    (20685, "Dwell time programmed with additional axes."), // 252216715
+    (20765, "Double-programmed M-function."), // 252469131
     (20704, "program end reached without restart mark found"), // blocksearch/15328482315
     (
         20721,
@@ -485,6 +595,19 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         21476,
         "Streaming data does not contain a correct line end marker",
     ), // tf5200_data_streaming/222589963
+    (21470, "After 'UNTIL' only the condition is permissible."), // 254806155
+    (
+        21500,
+        "There are pending invalid control blocks at local subroutine end.",
+    ), // 254941067
+    (
+        21501,
+        "There are pending invalid control blocks at main program end.",
+    ), // 254945419
+    (
+        21502,
+        "There are pending invalid control blocks at global subroutine end.",
+    ), // 254949771
     (21477, "Backward jump during streaming not allowed."), // 254836619
     (21478, "Loop during streaming not allowed."), // 254840971
     (
@@ -630,6 +753,17 @@ pub(crate) fn is_known_m(m: u32) -> bool {
 
 /// M and H functions: 0 to 65,535 (TF5200 "User-specific technology functions (M/H)").
 pub(crate) const MAX_M_H: u32 = 65_535;
+
+/// The highest self-defined M function: the kernel's table of them has 1000 entries
+/// (TF5200 channel parameters, P-CHAN-00041: `m_synch[i]` with i = 0 … 999). An undefined M
+/// above it is [`UNKNOWN_INTERNAL_M`], one up to it [`UNKNOWN_M`]; ncchannel's lists may define
+/// M functions above it too (docs/design-choices.md).
+pub(crate) const MAX_SELF_DEFINED_M: u32 = 999;
+
+/// The M functions with the kernel's own meaning for the program's flow: the stops M00/M01,
+/// the program ends M02/M30 and the subroutine ends M17/M29 (TF5200 programming manual,
+/// "User-specific M/H functions": the predefined M functions).
+pub(crate) const PROGRAM_FLOW_M: [u32; 6] = [0, 1, 2, 17, 29, 30];
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -92,7 +92,12 @@ impl Display for Item {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
         match self {
             Item::Word(w) => w.fmt(f),
-            Item::Assign { target, value, .. } => write!(f, "{target}={value}"),
+            Item::Assign {
+                target, value, op, ..
+            } => {
+                let op = op.map_or("", BinOp::symbol);
+                write!(f, "{target}{op}={value}")
+            }
             Item::GValue { g, value, .. } => match value {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),
                 Value::Expr(e) => write!(f, "G{g}={e}"),

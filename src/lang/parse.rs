@@ -338,14 +338,19 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             let (r, target) = ctx.var_ref(i)?;
             writable(&target, i)?;
             let r = ws(r);
-            let Some(r) = r.strip_prefix('=') else {
-                return Err(perr(r, SYNTAX, "`=` expected after the parameter"));
+            let (r, op) = match r.strip_prefix('=') {
+                Some(r) => (r, None),
+                None => match combined_assignment(r) {
+                    Some((r, op)) => (r, Some(op)),
+                    None => return Err(perr(r, SYNTAX, "`=` expected after the parameter")),
+                },
             };
             let (r, value) = ctx.expr(ws(r))?;
             items.push(Item::Assign {
                 target: Box::new(target),
                 value,
                 col,
+                op,
             });
             i = r;
         } else {
@@ -366,6 +371,20 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             return Err(perr(i, code, msg));
         }
     }
+}
+
+/// A combined assignment operator at `i`, `+=` `-=` `*=` `/=` (TF5200 diagnosis ID 20574:
+/// "the combined assignment operator /="), and the rest after it.
+fn combined_assignment(i: &str) -> Option<(&str, super::block::BinOp)> {
+    use super::block::BinOp;
+    let op = match i.as_bytes() {
+        [b'+', b'=', ..] => BinOp::Add,
+        [b'-', b'=', ..] => BinOp::Sub,
+        [b'*', b'=', ..] => BinOp::Mul,
+        [b'/', b'=', ..] => BinOp::Div,
+        _ => return None,
+    };
+    Some((&i[2..], op))
 }
 
 /// Is this item the dwell `G04` (with or without its value)?
@@ -400,21 +419,56 @@ fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
 
 /// A dwell stands alone in its block (TF5200 G04): besides `G04` only its time, as `G04 <t>`,
 /// `G04 P1` (a parameter's value), `G04 X<t>` or `G04 F<t>`, or its spindle revolutions
-/// `G04 S<n>`. Anything else — a second G, an M, another axis — is refused rather than
-/// executed as a move or a feed.
+/// `G04 S<n>`. Anything else — a second G, an M — is refused rather than executed as a move
+/// or a feed. Axes have the kernel's ids (TF5200 diagnosis): a time given directly and by an
+/// axis is 20013 (`G04 10 X2`), an axis without the first main axis 20014 (`G04 Y2`); further
+/// axes beside X (`G04 X2 Y3`) pass here and are the decoder's warning 20685. A named axis
+/// (`X1=2`) passes too: only the channel knows whether it is the first main axis.
 fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a>>> {
-    let mut time_given = items
+    use super::codes::{DWELL_DIRECT_AND_AXIS, DWELL_NOT_FIRST_AXIS};
+    let direct = items
         .iter()
         .any(|it| matches!(it, Item::GValue { g: 4, .. }));
+    let first_axis = items
+        .iter()
+        .any(|it| matches!(it, Item::Word(w) if w.letter == b'X'));
+    let mut time_given = direct;
     for it in items {
         if is_dwell(it) {
             continue;
+        }
+        let axis_col = match it {
+            Item::Word(w) if crate::vocab::axis::slot_of(w.letter).is_some() => Some(w.col),
+            Item::NamedAxis(a) => Some(a.col),
+            _ => None,
+        };
+        if let Some(col) = axis_col.filter(|_| direct) {
+            return Err(ctx.err_at(
+                col,
+                DWELL_DIRECT_AND_AXIS,
+                "dwell time programmed directly and via coordinate",
+            ));
         }
         let (col, what) = match it {
             Item::Word(w) if matches!(w.letter, b'X' | b'F' | b'S') && !time_given => {
                 time_given = true;
                 continue;
             }
+            Item::Word(w) if w.letter != b'X' && axis_col.is_some() => {
+                if !first_axis {
+                    return Err(ctx.err_at(
+                        w.col,
+                        DWELL_NOT_FIRST_AXIS,
+                        format!(
+                            "dwell time not programmed with the coordinate of the first axis X \
+                             but of {}",
+                            w.letter as char
+                        ),
+                    ));
+                }
+                continue;
+            }
+            Item::NamedAxis(_) => continue,
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
             Item::Assign { col, .. } => (*col, "an assignment".to_string()),
             Item::GValue { g, col, .. } => (*col, format!("G{g}")),
@@ -425,7 +479,6 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
-            Item::NamedAxis(a) => (a.col, a.name.to_string()),
         };
         return Err(ctx.err_at(
             col,
@@ -832,6 +885,28 @@ fn keyword_after<'a>(i: &'a str, buf: &mut [u8; 16]) -> Option<(&'a str, usize)>
     Some((rest, kw.len()))
 }
 
+/// The condition of `$CASE`, `$ENDDO` or `$UNTIL` and nothing after it: another word in its
+/// block is the kernel's "After 'CASE' (… 'ENDDO', 'UNTIL') only the condition is
+/// permissible." (TF5200 diagnosis IDs 20222, 20241, 21470), at that word.
+fn only_condition<'a>(ctx: &Ctx<'a>, i: &'a str, keyword: &'static str) -> PResult<'a, Expr> {
+    use super::codes::{CASE_NOT_ALONE, ENDDO_NOT_ALONE, UNTIL_NOT_ALONE};
+    let (r, e) = ctx.expr(i)?;
+    let rest = gap(r);
+    if rest.is_empty() {
+        return Ok((r, e));
+    }
+    let code = match keyword {
+        "$CASE" => CASE_NOT_ALONE,
+        "$ENDDO" => ENDDO_NOT_ALONE,
+        _ => UNTIL_NOT_ALONE,
+    };
+    fail(
+        rest,
+        code,
+        format!("only the condition may follow {keyword} in its block"),
+    )
+}
+
 fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
     let after = &i[1..];
     let mut buf = [0u8; 16];
@@ -852,12 +927,21 @@ fn control<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Control> {
             }
             return Ok((r, Control::If(cond)));
         }
+        b"ELSEIF" if gap(r).is_empty() => {
+            // An incomplete `$ELSEIF` (TF5200 diagnosis ID 20216: "A control block statement
+            // was programmed in incomplete syntax", whose wrong program is `$ELSEIF` alone).
+            return fail(
+                i,
+                super::codes::UNEXPECTED_ELSEIF,
+                "$ELSEIF without its condition",
+            );
+        }
         b"ELSEIF" => return ctx.expr(r).map(|(r, e)| (r, Control::ElseIf(e))),
         b"SWITCH" => return ctx.expr(r).map(|(r, e)| (r, Control::Switch(e))),
-        b"CASE" => return ctx.expr(r).map(|(r, e)| (r, Control::Case(e))),
+        b"CASE" => return only_condition(ctx, r, "$CASE").map(|(r, e)| (r, Control::Case(e))),
         b"WHILE" => return ctx.expr(r).map(|(r, e)| (r, Control::While(e))),
-        b"ENDDO" => return ctx.expr(r).map(|(r, e)| (r, Control::EndDo(e))),
-        b"UNTIL" => return ctx.expr(r).map(|(r, e)| (r, Control::Until(e))),
+        b"ENDDO" => return only_condition(ctx, r, "$ENDDO").map(|(r, e)| (r, Control::EndDo(e))),
+        b"UNTIL" => return only_condition(ctx, r, "$UNTIL").map(|(r, e)| (r, Control::Until(e))),
         b"GOTO" => return goto_target(r).map(|(r, t)| (r, Control::Goto(t))),
         b"FOR" => return for_head(ctx, r),
         b"ELSE" => Control::Else,

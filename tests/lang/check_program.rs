@@ -115,6 +115,46 @@ fn stray_control_statements_have_their_own_numbers() {
     );
 }
 
+/// Words after the condition of `$CASE`, `$ENDDO` or `$UNTIL` (TF5200 diagnosis IDs 20222,
+/// 20241, 21470 "After '…' only the condition is permissible.") and a `$ELSEIF` without its
+/// condition (ID 20216, "incomplete syntax"), at the offending word, in `check` and in a run
+/// — also where the run skips the line (a `$CASE` that does not match, a false `$IF`).
+#[test]
+fn words_after_a_control_condition_have_the_kernels_ids() {
+    let cases = [
+        (
+            "$SWITCH 5\n$CASE 5 G01 X100 F100\n$BREAK\n$ENDSWITCH",
+            2,
+            9,
+            20222,
+        ),
+        (
+            "$SWITCH 5\n$CASE 4 G01 X100 F100\n$BREAK\n$ENDSWITCH",
+            2,
+            9,
+            20222,
+        ),
+        ("P2=10\n$DO\n$ENDDO P2 >= 10 G01 X100 F1000", 3, 17, 20241),
+        ("$REPEAT\n$UNTIL P2 > 20 G01 X100 F1000", 2, 16, 21470),
+        ("$IF 0\n$ELSEIF\n$ENDIF", 2, 1, 20216),
+        ("$ELSEIF", 1, 1, 20216),
+    ];
+    let rig = crate::support::Rig::new();
+    for (prog, line, col, code) in cases {
+        let text = format!("{prog}\nM30\n");
+        // (`check` also lists the `$DO` the refused `$ENDDO` leaves open.)
+        assert!(codes(&text).contains(&(line, col, code)), "{prog}");
+        rig.program("ctl.nc", &text);
+        let r = rig.run("ctl.nc", None, 100_000);
+        assert_eq!(r.error_codes(), [u64::from(code)], "{prog}: {}", r.log);
+        assert_eq!(
+            r.of("error")[0]["line"].as_u64(),
+            Some(line as u64),
+            "{prog}"
+        );
+    }
+}
+
 #[test]
 fn well_formed_structures_pass() {
     let text = "\

@@ -226,6 +226,70 @@ fn m_and_h_run_from_0_to_65535_and_h_functions_are_events() {
     assert_eq!(hs, [7, 65535]);
 }
 
+/// Double programming the decoder finds (TF5200 diagnosis): G41 and G42 in one block is
+/// 20114, the same technology M function twice 20765 (`M10 M10`; M30 twice is a program
+/// end, not a technology function); an undefined M above the self-defined M0–M999 is 20160,
+/// one within them 20157.
+#[test]
+fn trc_twice_m_twice_and_unknown_internal_m_have_the_kernels_ids() {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "m_synch[10] MOS\nm_synch[5000] MOS\n",
+    )
+    .unwrap();
+    for (block, code) in [
+        ("G41 X10 Y20 G42", codes::TRC_TWICE),
+        ("G42 G41 X10", codes::TRC_TWICE),
+        ("G0 X10 M10 M10", codes::M_TWICE),
+        ("M1001", codes::UNKNOWN_INTERNAL_M),
+        ("M999", codes::UNKNOWN_M),
+    ] {
+        rig.program("twice.nc", &format!("G0 X0 Y0\n{block}\nM30\n"));
+        let r = rig.run("twice.nc", None, 100_000);
+        assert_eq!(r.error_codes(), [u64::from(code)], "{block}: {}", r.log);
+    }
+    // Defined in the channel's list, an M above M999 runs (docs/design-choices.md).
+    rig.program("ok.nc", "G0 X0 Y0\nM10 M5000\nG41 G40 X1\nM30\n");
+    let r = rig.run("ok.nc", None, 100_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+}
+
+/// The combined assignments `+=`, `-=`, `*=`, `/=` (TF5200 diagnosis ID 20574 names "the
+/// combined assignment operator /="): the target's value with the operand, printed back as
+/// written; `/=` by 0 is 20574, a `/` by 0 inside an expression stays 20396.
+#[test]
+fn combined_assignments_compute_on_the_old_value_and_divide_by_zero_is_20574() {
+    for line in ["P2/=P1", "P2+=[P1*2]", "V.L.X-=1", "P[3]*=2"] {
+        let text = parse_block(line).unwrap().to_string();
+        let (op, _) = line.split_at(line.find('=').unwrap() + 1);
+        assert!(text.starts_with(op), "{line}: {text}");
+        assert_eq!(parse_block(&text).unwrap().to_string(), text, "{line}");
+    }
+    let rig = Rig::new();
+    rig.program(
+        "comb.nc",
+        "P1=4\nP2=10\nP2+=P1 P2*=3 P2-=2\nP2/=P1\nX[P2] F100\nM30\n",
+    );
+    let r = rig.run("comb.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    assert!((r.position('X') - 10.0).abs() < 1e-9, "{}", r.position('X'));
+    for (prog, code) in [
+        (
+            "P1=0\nP2=1\nP2/=P1\nM30\n",
+            codes::COMBINED_DIVISION_BY_ZERO,
+        ),
+        (
+            "P1=0\nP2=1\nP2/=[1/P1]\nM30\n",
+            codes::EVAL_DIVISION_BY_ZERO,
+        ),
+    ] {
+        rig.program("div.nc", prog);
+        let r = rig.run("div.nc", None, 100_000);
+        assert_eq!(r.error_codes(), [u64::from(code)], "{prog}: {}", r.log);
+    }
+}
+
 /// Channel time from the start of the block `text` to the start of the next block.
 fn block_duration(r: &common::RunResult, text: &str) -> f64 {
     let blocks = r.of("block");
@@ -265,6 +329,26 @@ fn each_dwell_form_dwells_its_time() {
     }
 }
 
+/// `G04 X2 Y3 Z4`: X's time, one warning 20685 for each further axis, which does not move
+/// (TF5200 diagnosis ID 20685 "Dwell time programmed with additional axes.", class 1:
+/// processing continues).
+#[test]
+fn g04_with_further_axes_dwells_x_time_and_warns_for_each() {
+    let rig = Rig::new();
+    rig.program("dwell.nc", "G0 Y1 Z1\nG04 X2 Y3 Z4\nG0 X1\nM30\n");
+    let r = rig.run("dwell.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    let t = block_duration(&r, "G04 X2 Y3 Z4");
+    assert!((t - 2.0).abs() < 0.01, "dwelled {t} s");
+    let warnings: Vec<u64> = r
+        .of("warning")
+        .iter()
+        .filter_map(|w| w["code"].as_u64())
+        .collect();
+    assert_eq!(warnings, [u64::from(codes::DWELL_EXTRA_AXES); 2]);
+    assert_eq!((r.position('Y'), r.position('Z')), (1.0, 1.0));
+}
+
 /// `G04 S10` waits ten turns of the main spindle at its programmed speed (TF5200 programming
 /// manual, "Dwell time (G04), (#TIME)": `M3 S200`, `G04 S10` waits 3 s) and leaves the speed
 /// as it was; a spindle that does not turn never completes them: 20752.
@@ -301,10 +385,12 @@ const REFUSED_BLOCKS: &[(&str, u32, u32)] = &[
     ("S1000 M3 S1500", codes::S_TWICE, 10),
     ("G1 X1 F100 F200", codes::F_TWICE, 12),
     ("T1 D1 T2", codes::WORD_TWICE, 7),
+    ("T1 D1 D2", codes::D_TWICE, 7),
     ("G2 X1 Y1 I1 I2 F100", codes::WORD_TWICE, 13),
-    ("G04 Y2", codes::DWELL_NOT_ALONE, 5),
+    ("G04 Y2", codes::DWELL_NOT_FIRST_AXIS, 5),
     ("G4 F1.5 X2", codes::DWELL_NOT_ALONE, 9),
-    ("G04 2 X1", codes::DWELL_NOT_ALONE, 7),
+    ("G04 2 X1", codes::DWELL_DIRECT_AND_AXIS, 7),
+    ("G04 X1 Y2 M3", codes::DWELL_NOT_ALONE, 11),
     ("G04 X1 M3", codes::DWELL_NOT_ALONE, 8),
     ("G1 G04 X1", codes::DWELL_NOT_ALONE, 1),
     ("G33 Z-10 K1.5", codes::UNSUPPORTED, 1),
@@ -373,6 +459,19 @@ fn feed_per_revolution_is_f_times_s_and_needs_s() {
     assert_eq!(r.finish, Some(Finish::Error));
     assert_eq!(r.error_codes(), [u64::from(codes::NO_FEED)]);
     assert!(r.log.contains("needs a spindle speed"), "{}", r.log);
+}
+
+/// A G01 block without F that does not move is no motion block and runs (the TF5200 example
+/// of ID 21500 starts its main program with `N010 X0 Y0 Z0`); the first one that moves is
+/// 20008 (TF5200 diagnosis ID 20008 "Feed rate in motion block is 0.").
+#[test]
+fn g01_without_feed_is_20008_only_when_it_moves() {
+    let rig = Rig::new();
+    rig.program("still.nc", "G1 X0 Y0 Z0\nG91 X0\nG90 X5\nM30\n");
+    let r = rig.run("still.nc", None, 100_000);
+    assert_eq!(r.error_codes(), [u64::from(codes::NO_FEED)], "{}", r.log);
+    assert_eq!(r.of("error")[0]["line"].as_u64(), Some(3));
+    assert_eq!(r.position('X'), 0.0);
 }
 
 #[test]

@@ -250,7 +250,9 @@ fn assignments() {
     let targets: Vec<(&VarRef, &Expr, u32)> = items
         .iter()
         .map(|i| match i {
-            Item::Assign { target, value, col } => (target.as_ref(), value, *col),
+            Item::Assign {
+                target, value, col, ..
+            } => (target.as_ref(), value, *col),
             other => panic!("{other:?}"),
         })
         .collect();

@@ -199,7 +199,7 @@ fn structure_errors_in_files() {
         ("$ELSE\nM30\n", 20214),
         ("$CASE 1\nM30\n", 20221),
         ("$ENDFOR\nM30\n", 20232),
-        ("$IF 1\nX1 F100\nM30\n", 20375),
+        ("$IF 0\nX1 F100\nM30\n", 21501),
         ("M17\n", 20376),
         ("$GOTO [NOWHERE]\nM30\n", 20840),
         ("[A] X1 F100\n[A] X2\n$GOTO [A]\nM30\n", 20836),
@@ -226,6 +226,31 @@ fn subroutines_cycles_locals_and_variables() {
     assert_eq!(r.finish, Some(Finish::Ended), "{:?}", r.of("error"));
     let p = r.machine.channels()[0].report().position;
     assert_eq!((p[0], p[1]), (2.0, 7.0));
+}
+
+/// A control block whose branch ran, still open at M30 or M17, is the warning 20375 and the
+/// program goes on (TF5200 diagnosis ID 20375, class 1); a false branch still waiting for its
+/// end when the file ends is 21501 in the main program, 21502 in a global subroutine, 21500
+/// in a local one (TF5200 diagnosis IDs 21500–21502).
+#[test]
+fn open_control_blocks_at_the_end_valid_warn_invalid_stop() {
+    let rig = rig();
+    rig.program("open.nc", "X1 F100\n$IF 1\nM17\n");
+    rig.program("m.nc", "L open.nc\n$IF 1\nX9\nM30\n");
+    let r = rig.run("m.nc", None, 100_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{:?}", r.of("error"));
+    let warnings: Vec<_> = r.of("warning").iter().map(|w| w["code"].clone()).collect();
+    assert_eq!(warnings, [20375, 20375]);
+    assert!(r.block_texts().contains(&"X9".to_string()));
+    rig.program("invalid.nc", "$IF 0\nX1 F100\nM17\n");
+    for (text, code) in [
+        ("$IF 0\nX1 F100\nM30\n", 21501),
+        ("$SWITCH 2\n$CASE 1\nX1 F100\nM30\n", 21501),
+        ("L invalid.nc\nM30\n", 21502),
+        ("%L S\n$IF 0\nX1 F100\nM17\n%main\nLL S\nM30\n", 21500),
+    ] {
+        assert_eq!(file_errors(&rig, text), [code], "{text:?}");
+    }
 }
 
 #[test]

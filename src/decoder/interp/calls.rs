@@ -237,7 +237,7 @@ impl Interpreter {
         };
         match h.m {
             17 | 29 => {
-                rd.top().flow().check_open_flow()?;
+                rd.top().flow().warn_open_flow(notes);
                 self.return_from_subroutine(rd, notes);
                 self.resume_held_end(rd, notes, io)
             }

@@ -251,6 +251,18 @@ impl TechnoState {
                 continue;
             }
             let def = self.table.m_def(m).ok_or_else(|| {
+                if m > codes::MAX_SELF_DEFINED_M {
+                    // Above the self-defined M functions the kernel looks for an internal
+                    // one (TF5200 diagnosis ID 20160, whose example is `M1001`).
+                    return DecodeError::new(
+                        codes::UNKNOWN_INTERNAL_M,
+                        format!(
+                            "M{m} is above the self-defined M functions (M0 to M{}) and no \
+                             internal M function",
+                            codes::MAX_SELF_DEFINED_M
+                        ),
+                    );
+                }
                 DecodeError::new(
                     codes::UNKNOWN_M,
                     format!("M{m} is not defined in the channel parameters (m_synch[{m}])"),

@@ -65,7 +65,7 @@ impl Interpreter {
         // Step 4: the block's move (not yet queued), if it has one.
         let mv = if gs.dwell || gs.set_reference {
             None
-        } else if let Some(end) = self.target(w, gs) {
+        } else if let Some(end) = self.target(w, gs).filter(|&e| !self.stands_without_feed(e)) {
             let mut mv = self.motion(w, end)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
@@ -94,6 +94,18 @@ impl Interpreter {
         }
         // Step 4 queued: the dwell or the move.
         if gs.dwell {
+            // `G04 X2 Y3`: X's time; each further axis is a warning and does not move
+            // (TF5200 diagnosis ID 20685, class 1: processing continues).
+            for (i, name) in self.settings.axis_names.iter().enumerate() {
+                if w.axes_set & (1 << i) != 0 {
+                    notes.push(Note::Warning {
+                        code: codes::DWELL_EXTRA_AXES,
+                        msg: format!(
+                            "dwell time programmed with additional axes: {name} does not move"
+                        ),
+                    });
+                }
+            }
             let seconds = dwell_seconds(w.dwell_s.unwrap_or(0.0), codes::DWELL_RANGE_G04)?;
             self.emit(info.clone(), Action::Dwell { seconds }, false, io);
             queued = true;
@@ -116,7 +128,18 @@ impl Interpreter {
     /// of the block may read them.
     fn collect(&mut self, it: &Item, w: &mut Words) -> Res {
         match it {
-            Item::Assign { target, value, col } => self.assign(target, value, *col),
+            Item::Assign {
+                target,
+                value,
+                col,
+                op: None,
+            } => self.assign(target, value, *col),
+            Item::Assign {
+                target,
+                value,
+                col,
+                op: Some(op),
+            } => self.combined_assign(target, *op, value, *col),
             Item::GValue { g, value, col } => {
                 // G132..G134 weight ramps (no effect here); G04's value is its time.
                 let v = match value {
@@ -237,6 +260,30 @@ impl Interpreter {
         }
     }
 
+    /// `P2/=P1`, `P1+=2`: the target's value with the operand by `op`, assigned as `P2=P2/P1`
+    /// would be. The operand is a number; `/=` by 0 is the kernel's 20574 (TF5200 diagnosis
+    /// ID 20574 "Division by 0.", of "the combined assignment operator /=").
+    fn combined_assign(
+        &mut self,
+        target: &VarRef,
+        op: crate::lang::block::BinOp,
+        value: &crate::lang::block::Expr,
+        col: u32,
+    ) -> Res {
+        use crate::lang::block::{BinOp, Expr};
+        let operand = self.eval(value).map_err(|e| e.at(col))?;
+        if op == BinOp::Div && operand == 0.0 {
+            return Err(DecodeError::new(
+                codes::COMBINED_DIVISION_BY_ZERO,
+                "division by 0 in the combined assignment /=",
+            )
+            .at(col));
+        }
+        let old = Expr::Var(Box::new(target.clone()));
+        let new = Expr::Binary(op, Box::new(old), Box::new(Expr::Num(operand)));
+        self.assign(target, &new, col)
+    }
+
     /// `X1=10`: the axis whose configured name it is (resolved at set-up), as its slot's
     /// letter would be.
     fn collect_named_axis(&mut self, a: &crate::lang::block::NamedAxis, w: &mut Words) -> Res {
@@ -317,7 +364,19 @@ impl Interpreter {
     fn modal_changes(&mut self, w: &mut Words) -> Res<BlockGs> {
         let mut gs = BlockGs::default();
         let mut call = None;
+        let mut trc_selected = false;
         for &(g, col) in w.gs() {
+            if matches!(g, 41 | 42) {
+                // `G41 X10 Y20 G42`: TF5200 diagnosis ID 20114 "Double programmed selection
+                // of tool radius compensation.".
+                if std::mem::replace(&mut trc_selected, true) {
+                    return Err(DecodeError::new(
+                        codes::TRC_TWICE,
+                        format!("G{g}: tool radius compensation selected twice in the block"),
+                    )
+                    .at(col));
+                }
+            }
             if !apply_g(&mut self.modal, g, &mut gs) {
                 if crate::lang::gcall::G_CALLS.contains(&g) {
                     if call.replace((g, col)).is_some() {
@@ -338,7 +397,16 @@ impl Interpreter {
             w.axes_set = 0;
         }
         if gs.dwell {
-            // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed.
+            // `G04 X<t>` / `G04 F<t>`: the word is the time, not an axis or a feed. The
+            // parser refused a lettered axis without X; a named one (`Y1=2`) is known only
+            // here (TF5200 diagnosis ID 20014). Further axes stay in `axes_set` for the
+            // warning 20685 and do not move.
+            if w.axes_set != 0 && w.axes_set & 1 == 0 {
+                return Err(DecodeError::new(
+                    codes::DWELL_NOT_FIRST_AXIS,
+                    "dwell time not programmed with the coordinate of the first main axis",
+                ));
+            }
             if w.axes_set & 1 != 0 {
                 w.axes_set &= !1;
                 w.dwell_s = Some(w.axes[0]);
@@ -481,6 +549,16 @@ impl Interpreter {
         }
     }
 
+    /// A G01 block that ends where it starts while no feed is programmed: it does not move,
+    /// so it is no motion block and needs no F (TF5200 diagnosis ID 20008 "Feed rate in
+    /// motion block is 0." is of a block that moves; the local subroutine example of ID
+    /// 21500 runs `N010 X0 Y0 Z0` at program start without one).
+    fn stands_without_feed(&self, end: Position) -> bool {
+        self.modal.motion == MotionMode::Linear
+            && end == self.modal.pos
+            && self.path_feed().is_err()
+    }
+
     /// The path feed for G1/G2/G3, mm/min: F under G94, F × S under G95.
     fn path_feed(&self) -> Res<f64> {
         let feed = match self.modal.feed_mode {
@@ -620,7 +698,7 @@ impl Interpreter {
             if !queued {
                 self.emit(info, Action::None, false, io);
             }
-            rd.top().flow().check_open_flow()?;
+            rd.top().flow().warn_open_flow(notes);
             self.return_from_subroutine(rd, notes);
             return self.resume_held_end(rd, notes, io);
         }
@@ -679,7 +757,8 @@ impl Interpreter {
             });
             Ok(())
         } else {
-            rd.top().flow().check_open_flow()
+            rd.top().flow().warn_open_flow(notes);
+            Ok(())
         }
     }
 }
@@ -714,7 +793,15 @@ fn push_function(
         ));
     }
     // The parser admits only whole numbers 0..=65535 for M and H.
-    list[*n] = whole(v).unwrap_or(0);
+    let number = whole(v).unwrap_or(0);
+    if letter == 'M' && list[..*n].contains(&number) && !codes::PROGRAM_FLOW_M.contains(&number) {
+        // `M10 M10`: TF5200 diagnosis ID 20765 "Double-programmed M-function.".
+        return Err(DecodeError::new(
+            codes::M_TWICE,
+            format!("M{number} programmed twice in the block"),
+        ));
+    }
+    list[*n] = number;
     values[*n] = value;
     *n += 1;
     Ok(())
