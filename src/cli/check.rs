@@ -321,7 +321,7 @@ fn channel_techno(path: &Path, channel: u32) -> Result<TechnoTable, Vec<Diagnost
 }
 
 /// The M and H functions of an NC program that `techno` does not define: one error per
-/// number, at its first use (the kernel's 20157 / 20162 when the block is decoded).
+/// number, at its first use (the kernel's 20157 or 20160 / 20162 when the block is decoded).
 fn check_functions_file(path: &Path, techno: &TechnoTable) -> Vec<Diagnostic> {
     // An unreadable file was reported by the program check already.
     let Ok(text) = read_text(path) else {
@@ -331,7 +331,7 @@ fn check_functions_file(path: &Path, techno: &TechnoTable) -> Vec<Diagnostic> {
     let mut diags = Vec::new();
     for f in undefined_functions(&text, techno) {
         let (code, what) = match f.letter {
-            b'M' => (crate::lang::codes::UNKNOWN_M, "m_synch"),
+            b'M' => (crate::lang::codes::unknown_m(f.number), "m_synch"),
             _ => (crate::lang::codes::UNKNOWN_H, "h_synch"),
         };
         let letter = char::from(f.letter);

@@ -760,6 +760,16 @@ pub(crate) const MAX_M_H: u32 = 65_535;
 /// M functions above it too (docs/design-choices.md).
 pub(crate) const MAX_SELF_DEFINED_M: u32 = 999;
 
+/// The id of an M function the channel parameters do not define: 20157, or 20160 above the
+/// self-defined ones, where the kernel looks for an internal M function.
+pub(crate) fn unknown_m(m: u32) -> u32 {
+    if m > MAX_SELF_DEFINED_M {
+        UNKNOWN_INTERNAL_M
+    } else {
+        UNKNOWN_M
+    }
+}
+
 /// The M functions with the kernel's own meaning for the program's flow: the stops M00/M01,
 /// the program ends M02/M30 and the subroutine ends M17/M29 (TF5200 programming manual,
 /// "User-specific M/H functions": the predefined M functions).

@@ -411,7 +411,8 @@ fn check_reports_an_undefined_m_and_h_with_their_ids_and_places() {
          #COMMENT END\n\
          N20 X20 \\\n  H5 M8\n\
          N30 H7=12 M77\n\
-         N40 M3 M30\n",
+         N40 M3 M30\n\
+         N50 M1001\n",
     )
     .unwrap();
     let p = prog.to_str().unwrap();
@@ -424,6 +425,8 @@ fn check_reports_an_undefined_m_and_h_with_their_ids_and_places() {
             format!("{p}:1:18: error 20157: M77 is not defined in the channel's parameters (m_synch[77] missing) (used 2 times, first here)"),
             format!("{p}:6:3: error 20162: H5 is not defined in the channel's parameters (h_synch[5] missing)"),
             format!("{p}:7:5: error 20162: H7 is not defined in the channel's parameters (h_synch[7] missing)"),
+            // Above M999 the kernel looks for an internal M function (TF5200 diagnosis 20160).
+            format!("{p}:9:5: error 20160: M1001 is not defined in the channel's parameters (m_synch[1001] missing)"),
         ],
         "{out}"
     );

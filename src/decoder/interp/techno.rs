@@ -251,7 +251,7 @@ impl TechnoState {
                 continue;
             }
             let def = self.table.m_def(m).ok_or_else(|| {
-                if m > codes::MAX_SELF_DEFINED_M {
+                if codes::unknown_m(m) == codes::UNKNOWN_INTERNAL_M {
                     // Above the self-defined M functions the kernel looks for an internal
                     // one (TF5200 diagnosis ID 20160, whose example is `M1001`).
                     return DecodeError::new(
