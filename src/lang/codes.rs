@@ -36,6 +36,23 @@ pub const UNKNOWN_M: u32 = 20157;
 pub const UNKNOWN_H: u32 = 20162;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
+/// A negative feed F (kernel id 20176, "negative or zero F", as the kernel's error list names
+/// it; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]). F0 itself is accepted
+/// as a word: a motion block at feed 0 is [`NO_FEED`].
+pub const FEED_NEGATIVE: u32 = 20176;
+/// The same M function twice in one block, `M30 M30` (kernel id 20158; its TF5200 diagnosis
+/// page was not read, see [`KERNEL_UNREAD`]).
+pub const M_TWICE: u32 = 20158;
+/// A circle centre parameter (I, J or K) twice in one block (kernel id 20205, "double centre
+/// point" in the kernel's error list; its TF5200 diagnosis page was not read, see
+/// [`KERNEL_UNREAD`]).
+pub const ARC_CENTER_TWICE: u32 = 20205;
+/// Expression: square root of a negative number (kernel id 20398 in the kernel's error
+/// list; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]).
+pub const EVAL_SQRT_NEGATIVE: u32 = 20398;
+/// End of the main program's file without M30/M02 (kernel id 21129, "M02/M30 missing" in the
+/// kernel's error list; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]).
+pub const MAIN_END_MISSING: u32 = 21129;
 /// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",
 /// whose example is `S1000 M03 … S1500`).
 pub const S_TWICE: u32 = 20181;
@@ -190,9 +207,6 @@ pub const FLUSH_UNDER_HSC: u32 = 120434;
 
 // ---- Error ids: ours, 900000–999999 (no kernel id with this meaning read) ----------------
 
-/// Expression: square root of a negative number. (The kernel's 20398 may mean this; its page
-/// was not in the index searched, so the id stays ours until it is read.)
-pub const EVAL_SQRT_NEGATIVE: u32 = 900002;
 /// Expression: ASIN/ACOS outside -1..1.
 pub const EVAL_OUT_OF_DOMAIN: u32 = 900003;
 /// Expression: undefined variable or parameter. (Candidates to read: the kernel's 20196; its
@@ -210,8 +224,6 @@ pub const EVAL_STRING_AS_NUMBER: u32 = 900008;
 pub const EVAL_NUMBER_AS_STRING: u32 = 900009;
 /// The streaming program is already running (called a second time).
 pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
-/// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
-pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
 pub const SUB_END_MISSING: u32 = 900104;
 /// A warning: more block-number labels (`N10:`) or `%L` sections in a program file than its
@@ -226,7 +238,7 @@ pub const PROGRAM_UNREADABLE: u32 = 900111;
 pub const PROGRAM_BAD_NAME: u32 = 900112;
 /// Circle end point, centre and radius do not agree.
 pub const ARC_INCONSISTENT: u32 = 900130;
-/// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
+/// A value out of range (negative S, non-finite axis value, `$FOR` step 0, T or D not a
 /// whole number, …).
 pub const BAD_VALUE: u32 = 900132;
 /// A G function, `#` command, V.A./V.G. variable, `#FILENAME` file id or modal cycle call
@@ -237,8 +249,8 @@ pub const UNSUPPORTED: u32 = 900133;
 /// 20685 "Dwell time programmed with additional axes." is a warning about axes only, after
 /// which the kernel goes on; ours refuses every word, so it keeps its own id.
 pub const DWELL_NOT_ALONE: u32 = 900134;
-/// T, D, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], an
-/// axis [`AXIS_TWICE`]).
+/// T, D, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], I J K
+/// [`ARC_CENTER_TWICE`], an axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
 /// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
 pub const MSG_TOO_LONG: u32 = 900136;
@@ -255,6 +267,7 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
     match letter.to_ascii_uppercase() {
         b'F' => F_TWICE,
         b'S' => S_TWICE,
+        b'I' | b'J' | b'K' => ARC_CENTER_TWICE,
         _ => WORD_TWICE,
     }
 }
@@ -270,6 +283,9 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNKNOWN_M, "unknown M function"),
     (UNKNOWN_H, "unknown H function"),
     (F_TWICE, "F twice in a block"),
+    (FEED_NEGATIVE, "negative F"),
+    (M_TWICE, "same M function twice in a block"),
+    (ARC_CENTER_TWICE, "I, J or K twice in a block"),
     (S_TWICE, "S twice in a block"),
     (SYNTAX, "syntax"),
     (AXIS_TWICE, "axis twice in a block"),
@@ -296,6 +312,8 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNEXPECTED_SUB_END, "M17/M29 in the main program"),
     (UNEXPECTED_PROGRAM_END, "M30/M02 in a subroutine"),
     (EVAL_DIVISION_BY_ZERO, "division by zero"),
+    (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
+    (MAIN_END_MISSING, "main program without M30/M02"),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
@@ -333,7 +351,6 @@ pub const EMITTED: &[(u32, &str)] = &[
     (STRING_TOO_LONG, "string longer than 126 characters"),
     (FLUSH_UNDER_SPLINE, "#FLUSH under spline"),
     (FLUSH_UNDER_HSC, "#FLUSH under #HSC"),
-    (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
     (EVAL_OUT_OF_DOMAIN, "ASIN/ACOS outside -1..1"),
     (EVAL_UNDEFINED, "undefined variable"),
     (EVAL_BAD_INDEX, "invalid index"),
@@ -341,7 +358,6 @@ pub const EMITTED: &[(u32, &str)] = &[
     (EVAL_STRING_AS_NUMBER, "string used as a number"),
     (EVAL_NUMBER_AS_STRING, "number used as a string"),
     (STREAM_ALREADY_ACTIVE, "streaming program already running"),
-    (MAIN_END_MISSING, "main program without M30/M02"),
     (SUB_END_MISSING, "subroutine without M17/M29"),
     (
         LABEL_INDEX_FULL,
@@ -354,7 +370,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (BAD_VALUE, "value out of range"),
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
-    (WORD_TWICE, "T, D, I, J, K, R or E twice in a block"),
+    (WORD_TWICE, "T, D, R or E twice in a block"),
     (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
@@ -508,6 +524,14 @@ pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     // The kernel's id for an H function the channel does not define, as reported for the
     // TwinCAT CNC; its TF5200 diagnosis page was not read.
     (20162, "unknown H function"),
+    // 20176, 20205, 20398 and 21129 are named so in the kernel's error list; 20158 is the
+    // kernel's answer to `M30 M30` as reported for a TwinCAT CNC. None of the five TF5200
+    // diagnosis pages was in the index searched.
+    (20158, "M function programmed twice in a block"),
+    (20176, "negative or zero F"),
+    (20205, "double centre point"),
+    (20398, "square root of a negative value"),
+    (21129, "M02/M30 missing"),
     (20200, "NC command or axis name expected"),
     (20209, "unknown # command or $ statement"),
     (20240, "unexpected $ENDDO"),
@@ -751,8 +775,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20162, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840, 21469,
-                21560, 21561, 21562, 21563, 21564, 21897
+                20157, 20162, 20158, 20176, 20205, 20398, 21129, 20200, 20209, 20240, 20368, 20369,
+                20373, 20376, 20377, 20840, 21469, 21560, 21561, 21562, 21563, 21564, 21897
             ]
         );
     }

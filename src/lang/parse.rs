@@ -16,7 +16,7 @@ use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
     MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, TOO_MANY_INDICES,
-    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -520,7 +520,7 @@ fn word<'a>(
         b'H' if !integer_code(v).is_some_and(is_known_m) => {
             return Err(perr(
                 i,
-                UNKNOWN_M,
+                UNKNOWN_H,
                 format!("H function H{v} outside 0 to 65535"),
             ));
         }
@@ -548,7 +548,7 @@ fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
     match up {
         b'G' => Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
         b'M' => Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
-        b'H' => Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
+        b'H' => Err(perr(i, UNKNOWN_H, "an H function needs a literal number")),
         _ => Ok(()),
     }
 }

@@ -1,0 +1,58 @@
+//! Language behaviours real programs and the TF5200 programming manual's examples meet, each
+//! answered as the kernel answers it: the id it reports, or the position it reaches.
+
+use crate::support::{Rig, RunResult};
+use ncchannel::channel::Finish;
+
+/// `text` run from a file on `rig`.
+fn run(rig: &Rig, text: &str) -> RunResult {
+    rig.program("t.nc", text);
+    rig.run("t.nc", None, 1_000_000)
+}
+
+/// `text` fails with the one error `code`.
+fn fails(rig: &Rig, text: &str, code: u64) -> RunResult {
+    let r = run(rig, text);
+    assert_eq!(r.finish, Some(Finish::Error), "{text}\n{}", r.log);
+    assert_eq!(r.error_codes(), [code], "{text}\n{}", r.log);
+    r
+}
+
+/// `text` runs to its end without an error.
+fn ends(rig: &Rig, text: &str) -> RunResult {
+    let r = run(rig, text);
+    assert_eq!(r.finish, Some(Finish::Ended), "{text}\n{}", r.log);
+    assert_eq!(r.error_codes(), Vec::<u64>::new(), "{text}\n{}", r.log);
+    r
+}
+
+#[test]
+fn the_kernels_ids_for_a_negative_root_feed_and_a_missing_program_end() {
+    let rig = Rig::new();
+    // 20398: square root of a negative value.
+    fails(&rig, "P1 = SQRT[-1]\nM30\n", 20398);
+    // 20176: negative F. F0 is a word the kernel takes; a feed move at it is 20008.
+    fails(&rig, "G01 X10 F-5\nM30\n", 20176);
+    fails(&rig, "F0\nG01 X10\nM30\n", 20008);
+    // 21129: the main program's file ends without M30/M02.
+    fails(&rig, "G01 X10 F6000\n", 21129);
+}
+
+#[test]
+fn the_kernels_ids_for_words_programmed_twice() {
+    let rig = Rig::new();
+    // 20205: a circle centre parameter twice.
+    fails(&rig, "G02 X10 I5 I5 J0 F100\nM30\n", 20205);
+    // 20158: the same M function twice; two different ones stay allowed.
+    fails(&rig, "M30 M30\n", 20158);
+    ends(&rig, "M7 M8\nM30\n");
+    // T twice keeps its own id.
+    fails(&rig, "T1 T2\nM30\n", 900135);
+}
+
+#[test]
+fn an_h_function_outside_the_numbers_is_the_kernels_undefined_h() {
+    let rig = Rig::new();
+    fails(&rig, "H70000\nM30\n", 20162);
+    fails(&rig, "H5\nM30\n", 20162);
+}
