@@ -601,11 +601,11 @@ pub(crate) fn is_word_letter(b: u8) -> bool {
 /// planes G17–G19, tool radius compensation G40–G42, zero offsets G53–G59, contouring at
 /// block end G61, inch/metric G70/G71, absolute/incremental G90/G91, reference point offset
 /// G92, feed per minute/revolution G94/G95, spindle speed G97, spline off/on G150/G151,
-/// contouring off/on G260/G261. The rest of ISG's list is in [`super::dialect`] (accepted
+/// circle centre absolute/relative G161/G162, contouring off/on G260/G261. The rest of ISG's list is in [`super::dialect`] (accepted
 /// without effect, or refused by name); a number in neither is 20131.
 pub const KNOWN_G: &[u32] = &[
     0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 70, 71, 90, 91, 92, 94,
-    95, 97, 150, 151, 260, 261,
+    95, 97, 150, 151, 161, 162, 260, 261,
 ];
 
 /// G functions that take a value: `G133=<expr>`, `G134=<expr>` (TF5200 "Weighting the ramp
@@ -620,7 +620,7 @@ pub(crate) fn is_known_g(g: u32) -> bool {
     matches!(
         g,
         0..=4 | 17..=19 | 40..=42 | 53..=59 | 61 | 70 | 71 | 90..=92 | 94 | 95 | 97 | 150 | 151
-            | 260 | 261
+            | 161 | 162 | 260 | 261
     )
 }
 

@@ -56,3 +56,28 @@ fn an_h_function_outside_the_numbers_is_the_kernels_undefined_h() {
     fails(&rig, "H70000\nM30\n", 20162);
     fails(&rig, "H5\nM30\n", 20162);
 }
+
+#[test]
+fn under_g161_i_j_k_are_the_circle_centre_in_program_coordinates() {
+    let rig = Rig::new();
+    // TF5200 "Specifying centre point for circle definition (G161/G162)": the centre (0, 0)
+    // written absolutely; the half circle from (10, 0) ends at (-10, 0) and back.
+    ends(
+        &rig,
+        "G01 X10 Y0 F6000\nG161 G02 X-10 Y0 I0 J0\nG03 X10 Y0 I0 J0\nM30\n",
+    );
+    // Under G162, the initial state a new program starts in, I0 J0 puts the centre on the
+    // start point: no circle.
+    fails(&rig, "G01 X10 Y0 F6000\nG02 X-10 Y0 I0 J0\nM30\n", 900130);
+    // G162 in the program turns G161 off.
+    let r = ends(&rig, "G01 X10 Y0 F6000\nG161\nG162 G02 X-10 I-10 J0\nM30\n");
+    assert!((r.position('X') + 10.0).abs() < 1e-6, "{}", r.log);
+    // The programmer's coordinates: after G92 makes machine X20 program X10, the centre I0 J0
+    // is machine (10, 0), and the half circle ends at machine X0.
+    let r = ends(
+        &rig,
+        "G01 X20 Y0 F6000\nG92 X10 Y0\nG161 G02 X-10 I0 J0\nM30\n",
+    );
+    assert!(r.position('X').abs() < 1e-6, "{}", r.log);
+    assert!(r.position('Y').abs() < 1e-6, "{}", r.log);
+}

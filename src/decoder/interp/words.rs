@@ -66,7 +66,7 @@ impl Interpreter {
         let mv = if gs.dwell || gs.set_reference {
             None
         } else if let Some(end) = self.target(w, gs) {
-            let mut mv = self.motion(w, end)?;
+            let mut mv = self.motion(w, end, gs)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
             Some(mv)
@@ -433,7 +433,7 @@ impl Interpreter {
     }
 
     /// Step 4: the move from the last programmed position to `end`.
-    fn motion(&self, w: &Words, end: Position) -> Res<Move> {
+    fn motion(&self, w: &Words, end: Position, gs: BlockGs) -> Res<Move> {
         let start = self.modal.pos;
         let m = self.modal.motion;
         if m == MotionMode::Rapid {
@@ -457,10 +457,22 @@ impl Interpreter {
         }
         let unit = self.modal.units.mm_per_unit();
         let scaled = |v: Option<f64>| v.map(|v| v * unit);
+        let mut ijk = w.ijk.map(scaled);
+        if self.modal.centre_absolute {
+            // G161: the centre in program coordinates, made the offset from the start point
+            // the arc takes (TF5200 programming manual, "Specifying centre point for circle
+            // definition (G161/G162)").
+            let offset = self.program_offset(gs);
+            for (k, c) in ijk.iter_mut().enumerate() {
+                if let Some(c) = c {
+                    *c += offset[k] - start[k];
+                }
+            }
+        }
         arc::arc_move(
             &arc::ArcSpec {
                 plane: self.modal.plane,
-                ijk: w.ijk.map(scaled),
+                ijk,
                 radius: scaled(w.radius),
                 cw: m == MotionMode::ArcCw,
             },
