@@ -482,7 +482,7 @@ fn word<'a>(
         None => return Err(perr(after, SYNTAX, word_value_msg(up))),
     };
     let Some((mag, n)) = scan_unsigned(&ab[skip..]) else {
-        return Err(perr(after, SYNTAX, word_value_msg(up)));
+        return word_function(ctx, i, up, col, (&after[skip..], neg), items);
     };
     if !mag.is_finite() {
         return Err(perr(&after[skip..], SYNTAX, TOO_LARGE));
@@ -708,6 +708,74 @@ fn word_unbracketed<'a>(
         col,
     }));
     Ok(&after[end..])
+}
+
+/// `X SIN [P1 * 5]`, `X-SQRT[P2]`: a word whose value is a function call written after the
+/// address letter (TF5200 programming manual, "Arithmetical expressions <expr>": the
+/// mathematical functions are operands like numbers and parameters). `at` is the text after
+/// the letter and its sign; blanks may stand before the function's name and its bracket.
+/// Anything else there is the word's 20200.
+#[cold]
+fn word_function<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    (at, negate): (&'a str, bool),
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let no_value = || Err(perr(&i[1..], SYNTAX, word_value_msg(up)));
+    let start = ws(at);
+    let name_len = start
+        .bytes()
+        .take_while(|c| c.is_ascii_alphabetic())
+        .count();
+    let name = &start[..name_len];
+    let is_function = name_len > 0
+        && super::expr::FUNCS
+            .iter()
+            .any(|f| f.name().eq_ignore_ascii_case(name));
+    if !is_function || !ws(&start[name_len..]).starts_with('[') {
+        return no_value();
+    }
+    literal_only(i, up)?;
+    // The call runs to the `]` that closes its bracket.
+    let open = start.len() - ws(&start[name_len..]).len();
+    let mut depth = 0usize;
+    let Some(close) = start[open..].bytes().position(|b| {
+        match b {
+            b'[' => depth += 1,
+            b']' => depth -= 1,
+            _ => {}
+        }
+        depth == 0
+    }) else {
+        return Err(perr(start, SYNTAX, "`]` expected"));
+    };
+    let end = open + close + 1;
+    let cut = ctx.cut(ctx.line.len() - start.len() + end);
+    let text = &cut.line[cut.line.len() - end..];
+    let e = match cut.unbracketed_value(text) {
+        Ok(("", e)) => e,
+        Ok((rest, _)) => {
+            return Err(ctx.err_at(cut.col(rest), SYNTAX, "operator or blank expected"));
+        }
+        Err(e) => {
+            let e = cut.to_error(e);
+            return Err(ctx.err_at(e.col, e.code, e.message));
+        }
+    };
+    let e = if negate {
+        super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
+    } else {
+        e
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
+        col,
+    }));
+    Ok(&start[end..])
 }
 
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.

@@ -81,3 +81,26 @@ fn under_g161_i_j_k_are_the_circle_centre_in_program_coordinates() {
     assert!(r.position('X').abs() < 1e-6, "{}", r.log);
     assert!(r.position('Y').abs() < 1e-6, "{}", r.log);
 }
+
+#[test]
+fn a_function_may_follow_an_address_letter() {
+    let rig = Rig::new();
+    // TF5200 "Arithmetical expressions <expr>": a function is an operand; after an address
+    // letter it stands without the word's brackets, with or without blanks.
+    let r = ends(
+        &rig,
+        "P1 = 6\nP2 = 16\nG01 X SIN [P1 * 5] Y-SQRT[P2] ZCOS[0] F6000\nM30\n",
+    );
+    assert!((r.position('X') - 0.5).abs() < 1e-9, "{}", r.log);
+    assert!((r.position('Y') + 4.0).abs() < 1e-9, "{}", r.log);
+    assert!((r.position('Z') - 1.0).abs() < 1e-9, "{}", r.log);
+    assert_eq!(
+        ncchannel::lang::check_program("G01 X SIN [30] F100\nM30\n"),
+        []
+    );
+    // A name that is no function, or a function without its bracket, is no value.
+    fails(&rig, "G01 X FOO[1] F100\nM30\n", 20200);
+    fails(&rig, "G01 X SIN 30 F100\nM30\n", 20200);
+    // M, G and H still take literal numbers only.
+    fails(&rig, "M SIN[1]\nM30\n", 20157);
+}
