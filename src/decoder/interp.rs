@@ -12,6 +12,7 @@ mod expr;
 mod implicit;
 mod search;
 mod techno;
+mod transform;
 mod words;
 
 use super::error::{var_error, Res};

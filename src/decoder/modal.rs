@@ -126,6 +126,10 @@ pub struct Modal {
     /// the initial state): offsets from the start point (TF5200 programming manual,
     /// "Specifying centre point for circle definition (G161/G162)").
     pub(crate) centre_absolute: bool,
+    /// Bit n: `#CS DEF [n]` defined CS n (always the identity: `decoder::interp::transform`).
+    pub(crate) cs_defined: u64,
+    /// A CS was defined: `#CS ON` without an id selects the last one.
+    pub(crate) cs_last_defined: bool,
     /// G151 / `#SPLINE ON`.
     pub spline: bool,
     pub(crate) spline_type: SplineCommand,
@@ -159,6 +163,8 @@ impl Modal {
             contouring: false,
             contour_dev_mm: DEFAULT_PATH_DEV_MM,
             centre_absolute: false,
+            cs_defined: 0,
+            cs_last_defined: false,
             spline: false,
             spline_type: SplineCommand::TypeAkima,
             hsc: false,

@@ -448,11 +448,42 @@ pub enum Command {
     Msg(Box<Message>),
     /// `#TIME <seconds>`: a dwell (TF5200 "Dwell time").
     Time(Value),
+    /// `#TRAFO`, `#KIN`, `#CS` in a form that leaves the path as it is (`super::transform`).
+    /// Boxed: rare, and `Block` stays small.
+    Transform(Box<Transform>),
     /// A `#` command of ISG's list that ncchannel accepts without effect
     /// (`super::dialect`); the whole command text after `#` is kept verbatim.
     Inert {
         text: String,
     },
+}
+
+/// A transformation command in a neutral form (`super::transform`); `text` is the command
+/// after `#`, verbatim.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Transform {
+    /// `#TRAFO OFF`, `#TRAFO [NONE]`, `#KIN ID [NONE]`, `#CS OFF`, `#CS OFF ALL`.
+    Off { text: String },
+    /// `#CS DEF [id] [v1,v2,v3,φ1,φ2,φ3]`, or `#CS ON …` (`select`) with the values.
+    CsDefine {
+        text: String,
+        id: Option<Expr>,
+        values: Vec<Expr>,
+        select: bool,
+    },
+    /// `#CS ON [id]`, `#CS ON`: a CS defined before.
+    CsSelect { text: String, id: Option<Expr> },
+}
+
+impl Transform {
+    /// The command after `#`, as written.
+    pub fn text(&self) -> &str {
+        match self {
+            Transform::Off { text }
+            | Transform::CsDefine { text, .. }
+            | Transform::CsSelect { text, .. } => text,
+        }
+    }
 }
 
 /// An operator message (TF5200 programming manual, "Messages from the NC program").

@@ -252,6 +252,10 @@ pub const DWELL_NOT_ALONE: u32 = 900134;
 /// T, D, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], I J K
 /// [`ARC_CENTER_TWICE`], an axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
+/// A warning: a transformation command in its neutral form (`#TRAFO OFF`, `#CS OFF`, an
+/// identity `#CS DEF`/`#CS ON`, `#KIN ID [NONE]`) was accepted and changes nothing
+/// (`lang::transform`).
+pub const NEUTRAL_TRANSFORMATION: u32 = 900137;
 /// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
 pub const MSG_TOO_LONG: u32 = 900136;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
@@ -371,6 +375,10 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
     (WORD_TWICE, "T, D, R or E twice in a block"),
+    (
+        NEUTRAL_TRANSFORMATION,
+        "neutral transformation command: no effect",
+    ),
     (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),

@@ -441,6 +441,7 @@ impl Display for Command {
             }
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),
+            Command::Transform(t) => write!(f, "#{}", t.text()),
         }
     }
 }

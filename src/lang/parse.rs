@@ -1089,6 +1089,10 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let (r, v) = ctx.expr(r)?;
             Ok((r, Command::Time(expr_value(v))))
         }
+        kw @ (b"TRAFO" | b"KIN" | b"CS") => match super::transform::neutral(ctx, i, kw, r) {
+            Some(parsed) => parsed,
+            None => dialect_command(i, kw, &after[..after.len() - rest.len()]),
+        },
         kw => dialect_command(i, kw, &after[..after.len() - rest.len()]),
     }
 }

@@ -104,3 +104,67 @@ fn a_function_may_follow_an_address_letter() {
     // M, G and H still take literal numbers only.
     fails(&rig, "M SIN[1]\nM30\n", 20157);
 }
+
+/// The codes of the run's warning events, in order.
+fn warnings(r: &RunResult) -> Vec<u64> {
+    r.of("warning")
+        .iter()
+        .map(|e| e["code"].as_u64().unwrap_or(0))
+        .collect()
+}
+
+#[test]
+fn neutral_transformations_run_as_no_ops_with_a_warning() {
+    let rig = Rig::new();
+    // TF5200 programming manual: "Combined preselection and activation" (#TRAFO [OFF|NONE]),
+    // "Separate preselection and activation" (#KIN ID [NONE]), "Definition of a machining
+    // coordinate system (CS)" (#CS DEF / ON / OFF).
+    for (text, n) in [
+        ("#TRAFO OFF", 1),
+        ("#TRAFO [NONE, NONE]", 1),
+        ("#TRAFO [OFF]", 1),
+        ("#KIN ID [NONE]", 1),
+        ("#KIN ID [NONE, NONE]", 1),
+        ("#CS OFF", 1),
+        ("#CS OFF ALL", 1),
+        ("#CS DEF [1] [0,0,0,0,0,0]\n#CS ON [1]\n#CS OFF", 3),
+        ("#CS ON [2] [0, 0, P1, 0, 0, 0]\n#CS OFF\n#CS ON [2]", 3),
+        ("#CS DEF [0,0,0,0,0,0]\n#CS ON", 2),
+    ] {
+        let r = ends(&rig, &format!("P1 = 0\nG01 X10 F6000\n{text}\nY5\nM30\n"));
+        assert_eq!(warnings(&r), vec![900137; n], "{text}\n{}", r.log);
+        assert!((r.position('X') - 10.0).abs() < 1e-9, "{text}");
+        assert!((r.position('Y') - 5.0).abs() < 1e-9, "{text}");
+    }
+}
+
+#[test]
+fn a_transformation_that_would_move_the_path_stays_refused() {
+    let rig = Rig::new();
+    for text in [
+        "#CS ON [1] [10,0,0,0,0,0]",
+        "#CS DEF [1] [0,0,0,0,0,45]",
+        // Selecting a CS never defined.
+        "#CS ON [2]",
+        "#CS ON",
+        "#TRAFO ON",
+        "#TRAFO [86]",
+        "#KIN ID [86]",
+        "#CS ADD [ICS] [0,0,0,0,0,0]",
+    ] {
+        let r = fails(&rig, &format!("G01 X10 F6000\n{text}\nY5\nM30\n"), 900133);
+        assert!((r.position('Y')).abs() < 1e-9, "{text}");
+    }
+    // Three values are no CS definition ncchannel knows: refused by name too.
+    fails(&rig, "#CS DEF [1] [0,0,0]\nM30\n", 900133);
+    // A shift computed at run time is refused when the block runs; a literal one already by
+    // `check`.
+    fails(&rig, "P1 = 10\n#CS ON [1] [P1,0,0,0,0,0]\nM30\n", 900133);
+    let d = ncchannel::lang::check_program("#CS ON [1] [10,0,0,0,0,0]\nM30\n");
+    assert_eq!(
+        d.iter()
+            .map(|d| (d.line, d.col, d.code))
+            .collect::<Vec<_>>(),
+        [(1, 1, 900133)]
+    );
+}
