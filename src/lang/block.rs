@@ -117,7 +117,7 @@ impl AxisName {
         let b = name.as_bytes();
         let first = b.first()?.to_ascii_uppercase();
         if b.len() > AXIS_NAME_MAX
-            || !b"XYZABC".contains(&first)
+            || !b"XYZABCUVW".contains(&first)
             || !b[1..]
                 .iter()
                 .all(|c| c.is_ascii_alphanumeric() || *c == b'_')
@@ -134,7 +134,8 @@ impl AxisName {
         })
     }
 
-    /// The axis letter the name starts with: the interpolator slot the axis takes.
+    /// The axis letter the name starts with: for X Y Z A B C the interpolator slot the axis
+    /// takes (`params::runtime::channel_slots`).
     pub fn letter(&self) -> u8 {
         self.bytes[0]
     }

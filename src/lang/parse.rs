@@ -383,7 +383,7 @@ fn is_dwell(it: &Item) -> bool {
 /// for the rest.
 fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
     let l = letter as char;
-    if crate::vocab::axis::AXIS_LETTERS.contains(&letter) {
+    if is_axis_letter(letter) {
         perr(
             at,
             AXIS_TWICE,
@@ -449,7 +449,7 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
-    let slot_letter = crate::vocab::axis::slot_of(up).is_some();
+    let slot_letter = is_axis_letter(up);
     if slot_letter
         && ab
             .first()
@@ -641,8 +641,9 @@ fn axis_assigned<'a>(
     Ok(r)
 }
 
-/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`) are
+/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`, `W2 = 1`) are
 /// [`named_axis`]'s.
+#[inline]
 fn is_axis_letter(up: u8) -> bool {
     matches!(
         up,

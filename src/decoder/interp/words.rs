@@ -162,11 +162,17 @@ impl Interpreter {
                 if let Some(i) = slot_of(word.letter).filter(|_| renamed) {
                     let name = &self.settings.axis_names[i];
                     if self.renamed_slots & (1 << i) != 0 {
-                        // The axis in this slot is named `X1`: `X` alone names no axis.
+                        // The axis in this slot is named `X1` (or `W`): `X` alone names no
+                        // axis.
+                        let written = if name.is_letter() {
+                            String::new()
+                        } else {
+                            format!(", written {name}=…")
+                        };
                         return Err(DecodeError::new(
                             codes::SYNTAX,
                             format!(
-                                "axis {} is not configured in this channel (its axis is {name}, written {name}=…)",
+                                "axis {} is not configured in this channel (its axis is {name}{written})",
                                 word.letter as char
                             ),
                         )
@@ -270,7 +276,11 @@ impl Interpreter {
             b'K' => w.ijk[2] = Some(v),
             b'R' => w.radius = Some(v),
             letter => {
-                if let Some(i) = slot_of(letter) {
+                let slot = match slot_of(letter) {
+                    Some(i) => Some(i),
+                    None => self.lettered_slot(letter)?,
+                };
+                if let Some(i) = slot {
                     if self.settings.axes[i] && w.axes_set & (1 << i) != 0 {
                         // `X1=5` and `X5` both name the slot of axis X1 (the parser sees
                         // only letters twice).
@@ -629,6 +639,24 @@ fn two_calls() -> DecodeError {
         codes::UNSUPPORTED,
         "two implicit subroutine calls (G800–G819) in one block",
     )
+}
+
+impl Interpreter {
+    /// The slot of the configured axis named by the one letter `letter` outside X Y Z A B C
+    /// (`W10` where the channel list names an axis `W`): `Some(None)` for a letter that is no
+    /// axis word (E), an error for an axis letter the channel does not configure (U V W).
+    #[cold]
+    fn lettered_slot(&self, letter: u8) -> Result<Option<usize>, DecodeError> {
+        let slot = (0..MAX_AXES).find(|&i| {
+            let n = &self.settings.axis_names[i];
+            self.settings.axes[i] && n.is_letter() && n.letter() == letter
+        });
+        match slot {
+            Some(i) => Ok(Some(i)),
+            None if matches!(letter, b'U' | b'V' | b'W') => Err(unconfigured(letter)),
+            None => Ok(None),
+        }
+    }
 }
 
 fn unconfigured(letter: u8) -> DecodeError {
