@@ -711,11 +711,12 @@ fn word_unbracketed<'a>(
     Ok(&after[end..])
 }
 
-/// `X SIN [P1 * 5]`, `X-SQRT[P2]`: a word whose value is a function call written after the
-/// address letter (TF5200 programming manual, "Arithmetical expressions <expr>": the
-/// mathematical functions are operands like numbers and parameters). `at` is the text after
-/// the letter and its sign; blanks may stand before the function's name and its bracket.
-/// Anything else there is the word's 20200.
+/// `X SIN [P1 * 5]`, `X-SQRT[P2]`, `A SQRT [2]/2`: a word whose value is an expression that
+/// starts with a function, written after the address letter without the word's brackets
+/// (TF5200 programming manual, "Axis commands": "X <int, double, expr>", with the examples
+/// `Z SIN [30]` and `A SQRT [2]/2`). The expression runs as far as it goes, blanks between
+/// its operators included. `at` is the text after the letter and its sign. Anything else
+/// there is the word's 20200.
 #[cold]
 fn word_function<'a>(
     ctx: &Ctx<'a>,
@@ -725,7 +726,6 @@ fn word_function<'a>(
     (at, negate): (&'a str, bool),
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
-    let no_value = || Err(perr(&i[1..], SYNTAX, word_value_msg(up)));
     let start = ws(at);
     let name_len = start
         .bytes()
@@ -737,35 +737,10 @@ fn word_function<'a>(
             .iter()
             .any(|f| f.name().eq_ignore_ascii_case(name));
     if !is_function || !ws(&start[name_len..]).starts_with('[') {
-        return no_value();
+        return Err(perr(&i[1..], SYNTAX, word_value_msg(up)));
     }
     literal_only(i, up)?;
-    // The call runs to the `]` that closes its bracket.
-    let open = start.len() - ws(&start[name_len..]).len();
-    let mut depth = 0usize;
-    let Some(close) = start[open..].bytes().position(|b| {
-        match b {
-            b'[' => depth += 1,
-            b']' => depth -= 1,
-            _ => {}
-        }
-        depth == 0
-    }) else {
-        return Err(perr(start, SYNTAX, "`]` expected"));
-    };
-    let end = open + close + 1;
-    let cut = ctx.cut(ctx.line.len() - start.len() + end);
-    let text = &cut.line[cut.line.len() - end..];
-    let e = match cut.unbracketed_value(text) {
-        Ok(("", e)) => e,
-        Ok((rest, _)) => {
-            return Err(ctx.err_at(cut.col(rest), SYNTAX, "operator or blank expected"));
-        }
-        Err(e) => {
-            let e = cut.to_error(e);
-            return Err(ctx.err_at(e.col, e.code, e.message));
-        }
-    };
+    let (rest, e) = ctx.unbracketed_value(start)?;
     let e = if negate {
         super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
     } else {
@@ -776,7 +751,7 @@ fn word_function<'a>(
         value: Value::Expr(e),
         col,
     }));
-    Ok(&start[end..])
+    Ok(rest)
 }
 
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.

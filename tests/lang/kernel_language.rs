@@ -85,11 +85,12 @@ fn under_g161_i_j_k_are_the_circle_centre_in_program_coordinates() {
 #[test]
 fn a_function_may_follow_an_address_letter() {
     let rig = Rig::new();
-    // TF5200 "Arithmetical expressions <expr>": a function is an operand; after an address
-    // letter it stands without the word's brackets, with or without blanks.
+    // TF5200 "Axis commands": "X <int, double, expr>", as `Z SIN [30]` and `A SQRT [2]/2`:
+    // after the address letter the expression stands without the word's brackets, with or
+    // without blanks, and runs on through its operators.
     let r = ends(
         &rig,
-        "P1 = 6\nP2 = 16\nG01 X SIN [P1 * 5] Y-SQRT[P2] ZCOS[0] F6000\nM30\n",
+        "P1 = 6\nP2 = 16\nG01 X SIN [P1 * 5] Y-SQRT[P2] Z SQRT [4]/2 F6000\nM30\n",
     );
     assert!((r.position('X') - 0.5).abs() < 1e-9, "{}", r.log);
     assert!((r.position('Y') + 4.0).abs() < 1e-9, "{}", r.log);
