@@ -15,8 +15,9 @@ use super::block::{
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, TOO_MANY_INDICES,
-    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE,
+    TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M, UNSUPPORTED,
+    VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -326,7 +327,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             i = word(ctx, i, up, &mut items)?;
             if let b'G' | b'M' | b'H' = up {
                 dwell |= up == b'G' && items.last().is_some_and(is_dwell);
-            } else {
+            } else if !ends_in_function(&items) {
                 let bit = 1u32 << (up - b'A');
                 if seen & bit != 0 {
                     return Err(twice(at, up));
@@ -365,6 +366,18 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             };
             return Err(perr(i, code, msg));
         }
+    }
+}
+
+/// Did the word just read end in an M or H function: `X[M54]`, `S[M3 M10]`, the functions of
+/// an axis or the spindle, which program neither the axis nor the speed (`X[M54] X10` is one
+/// X)?
+#[inline]
+fn ends_in_function(items: &[Item]) -> bool {
+    match items.last() {
+        Some(Item::FunctionValue { .. }) => true,
+        Some(Item::Word(w)) => matches!(w.letter, b'M' | b'H'),
+        _ => false,
     }
 }
 
@@ -754,6 +767,116 @@ fn word_function<'a>(
     Ok(rest)
 }
 
+/// `X[M54=P1]`, `S[REV 1000 M03 M63=-789]`: the technology functions of one axis or of the
+/// spindle in brackets after its name (TF5200 programming manual, "Programming in
+/// spindle-specific syntax": `<spindle_name> [ [M3|M4|M5|M19] [REV..] {M..} {H..} … ]`, and
+/// "User-specific M/H function for spindles"; axis-specific M functions alike). The M and H
+/// functions go to the technology units as the block's own (`M63=-789` with its value), `REV`
+/// is the spindle speed, as an S word. `None` when the bracket holds an expression (`X[P1*2]`);
+/// any other keyword in a function bracket (`POS`, `G74`, `CALLAX`, …) is refused by name.
+#[cold]
+fn function_bracket<'a>(
+    ctx: &Ctx<'a>,
+    up: u8,
+    col: u32,
+    bracket: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let starts_function = |r: &str| {
+        let b = r.as_bytes();
+        matches!(b.first(), Some(b'M' | b'm' | b'H' | b'h'))
+            && b.get(1).is_some_and(u8::is_ascii_digit)
+    };
+    let first = ws(&bracket[1..]);
+    let is_spindle = up == b'S';
+    if !(starts_function(first) || is_spindle && keyword_prefix(first, "REV").is_some()) {
+        return Ok(None);
+    }
+    let mut r = first;
+    let mut speed = None;
+    loop {
+        r = ws(r);
+        if let Some(rest) = r.strip_prefix(']') {
+            if let Some(value) = speed {
+                items.push(Item::Word(Word {
+                    letter: b'S',
+                    value,
+                    col,
+                }));
+            }
+            return Ok(Some(rest));
+        }
+        if starts_function(r) {
+            let letter = r.as_bytes()[0].to_ascii_uppercase();
+            let (rest, number) = super::expr::uint(&r[1..])?;
+            if !is_known_m(number) {
+                let code = if letter == b'M' { UNKNOWN_M } else { UNKNOWN_H };
+                return Err(perr(
+                    r,
+                    code,
+                    format!("{}{number} outside 0 to 65535", letter as char),
+                ));
+            }
+            let fcol = ctx.col(r);
+            if let Some(v) = ws(rest).strip_prefix('=') {
+                let (rest, e) = ctx.expr(ws(v))?;
+                items.push(Item::FunctionValue {
+                    letter,
+                    number,
+                    value: expr_value(e),
+                    col: fcol,
+                });
+                r = rest;
+            } else {
+                items.push(Item::Word(Word {
+                    letter,
+                    value: Value::Num(f64::from(number)),
+                    col: fcol,
+                }));
+                r = rest;
+            }
+            continue;
+        }
+        match keyword_prefix(r, "REV") {
+            Some(rest) if is_spindle && speed.is_none() => {
+                let rest = ws(rest);
+                let rest = rest.strip_prefix('=').map_or(rest, ws);
+                let (rest, e) = ctx.expr(rest)?;
+                speed = Some(expr_value(e));
+                r = rest;
+            }
+            Some(_) if is_spindle => return Err(perr(r, S_TWICE, "REV programmed twice")),
+            _ => {
+                let what = if is_spindle {
+                    "a spindle's"
+                } else {
+                    "an axis's"
+                };
+                return Err(perr(
+                    r,
+                    UNSUPPORTED,
+                    format!(
+                        "only M and H functions{} are modelled in {what} brackets",
+                        if is_spindle { " and REV" } else { "" }
+                    ),
+                ));
+            }
+        }
+    }
+}
+
+/// `kw` (any case) at the start of `r`, a number or `=` allowed right after it (`REV1000`):
+/// the rest.
+fn keyword_prefix<'a>(r: &'a str, kw: &str) -> Option<&'a str> {
+    let head = r.get(..kw.len())?;
+    let rest = &r[kw.len()..];
+    let next_is_name = rest
+        .as_bytes()
+        .first()
+        .is_some_and(|c| c.is_ascii_alphabetic() || *c == b'_');
+    (head.eq_ignore_ascii_case(kw) && !next_is_name).then_some(rest)
+}
+
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
 fn word_expr<'a>(
     ctx: &Ctx<'a>,
@@ -765,6 +888,11 @@ fn word_expr<'a>(
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
     literal_only(i, up)?;
+    if !negate && (up == b'S' || is_axis_letter(up)) {
+        if let Some(r) = function_bracket(ctx, up, col, bracket, items)? {
+            return Ok(r);
+        }
+    }
     let (rest, e) = ctx.bracketed(bracket)?;
     let e = if negate {
         super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))

@@ -169,3 +169,64 @@ fn a_transformation_that_would_move_the_path_stays_refused() {
         [(1, 1, 900133)]
     );
 }
+
+/// (kind, number, value) of the run's technology outputs.
+fn outputs(r: &RunResult) -> Vec<(String, u64, Option<i64>)> {
+    r.of("techno_output")
+        .iter()
+        .map(|e| {
+            (
+                e["kind"].as_str().unwrap_or("").to_string(),
+                e["number"].as_u64().unwrap_or(0),
+                e["value"].as_i64(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
+    let rig = Rig::new();
+    std::fs::write(
+        rig.startup().with_file_name("channel1.lis"),
+        "streaming_prog_file streaming.nc\nm_synch[54] MOS\nm_synch[63] MOS\nh_synch[20] MOS\n\
+         spindel[0].s_synch MOS\n",
+    )
+    .unwrap();
+    // TF5200 "Programming in spindle-specific syntax" and "User-specific M/H function for
+    // spindles": the speed REV, the spindle's M3 and its own functions with their values.
+    let r = ends(
+        &rig,
+        "P1 = 3\nG01 X10 F6000 X[M54=P1]\nS[REV 1000 M03 M63=-789 H20]\nS[REV=500]\nM30\n",
+    );
+    assert!((r.position('X') - 10.0).abs() < 1e-9);
+    assert_eq!(
+        outputs(&r)
+            .into_iter()
+            .filter(|(k, _, _)| k != "s")
+            .collect::<Vec<_>>(),
+        [
+            ("m".to_string(), 54, Some(3)),
+            ("m".to_string(), 63, Some(-789)),
+            ("h".to_string(), 20, None)
+        ],
+        "{}",
+        r.log
+    );
+    let speeds: Vec<Option<i64>> = outputs(&r)
+        .into_iter()
+        .filter(|(k, _, _)| k == "s")
+        .map(|(_, _, v)| v)
+        .collect();
+    assert_eq!(speeds, [Some(1000), Some(500)], "{}", r.log);
+    // An M number the channel list does not define is refused as a plain M word is.
+    fails(&rig, "X[M55]\nM30\n", 20157);
+    fails(&rig, "S[REV 100 M64=1]\nM30\n", 20157);
+    // What a bracket may hold besides M, H and REV is not modelled.
+    fails(&rig, "S[M3 POS45]\nM30\n", 900133);
+    // The bracket names the functions, not the axis: X may still move in the block.
+    ends(&rig, "X[M54] X5 F6000 G01\nM30\n");
+    // A bracket that is an expression stays one.
+    let r = ends(&rig, "P1 = 2\nG01 X[P1*2] F6000\nM30\n");
+    assert!((r.position('X') - 4.0).abs() < 1e-9);
+}
