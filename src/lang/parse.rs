@@ -327,7 +327,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             i = word(ctx, i, up, &mut items)?;
             if let b'G' | b'M' | b'H' = up {
                 dwell |= up == b'G' && items.last().is_some_and(is_dwell);
-            } else if !ends_in_function(&items) {
+            } else if !(bytes.get(1) == Some(&b'[') && ends_in_function(&items)) {
                 let bit = 1u32 << (up - b'A');
                 if seen & bit != 0 {
                     return Err(twice(at, up));
@@ -371,7 +371,8 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
 
 /// Did the word just read end in an M or H function: `X[M54]`, `S[M3 M10]`, the functions of
 /// an axis or the spindle, which program neither the axis nor the speed (`X[M54] X10` is one
-/// X)?
+/// X)? Asked only for a word whose letter a bracket follows: the literal words of the hot
+/// path skip it.
 #[inline]
 fn ends_in_function(items: &[Item]) -> bool {
     match items.last() {
