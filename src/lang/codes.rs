@@ -40,12 +40,12 @@ pub const F_TWICE: u32 = 20175;
 /// it; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]). F0 itself is accepted
 /// as a word: a motion block at feed 0 is [`NO_FEED`].
 pub const FEED_NEGATIVE: u32 = 20176;
-/// The same M function twice in one block, `M30 M30` (kernel id 20158; its TF5200 diagnosis
-/// page was not read, see [`KERNEL_UNREAD`]).
-pub const M_TWICE: u32 = 20158;
-/// A circle centre parameter (I, J or K) twice in one block (kernel id 20205, "double centre
-/// point" in the kernel's error list; its TF5200 diagnosis page was not read, see
-/// [`KERNEL_UNREAD`]).
+/// The same M function twice in one block in one scope: `M10 M10`, `S[M10 M10]` (TF5200
+/// diagnosis ID 20765 "Double-programmed M-function.", which allows `M10 X[M10] S[M10]`: a
+/// channel's, an axis's and a spindle's M function are three).
+pub const M_TWICE: u32 = 20765;
+/// A circle centre parameter (I, J or K) twice in one block (TF5200 diagnosis ID 20205
+/// "Double-programmed centre point coordinate.", whose example is `G02 I10 I20 J30`).
 pub const ARC_CENTER_TWICE: u32 = 20205;
 /// Expression: square root of a negative number (kernel id 20398 in the kernel's error
 /// list; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]).
@@ -413,6 +413,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20175, "Double-programmed F-word."), // 250998155
     (20181, "Double-programmed spindle."), // 251019915
     (20203, "Double-programmed axis."),  // 251085195
+    (20205, "Double-programmed centre point coordinate."), // 251089547
     (
         20206,
         "$ command must be programmed exclusively in NC block.",
@@ -475,6 +476,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (20765, "Double-programmed M-function."), // 252469131
     (
         20829,
         "Number of string labels too big for optimised program execution.",
@@ -532,12 +534,9 @@ pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     // The kernel's id for an H function the channel does not define, as reported for the
     // TwinCAT CNC; its TF5200 diagnosis page was not read.
     (20162, "unknown H function"),
-    // 20176, 20205, 20398 and 21129 are named so in the kernel's error list; 20158 is the
-    // kernel's answer to `M30 M30` as reported for a TwinCAT CNC. None of the five TF5200
-    // diagnosis pages was in the index searched.
-    (20158, "M function programmed twice in a block"),
+    // 20176, 20398 and 21129 are named so in the kernel's error list; their TF5200 diagnosis
+    // pages were not in the index searched.
     (20176, "negative or zero F"),
-    (20205, "double centre point"),
     (20398, "square root of a negative value"),
     (21129, "M02/M30 missing"),
     (20200, "NC command or axis name expected"),
@@ -783,8 +782,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20162, 20158, 20176, 20205, 20398, 21129, 20200, 20209, 20240, 20368, 20369,
-                20373, 20376, 20377, 20840, 21469, 21560, 21561, 21562, 21563, 21564, 21897
+                20157, 20162, 20176, 20398, 21129, 20200, 20209, 20240, 20368, 20369, 20373, 20376,
+                20377, 20840, 21469, 21560, 21561, 21562, 21563, 21564, 21897
             ]
         );
     }

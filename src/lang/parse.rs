@@ -15,7 +15,7 @@ use super::block::{
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE,
     TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M, UNSUPPORTED,
     VARIABLE_MEMORY_FULL,
 };
@@ -310,6 +310,8 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
     let mut items = Vec::with_capacity(item_capacity(i));
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
+    // The block's own M functions so far: one twice is 20765.
+    let mut ms = FunctionNumbers::default();
     let mut dwell = false;
     loop {
         i = gap(i);
@@ -327,6 +329,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             i = word(ctx, i, up, &mut items)?;
             if let b'G' | b'M' | b'H' = up {
                 dwell |= up == b'G' && items.last().is_some_and(is_dwell);
+                if up == b'M' {
+                    ms.add(items.last(), at)?;
+                }
             } else if !(bytes.get(1) == Some(&b'[') && ends_in_function(&items)) {
                 let bit = 1u32 << (up - b'A');
                 if seen & bit != 0 {
@@ -366,6 +371,47 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             };
             return Err(perr(i, code, msg));
         }
+    }
+}
+
+/// The M numbers one scope of a block programs (the channel's, or one bracket's), for the
+/// kernel's 20765: the same M twice in one scope (TF5200 diagnosis ID 20765: `M10 M10` and
+/// `S[M10 M10]` are refused, `M10 X[M10] S[M10]` is three functions). Blocks carry a handful;
+/// past [`FunctionNumbers::KEPT`] no more are compared (the decoder bounds the count).
+#[derive(Default)]
+struct FunctionNumbers {
+    numbers: [u32; FunctionNumbers::KEPT],
+    n: usize,
+}
+
+impl FunctionNumbers {
+    const KEPT: usize = 16;
+
+    /// The M function `item` just read at `at`: refused when its number came before.
+    fn add<'a>(&mut self, item: Option<&Item>, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
+        let number = match item {
+            Some(Item::Word(w)) => match w.value {
+                Value::Num(v) => integer_code(v),
+                Value::Expr(_) => None,
+            },
+            Some(Item::FunctionValue { number, .. }) => Some(*number),
+            _ => None,
+        };
+        let Some(number) = number else {
+            return Ok(());
+        };
+        if self.numbers[..self.n].contains(&number) {
+            return Err(perr(
+                at,
+                M_TWICE,
+                format!("M{number} programmed twice in the block"),
+            ));
+        }
+        if self.n < Self::KEPT {
+            self.numbers[self.n] = number;
+            self.n += 1;
+        }
+        Ok(())
     }
 }
 
@@ -795,6 +841,7 @@ fn function_bracket<'a>(
     }
     let mut r = first;
     let mut speed = None;
+    let mut ms = FunctionNumbers::default();
     loop {
         r = ws(r);
         if let Some(rest) = r.strip_prefix(']') {
@@ -808,6 +855,7 @@ fn function_bracket<'a>(
             return Ok(Some(rest));
         }
         if starts_function(r) {
+            let at = r;
             let letter = r.as_bytes()[0].to_ascii_uppercase();
             let (rest, number) = super::expr::uint(&r[1..])?;
             if !is_known_m(number) {
@@ -835,6 +883,9 @@ fn function_bracket<'a>(
                     col: fcol,
                 }));
                 r = rest;
+            }
+            if letter == b'M' {
+                ms.add(items.last(), at)?;
             }
             continue;
         }

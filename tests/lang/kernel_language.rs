@@ -43,8 +43,13 @@ fn the_kernels_ids_for_words_programmed_twice() {
     let rig = Rig::new();
     // 20205: a circle centre parameter twice.
     fails(&rig, "G02 X10 I5 I5 J0 F100\nM30\n", 20205);
-    // 20158: the same M function twice; two different ones stay allowed.
-    fails(&rig, "M30 M30\n", 20158);
+    // 20765 (TF5200 diagnosis "Double-programmed M-function."): the same M function twice;
+    // two different ones stay allowed.
+    fails(&rig, "M30 M30\n", 20765);
+    assert_eq!(
+        ncchannel::lang::parse_block("M7 M7").unwrap_err().code,
+        20765
+    );
     ends(&rig, "M7 M8\nM30\n");
     // T twice keeps its own id.
     fails(&rig, "T1 T2\nM30\n", 900135);
@@ -224,6 +229,11 @@ fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
     fails(&rig, "S[REV 100 M64=1]\nM30\n", 20157);
     // What a bracket may hold besides M, H and REV is not modelled.
     fails(&rig, "S[M3 POS45]\nM30\n", 900133);
+    // One M number once per scope: the channel's, an axis's and the spindle's are three
+    // (TF5200 diagnosis ID 20765, whose example this is); twice in one bracket is 20765.
+    let r = ends(&rig, "M54 X[M54] S[M54]\nM30\n");
+    assert_eq!(outputs(&r).len(), 3, "{}", r.log);
+    fails(&rig, "S[M54 M54]\nM30\n", 20765);
     // The bracket names the functions, not the axis: X may still move in the block.
     ends(&rig, "X[M54] X5 F6000 G01\nM30\n");
     // A bracket that is an expression stays one.

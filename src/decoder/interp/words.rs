@@ -682,15 +682,7 @@ fn push_function(
         ));
     }
     // The parser admits only whole numbers 0..=65535 for M and H.
-    let number = whole(v).unwrap_or(0);
-    if letter == 'M' && list[..*n].contains(&number) {
-        // `M30 M30`: the kernel refuses the same M function twice in a block.
-        return Err(DecodeError::new(
-            codes::M_TWICE,
-            format!("M{number} programmed twice in the block"),
-        ));
-    }
-    list[*n] = number;
+    list[*n] = whole(v).unwrap_or(0);
     values[*n] = value;
     *n += 1;
     Ok(())
