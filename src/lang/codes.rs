@@ -19,6 +19,14 @@ pub const WRITE_REJECTED: u32 = 11012;
 /// G1/G2/G3 with path feed 0: no F programmed, or G95 without a spindle speed (TF5200
 /// diagnosis ID 20008 "Feed rate in motion block is 0.").
 pub const NO_FEED: u32 = 20008;
+/// A warning: a G function that needs an axis in its block programmed without one, `G160=2`
+/// (TwinCAT CNC diagnosis ID 20003, "Programmierte G-Funktion nur mit Achsangabe sinnvoll.",
+/// class 1: the program goes on).
+pub const G_WITHOUT_AXIS: u32 = 20003;
+/// G63 (tapping) with spindle speed 0 (TF5200 diagnosis ID 20007 "Spindle speed is 0.", whose
+/// example is `G63 Z10 F300 S0`); ncchannel reports it for a literal `S0` in the G63 block and
+/// refuses every other G63 by name (it does not model tapping).
+pub const SPINDLE_SPEED_0: u32 = 20007;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
@@ -279,6 +287,8 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
 /// Every error id ncchannel can emit, with a short meaning: the constants above, once each.
 pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
+    (G_WITHOUT_AXIS, "G function without its axis: no effect"),
+    (SPINDLE_SPEED_0, "G63 with spindle speed 0"),
     (NO_FEED, "feed 0 in a motion block"),
     (ARC_CENTER_RANGE, "circle centre outside the data format"),
     (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
@@ -396,6 +406,11 @@ pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
 /// 15328482315, "Exceptions / Errors"), whose TF5200 edition names the same id.
 pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
+    (
+        20003,
+        "Programmierte G-Funktion nur mit Achsangabe sinnvoll.",
+    ), // TwinCAT CNC diagnosis, German: 1031/tccncdiagnosis/15651573131 "ID-Bereich 20000-20249"
+    (20007, "Spindle speed is 0."),      // 250510731
     (20008, "Feed rate in motion block is 0."), // 250515083
     (
         20020,

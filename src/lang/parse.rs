@@ -15,9 +15,9 @@ use super::block::{
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE,
-    TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M, UNSUPPORTED,
-    VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, SPINDLE_SPEED_0, STRING_TOO_LONG_FOR_VARIABLE,
+    SYNTAX, S_TWICE, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M,
+    UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -561,6 +561,14 @@ fn word<'a>(
                 return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if !is_known_g(g) {
+                if g == 160 {
+                    if let Some(r) = axis_zero_offsets(ctx, rest, col, items)? {
+                        return Ok(r);
+                    }
+                }
+                if g == 63 {
+                    tapping_at_speed_0(i, rest, items)?;
+                }
                 dialect_g(i, g)?;
                 if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
                     return Ok(r);
@@ -957,6 +965,63 @@ fn word_expr<'a>(
         col,
     }));
     Ok(rest)
+}
+
+/// G63 (tapping), which ncchannel does not model, with a literal `S0` in its block: the
+/// kernel's 20007 first (TF5200 diagnosis ID 20007 "Spindle speed is 0.", whose example is
+/// `G63 Z10 F300 S0`), at the S. Any other G63 is refused by name after this.
+#[cold]
+fn tapping_at_speed_0<'a>(
+    i: &'a str,
+    rest: &'a str,
+    items: &[Item],
+) -> Result<(), nom::Err<PErr<'a>>> {
+    let err = |at: &'a str| {
+        perr(
+            at,
+            SPINDLE_SPEED_0,
+            "spindle speed 0 with G63 (tapping): the spindle speed must not be 0",
+        )
+    };
+    let before = items
+        .iter()
+        .any(|it| matches!(it, Item::Word(w) if w.letter == b'S' && w.value == Value::Num(0.0)));
+    if before {
+        return Err(err(i));
+    }
+    // A later `S0` of the block: an S after a blank, then a literal that reads as 0.
+    let text = rest.split([';', '(']).next().unwrap_or("");
+    for (k, _) in text.match_indices(['S', 's']) {
+        let after_blank = k == 0 || matches!(text.as_bytes()[k - 1], b' ' | b'\t');
+        let value = scan_unsigned(text[k + 1..].as_bytes());
+        if after_blank && value.is_some_and(|(v, _)| v == 0.0) {
+            return Err(err(&rest[k..]));
+        }
+    }
+    Ok(())
+}
+
+/// `G160=2` (`i` after the number): the axis-specific zero offsets, which take their axes in
+/// the block (TF5200 diagnosis ID 20003, whose example is `G160=2 X1 Z1`). Read with its value
+/// for the decoder: without an axis it is the kernel's warning 20003 and changes nothing, with
+/// one it is refused by name. `None` for `G160` without a value (refused here).
+#[cold]
+fn axis_zero_offsets<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    col: u32,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let Some(r) = ws(i).strip_prefix('=') else {
+        return Ok(None);
+    };
+    let (r, e) = ctx.expr(ws(r))?;
+    items.push(Item::GValue {
+        g: 160,
+        value: expr_value(e),
+        col,
+    });
+    Ok(Some(r))
 }
 
 /// A G function outside the implemented fast path: one ISG lists and ncchannel accepts

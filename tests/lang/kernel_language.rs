@@ -240,3 +240,32 @@ fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
     let r = ends(&rig, "P1 = 2\nG01 X[P1*2] F6000\nM30\n");
     assert!((r.position('X') - 4.0).abs() < 1e-9);
 }
+
+#[test]
+fn g160_without_an_axis_is_the_kernels_warning_and_the_program_goes_on() {
+    let rig = Rig::new();
+    // TwinCAT CNC diagnosis ID 20003 (class 1: processing continues), whose example is
+    // `G160=2` without the axes of `G160=2 X1 Z1`.
+    let r = ends(&rig, "G01 X10 F6000\nG160=2\nY5\nM30\n");
+    assert_eq!(warnings(&r), [20003], "{}", r.log);
+    assert!((r.position('Y') - 5.0).abs() < 1e-9);
+    // With its axes it would offset them, which ncchannel does not model.
+    fails(&rig, "G160=2 X1 Z1\nM30\n", 900133);
+}
+
+#[test]
+fn g63_with_spindle_speed_0_is_the_kernels_20007() {
+    let rig = Rig::new();
+    // TF5200 diagnosis ID 20007 "Spindle speed is 0.", example `G63 Z10 F300 S0`; another
+    // G63 is refused by name: ncchannel does not model tapping.
+    fails(&rig, "G63 Z10 F300 S0\nM30\n", 20007);
+    fails(&rig, "S0 G63 Z10 F300\nM30\n", 20007);
+    fails(&rig, "G63 Z10 F300 S17\nM30\n", 900133);
+    let d = ncchannel::lang::check_program("G63 Z10 F300 S0\nM30\n");
+    assert_eq!(
+        d.iter()
+            .map(|d| (d.line, d.col, d.code))
+            .collect::<Vec<_>>(),
+        [(1, 14, 20007)]
+    );
+}

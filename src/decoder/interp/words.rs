@@ -60,6 +60,9 @@ impl Interpreter {
         for it in items {
             self.collect(it, w)?;
         }
+        if w.gs().iter().any(|&(g, _)| g == 160) {
+            self.axis_zero_offsets(w, notes)?;
+        }
         let gs = self.modal_changes(w)?;
         let info = self.info(rd, at, io);
         // Step 4: the block's move (not yet queued), if it has one.
@@ -310,6 +313,10 @@ impl Interpreter {
         let mut gs = BlockGs::default();
         let mut call = None;
         for &(g, col) in w.gs() {
+            if g == 160 {
+                // `G160=n` without axes: the warning was given ([`Self::axis_zero_offsets`]).
+                continue;
+            }
             if !apply_g(&mut self.modal, g, &mut gs) {
                 if crate::lang::gcall::G_CALLS.contains(&g) {
                     if call.replace((g, col)).is_some() {
@@ -642,6 +649,31 @@ fn two_calls() -> DecodeError {
 }
 
 impl Interpreter {
+    /// `G160=n`: without an axis in the block the kernel's warning 20003 (TF5200 diagnosis ID
+    /// 20003, "programmed G function only useful with an axis", class 1: the program goes
+    /// on) and nothing else; with axes the axis-specific zero offsets, which ncchannel does
+    /// not model (900133).
+    #[cold]
+    fn axis_zero_offsets(&self, w: &Words, notes: &mut Vec<Note>) -> Res {
+        let col = w
+            .gs()
+            .iter()
+            .find(|&&(g, _)| g == 160)
+            .map_or(1, |&(_, c)| c);
+        if w.axes_set != 0 {
+            return Err(DecodeError::new(
+                codes::UNSUPPORTED,
+                "G160 (axis-specific zero offsets) is not supported by ncchannel",
+            )
+            .at(col));
+        }
+        notes.push(Note::Warning {
+            code: codes::G_WITHOUT_AXIS,
+            msg: format!("G160 without an axis has no effect (column {col})"),
+        });
+        Ok(())
+    }
+
     /// The slot of the configured axis named by the one letter `letter` outside X Y Z A B C
     /// (`W10` where the channel list names an axis `W`): `Some(None)` for a letter that is no
     /// axis word (E), an error for an axis letter the channel does not configure (U V W).
