@@ -561,13 +561,8 @@ fn word<'a>(
                 return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if !is_known_g(g) {
-                if g == 160 {
-                    if let Some(r) = axis_zero_offsets(ctx, rest, col, items)? {
-                        return Ok(r);
-                    }
-                }
-                if g == 63 {
-                    tapping_at_speed_0(i, rest, items)?;
+                if let Some(r) = refused_g_first(ctx, (i, rest), g, col, items)? {
+                    return Ok(r);
                 }
                 dialect_g(i, g)?;
                 if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
@@ -967,6 +962,24 @@ fn word_expr<'a>(
     Ok(rest)
 }
 
+/// The refused G functions the kernel answers with its own id first: G160 with a value (see
+/// [`axis_zero_offsets`]) and G63 with `S0` ([`tapping_at_speed_0`]). `i` is at the G, `rest`
+/// after its number.
+#[cold]
+fn refused_g_first<'a>(
+    ctx: &Ctx<'a>,
+    (i, rest): (&'a str, &'a str),
+    g: u32,
+    col: u32,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    match g {
+        160 => axis_zero_offsets(ctx, rest, col, items),
+        63 => tapping_at_speed_0(i, rest, items).map(|()| None),
+        _ => Ok(None),
+    }
+}
+
 /// G63 (tapping), which ncchannel does not model, with a literal `S0` in its block: the
 /// kernel's 20007 first (TF5200 diagnosis ID 20007 "Spindle speed is 0.", whose example is
 /// `G63 Z10 F300 S0`), at the S. Any other G63 is refused by name after this.
@@ -993,7 +1006,7 @@ fn tapping_at_speed_0<'a>(
     let text = rest.split([';', '(']).next().unwrap_or("");
     for (k, _) in text.match_indices(['S', 's']) {
         let after_blank = k == 0 || matches!(text.as_bytes()[k - 1], b' ' | b'\t');
-        let value = scan_unsigned(text[k + 1..].as_bytes());
+        let value = scan_unsigned(&text.as_bytes()[k + 1..]);
         if after_blank && value.is_some_and(|(v, _)| v == 0.0) {
             return Err(err(&rest[k..]));
         }
