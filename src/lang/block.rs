@@ -89,6 +89,22 @@ pub enum Item {
     /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
     /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
     GCall(Box<GCall>),
+    /// `X[M54=P1]`, `S[REV 1000 M03 M63=-789]`: the technology functions of one axis or of
+    /// the spindle (TF5200 programming manual, "Programming in spindle-specific syntax").
+    /// Boxed, as [`Item::GCall`].
+    Functions(Box<Functions>),
+}
+
+/// The functions in an axis's or the spindle's brackets ([`Item::Functions`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Functions {
+    /// The axis letter, or `S` for the spindle.
+    pub owner: u8,
+    /// M and H words (`Item::Word`, `Item::FunctionValue`) and, for the spindle, its speed
+    /// `REV` as an S word, in written order.
+    pub items: Vec<Item>,
+    /// The owner's column.
+    pub col: u32,
 }
 
 /// An axis named by more than its letter with its value ([`Item::NamedAxis`]).

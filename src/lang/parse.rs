@@ -9,8 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Item, Label,
-    NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Item,
+    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -415,15 +415,16 @@ impl FunctionNumbers {
     }
 }
 
-/// Did the word just read end in an M or H function: `X[M54]`, `S[M3 M10]`, the functions of
-/// an axis or the spindle, which program neither the axis nor the speed (`X[M54] X10` is one
-/// X)? Asked only for a word whose letter a bracket follows: the literal words of the hot
-/// path skip it.
+/// Was the word just read an axis's or the spindle's functions without a speed: `X[M54]`,
+/// `S[M3 M10]`, which program neither the axis nor the speed (`X[M54] X10` is one X)? Asked
+/// only for a word whose letter a bracket follows: the literal words of the hot path skip it.
 #[inline]
 fn ends_in_function(items: &[Item]) -> bool {
     match items.last() {
-        Some(Item::FunctionValue { .. }) => true,
-        Some(Item::Word(w)) => matches!(w.letter, b'M' | b'H'),
+        Some(Item::Functions(fs)) => !fs
+            .items
+            .iter()
+            .any(|it| matches!(it, Item::Word(w) if w.letter == b'S')),
         _ => false,
     }
 }
@@ -433,9 +434,11 @@ fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) | Item::NamedAxis(_) => {
-            false
-        }
+        Item::Assign { .. }
+        | Item::FunctionValue { .. }
+        | Item::GCall(_)
+        | Item::NamedAxis(_)
+        | Item::Functions(_) => false,
     }
 }
 
@@ -485,6 +488,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
             Item::NamedAxis(a) => (a.col, a.name.to_string()),
+            Item::Functions(fs) => (fs.col, format!("{}[…]", char::from(fs.owner))),
         };
         return Err(ctx.err_at(
             col,
@@ -845,16 +849,22 @@ fn function_bracket<'a>(
     let mut r = first;
     let mut speed = None;
     let mut ms = FunctionNumbers::default();
+    let mut inner = Vec::new();
     loop {
         r = ws(r);
         if let Some(rest) = r.strip_prefix(']') {
             if let Some(value) = speed {
-                items.push(Item::Word(Word {
+                inner.push(Item::Word(Word {
                     letter: b'S',
                     value,
                     col,
                 }));
             }
+            items.push(Item::Functions(Box::new(Functions {
+                owner: up,
+                items: inner,
+                col,
+            })));
             return Ok(Some(rest));
         }
         if starts_function(r) {
@@ -872,7 +882,7 @@ fn function_bracket<'a>(
             let fcol = ctx.col(r);
             if let Some(v) = ws(rest).strip_prefix('=') {
                 let (rest, e) = ctx.expr(ws(v))?;
-                items.push(Item::FunctionValue {
+                inner.push(Item::FunctionValue {
                     letter,
                     number,
                     value: expr_value(e),
@@ -880,7 +890,7 @@ fn function_bracket<'a>(
                 });
                 r = rest;
             } else {
-                items.push(Item::Word(Word {
+                inner.push(Item::Word(Word {
                     letter,
                     value: Value::Num(f64::from(number)),
                     col: fcol,
@@ -888,7 +898,10 @@ fn function_bracket<'a>(
                 r = rest;
             }
             if letter == b'M' {
-                ms.add(items.last(), at)?;
+                ms.add(inner.last(), at)?;
+            }
+            if inner.len() > FunctionNumbers::KEPT {
+                return Err(perr(at, SYNTAX, "too many functions in one bracket"));
             }
             continue;
         }

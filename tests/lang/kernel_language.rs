@@ -236,6 +236,12 @@ fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
     fails(&rig, "S[M54 M54]\nM30\n", 20765);
     // The bracket names the functions, not the axis: X may still move in the block.
     ends(&rig, "X[M54] X5 F6000 G01\nM30\n");
+    // The brackets print as written, so the printed block reads back (and keeps M54 twice in
+    // two scopes legal).
+    let b = ncchannel::lang::parse_block("M54 X[M54=P1] S[REV 1000 M03 M63=-789]").unwrap();
+    let printed = b.to_string();
+    assert_eq!(printed, "M54 X[M54=P1] S[M3 M63=-789 REV1000]");
+    assert_eq!(ncchannel::lang::parse_block(&printed).unwrap().to_string(), printed);
     // A bracket that is an expression stays one.
     let r = ends(&rig, "P1 = 2\nG01 X[P1*2] F6000\nM30\n");
     assert!((r.position('X') - 4.0).abs() < 1e-9);

@@ -160,6 +160,9 @@ impl Interpreter {
                 Ok(())
             }
             Item::NamedAxis(a) => self.collect_named_axis(a, w),
+            // An axis's or the spindle's functions: the block's own (one spindle, one set of
+            // units).
+            Item::Functions(fs) => fs.items.iter().try_for_each(|it| self.collect(it, w)),
             Item::Word(word) => {
                 let renamed = self.renamed_slots != 0;
                 if let Some(i) = slot_of(word.letter).filter(|_| renamed) {
