@@ -310,8 +310,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
     let mut items = Vec::with_capacity(item_capacity(i));
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
-    // The block's own M functions so far: one twice is 20765.
-    let mut ms = FunctionNumbers::default();
+    // The block's own M functions so far: one twice is 20765. Made at the first M, so a
+    // block without one does not pay for it.
+    let mut ms: Option<FunctionNumbers> = None;
     let mut dwell = false;
     loop {
         i = gap(i);
@@ -330,7 +331,8 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             if let b'G' | b'M' | b'H' = up {
                 dwell |= up == b'G' && items.last().is_some_and(is_dwell);
                 if up == b'M' {
-                    ms.add(items.last(), at)?;
+                    ms.get_or_insert_with(FunctionNumbers::default)
+                        .add(items.last(), at)?;
                 }
             } else if !(bytes.get(1) == Some(&b'[') && ends_in_function(&items)) {
                 let bit = 1u32 << (up - b'A');

@@ -56,6 +56,15 @@ fn the_kernels_ids_for_words_programmed_twice() {
 }
 
 #[test]
+fn u_v_w_twice_in_a_block_is_an_axis_twice() {
+    // TF5200 "Axis commands": U V W are axis letters like X Y Z A B C.
+    for (line, col) in [("W1 W2", 4), ("U=1 U=2", 5)] {
+        let e = ncchannel::lang::parse_block(line).unwrap_err();
+        assert_eq!((e.code, e.col), (20203, col), "{line}");
+    }
+}
+
+#[test]
 fn an_h_function_outside_the_numbers_is_the_kernels_undefined_h() {
     let rig = Rig::new();
     fails(&rig, "H70000\nM30\n", 20162);
@@ -241,7 +250,10 @@ fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
     let b = ncchannel::lang::parse_block("M54 X[M54=P1] S[REV 1000 M03 M63=-789]").unwrap();
     let printed = b.to_string();
     assert_eq!(printed, "M54 X[M54=P1] S[M3 M63=-789 REV1000]");
-    assert_eq!(ncchannel::lang::parse_block(&printed).unwrap().to_string(), printed);
+    assert_eq!(
+        ncchannel::lang::parse_block(&printed).unwrap().to_string(),
+        printed
+    );
     // A bracket that is an expression stays one.
     let r = ends(&rig, "P1 = 2\nG01 X[P1*2] F6000\nM30\n");
     assert!((r.position('X') - 4.0).abs() < 1e-9);
