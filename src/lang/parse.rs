@@ -567,10 +567,9 @@ fn word<'a>(
                 return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if !is_known_g(g) {
-                if let Some(r) = refused_g_first(ctx, (i, rest), g, col, items)? {
-                    return Ok(r);
+                if let Err(refused) = dialect_g(i, g) {
+                    return refused_g_first(ctx, (i, rest), (g, col), items, refused);
                 }
-                dialect_g(i, g)?;
                 if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
                     return Ok(r);
                 }
@@ -977,21 +976,22 @@ fn word_expr<'a>(
     Ok(rest)
 }
 
-/// The refused G functions the kernel answers with its own id first: G160 with a value (see
-/// [`axis_zero_offsets`]) and G63 with `S0` ([`tapping_at_speed_0`]). `i` is at the G, `rest`
-/// after its number.
+/// A refused G function (`refused`, from [`dialect_g`]), unless the kernel answers it with
+/// its own id first: G160 with a value is read for the decoder ([`axis_zero_offsets`]), G63
+/// with `S0` is 20007 ([`tapping_at_speed_0`]). `i` is at the G, `rest` after its number;
+/// the rest of the block when G160 was read.
 #[cold]
 fn refused_g_first<'a>(
     ctx: &Ctx<'a>,
     (i, rest): (&'a str, &'a str),
-    g: u32,
-    col: u32,
+    (g, col): (u32, u32),
     items: &mut Vec<Item>,
-) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    refused: nom::Err<PErr<'a>>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
     match g {
-        160 => axis_zero_offsets(ctx, rest, col, items),
-        63 => tapping_at_speed_0(i, rest, items).map(|()| None),
-        _ => Ok(None),
+        160 => axis_zero_offsets(ctx, rest, col, items)?.ok_or(refused),
+        63 => tapping_at_speed_0(i, rest, items).and(Err(refused)),
+        _ => Err(refused),
     }
 }
 
