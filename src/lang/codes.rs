@@ -27,6 +27,9 @@ pub const G_WITHOUT_AXIS: u32 = 20003;
 /// example is `G63 Z10 F300 S0`); ncchannel reports it for a literal `S0` in the G63 block and
 /// refuses every other G63 by name (it does not model tapping).
 pub const SPINDLE_SPEED_0: u32 = 20007;
+/// A negative literal speed `REV` in the spindle's brackets, `S[REV -5]` (TF5200 diagnosis ID
+/// 20991 "Negative spindle speed not permitted.", for spindle-specific programming `S[...]`).
+pub const SPINDLE_SPEED_NEGATIVE: u32 = 20991;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
@@ -289,6 +292,7 @@ pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
     (G_WITHOUT_AXIS, "G function without its axis: no effect"),
     (SPINDLE_SPEED_0, "G63 with spindle speed 0"),
+    (SPINDLE_SPEED_NEGATIVE, "negative REV in S[...]"),
     (NO_FEED, "feed 0 in a motion block"),
     (ARC_CENTER_RANGE, "circle centre outside the data format"),
     (ARC_FULL_CIRCLE_BY_RADIUS, "full circle programmed with R"),
@@ -502,6 +506,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         "Memory for variables limited, allocation of new variable impossible.",
     ), // 253126283
     (20974, "Too many indices in variable array programmed."), // 253143691
+    (20991, "Negative spindle speed not permitted."), // 253182859
     (
         21476,
         "Streaming data does not contain a correct line end marker",

@@ -15,9 +15,9 @@ use super::block::{
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, SPINDLE_SPEED_0, STRING_TOO_LONG_FOR_VARIABLE,
-    SYNTAX, S_TWICE, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_H, UNKNOWN_M,
-    UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, SPINDLE_SPEED_0, SPINDLE_SPEED_NEGATIVE,
+    STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G,
+    UNKNOWN_H, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -910,9 +910,19 @@ fn function_bracket<'a>(
             Some(rest) if is_spindle && speed.is_none() => {
                 let rest = ws(rest);
                 let rest = rest.strip_prefix('=').map_or(rest, ws);
-                let (rest, e) = ctx.expr(rest)?;
-                speed = Some(expr_value(e));
-                r = rest;
+                let (after, e) = ctx.expr(rest)?;
+                let value = expr_value(e);
+                if matches!(value, Value::Num(v) if v < 0.0)
+                    || matches!(&value, Value::Expr(Expr::Unary(super::block::UnOp::Neg, e)) if matches!(**e, Expr::Num(_)))
+                {
+                    return Err(perr(
+                        rest,
+                        SPINDLE_SPEED_NEGATIVE,
+                        "negative spindle speed in S[...] is not permitted",
+                    ));
+                }
+                speed = Some(value);
+                r = after;
             }
             Some(_) if is_spindle => return Err(perr(r, S_TWICE, "REV programmed twice")),
             _ => {

@@ -236,6 +236,8 @@ fn axis_and_spindle_brackets_hand_their_functions_to_the_units() {
     // An M number the channel list does not define is refused as a plain M word is.
     fails(&rig, "X[M55]\nM30\n", 20157);
     fails(&rig, "S[REV 100 M64=1]\nM30\n", 20157);
+    // TF5200 diagnosis ID 20991 "Negative spindle speed not permitted." in S[...].
+    fails(&rig, "S[REV -5 M3]\nM30\n", 20991);
     // What a bracket may hold besides M, H and REV is not modelled.
     fails(&rig, "S[M3 POS45]\nM30\n", 900133);
     // One M number once per scope: the channel's, an axis's and the spindle's are three
