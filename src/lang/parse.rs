@@ -908,19 +908,7 @@ fn function_bracket<'a>(
         }
         match keyword_prefix(r, "REV") {
             Some(rest) if is_spindle && speed.is_none() => {
-                let rest = ws(rest);
-                let rest = rest.strip_prefix('=').map_or(rest, ws);
-                let (after, e) = ctx.expr(rest)?;
-                let value = expr_value(e);
-                if matches!(value, Value::Num(v) if v < 0.0)
-                    || matches!(&value, Value::Expr(Expr::Unary(super::block::UnOp::Neg, e)) if matches!(**e, Expr::Num(_)))
-                {
-                    return Err(perr(
-                        rest,
-                        SPINDLE_SPEED_NEGATIVE,
-                        "negative spindle speed in S[...] is not permitted",
-                    ));
-                }
+                let (after, value) = spindle_speed(ctx, rest)?;
                 speed = Some(value);
                 r = after;
             }
@@ -942,6 +930,28 @@ fn function_bracket<'a>(
             }
         }
     }
+}
+
+/// The value after `REV` (`rest`), `=` optional: a negative literal is the kernel's 20991
+/// (TF5200 diagnosis ID 20991 "Negative spindle speed not permitted.", spindle-specific
+/// programming `S[...]`).
+fn spindle_speed<'a>(ctx: &Ctx<'a>, rest: &'a str) -> Result<(&'a str, Value), nom::Err<PErr<'a>>> {
+    let rest = ws(rest);
+    let rest = rest.strip_prefix('=').map_or(rest, ws);
+    let (after, e) = ctx.expr(rest)?;
+    let negative = match &e {
+        Expr::Num(v) => *v < 0.0,
+        Expr::Unary(super::block::UnOp::Neg, inner) => matches!(**inner, Expr::Num(_)),
+        _ => false,
+    };
+    if negative {
+        return Err(perr(
+            rest,
+            SPINDLE_SPEED_NEGATIVE,
+            "negative spindle speed in S[...] is not permitted",
+        ));
+    }
+    Ok((after, expr_value(e)))
 }
 
 /// `kw` (any case) at the start of `r`, a number or `=` allowed right after it (`REV1000`):
