@@ -8,7 +8,7 @@ use crate::channel::{Channel, ChannelSettings};
 use crate::decoder::DecoderSettings;
 use crate::geometry::SoftLimits;
 use crate::motion::{AxisLimits, PlannerSettings};
-use crate::params::runtime::axis_index;
+use crate::params::runtime::channel_slots;
 use crate::params::{ChannelConfig, Config, MAIN_PROGRAMS, SUBROUTINES};
 use crate::source::cache::CacheLimits;
 use crate::source::loader::Loader;
@@ -18,7 +18,7 @@ use crate::vocab::axis::MAX_AXES;
 #[derive(Debug, Error)]
 pub enum SetupError {
     #[error(
-        "axis '{0}': ncchannel knows the axes X Y Z A B C (or a name starting with one, as X1)"
+        "axis '{0}': ncchannel knows the axes X Y Z A B C U V W (or a name starting with one, as X1)"
     )]
     UnknownAxis(String),
     #[error("channel {0} does not exist (the start-up list has {1})")]
@@ -37,11 +37,12 @@ pub fn axes(config: &Config) -> Result<Vec<AxisLimits>, SetupError> {
 /// Axis limits of a channel's axes (its one axis table: axis lists or runtime.toml), by
 /// `AXIS_LETTERS` index.
 pub(crate) fn channel_axes(ch: &ChannelConfig) -> Result<Vec<AxisLimits>, SetupError> {
+    let slots = channel_slots(ch.axes.iter().map(|a| a.name.as_str()));
     ch.axes
         .iter()
-        .map(|a| {
-            let index =
-                axis_index(&a.name).ok_or_else(|| SetupError::UnknownAxis(a.name.clone()))?;
+        .zip(slots)
+        .map(|(a, slot)| {
+            let index = slot.ok_or_else(|| SetupError::UnknownAxis(a.name.clone()))?;
             Ok(AxisLimits {
                 index,
                 max_velocity_mm_per_min: a.max_velocity_mm_per_min,

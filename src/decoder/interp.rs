@@ -12,6 +12,7 @@ mod expr;
 mod implicit;
 mod search;
 mod techno;
+mod transform;
 mod words;
 
 use super::error::{var_error, Res};
@@ -69,8 +70,13 @@ pub(super) struct Interpreter {
 
 impl Interpreter {
     pub(super) fn new(settings: DecoderSettings, loader: Loader) -> Self {
+        // `X1` in slot X, or `W` in slot Z: the slot's letter alone names no axis.
         let renamed_slots = (0..MAX_AXES)
-            .filter(|&i| settings.axes[i] && !settings.axis_names[i].is_letter())
+            .filter(|&i| {
+                let n = &settings.axis_names[i];
+                settings.axes[i]
+                    && !(n.is_letter() && n.letter() == crate::vocab::axis::AXIS_LETTERS[i])
+            })
             .fold(0u8, |m, i| m | 1 << i);
         let techno = TechnoState::new(settings.techno.clone(), settings.implicit.at_m6.is_some());
         let mut vars = VarStore::new(loader);

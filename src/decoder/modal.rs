@@ -122,6 +122,14 @@ pub struct Modal {
     pub contouring: bool,
     /// `#CONTOUR MODE [DEV PATH_DEV=…]`: corner deviation for G261/G61, mm.
     pub contour_dev_mm: f64,
+    /// G161: I J K give the circle centre in absolute program coordinates; G162 (false,
+    /// the initial state): offsets from the start point (TF5200 programming manual,
+    /// "Specifying centre point for circle definition (G161/G162)").
+    pub(crate) centre_absolute: bool,
+    /// Bit n: `#CS DEF [n]` defined CS n (always the identity: `decoder::interp::transform`).
+    pub(crate) cs_defined: u64,
+    /// A CS was defined: `#CS ON` without an id selects the last one.
+    pub(crate) cs_last_defined: bool,
     /// G151 / `#SPLINE ON`.
     pub spline: bool,
     pub(crate) spline_type: SplineCommand,
@@ -154,6 +162,9 @@ impl Modal {
             radius_comp: RadiusComp::Off,
             contouring: false,
             contour_dev_mm: DEFAULT_PATH_DEV_MM,
+            centre_absolute: false,
+            cs_defined: 0,
+            cs_last_defined: false,
             spline: false,
             spline_type: SplineCommand::TypeAkima,
             hsc: false,
@@ -253,6 +264,8 @@ pub(crate) fn apply_g(m: &mut Modal, g: u32, b: &mut BlockGs) -> bool {
         360 => m.block_end = BlockEnd::ExactStop,
         150 => m.spline = false,
         151 => m.spline = true,
+        161 => m.centre_absolute = true,
+        162 => m.centre_absolute = false,
         260 => m.contouring = false,
         261 => m.contouring = true,
         // The rest of ISG's list that ncchannel accepts without effect (lang::dialect).

@@ -94,6 +94,22 @@ pub enum Item {
     /// `G800` without a bracket is an ordinary G word. `col` is the G's column. Boxed, so
     /// the variant leaves the enum's layout, and the drop of every plain word, as it was.
     GCall(Box<GCall>),
+    /// `X[M54=P1]`, `S[REV 1000 M03 M63=-789]`: the technology functions of one axis or of
+    /// the spindle (TF5200 programming manual, "Programming in spindle-specific syntax").
+    /// Boxed, as [`Item::GCall`].
+    Functions(Box<Functions>),
+}
+
+/// The functions in an axis's or the spindle's brackets ([`Item::Functions`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Functions {
+    /// The axis letter, or `S` for the spindle.
+    pub owner: u8,
+    /// M and H words (`Item::Word`, `Item::FunctionValue`) and, for the spindle, its speed
+    /// `REV` as an S word, in written order.
+    pub items: Vec<Item>,
+    /// The owner's column.
+    pub col: u32,
 }
 
 /// An axis named by more than its letter with its value ([`Item::NamedAxis`]).
@@ -122,7 +138,7 @@ impl AxisName {
         let b = name.as_bytes();
         let first = b.first()?.to_ascii_uppercase();
         if b.len() > AXIS_NAME_MAX
-            || !b"XYZABC".contains(&first)
+            || !b"XYZABCUVW".contains(&first)
             || !b[1..]
                 .iter()
                 .all(|c| c.is_ascii_alphanumeric() || *c == b'_')
@@ -139,7 +155,8 @@ impl AxisName {
         })
     }
 
-    /// The axis letter the name starts with: the interpolator slot the axis takes.
+    /// The axis letter the name starts with: for X Y Z A B C the interpolator slot the axis
+    /// takes (`params::runtime::channel_slots`).
     pub fn letter(&self) -> u8 {
         self.bytes[0]
     }
@@ -480,11 +497,42 @@ pub enum Command {
     /// from a V.E. string the HMI sets). ncchannel writes no report file, but the variable
     /// is read, so an undeclared or numeric one is refused as the kernel would.
     MsgFileName(Box<VarRef>),
+    /// `#TRAFO`, `#KIN`, `#CS` in a form that leaves the path as it is (`super::transform`).
+    /// Boxed: rare, and `Block` stays small.
+    Transform(Box<Transform>),
     /// A `#` command of ISG's list that ncchannel accepts without effect
     /// (`super::dialect`); the whole command text after `#` is kept verbatim.
     Inert {
         text: String,
     },
+}
+
+/// A transformation command in a neutral form (`super::transform`); `text` is the command
+/// after `#`, verbatim.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Transform {
+    /// `#TRAFO OFF`, `#TRAFO [NONE]`, `#KIN ID [NONE]`, `#CS OFF`, `#CS OFF ALL`.
+    Off { text: String },
+    /// `#CS DEF [id] [v1,v2,v3,φ1,φ2,φ3]`, or `#CS ON …` (`select`) with the values.
+    CsDefine {
+        text: String,
+        id: Option<Expr>,
+        values: Vec<Expr>,
+        select: bool,
+    },
+    /// `#CS ON [id]`, `#CS ON`: a CS defined before.
+    CsSelect { text: String, id: Option<Expr> },
+}
+
+impl Transform {
+    /// The command after `#`, as written.
+    pub fn text(&self) -> &str {
+        match self {
+            Transform::Off { text }
+            | Transform::CsDefine { text, .. }
+            | Transform::CsSelect { text, .. } => text,
+        }
+    }
 }
 
 /// An operator message (TF5200 programming manual, "Messages from the NC program").

@@ -25,6 +25,17 @@ pub const DWELL_DIRECT_AND_AXIS: u32 = 20013;
 /// G04 with its time given by an axis other than the first main axis, `G04 Y2` (TF5200
 /// diagnosis ID 20014 "Dwell time is not programmed with the coordinate of first axis.").
 pub const DWELL_NOT_FIRST_AXIS: u32 = 20014;
+/// A warning: a G function that needs an axis in its block programmed without one, `G160=2`
+/// (TwinCAT CNC diagnosis ID 20003, "Programmierte G-Funktion nur mit Achsangabe sinnvoll.",
+/// class 1: the program goes on).
+pub const G_WITHOUT_AXIS: u32 = 20003;
+/// G63 (tapping) with spindle speed 0 (TF5200 diagnosis ID 20007 "Spindle speed is 0.", whose
+/// example is `G63 Z10 F300 S0`); ncchannel reports it for a literal `S0` in the G63 block and
+/// refuses every other G63 by name (it does not model tapping).
+pub const SPINDLE_SPEED_0: u32 = 20007;
+/// A negative literal speed `REV` in the spindle's brackets, `S[REV -5]` (TF5200 diagnosis ID
+/// 20991 "Negative spindle speed not permitted.", for spindle-specific programming `S[...]`).
+pub const SPINDLE_SPEED_NEGATIVE: u32 = 20991;
 /// Circle centre parameter (I, J, K) outside the data format (TF5200 diagnosis ID 20020).
 pub const ARC_CENTER_RANGE: u32 = 20020;
 /// A full circle programmed with a radius: start and end point coincide, so R leaves the
@@ -52,6 +63,23 @@ pub const UNKNOWN_H: u32 = 20162;
 pub const D_TWICE: u32 = 20170;
 /// A second F word in one block (TF5200 diagnosis ID 20175 "Double-programmed F-word.").
 pub const F_TWICE: u32 = 20175;
+/// A negative feed F (kernel id 20176, "negative or zero F", as the kernel's error list names
+/// it; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]). F0 itself is accepted
+/// as a word: a motion block at feed 0 is [`NO_FEED`].
+pub const FEED_NEGATIVE: u32 = 20176;
+/// The same M function twice in one block in one scope: `M10 M10`, `S[M10 M10]` (TF5200
+/// diagnosis ID 20765 "Double-programmed M-function.", which allows `M10 X[M10] S[M10]`: a
+/// channel's, an axis's and a spindle's M function are three).
+pub const M_TWICE: u32 = 20765;
+/// A circle centre parameter (I, J or K) twice in one block (TF5200 diagnosis ID 20205
+/// "Double-programmed centre point coordinate.", whose example is `G02 I10 I20 J30`).
+pub const ARC_CENTER_TWICE: u32 = 20205;
+/// Expression: square root of a negative number (kernel id 20398 in the kernel's error
+/// list; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]).
+pub const EVAL_SQRT_NEGATIVE: u32 = 20398;
+/// End of the main program's file without M30/M02 (kernel id 21129, "M02/M30 missing" in the
+/// kernel's error list; its TF5200 diagnosis page was not read, see [`KERNEL_UNREAD`]).
+pub const MAIN_END_MISSING: u32 = 21129;
 /// A second S word in one block (TF5200 diagnosis ID 20181 "Double-programmed spindle.",
 /// whose example is `S1000 M03 … S1500`).
 pub const S_TWICE: u32 = 20181;
@@ -144,10 +172,6 @@ pub const FLUSH_UNDER_TRC: u32 = 20651;
 /// X's time and the other axes do not move (TF5200 diagnosis ID 20685 "Dwell time
 /// programmed with additional axes.", class 1, processing continues).
 pub const DWELL_EXTRA_AXES: u32 = 20685;
-/// The same technology M function twice in one block, `M10 M10` (TF5200 diagnosis ID 20765
-/// "Double-programmed M-function.", channel-specific). The program-flow M functions
-/// ([`PROGRAM_FLOW_M`]) are not technology functions and are not checked here.
-pub const M_TWICE: u32 = 20765;
 /// `#MSG`: the values programmed do not match the text's format elements (TF5200 diagnosis
 /// ID 20721 "Number of parameters and the number of format specifiers do not match.").
 pub const MSG_ARG_COUNT: u32 = 20721;
@@ -245,9 +269,6 @@ pub const FLUSH_UNDER_HSC: u32 = 120434;
 
 // ---- Error ids: ours, 900000–999999 (no kernel id with this meaning read) ----------------
 
-/// Expression: square root of a negative number. (The kernel's 20398 may mean this; its page
-/// was not in the index searched, so the id stays ours until it is read.)
-pub const EVAL_SQRT_NEGATIVE: u32 = 900002;
 /// Expression: ASIN/ACOS outside -1..1.
 pub const EVAL_OUT_OF_DOMAIN: u32 = 900003;
 /// Expression: undefined variable or parameter. (Candidates to read: the kernel's 20196; its
@@ -265,8 +286,6 @@ pub const EVAL_STRING_AS_NUMBER: u32 = 900008;
 pub const EVAL_NUMBER_AS_STRING: u32 = 900009;
 /// The streaming program is already running (called a second time).
 pub const STREAM_ALREADY_ACTIVE: u32 = 900102;
-/// End of the main program's file without M30/M02. (Candidate to read: the kernel's 21129.)
-pub const MAIN_END_MISSING: u32 = 900103;
 /// End of a subroutine's file without M17/M29.
 pub const SUB_END_MISSING: u32 = 900104;
 /// A warning: more block-number labels (`N10:`) or `%L` sections in a program file than its
@@ -281,7 +300,7 @@ pub const PROGRAM_UNREADABLE: u32 = 900111;
 pub const PROGRAM_BAD_NAME: u32 = 900112;
 /// Circle end point, centre and radius do not agree.
 pub const ARC_INCONSISTENT: u32 = 900130;
-/// A value out of range (negative F or S, non-finite axis value, `$FOR` step 0, T or D not a
+/// A value out of range (negative S, non-finite axis value, `$FOR` step 0, T or D not a
 /// whole number, …).
 pub const BAD_VALUE: u32 = 900132;
 /// A G function, `#` command, V.A./V.G. variable, `#FILENAME` file id or modal cycle call
@@ -292,9 +311,13 @@ pub const UNSUPPORTED: u32 = 900133;
 /// assignment, F or S beside the time): refused. The axes have the kernel's ids
 /// ([`DWELL_DIRECT_AND_AXIS`], [`DWELL_NOT_FIRST_AXIS`], [`DWELL_EXTRA_AXES`]).
 pub const DWELL_NOT_ALONE: u32 = 900134;
-/// T, I, J, K, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], D
-/// [`D_TWICE`], an axis [`AXIS_TWICE`]).
+/// T, R or E programmed twice in one block (F is [`F_TWICE`], S [`S_TWICE`], D
+/// [`D_TWICE`], I J K [`ARC_CENTER_TWICE`], an axis [`AXIS_TWICE`]).
 pub const WORD_TWICE: u32 = 900135;
+/// A warning: a transformation command in its neutral form (`#TRAFO OFF`, `#CS OFF`, an
+/// identity `#CS DEF`/`#CS ON`, `#KIN ID [NONE]`) was accepted and changes nothing
+/// (`lang::transform`).
+pub const NEUTRAL_TRANSFORMATION: u32 = 900137;
 /// A formatted `#MSG` text longer than `lang::msg::MAX_MSG_CHARS`.
 pub const MSG_TOO_LONG: u32 = 900136;
 /// Tool radius compensation impossible: the radius is not below an inner arc's, offset
@@ -311,6 +334,7 @@ pub(crate) fn word_twice(letter: u8) -> u32 {
         b'F' => F_TWICE,
         b'S' => S_TWICE,
         b'D' => D_TWICE,
+        b'I' | b'J' | b'K' => ARC_CENTER_TWICE,
         _ => WORD_TWICE,
     }
 }
@@ -328,6 +352,9 @@ pub(crate) fn is_control_statement_fault(code: u32) -> bool {
 /// Every error id ncchannel can emit, with a short meaning: the constants above, once each.
 pub const EMITTED: &[(u32, &str)] = &[
     (WRITE_REJECTED, "stream write rejected"),
+    (G_WITHOUT_AXIS, "G function without its axis: no effect"),
+    (SPINDLE_SPEED_0, "G63 with spindle speed 0"),
+    (SPINDLE_SPEED_NEGATIVE, "negative REV in S[...]"),
     (NO_FEED, "feed 0 in a motion block"),
     (DWELL_DIRECT_AND_AXIS, "dwell time direct and by an axis"),
     (
@@ -347,6 +374,9 @@ pub const EMITTED: &[(u32, &str)] = &[
     (UNKNOWN_H, "unknown H function"),
     (D_TWICE, "D twice in a block"),
     (F_TWICE, "F twice in a block"),
+    (FEED_NEGATIVE, "negative F"),
+    (M_TWICE, "same M function twice in a block"),
+    (ARC_CENTER_TWICE, "I, J or K twice in a block"),
     (S_TWICE, "S twice in a block"),
     (SYNTAX, "syntax"),
     (AXIS_TWICE, "axis twice in a block"),
@@ -387,13 +417,14 @@ pub const EMITTED: &[(u32, &str)] = &[
         VARIABLE_OUT_OF_FORMAT,
         "value outside the V.E. variable's type",
     ),
+    (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
+    (MAIN_END_MISSING, "main program without M30/M02"),
     (EVAL_LOG_NON_POSITIVE, "logarithm of a number <= 0"),
     (FLUSH_UNDER_TRC, "#FLUSH under tool radius compensation"),
     (
         DWELL_EXTRA_AXES,
         "dwell with further axes: they do not move",
     ),
-    (M_TWICE, "the same technology M function twice in a block"),
     (MSG_ARG_COUNT, "#MSG values do not match the format"),
     (MSG_TOO_MANY_VALUES, "#MSG with too many format elements"),
     (MSG_NO_VALUE, "#MSG comma without a value"),
@@ -441,7 +472,6 @@ pub const EMITTED: &[(u32, &str)] = &[
     (STRING_TOO_LONG, "string longer than 126 characters"),
     (FLUSH_UNDER_SPLINE, "#FLUSH under spline"),
     (FLUSH_UNDER_HSC, "#FLUSH under #HSC"),
-    (EVAL_SQRT_NEGATIVE, "square root of a negative number"),
     (EVAL_OUT_OF_DOMAIN, "ASIN/ACOS outside -1..1"),
     (EVAL_UNDEFINED, "undefined variable"),
     (EVAL_BAD_INDEX, "invalid index"),
@@ -449,7 +479,6 @@ pub const EMITTED: &[(u32, &str)] = &[
     (EVAL_STRING_AS_NUMBER, "string used as a number"),
     (EVAL_NUMBER_AS_STRING, "number used as a string"),
     (STREAM_ALREADY_ACTIVE, "streaming program already running"),
-    (MAIN_END_MISSING, "main program without M30/M02"),
     (SUB_END_MISSING, "subroutine without M17/M29"),
     (
         LABEL_INDEX_FULL,
@@ -462,7 +491,11 @@ pub const EMITTED: &[(u32, &str)] = &[
     (BAD_VALUE, "value out of range"),
     (UNSUPPORTED, "dialect function refused by name"),
     (DWELL_NOT_ALONE, "dwell not alone in its block"),
-    (WORD_TWICE, "T, I, J, K, R or E twice in a block"),
+    (WORD_TWICE, "T, R or E twice in a block"),
+    (
+        NEUTRAL_TRANSFORMATION,
+        "neutral transformation command: no effect",
+    ),
     (MSG_TOO_LONG, "formatted #MSG text too long"),
     (TRC_IMPOSSIBLE, "tool radius compensation impossible"),
     (CACHE_NOT_ENABLED, "#CACHE without the file cache"),
@@ -480,6 +513,11 @@ pub const OURS: std::ops::RangeInclusive<u32> = 900000..=999999;
 /// 15328482315, "Exceptions / Errors"), whose TF5200 edition names the same id.
 pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (11012, "Failure to write object."), // datastreaming/15421096203 "Error messages"
+    (
+        20003,
+        "Programmierte G-Funktion nur mit Achsangabe sinnvoll.",
+    ), // TwinCAT CNC diagnosis, German: 1031/tccncdiagnosis/15651573131 "ID-Bereich 20000-20249"
+    (20007, "Spindle speed is 0."),      // 250510731
     (20008, "Feed rate in motion block is 0."), // 250515083
     (
         20013,
@@ -513,6 +551,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     (20175, "Double-programmed F-word."), // 250998155
     (20181, "Double-programmed spindle."), // 251019915
     (20203, "Double-programmed axis."),  // 251085195
+    (20205, "Double-programmed centre point coordinate."), // 251089547
     (
         20206,
         "$ command must be programmed exclusively in NC block.",
@@ -580,6 +619,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
     ), // 252347275
     (20751, "Dwell time is out of range of permissible values."), // 252425611
     (20752, "Dwell time is out of range of permissible values."), // 252429963
+    (20765, "Double-programmed M-function."), // 252469131
     (
         20829,
         "Number of string labels too big for optimised program execution.",
@@ -591,6 +631,7 @@ pub const KERNEL_TITLES: &[(u32, &str)] = &[
         "Memory for variables limited, allocation of new variable impossible.",
     ), // 253126283
     (20974, "Too many indices in variable array programmed."), // 253143691
+    (20991, "Negative spindle speed not permitted."), // 253182859
     (
         21476,
         "Streaming data does not contain a correct line end marker",
@@ -652,6 +693,11 @@ pub const KERNEL_UNREAD: &[(u32, &str)] = &[
     // TwinCAT CNC; its TF5200 diagnosis page was not read.
     (20162, "unknown H function"),
     (20196, "unknown variable"),
+    // 20176, 20398 and 21129 are named so in the kernel's error list; their TF5200 diagnosis
+    // pages were not in the index searched.
+    (20176, "negative or zero F"),
+    (20398, "square root of a negative value"),
+    (21129, "M02/M30 missing"),
     (20200, "NC command or axis name expected"),
     (20209, "unknown # command or $ statement"),
     (20240, "unexpected $ENDDO"),
@@ -721,11 +767,11 @@ pub(crate) fn is_word_letter(b: u8) -> bool {
 /// planes G17–G19, tool radius compensation G40–G42, zero offsets G53–G59, contouring at
 /// block end G61, inch/metric G70/G71, absolute/incremental G90/G91, reference point offset
 /// G92, feed per minute/revolution G94/G95, spindle speed G97, spline off/on G150/G151,
-/// contouring off/on G260/G261. The rest of ISG's list is in [`super::dialect`] (accepted
+/// circle centre absolute/relative G161/G162, contouring off/on G260/G261. The rest of ISG's list is in [`super::dialect`] (accepted
 /// without effect, or refused by name); a number in neither is 20131.
 pub const KNOWN_G: &[u32] = &[
     0, 1, 2, 3, 4, 17, 18, 19, 40, 41, 42, 53, 54, 55, 56, 57, 58, 59, 61, 70, 71, 90, 91, 92, 94,
-    95, 97, 150, 151, 260, 261,
+    95, 97, 150, 151, 161, 162, 260, 261,
 ];
 
 /// G functions that take a value: `G133=<expr>`, `G134=<expr>` (TF5200 "Weighting the ramp
@@ -740,7 +786,7 @@ pub(crate) fn is_known_g(g: u32) -> bool {
     matches!(
         g,
         0..=4 | 17..=19 | 40..=42 | 53..=59 | 61 | 70 | 71 | 90..=92 | 94 | 95 | 97 | 150 | 151
-            | 260 | 261
+            | 161 | 162 | 260 | 261
     )
 }
 
@@ -769,11 +815,6 @@ pub(crate) fn unknown_m(m: u32) -> u32 {
         UNKNOWN_M
     }
 }
-
-/// The M functions with the kernel's own meaning for the program's flow: the stops M00/M01,
-/// the program ends M02/M30 and the subroutine ends M17/M29 (TF5200 programming manual,
-/// "User-specific M/H functions": the predefined M functions).
-pub(crate) const PROGRAM_FLOW_M: [u32; 6] = [0, 1, 2, 17, 29, 30];
 
 /// A `$` control statement's kind, used for the structure check and its error numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -916,8 +957,8 @@ mod tests {
         assert_eq!(
             unread,
             [
-                20157, 20162, 20196, 20200, 20209, 20240, 20368, 20369, 20373, 20376, 20377, 20840,
-                21469, 21560, 21561, 21562, 21563, 21564, 21897
+                20157, 20162, 20176, 20196, 20398, 21129, 20200, 20209, 20240, 20368, 20369, 20373,
+                20376, 20377, 20840, 21469, 21560, 21561, 21562, 21563, 21564, 21897
             ]
         );
     }

@@ -98,8 +98,11 @@ const G_TABLE: &[(u32, u32, &str, Support)] = &[
         I,
     ),
     (159, 160, "extended / axis-specific zero offsets", R),
-    (161, 161, "circle centre absolute", R),
-    (162, 162, "circle centre relative (initial state)", N),
+    // TF5200 programming manual, "Specifying centre point for circle definition
+    // (G161/G162)": under G161 I J K are absolute in the programmer's coordinate system, under
+    // G162 (the initial state) relative to the circle's start point.
+    (161, 161, "circle centre absolute", I),
+    (162, 162, "circle centre relative (initial state)", I),
     (163, 163, "radius programming (R is always accepted)", N),
     (164, 165, "circle centre point correction", N),
     (166, 167, "override 100 %", N),

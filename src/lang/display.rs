@@ -122,6 +122,20 @@ impl Display for Item {
                 write!(f, "G{}", c.g)?;
                 list(f, &c.args, |f, a| a.as_ref().map_or(Ok(()), |e| e.fmt(f)))
             }
+            Item::Functions(fs) => {
+                write!(f, "{}[", char::from(fs.owner))?;
+                for (k, it) in fs.items.iter().enumerate() {
+                    if k > 0 {
+                        f.write_char(' ')?;
+                    }
+                    match it {
+                        // The spindle's speed is written REV inside its brackets.
+                        Item::Word(w) if w.letter == b'S' => write!(f, "REV{}", w.value)?,
+                        it => it.fmt(f)?,
+                    }
+                }
+                f.write_char(']')
+            }
         }
     }
 }
@@ -473,6 +487,7 @@ impl Display for Command {
             Command::Time(v) => write!(f, "#TIME {v}"),
             Command::Inert { text } => write!(f, "#{text}"),
             Command::MsgFileName(v) => write!(f, "#FILENAME [MSG={v}]"),
+            Command::Transform(t) => write!(f, "#{}", t.text()),
         }
     }
 }

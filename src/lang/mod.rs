@@ -21,6 +21,7 @@ pub mod msg;
 mod number;
 pub mod parse;
 pub mod range;
+pub(crate) mod transform;
 
 pub use block::*;
 pub use check::{check_program, check_program_counted, ProgramDiag, MAX_PROGRAM_DIAGS};

@@ -9,14 +9,15 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Item, Label,
-    NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Item,
+    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
     COMMAND_NOT_ALONE, CONTROL_NOT_ALONE, DWELL_NOT_ALONE, G_WITH_VALUE, MAX_ARRAY_DIMS,
-    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, TOO_MANY_INDICES,
-    UNKNOWN_COMMAND, UNKNOWN_G, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
+    MAX_ARRAY_ELEMENTS, MAX_BLOCK_CHARS, M_TWICE, SPINDLE_SPEED_0, SPINDLE_SPEED_NEGATIVE,
+    STRING_TOO_LONG_FOR_VARIABLE, SYNTAX, S_TWICE, TOO_MANY_INDICES, UNKNOWN_COMMAND, UNKNOWN_G,
+    UNKNOWN_H, UNKNOWN_M, UNSUPPORTED, VARIABLE_MEMORY_FULL,
 };
 use super::dialect::{command_support, g_support, Support};
 use super::error::SyntaxError;
@@ -309,6 +310,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
     let mut items = Vec::with_capacity(item_capacity(i));
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
+    // The block's own M functions so far: one twice is 20765. Made at the first M, so a
+    // block without one does not pay for it.
+    let mut ms: Option<FunctionNumbers> = None;
     let mut dwell = false;
     loop {
         i = gap(i);
@@ -326,7 +330,11 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             i = word(ctx, i, up, &mut items)?;
             if let b'G' | b'M' | b'H' = up {
                 dwell |= up == b'G' && items.last().is_some_and(is_dwell);
-            } else {
+                if up == b'M' {
+                    ms.get_or_insert_with(FunctionNumbers::default)
+                        .add(items.last(), at)?;
+                }
+            } else if !(bytes.get(1) == Some(&b'[') && ends_in_function(&items)) {
                 let bit = 1u32 << (up - b'A');
                 if seen & bit != 0 {
                     return Err(twice(at, up));
@@ -387,14 +395,71 @@ fn combined_assignment(i: &str) -> Option<(&str, super::block::BinOp)> {
     Some((&i[2..], op))
 }
 
+/// The M numbers one scope of a block programs (the channel's, or one bracket's), for the
+/// kernel's 20765: the same M twice in one scope (TF5200 diagnosis ID 20765: `M10 M10` and
+/// `S[M10 M10]` are refused, `M10 X[M10] S[M10]` is three functions). Blocks carry a handful;
+/// past [`FunctionNumbers::KEPT`] no more are compared (the decoder bounds the count).
+#[derive(Default)]
+struct FunctionNumbers {
+    numbers: [u32; FunctionNumbers::KEPT],
+    n: usize,
+}
+
+impl FunctionNumbers {
+    const KEPT: usize = 16;
+
+    /// The M function `item` just read at `at`: refused when its number came before.
+    fn add<'a>(&mut self, item: Option<&Item>, at: &'a str) -> Result<(), nom::Err<PErr<'a>>> {
+        let number = match item {
+            Some(Item::Word(w)) => match w.value {
+                Value::Num(v) => integer_code(v),
+                Value::Expr(_) => None,
+            },
+            Some(Item::FunctionValue { number, .. }) => Some(*number),
+            _ => None,
+        };
+        let Some(number) = number else {
+            return Ok(());
+        };
+        if self.numbers[..self.n].contains(&number) {
+            return Err(perr(
+                at,
+                M_TWICE,
+                format!("M{number} programmed twice in the block"),
+            ));
+        }
+        if self.n < Self::KEPT {
+            self.numbers[self.n] = number;
+            self.n += 1;
+        }
+        Ok(())
+    }
+}
+
+/// Was the word just read an axis's or the spindle's functions without a speed: `X[M54]`,
+/// `S[M3 M10]`, which program neither the axis nor the speed (`X[M54] X10` is one X)? Asked
+/// only for a word whose letter a bracket follows: the literal words of the hot path skip it.
+#[inline]
+fn ends_in_function(items: &[Item]) -> bool {
+    match items.last() {
+        Some(Item::Functions(fs)) => !fs
+            .items
+            .iter()
+            .any(|it| matches!(it, Item::Word(w) if w.letter == b'S')),
+        _ => false,
+    }
+}
+
 /// Is this item the dwell `G04` (with or without its value)?
 fn is_dwell(it: &Item) -> bool {
     match it {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
-        Item::Assign { .. } | Item::FunctionValue { .. } | Item::GCall(_) | Item::NamedAxis(_) => {
-            false
-        }
+        Item::Assign { .. }
+        | Item::FunctionValue { .. }
+        | Item::GCall(_)
+        | Item::NamedAxis(_)
+        | Item::Functions(_) => false,
     }
 }
 
@@ -402,7 +467,7 @@ fn is_dwell(it: &Item) -> bool {
 /// for the rest.
 fn twice(at: &str, letter: u8) -> nom::Err<PErr<'_>> {
     let l = letter as char;
-    if crate::vocab::axis::AXIS_LETTERS.contains(&letter) {
+    if is_axis_letter(letter) {
         perr(
             at,
             AXIS_TWICE,
@@ -479,6 +544,7 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
                 ..
             } => (*col, format!("{}{number}", char::from(*letter))),
             Item::GCall(c) => (c.col, format!("G{}", c.g)),
+            Item::Functions(fs) => (fs.col, format!("{}[…]", char::from(fs.owner))),
         };
         return Err(ctx.err_at(
             col,
@@ -503,7 +569,7 @@ fn word<'a>(
     let col = ctx.col(i);
     let after = &i[1..];
     let ab = after.as_bytes();
-    let slot_letter = crate::vocab::axis::slot_of(up).is_some();
+    let slot_letter = is_axis_letter(up);
     if slot_letter
         && ab
             .first()
@@ -536,7 +602,7 @@ fn word<'a>(
         None => return Err(perr(after, SYNTAX, word_value_msg(up))),
     };
     let Some((mag, n)) = scan_unsigned(&ab[skip..]) else {
-        return Err(perr(after, SYNTAX, word_value_msg(up)));
+        return word_function(ctx, i, up, col, (&after[skip..], neg), items);
     };
     if !mag.is_finite() {
         return Err(perr(&after[skip..], SYNTAX, TOO_LARGE));
@@ -555,7 +621,9 @@ fn word<'a>(
                 return Err(perr(i, UNKNOWN_G, format!("unknown G function G{v}")));
             };
             if !is_known_g(g) {
-                dialect_g(i, g)?;
+                if let Err(refused) = dialect_g(i, g) {
+                    return refused_g_first(ctx, (i, rest), (g, col), items, refused);
+                }
                 if let Some(r) = super::gcall::g_call(ctx, rest, g, col, items)? {
                     return Ok(r);
                 }
@@ -574,7 +642,7 @@ fn word<'a>(
         b'H' if !integer_code(v).is_some_and(is_known_m) => {
             return Err(perr(
                 i,
-                UNKNOWN_M,
+                UNKNOWN_H,
                 format!("H function H{v} outside 0 to 65535"),
             ));
         }
@@ -602,7 +670,7 @@ fn literal_only(i: &str, up: u8) -> Result<(), nom::Err<PErr<'_>>> {
     match up {
         b'G' => Err(perr(i, UNKNOWN_G, "a G function needs a literal number")),
         b'M' => Err(perr(i, UNKNOWN_M, "an M function needs a literal number")),
-        b'H' => Err(perr(i, UNKNOWN_M, "an H function needs a literal number")),
+        b'H' => Err(perr(i, UNKNOWN_H, "an H function needs a literal number")),
         _ => Ok(()),
     }
 }
@@ -695,8 +763,9 @@ fn axis_assigned<'a>(
     Ok(r)
 }
 
-/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`) are
+/// An axis name: X Y Z A B C and the further axis names U V W. Longer names (`A1 = 0`, `W2 = 1`) are
 /// [`named_axis`]'s.
+#[inline]
 fn is_axis_letter(up: u8) -> bool {
     matches!(
         up,
@@ -774,6 +843,193 @@ fn unbracketed_expr<'a>(
     Ok((&after[end..], e))
 }
 
+/// `X SIN [P1 * 5]`, `X-SQRT[P2]`, `A SQRT [2]/2`: a word whose value is an expression that
+/// starts with a function, written after the address letter without the word's brackets
+/// (TF5200 programming manual, "Axis commands": "X <int, double, expr>", with the examples
+/// `Z SIN [30]` and `A SQRT [2]/2`). The expression runs as far as it goes, blanks between
+/// its operators included. `at` is the text after the letter and its sign. Anything else
+/// there is the word's 20200.
+#[cold]
+fn word_function<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    up: u8,
+    col: u32,
+    (at, negate): (&'a str, bool),
+    items: &mut Vec<Item>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    let start = ws(at);
+    let name_len = start
+        .bytes()
+        .take_while(|c| c.is_ascii_alphabetic())
+        .count();
+    let name = &start[..name_len];
+    let is_function = name_len > 0
+        && super::expr::FUNCS
+            .iter()
+            .any(|f| f.name().eq_ignore_ascii_case(name));
+    if !is_function || !ws(&start[name_len..]).starts_with('[') {
+        return Err(perr(&i[1..], SYNTAX, word_value_msg(up)));
+    }
+    literal_only(i, up)?;
+    let (rest, e) = ctx.unbracketed_value(start)?;
+    let e = if negate {
+        super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
+    } else {
+        e
+    };
+    items.push(Item::Word(Word {
+        letter: up,
+        value: Value::Expr(e),
+        col,
+    }));
+    Ok(rest)
+}
+
+/// `X[M54=P1]`, `S[REV 1000 M03 M63=-789]`: the technology functions of one axis or of the
+/// spindle in brackets after its name (TF5200 programming manual, "Programming in
+/// spindle-specific syntax": `<spindle_name> [ [M3|M4|M5|M19] [REV..] {M..} {H..} … ]`, and
+/// "User-specific M/H function for spindles"; axis-specific M functions alike). The M and H
+/// functions go to the technology units as the block's own (`M63=-789` with its value), `REV`
+/// is the spindle speed, as an S word. `None` when the bracket holds an expression (`X[P1*2]`);
+/// any other keyword in a function bracket (`POS`, `G74`, `CALLAX`, …) is refused by name.
+#[cold]
+fn function_bracket<'a>(
+    ctx: &Ctx<'a>,
+    up: u8,
+    col: u32,
+    bracket: &'a str,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let starts_function = |r: &str| {
+        let b = r.as_bytes();
+        matches!(b.first(), Some(b'M' | b'm' | b'H' | b'h'))
+            && b.get(1).is_some_and(u8::is_ascii_digit)
+    };
+    let first = ws(&bracket[1..]);
+    let is_spindle = up == b'S';
+    if !(starts_function(first) || is_spindle && keyword_prefix(first, "REV").is_some()) {
+        return Ok(None);
+    }
+    let mut r = first;
+    let mut speed = None;
+    let mut ms = FunctionNumbers::default();
+    let mut inner = Vec::new();
+    loop {
+        r = ws(r);
+        if let Some(rest) = r.strip_prefix(']') {
+            if let Some(value) = speed {
+                inner.push(Item::Word(Word {
+                    letter: b'S',
+                    value,
+                    col,
+                }));
+            }
+            items.push(Item::Functions(Box::new(Functions {
+                owner: up,
+                items: inner,
+                col,
+            })));
+            return Ok(Some(rest));
+        }
+        if starts_function(r) {
+            let at = r;
+            let letter = r.as_bytes()[0].to_ascii_uppercase();
+            let (rest, number) = super::expr::uint(&r[1..])?;
+            if !is_known_m(number) {
+                let code = if letter == b'M' { UNKNOWN_M } else { UNKNOWN_H };
+                return Err(perr(
+                    r,
+                    code,
+                    format!("{}{number} outside 0 to 65535", letter as char),
+                ));
+            }
+            let fcol = ctx.col(r);
+            if let Some(v) = ws(rest).strip_prefix('=') {
+                let (rest, e) = ctx.expr(ws(v))?;
+                inner.push(Item::FunctionValue {
+                    letter,
+                    number,
+                    value: expr_value(e),
+                    col: fcol,
+                });
+                r = rest;
+            } else {
+                inner.push(Item::Word(Word {
+                    letter,
+                    value: Value::Num(f64::from(number)),
+                    col: fcol,
+                }));
+                r = rest;
+            }
+            if letter == b'M' {
+                ms.add(inner.last(), at)?;
+            }
+            if inner.len() > FunctionNumbers::KEPT {
+                return Err(perr(at, SYNTAX, "too many functions in one bracket"));
+            }
+            continue;
+        }
+        match keyword_prefix(r, "REV") {
+            Some(rest) if is_spindle && speed.is_none() => {
+                let (after, value) = spindle_speed(ctx, rest)?;
+                speed = Some(value);
+                r = after;
+            }
+            Some(_) if is_spindle => return Err(perr(r, S_TWICE, "REV programmed twice")),
+            _ => {
+                let what = if is_spindle {
+                    "a spindle's"
+                } else {
+                    "an axis's"
+                };
+                return Err(perr(
+                    r,
+                    UNSUPPORTED,
+                    format!(
+                        "only M and H functions{} are modelled in {what} brackets",
+                        if is_spindle { " and REV" } else { "" }
+                    ),
+                ));
+            }
+        }
+    }
+}
+
+/// The value after `REV` (`rest`), `=` optional: a negative literal is the kernel's 20991
+/// (TF5200 diagnosis ID 20991 "Negative spindle speed not permitted.", spindle-specific
+/// programming `S[...]`).
+fn spindle_speed<'a>(ctx: &Ctx<'a>, rest: &'a str) -> Result<(&'a str, Value), nom::Err<PErr<'a>>> {
+    let rest = ws(rest);
+    let rest = rest.strip_prefix('=').map_or(rest, ws);
+    let (after, e) = ctx.expr(rest)?;
+    let negative = match &e {
+        Expr::Num(v) => *v < 0.0,
+        Expr::Unary(super::block::UnOp::Neg, inner) => matches!(**inner, Expr::Num(_)),
+        _ => false,
+    };
+    if negative {
+        return Err(perr(
+            rest,
+            SPINDLE_SPEED_NEGATIVE,
+            "negative spindle speed in S[...] is not permitted",
+        ));
+    }
+    Ok((after, expr_value(e)))
+}
+
+/// `kw` (any case) at the start of `r`, a number or `=` allowed right after it (`REV1000`):
+/// the rest.
+fn keyword_prefix<'a>(r: &'a str, kw: &str) -> Option<&'a str> {
+    let head = r.get(..kw.len())?;
+    let rest = &r[kw.len()..];
+    let next_is_name = rest
+        .as_bytes()
+        .first()
+        .is_some_and(|c| c.is_ascii_alphabetic() || *c == b'_');
+    (head.eq_ignore_ascii_case(kw) && !next_is_name).then_some(rest)
+}
+
 /// A word with a bracketed value `X[..]` (or `X-[..]`). G and M need literal numbers.
 fn word_expr<'a>(
     ctx: &Ctx<'a>,
@@ -785,6 +1041,11 @@ fn word_expr<'a>(
     items: &mut Vec<Item>,
 ) -> Result<&'a str, nom::Err<PErr<'a>>> {
     literal_only(i, up)?;
+    if !negate && (up == b'S' || is_axis_letter(up)) {
+        if let Some(r) = function_bracket(ctx, up, col, bracket, items)? {
+            return Ok(r);
+        }
+    }
     let (rest, e) = ctx.bracketed(bracket)?;
     let e = if negate {
         super::block::Expr::Unary(super::block::UnOp::Neg, Box::new(e))
@@ -797,6 +1058,82 @@ fn word_expr<'a>(
         col,
     }));
     Ok(rest)
+}
+
+/// A refused G function (`refused`, from [`dialect_g`]), unless the kernel answers it with
+/// its own id first: G160 with a value is read for the decoder ([`axis_zero_offsets`]), G63
+/// with `S0` is 20007 ([`tapping_at_speed_0`]). `i` is at the G, `rest` after its number;
+/// the rest of the block when G160 was read.
+#[cold]
+fn refused_g_first<'a>(
+    ctx: &Ctx<'a>,
+    (i, rest): (&'a str, &'a str),
+    (g, col): (u32, u32),
+    items: &mut Vec<Item>,
+    refused: nom::Err<PErr<'a>>,
+) -> Result<&'a str, nom::Err<PErr<'a>>> {
+    match g {
+        160 => axis_zero_offsets(ctx, rest, col, items)?.ok_or(refused),
+        63 => tapping_at_speed_0(i, rest, items).and(Err(refused)),
+        _ => Err(refused),
+    }
+}
+
+/// G63 (tapping), which ncchannel does not model, with a literal `S0` in its block: the
+/// kernel's 20007 first (TF5200 diagnosis ID 20007 "Spindle speed is 0.", whose example is
+/// `G63 Z10 F300 S0`), at the S. Any other G63 is refused by name after this.
+#[cold]
+fn tapping_at_speed_0<'a>(
+    i: &'a str,
+    rest: &'a str,
+    items: &[Item],
+) -> Result<(), nom::Err<PErr<'a>>> {
+    let err = |at: &'a str| {
+        perr(
+            at,
+            SPINDLE_SPEED_0,
+            "spindle speed 0 with G63 (tapping): the spindle speed must not be 0",
+        )
+    };
+    let before = items
+        .iter()
+        .any(|it| matches!(it, Item::Word(w) if w.letter == b'S' && w.value == Value::Num(0.0)));
+    if before {
+        return Err(err(i));
+    }
+    // A later `S0` of the block: an S after a blank, then a literal that reads as 0.
+    let text = rest.split([';', '(']).next().unwrap_or("");
+    for (k, _) in text.match_indices(['S', 's']) {
+        let after_blank = k == 0 || matches!(text.as_bytes()[k - 1], b' ' | b'\t');
+        let value = scan_unsigned(&text.as_bytes()[k + 1..]);
+        if after_blank && value.is_some_and(|(v, _)| v == 0.0) {
+            return Err(err(&rest[k..]));
+        }
+    }
+    Ok(())
+}
+
+/// `G160=2` (`i` after the number): the axis-specific zero offsets, which take their axes in
+/// the block (TF5200 diagnosis ID 20003, whose example is `G160=2 X1 Z1`). Read with its value
+/// for the decoder: without an axis it is the kernel's warning 20003 and changes nothing, with
+/// one it is refused by name. `None` for `G160` without a value (refused here).
+#[cold]
+fn axis_zero_offsets<'a>(
+    ctx: &Ctx<'a>,
+    i: &'a str,
+    col: u32,
+    items: &mut Vec<Item>,
+) -> Result<Option<&'a str>, nom::Err<PErr<'a>>> {
+    let Some(r) = ws(i).strip_prefix('=') else {
+        return Ok(None);
+    };
+    let (r, e) = ctx.expr(ws(r))?;
+    items.push(Item::GValue {
+        g: 160,
+        value: expr_value(e),
+        col,
+    });
+    Ok(Some(r))
 }
 
 /// A G function outside the implemented fast path: one ISG lists and ncchannel accepts
@@ -1112,6 +1449,10 @@ fn command<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Command> {
             let (r, v) = ctx.expr(r)?;
             Ok((r, Command::Time(expr_value(v))))
         }
+        kw @ (b"TRAFO" | b"KIN" | b"CS") => match super::transform::neutral(ctx, i, kw, r) {
+            Some(parsed) => parsed,
+            None => dialect_command(i, kw, &after[..after.len() - rest.len()]),
+        },
         kw => dialect_command(i, kw, &after[..after.len() - rest.len()]),
     }
 }

@@ -7,7 +7,8 @@
 //!
 //! | word | range | refused with |
 //! |---|---|---|
-//! | F, S | not negative | 900132 |
+//! | F | not negative | 20176 (the kernel's "negative or zero F"; F0 is [`super::codes::NO_FEED`] in a feed move) |
+//! | S | not negative | 900132 |
 //! | T, D | a whole number 0 to 4294967295 | 900132 |
 //! | I, J, K | within ±214,748.3647 | 20020 (TF5200: circle centre parameter outside the data format) |
 //! | R | within ±214,748.3647 | 20054 (TF5200: centre outside the data format, example `R1000000`) |
@@ -15,7 +16,7 @@
 //! Axis words are bounded where the machine is known: by the software limits of
 //! runtime.toml, which the decoder checks for every end point (21897).
 
-use super::codes::{ARC_CENTER_RANGE, ARC_RADIUS_RANGE, BAD_VALUE, MAX_COORD_MM};
+use super::codes::{ARC_CENTER_RANGE, ARC_RADIUS_RANGE, BAD_VALUE, FEED_NEGATIVE, MAX_COORD_MM};
 
 /// A word value outside its range: the number to report and what was wrong.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -33,7 +34,8 @@ pub fn word_value(letter: u8, v: f64) -> Result<(), RangeError> {
         return err(BAD_VALUE, format!("{l} value is not a finite number"));
     }
     match letter {
-        b'F' | b'S' if v < 0.0 => err(BAD_VALUE, format!("{l}{v} out of range: negative")),
+        b'F' if v < 0.0 => err(FEED_NEGATIVE, format!("F{v} out of range: negative")),
+        b'S' if v < 0.0 => err(BAD_VALUE, format!("S{v} out of range: negative")),
         b'T' | b'D' if whole_u32(v).is_none() => err(
             BAD_VALUE,
             format!("{l}{v} out of range: a whole number from 0 to 4294967295"),
@@ -63,7 +65,7 @@ mod tests {
     #[test]
     fn ranges_and_their_numbers() {
         assert_eq!(word_value(b'X', -5000.0), Ok(()));
-        assert_eq!(word_value(b'F', -1.0).unwrap_err().code, BAD_VALUE);
+        assert_eq!(word_value(b'F', -1.0).unwrap_err().code, FEED_NEGATIVE);
         assert_eq!(word_value(b'S', -1.0).unwrap_err().code, BAD_VALUE);
         assert_eq!(word_value(b'T', 1.5).unwrap_err().code, BAD_VALUE);
         assert_eq!(word_value(b'D', 5e9).unwrap_err().code, BAD_VALUE);

@@ -25,7 +25,7 @@ use std::path::Path;
 use super::catalog::{self, ListKind, ListSummary, Tally};
 use super::channel::ChannelList;
 use super::list::{Entry, ParamList, ValueKind};
-use super::runtime::{axis_index, AxisConfig, AxisKind, RuntimeConfig};
+use super::runtime::{axis_index, is_axis_name, AxisConfig, AxisKind, RuntimeConfig};
 use super::value::{number_value, unresolved};
 use crate::diag::{Diagnostic, Severity};
 use crate::vocab::axis::MAX_AXES;
@@ -369,9 +369,9 @@ fn push_axis(
         Diagnostic::error(file, e.value_pos.line, e.value_pos.col, None, message)
             .with_source(&e.line_text)
     };
-    if axis_index(name).is_none() {
+    if !is_axis_name(name) {
         diags.push(at(format!(
-            "{}: `{name}` is not an axis name ncchannel drives (X Y Z A B C, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
+            "{}: `{name}` is not an axis name ncchannel drives (X Y Z A B C U V W, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
             e.name.text
         )));
         return;
@@ -382,10 +382,10 @@ fn push_axis(
     }
     if let Some(b) = axes
         .iter()
-        .find(|b| axis_index(&b.name) == axis_index(name))
+        .find(|b| axis_index(&b.name).is_some() && axis_index(&b.name) == axis_index(name))
     {
         diags.push(at(format!(
-            "{}: axis `{name}` takes the slot of axis `{}` (ncchannel drives one axis per letter X Y Z A B C)",
+            "{}: axis `{name}` takes the slot of axis `{}` (ncchannel drives one axis per letter X Y Z A B C; U V W take a slot left free)",
             e.name.text, b.name
         )));
         return;

@@ -129,14 +129,45 @@ impl AxisConfig {
     }
 }
 
-/// The interpolator's index (`AXIS_LETTERS`) of an axis name such as `x`, `Z` or `X1`: the
-/// slot of its first letter (an axis name is a letter X Y Z A B C, then at most 15 letters,
-/// digits or `_`: `lang::block::AxisName`). The one rule `setup` relies on, so `check`
-/// refuses exactly what `run` could not build; two axes in one slot (`X` and `X1`) are
-/// refused where the axes are listed.
+/// Is `name` an axis name ncchannel drives: a letter X Y Z A B C U V W, then at most 15
+/// letters, digits or `_` (`lang::block::AxisName`)?
+pub(crate) fn is_axis_name(name: &str) -> bool {
+    crate::lang::block::AxisName::new(name.trim()).is_some()
+}
+
+/// The interpolator's index (`AXIS_LETTERS`) an axis name such as `x`, `Z` or `X1` claims: the
+/// slot of its first letter X Y Z A B C. `None` for U V W (and `U1`…), which take a slot no
+/// name claims ([`channel_slots`]), and for a name that is no axis name. Two axes claiming one
+/// slot (`X` and `X1`) are refused where the axes are listed.
 pub(crate) fn axis_index(name: &str) -> Option<usize> {
     let n = crate::lang::block::AxisName::new(name.trim())?;
     AXIS_LETTERS.iter().position(|&l| l == n.letter())
+}
+
+/// The slot of each of a channel's axes, in list order: the one its name claims
+/// ([`axis_index`]), or for a U, V or W the first slot, in `AXIS_LETTERS` order, that no name
+/// of the list claims and no earlier U V W took (TF5200 channel parameters, P-CHAN-00006:
+/// the axis names are the channel list's). `None` for a name that is no axis name or when
+/// no slot is left. The one rule `setup` and the validation share.
+pub(crate) fn channel_slots<'a>(
+    names: impl Iterator<Item = &'a str> + Clone,
+) -> Vec<Option<usize>> {
+    let mut taken = [false; AXIS_LETTERS.len()];
+    for i in names.clone().filter_map(axis_index) {
+        taken[i] = true;
+    }
+    names
+        .map(|n| {
+            if !is_axis_name(n) {
+                return None;
+            }
+            axis_index(n).or_else(|| {
+                let free = taken.iter().position(|t| !t)?;
+                taken[free] = true;
+                Some(free)
+            })
+        })
+        .collect()
 }
 
 /// Decoder budgets.
@@ -587,13 +618,13 @@ fn validate_axis(
     fail: &mut impl FnMut(&str, Option<usize>, &str, String),
 ) {
     let at = Some(i);
-    if axis_index(&a.name).is_none() {
+    if !is_axis_name(&a.name) {
         fail(
             "axes",
             at,
             "name",
             format!(
-                "`{}` is not an axis name ncchannel drives (X Y Z A B C, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
+                "`{}` is not an axis name ncchannel drives (X Y Z A B C U V W, or one of them followed by at most 15 letters, digits or `_`, as `X1`)",
                 a.name
             ),
         );
@@ -799,12 +830,12 @@ mod tests {
 
     #[test]
     fn diagnostics_point_at_the_key_where_it_is_written() {
-        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"U\"\n\n[decoder]\nx = 1\nblocks_per_tick = 0\n";
+        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"Q\"\n\n[decoder]\nx = 1\nblocks_per_tick = 0\n";
         let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
         // `x` is an unknown key: a toml error at its own place, named with its table.
         assert_eq!((errs[0].line, errs[0].col), (10, 1), "{errs:?}");
         assert!(errs[0].message.contains("x"), "{errs:?}");
-        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"U\"\n\n[decoder]\nblocks_per_tick = 0\n";
+        let text = "cycle_period_us = 1000\n\n[[axes]]\nname = \"X\"\n\n[[axes]]\n  name = \"Q\"\n\n[decoder]\nblocks_per_tick = 0\n";
         let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
         let at: Vec<(usize, usize, &str)> = errs
             .iter()

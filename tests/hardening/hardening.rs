@@ -226,7 +226,7 @@ fn values_that_cannot_be_real_are_refused_in_check_and_run() {
         ("T1.5".to_string(), 900132),
         ("D-2".to_string(), 900132),
         ("S-100".to_string(), 900132),
-        ("F-1".to_string(), 900132),
+        ("F-1".to_string(), 20176),
     ] {
         let text = format!("{block}\nM30\n");
         assert_eq!(check_codes(&text), [code], "check {block:.40}");

@@ -205,8 +205,12 @@ fn m_and_h_run_from_0_to_65535_and_h_functions_are_events() {
     for l in ["M0", "M100", "M65535", "H0", "H65535", "M3 M8 H12 H13"] {
         parse_block(l).unwrap_or_else(|e| panic!("{l}: {e}"));
     }
-    for l in ["M65536", "H65536", "H1.5", "M[1]"] {
+    for l in ["M65536", "M[1]"] {
         assert_eq!(parse_block(l).unwrap_err().code, codes::UNKNOWN_M, "{l}");
+    }
+    // An H number no channel list can define is the kernel's undefined H.
+    for l in ["H65536", "H1.5", "H[1]"] {
+        assert_eq!(parse_block(l).unwrap_err().code, codes::UNKNOWN_H, "{l}");
     }
     let rig = Rig::new();
     std::fs::write(
@@ -386,7 +390,7 @@ const REFUSED_BLOCKS: &[(&str, u32, u32)] = &[
     ("G1 X1 F100 F200", codes::F_TWICE, 12),
     ("T1 D1 T2", codes::WORD_TWICE, 7),
     ("T1 D1 D2", codes::D_TWICE, 7),
-    ("G2 X1 Y1 I1 I2 F100", codes::WORD_TWICE, 13),
+    ("G2 X1 Y1 I1 I2 F100", codes::ARC_CENTER_TWICE, 13),
     ("G04 Y2", codes::DWELL_NOT_FIRST_AXIS, 5),
     ("G4 F1.5 X2", codes::DWELL_NOT_ALONE, 9),
     ("G04 2 X1", codes::DWELL_DIRECT_AND_AXIS, 7),

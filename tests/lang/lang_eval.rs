@@ -125,7 +125,7 @@ fn function_syntax_errors() {
 fn evaluation_errors_have_numbers() {
     assert_eq!(ev_err("1 / 0"), 20396);
     assert_eq!(ev_err("1 MOD 0"), 20396);
-    assert_eq!(ev_err("SQRT[-1]"), 900002);
+    assert_eq!(ev_err("SQRT[-1]"), 20398);
     assert_eq!(ev_err("ACOS[1.5]"), 900003);
     assert_eq!(ev_err("ASIN[-2]"), 900003);
     assert_eq!(ev_err("LN[0]"), 20399);

@@ -25,6 +25,16 @@ fn without_cols(mut b: Block) -> Block {
                 | Item::FunctionValue { col, .. } => *col = 0,
                 Item::GCall(c) => c.col = 0,
                 Item::NamedAxis(a) => a.col = 0,
+                Item::Functions(fs) => {
+                    fs.col = 0;
+                    for it in &mut fs.items {
+                        match it {
+                            Item::Word(w) => w.col = 0,
+                            Item::FunctionValue { col, .. } => *col = 0,
+                            _ => {}
+                        }
+                    }
+                }
             }
         }
     }

@@ -150,12 +150,28 @@ fn value() -> impl Strategy<Value = Value> {
     prop_oneof![3 => num().prop_map(Value::Num), 1 => expr().prop_map(Value::Expr)]
 }
 
-/// A letter other than G, M, H at most once per block (a second one is double programming).
+/// A letter other than G, M, H at most once per block, and an M number at most once (a second
+/// one is double programming: 20765 for M).
 fn once_per_letter(items: Vec<Item>) -> Vec<Item> {
     let mut seen = Vec::new();
+    let mut ms = Vec::new();
+    let mut m_once = |n: u32| {
+        let first = !ms.contains(&n);
+        ms.push(n);
+        first
+    };
     items
         .into_iter()
         .filter(|it| match it {
+            Item::Word(w) if w.letter == b'M' => match w.value {
+                Value::Num(v) => m_once(v as u32),
+                Value::Expr(_) => true,
+            },
+            Item::FunctionValue {
+                letter: b'M',
+                number,
+                ..
+            } => m_once(*number),
             Item::Word(w) if !matches!(w.letter, b'G' | b'M' | b'H') => {
                 let first = !seen.contains(&w.letter);
                 seen.push(w.letter);
@@ -368,6 +384,16 @@ fn without_cols(mut b: Block) -> Block {
                 | Item::FunctionValue { col, .. } => *col = 0,
                 Item::GCall(c) => c.col = 0,
                 Item::NamedAxis(a) => a.col = 0,
+                Item::Functions(fs) => {
+                    fs.col = 0;
+                    for it in &mut fs.items {
+                        match it {
+                            Item::Word(w) => w.col = 0,
+                            Item::FunctionValue { col, .. } => *col = 0,
+                            _ => {}
+                        }
+                    }
+                }
             }
         }
     }

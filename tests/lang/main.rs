@@ -7,6 +7,7 @@ mod support;
 mod check_program;
 mod dialect;
 mod isg_syntax;
+mod kernel_language;
 mod label_index;
 mod lang_eval;
 mod lang_parse;

@@ -80,7 +80,7 @@ fn check_and_run_refuse_the_same_bad_files_with_the_same_words() {
     // Each runtime.toml is refused by both, naming the same key; a good one passes both.
     let cases = [
         ("[[axes]]\nname = \"Q1\"\n", "axes[0].name"),
-        ("[[axes]]\nname = \"U\"\n", "axes[0].name"),
+        ("[[axes]]\nname = \"F\"\n", "axes[0].name"),
         (
             "[decoder]\nblocks_per_tick = 0\n",
             "decoder.blocks_per_tick",

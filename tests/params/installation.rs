@@ -453,6 +453,74 @@ fn m6_with_an_end_in_its_block_calls_the_tool_change_then_ends() {
         }));
 }
 
+/// P-CHAN-00006 names an axis with a letter outside X Y Z A B C: `W` (TF5200 channel
+/// parameters, "Axis name" P-CHAN-00006). It takes the slot no name claims (Z's here), the
+/// program writes `W…` or `W=…`, and `Z` names no axis of the channel.
+#[test]
+fn an_axis_the_channel_list_names_w_is_programmed_as_w() {
+    let i = Installation::new("gruppe[0].achse[2].bezeichnung W\n");
+    i.write(
+        "prg/w.nc",
+        "N10 G01 X10 W5 F6000\nN20 W = 2 * 3 Y1\nN30 G91 W-1\nN40 M30\n",
+    );
+    let mut c = i.channel();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("w.nc".into())),
+        Reply::Command(Ok(()))
+    );
+    let ev = run(&mut c, &[], 20_000);
+    end_tick(&ev);
+    let named: Vec<(String, f64)> = c
+        .report()
+        .named_positions
+        .into_iter()
+        .map(|(n, v)| (n.to_string(), v))
+        .collect();
+    assert_eq!(
+        named,
+        [
+            ("X".to_string(), 10.0),
+            ("Y".to_string(), 1.0),
+            ("W".to_string(), 5.0)
+        ]
+    );
+    // Z is no axis of this channel, nor is U.
+    for (name, text) in [
+        ("z.nc", "N10 G01 Z20 F6000\nN20 M30\n"),
+        ("u.nc", "N10 G01 U20 F6000\nN20 M30\n"),
+    ] {
+        i.write(&format!("prg/{name}"), text);
+        let mut c = i.channel();
+        assert_eq!(
+            c.apply(&tick(0), Op::Start(name.into())),
+            Reply::Command(Ok(()))
+        );
+        let ev = run(&mut c, &[], 20_000);
+        assert!(
+            ev.iter()
+                .any(|(_, e)| matches!(e, EventKind::Error { code: 20200, .. })),
+            "{name}: {ev:#?}"
+        );
+    }
+    // A longer name with such a letter takes `=`: `U1` in X's slot, which no name claims.
+    let i = Installation::new("gruppe[0].achse[0].bezeichnung U1\n");
+    i.write("prg/u1.nc", "N10 G01 U1=7 Y2 F6000\nN20 M30\n");
+    let mut c = i.channel();
+    assert_eq!(
+        c.apply(&tick(0), Op::Start("u1.nc".into())),
+        Reply::Command(Ok(()))
+    );
+    let ev = run(&mut c, &[], 20_000);
+    end_tick(&ev);
+    let named: Vec<(String, f64)> = c
+        .report()
+        .named_positions
+        .into_iter()
+        .map(|(n, v)| (n.to_string(), v))
+        .collect();
+    assert_eq!(named[0], ("U1".to_string(), 7.0));
+}
+
 /// P-CHAN-00006 names an axis `X1` (a name of more than one character): the program writes
 /// `X1=…`, and the axis takes X's slot (TF5200 programming manual, "Axis commands").
 #[test]

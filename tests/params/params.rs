@@ -813,9 +813,9 @@ fn axis_list_problems_name_file_line_and_column() {
         "kopf.achs_nr 7",
     );
     // A name ncchannel does not drive.
-    installation(d, &chan(2, "U1"), AXIS_Y);
+    installation(d, &chan(2, "Q1"), AXIS_Y);
     let errs = errors_of(params::load(&startup));
-    one_error(&errs, &d.join("listen/sda_mds1.lis"), 3, 32, "U1");
+    one_error(&errs, &d.join("listen/sda_mds1.lis"), 3, 32, "Q1");
     // A spindle as a path axis.
     installation(
         d,

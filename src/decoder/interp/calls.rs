@@ -346,6 +346,10 @@ impl Interpreter {
             }
             // Accepted without effect (lang::dialect): a block like any other.
             Command::Inert { .. } => self.emit(info, Action::None, false, io),
+            Command::Transform(t) => {
+                self.transform(t, notes)?;
+                self.emit(info, Action::None, false, io);
+            }
         }
         Ok(())
     }

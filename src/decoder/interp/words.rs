@@ -60,13 +60,16 @@ impl Interpreter {
         for it in items {
             self.collect(it, w)?;
         }
+        if w.gs().iter().any(|&(g, _)| g == 160) {
+            self.axis_zero_offsets(w, notes)?;
+        }
         let gs = self.modal_changes(w)?;
         let info = self.info(rd, at, io);
         // Step 4: the block's move (not yet queued), if it has one.
         let mv = if gs.dwell || gs.set_reference {
             None
         } else if let Some(end) = self.target(w, gs).filter(|&e| !self.stands_without_feed(e)) {
-            let mut mv = self.motion(w, end)?;
+            let mut mv = self.motion(w, end, gs)?;
             self.within_soft_limits(&mv)?;
             mv.path = self.modal.path_mode(gs.contour_this_block);
             Some(mv)
@@ -180,16 +183,25 @@ impl Interpreter {
                 Ok(())
             }
             Item::NamedAxis(a) => self.collect_named_axis(a, w),
+            // An axis's or the spindle's functions: the block's own (one spindle, one set of
+            // units).
+            Item::Functions(fs) => fs.items.iter().try_for_each(|it| self.collect(it, w)),
             Item::Word(word) => {
                 let renamed = self.renamed_slots != 0;
                 if let Some(i) = slot_of(word.letter).filter(|_| renamed) {
                     let name = &self.settings.axis_names[i];
                     if self.renamed_slots & (1 << i) != 0 {
-                        // The axis in this slot is named `X1`: `X` alone names no axis.
+                        // The axis in this slot is named `X1` (or `W`): `X` alone names no
+                        // axis.
+                        let written = if name.is_letter() {
+                            String::new()
+                        } else {
+                            format!(", written {name}=…")
+                        };
                         return Err(DecodeError::new(
                             codes::SYNTAX,
                             format!(
-                                "axis {} is not configured in this channel (its axis is {name}, written {name}=…)",
+                                "axis {} is not configured in this channel (its axis is {name}{written})",
                                 word.letter as char
                             ),
                         )
@@ -335,7 +347,11 @@ impl Interpreter {
             b'K' => w.ijk[2] = Some(v),
             b'R' => w.radius = Some(v),
             letter => {
-                if let Some(i) = slot_of(letter) {
+                let slot = match slot_of(letter) {
+                    Some(i) => Some(i),
+                    None => self.lettered_slot(letter)?,
+                };
+                if let Some(i) = slot {
                     if self.settings.axes[i] && w.axes_set & (1 << i) != 0 {
                         // `X1=5` and `X5` both name the slot of axis X1 (the parser sees
                         // only letters twice).
@@ -376,6 +392,10 @@ impl Interpreter {
                     )
                     .at(col));
                 }
+            }
+            if g == 160 {
+                // `G160=n` without axes: the warning was given ([`Self::axis_zero_offsets`]).
+                continue;
             }
             if !apply_g(&mut self.modal, g, &mut gs) {
                 if crate::lang::gcall::G_CALLS.contains(&g) {
@@ -583,7 +603,7 @@ impl Interpreter {
     }
 
     /// Step 4: the move from the last programmed position to `end`.
-    fn motion(&self, w: &Words, end: Position) -> Res<Move> {
+    fn motion(&self, w: &Words, end: Position, gs: BlockGs) -> Res<Move> {
         let start = self.modal.pos;
         let m = self.modal.motion;
         if m == MotionMode::Rapid {
@@ -607,10 +627,22 @@ impl Interpreter {
         }
         let unit = self.modal.units.mm_per_unit();
         let scaled = |v: Option<f64>| v.map(|v| v * unit);
+        let mut ijk = w.ijk.map(scaled);
+        if self.modal.centre_absolute {
+            // G161: the centre in program coordinates, made the offset from the start point
+            // the arc takes (TF5200 programming manual, "Specifying centre point for circle
+            // definition (G161/G162)").
+            let offset = self.program_offset(gs);
+            for (k, c) in ijk.iter_mut().enumerate() {
+                if let Some(c) = c {
+                    *c += offset[k] - start[k];
+                }
+            }
+        }
         arc::arc_move(
             &arc::ArcSpec {
                 plane: self.modal.plane,
-                ijk: w.ijk.map(scaled),
+                ijk,
                 radius: scaled(w.radius),
                 cw: m == MotionMode::ArcCw,
             },
@@ -770,6 +802,49 @@ fn two_calls() -> DecodeError {
     )
 }
 
+impl Interpreter {
+    /// `G160=n`: without an axis in the block the kernel's warning 20003 (TF5200 diagnosis ID
+    /// 20003, "programmed G function only useful with an axis", class 1: the program goes
+    /// on) and nothing else; with axes the axis-specific zero offsets, which ncchannel does
+    /// not model (900133).
+    #[cold]
+    fn axis_zero_offsets(&self, w: &Words, notes: &mut Vec<Note>) -> Res {
+        let col = w
+            .gs()
+            .iter()
+            .find(|&&(g, _)| g == 160)
+            .map_or(1, |&(_, c)| c);
+        if w.axes_set != 0 {
+            return Err(DecodeError::new(
+                codes::UNSUPPORTED,
+                "G160 (axis-specific zero offsets) is not supported by ncchannel",
+            )
+            .at(col));
+        }
+        notes.push(Note::Warning {
+            code: codes::G_WITHOUT_AXIS,
+            msg: format!("G160 without an axis has no effect (column {col})"),
+        });
+        Ok(())
+    }
+
+    /// The slot of the configured axis named by the one letter `letter` outside X Y Z A B C
+    /// (`W10` where the channel list names an axis `W`): `Some(None)` for a letter that is no
+    /// axis word (E), an error for an axis letter the channel does not configure (U V W).
+    #[cold]
+    fn lettered_slot(&self, letter: u8) -> Result<Option<usize>, DecodeError> {
+        let slot = (0..MAX_AXES).find(|&i| {
+            let n = &self.settings.axis_names[i];
+            self.settings.axes[i] && n.is_letter() && n.letter() == letter
+        });
+        match slot {
+            Some(i) => Ok(Some(i)),
+            None if matches!(letter, b'U' | b'V' | b'W') => Err(unconfigured(letter)),
+            None => Ok(None),
+        }
+    }
+}
+
 fn unconfigured(letter: u8) -> DecodeError {
     DecodeError::new(
         codes::SYNTAX,
@@ -792,15 +867,9 @@ fn push_function(
             format!("too many {letter} functions in one block"),
         ));
     }
-    // The parser admits only whole numbers 0..=65535 for M and H.
+    // The parser admits only whole numbers 0..=65535 for M and H, and refuses the same M
+    // twice in one scope (20765).
     let number = whole(v).unwrap_or(0);
-    if letter == 'M' && list[..*n].contains(&number) && !codes::PROGRAM_FLOW_M.contains(&number) {
-        // `M10 M10`: TF5200 diagnosis ID 20765 "Double-programmed M-function.".
-        return Err(DecodeError::new(
-            codes::M_TWICE,
-            format!("M{number} programmed twice in the block"),
-        ));
-    }
     list[*n] = number;
     values[*n] = value;
     *n += 1;
