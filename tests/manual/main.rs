@@ -38,6 +38,10 @@ const MAX_TICKS: u64 = 1_000_000;
 const POSITION_TOL_MM: f64 = 1e-3;
 const DWELL_TOL_S: f64 = 0.01;
 
+/// runtime.toml's axes for the corpus: X Y Z with the default limits, and U.
+const AXES_TOML: &str =
+    "[[axes]]\nname = \"X\"\n[[axes]]\nname = \"Y\"\n[[axes]]\nname = \"Z\"\n[[axes]]\nname = \"U\"\n";
+
 fn corpus_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/manual")
 }
@@ -154,9 +158,10 @@ fn n_number(w: &str) -> Result<u64, String> {
 
 /// The channel the corpus runs in: the test rig's, file caching for 6 files of 6000 bytes
 /// (TF5200 channel parameters, P-CHAN-00503/-00504: their parameterisation example), with the
-/// fixture's channel and tool lists.
+/// fixture's channel and tool lists, and the axes X Y Z and U (the tracking axis of the
+/// programming manual's G01 examples).
 fn rig() -> Rig {
-    let rig = Rig::with_cache(Some((6, 6000)), "");
+    let rig = Rig::with_cache(Some((6, 6000)), AXES_TOML);
     for f in ["channel1.lis", "tools.lis"] {
         std::fs::copy(
             corpus_dir().join("fixture").join(f),
@@ -261,12 +266,14 @@ fn error_texts(r: &RunResult) -> String {
 }
 
 /// Where `axis` stands at the end, mm (`None`: no such axis in the channel).
+/// Where the axis the channel names `axis` stands (a U axis drives a free slot: its name,
+/// not the slot's letter, finds it).
 fn position(r: &RunResult, axis: char) -> Option<f64> {
     r.machine.channels()[0]
-        .status()
-        .positions
+        .report()
+        .named_positions
         .into_iter()
-        .find(|(a, _)| *a == axis)
+        .find(|(a, _)| a.to_string() == axis.to_string())
         .map(|(_, v)| v)
 }
 
