@@ -29,9 +29,9 @@ use super::catalog::{ListKind, ListSummary, Tally};
 use super::list::{read_list, Entry, ParamList, ValueKind};
 use super::startup::{shape, warn_duplicates};
 use super::value::uint_value;
-use crate::vocab::vars::{CLASS_BYTES, ENTRY_BYTES};
 use crate::diag::Diagnostic;
 use crate::lang::codes::{MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS};
+use crate::vocab::vars::{CLASS_BYTES, ENTRY_BYTES};
 
 /// Highest `var[i]` index + 1: P-EXTV-00010 `number_used_variables` is an UNS16.
 pub(crate) const MAX_VARS: u32 = 65_535;

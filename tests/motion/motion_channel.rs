@@ -963,11 +963,17 @@ fn v_g_wz_akt_and_v_g_np_read_the_lists() {
 fn a_program_writes_zero_offsets_through_v_g_np_and_they_outlive_a_reset() {
     let s = kernel_lists("");
     // TF5200 "Zero offsets": `V.G.NP[1].V.X=10` then `G54` (group 1).
-    let mut c = run_program(&s, "V.G.NP[1].V.X = 25\nV.G.NP[2].V[1] = -4\nG54 G90 G0 X0\nM30\n");
+    let mut c = run_program(
+        &s,
+        "V.G.NP[1].V.X = 25\nV.G.NP[2].V[1] = -4\nG54 G90 G0 X0\nM30\n",
+    );
     assert_eq!(c.report().position[0], 25.0);
     // The table is the channel's data: the next program, after a reset, still sees it.
     c.apply(&tick(200_000), Op::Reset);
-    s.write("nc/next.nc", "G55 G90 G0 X0 Y0\nP1 = V.G.NP[1].V.X\nG53 G0 Z[P1]\nM30\n");
+    s.write(
+        "nc/next.nc",
+        "G55 G90 G0 X0 Y0\nP1 = V.G.NP[1].V.X\nG53 G0 Z[P1]\nM30\n",
+    );
     start(&mut c, &tick(200_001), "next.nc");
     for k in 200_002..400_000u64 {
         c.step(&tick(k));
@@ -982,7 +988,11 @@ fn a_program_writes_zero_offsets_through_v_g_np_and_they_outlive_a_reset() {
     // Group 0 is G53 (no offset) and cannot be written; nor can tool data.
     for prog in ["V.G.NP[0].V.X = 1\nM30\n", "V.G.WZ_AKT.L = 5\nM30\n"] {
         let c = run_program(&s, prog);
-        assert_eq!(c.report().last_error.map(|e| e.code), Some(900133), "{prog}");
+        assert_eq!(
+            c.report().last_error.map(|e| e.code),
+            Some(900133),
+            "{prog}"
+        );
     }
 }
 

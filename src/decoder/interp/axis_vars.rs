@@ -13,8 +13,8 @@ use super::Interpreter;
 use crate::decoder::error::{DecodeError, Res};
 use crate::decoder::modal;
 use crate::lang::codes;
-use crate::lang::VarKey;
 use crate::lang::ToolFieldId;
+use crate::lang::VarKey;
 use crate::params::tools::ToolData;
 use crate::vocab::axis::{AXIS_LETTERS, MAX_AXES};
 
