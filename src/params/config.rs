@@ -21,7 +21,7 @@ use super::ext_vars::{interpret_ext_vars, is_ext_var_list, read_ext_vars, ExtVar
 use super::list::{parse_list, read_list, read_list_text, Entry, ParamList};
 use super::runtime::{read_runtime, AxisConfig, RuntimeConfig};
 use super::search_path::{list_folder, SearchPath};
-use super::startup::{interpret_startup, is_startup_list, StartupList};
+use super::startup::{interpret_startup, is_startup_list, ListRef, StartupList};
 use super::tools::{read_tools, ToolFormat, ToolTable};
 use super::zero_offsets::{
     interpret_zero_offsets, is_zero_offset_list, read_zero_offsets, ZeroOffsetTable,
@@ -297,6 +297,33 @@ fn build(
 }
 
 /// A file named by `entry` could not be read: the error at the entry's value.
+/// A list the start-up list names for a channel (`r`), read once however many channels name
+/// its file (`tables`, by path) and reported once; `None` when it cannot be read (the error,
+/// at the naming entry, is in `diags`).
+fn read_once<T: Clone>(
+    tables: &mut HashMap<PathBuf, Option<T>>,
+    startup: &StartupList,
+    r: &ListRef,
+    what: &str,
+    diags: &mut Vec<Diagnostic>,
+    lists: &mut Vec<ListSummary>,
+    read: impl FnOnce(&Path, &mut Vec<Diagnostic>) -> Result<(T, ListSummary), Diagnostic>,
+) -> Option<T> {
+    tables
+        .entry(r.path.clone())
+        .or_insert_with(|| match read(&r.path, diags) {
+            Ok((t, summary)) => {
+                lists.push(summary);
+                Some(t)
+            }
+            Err(e) => {
+                diags.push(cannot_read(&startup.list, &r.entry, what, &r.path, &e));
+                None
+            }
+        })
+        .clone()
+}
+
 fn cannot_read(
     list: &ParamList,
     entry: &Entry,
@@ -427,32 +454,22 @@ fn channels(
         out.push(combine(startup, i, chan, axes, diags));
     }
     // Zero-offset lists; channels may share one: read and report it once.
-    let mut tables: HashMap<PathBuf, Option<ZeroOffsetTable>> = HashMap::new();
+    let mut tables = HashMap::new();
     for c in &mut out {
         let Some(r) = startup.zero_offset_list(c.index as u32) else {
             continue;
         };
-        let table = tables.entry(r.path.clone()).or_insert_with(|| {
-            match read_zero_offsets(&r.path, diags) {
-                Ok((t, summary)) => {
-                    lists.push(summary);
-                    Some(t)
-                }
-                Err(e) => {
-                    diags.push(cannot_read(
-                        &startup.list,
-                        &r.entry,
-                        "zero-offset list",
-                        &r.path,
-                        &e,
-                    ));
-                    None
-                }
-            }
-        });
-        if let Some(t) = table {
+        if let Some(t) = read_once(
+            &mut tables,
+            startup,
+            r,
+            "zero-offset list",
+            diags,
+            lists,
+            read_zero_offsets,
+        ) {
             c.zero_offset_list = Some(r.path.clone());
-            c.zero_offsets = *t;
+            c.zero_offsets = t;
         }
     }
     ext_var_lists(startup, &mut out, diags, lists);
@@ -469,34 +486,24 @@ fn channel_tools(
     diags: &mut Vec<Diagnostic>,
     lists: &mut Vec<ListSummary>,
 ) {
-    let mut tables: HashMap<PathBuf, Option<ToolTable>> = HashMap::new();
+    let mut tables = HashMap::new();
     for c in channels {
         let Some(r) = startup.tool_lists.get(&(c.index as u32)) else {
             c.tool_list = fallback_file.map(Path::to_path_buf);
             c.tools = fallback.clone();
             continue;
         };
-        let table = tables.entry(r.path.clone()).or_insert_with(|| {
-            match read_tools(&r.path, ToolFormat::Kernel, diags) {
-                Ok((t, summary)) => {
-                    lists.push(summary);
-                    Some(t)
-                }
-                Err(e) => {
-                    diags.push(cannot_read(
-                        &startup.list,
-                        &r.entry,
-                        "tool list",
-                        &r.path,
-                        &e,
-                    ));
-                    None
-                }
-            }
-        });
-        if let Some(t) = table {
+        if let Some(t) = read_once(
+            &mut tables,
+            startup,
+            r,
+            "tool list",
+            diags,
+            lists,
+            |p, d| read_tools(p, ToolFormat::Kernel, d),
+        ) {
             c.tool_list = Some(r.path.clone());
-            c.tools = t.clone();
+            c.tools = t;
         }
     }
 }
@@ -543,30 +550,19 @@ fn ext_var_lists(
     diags: &mut Vec<Diagnostic>,
     lists: &mut Vec<ListSummary>,
 ) {
-    let mut tables: HashMap<PathBuf, Option<Arc<ExtVarTable>>> = HashMap::new();
+    let mut tables = HashMap::new();
     for c in out {
         let Some(r) = startup.ext_var_lists.get(&(c.index as u32)) else {
             continue;
         };
-        let table =
-            tables
-                .entry(r.path.clone())
-                .or_insert_with(|| match read_ext_vars(&r.path, diags) {
-                    Ok((t, summary)) => {
-                        lists.push(summary);
-                        Some(Arc::new(t))
-                    }
-                    Err(e) => {
-                        diags.push(cannot_read(
-                            &startup.list,
-                            &r.entry,
-                            "external variable list",
-                            &r.path,
-                            &e,
-                        ));
-                        None
-                    }
-                });
-        c.ext_vars = table.clone();
+        c.ext_vars = read_once(
+            &mut tables,
+            startup,
+            r,
+            "external variable list",
+            diags,
+            lists,
+            |p, d| read_ext_vars(p, d).map(|(t, summary)| (Arc::new(t), summary)),
+        );
     }
 }
