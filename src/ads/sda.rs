@@ -25,7 +25,7 @@ use super::backend::{CncBackend, DeviceError};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
 use crate::decoder::vars::ExternalValue;
-use crate::params::ext_vars::ExtType;
+use crate::lang::block::VarType;
 use crate::vocab::axis::slot_of;
 
 pub const PORT: u16 = 552;
@@ -162,33 +162,30 @@ fn encode(v: &ExternalValue) -> Vec<u8> {
         }
         // The store holds whole numbers in range for an integer type: the casts are exact.
         ExternalValue::Num(v, ty) => match ty {
-            None | Some(ExtType::Real64) | Some(ExtType::Str { .. }) => v.to_le_bytes().to_vec(),
-            Some(ExtType::Boolean | ExtType::Uns08) => vec![*v as u8],
-            Some(ExtType::Sgn08) => (*v as i8).to_le_bytes().to_vec(),
-            Some(ExtType::Sgn16) => (*v as i16).to_le_bytes().to_vec(),
-            Some(ExtType::Uns16) => (*v as u16).to_le_bytes().to_vec(),
-            Some(ExtType::Sgn32) => (*v as i32).to_le_bytes().to_vec(),
-            Some(ExtType::Uns32) => (*v as u32).to_le_bytes().to_vec(),
+            None | Some(VarType::Real) | Some(VarType::String(_)) => v.to_le_bytes().to_vec(),
+            Some(VarType::Boolean | VarType::Uns08) => vec![*v as u8],
+            Some(VarType::Sgn08) => (*v as i8).to_le_bytes().to_vec(),
+            Some(VarType::Sgn16) => (*v as i16).to_le_bytes().to_vec(),
+            Some(VarType::Uns16) => (*v as u16).to_le_bytes().to_vec(),
+            Some(VarType::Sgn32) => (*v as i32).to_le_bytes().to_vec(),
+            Some(VarType::Uns32) => (*v as u32).to_le_bytes().to_vec(),
         },
     }
 }
 
 /// The number a write of `data` to a V.E. of type `ty` carries: exactly the type's bytes.
-fn decode(data: &[u8], ty: Option<ExtType>) -> Result<f64, AdsResult> {
-    let Some(ty) = ty.filter(|t| *t != ExtType::Real64) else {
+fn decode(data: &[u8], ty: Option<VarType>) -> Result<f64, AdsResult> {
+    let Some(ty) = ty.filter(|t| *t != VarType::Real) else {
         return value_arg(data);
     };
-    let (_, size) = ty.plc_type();
-    if data.len() != size as usize {
-        return Err(AdsResult::INVALID_SIZE);
-    }
+    // Each type takes exactly its bytes: any other length is the size error.
     Ok(match (ty, data) {
-        (ExtType::Sgn08, [b]) => f64::from(*b as i8),
-        (ExtType::Boolean | ExtType::Uns08, [b]) => f64::from(*b),
-        (ExtType::Sgn16, [a, b]) => f64::from(i16::from_le_bytes([*a, *b])),
-        (ExtType::Uns16, [a, b]) => f64::from(u16::from_le_bytes([*a, *b])),
-        (ExtType::Sgn32, [a, b, c, d]) => f64::from(i32::from_le_bytes([*a, *b, *c, *d])),
-        (ExtType::Uns32, [a, b, c, d]) => f64::from(u32::from_le_bytes([*a, *b, *c, *d])),
+        (VarType::Sgn08, [b]) => f64::from(*b as i8),
+        (VarType::Boolean | VarType::Uns08, [b]) => f64::from(*b),
+        (VarType::Sgn16, [a, b]) => f64::from(i16::from_le_bytes([*a, *b])),
+        (VarType::Uns16, [a, b]) => f64::from(u16::from_le_bytes([*a, *b])),
+        (VarType::Sgn32, [a, b, c, d]) => f64::from(i32::from_le_bytes([*a, *b, *c, *d])),
+        (VarType::Uns32, [a, b, c, d]) => f64::from(u32::from_le_bytes([*a, *b, *c, *d])),
         _ => return Err(AdsResult::INVALID_SIZE),
     })
 }

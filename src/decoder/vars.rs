@@ -15,15 +15,15 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use crate::lang::block::VScope;
 use crate::lang::block::MAX_STRING;
+use crate::lang::block::{VScope, VarType};
 use crate::lang::codes::{
     ARRAY_INDEX_RANGE, EVAL_NUMBER_AS_STRING, EVAL_STRING_AS_NUMBER, EVAL_UNDEFINED,
     MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS, STRING_TOO_LONG_FOR_VARIABLE, TOO_MANY_INDICES,
     VARIABLE_MEMORY_FULL, VARIABLE_OUT_OF_FORMAT, VARIABLE_READ_DENIED, VARIABLE_UNKNOWN,
     VARIABLE_WRITE_DENIED,
 };
-use crate::params::ext_vars::{ExtAccess, ExtType, ExtVar, ExtVarTable};
+use crate::params::ext_vars::{ExtAccess, ExtVar, ExtVarTable};
 use crate::source::loader::Loader;
 
 /// Array indices of a variable, evaluated. At most three dimensions, as ISG arrays have.
@@ -309,7 +309,7 @@ impl VarStore {
     pub(crate) fn declare_externals(&mut self, table: Arc<ExtVarTable>) -> Result<(), VarError> {
         for v in &table.vars {
             match v.ty {
-                ExtType::Str { max_chars } => {
+                VarType::String(max_chars) => {
                     self.declare_str(VScope::External, &v.name, &v.sizes, max_chars, "")?
                 }
                 _ => self.declare(VScope::External, &v.name, &v.sizes, 0.0)?,
@@ -887,7 +887,7 @@ impl VarStore {
         }
         let text = self.get_str(&k)?;
         let max = match ty {
-            Some(ExtType::Str { max_chars }) => max_chars,
+            Some(VarType::String(max_chars)) => max_chars,
             _ => MAX_STRING as u8,
         };
         Some(ExternalValue::Str(text.to_string(), max))
@@ -898,7 +898,7 @@ impl VarStore {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ExternalValue {
     /// The value and the declared type (`None`: no list, an LREAL).
-    Num(f64, Option<ExtType>),
+    Num(f64, Option<VarType>),
     /// The text and the characters the variable may hold.
     Str(String, u8),
 }
@@ -1115,7 +1115,7 @@ mod tests {
 
     #[test]
     fn declared_externals_are_typed_and_bind_programs_not_the_plc() {
-        use crate::params::ext_vars::{ExtAccess, ExtType, ExtVar, ExtVarTable};
+        use crate::params::ext_vars::{ExtAccess, ExtVar, ExtVarTable};
         let leaf = |name: &str, sizes: Vec<u32>, ty, access| ExtVar {
             name: name.into(),
             sizes,
@@ -1126,13 +1126,8 @@ mod tests {
         let table = ExtVarTable {
             file: "ve.lis".into(),
             vars: vec![
-                leaf("INFO.X", vec![2], ExtType::Uns08, ExtAccess::ReadOnly),
-                leaf(
-                    "MSG",
-                    vec![],
-                    ExtType::Str { max_chars: 4 },
-                    ExtAccess::ReadWrite,
-                ),
+                leaf("INFO.X", vec![2], VarType::Uns08, ExtAccess::ReadOnly),
+                leaf("MSG", vec![], VarType::String(4), ExtAccess::ReadWrite),
             ],
         };
         s.declare_externals(Arc::new(table)).unwrap();
@@ -1170,7 +1165,7 @@ mod tests {
         s.reset();
         assert_eq!(
             s.external_value("INFO[1].X"),
-            Some(ExternalValue::Num(7.0, Some(ExtType::Uns08)))
+            Some(ExternalValue::Num(7.0, Some(VarType::Uns08)))
         );
     }
 

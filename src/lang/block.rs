@@ -628,6 +628,40 @@ pub enum VarType {
 }
 
 impl VarType {
+    /// The numeric types, each named by [`VarType::name`].
+    const NUMERIC: [VarType; 8] = [
+        VarType::Boolean,
+        VarType::Sgn08,
+        VarType::Uns08,
+        VarType::Sgn16,
+        VarType::Uns16,
+        VarType::Sgn32,
+        VarType::Uns32,
+        VarType::Real,
+    ];
+
+    /// The numeric type named `upper` (upper case; `REAL` is `REAL64`).
+    pub fn numeric(upper: &str) -> Option<VarType> {
+        if upper == "REAL" {
+            return Some(VarType::Real);
+        }
+        Self::NUMERIC.into_iter().find(|t| t.name() == upper)
+    }
+
+    /// The values an integer type holds (BOOLEAN 0 … 1); `None` for REAL64 and strings.
+    pub fn range(self) -> Option<(f64, f64)> {
+        Some(match self {
+            VarType::Boolean => (0.0, 1.0),
+            VarType::Sgn08 => (f64::from(i8::MIN), f64::from(i8::MAX)),
+            VarType::Uns08 => (0.0, f64::from(u8::MAX)),
+            VarType::Sgn16 => (f64::from(i16::MIN), f64::from(i16::MAX)),
+            VarType::Uns16 => (0.0, f64::from(u16::MAX)),
+            VarType::Sgn32 => (f64::from(i32::MIN), f64::from(i32::MAX)),
+            VarType::Uns32 => (0.0, f64::from(u32::MAX)),
+            VarType::Real | VarType::String(_) => return None,
+        })
+    }
+
     /// The type's name as written in a declaration (`REAL` as `REAL64`).
     pub fn name(self) -> &'static str {
         match self {

@@ -1910,15 +1910,8 @@ fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
         .take_while(u8::is_ascii_alphanumeric)
         .count()
         .min(16);
-    let ty = match t[..len].to_ascii_uppercase().as_str() {
-        "BOOLEAN" => VarType::Boolean,
-        "SGN08" => VarType::Sgn08,
-        "UNS08" => VarType::Uns08,
-        "SGN16" => VarType::Sgn16,
-        "UNS16" => VarType::Uns16,
-        "SGN32" => VarType::Sgn32,
-        "UNS32" => VarType::Uns32,
-        "REAL" | "REAL64" => VarType::Real,
+    let upper = t[..len].to_ascii_uppercase();
+    let ty = match upper.as_str() {
         "STRING" => {
             let s = &t[len..];
             let size = s.strip_prefix('[').and_then(|n| {
@@ -1931,13 +1924,16 @@ fn var_type<'a>(i: &'a str, none: &'a str) -> PResult<'a, Option<VarType>> {
                 None => fail(s, SYNTAX, "STRING[<length 1 to 126>] expected"),
             };
         }
-        _ => {
-            return fail(
-                t,
-                SYNTAX,
-                "data type BOOLEAN, SGN08, UNS08, SGN16, UNS16, SGN32, UNS32, REAL64 or STRING[n] expected",
-            )
-        }
+        name => match VarType::numeric(name) {
+            Some(ty) => ty,
+            None => {
+                return fail(
+                    t,
+                    SYNTAX,
+                    "data type BOOLEAN, SGN08, UNS08, SGN16, UNS16, SGN32, UNS32, REAL64 or STRING[n] expected",
+                )
+            }
+        },
     };
     Ok((&t[len..], Some(ty)))
 }

@@ -30,6 +30,7 @@ use super::list::{read_list, Entry, ParamList, ValueKind};
 use super::startup::{shape, warn_duplicates};
 use super::value::uint_value;
 use crate::diag::Diagnostic;
+use crate::lang::block::VarType;
 use crate::lang::codes::{MAX_ARRAY_DIMS, MAX_ARRAY_ELEMENTS};
 use crate::vocab::vars::{CLASS_BYTES, ENTRY_BYTES};
 
@@ -58,71 +59,14 @@ pub(crate) const EXTENDED_STRING_CHARS: u8 = 127;
 pub(crate) const DEFAULT_VSTRING_BYTES: u64 = 128;
 pub(crate) const MAX_VSTRING_BYTES: u64 = 256;
 
-/// The type of a V.E. leaf (P-EXTV-00003: BOOLEAN, SGN08 … UNS32, REAL64, STRING, VSTRING).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExtType {
-    Boolean,
-    Sgn08,
-    Uns08,
-    Sgn16,
-    Uns16,
-    Sgn32,
-    Uns32,
-    Real64,
-    /// STRING or VSTRING: at most `max_chars` characters.
-    Str {
-        max_chars: u8,
-    },
-}
-
-impl ExtType {
-    /// The elementary type named `word` (upper case); STRING takes `string_chars`.
-    fn elementary(word: &str, string_chars: u8) -> Option<Self> {
-        Some(match word {
-            "BOOLEAN" => ExtType::Boolean,
-            "SGN08" => ExtType::Sgn08,
-            "UNS08" => ExtType::Uns08,
-            "SGN16" => ExtType::Sgn16,
-            "UNS16" => ExtType::Uns16,
-            "SGN32" => ExtType::Sgn32,
-            "UNS32" => ExtType::Uns32,
-            "REAL64" => ExtType::Real64,
-            "STRING" => ExtType::Str {
-                max_chars: string_chars,
-            },
-            _ => return None,
-        })
-    }
-
-    /// The values an integer type holds, `None` for REAL64 and strings.
-    pub fn range(self) -> Option<(f64, f64)> {
-        Some(match self {
-            ExtType::Boolean => (0.0, 1.0),
-            ExtType::Sgn08 => (f64::from(i8::MIN), f64::from(i8::MAX)),
-            ExtType::Uns08 => (0.0, f64::from(u8::MAX)),
-            ExtType::Sgn16 => (f64::from(i16::MIN), f64::from(i16::MAX)),
-            ExtType::Uns16 => (0.0, f64::from(u16::MAX)),
-            ExtType::Sgn32 => (f64::from(i32::MIN), f64::from(i32::MAX)),
-            ExtType::Uns32 => (0.0, f64::from(u32::MAX)),
-            ExtType::Real64 | ExtType::Str { .. } => return None,
-        })
-    }
-
-    /// The PLC (IEC 61131-3) type the ADS side gives the leaf, and its size in bytes.
-    pub fn plc_type(self) -> (String, u32) {
-        match self {
-            ExtType::Boolean => ("BOOL".into(), 1),
-            ExtType::Sgn08 => ("SINT".into(), 1),
-            ExtType::Uns08 => ("USINT".into(), 1),
-            ExtType::Sgn16 => ("INT".into(), 2),
-            ExtType::Uns16 => ("UINT".into(), 2),
-            ExtType::Sgn32 => ("DINT".into(), 4),
-            ExtType::Uns32 => ("UDINT".into(), 4),
-            ExtType::Real64 => ("LREAL".into(), 8),
-            ExtType::Str { max_chars } => {
-                (format!("STRING({max_chars})"), u32::from(max_chars) + 1)
-            }
-        }
+/// The elementary type a V.E. list names (P-EXTV-00003: BOOLEAN, SGN08 … UNS32, REAL64,
+/// STRING; VSTRING is read with its size), in the language's vocabulary of declared types;
+/// STRING takes `string_chars`.
+fn elementary(word: &str, string_chars: u8) -> Option<VarType> {
+    match word {
+        "STRING" => Some(VarType::String(string_chars)),
+        "REAL" => None,
+        w => VarType::numeric(w),
     }
 }
 
@@ -142,7 +86,7 @@ pub struct ExtVar {
     pub name: String,
     /// The array sizes along the path, outermost first (empty: a scalar).
     pub sizes: Vec<u32>,
-    pub ty: ExtType,
+    pub ty: VarType,
     pub access: ExtAccess,
 }
 
@@ -343,7 +287,7 @@ impl<'l> Unfold<'l, '_> {
                 continue;
             };
             if let Some(name) = self.name(n) {
-                if ExtType::elementary(&name, self.string_chars).is_some() || name == "VSTRING" {
+                if elementary(&name, self.string_chars).is_some() || name == "VSTRING" {
                     self.diags.push(self.list.error_at(
                         n,
                         n.value_pos,
@@ -483,7 +427,7 @@ impl<'l> Unfold<'l, '_> {
 
     /// A VSTRING of `f.size` bytes with the NUL (P-EXTV-00008 / -00021; default 128);
     /// `None` after an error.
-    fn vstring(&mut self, f: &Fields<'l>) -> Option<ExtType> {
+    fn vstring(&mut self, f: &Fields<'l>) -> Option<VarType> {
         let bytes = match f.size {
             None => DEFAULT_VSTRING_BYTES,
             Some(e) => match uint_value(self.list, e, MAX_VSTRING_BYTES) {
@@ -502,9 +446,7 @@ impl<'l> Unfold<'l, '_> {
                 }
             },
         };
-        Some(ExtType::Str {
-            max_chars: (bytes - 1) as u8,
-        })
+        Some(VarType::String((bytes - 1) as u8))
     }
 
     /// One variable or element `f` named `path`, under arrays `sizes`, inheriting `access`.
@@ -538,7 +480,7 @@ impl<'l> Unfold<'l, '_> {
         let word = f.ty.map_or("UNS32".to_string(), |e| {
             e.value.text.trim().to_ascii_uppercase()
         });
-        let ty = match (ExtType::elementary(&word, self.string_chars), word.as_str()) {
+        let ty = match (elementary(&word, self.string_chars), word.as_str()) {
             (Some(t), _) => t,
             (None, "VSTRING") => match self.vstring(f) {
                 Some(t) => t,
@@ -585,7 +527,7 @@ impl<'l> Unfold<'l, '_> {
             + ENTRY_BYTES
             + elements
                 * match ty {
-                    ExtType::Str { max_chars } => {
+                    VarType::String(max_chars) => {
                         std::mem::size_of::<Box<str>>() + usize::from(max_chars)
                     }
                     _ => std::mem::size_of::<f64>(),
@@ -665,10 +607,10 @@ mod tests {
         let x = t.get("INFO.X").expect("leaf");
         assert_eq!(
             (x.sizes.as_slice(), x.ty, x.access),
-            (&[2][..], ExtType::Uns16, ExtAccess::ReadOnly)
+            (&[2][..], VarType::Uns16, ExtAccess::ReadOnly)
         );
         let tag = t.get("INFO.TAG").expect("leaf");
-        assert_eq!(tag.ty, ExtType::Str { max_chars: 20 });
+        assert_eq!(tag.ty, VarType::String(20));
         assert_eq!(tag.access, ExtAccess::ReadWrite);
     }
 
