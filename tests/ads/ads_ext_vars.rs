@@ -15,18 +15,9 @@ const HANDLE_BY_NAME: u32 = 0x46;
 const READ_BY_NAME: u32 = 0x48;
 const WRITE_BY_NAME: u32 = 0x4A;
 
+/// A client of the SDA port (552), where V.E. variables are read and written by name.
 fn connect(served: &Served) -> AdsClient {
-    let target = ncchannel::ads::frame::AmsAddr {
-        port: 552,
-        ..device()
-    };
-    AdsClient::connect(
-        served.server.local_addr(),
-        target,
-        None,
-        Duration::from_secs(5),
-    )
-    .unwrap()
+    super::ads_model_objects::connect(served, 552)
 }
 
 fn refused(r: Result<impl std::fmt::Debug, ClientError>) -> u32 {

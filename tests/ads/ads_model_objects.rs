@@ -13,7 +13,7 @@ use ncchannel::ads::frame::AmsAddr;
 const CH: u32 = 0x120101;
 const IPO: u32 = 0x121301;
 
-fn connect(served: &Served, port: u16) -> AdsClient {
+pub(crate) fn connect(served: &Served, port: u16) -> AdsClient {
     let target = AmsAddr { port, ..device() };
     AdsClient::connect(
         served.server.local_addr(),

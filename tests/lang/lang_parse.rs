@@ -3,6 +3,8 @@
 use ncchannel::lang::*;
 use ncchannel::vocab::flush::FlushKind;
 
+use super::lang_roundtrip::without_cols;
+
 fn p(line: &str) -> Block {
     parse_block(line).unwrap_or_else(|e| panic!("{line:?}: {e}"))
 }
@@ -12,33 +14,6 @@ fn err(line: &str) -> (u32, u32) {
         Ok(b) => panic!("{line:?} parsed as {b:?}"),
         Err(e) => (e.code, e.col),
     }
-}
-
-/// Columns differ between a line and its canonical text; compare blocks without them.
-fn without_cols(mut b: Block) -> Block {
-    if let Body::Items(items) = &mut b.body {
-        for item in items {
-            match item {
-                Item::Word(w) => w.col = 0,
-                Item::Assign { col, .. }
-                | Item::GValue { col, .. }
-                | Item::FunctionValue { col, .. } => *col = 0,
-                Item::GCall(c) => c.col = 0,
-                Item::NamedAxis(a) => a.col = 0,
-                Item::Functions(fs) => {
-                    fs.col = 0;
-                    for it in &mut fs.items {
-                        match it {
-                            Item::Word(w) => w.col = 0,
-                            Item::FunctionValue { col, .. } => *col = 0,
-                            _ => {}
-                        }
-                    }
-                }
-            }
-        }
-    }
-    b
 }
 
 /// Parse, print canonically, and check the canonical text reads back to the same block and

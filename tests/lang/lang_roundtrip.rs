@@ -374,7 +374,8 @@ fn block() -> impl Strategy<Value = Block> {
     })
 }
 
-fn without_cols(mut b: Block) -> Block {
+/// Columns differ between a line and its canonical text; compare blocks without them.
+pub(crate) fn without_cols(mut b: Block) -> Block {
     if let Body::Items(items) = &mut b.body {
         for item in items {
             match item {
