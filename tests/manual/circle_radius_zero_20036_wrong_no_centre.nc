@@ -1,0 +1,7 @@
+; TF5200 diagnosis, ID 20036 "Radius of circle is 0.": the first wrong program (missing centre point coordinates)
+; https://infosys.beckhoff.com/content/1033/tf5200_diagnosis/250610827.html
+; adapted: none.
+; expect: error 20036
+N10 G00 X0 Y0 Z0
+N20 G164 G02 X10 F1000 (missing centre point coordinates)
+N1000 M30

@@ -1,0 +1,9 @@
+; TF5200 diagnosis, ID 21316 "Tangential selection or deselection during active inner corner selection not allowed.": the wrong program (a warning; G05 is ignored)
+; https://infosys.beckhoff.com/content/1033/tf5200_diagnosis/254188171.html
+; adapted: the page's ":" lines dropped.
+; expect: warning 21316
+; expect: end X=100
+N10 G238
+N100 G41 G05
+N110 G01 X100 F1000
+N1000 M30
