@@ -328,18 +328,18 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
         if is_word_letter(up) && !(up == b'V' && dot_follows) {
             let at = i;
             i = word(ctx, i, up, &mut items)?;
-            if let b'G' | b'M' | b'H' = up {
-                dwell |= up == b'G' && items.last().is_some_and(is_dwell);
-                if up == b'M' {
-                    ms.get_or_insert_with(FunctionNumbers::default)
-                        .add(items.last(), at)?;
+            match up {
+                b'G' => dwell |= items.last().is_some_and(is_dwell),
+                b'M' => once_per_block(&mut ms, items.last(), at)?,
+                b'H' => {}
+                _ if bytes.get(1) == Some(&b'[') && ends_in_function(&items) => {}
+                _ => {
+                    let bit = 1u32 << (up - b'A');
+                    if seen & bit != 0 {
+                        return Err(twice(at, up));
+                    }
+                    seen |= bit;
                 }
-            } else if !(bytes.get(1) == Some(&b'[') && ends_in_function(&items)) {
-                let bit = 1u32 << (up - b'A');
-                if seen & bit != 0 {
-                    return Err(twice(at, up));
-                }
-                seen |= bit;
             }
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
@@ -434,6 +434,17 @@ impl FunctionNumbers {
         }
         Ok(())
     }
+}
+
+/// The M function just read (`item`, at `at`) against the block's others: out of the literal
+/// words' path, which meets no M in most blocks.
+#[inline(never)]
+fn once_per_block<'a>(
+    ms: &mut Option<FunctionNumbers>,
+    item: Option<&Item>,
+    at: &'a str,
+) -> Result<(), nom::Err<PErr<'a>>> {
+    ms.get_or_insert_with(FunctionNumbers::default).add(item, at)
 }
 
 /// Was the word just read an axis's or the spindle's functions without a speed: `X[M54]`,
