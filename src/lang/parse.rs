@@ -444,7 +444,8 @@ fn once_per_block<'a>(
     item: Option<&Item>,
     at: &'a str,
 ) -> Result<(), nom::Err<PErr<'a>>> {
-    ms.get_or_insert_with(FunctionNumbers::default).add(item, at)
+    ms.get_or_insert_with(FunctionNumbers::default)
+        .add(item, at)
 }
 
 /// Was the word just read an axis's or the spindle's functions without a speed: `X[M54]`,
