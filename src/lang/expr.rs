@@ -225,6 +225,11 @@ impl<'a> Ctx<'a> {
         code: u32,
         msg: impl Into<Cow<'static, str>>,
     ) -> nom::Err<PErr<'a>> {
+        perr(self.rest_at(col), code, msg)
+    }
+
+    /// The line from 1-based character column `col` on.
+    pub(crate) fn rest_at(&self, col: u32) -> &'a str {
         let k = (col as usize).saturating_sub(1);
         let off = if self.ascii {
             k.min(self.line.len())
@@ -234,7 +239,7 @@ impl<'a> Ctx<'a> {
                 .nth(k)
                 .map_or(self.line.len(), |(o, _)| o)
         };
-        perr(&self.line[off..], code, msg)
+        &self.line[off..]
     }
 
     pub(crate) fn to_error(&self, e: nom::Err<PErr<'_>>) -> SyntaxError {

@@ -310,9 +310,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
     let mut items = Vec::with_capacity(item_capacity(i));
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
-    // The block's own M functions so far: one twice is 20765. Made at the first M, so a
-    // block without one does not pay for it.
-    let mut ms: Option<FunctionNumbers> = None;
+    // The block's own M words: with two or more, each number once (20765), checked at the
+    // end so the literal words' loop only counts them.
+    let mut ms = 0usize;
     let mut dwell = false;
     loop {
         i = gap(i);
@@ -320,6 +320,9 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
         let Some(&b) = bytes.first() else {
             if dwell {
                 dwell_alone(ctx, &items)?;
+            }
+            if ms > 1 {
+                functions_once(ctx, &items)?;
             }
             return Ok(items);
         };
@@ -330,7 +333,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             i = word(ctx, i, up, &mut items)?;
             match up {
                 b'G' => dwell |= items.last().is_some_and(is_dwell),
-                b'M' => once_per_block(&mut ms, items.last(), at)?,
+                b'M' => ms += 1,
                 b'H' => {}
                 _ if bytes.get(1) == Some(&b'[') && ends_in_function(&items) => {}
                 _ => {
@@ -436,16 +439,23 @@ impl FunctionNumbers {
     }
 }
 
-/// The M function just read (`item`, at `at`) against the block's others: out of the literal
-/// words' path, which meets no M in most blocks.
-#[inline(never)]
-fn once_per_block<'a>(
-    ms: &mut Option<FunctionNumbers>,
-    item: Option<&Item>,
-    at: &'a str,
-) -> Result<(), nom::Err<PErr<'a>>> {
-    ms.get_or_insert_with(FunctionNumbers::default)
-        .add(item, at)
+/// The block's own M functions (not those in an axis's or the spindle's brackets), each
+/// number once: the second of one number is 20765 at its word.
+#[cold]
+fn functions_once<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a>>> {
+    let mut ms = FunctionNumbers::default();
+    for it in items {
+        let col = match it {
+            Item::Word(w) if w.letter == b'M' => w.col,
+            Item::FunctionValue {
+                letter: b'M', col, ..
+            } => *col,
+            _ => continue,
+        };
+        let at = ctx.rest_at(col);
+        ms.add(Some(it), at)?;
+    }
+    Ok(())
 }
 
 /// Was the word just read an axis's or the spindle's functions without a speed: `X[M54]`,
