@@ -91,7 +91,11 @@ impl Interpreter {
     /// takes it back. Group 0 (G53, no offset) and groups past G59 cannot be written.
     pub(super) fn set_zero_offset(&mut self, key: &VarKey<'_>, value_mm: f64) -> Res {
         let VarKey::ZeroOffset { group, axis } = *key else {
-            return Ok(());
+            // Only a `V.G.NP` target resolves here; anything else is refused, never dropped.
+            return Err(DecodeError::new(
+                codes::UNSUPPORTED,
+                format!("{key}: not a zero offset"),
+            ));
         };
         let Some(i) = self.axis_slot(axis) else {
             return Err(DecodeError::new(
