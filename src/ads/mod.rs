@@ -33,4 +33,4 @@ pub use backend::{CncBackend, DeviceError};
 pub use frame::AmsAddr;
 pub use result::AdsResult;
 pub use server::{spawn, ServerConfig, ServerHandle};
-pub use slots::EVICT_QUIET;
+pub use slots::{EVICT_QUIET, FIRST_REQUEST_GRACE};

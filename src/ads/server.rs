@@ -25,7 +25,7 @@ use super::frame::{
 use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
-use super::slots::{Admission, Progress, Slots, EVICT_QUIET};
+use super::slots::{Admission, Progress, Slots, EVICT_QUIET, FIRST_REQUEST_GRACE};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
@@ -386,20 +386,27 @@ fn admit(shared: &Shared, stream: &TcpStream, peer: SocketAddr) -> Option<(u64, 
             id,
             progress,
             victim,
-            quiet,
+            why,
         } => {
             shared.evicted_log.log(format_args!(
-                "connection limit {} reached: {victim} (no request for {:.1} s) closed to serve {peer}",
+                "connection limit {} reached: {victim} ({why}) closed to serve {peer}",
                 shared.config.max_connections,
-                quiet.as_secs_f64()
             ));
             Some((id, progress))
         }
         Admission::Full => {
             shared.refused_log.log(format_args!(
-                "{peer}: connection limit {} reached (every connection made a request within {} s): connection closed",
+                "{peer}: connection limit {} reached (every connection made a request within {} s or connected within {} ms): connection closed",
                 shared.config.max_connections,
-                EVICT_QUIET.as_secs()
+                EVICT_QUIET.as_secs(),
+                FIRST_REQUEST_GRACE.as_millis()
+            ));
+            None
+        }
+        Admission::PeerFull(held) => {
+            shared.refused_log.log(format_args!(
+                "{peer}: its address already holds {held} of the {} connections (a quarter per remote address): connection closed",
+                shared.config.max_connections,
             ));
             None
         }

@@ -222,3 +222,55 @@ fn sixty_four_connections_that_make_no_progress_give_way_to_a_new_client() {
         let _ = t.join();
     }
 }
+
+/// Connections that connect and never send a byte, 60 a second (a port scanner, a crashed
+/// client's reconnect loop): a client that connects meanwhile and reads must still be served.
+/// A connection that has not completed a request within `ads::FIRST_REQUEST_GRACE` gives its
+/// slot up before any connection that has (docs/ads-limits.md, "Slots").
+#[test]
+fn connection_churn_that_never_sends_does_not_lock_out_a_client() {
+    const CHURN_PER_S: u64 = 60;
+    const PROBES: usize = 30;
+    let srv = Serve::start(&[]);
+    let addr = srv.addr();
+    let stop = Arc::new(Mutex::new(false));
+    let churn = {
+        let stop = Arc::clone(&stop);
+        std::thread::spawn(move || {
+            // Kept open (never a byte sent) until the end; the server closes those it evicts.
+            let mut held = Vec::new();
+            let start = Instant::now();
+            let mut n = 0u64;
+            while !*stop.lock().unwrap() && held.len() < 2_000 {
+                if let Ok(s) = std::net::TcpStream::connect(addr) {
+                    held.push(s);
+                }
+                n += 1;
+                let next = start + Duration::from_micros(n * 1_000_000 / CHURN_PER_S);
+                std::thread::sleep(next.saturating_duration_since(Instant::now()));
+            }
+            held.len()
+        })
+    };
+    // The table is full after a little over a second of churn (64 slots at 60 a second).
+    std::thread::sleep(Duration::from_millis(1_500));
+    let mut served = 0usize;
+    for _ in 0..PROBES {
+        if srv.connect().read_tick().is_some() {
+            served += 1;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    *stop.lock().unwrap() = true;
+    let churned = churn.join().expect("churn thread");
+    println!(
+        "CHURN: {churned} connections at {CHURN_PER_S}/s that never sent a byte; {served} of {PROBES} probes served"
+    );
+    assert!(
+        served >= PROBES * 9 / 10,
+        "only {served} of {PROBES} probes served under churn\n{}",
+        srv.log()
+    );
+    let log = srv.log_once_it_says("closed to serve");
+    assert!(log.contains("no request since it connected"), "{log}");
+}
