@@ -6,6 +6,7 @@ use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters_backend::{BackendColor, BackendCoord, BackendStyle, DrawingErrorKind};
 use thiserror::Error;
 
 /// DejaVu Sans cut to Latin-1 and the plots' symbols (assets/fonts/LICENSE-DejaVu.txt): the
@@ -96,13 +97,77 @@ pub(crate) fn encode(picture: &impl Picture, format: Format) -> Result<Vec<u8>, 
             let (w, h) = size;
             let mut rgb = vec![0u8; w as usize * h as usize * 3];
             {
-                let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                let root =
+                    RowsLeftToRight(BitMapBackend::with_buffer(&mut rgb, size)).into_drawing_area();
                 picture.draw(&root).map_err(draw_err)?;
                 root.present()
                     .map_err(|e| PictureError::Draw(e.to_string()))?;
             }
             png_of(&rgb, size)
         }
+    }
+}
+
+/// The bitmap backend with its horizontal lines drawn from left to right. plotters-bitmap
+/// 0.3.7's `draw_line` fills a one-pixel-high line from `from` to `to + 1`, which leaves out
+/// both ends of a line drawn right to left and all of one that is a pixel long: a tool path
+/// traced leftwards at about a pixel a sample came out as a row of dots in a PNG (its SVG was
+/// a clean line). Everything else is the bitmap backend's own.
+struct RowsLeftToRight<'a>(BitMapBackend<'a>);
+
+impl DrawingBackend for RowsLeftToRight<'_> {
+    type ErrorType = <BitMapBackend<'static> as DrawingBackend>::ErrorType;
+
+    fn get_size(&self) -> (u32, u32) {
+        self.0.get_size()
+    }
+
+    fn ensure_prepared(&mut self) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.0.ensure_prepared()
+    }
+
+    fn present(&mut self) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.0.present()
+    }
+
+    fn draw_pixel(
+        &mut self,
+        point: BackendCoord,
+        color: BackendColor,
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.0.draw_pixel(point, color)
+    }
+
+    fn draw_line<S: BackendStyle>(
+        &mut self,
+        from: BackendCoord,
+        to: BackendCoord,
+        style: &S,
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        if from.1 == to.1 && to.0 < from.0 {
+            self.0.draw_line(to, from, style)
+        } else {
+            self.0.draw_line(from, to, style)
+        }
+    }
+
+    fn draw_rect<S: BackendStyle>(
+        &mut self,
+        upper_left: BackendCoord,
+        bottom_right: BackendCoord,
+        style: &S,
+        fill: bool,
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.0.draw_rect(upper_left, bottom_right, style, fill)
+    }
+
+    fn blit_bitmap(
+        &mut self,
+        pos: BackendCoord,
+        size: (u32, u32),
+        src: &[u8],
+    ) -> Result<(), DrawingErrorKind<Self::ErrorType>> {
+        self.0.blit_bitmap(pos, size, src)
     }
 }
 

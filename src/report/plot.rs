@@ -328,4 +328,41 @@ mod tests {
         let reader = dec.read_info().unwrap();
         assert_eq!((reader.info().width, reader.info().height), (WIDTH, HEIGHT));
     }
+
+    /// Pixels of the tool path's colour in the PNG of a straight line along X at about a
+    /// pixel a sample, traced from `from_x` to `to_x` (mm).
+    fn path_pixels_of_line(from_x: f64, to_x: f64) -> usize {
+        let mut t = Trace::new(2000);
+        for k in 0..=1000 {
+            let x = from_x + (to_x - from_x) * f64::from(k) / 1000.0;
+            t.record(sample(f64::from(k), [x, 5.0, 1.0]));
+        }
+        let png = encode(
+            &RunPlot {
+                trace: &t,
+                title: "t",
+            },
+            Format::Png,
+        )
+        .unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        let mut rgb = vec![0; reader.output_buffer_size()];
+        reader.next_frame(&mut rgb).unwrap();
+        rgb.chunks_exact(3)
+            .filter(|p| *p == [PATH.0, PATH.1, PATH.2])
+            .count()
+    }
+
+    #[test]
+    fn png_draws_a_path_traced_leftwards_as_a_line_not_dots() {
+        let rightwards = path_pixels_of_line(0.0, 150.0);
+        let leftwards = path_pixels_of_line(150.0, 0.0);
+        assert!(rightwards > 500, "{rightwards} path pixels");
+        assert!(
+            leftwards.abs_diff(rightwards) <= rightwards / 50,
+            "leftwards {leftwards} path pixels, rightwards {rightwards}"
+        );
+    }
 }
