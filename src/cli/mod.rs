@@ -63,8 +63,8 @@ pub enum Command {
     Init(init::InitArgs),
     /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(manual::CompletionsArgs),
-    /// Print the man page (roff).
-    Man,
+    /// Print a man page (roff): the main one, a subcommand's, or write them all (`--dir`).
+    Man(manual::ManArgs),
     /// Run one program on a channel, optionally streamed by the built-in feeder.
     Run(run::RunArgs),
     /// Serve the channels over ADS/TCP in real time.
@@ -86,7 +86,7 @@ impl Cli {
             Some(Command::Check(args)) => check::execute(args),
             Some(Command::Init(args)) => init::execute(args),
             Some(Command::Completions(args)) => manual::completions(args),
-            Some(Command::Man) => manual::man(),
+            Some(Command::Man(args)) => manual::man(args),
             Some(Command::Receive(args)) => receive::execute(args),
             Some(Command::Run(args)) => run::execute(args),
             Some(Command::Serve(args)) => serve::execute(args),

@@ -243,4 +243,29 @@ fn completions_and_man_page_come_from_the_binary() {
         ncchannel(&["completions", "nosuchshell"]).status.code(),
         Some(2)
     );
+    // A subcommand's page carries its options.
+    let out = ncchannel(&["man", "run"]);
+    assert_eq!(out.status.code(), Some(0));
+    let run = text(&out.stdout);
+    assert!(
+        run.contains(".TH ncchannel-run 1") && run.contains("\\-\\-plot"),
+        "{run}"
+    );
+    assert_eq!(ncchannel(&["man", "nosuchcommand"]).status.code(), Some(2));
+    // --dir writes every page the main page names, each with its options.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = ncchannel(&["man", "--dir", &dir.path().display().to_string()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let named: Vec<String> = man
+        .lines()
+        .filter_map(|l| l.strip_prefix("ncchannel\\-"))
+        .filter_map(|l| l.strip_suffix("(1)"))
+        .map(|sub| format!("ncchannel-{}.1", sub.replace("\\-", "-")))
+        .collect();
+    assert!(named.len() >= 10, "{named:?}");
+    for page in &named {
+        let body = std::fs::read_to_string(dir.path().join(page))
+            .unwrap_or_else(|e| panic!("{page} named by the main page: {e}"));
+        assert!(body.contains(".SH OPTIONS"), "{page}: {body}");
+    }
 }
