@@ -5,5 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    ncchannel::cli::Cli::parse().execute()
+    let code = ncchannel::cli::Cli::parse().execute();
+    ncchannel::params::shipped::remove_private_copy();
+    code
 }

@@ -132,11 +132,34 @@ fn cache_root() -> PathBuf {
 
 /// The cached copy of the set, written on first use. Concurrent first uses each write a
 /// private copy and move it into place; the loser of the race removes its own and reads the
-/// winner's, so no process ever reads a half-written set.
+/// winner's, so no process ever reads a half-written set. When the cache folder cannot be
+/// written (a read-only home, a container without one), the set is written into a private
+/// temporary folder for this process instead ([`private_copy`]), with one line that says so.
 pub fn cached() -> Result<PathBuf, ShippedError> {
+    if let Some(dir) = PRIVATE_COPY
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .as_ref()
+    {
+        return Ok(dir.path().to_path_buf());
+    }
     let root = cache_root();
+    match write_cache(&root) {
+        Ok(root) => Ok(root),
+        Err(e) => {
+            let copy = private_copy()?;
+            log::warn!(
+                "{e}: the cache folder cannot be written; the set built into ncchannel is read from a private copy for this run ({}), removed at exit",
+                copy.display()
+            );
+            Ok(copy)
+        }
+    }
+}
+
+fn write_cache(root: &Path) -> Result<PathBuf, ShippedError> {
     if root.is_dir() {
-        return Ok(root);
+        return Ok(root.to_path_buf());
     }
     let parent = root.parent().unwrap_or(Path::new("."));
     fs::create_dir_all(parent).map_err(io_at(parent))?;
@@ -146,16 +169,46 @@ pub fn cached() -> Result<PathBuf, ShippedError> {
         .map_err(io_at(parent))?;
     write_set(staging.path())?;
     let staged = staging.keep();
-    if let Err(e) = fs::rename(&staged, &root) {
+    if let Err(e) = fs::rename(&staged, root) {
         let _ = fs::remove_dir_all(&staged);
         if !root.is_dir() {
             return Err(ShippedError::Io {
-                path: root,
+                path: root.to_path_buf(),
                 source: e,
             });
         }
     }
-    Ok(root)
+    Ok(root.to_path_buf())
+}
+
+/// The process's own copy of the set when the cache cannot be written: a new folder in the
+/// temporary folder, readable by this user only (`tempfile`), written once per process and
+/// removed by [`remove_private_copy`] when the command ends.
+static PRIVATE_COPY: std::sync::Mutex<Option<tempfile::TempDir>> = std::sync::Mutex::new(None);
+
+fn private_copy() -> Result<PathBuf, ShippedError> {
+    let mut held = PRIVATE_COPY.lock().unwrap_or_else(|p| p.into_inner());
+    if let Some(dir) = held.as_ref() {
+        return Ok(dir.path().to_path_buf());
+    }
+    let tmp = std::env::temp_dir();
+    let dir = tempfile::Builder::new()
+        .prefix("ncchannel-set-")
+        .tempdir_in(&tmp)
+        .map_err(io_at(&tmp))?;
+    write_set(dir.path())?;
+    let path = dir.path().to_path_buf();
+    *held = Some(dir);
+    Ok(path)
+}
+
+/// Remove the private copy of the set, if this process wrote one (the command has ended).
+pub fn remove_private_copy() {
+    let taken = PRIVATE_COPY
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .take();
+    drop(taken);
 }
 
 /// Whether `rel` (like `params/soak/stream_resets.toml` or `nc/demo.nc`) is a file of the set.

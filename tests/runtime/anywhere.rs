@@ -131,3 +131,32 @@ fn a_shipped_soak_scenario_runs_outside_a_clone() {
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}\n{err}");
 }
+
+#[test]
+fn an_unwritable_cache_folder_reads_the_set_from_a_private_copy_removed_at_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    // A cache folder under a regular file cannot be created, whoever runs the test.
+    std::fs::write(dir.path().join("file"), "").unwrap();
+    let tmp = dir.path().join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .current_dir(dir.path())
+        .env("XDG_CACHE_HOME", dir.path().join("file/cache"))
+        .env("TMPDIR", &tmp)
+        .env_remove("NCCHANNEL_PARAMS")
+        .output()
+        .expect("ncchannel starts");
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}\n{err}");
+    assert!(out.contains("outcome:    program ended"), "{out}");
+    assert_eq!(
+        err.matches("the cache folder cannot be written").count(),
+        1,
+        "said once: {err}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&tmp).unwrap().count(),
+        0,
+        "the private copy is removed at exit"
+    );
+}
