@@ -131,41 +131,66 @@ fn locate_files(args: &mut RunArgs) -> Result<(), String> {
         args.stream = Some(locate(s).map_err(|e| e.to_string())?);
     }
     if let Some(p) = &args.program {
-        let path = Path::new(p);
-        let as_path = program_path(p).is_some();
-        if as_path || path.is_file() {
-            let found = locate(path).map_err(|e| e.to_string())?;
-            if !found.is_file() {
-                return Err(format!("{p}: no such program file"));
-            }
-            let shown = if found.is_absolute() || as_path {
-                found
-            } else {
-                Path::new(".").join(found)
-            };
-            args.program = Some(shown.to_string_lossy().into_owned());
-        }
+        args.program = Some(locate_program(p)?);
     }
     Ok(())
+}
+
+/// A PROGRAM argument as `run` and `serve --start` take it: a file of the current folder is
+/// taken as a path (`far.nc` → `./far.nc`); one written as a path is looked up (in the
+/// current folder, else the set built into the binary) and must exist; a name is kept for the
+/// channel's search paths.
+pub(crate) fn locate_program(p: &str) -> Result<String, String> {
+    let path = Path::new(p);
+    let as_path = program_path(p).is_some();
+    if !(as_path || path.is_file()) {
+        return Ok(p.to_string());
+    }
+    let found = crate::params::shipped::locate(path).map_err(|e| e.to_string())?;
+    if !found.is_file() {
+        return Err(format!("{p}: no such program file"));
+    }
+    let shown = if found.is_absolute() || as_path {
+        found
+    } else {
+        Path::new(".").join(found)
+    };
+    Ok(shown.to_string_lossy().into_owned())
+}
+
+/// The name channel `ch` (0-based) starts `program` by: a path's folder goes first into the
+/// channel's search paths and the program is started by its file name; a name is kept.
+pub(crate) fn program_by_path(
+    config: &mut crate::params::Config,
+    ch: usize,
+    program: &str,
+    origin: &str,
+) -> String {
+    match program_path(program) {
+        Some((dir, name)) => {
+            search_first(config, ch, dir, origin);
+            name
+        }
+        None => program.to_string(),
+    }
 }
 
 /// A PROGRAM given by name must be found through the channel's search paths (or be its
 /// streaming program): otherwise a usage error (exit 2) names the folders searched, instead
 /// of a channel error with a summary of zeros.
-fn program_exists(
+pub(crate) fn program_exists(
     channels: &[crate::channel::Channel],
-    args: &RunArgs,
+    channel: u32,
     program: &str,
 ) -> Result<(), String> {
-    let Some(c) = channels.get((args.channel as usize).wrapping_sub(1)) else {
+    let Some(c) = channels.get((channel as usize).wrapping_sub(1)) else {
         return Ok(());
     };
     let Err(dirs) = c.find_program(program) else {
         return Ok(());
     };
     Err(format!(
-        "program {program} not found in the current folder nor in channel {}'s search paths ({})",
-        args.channel,
+        "program {program} not found in the current folder nor in channel {channel}'s search paths ({})",
         dirs.join(", ")
     ))
 }
@@ -308,7 +333,7 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
         Ok(p) => p,
         Err(msg) => return usage(msg),
     };
-    if let Err(msg) = program_exists(&channels, &args, &program) {
+    if let Err(msg) = program_exists(&channels, args.channel, &program) {
         return usage(msg);
     }
     let feeder = match open_feeder(&args) {

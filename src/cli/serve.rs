@@ -32,7 +32,9 @@ pub struct ServeArgs {
     /// This device's AMS NetId (default: runtime.toml `ads.net_id`).
     #[arg(long)]
     pub net_id: Option<AmsNetId>,
-    /// Start this program on channel 1 when the channel is up.
+    /// Start this program on channel 1 at the first tick: a file of the current folder by its
+    /// path, else a name through channel 1's search paths, as `run PROGRAM`; one found nowhere
+    /// is a usage error (exit 2), a start the channel refuses exits 1.
     #[arg(long)]
     pub start: Option<String>,
     /// Event log (JSON Lines): a file, or - for standard output.
@@ -135,11 +137,34 @@ fn event_log(target: Option<&str>, soak: bool) -> Result<EventLog, ExitCode> {
     }
 }
 
-/// `--start`: channel 1 runs `program` from the first tick; a refusal is reported, not fatal.
-fn start(machine: &mut Machine, period: Duration, program: &str) {
-    if let Err(e) = start_at_first_tick(machine, period, program) {
-        say(format_args!("ncchannel serve: --start {program}: {e}"));
+/// The served channels, and the program `--start` names as channel 1 starts it. `--start`
+/// resolves as `run PROGRAM` does: a file of the current folder by its path, a name through
+/// channel 1's search paths; one found nowhere is a usage error.
+fn load_with_start(
+    args: &ServeArgs,
+    events: bool,
+    loader: &crate::source::loader::Loader,
+) -> Result<
+    (
+        crate::params::Config,
+        Vec<crate::channel::Channel>,
+        Option<String>,
+    ),
+    String,
+> {
+    let start = match args.start.as_deref().map(super::run::locate_program) {
+        None => None,
+        Some(Ok(p)) => Some(p),
+        Some(Err(msg)) => return Err(format!("--start {msg}")),
+    };
+    let mut config = super::run::load_config(&args.params)?;
+    let start =
+        start.map(|p| super::run::program_by_path(&mut config, 0, &p, "ncchannel serve --start"));
+    let channels = crate::setup::channels(&config, events, loader).map_err(|e| e.to_string())?;
+    if let Some(p) = &start {
+        super::run::program_exists(&channels, 1, p).map_err(|msg| format!("--start {msg}"))?;
     }
+    Ok((config, channels, start))
 }
 
 /// Channel 1 starts `program` before the runtime's first tick (`serve --start`, the live-view
@@ -217,14 +242,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // The program loader of the served channels: large program files are read, and large
     // texts freed, off the runtime thread.
     let loader = crate::source::loader::Loader::start();
-    let (config, channels) = match super::run::load_channels(
-        &args.params,
-        args.events.is_some() || scenario.is_some(),
-        &loader,
-    ) {
-        Ok(c) => c,
-        Err(msg) => return usage(msg),
-    };
+    let (config, channels, start) =
+        match load_with_start(&args, args.events.is_some() || scenario.is_some(), &loader) {
+            Ok(c) => c,
+            Err(msg) => return usage(msg),
+        };
     let log = match event_log(args.events.as_deref(), scenario.is_some()) {
         Ok(l) => l,
         Err(code) => return code,
@@ -235,8 +257,11 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     if let Err(msg) = super::run::attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
         return usage(msg);
     }
-    if let Some(p) = &args.start {
-        start(&mut machine, period, p);
+    if let Some(p) = &start {
+        if let Err(e) = start_at_first_tick(&mut machine, period, p) {
+            say(format_args!("ncchannel serve: --start {p}: {e}"));
+            return ExitCode::from(super::exit::CHANNEL_ERROR);
+        }
     }
     if let Some(sc) = scenario {
         let cycle = supervised(machine, &sc, &config);

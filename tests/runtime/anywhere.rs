@@ -160,3 +160,70 @@ fn an_unwritable_cache_folder_reads_the_set_from_a_private_copy_removed_at_exit(
         "the private copy is removed at exit"
     );
 }
+
+/// `serve` in `cwd` until it exits, its standard output says `until`, or 30 s pass (then it
+/// is killed): exit code, whether it exited by itself, stdout and stderr.
+fn serve_until(cwd: &Path, args: &[&str], until: &str) -> (Option<i32>, bool, String, String) {
+    use std::io::Read;
+    use std::sync::{Arc, Mutex};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args(["serve", "--bind", "127.0.0.1:0"])
+        .args(args)
+        .current_dir(cwd)
+        .env("XDG_CACHE_HOME", cwd.join("cache"))
+        .env_remove("NCCHANNEL_PARAMS")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("serve starts");
+    let collect = |mut r: Box<dyn Read + Send>| {
+        let text = Arc::new(Mutex::new(String::new()));
+        let sink = Arc::clone(&text);
+        let reader = std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n @ 1..) = r.read(&mut buf) {
+                sink.lock()
+                    .unwrap()
+                    .push_str(&String::from_utf8_lossy(&buf[..n]));
+            }
+        });
+        (text, reader)
+    };
+    let (out, out_reader) = collect(Box::new(child.stdout.take().expect("stdout")));
+    let (err, err_reader) = collect(Box::new(child.stderr.take().expect("stderr")));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    let exited = loop {
+        if child.try_wait().expect("try_wait").is_some() {
+            break true;
+        }
+        if out.lock().unwrap().contains(until) || std::time::Instant::now() >= deadline {
+            let _ = child.kill();
+            break false;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let status = child.wait().expect("wait");
+    let _ = (out_reader.join(), err_reader.join());
+    let text = |t: &Arc<Mutex<String>>| t.lock().unwrap().clone();
+    (status.code(), exited, text(&out), text(&err))
+}
+
+#[test]
+fn serve_start_finds_a_program_of_the_current_folder_and_fails_on_one_found_nowhere() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("part.nc"), "G01 X12.5 F1000\nM30\n").unwrap();
+    // Found as `run part.nc` finds it: its blocks run (the server runs on until killed).
+    let end = r#""ev":"program_end","prog":"part.nc","end":"M30""#;
+    let (_, exited, out, err) =
+        serve_until(dir.path(), &["--start", "part.nc", "--events", "-"], end);
+    assert!(!exited, "serve runs on: {err}");
+    assert!(out.contains(end), "{out}\n{err}");
+    // Found nowhere: a usage error at once, not a server with its channel in ERROR.
+    let (code, exited, _, err) = serve_until(dir.path(), &["--start", "nosuch.nc"], "never");
+    assert!(exited, "serve exits: {err}");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("nosuch.nc not found in the current folder"),
+        "{err}"
+    );
+}
