@@ -46,7 +46,7 @@ use super::symbols::{
 use crate::channel::techno::{
     TechnoStatus, TechnoWrite, Unit as TechnoUnit, UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS,
 };
-use crate::vocab::mode::Mode;
+use crate::vocab::mode::{Mode, State};
 
 pub const PORT: u16 = 851;
 pub(crate) const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
@@ -789,10 +789,19 @@ impl Hli {
         let b = &self.backend;
         let before = b.status(ch).ok();
         let r = (|| {
-            let mode = b.status(ch)?.mode;
+            let st = b.status(ch)?;
+            let mode = st.mode;
             let target = if to_mode == 0 { mode as u32 } else { to_mode };
             if target == Mode::Mdi as u32 && !program.is_empty() {
                 return Err(DeviceError::NotReady);
+            }
+            // To STANDBY is the way out of a running program or ERROR (TwinSharp
+            // `OperationModeManager.Reset()` commands STANDBY, then the old mode): the channel
+            // is reset first, then it changes mode.
+            if to_mode == Mode::Standby as u32
+                && matches!(st.state, State::Active | State::Hold | State::Error)
+            {
+                b.command(ch, Op::Reset)?;
             }
             if to_mode != 0 && to_mode != mode as u32 {
                 b.command(ch, Op::CommandMode(to_mode as i32))?;
@@ -825,6 +834,24 @@ impl Hli {
         }
         img.memory()[areas.command_semaphore][0] = 0;
         // Shown at once when the PLC has taken the last record (else on its next read).
+        let _ = self.post_error(img, ch);
+    }
+
+    /// A mode or state command of channel `ch` that the HMI gave through COM was refused by
+    /// its mode and state: 270061 waits for `mc_error` as one the PLC's own command posts.
+    /// Nothing when no PLC client has read the HLI yet (no one to take the record).
+    pub(crate) fn note_refusal(&self, ch: u16) {
+        let Some(img) = self.image.get() else { return };
+        let Some(i) = usize::from(ch).checked_sub(1) else {
+            return;
+        };
+        {
+            let mut refused = img.refused.lock().unwrap_or_else(|p| p.into_inner());
+            match refused.get_mut(i) {
+                Some(q) if q.len() < MAX_REFUSALS_WAITING => q.push_back(REFUSED_TRANSITION_ERROR),
+                _ => return,
+            }
+        }
         let _ = self.post_error(img, ch);
     }
 
@@ -1352,9 +1379,9 @@ mod tests {
             hli.read(GROUP_VALUE_BY_HANDLE, id, 4).unwrap(),
             REFUSED_TRANSITION_ERROR.to_le_bytes()
         );
-        // STANDBY/SELECTED: refused by the channel as a whole (the mode stays); posted after
+        // MANUAL/ACTIVE: refused by the channel as a whole (the mode stays); posted after
         // the PLC took the first.
-        command(&hli, Mode::Standby as u32, State::Selected as u32, "");
+        command(&hli, Mode::Manual as u32, State::Active as u32, "");
         assert_eq!(
             mode_state(b),
             (Mode::Automatic, State::Ready),
