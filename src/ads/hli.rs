@@ -32,6 +32,7 @@
 //! client that never releases cannot exhaust anything.
 
 use std::collections::{HashMap, VecDeque};
+use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 use super::backend::{CncBackend, DeviceError, Op, Reply};
@@ -43,6 +44,7 @@ use super::symbols::{
     GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
     GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
 };
+use super::system;
 use crate::channel::techno::{
     TechnoStatus, TechnoWrite, Unit as TechnoUnit, UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS,
 };
@@ -174,6 +176,8 @@ struct Image {
     by_name: HashMap<String, usize>,
     roles: Vec<Role>,
     memory: Mutex<Vec<Vec<u8>>>,
+    /// The memory as built (constants set, everything else zero): what a PLC reset restores.
+    initial: Vec<Vec<u8>>,
     channels: Vec<ChannelAreas>,
     /// Per channel: errors handed to the PLC so far.
     posted: Mutex<Vec<u64>>,
@@ -566,6 +570,7 @@ impl Image {
                 by_name: HashMap::new(),
                 roles: Vec::new(),
                 memory: Mutex::new(Vec::new()),
+                initial: Vec::new(),
                 channels: Vec::new(),
                 posted: Mutex::new(vec![0; axes_per_channel.len()]),
                 refused: Mutex::new(vec![VecDeque::new(); axes_per_channel.len()]),
@@ -585,6 +590,8 @@ impl Image {
         for a in 0..axes_per_channel.iter().sum::<usize>() {
             b.axis(a);
         }
+        let initial = b.img.memory().clone();
+        b.img.initial = initial;
         b.img
     }
 
@@ -604,6 +611,8 @@ impl Image {
 /// The HLI of one server: built on first use from the channels the backend has.
 pub struct Hli {
     backend: Arc<dyn CncBackend>,
+    /// The PLC runtime's ADS state: RUN, or STOP after WriteControl STOP or RESET.
+    state: AtomicU16,
     image: OnceLock<Image>,
     uploads: OnceLock<Uploads>,
 }
@@ -619,8 +628,63 @@ impl Hli {
     pub fn new(backend: Arc<dyn CncBackend>) -> Self {
         Hli {
             backend,
+            state: AtomicU16::new(system::state::RUN),
             image: OnceLock::new(),
             uploads: OnceLock::new(),
+        }
+    }
+
+    /// The PLC runtime's ADS state (ReadState and 0xF100 on port 851).
+    pub(crate) fn ads_state(&self) -> u16 {
+        self.state.load(Ordering::SeqCst)
+    }
+
+    /// WriteControl on port 851 (ads-client `startPlc`/`stopPlc`/`resetPlc`, pyads
+    /// `write_control`): RUN starts, STOP stops, RESET puts every variable back to its
+    /// initial value and leaves the runtime in STOP, as a TwinCAT PLC reset does. The
+    /// symbols stay readable and writable in STOP (as a TwinCAT PLC's are); the channels
+    /// keep running. 0x706 for any other state.
+    pub(crate) fn control(&self, ads_state: u16) -> Result<(), AdsResult> {
+        match ads_state {
+            system::state::RUN | system::state::STOP => {}
+            system::state::RESET => self.reinitialise(),
+            _ => return Err(AdsResult::INVALID_DATA),
+        }
+        let next = if ads_state == system::state::RUN {
+            system::state::RUN
+        } else {
+            system::state::STOP
+        };
+        self.state.store(next, Ordering::SeqCst);
+        Ok(())
+    }
+
+    /// The system restarted: the runtime starts afresh (variables initial) in RUN.
+    pub(crate) fn restart(&self) {
+        self.reinitialise();
+        self.state.store(system::state::RUN, Ordering::SeqCst);
+    }
+
+    /// Every variable back to its initial value; refusals waiting for `mc_error` and HMI
+    /// requests half written are dropped with them. Errors already handed over stay so.
+    fn reinitialise(&self) {
+        let Some(img) = self.image.get() else { return };
+        img.memory().clone_from(&img.initial);
+        for q in img
+            .refused
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter_mut()
+        {
+            q.clear();
+        }
+        for p in img
+            .pending
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter_mut()
+        {
+            *p = PendingRequest::default();
         }
     }
 
@@ -1047,7 +1111,7 @@ impl Hli {
         match group {
             GROUP_VALUE_BY_HANDLE => self.read_symbol(self.symbol_by_handle(offset)?, length),
             GROUP_SYMBOL_VERSION => symbols::symbol_version(length),
-            GROUP_DEVICE_DATA => symbols::device_data(offset, length),
+            GROUP_DEVICE_DATA => symbols::device_data(self.ads_state(), offset, length),
             GROUP_UPLOAD_INFO => symbols::fit(self.uploads()?.info.v1(), length),
             GROUP_UPLOAD_INFO2 => self.uploads()?.info.for_length(length),
             GROUP_SYMBOL_UPLOAD => symbols::fit(self.uploads()?.symbols.clone(), length),

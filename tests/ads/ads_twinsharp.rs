@@ -413,8 +413,12 @@ fn twinsharp_reset_stops_a_running_program() {
     assert_eq!(posted_errors(&plc), [270_061]);
 
     let mut mode = [0u8; 4];
-    plc.read_exact(0xF005, handle(&plc, &format!("{ms}.state_r.mode")), &mut mode)
-        .unwrap();
+    plc.read_exact(
+        0xF005,
+        handle(&plc, &format!("{ms}.state_r.mode")),
+        &mut mode,
+    )
+    .unwrap();
     set_mode_and_state(&plc, ms, 1, 2);
     assert_eq!(mode_state(&plc, ms), (1, 3), "STANDBY / READY: stopped");
     set_mode_and_state(&plc, ms, u32_of(&mode), 2);
