@@ -70,10 +70,7 @@ fn node_ads_client_controls_the_ads_states_and_reads_every_symbol_level() {
         "/tests/node/ads_client_control_test.js"
     );
     let (seen, _events) = common::run_client(served, &node, script, &[]);
-    assert_eq!(
-        seen["extended"],
-        serde_json::json!(["Run", 0, 3, 1, 4024])
-    );
+    assert_eq!(seen["extended"], serde_json::json!(["Run", 0, 3, 1, 4024]));
     assert_eq!(seen["kopf_fields"], 21, "HLI_ERROR_SATZ_KOPF's members");
     assert_eq!(seen["mode_and_state"], serde_json::json!([665, 2, 3]));
     assert_eq!(

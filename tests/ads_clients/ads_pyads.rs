@@ -130,7 +130,10 @@ fn pyads_controls_the_ads_states_and_reaches_every_symbol_level() {
         "/tests/python/control_with_pyads.py"
     );
     let (seen, _events) = common::run_client(served, &python, script, &[]);
-    assert_eq!(seen["kopf"], serde_json::json!(["HLI_ERROR_SATZ_KOPF", 104]));
+    assert_eq!(
+        seen["kopf"],
+        serde_json::json!(["HLI_ERROR_SATZ_KOPF", 104])
+    );
     assert_eq!(
         seen["mode_and_state"],
         serde_json::json!(["ARRAY [0..664] OF BYTE", 665])
