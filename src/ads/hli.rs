@@ -40,11 +40,10 @@ use super::description::{Access, AdsType, ObjectInfo};
 use super::plc_types::DataType;
 use super::result::AdsResult;
 use super::symbols::{
-    self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_LOCATION_BY_NAME,
-    GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
-    GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
+    self, ads_state, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA,
+    GROUP_LOCATION_BY_NAME, GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME,
+    GROUP_TYPE_UPLOAD, GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
 };
-use super::system;
 use crate::channel::techno::{
     TechnoStatus, TechnoWrite, Unit as TechnoUnit, UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS,
 };
@@ -752,7 +751,7 @@ impl Hli {
     pub fn new(backend: Arc<dyn CncBackend>) -> Self {
         Hli {
             backend,
-            state: AtomicU16::new(system::state::RUN),
+            state: AtomicU16::new(ads_state::RUN),
             image: OnceLock::new(),
             uploads: OnceLock::new(),
         }
@@ -770,14 +769,14 @@ impl Hli {
     /// keep running. 0x706 for any other state.
     pub(crate) fn control(&self, ads_state: u16) -> Result<(), AdsResult> {
         match ads_state {
-            system::state::RUN | system::state::STOP => {}
-            system::state::RESET => self.reinitialise(),
+            ads_state::RUN | ads_state::STOP => {}
+            ads_state::RESET => self.reinitialise(),
             _ => return Err(AdsResult::INVALID_DATA),
         }
-        let next = if ads_state == system::state::RUN {
-            system::state::RUN
+        let next = if ads_state == ads_state::RUN {
+            ads_state::RUN
         } else {
-            system::state::STOP
+            ads_state::STOP
         };
         self.state.store(next, Ordering::SeqCst);
         Ok(())
@@ -786,7 +785,7 @@ impl Hli {
     /// The system restarted: the runtime starts afresh (variables initial) in RUN.
     pub(crate) fn restart(&self) {
         self.reinitialise();
-        self.state.store(system::state::RUN, Ordering::SeqCst);
+        self.state.store(ads_state::RUN, Ordering::SeqCst);
     }
 
     /// Every variable back to its initial value; refusals waiting for `mc_error` and HMI

@@ -25,6 +25,15 @@ pub(crate) const GROUP_LOCATION_BY_NAME: u32 = 0xF007;
 pub(crate) const GROUP_TYPE_BY_NAME: u32 = 0xF011;
 /// 0xF100: ADS state (u16) and device state (u16) of the runtime, as ReadState answers.
 pub(crate) const GROUP_DEVICE_DATA: u32 = 0xF100;
+/// ADS states (`ADSSTATE_*`, Beckhoff AdsLib `AdsDef.h`): what ReadState and 0xF100 answer
+/// and WriteControl asks for (the system service's are in [`super::system`]).
+pub(crate) mod ads_state {
+    pub const RESET: u16 = 2;
+    pub const RUN: u16 = 5;
+    pub const STOP: u16 = 6;
+    pub const CONFIG: u16 = 15;
+    pub const RECONFIG: u16 = 16;
+}
 /// The symbol version served: the HLI's symbols are fixed while the server runs.
 const SYMBOL_VERSION: u8 = 1;
 /// Code page of STRING data and names in upload info 3: Windows-1252 (the HLI's names and

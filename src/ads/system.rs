@@ -17,14 +17,7 @@ use super::result::AdsResult;
 /// AMS port of the TwinCAT system service.
 pub const PORT: u16 = 10000;
 
-/// ADS states (`ADSSTATE_*`).
-pub(crate) mod state {
-    pub const RESET: u16 = 2;
-    pub const RUN: u16 = 5;
-    pub const STOP: u16 = 6;
-    pub const CONFIG: u16 = 15;
-    pub const RECONFIG: u16 = 16;
-}
+pub(crate) use super::symbols::ads_state as state;
 
 /// Index group of the system service's extended state (ads-client
 /// `readTcSystemExtendedState`: `readRaw(240, 0, 16)`).
