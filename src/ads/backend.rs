@@ -14,7 +14,7 @@ pub use crate::machine::{HmiOp, Op, Reply, Status};
 impl From<DeviceError> for AdsResult {
     fn from(e: DeviceError) -> Self {
         match e {
-            DeviceError::NotReady => AdsResult::NOT_READY,
+            DeviceError::NotReady | DeviceError::Refused => AdsResult::NOT_READY,
             DeviceError::Busy => AdsResult::BUSY,
             DeviceError::InvalidValue => AdsResult::INVALID_DATA,
             DeviceError::NotFound => AdsResult::NOT_FOUND,

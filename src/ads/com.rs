@@ -964,14 +964,14 @@ fn write_mcm(
             let m = i32_arg(data)?;
             match hli.redirect(ch, HmiRequest::ToMode(m)) {
                 Some(r) => r,
-                None => unit(backend.command(ch, Op::CommandMode(m))),
+                None => refused(hli, ch, backend.command(ch, Op::CommandMode(m))),
             }
         }
         Field::McmToState => {
             let s = i32_arg(data)?;
             match hli.redirect(ch, HmiRequest::ToState(s)) {
                 Some(r) => r,
-                None => unit(backend.command(ch, Op::CommandState(s))),
+                None => refused(hli, ch, backend.command(ch, Op::CommandState(s))),
             }
         }
         Field::McmFromMode | Field::McmFromState => {
@@ -997,8 +997,18 @@ fn write_mcm(
     }
 }
 
+/// A mode or state command's result; one the channel's mode and state do not allow also
+/// posts the kernel's 270061 in the PLC's `mc_error` (as the kernel reports a refused
+/// transition whoever asked for it) and answers 0x707.
+fn refused(hli: &Hli, ch: u16, r: Result<(), DeviceError>) -> Result<(), AdsResult> {
+    if r == Err(DeviceError::Refused) {
+        hli.note_refusal(ch);
+    }
+    unit(r)
+}
+
 /// Write step: `mc_feedhold_channel_w`, one BOOL; the channel decides (a TRUE with no
-/// program running is 0x708, as a state command it cannot take now).
+/// program running is 0x707, a state command its state does not allow).
 fn write_feed_hold(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Result<(), AdsResult> {
     unit(backend.command(ch, Op::Hmi(HmiOp::FeedHold(bool_arg(data)?))))
 }

@@ -32,6 +32,7 @@
 //! client that never releases cannot exhaust anything.
 
 use std::collections::{HashMap, VecDeque};
+use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 use super::backend::{CncBackend, DeviceError, Op, Reply};
@@ -39,14 +40,14 @@ use super::description::{Access, AdsType, ObjectInfo};
 use super::plc_types::DataType;
 use super::result::AdsResult;
 use super::symbols::{
-    self, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA, GROUP_LOCATION_BY_NAME,
-    GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME, GROUP_TYPE_UPLOAD,
-    GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
+    self, ads_state, symbol_entry, SymbolInfo, UploadInfo, GROUP_DEVICE_DATA,
+    GROUP_LOCATION_BY_NAME, GROUP_SYMBOL_UPLOAD, GROUP_SYMBOL_VERSION, GROUP_TYPE_BY_NAME,
+    GROUP_TYPE_UPLOAD, GROUP_UPLOAD_INFO, GROUP_UPLOAD_INFO2,
 };
 use crate::channel::techno::{
     TechnoStatus, TechnoWrite, Unit as TechnoUnit, UnitSet, LATE_SYNC_UNITS, STD_SYNC_UNITS,
 };
-use crate::vocab::mode::Mode;
+use crate::vocab::mode::{Mode, State};
 
 pub const PORT: u16 = 851;
 pub(crate) const GROUP_HANDLE_BY_NAME: u32 = 0xF003;
@@ -141,7 +142,27 @@ struct Symbol {
     size: usize,
     ty: &'static str,
     adst: u32,
+    /// A level above the root areas (`…mode_and_state`, `gpCh[0]^`, `HLI_Global_Variables`):
+    /// the root areas below it, back to back; `root`, `at` and `ty` are then unused.
+    composite: Option<Composite>,
 }
+
+/// The root areas a level above them spans, in layout order, and its type's name.
+#[derive(Debug, Clone)]
+struct Composite {
+    parts: Vec<usize>,
+    ty: String,
+}
+
+impl Symbol {
+    fn type_name(&self) -> &str {
+        self.composite.as_ref().map_or(self.ty, |c| c.ty.as_str())
+    }
+}
+
+/// Levels inside one root's type named at most (the largest HLI type, an error record with
+/// its 838-byte body, has under a thousand).
+const MAX_LEVELS_PER_ROOT: usize = 4096;
 
 /// Per channel: where its control-unit areas are.
 #[derive(Debug, Clone, Copy, Default)]
@@ -171,9 +192,14 @@ impl ChannelAreas {
 /// The symbol table and its memory, built once the channels are known.
 struct Image {
     symbols: Vec<Symbol>,
+    /// The symbols the object map and the upload list (`symbols[..listed]`); the rest are
+    /// the levels [`Builder::derive`] names.
+    listed: usize,
     by_name: HashMap<String, usize>,
     roles: Vec<Role>,
     memory: Mutex<Vec<Vec<u8>>>,
+    /// The memory as built (constants set, everything else zero): what a PLC reset restores.
+    initial: Vec<Vec<u8>>,
     channels: Vec<ChannelAreas>,
     /// Per channel: errors handed to the PLC so far.
     posted: Mutex<Vec<u64>>,
@@ -240,7 +266,89 @@ impl Builder {
             size,
             ty,
             adst,
+            composite: None,
         });
+    }
+
+    /// Name every level of the type tree the listed symbols leave out, after them (their
+    /// handles stay): inside a root, each member and array element its type has
+    /// (`…mc_error.satz_r.kopf`, `…rumpf[5]`), a window of the root; above the roots, each
+    /// prefix of their names at a `.` or `[` (`…mode_and_state`, `…gpCh[0]^`,
+    /// `HLI_Global_Variables`), the roots below it back to back. A pointer array's own
+    /// levels (`gpCh`, `gpCh[0]`: addresses in a PLC) are not named: `gpCh[0]^` is.
+    fn derive(&mut self) {
+        let listed = self.img.symbols.len();
+        // Each root's own symbol: the first one naming it.
+        let mut seen = vec![false; self.img.roles.len()];
+        let roots: Vec<usize> = (0..listed)
+            .filter(|&i| !std::mem::replace(&mut seen[self.img.symbols[i].root], true))
+            .collect();
+        for &i in &roots {
+            let (name, root, ty) = {
+                let s = &self.img.symbols[i];
+                (s.name.clone(), s.root, s.ty)
+            };
+            let Some(t) = DataType::lookup(ty) else {
+                continue;
+            };
+            for (path, at, sub) in t.sub_paths(MAX_LEVELS_PER_ROOT) {
+                let full = format!("{name}{path}");
+                let Some(size) = sub.size_bytes() else {
+                    continue;
+                };
+                if !self.img.by_name.contains_key(&full.to_ascii_lowercase()) {
+                    self.sub(
+                        full,
+                        root,
+                        at as usize,
+                        size as usize,
+                        sub.name_a(),
+                        sub.adst(),
+                    );
+                }
+            }
+        }
+        let mut levels: Vec<(String, Vec<usize>)> = Vec::new();
+        let mut at_level: HashMap<String, usize> = HashMap::new();
+        for &i in &roots {
+            let name = &self.img.symbols[i].name;
+            for (p, c) in name.char_indices().filter(|&(_, c)| c == '.' || c == '[') {
+                let pointers = c == '['
+                    && name[p..]
+                        .split_once(']')
+                        .is_some_and(|(_, rest)| rest.starts_with('^'));
+                let key = name[..p].to_ascii_lowercase();
+                if pointers || self.img.by_name.contains_key(&key) {
+                    continue;
+                }
+                let k = *at_level.entry(key).or_insert_with(|| {
+                    levels.push((name[..p].to_string(), Vec::new()));
+                    levels.len() - 1
+                });
+                levels[k].1.push(i);
+            }
+        }
+        for (name, parts) in levels {
+            let size: usize = parts.iter().map(|&p| self.img.symbols[p].size).sum();
+            let Some(&first) = parts.first() else {
+                continue;
+            };
+            self.img
+                .by_name
+                .insert(name.to_ascii_lowercase(), self.img.symbols.len());
+            self.img.symbols.push(Symbol {
+                name,
+                root: self.img.symbols[first].root,
+                at: 0,
+                size,
+                ty: "",
+                adst: ADST_BIGTYPE,
+                composite: Some(Composite {
+                    ty: format!("ARRAY [0..{}] OF BYTE", size.saturating_sub(1)),
+                    parts,
+                }),
+            });
+        }
     }
 
     fn bool(&mut self, name: String) -> usize {
@@ -563,9 +671,11 @@ impl Image {
         let mut b = Builder {
             img: Image {
                 symbols: Vec::new(),
+                listed: 0,
                 by_name: HashMap::new(),
                 roles: Vec::new(),
                 memory: Mutex::new(Vec::new()),
+                initial: Vec::new(),
                 channels: Vec::new(),
                 posted: Mutex::new(vec![0; axes_per_channel.len()]),
                 refused: Mutex::new(vec![VecDeque::new(); axes_per_channel.len()]),
@@ -585,7 +695,27 @@ impl Image {
         for a in 0..axes_per_channel.iter().sum::<usize>() {
             b.axis(a);
         }
+        b.img.listed = b.img.symbols.len();
+        b.derive();
+        let initial = b.img.memory().clone();
+        b.img.initial = initial;
         b.img
+    }
+
+    /// Whether a write of a whole level above root `i` must leave it alone: read-only roots
+    /// and the technology units (only their flags are written, one at a time).
+    fn composite_read_only(&self, i: usize) -> bool {
+        let role = self.roles[self.symbols[i].root];
+        role.read_only() || matches!(role, Role::TechnoUnits(..))
+    }
+
+    /// Whether symbol `i` is read-only as a whole (its entry's flag).
+    fn read_only(&self, i: usize) -> bool {
+        let s = &self.symbols[i];
+        match &s.composite {
+            Some(c) => c.parts.iter().any(|&p| self.composite_read_only(p)),
+            None => self.roles[s.root].read_only(),
+        }
     }
 
     fn memory(&self) -> MutexGuard<'_, Vec<Vec<u8>>> {
@@ -604,6 +734,8 @@ impl Image {
 /// The HLI of one server: built on first use from the channels the backend has.
 pub struct Hli {
     backend: Arc<dyn CncBackend>,
+    /// The PLC runtime's ADS state: RUN, or STOP after WriteControl STOP or RESET.
+    state: AtomicU16,
     image: OnceLock<Image>,
     uploads: OnceLock<Uploads>,
 }
@@ -619,8 +751,63 @@ impl Hli {
     pub fn new(backend: Arc<dyn CncBackend>) -> Self {
         Hli {
             backend,
+            state: AtomicU16::new(ads_state::RUN),
             image: OnceLock::new(),
             uploads: OnceLock::new(),
+        }
+    }
+
+    /// The PLC runtime's ADS state (ReadState and 0xF100 on port 851).
+    pub(crate) fn ads_state(&self) -> u16 {
+        self.state.load(Ordering::SeqCst)
+    }
+
+    /// WriteControl on port 851 (ads-client `startPlc`/`stopPlc`/`resetPlc`, pyads
+    /// `write_control`): RUN starts, STOP stops, RESET puts every variable back to its
+    /// initial value and leaves the runtime in STOP, as a TwinCAT PLC reset does. The
+    /// symbols stay readable and writable in STOP (as a TwinCAT PLC's are); the channels
+    /// keep running. 0x706 for any other state.
+    pub(crate) fn control(&self, ads_state: u16) -> Result<(), AdsResult> {
+        match ads_state {
+            ads_state::RUN | ads_state::STOP => {}
+            ads_state::RESET => self.reinitialise(),
+            _ => return Err(AdsResult::INVALID_DATA),
+        }
+        let next = if ads_state == ads_state::RUN {
+            ads_state::RUN
+        } else {
+            ads_state::STOP
+        };
+        self.state.store(next, Ordering::SeqCst);
+        Ok(())
+    }
+
+    /// The system restarted: the runtime starts afresh (variables initial) in RUN.
+    pub(crate) fn restart(&self) {
+        self.reinitialise();
+        self.state.store(ads_state::RUN, Ordering::SeqCst);
+    }
+
+    /// Every variable back to its initial value; refusals waiting for `mc_error` and HMI
+    /// requests half written are dropped with them. Errors already handed over stay so.
+    fn reinitialise(&self) {
+        let Some(img) = self.image.get() else { return };
+        img.memory().clone_from(&img.initial);
+        for q in img
+            .refused
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter_mut()
+        {
+            q.clear();
+        }
+        for p in img
+            .pending
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .iter_mut()
+        {
+            *p = PendingRequest::default();
         }
     }
 
@@ -644,8 +831,7 @@ impl Hli {
     /// Every symbol, for the object map (`group` 0xF005 and `offset` = its handle).
     pub fn objects(&self) -> Result<Vec<ObjectInfo>, AdsResult> {
         let img = self.image()?;
-        Ok(img
-            .symbols
+        Ok(img.symbols[..img.listed]
             .iter()
             .enumerate()
             .map(|(i, s)| ObjectInfo {
@@ -691,6 +877,16 @@ impl Hli {
         let img = self.image()?;
         let s = &img.symbols[i];
         let n = s.size.min(length as usize);
+        if let Some(c) = &s.composite {
+            let mut out = Vec::with_capacity(n);
+            for &p in &c.parts {
+                let Some(left) = n.checked_sub(out.len()).filter(|&l| l > 0) else {
+                    break;
+                };
+                out.extend(self.read_symbol(p, u32::try_from(left).unwrap_or(u32::MAX))?);
+            }
+            return Ok(out);
+        }
         if let Some(bytes) = self.techno_root(img.roles[s.root])? {
             return bytes
                 .get(s.at..s.at + n)
@@ -759,6 +955,9 @@ impl Hli {
         if data.is_empty() || data.len() > s.size {
             return Err(AdsResult::INVALID_SIZE);
         }
+        if let Some(c) = &s.composite {
+            return self.write_composite(img, c, data);
+        }
         let role = img.roles[s.root];
         if role.read_only() {
             return Err(AdsResult::ACCESS_DENIED);
@@ -769,6 +968,30 @@ impl Hli {
         img.memory()[s.root][s.at..s.at + data.len()].copy_from_slice(data);
         if let (Role::CommandSemaphore(ch), [1, ..]) = (role, data) {
             self.take_command(img, ch);
+        }
+        Ok(())
+    }
+
+    /// A write to a level above the roots: the bytes go to the roots below it in order, each
+    /// as its own write (a semaphore written TRUE acts as it does alone). Refused as a whole,
+    /// 0x704, when a root it reaches is read-only (`state_r`, `satz_r`, the technology
+    /// units), as a write to a read-only symbol is.
+    fn write_composite(&self, img: &Image, c: &Composite, data: &[u8]) -> Result<(), AdsResult> {
+        let mut touched = Vec::new();
+        let mut rest = data;
+        for &p in &c.parts {
+            if rest.is_empty() {
+                break;
+            }
+            let (head, tail) = rest.split_at(rest.len().min(img.symbols[p].size));
+            touched.push((p, head));
+            rest = tail;
+        }
+        if touched.iter().any(|&(p, _)| img.composite_read_only(p)) {
+            return Err(AdsResult::ACCESS_DENIED);
+        }
+        for (p, d) in touched {
+            self.write_symbol(p, d)?;
         }
         Ok(())
     }
@@ -789,10 +1012,19 @@ impl Hli {
         let b = &self.backend;
         let before = b.status(ch).ok();
         let r = (|| {
-            let mode = b.status(ch)?.mode;
+            let st = b.status(ch)?;
+            let mode = st.mode;
             let target = if to_mode == 0 { mode as u32 } else { to_mode };
             if target == Mode::Mdi as u32 && !program.is_empty() {
                 return Err(DeviceError::NotReady);
+            }
+            // To STANDBY is the way out of a running program or ERROR (TwinSharp
+            // `OperationModeManager.Reset()` commands STANDBY, then the old mode): the channel
+            // is reset first, then it changes mode.
+            if to_mode == Mode::Standby as u32
+                && matches!(st.state, State::Active | State::Hold | State::Error)
+            {
+                b.command(ch, Op::Reset)?;
             }
             if to_mode != 0 && to_mode != mode as u32 {
                 b.command(ch, Op::CommandMode(to_mode as i32))?;
@@ -825,6 +1057,24 @@ impl Hli {
         }
         img.memory()[areas.command_semaphore][0] = 0;
         // Shown at once when the PLC has taken the last record (else on its next read).
+        let _ = self.post_error(img, ch);
+    }
+
+    /// A mode or state command of channel `ch` that the HMI gave through COM was refused by
+    /// its mode and state: 270061 waits for `mc_error` as one the PLC's own command posts.
+    /// Nothing when no PLC client has read the HLI yet (no one to take the record).
+    pub(crate) fn note_refusal(&self, ch: u16) {
+        let Some(img) = self.image.get() else { return };
+        let Some(i) = usize::from(ch).checked_sub(1) else {
+            return;
+        };
+        {
+            let mut refused = img.refused.lock().unwrap_or_else(|p| p.into_inner());
+            match refused.get_mut(i) {
+                Some(q) if q.len() < MAX_REFUSALS_WAITING => q.push_back(REFUSED_TRANSITION_ERROR),
+                _ => return,
+            }
+        }
         let _ = self.post_error(img, ch);
     }
 
@@ -965,12 +1215,12 @@ impl Hli {
         let s = &img.symbols[i];
         SymbolInfo {
             name: &s.name,
-            ty: s.ty,
+            ty: s.type_name(),
             group: GROUP_VALUE_BY_HANDLE,
             offset: i as u32 + 1,
             size_bytes: s.size as u32,
             adst: s.adst,
-            read_only: img.roles[s.root].read_only(),
+            read_only: img.read_only(i),
         }
     }
 
@@ -985,7 +1235,7 @@ impl Hli {
         let mut count = 0u32;
         let mut type_names = Vec::new();
         let mut last_root = None;
-        for (i, s) in img.symbols.iter().enumerate() {
+        for (i, s) in img.symbols[..img.listed].iter().enumerate() {
             if last_root == Some(s.root) {
                 continue;
             }
@@ -1020,7 +1270,7 @@ impl Hli {
         match group {
             GROUP_VALUE_BY_HANDLE => self.read_symbol(self.symbol_by_handle(offset)?, length),
             GROUP_SYMBOL_VERSION => symbols::symbol_version(length),
-            GROUP_DEVICE_DATA => symbols::device_data(offset, length),
+            GROUP_DEVICE_DATA => symbols::device_data(self.ads_state(), offset, length),
             GROUP_UPLOAD_INFO => symbols::fit(self.uploads()?.info.v1(), length),
             GROUP_UPLOAD_INFO2 => self.uploads()?.info.for_length(length),
             GROUP_SYMBOL_UPLOAD => symbols::fit(self.uploads()?.symbols.clone(), length),
@@ -1104,12 +1354,13 @@ impl Hli {
 /// `createVariableHandle` asks for any length) also gets the symbol's size, the type
 /// decoration (0: no decoration), the type name's length (u16) and the type name with NUL.
 fn handle_reply(s: &Symbol, handle: u32) -> Vec<u8> {
-    let mut out = Vec::with_capacity(15 + s.ty.len());
+    let ty = s.type_name();
+    let mut out = Vec::with_capacity(15 + ty.len());
     for w in [handle, s.size as u32, 0] {
         out.extend_from_slice(&w.to_le_bytes());
     }
-    out.extend_from_slice(&(s.ty.len() as u16).to_le_bytes());
-    out.extend_from_slice(s.ty.as_bytes());
+    out.extend_from_slice(&(ty.len() as u16).to_le_bytes());
+    out.extend_from_slice(ty.as_bytes());
     out.push(0);
     out
 }
@@ -1352,9 +1603,9 @@ mod tests {
             hli.read(GROUP_VALUE_BY_HANDLE, id, 4).unwrap(),
             REFUSED_TRANSITION_ERROR.to_le_bytes()
         );
-        // STANDBY/SELECTED: refused by the channel as a whole (the mode stays); posted after
+        // MANUAL/ACTIVE: refused by the channel as a whole (the mode stays); posted after
         // the PLC took the first.
-        command(&hli, Mode::Standby as u32, State::Selected as u32, "");
+        command(&hli, Mode::Manual as u32, State::Active as u32, "");
         assert_eq!(
             mode_state(b),
             (Mode::Automatic, State::Ready),
@@ -1383,7 +1634,7 @@ mod tests {
         let hli = Hli::new(Arc::clone(&t.backend));
         let img = hli.image().unwrap();
         let mut roots: HashMap<usize, &Symbol> = HashMap::new();
-        for s in &img.symbols {
+        for s in img.symbols.iter().filter(|s| s.composite.is_none()) {
             let ty = DataType::lookup(s.ty).unwrap_or_else(|| panic!("type {}", s.ty));
             assert_eq!(ty.size_bytes(), Some(s.size as u32), "{}", s.name);
             assert_eq!(ty.adst(), s.adst, "{}", s.name);
@@ -1400,6 +1651,62 @@ mod tests {
                 s.name
             );
         }
+    }
+
+    #[test]
+    fn every_level_between_the_listed_symbols_resolves() {
+        let t = testing::channels(2);
+        let hli = Hli::new(Arc::clone(&t.backend));
+        let p = "HLI_Global_Variables.gpCh[0]^";
+        let ms = format!("{p}.channel_mc_control.mode_and_state");
+        // Inside a root: the error record's head, a window of it.
+        let kopf = handle_of(&hli, &format!("{p}.mc_error.satz_r.kopf"));
+        assert_eq!(
+            hli.read(GROUP_VALUE_BY_HANDLE, kopf, 1000).unwrap().len(),
+            104
+        );
+        handle_of(&hli, &format!("{p}.mc_error.satz_r.rumpf[837]"));
+        handle_of(&hli, &format!("{ms}.command_w.fill_up_2"));
+        // Above the roots: the unit's areas back to back (state_r, request_r, enable_w,
+        // command_w, request_semaphor_rw, command_semaphor_rw).
+        let unit = handle_of(&hli, &ms);
+        let bytes = hli.read(GROUP_VALUE_BY_HANDLE, unit, 4096).unwrap();
+        assert_eq!(bytes.len(), 8 + 327 + 1 + 327 + 1 + 1);
+        assert_eq!(&bytes[0..8], &[2, 0, 0, 0, 3, 0, 0, 0], "state_r first");
+        assert_eq!(
+            hli.write(GROUP_VALUE_BY_HANDLE, unit, &[0; 20]),
+            Err(AdsResult::ACCESS_DENIED),
+            "state_r is read-only"
+        );
+        let info = hli
+            .read_write(GROUP_INFO_BY_NAME, 0, 1024, ms.as_bytes())
+            .unwrap();
+        assert_eq!(&info[20..24], &0x20u32.to_le_bytes(), "read-only flag");
+        // A writable level: the activation unit (enable_w, command_w, semaphore).
+        let act = handle_of(&hli, &format!("{p}.hb_mc_control.activation"));
+        hli.write(GROUP_VALUE_BY_HANDLE, act, &[1, 7]).unwrap();
+        let en = handle_of(&hli, &format!("{p}.hb_mc_control.activation.enable_w"));
+        let cmd = handle_of(&hli, &format!("{p}.hb_mc_control.activation.command_w"));
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, en, 1).unwrap(), [1]);
+        assert_eq!(hli.read(GROUP_VALUE_BY_HANDLE, cmd, 1).unwrap(), [7]);
+        for name in [p, "HLI_Global_Variables", "hli_global_constants"] {
+            assert!(hli.symbol_by_name(name.as_bytes()).is_ok(), "{name}");
+        }
+        for name in ["HLI_Global_Variables.gpCh", "HLI_Global_Variables.gpCh[0]"] {
+            assert_eq!(
+                hli.symbol_by_name(name.as_bytes()),
+                Err(SYMBOL_NOT_FOUND),
+                "{name}: pointers are not served"
+            );
+        }
+        // The listed symbols keep their handles; the levels are not in the object map.
+        let img = hli.image().unwrap();
+        assert_eq!(
+            handle_of(&hli, &format!("{ms}.state_r")),
+            3,
+            "after the constants"
+        );
+        assert_eq!(hli.objects().unwrap().len(), img.listed);
     }
 
     #[test]

@@ -7,7 +7,7 @@
 //! | 552 | SDA (NC variables) | [`super::sda`] |
 //! | 553 | COM (platform, channel, axis objects; description table) | [`super::com`] |
 //! | 851 | PLC runtime 1 (HLI symbols) | [`super::hli`] |
-//! | 10000 | TwinCAT system service (state, device info) | [`super::system`] |
+//! | 10000 | TwinCAT system service (state, extended state, state control, device info) | [`super::system`] |
 //!
 //! Port numbers: TwinSharp `CNC.cs` (`Connect(target, 551/552/553/851)`); 553 is also the
 //! documented COM port (ISG kernel docs 348532363). Any other port answers AMS error 6.
@@ -16,12 +16,13 @@
 use std::fmt::Write as _;
 use std::sync::Arc;
 
-use super::backend::CncBackend;
+use super::backend::{CncBackend, Op};
 use super::description::ObjectInfo;
 use super::hli::Hli;
 use super::result::AdsResult;
 use super::sda::Sda;
 use super::sum::{self, Port};
+use super::system::{System, SystemChange};
 use super::{com, geo, hli, sda, system};
 
 /// AMS port of the CNC's COM task.
@@ -66,11 +67,12 @@ pub mod offset {
     pub const POSITIONS: u32 = 0x8003;
 }
 
-/// The four tasks over one backend.
+/// The four tasks and the system service over one backend.
 pub struct Devices {
     backend: Arc<dyn CncBackend>,
     hli: Hli,
     sda: Sda,
+    system: System,
 }
 
 impl Devices {
@@ -78,6 +80,7 @@ impl Devices {
         Devices {
             hli: Hli::new(Arc::clone(&backend)),
             sda: Sda::new(Arc::clone(&backend)),
+            system: System::new(),
             backend,
         }
     }
@@ -85,6 +88,77 @@ impl Devices {
     /// Whether `port` is served (else the router answers AMS error 6).
     pub fn serves(port: u16) -> bool {
         PORTS.contains(&port)
+    }
+
+    /// Whether `port` is there now: the system service always, the runtime's ports (CNC
+    /// tasks, PLC runtime) only while the system is in RUN (a TwinCAT system in CONFIG or
+    /// STOP has no runtime; the router answers AMS error 6 for them).
+    pub fn serves_now(&self, port: u16) -> bool {
+        Self::serves(port) && (port == system::PORT || self.system.running())
+    }
+
+    /// ReadState on `port`: (ADS state, device state). The system service answers the
+    /// system's state, the PLC runtime its own (RUN or STOP), the CNC tasks RUN: they run
+    /// while the system does.
+    pub fn read_state(&self, port: u16) -> (u16, u16) {
+        match port {
+            system::PORT => (self.system.state(), 0),
+            hli::PORT => (self.hli.ads_state(), 0),
+            _ => (system::state::RUN, 0),
+        }
+    }
+
+    /// WriteControl `ads_state` on `port` (the device state is kept: 0). docs/ads.md
+    /// ("ADS state control") says what each does on each port:
+    /// - 10000: RESET restarts the system (every channel reset, the PLC runtime afresh in
+    ///   RUN, the restart index counts), RUN starts a system that is not running, CONFIG and
+    ///   RECONFIG enter CONFIG and STOP stops (every channel reset; the runtime ports answer
+    ///   AMS error 6 until a restart);
+    /// - 851: RUN, STOP, RESET of the PLC runtime ([`Hli::control`]); CONFIG/RECONFIG go to
+    ///   the system service (there is one configuration mode for all tasks);
+    /// - 553 and the other CNC tasks: RESET and STOP reset every channel (the program stops,
+    ///   READY; the task keeps running, so its state stays RUN), RUN changes nothing,
+    ///   CONFIG/RECONFIG go to the system service.
+    ///
+    /// 0x706 for a state the port does not take.
+    pub fn write_control(&self, port: u16, ads_state: u16) -> Result<(), AdsResult> {
+        use system::state;
+        let system_wide =
+            port == system::PORT || matches!(ads_state, state::CONFIG | state::RECONFIG);
+        if system_wide {
+            return match self.system.control(ads_state)? {
+                Some(SystemChange::Restart) => {
+                    self.reset_channels();
+                    self.hli.restart();
+                    Ok(())
+                }
+                Some(SystemChange::Halt) => {
+                    self.reset_channels();
+                    Ok(())
+                }
+                None => Ok(()),
+            };
+        }
+        match (port, ads_state) {
+            (hli::PORT, _) => self.hli.control(ads_state),
+            (_, state::RESET | state::STOP) => {
+                self.reset_channels();
+                Ok(())
+            }
+            (_, state::RUN) => Ok(()),
+            _ => Err(AdsResult::INVALID_DATA),
+        }
+    }
+
+    /// NC reset of every channel (`mcm_automatic_reset_w`'s reset): programs end, motion
+    /// stops, READY. A channel the runtime cannot reach now is left as it is (logged).
+    fn reset_channels(&self) {
+        let b = self.backend.as_ref();
+        for ch in 1..=b.channel_count() {
+            if let Err(e) = b.command(ch, Op::Reset) {
+                log::warn!("ADS state control: channel {ch} not reset: {e}");
+            }
+        }
     }
 
     /// ADS Read.
@@ -101,7 +175,7 @@ impl Devices {
             geo::PORT => geo::read(b, &self.hli, group, offset, length),
             sda::PORT => self.sda.read(group, offset, length),
             hli::PORT => self.hli.read(group, offset, length),
-            system::PORT => Err(AdsResult::INVALID_GROUP),
+            system::PORT => self.system.read(group, offset, length),
             _ => Err(AdsResult::SERVICE_NOT_SUPPORTED),
         }
     }
@@ -140,7 +214,7 @@ impl Devices {
             geo::PORT => geo::read_write(self.backend.as_ref(), group, offset, read_length, data),
             sda::PORT => self.sda.read_write(group, offset, read_length, data),
             hli::PORT => self.hli.read_write(group, offset, read_length, data),
-            system::PORT => Err(AdsResult::INVALID_GROUP),
+            system::PORT => self.system.read(group, offset, read_length),
             _ => Err(AdsResult::SERVICE_NOT_SUPPORTED),
         }
     }

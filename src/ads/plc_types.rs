@@ -398,6 +398,72 @@ impl<'a> DataType<'a> {
         }
     }
 
+    /// Every member and array element below this type, depth first, as symbol names
+    /// continue a root's name (`.kopf`, `.kopf.error_id`, `[3]`, `[3].done_w`): the path,
+    /// its byte offset in this type and its type. At most `limit` entries and
+    /// [`MAX_DEPTH`] levels (the HLI's types are finite; the bounds keep a wrong table from
+    /// growing without end).
+    pub(crate) fn sub_paths(&self, limit: usize) -> Vec<(String, u32, DataType<'a>)> {
+        let mut out = Vec::new();
+        self.sub_paths_at(&mut String::new(), 0, 0, limit, &mut out);
+        out
+    }
+
+    fn sub_paths_at(
+        &self,
+        path: &mut String,
+        at: u32,
+        depth: usize,
+        limit: usize,
+        out: &mut Vec<(String, u32, DataType<'a>)>,
+    ) {
+        if depth >= MAX_DEPTH {
+            return;
+        }
+        let visit = |out: &mut Vec<_>, path: &mut String, part: String, at, ty: DataType<'a>| {
+            if out.len() >= limit {
+                return;
+            }
+            let len = path.len();
+            path.push_str(&part);
+            out.push((path.clone(), at, ty));
+            ty.sub_paths_at(path, at, depth + 1, limit, out);
+            path.truncate(len);
+        };
+        match self {
+            DataType::Struct(st) => {
+                for mem in st.members {
+                    let Some(ty) = DataType::lookup(mem.ty) else {
+                        continue;
+                    };
+                    let Some(off) = at.checked_add(mem.offset_bytes) else {
+                        continue;
+                    };
+                    visit(out, path, format!(".{}", mem.name), off, ty);
+                }
+            }
+            DataType::Array {
+                lower,
+                elements,
+                element,
+                ..
+            } => {
+                let Some(el) = DataType::lookup(element) else {
+                    return;
+                };
+                let Some(size) = el.size_bytes() else { return };
+                for k in 0..*elements {
+                    let Some(off) = k.checked_mul(size).and_then(|o| at.checked_add(o)) else {
+                        return;
+                    };
+                    let index = i64::from(*lower) + i64::from(k);
+                    visit(out, path, format!("[{index}]"), off, el);
+                }
+            }
+            DataType::Base { .. } | DataType::String { .. } => {}
+        }
+    }
+
     #[cfg(test)]
     /// The member at `path` (`.a.b[3].c`, as symbol names continue a root's name): byte
     /// offset, size and type name. `None` when the path names nothing in this type.
@@ -439,9 +505,8 @@ impl<'a> DataType<'a> {
         Some((at, ty.size_bytes()?, ty.name_a()))
     }
 
-    #[cfg(test)]
     /// The name with the lifetime of the text it was parsed from.
-    fn name_a(self) -> &'a str {
+    pub(crate) fn name_a(self) -> &'a str {
         match self {
             DataType::Base { name, .. } => name,
             DataType::String { name, .. } | DataType::Array { name, .. } => name,
@@ -579,6 +644,24 @@ mod tests {
             Some((68, 4, "UDINT"))
         );
         assert_eq!(e.member_at(".nope"), None);
+    }
+
+    #[test]
+    fn sub_paths_name_every_level_where_member_at_finds_it() {
+        let e = DataType::lookup("HLI_ERROR_SATZ").unwrap();
+        let paths = e.sub_paths(10_000);
+        assert_eq!(paths[0].0, ".kopf");
+        let names: Vec<&str> = paths.iter().map(|p| p.0.as_str()).collect();
+        assert!(names.contains(&".kopf.time_stamp.cycle_counter"));
+        assert!(names.contains(&".rumpf[837]"));
+        for (path, at, ty) in &paths {
+            assert_eq!(
+                e.member_at(path),
+                Some((*at, ty.size_bytes().unwrap(), ty.name_a())),
+                "{path}"
+            );
+        }
+        assert_eq!(e.sub_paths(3).len(), 3, "bounded");
     }
 
     #[test]

@@ -835,7 +835,7 @@ fn handle_request(
             ));
         }
     }
-    if !Devices::serves(header.target.port) {
+    if !shared.devices.serves_now(header.target.port) {
         // rule 5: router-level error in the header, empty payload.
         return Some(frame::encode(&header.response(AMS_ERR_PORT_NOT_FOUND), &[]));
     }
@@ -859,12 +859,16 @@ fn handle_request(
                     response::device_info(major, minor, build, &device_name())
                 }
             },
-            Request::ReadState => response::state(5, 0),
-            Request::WriteControl { ads_state, .. } => response::result_only(if ads_state == 5 {
-                AdsResult::OK
-            } else {
-                AdsResult::SERVICE_NOT_SUPPORTED
-            }),
+            Request::ReadState => {
+                let (ads_state, device_state) = devices.read_state(port);
+                response::state(ads_state, device_state)
+            }
+            Request::WriteControl { ads_state, .. } => {
+                response::result_only(match devices.write_control(port, ads_state) {
+                    Ok(()) => AdsResult::OK,
+                    Err(r) => r,
+                })
+            }
             Request::Read {
                 group,
                 offset,

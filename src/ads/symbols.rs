@@ -25,8 +25,15 @@ pub(crate) const GROUP_LOCATION_BY_NAME: u32 = 0xF007;
 pub(crate) const GROUP_TYPE_BY_NAME: u32 = 0xF011;
 /// 0xF100: ADS state (u16) and device state (u16) of the runtime, as ReadState answers.
 pub(crate) const GROUP_DEVICE_DATA: u32 = 0xF100;
-/// ADS state RUN (`ADSSTATE_RUN`).
-pub(crate) const ADS_STATE_RUN: u16 = 5;
+/// ADS states (`ADSSTATE_*`, Beckhoff AdsLib `AdsDef.h`): what ReadState and 0xF100 answer
+/// and WriteControl asks for (the system service's are in [`super::system`]).
+pub(crate) mod ads_state {
+    pub const RESET: u16 = 2;
+    pub const RUN: u16 = 5;
+    pub const STOP: u16 = 6;
+    pub const CONFIG: u16 = 15;
+    pub const RECONFIG: u16 = 16;
+}
 /// The symbol version served: the HLI's symbols are fixed while the server runs.
 const SYMBOL_VERSION: u8 = 1;
 /// Code page of STRING data and names in upload info 3: Windows-1252 (the HLI's names and
@@ -142,10 +149,11 @@ pub(crate) fn symbol_version(length: u32) -> Result<Vec<u8>, AdsResult> {
     Ok(vec![SYMBOL_VERSION])
 }
 
-/// 0xF100: ADS state RUN and device state 0 from `offset` (0 = both, 2 = device state), at
-/// most `length` bytes.
-pub(crate) fn device_data(offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
-    let mut all = ADS_STATE_RUN.to_le_bytes().to_vec();
+/// 0xF100: the runtime's ADS state (`ads_state`: RUN, or STOP after WriteControl STOP or
+/// RESET) and device state 0 from `offset` (0 = both, 2 = device state), at most `length`
+/// bytes.
+pub(crate) fn device_data(ads_state: u16, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+    let mut all = ads_state.to_le_bytes().to_vec();
     all.extend_from_slice(&0u16.to_le_bytes());
     let from = usize::try_from(offset)
         .ok()
@@ -181,10 +189,11 @@ mod tests {
     }
 
     #[test]
-    fn device_data_is_run_and_device_state() {
-        assert_eq!(device_data(0, 4), Ok(vec![5, 0, 0, 0]));
-        assert_eq!(device_data(2, 2), Ok(vec![0, 0]));
-        assert_eq!(device_data(4, 2), Err(AdsResult::INVALID_OFFSET));
+    fn device_data_is_ads_state_and_device_state() {
+        assert_eq!(device_data(5, 0, 4), Ok(vec![5, 0, 0, 0]));
+        assert_eq!(device_data(6, 0, 2), Ok(vec![6, 0]));
+        assert_eq!(device_data(5, 2, 2), Ok(vec![0, 0]));
+        assert_eq!(device_data(5, 4, 2), Err(AdsResult::INVALID_OFFSET));
         assert_eq!(fit(vec![1, 2], 1), Err(AdsResult::INVALID_SIZE));
     }
 }

@@ -23,7 +23,7 @@ pub(super) enum StateCommand {
     Resume,
     /// ACTIVE from READY or SELECTED in automatic mode: start the command parameter's program.
     Start,
-    /// ACTIVE while ACTIVE: nothing to do.
+    /// Nothing to do: ACTIVE while ACTIVE, SELECTED while READY.
     Nothing,
     /// HOLD: feed hold.
     Hold,
@@ -112,6 +112,12 @@ impl Isg {
             },
             State::Hold => Ok(StateCommand::Hold),
             State::Ready => Ok(StateCommand::Reset),
+            // PROCESS_SELECTED, the state a mode change leads to (TwinSharp
+            // `OperationModeManager.Reset()` asks for it with the old mode): a channel that
+            // runs nothing is there already (READY: its program is selected).
+            State::Selected if matches!(self.state, State::Ready | State::Selected) => {
+                Ok(StateCommand::Nothing)
+            }
             _ => Err(self.busy()),
         }
     }

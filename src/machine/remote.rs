@@ -158,6 +158,11 @@ pub enum DeviceError {
     /// Try again shortly (0x708).
     #[error("device busy")]
     Busy,
+    /// The channel's mode and state do not allow the command: retrying cannot help until
+    /// something else changes them, e.g. a start while in ERROR or a mode change while ACTIVE
+    /// (0x707; the HLI posts the kernel's 270061 in `mc_error`).
+    #[error("not permitted in the channel's mode and state")]
+    Refused,
     /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
     #[error("invalid parameter value")]
     InvalidValue,
@@ -187,13 +192,13 @@ pub struct ErrorRecord {
 }
 
 /// How a refused command maps onto a device error: a value the channel does not know is
-/// invalid (ADS 0x706), a command its mode/state does not allow now is busy (0x708: the same
-/// command succeeds once the state changes), a start without a program or that failed is not
-/// ready (0x707).
+/// invalid (ADS 0x706), a command its mode/state does not allow is refused (0x707: retrying
+/// the same command cannot succeed until a reset or the program's end changes the state, so
+/// it is not "busy, retry"), a start without a program or that failed is not ready (0x707).
 fn command_error(e: &CommandError) -> DeviceError {
     match e {
         CommandError::InvalidValue(_) | CommandError::BadOverride(_) => DeviceError::InvalidValue,
-        CommandError::Busy { .. } => DeviceError::Busy,
+        CommandError::Busy { .. } => DeviceError::Refused,
         CommandError::NoProgram | CommandError::StartFailed { .. } => DeviceError::NotReady,
     }
 }

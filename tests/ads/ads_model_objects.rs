@@ -92,7 +92,7 @@ fn feed_hold_written_holds_the_channel_and_reads_back() {
     assert_eq!(c.read(CH, 0x15, 1).unwrap(), [0], "no feed hold at start");
     assert_eq!(
         refused(c.write(CH, 0x16, &[1])),
-        0x708,
+        0x707,
         "nothing runs: nothing to hold (yet)"
     );
     start_program(&mut c, 1, "long.nc").unwrap();
@@ -148,7 +148,7 @@ fn releasing_the_feed_hold_leaves_a_programmed_stop_held() {
     assert_eq!(u32_of(&mut c, CH, 0x109), 5, "still held at M00");
     assert_eq!(
         refused(c.write(CH, 0x16, &[1])),
-        0x708,
+        0x707,
         "held by M00: no motion to hold"
     );
     c.write(CH, 0x105, &4i32.to_le_bytes()).unwrap();

@@ -290,14 +290,17 @@ fn unknown_command_is_0x701_and_unknown_port_is_header_error_6() {
 }
 
 #[test]
-fn write_control_run_is_accepted_others_are_not_supported() {
+fn write_control_on_the_cnc_task_keeps_it_running_and_refuses_unknown_states() {
     let (srv, _b) = server();
     let mut raw = Raw::connect(srv.local_addr());
     let mut wc = vec![5, 0, 0, 0];
     wc.extend_from_slice(&0u32.to_le_bytes());
     assert_eq!(raw.call(WRITE_CONTROL, 1, &wc).1, [0, 0, 0, 0]);
-    wc[0] = 6; // STOP
-    assert_eq!(raw.call(WRITE_CONTROL, 2, &wc).1, 0x701u32.to_le_bytes());
+    wc[0] = 6; // STOP: every channel reset, the task runs on
+    assert_eq!(raw.call(WRITE_CONTROL, 2, &wc).1, [0, 0, 0, 0]);
+    assert_eq!(raw.call(READ_STATE, 3, &[]).1, [0, 0, 0, 0, 5, 0, 0, 0]);
+    wc[0] = 99;
+    assert_eq!(raw.call(WRITE_CONTROL, 4, &wc).1, 0x706u32.to_le_bytes());
 }
 
 #[test]

@@ -81,7 +81,18 @@ fn the_system_service_on_10000_is_in_run_and_names_itself() {
     let info = call(&mut raw, 10000, READ_DEVICE_INFO, &[]);
     assert_eq!(u32_at(&info, 0), 0);
     assert_eq!(&info[8..22], b"TwinCAT System");
-    assert_eq!(read(&mut raw, 10000, 0xF0, 0, 16).0, 0x702, "no objects");
+    let (r, ext) = read(&mut raw, 10000, 0xF0, 0, 16);
+    assert_eq!((r, ext.len()), (0, 16), "the extended state");
+    assert_eq!(
+        &ext[0..6],
+        &[5, 0, 0, 0, 0, 0],
+        "RUN, device state 0, no restart"
+    );
+    assert_eq!(
+        read(&mut raw, 10000, 0xF1, 0, 16).0,
+        0x702,
+        "no other objects"
+    );
     let plc = call(&mut raw, 851, READ_DEVICE_INFO, &[]);
     assert_eq!(&plc[8..17], b"Plc30 App");
     // The PLC runtime's device data: ADS state RUN, device state 0.

@@ -340,3 +340,123 @@ fn every_record_reads_back(com: &ads::Device<'_>, dict: &HashMap<String, Record>
         }
     }
 }
+
+/// A channel's mode and state as `state_r` shows them (mode, state).
+fn mode_state(plc: &ads::Device<'_>, ms: &str) -> (u32, u32) {
+    let mut b = [0u8; 8];
+    plc.read_exact(0xF005, handle(plc, &format!("{ms}.state_r")), &mut b)
+        .unwrap();
+    (u32_of(&b), u32_of(&b[4..]))
+}
+
+/// TwinSharp `OperationModeManager.SetModeAndState`: `command_w`, then the semaphore TRUE.
+fn set_mode_and_state(plc: &ads::Device<'_>, ms: &str, to_mode: u32, to_state: u32) {
+    let mut cmd = [0u8; 327];
+    cmd[8..12].copy_from_slice(&to_mode.to_le_bytes());
+    cmd[12..16].copy_from_slice(&to_state.to_le_bytes());
+    plc.write(0xF005, handle(plc, &format!("{ms}.command_w")), &cmd)
+        .unwrap();
+    plc.write(
+        0xF005,
+        handle(plc, &format!("{ms}.command_semaphor_rw")),
+        &[1],
+    )
+    .unwrap();
+}
+
+/// The error ids `mc_error` hands the PLC, taking each (semaphore FALSE) until none is left.
+fn posted_errors(plc: &ads::Device<'_>) -> Vec<u32> {
+    let p = "HLI_Global_Variables.gpCh[0]^.mc_error";
+    let sem = handle(plc, &format!("{p}.semaphor_rw"));
+    let id = handle(plc, &format!("{p}.satz_r.kopf.error_id"));
+    let mut out = Vec::new();
+    for _ in 0..16 {
+        let mut s = [0u8; 1];
+        plc.read_exact(0xF005, sem, &mut s).unwrap();
+        if s == [0] {
+            break;
+        }
+        let mut v = [0u8; 4];
+        plc.read_exact(0xF005, id, &mut v).unwrap();
+        out.push(u32::from_le_bytes(v));
+        plc.write(0xF005, sem, &[0]).unwrap();
+    }
+    out
+}
+
+/// TwinSharp `OperationModeManager.Reset()` request by request while a program runs: read
+/// `state_r.mode`, command STANDBY / PROCESS_SELECTED, then the old mode / PROCESS_SELECTED.
+/// The program stops (READY in the old mode) and no refusal is posted. Before it, a mode
+/// change through COM while ACTIVE is refused for good (0x707) with 270061 posted once.
+#[test]
+fn twinsharp_reset_stops_a_running_program() {
+    let served = ads_common::Served::start(ads_common::Params::new(1));
+    let client = Client::new(
+        served.server.local_addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Addr(AmsAddr::new(AmsNetId::new(10, 1, 2, 3, 1, 1), 40101)),
+    )
+    .unwrap();
+    let target = |port| AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), port);
+    let (com, plc) = (client.device(target(553)), client.device(target(851)));
+    let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+    com.write(0x20101, 0x104, &2i32.to_le_bytes()).unwrap();
+    com.write(0x20101, 0x108, b"streaming.nc\0").unwrap();
+    com.write(0x20101, 0x105, &4i32.to_le_bytes()).unwrap();
+    assert_eq!(mode_state(&plc, ms), (2, 4), "AUTOMATIC / ACTIVE");
+    // A mode change while ACTIVE through COM: refused for good (0x707), 270061 posted.
+    let manual = com.write(0x20101, 0x104, &4i32.to_le_bytes());
+    assert!(
+        matches!(manual, Err(ads::Error::Ads(_, _, 0x707))),
+        "mode change while ACTIVE: {manual:?}"
+    );
+    assert_eq!(posted_errors(&plc), [270_061]);
+
+    let mut mode = [0u8; 4];
+    plc.read_exact(
+        0xF005,
+        handle(&plc, &format!("{ms}.state_r.mode")),
+        &mut mode,
+    )
+    .unwrap();
+    set_mode_and_state(&plc, ms, 1, 2);
+    assert_eq!(mode_state(&plc, ms), (1, 3), "STANDBY / READY: stopped");
+    set_mode_and_state(&plc, ms, u32_of(&mode), 2);
+    assert_eq!(mode_state(&plc, ms), (2, 3), "AUTOMATIC / READY");
+    assert_eq!(posted_errors(&plc), Vec::<u32>::new(), "nothing refused");
+    drop(client);
+    served.finish();
+}
+
+/// A start while the channel is in ERROR cannot succeed on retry: 0x707 (not 0x708), and
+/// the PLC's `mc_error` hands over 270061 beside the error that stopped the channel.
+#[test]
+fn start_in_error_is_not_ready_with_the_hli_record() {
+    let served = ads_common::Served::start(ads_common::Params::new(1));
+    let client = Client::new(
+        served.server.local_addr(),
+        Timeouts::new(Duration::from_secs(5)),
+        Source::Addr(AmsAddr::new(AmsNetId::new(10, 1, 2, 3, 1, 1), 40102)),
+    )
+    .unwrap();
+    let target = |port| AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), port);
+    let (com, plc) = (client.device(target(553)), client.device(target(851)));
+    let ms = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state";
+    assert_eq!(posted_errors(&plc), Vec::<u32>::new());
+    com.write(0x20101, 0x104, &2i32.to_le_bytes()).unwrap();
+    com.write(0x20101, 0x108, b"streaming.nc\0").unwrap();
+    com.write(0x20101, 0x105, &4i32.to_le_bytes()).unwrap();
+    // A line without CR LF: error 21476, ERROR.
+    assert!(com.write(0x20101, 0x90, b"N10 X1\n").is_err());
+    assert_eq!(mode_state(&plc, ms), (2, 6), "AUTOMATIC / ERROR");
+    let start = com.write(0x20101, 0x105, &4i32.to_le_bytes());
+    assert!(
+        matches!(start, Err(ads::Error::Ads(_, _, 0x707))),
+        "start in ERROR: {start:?}"
+    );
+    let mut posted = posted_errors(&plc);
+    posted.sort_unstable();
+    assert_eq!(posted, [21476, 270_061]);
+    drop(client);
+    served.finish();
+}

@@ -13,6 +13,7 @@ mod ads_housekeeping;
 mod ads_model_objects;
 mod ads_serve;
 mod ads_server;
+mod ads_state_control;
 mod ads_stream;
 mod ads_symbols;
 mod ads_techno;

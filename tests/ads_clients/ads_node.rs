@@ -55,3 +55,32 @@ fn node_ads_client_default_connect_reads_and_writes_hli_symbols() {
         .any(|e| e["state"] == "ACTIVE");
     assert!(started, "the channel ran the streaming program");
 }
+
+/// The unmodified Node `ads-client`: `readTcSystemExtendedState`, `readValue` and
+/// `createVariableHandle` of levels between the listed HLI symbols, `stopPlc`, `startPlc`,
+/// `resetPlc`, `setTcSystemToConfig` and the restart (WriteControl RESET to 10000).
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_ads_client_controls_the_ads_states_and_reads_every_symbol_level() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/node/ads_client_control_test.js"
+    );
+    let (seen, _events) = common::run_client(served, &node, script, &[]);
+    assert_eq!(seen["extended"], serde_json::json!(["Run", 0, 3, 1, 4024]));
+    assert_eq!(seen["kopf_fields"], 21, "HLI_ERROR_SATZ_KOPF's members");
+    assert_eq!(seen["mode_and_state"], serde_json::json!([665, 2, 3]));
+    assert_eq!(
+        seen["plc_states"],
+        serde_json::json!(["Stop", "Run", "Stop", "Run"])
+    );
+    assert_eq!(
+        seen["system"],
+        serde_json::json!(["Config", 6, "Run", 1]),
+        "{seen}"
+    );
+    assert_eq!(seen["plc_after_restart"], "Run");
+}

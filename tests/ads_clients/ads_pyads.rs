@@ -116,3 +116,40 @@ fn pyads_reads_symbols_and_drives_the_hli_by_sum_commands() {
     assert_eq!(starts.len(), 1, "started once: {starts:?}");
     assert_eq!(starts[0]["prog"], "streaming.nc");
 }
+
+/// pyads `write_control` / `read_state` on 851, 553 and 10000, levels of the HLI's type tree
+/// by `get_symbol` / `get_handle` / `read_by_name`, and a start in ERROR answered 0x707.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_controls_the_ads_states_and_reaches_every_symbol_level() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/control_with_pyads.py"
+    );
+    let (seen, _events) = common::run_client(served, &python, script, &[]);
+    assert_eq!(
+        seen["kopf"],
+        serde_json::json!(["HLI_ERROR_SATZ_KOPF", 104])
+    );
+    assert_eq!(
+        seen["mode_and_state"],
+        serde_json::json!(["ARRAY [0..664] OF BYTE", 665])
+    );
+    assert_eq!(
+        seen["mode_and_state_head"],
+        serde_json::json!([2, 0, 0, 0, 3, 0, 0, 0])
+    );
+    assert_eq!(seen["gpCh_pointer"], 0x710);
+    assert_eq!(seen["write_mode_and_state"], 0x704);
+    assert_eq!(seen["plc_states"], serde_json::json!([6, 5, 6]));
+    assert_eq!(seen["enable_after_reset"], false);
+    assert_eq!(seen["no_line_end"], 0x706);
+    assert_eq!(seen["start_in_error"], 0x707);
+    assert_eq!(seen["after_cnc_reset"], serde_json::json!([3, 5]));
+    assert_eq!(seen["system_config"], 15);
+    assert_eq!(seen["plc_in_config"], 6);
+    assert_eq!(seen["after_restart"], serde_json::json!([5, 5, 3]));
+}
