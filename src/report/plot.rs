@@ -309,6 +309,25 @@ mod tests {
         assert!(svg.contains("&lt;b&gt;"), "title escaped");
     }
 
+    /// The plot of `t` as a PNG, decoded: its size (px) and RGB bytes.
+    fn png_pixels(t: &Trace) -> ((u32, u32), Vec<u8>) {
+        let png = encode(
+            &RunPlot {
+                trace: t,
+                title: "t",
+            },
+            Format::Png,
+        )
+        .unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        let size = (reader.info().width, reader.info().height);
+        let mut rgb = vec![0; reader.output_buffer_size()];
+        reader.next_frame(&mut rgb).unwrap();
+        (size, rgb)
+    }
+
     #[test]
     fn png_is_a_png_of_the_plot_size() {
         let mut t = Trace::new(100);
@@ -316,17 +335,7 @@ mod tests {
             let k = f64::from(k);
             t.record(sample(k, [k, k, k]));
         }
-        let png = encode(
-            &RunPlot {
-                trace: &t,
-                title: "t",
-            },
-            Format::Png,
-        )
-        .unwrap();
-        let dec = png::Decoder::new(std::io::Cursor::new(png));
-        let reader = dec.read_info().unwrap();
-        assert_eq!((reader.info().width, reader.info().height), (WIDTH, HEIGHT));
+        assert_eq!(png_pixels(&t).0, (WIDTH, HEIGHT));
     }
 
     /// Pixels of the tool path's colour in the PNG of a straight line along X at about a
@@ -337,20 +346,9 @@ mod tests {
             let x = from_x + (to_x - from_x) * f64::from(k) / 1000.0;
             t.record(sample(f64::from(k), [x, 5.0, 1.0]));
         }
-        let png = encode(
-            &RunPlot {
-                trace: &t,
-                title: "t",
-            },
-            Format::Png,
-        )
-        .unwrap();
-        let mut reader = png::Decoder::new(std::io::Cursor::new(png))
-            .read_info()
-            .unwrap();
-        let mut rgb = vec![0; reader.output_buffer_size()];
-        reader.next_frame(&mut rgb).unwrap();
-        rgb.chunks_exact(3)
+        png_pixels(&t)
+            .1
+            .chunks_exact(3)
             .filter(|p| *p == [PATH.0, PATH.1, PATH.2])
             .count()
     }
