@@ -78,6 +78,7 @@ fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConf
         bind: args.bind.unwrap_or(ads.bind.0),
         allow_non_loopback: args.allow_non_loopback,
         net_id: Some(args.net_id.unwrap_or(ads.net_id)),
+        route_service: true,
         max_frame_bytes: ads.max_frame_bytes as usize,
         allow: ads.allowed_clients.clone(),
         max_connections: ads.max_connections as usize,
@@ -91,6 +92,29 @@ fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConf
             .unwrap_or(Duration::from_secs(u64::from(ads.idle_timeout_s))),
         ..ServerConfig::default()
     }
+}
+
+/// The first stderr line of every serve, plain or `--soak` (`soak` is `soak FILE, ` or
+/// empty): where the server listens and which NetId it answers, the route service's UDP
+/// address, the channels and the cycle. Tests and supervisors parse it.
+pub(super) fn listening_line(
+    server: &crate::ads::ServerHandle,
+    net_id: Option<AmsNetId>,
+    soak: &str,
+    nch: u16,
+    period: Duration,
+) -> String {
+    let net_id = net_id.unwrap_or(crate::vocab::ams::DEFAULT_NET_ID);
+    let udp = server
+        .route_service_addr()
+        .map(|a| format!("route service UDP {a}, "))
+        .unwrap_or_default();
+    format!(
+        "listening on {} (AMS NetId {net_id}, port 553, also as {}, {udp}{soak}{nch} channel(s), cycle {} µs)",
+        server.local_addr(),
+        AmsNetId::LOCAL,
+        period.as_micros()
+    )
 }
 
 /// `--seconds`: `None` runs until a signal (no value, `inf`, or longer than `Duration` holds);
@@ -265,12 +289,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     };
     // From here on stderr is written through the logger's queue: a supervisor that stops
     // reading it (a full pipe) must hold up neither the server nor the stop.
-    super::logger::handshake(format_args!(
-        "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
-        server.local_addr(),
-        net_id.map(|n| n.to_string()).unwrap_or_default(),
-        period.as_micros()
-    ));
+    let line = listening_line(&server, net_id, "", nch, period);
+    super::logger::handshake(format_args!("{line}"));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
         Err(e) => super::logger::line(format_args!(
