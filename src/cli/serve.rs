@@ -94,29 +94,6 @@ fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConf
     }
 }
 
-/// The first stderr line of every serve, plain or `--soak` (`soak` is `soak FILE, ` or
-/// empty): where the server listens and which NetId it answers, the route service's UDP
-/// address, the channels and the cycle. Tests and supervisors parse it.
-pub(super) fn listening_line(
-    server: &crate::ads::ServerHandle,
-    net_id: Option<AmsNetId>,
-    soak: &str,
-    nch: u16,
-    period: Duration,
-) -> String {
-    let net_id = net_id.unwrap_or(crate::vocab::ams::DEFAULT_NET_ID);
-    let udp = server
-        .route_service_addr()
-        .map(|a| format!("route service UDP {a}, "))
-        .unwrap_or_default();
-    format!(
-        "listening on {} (AMS NetId {net_id}, port 553, also as {}, {udp}{soak}{nch} channel(s), cycle {} µs)",
-        server.local_addr(),
-        AmsNetId::LOCAL,
-        period.as_micros()
-    )
-}
-
 /// `--seconds`: `None` runs until a signal (no value, `inf`, or longer than `Duration` holds);
 /// a negative or NaN value is a usage error. `Duration::from_secs_f64` would panic on those.
 fn run_limit(seconds: Option<f64>) -> Result<Option<Duration>, String> {
@@ -289,7 +266,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     };
     // From here on stderr is written through the logger's queue: a supervisor that stops
     // reading it (a full pipe) must hold up neither the server nor the stop.
-    let line = listening_line(&server, net_id, "", nch, period);
+    let line = super::logger::listening_line(&server, net_id, "", nch, period);
     super::logger::handshake(format_args!("{line}"));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),

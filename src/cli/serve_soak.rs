@@ -51,7 +51,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         }
     };
     let soak = format!("soak {}, ", scenario.path.display());
-    let line = super::serve::listening_line(&server, net_id, &soak, nch, period);
+    let line = super::logger::listening_line(&server, net_id, &soak, nch, period);
     say(format_args!("{line}"));
     let signal = super::signal::StopSignal::install().ok();
     if let Some(s) = &signal {
