@@ -320,13 +320,12 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
     let max_connections = config.max_connections;
     let routes = Arc::new(RouteTable::new(&config.allow));
     let route_log = Arc::new(RateLimitedLog::new(1));
+    // Without its UDP port (another router or server holds it) the server still serves
+    // TCP: the route service is a convenience, and the listening line then names none.
     let route_service = if config.route_service {
-        Some(spawn_route_service(
-            &config,
-            local_addr,
-            Arc::clone(&routes),
-            route_log,
-        )?)
+        spawn_route_service(&config, local_addr, Arc::clone(&routes), route_log)
+            .map_err(|e| log(format_args!("{e}: not started")))
+            .ok()
     } else {
         None
     };

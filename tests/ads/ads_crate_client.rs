@@ -160,6 +160,30 @@ fn a_route_added_over_udp_lets_its_client_through_the_allow_list() {
     );
 }
 
+/// With the route service's UDP port held by someone else (another router, a second serve on
+/// another TCP port) the server still serves TCP, without a route service.
+#[test]
+fn a_taken_route_service_port_leaves_the_tcp_server_serving() {
+    let _held = std::net::UdpSocket::bind("127.0.0.1:48899");
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .unwrap()
+        .port();
+    let channels = Channels::start(1);
+    let config = ncchannel::ads::ServerConfig {
+        bind: std::net::SocketAddr::from(([127, 0, 0, 1], port)),
+        route_service: true,
+        ..Default::default()
+    };
+    let srv = ncchannel::ads::spawn(config, std::sync::Arc::clone(&channels.backend)).unwrap();
+    assert_eq!(srv.route_service_addr(), None);
+    let client = connect(&srv, 40022);
+    assert_eq!(
+        client.device(target()).get_state().unwrap().0,
+        AdsState::Run
+    );
+}
+
 #[test]
 fn router_port_request_works_with_the_crate() {
     let (srv, _b) = server();
