@@ -11,6 +11,8 @@ use arbitrary::{Arbitrary, Unstructured};
 
 use ncchannel::ads::frame::{self, Frame};
 use ncchannel::ads::payload;
+use ncchannel::ads::route_service::{self, Identity};
+use ncchannel::ads::routes::{RouteTable, MAX_ROUTES};
 use ncchannel::dnc::markers::{Anchor, Markers};
 use ncchannel::dnc::splitter::{ProgramEnd, ProgramSink, ProgramStart, Splitter};
 use ncchannel::lang::{self, VarKey, Vars};
@@ -110,6 +112,28 @@ pub fn program_check(data: &[u8]) {
 pub fn param_list(data: &[u8]) {
     let Some(src) = text(data) else { return };
     let (_list, _diags) = ncchannel::params::list::parse_list(Path::new("fuzz.lis"), src);
+}
+
+/// The route service (UDP 48899) takes any datagram: a clear error, or a reply that parses
+/// back with the request's invoke id and the response bit, of a bounded size; the route
+/// table stays within its bound.
+pub fn route_datagram(data: &[u8]) {
+    let me = Identity {
+        net_id: ncchannel::vocab::ams::AmsNetId([127, 0, 0, 2, 1, 1]),
+        host_name: "fuzz".into(),
+    };
+    let routes = RouteTable::new(&["10.0.0.1".parse().expect("an IP")]);
+    let Ok((reply, _)) = route_service::answer(data, &me, &routes) else {
+        return;
+    };
+    let request = route_service::parse(data).expect("an answered datagram parses");
+    if let Some(r) = reply {
+        assert!(r.len() <= 1024, "reply of {} bytes", r.len());
+        let back = route_service::parse(&r).expect("a reply parses");
+        assert_eq!(back.invoke_id, request.invoke_id);
+        assert_eq!(back.service, request.service | 0x8000_0000);
+    }
+    assert!(routes.entries().len() <= MAX_ROUTES);
 }
 
 /// The AMS/TCP codec cuts any byte stream into frames or a clear error, never reads past what

@@ -19,6 +19,8 @@ pub mod objects;
 pub mod payload;
 pub(crate) mod plc_types;
 pub mod result;
+pub mod route_service;
+pub mod routes;
 pub(crate) mod sda;
 pub mod server;
 mod slots;

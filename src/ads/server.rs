@@ -25,11 +25,13 @@ use super::frame::{
 use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
+use super::route_service::{self, Identity, RouteService, ROUTE_SERVICE_PORT};
+use super::routes::RouteTable;
 use super::slots::{Admission, Progress, Slots, EVICT_QUIET, FIRST_REQUEST_GRACE};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
-    DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+    DEFAULT_NET_ID, DEFAULT_NOTIFICATION_SAMPLES_PER_S,
 };
 
 /// Default bound on the bytes waiting in one connection's send queue.
@@ -51,9 +53,13 @@ pub struct ServerConfig {
     /// A non-loopback `bind` is refused unless this is set (and then logs a warning): the
     /// server moves machine axes on request and has no authentication.
     pub allow_non_loopback: bool,
-    /// This device's NetId. `Some`: frames addressed to another NetId get AMS error 7.
+    /// This device's NetId. `Some`: frames addressed to another NetId than this one or its
+    /// loopback alias 127.0.0.1.1.1 get AMS error 7 (logged once per source and connection).
     /// `None`: any target NetId is accepted (a single-device emulator).
     pub net_id: Option<AmsNetId>,
+    /// Also answer the ADS route service (UDP, identify and add-route) on the bind address:
+    /// port 48899, or a free port when `bind`'s port is 0.
+    pub route_service: bool,
     /// Upper bound of the AMS/TCP length field; longer frames close the connection.
     pub max_frame_bytes: usize,
     /// Simultaneous connections; more are closed at once.
@@ -74,7 +80,8 @@ pub struct ServerConfig {
     pub max_send_queue_bytes: usize,
     /// Route allow-list; empty = allow all. A client is served when its peer IP or the
     /// source NetId of its frame is listed; others are dropped silently (after a log line),
-    /// as a router without a route drops them.
+    /// as a router without a route drops them. Routes added through the route service join
+    /// it at run time (`routes.rs`).
     pub allow: Vec<RouteEntry>,
 }
 
@@ -84,6 +91,7 @@ impl Default for ServerConfig {
             bind: DEFAULT_BIND,
             allow_non_loopback: false,
             net_id: None,
+            route_service: false,
             max_frame_bytes: DEFAULT_MAX_FRAME_BYTES,
             max_connections: DEFAULT_MAX_CONNECTIONS,
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
@@ -101,12 +109,23 @@ pub struct ServerHandle {
     local_addr: SocketAddr,
     shared: Arc<Shared>,
     accept: Option<JoinHandle<()>>,
+    route_service: Option<RouteService>,
 }
 
 impl ServerHandle {
     /// The address actually bound (useful with port 0).
     pub fn local_addr(&self) -> SocketAddr {
         self.local_addr
+    }
+
+    /// Where the route service answers (UDP), when it runs.
+    pub fn route_service_addr(&self) -> Option<SocketAddr> {
+        self.route_service.as_ref().map(RouteService::local_addr)
+    }
+
+    /// The route table: the configured allow-list and the routes added since.
+    pub fn routes(&self) -> Vec<RouteEntry> {
+        self.shared.routes.entries()
     }
 
     /// Number of connections currently served.
@@ -122,6 +141,9 @@ impl ServerHandle {
     fn stop(&mut self) {
         if self.shared.stopping.swap(true, Ordering::SeqCst) {
             return;
+        }
+        if let Some(mut r) = self.route_service.take() {
+            r.stop();
         }
         // Wake the blocking accept() with a connection of our own.
         let wake = match self.local_addr.ip() {
@@ -155,11 +177,15 @@ struct Shared {
     slots: Slots,
     /// Next AMS port handed out by the router "port connect" command.
     next_router_port: AtomicU16,
+    /// Who may talk to the server: the allow-list and the routes added at run time.
+    routes: Arc<RouteTable>,
     /// Notification handles and sample rate in use over all connections.
     budget: Mutex<NotifyBudget>,
     /// Log lines that a client can provoke at will, at most one a second each.
     refused_log: RateLimitedLog,
     router_log: RateLimitedLog,
+    /// Frames for another device's NetId.
+    target_log: RateLimitedLog,
     evicted_log: RateLimitedLog,
     /// The line each connection may write when it ends (why), all together at
     /// most [`CONN_LINES_PER_S`] a second: a thousand connections ending at once cost a
@@ -292,8 +318,21 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
     let listener = TcpListener::bind(config.bind)?;
     let local_addr = listener.local_addr()?;
     let max_connections = config.max_connections;
+    let routes = Arc::new(RouteTable::new(&config.allow));
+    let route_log = Arc::new(RateLimitedLog::new(1));
+    // Without its UDP port (another router or server holds it) the server still serves
+    // TCP: the route service is a convenience, and the listening line then names none.
+    let route_service = if config.route_service {
+        spawn_route_service(&config, local_addr, Arc::clone(&routes), route_log)
+            .map_err(|e| log(format_args!("{e}: not started")))
+            .ok()
+    } else {
+        None
+    };
     let shared = Arc::new(Shared {
         config,
+        routes,
+        target_log: RateLimitedLog::new(1),
         devices: Devices::new(backend),
         stopping: AtomicBool::new(false),
         active: AtomicUsize::new(0),
@@ -313,7 +352,30 @@ pub fn spawn(config: ServerConfig, backend: Arc<dyn CncBackend>) -> io::Result<S
         local_addr,
         shared,
         accept: Some(accept),
+        route_service,
     })
+}
+
+/// The route service on the TCP server's address (already checked: loopback, or allowed),
+/// port 48899, or a free one when the TCP port was picked (port 0: tests, several servers).
+fn spawn_route_service(
+    config: &ServerConfig,
+    tcp: SocketAddr,
+    routes: Arc<RouteTable>,
+    log: Arc<RateLimitedLog>,
+) -> io::Result<RouteService> {
+    let port = if config.bind.port() == 0 {
+        0
+    } else {
+        ROUTE_SERVICE_PORT
+    };
+    let me = Identity {
+        net_id: config.net_id.unwrap_or(DEFAULT_NET_ID),
+        host_name: route_service::host_name(),
+    };
+    let bind = SocketAddr::new(tcp.ip(), port);
+    RouteService::spawn(bind, me, routes, move |line| log.log(line))
+        .map_err(|e| io::Error::new(e.kind(), format!("route service on UDP {bind}: {e}")))
 }
 
 fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
@@ -333,10 +395,8 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
             Ok(p) => p,
             Err(_) => continue,
         };
-        let cfg = &shared.config;
-        let ip_listed = cfg.allow.contains(&RouteEntry::Ip(peer.ip()));
-        let any_netid_routes = cfg.allow.iter().any(|r| matches!(r, RouteEntry::NetId(_)));
-        if !cfg.allow.is_empty() && !ip_listed && !any_netid_routes {
+        let ip_listed = shared.routes.routes_ip(peer.ip());
+        if !ip_listed && !shared.routes.has_net_id_routes() {
             shared
                 .refused_log
                 .log(format_args!("no route for {peer}: connection closed"));
@@ -352,10 +412,9 @@ fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
         let spawned = std::thread::Builder::new()
             .name(format!("ads-conn-{id}"))
             .spawn(move || {
-                let unrouted_ok = ip_listed || conn_shared.config.allow.is_empty();
                 let conn = Conn {
                     peer,
-                    ip_routed: unrouted_ok,
+                    ip_routed: ip_listed,
                     progress,
                 };
                 let ended = serve_connection(stream, &conn, &conn_shared);
@@ -612,6 +671,7 @@ fn request_loop(
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
     let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
+    let mut logged_foreign: Vec<AmsNetId> = Vec::new();
     let mut last_frame = Instant::now();
     loop {
         // Cut every complete frame out of the buffer (rule 1) before reading more; the
@@ -623,13 +683,15 @@ fn request_loop(
             last_frame = Instant::now();
             match frame {
                 Frame::Ams { header, data } => {
-                    let routed = ip_routed
-                        || shared
-                            .config
-                            .allow
-                            .contains(&RouteEntry::NetId(header.source.net_id));
+                    let routed = ip_routed || shared.routes.routes_net_id(header.source.net_id);
                     if !routed {
                         note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
+                        continue;
+                    }
+                    if !serves_target(shared.config.net_id, header.target.net_id) {
+                        note_foreign_target(shared, peer, &mut logged_foreign, &header);
+                        let refusal = header.response(AMS_ERR_MACHINE_NOT_FOUND);
+                        send(writer, &frame::encode(&refusal, &[]))?;
                         continue;
                     }
                     if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
@@ -714,6 +776,32 @@ fn note_unrouted(peer: SocketAddr, logged_unrouted: &mut Vec<AmsNetId>, id: AmsN
     }
 }
 
+/// Whether a frame for `target` is this device's: its NetId or the loopback alias
+/// 127.0.0.1.1.1, which a TwinCAT router serves as its own (`None`: every NetId is).
+fn serves_target(device: Option<AmsNetId>, target: AmsNetId) -> bool {
+    device.is_none_or(|id| target == id || target == AmsNetId::LOCAL)
+}
+
+/// Log a frame answered AMS error 7 for its target NetId, once per source NetId and
+/// connection (bounded as the unrouted ones), through the server's rate-limited line.
+fn note_foreign_target(
+    shared: &Shared,
+    peer: SocketAddr,
+    logged: &mut Vec<AmsNetId>,
+    header: &AmsHeader,
+) {
+    let source = header.source.net_id;
+    if logged.len() < MAX_LOGGED_UNROUTED && !logged.contains(&source) {
+        logged.push(source);
+        let own = shared.config.net_id.unwrap_or(DEFAULT_NET_ID);
+        shared.target_log.log(format_args!(
+            "{peer}: frames from {source} for AMS NetId {} answered AMS error 7: this device is {own} (or {})",
+            header.target.net_id,
+            AmsNetId::LOCAL
+        ));
+    }
+}
+
 /// After a read timed out: end the connection when no frame came for the idle timeout and
 /// it is waiting on the client (a frame half sent, or no notifications to keep it alive).
 fn check_idle(
@@ -779,9 +867,11 @@ fn arm_notifications(notifs: &Notifications) {
     }
 }
 
-/// AMS router commands. 0x1000 "port connect" (sent by clients that expect a local router,
-/// e.g. the `ads` crate's `Source::Request`) gets a NetId made from the peer's IPv4 address
-/// plus `.1.1` and a fresh port; everything else is ignored.
+/// AMS router commands. 0x1000 "port connect" (sent by clients that expect a local router:
+/// ads-client's `connect()`, the `ads` crate's `Source::Request`) gets the router's loopback
+/// NetId 127.0.0.1.1.1 and a fresh port: a NetId on the router, served as the device's own
+/// (docs/design-choices.md says why not the device's configured NetId); everything else is
+/// ignored.
 fn handle_router(command: u16, _body: &[u8], peer: SocketAddr, shared: &Shared) -> Option<Vec<u8>> {
     if command != 0x1000 {
         shared.router_log.log(format_args!(
@@ -789,14 +879,9 @@ fn handle_router(command: u16, _body: &[u8], peer: SocketAddr, shared: &Shared) 
         ));
         return None;
     }
-    let ip = match peer.ip() {
-        IpAddr::V4(v4) => v4.octets(),
-        IpAddr::V6(_) => [127, 0, 0, 1],
-    };
     let port = shared.next_router_port.fetch_add(1, Ordering::SeqCst);
     let mut out = vec![0x00, 0x10, 8, 0, 0, 0];
-    out.extend_from_slice(&ip);
-    out.extend_from_slice(&[1, 1]);
+    out.extend_from_slice(&AmsNetId::LOCAL.0);
     out.extend_from_slice(&port.to_le_bytes());
     Some(out)
 }
@@ -826,14 +911,6 @@ fn handle_request(
 ) -> Option<Vec<u8>> {
     if header.state_flags & 0x0001 != 0 {
         return None; // a response; we never asked anything
-    }
-    if let Some(id) = shared.config.net_id {
-        if header.target.net_id != id {
-            return Some(frame::encode(
-                &header.response(AMS_ERR_MACHINE_NOT_FOUND),
-                &[],
-            ));
-        }
     }
     if !shared.devices.serves_now(header.target.port) {
         // rule 5: router-level error in the header, empty payload.

@@ -151,3 +151,26 @@ pub fn init() {
         log::set_max_level(LevelFilter::Info);
     }
 }
+
+/// The first stderr line of every serve, plain or `--soak` (`soak` is `soak FILE, ` or
+/// empty): where the server listens and which NetId it answers, the route service's UDP
+/// address, the channels and the cycle. Tests and supervisors parse it.
+pub(super) fn listening_line(
+    server: &crate::ads::ServerHandle,
+    net_id: Option<crate::vocab::ams::AmsNetId>,
+    soak: &str,
+    nch: u16,
+    period: Duration,
+) -> String {
+    let net_id = net_id.unwrap_or(crate::vocab::ams::DEFAULT_NET_ID);
+    let udp = server
+        .route_service_addr()
+        .map(|a| format!("route service UDP {a}, "))
+        .unwrap_or_default();
+    format!(
+        "listening on {} (AMS NetId {net_id}, port 553, also as {}, {udp}{soak}{nch} channel(s), cycle {} µs)",
+        server.local_addr(),
+        crate::vocab::ams::AmsNetId::LOCAL,
+        period.as_micros()
+    )
+}

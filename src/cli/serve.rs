@@ -80,6 +80,7 @@ fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConf
         bind: args.bind.unwrap_or(ads.bind.0),
         allow_non_loopback: args.allow_non_loopback,
         net_id: Some(args.net_id.unwrap_or(ads.net_id)),
+        route_service: true,
         max_frame_bytes: ads.max_frame_bytes as usize,
         allow: ads.allowed_clients.clone(),
         max_connections: ads.max_connections as usize,
@@ -290,12 +291,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     };
     // From here on stderr is written through the logger's queue: a supervisor that stops
     // reading it (a full pipe) must hold up neither the server nor the stop.
-    super::logger::handshake(format_args!(
-        "listening on {} (AMS NetId {}, port 553, {nch} channel(s), cycle {} µs)",
-        server.local_addr(),
-        net_id.map(|n| n.to_string()).unwrap_or_default(),
-        period.as_micros()
-    ));
+    let line = super::logger::listening_line(&server, net_id, "", nch, period);
+    super::logger::handshake(format_args!("{line}"));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
         Err(e) => super::logger::line(format_args!(

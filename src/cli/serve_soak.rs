@@ -40,6 +40,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         channels: nch,
         reply_timeout,
     } = soak;
+    let net_id = server_config.net_id;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
     let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
     let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
@@ -49,12 +50,9 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
             return ExitCode::from(exit::USAGE);
         }
     };
-    say(format_args!(
-        "listening on {} (soak {}, {nch} channel(s), cycle {} µs)",
-        server.local_addr(),
-        scenario.path.display(),
-        period.as_micros()
-    ));
+    let soak = format!("soak {}, ", scenario.path.display());
+    let line = super::logger::listening_line(&server, net_id, &soak, nch, period);
+    say(format_args!("{line}"));
     let signal = super::signal::StopSignal::install().ok();
     if let Some(s) = &signal {
         rt.stop_on(s.flag());

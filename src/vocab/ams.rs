@@ -100,6 +100,15 @@ pub enum RouteEntry {
     Ip(IpAddr),
 }
 
+impl fmt::Display for RouteEntry {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RouteEntry::NetId(id) => write!(f, "{id}"),
+            RouteEntry::Ip(ip) => write!(f, "{ip}"),
+        }
+    }
+}
+
 impl TryFrom<String> for RouteEntry {
     type Error = String;
     fn try_from(s: String) -> Result<Self, String> {

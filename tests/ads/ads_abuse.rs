@@ -48,6 +48,8 @@ pub(crate) struct Serve {
     pub(crate) child: Child,
     addr: SocketAddr,
     net_id: AmsNetId,
+    /// The route service's UDP address, from the listening line.
+    route_service: Option<SocketAddr>,
     period: Duration,
     pub(crate) stderr: Arc<Mutex<String>>,
     /// Held and never read (`--events -` into a pipe nobody reads).
@@ -93,11 +95,16 @@ impl Serve {
             .position(|w| *w == "cycle")
             .and_then(|i| words[i + 1].parse::<u64>().ok())
             .expect("cycle");
+        let route_service = words
+            .iter()
+            .position(|w| *w == "UDP")
+            .and_then(|i| words[i + 1].trim_end_matches(',').parse().ok());
         Serve {
             _turn: turn,
             child,
             addr,
             net_id,
+            route_service,
             period: Duration::from_micros(cycle),
             stderr,
             _stdout: stdout,
@@ -120,6 +127,11 @@ impl Serve {
 
     pub(crate) fn addr(&self) -> SocketAddr {
         self.addr
+    }
+
+    pub(crate) fn route_service(&self) -> SocketAddr {
+        self.route_service
+            .expect("the listening line names the route service")
     }
 
     pub(crate) fn device(&self) -> AmsAddr {

@@ -127,6 +127,63 @@ fn notifications_reach_the_crate_on_mode_change() {
     dev.delete_notification(handle).unwrap();
 }
 
+/// A route added through the route service (the `ads` crate's `udp::add_route`) joins the
+/// configured allow-list: a client whose NetId was not listed is served once it is added.
+#[test]
+fn a_route_added_over_udp_lets_its_client_through_the_allow_list() {
+    let listed = "10.9.9.9.1.1".parse().unwrap();
+    let (srv, _b) = server_with(ncchannel::ads::ServerConfig {
+        allow: vec![listed],
+        route_service: true,
+        ..Default::default()
+    });
+    let udp = srv.route_service_addr().expect("route service runs");
+    let id = ncchannel::vocab::ams::AmsNetId([10, 1, 2, 3, 1, 1]);
+    let route = ncchannel::ads::RouteEntry::NetId(id);
+    assert!(!srv.routes().contains(&route));
+    let host = udp.ip().to_string();
+    ads::udp::add_route(
+        (host.as_str(), udp.port()),
+        AmsNetId::new(10, 1, 2, 3, 1, 1),
+        "a-host-name",
+        None,
+        None,
+        None,
+        false,
+    )
+    .unwrap();
+    assert_eq!(srv.routes(), [listed, route], "a host name adds no IP");
+    let client = connect(&srv, 40021);
+    assert_eq!(
+        client.device(target()).get_state().unwrap().0,
+        AdsState::Run
+    );
+}
+
+/// With the route service's UDP port held by someone else (another router, a second serve on
+/// another TCP port) the server still serves TCP, without a route service.
+#[test]
+fn a_taken_route_service_port_leaves_the_tcp_server_serving() {
+    let _held = std::net::UdpSocket::bind("127.0.0.1:48899");
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .unwrap()
+        .port();
+    let channels = Channels::start(1);
+    let config = ncchannel::ads::ServerConfig {
+        bind: std::net::SocketAddr::from(([127, 0, 0, 1], port)),
+        route_service: true,
+        ..Default::default()
+    };
+    let srv = ncchannel::ads::spawn(config, std::sync::Arc::clone(&channels.backend)).unwrap();
+    assert_eq!(srv.route_service_addr(), None);
+    let client = connect(&srv, 40022);
+    assert_eq!(
+        client.device(target()).get_state().unwrap().0,
+        AdsState::Run
+    );
+}
+
 #[test]
 fn router_port_request_works_with_the_crate() {
     let (srv, _b) = server();

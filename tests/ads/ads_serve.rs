@@ -146,26 +146,63 @@ fn reset_over_ads_empties_the_stream_and_reads_back_ready() {
     served.finish();
 }
 
-/// The default AMS NetId of `serve` is one the `ads` crate leaves alone: a client that asks
-/// the router for its own address (`Source::Request`, as for a local PLC) reaches the device
-/// at 127.0.0.2.1.1; `127.0.0.1.1.1`, the NetId the `ads` crate rewrites to the client's own,
-/// is not the server's and answers AMS error 7.
+/// `ncchannel serve` with its defaults (NetId 127.0.0.2.1.1) and each local idiom of the `ads`
+/// crate: `Source::Request` (the router's port connect) with `AmsNetId::local()`, which the
+/// crate rewrites to the NetId the router handed out (`Client::device`); `Source::Auto`
+/// (127.0.0.1.1.1 on loopback) with `AmsNetId::local()`; and the device's own NetId. A frame
+/// for another NetId answers AMS error 7, logged once per source.
 #[test]
-fn the_ads_crate_reaches_serve_at_its_default_net_id() {
+fn the_ads_crate_reaches_serve_by_its_local_idioms() {
     let srv = crate::ads_abuse::Serve::start(&[]);
     assert_eq!(srv.device().net_id.to_string(), "127.0.0.2.1.1");
-    let client = Client::new(
-        srv.addr(),
-        Timeouts::new(Duration::from_secs(5)),
-        Source::Request,
-    )
-    .unwrap();
-    let default = AmsAddr::new(AmsNetId::new(127, 0, 0, 2, 1, 1), 553);
-    let info = client.device(default).get_info().unwrap();
+    let timeouts = Timeouts::new(Duration::from_secs(5));
+    let client = Client::new(srv.addr(), timeouts, Source::Request).unwrap();
+    assert_eq!(
+        client.source().netid(),
+        AmsNetId::local(),
+        "the router hands out its loopback NetId, not the device's"
+    );
+    let plc = client.device(AmsAddr::new(AmsNetId::local(), 851));
+    assert_eq!(plc.get_info().unwrap().name, "Plc30 App");
+    let own = client.device(AmsAddr::new(AmsNetId::new(127, 0, 0, 2, 1, 1), 553));
+    let info = own.get_info().unwrap();
     assert!(info.name.starts_with("ncchannel"), "{}", info.name);
-    let rewritten = client.device(AmsAddr::new(AmsNetId::local(), 553));
-    match rewritten.get_info() {
-        Err(ads::Error::Ads(_, _, 7)) => {}
-        other => panic!("127.0.0.1.1.1 is the client's own NetId: {other:?}"),
+    let auto = Client::new(srv.addr(), timeouts, Source::Auto).unwrap();
+    let system = auto.device(AmsAddr::new(AmsNetId::local(), 10000));
+    assert_eq!(system.get_state().unwrap().0, ads::AdsState::Run);
+    let other = client.device(AmsAddr::new(AmsNetId::new(5, 6, 7, 8, 1, 1), 553));
+    for _ in 0..3 {
+        match other.get_info() {
+            Err(ads::Error::Ads(_, _, 7)) => {}
+            got => panic!("5.6.7.8.1.1 is another device: {got:?}"),
+        }
     }
+    let line = "for AMS NetId 5.6.7.8.1.1 answered AMS error 7";
+    let log = srv.log_once_it_says(line);
+    assert_eq!(log.matches(line).count(), 1, "{log}");
+}
+
+/// The ADS route service on UDP beside `serve`, through the `ads` crate's `udp` calls:
+/// identify (NetId, host name, TwinCAT version, OS) and add-route.
+#[test]
+fn the_route_service_answers_the_ads_crates_udp_calls() {
+    let srv = crate::ads_abuse::Serve::start(&[]);
+    let udp = srv.route_service();
+    assert_eq!(udp.ip(), srv.addr().ip(), "bound where the TCP server is");
+    let host = udp.ip().to_string();
+    let to = (host.as_str(), udp.port());
+    let own = AmsNetId::new(127, 0, 0, 2, 1, 1);
+    assert_eq!(ads::udp::get_netid(to).unwrap(), own);
+    let info = ads::udp::get_info(to).unwrap();
+    assert_eq!(info.netid, own);
+    assert_eq!(info.twincat_version, (3, 1, 4024));
+    assert!(!info.hostname.is_empty());
+    assert_eq!(info.os_version.4, std::env::consts::OS);
+    let client = AmsNetId::new(10, 1, 2, 3, 1, 1);
+    ads::udp::add_route(to, client, "127.0.0.1", Some("test"), None, None, false).unwrap();
+    let log = srv.log_once_it_says("route added");
+    assert!(
+        log.contains("route added: 10.1.2.3.1.1, 127.0.0.1"),
+        "{log}"
+    );
 }

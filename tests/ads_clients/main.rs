@@ -4,6 +4,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod ads_local_idioms;
 mod ads_node;
 mod ads_node_stall;
 mod ads_pyads;

@@ -20,6 +20,7 @@ const TARGETS: &[Target] = &[
     ("program_check", checks::program_check),
     ("param_list", checks::param_list),
     ("ams_codec", checks::ams_codec),
+    ("route_datagram", checks::route_datagram),
     ("dnc_split", checks::dnc_split),
     ("stream_buffer", checks::stream_buffer),
     ("channel_program", checks::channel_program),

@@ -56,14 +56,7 @@ fn serve_soak(
     report: &Path,
 ) -> (Child, String, std::thread::JoinHandle<String>) {
     let mut child = Command::new(bin())
-        .args([
-            "serve",
-            "--bind",
-            "127.0.0.1:0",
-            "--net-id",
-            "127.0.0.1.1.1",
-            "--soak",
-        ])
+        .args(["serve", "--bind", "127.0.0.1:0", "--soak"])
         .arg(scenario)
         .args(["--seconds", &seconds.to_string(), "--report"])
         .arg(report)
@@ -74,6 +67,11 @@ fn serve_soak(
     let mut err = BufReader::new(child.stderr.take().unwrap());
     let mut first = String::new();
     err.read_line(&mut first).unwrap();
+    // The soak's shipped runtime.toml, announced as every serve announces its NetId.
+    assert!(
+        first.contains("(AMS NetId 127.0.0.2.1.1, port 553, also as 127.0.0.1.1.1, route service UDP 127.0.0.1:"),
+        "{first}"
+    );
     let addr = first
         .strip_prefix("listening on ")
         .and_then(|r| r.split(' ').next())
@@ -116,9 +114,9 @@ fn ncchannel_stream_as_external_client_under_resets_every_invariant_holds() {
     let file = nc_file(dir.path(), 3_000);
     let report = dir.path().join("report.json");
     let (child, addr, err) = serve_soak(&sc, 12, &report);
-    // serve_soak gives the server the NetId 127.0.0.1.1.1; `stream` targets it by name.
+    // `stream` with its default target NetId reaches `serve --soak` at its shipped one.
     let client = Command::new(bin())
-        .args(["stream", "--net-id", "127.0.0.1.1.1", "--target", &addr])
+        .args(["stream", "--target", &addr])
         .arg(&file)
         .output()
         .unwrap();
