@@ -29,7 +29,7 @@ use super::slots::{Admission, Progress, Slots, EVICT_QUIET};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
-    DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+    DEFAULT_NOTIFICATION_SAMPLES_PER_S, DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION,
 };
 
 /// Default bound on the bytes waiting in one connection's send queue.
@@ -65,6 +65,9 @@ pub struct ServerConfig {
     /// Notification samples per second over all connections (each handle costs one sample
     /// per cycle time); a handle that would exceed it is answered 0x716.
     pub notification_samples_per_s: u64,
+    /// Notification samples per second of one connection; a handle that would exceed it is
+    /// answered 0x716 to that connection only.
+    pub notification_samples_per_s_per_connection: u64,
     /// A connection that has not completed a frame for this long is closed when it is in the
     /// middle of a frame (a slow or stalled sender) or holds no notification handles (an
     /// idle client holding a slot). A client with notifications may stay silent for ever.
@@ -89,6 +92,8 @@ impl Default for ServerConfig {
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
             max_notifications_total: DEFAULT_MAX_NOTIFICATIONS_TOTAL,
             notification_samples_per_s: DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+            notification_samples_per_s_per_connection:
+                DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
             max_send_queue_bytes: DEFAULT_MAX_SEND_QUEUE_BYTES,
             allow: Vec::new(),
@@ -930,9 +935,18 @@ fn add_notification(
     let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
         .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
     let mut table = lock(&notifs.table);
-    // 0x716 (no more handles) both for the connection's limit and the whole server's budget:
-    // the one error a client already handles when a table is full.
-    if table.len() >= shared.config.max_notifications || !shared.reserve(cycle) {
+    // 0x716 (no more handles) for the connection's limits (handles, samples a second) and the
+    // whole server's budget: the one error a client already handles when a table is full.
+    // The connection's rate is summed over its table (at most `max_notifications` handles).
+    let conn_rate: u64 = table.values().map(|n| rate_mhz(n.cycle)).sum();
+    let conn_limit = shared
+        .config
+        .notification_samples_per_s_per_connection
+        .saturating_mul(1000);
+    if table.len() >= shared.config.max_notifications
+        || conn_rate.saturating_add(rate_mhz(cycle)) > conn_limit
+        || !shared.reserve(cycle)
+    {
         return (AdsResult::NO_MORE_HANDLES, 0);
     }
     let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);

@@ -776,3 +776,39 @@ fn router_port_connect_hands_out_an_address() {
     assert_eq!(&reply[6..12], &[127, 0, 0, 1, 1, 1]);
     assert!(u16::from_le_bytes([reply[12], reply[13]]) >= 32768);
 }
+
+/// AddDeviceNotification result of one request on `raw` (skipping samples in between).
+fn add_result(raw: &mut Raw, invoke: u32, add: &[u8]) -> u32 {
+    raw.send(&request_bytes(
+        ADD_NOTIFICATION,
+        device(),
+        client_addr(40000),
+        invoke,
+        add,
+    ));
+    loop {
+        let (h, d) = raw.frame();
+        if h.command.to_u16() == ADD_NOTIFICATION && h.invoke_id == invoke {
+            return u32_at(&d, 0);
+        }
+    }
+}
+
+#[test]
+fn one_connection_spending_its_sample_budget_leaves_the_others_theirs() {
+    let (srv, _b) = server();
+    let mut greedy = Raw::connect(srv.local_addr());
+    // Cyclic at 1 ms: 1000 samples a second each; ten fill one connection's budget.
+    let one_ms = request::add_notification(CH1, offset::BLOCK_COUNTER, 8, 3, 0, 10_000);
+    let results: Vec<u32> = (1..=11)
+        .map(|i| add_result(&mut greedy, i, &one_ms))
+        .collect();
+    assert_eq!(results[..10], [0; 10], "ten 1 ms handles on one connection");
+    assert_eq!(results[10], 0x716, "the eleventh is beyond its own budget");
+    // Another client still gets a 100 ms handle and 1 ms handles of its own.
+    let mut other = Raw::connect(srv.local_addr());
+    let slow = request::add_notification(CH1, offset::MODE_STATE, 8, 4, 0, 1_000_000);
+    assert_eq!(add_result(&mut other, 1, &slow), 0);
+    assert_eq!(add_result(&mut other, 2, &one_ms), 0);
+    assert_eq!(add_result(&mut other, 3, &one_ms), 0);
+}
