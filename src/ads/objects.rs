@@ -82,6 +82,12 @@ impl Devices {
         }
     }
 
+    /// Whether a request that reached the server at `arrived` is answered "busy" without
+    /// asking the runtime ([`CncBackend::overdue`]).
+    pub fn overdue(&self, arrived: std::time::Instant) -> bool {
+        self.backend.overdue(arrived)
+    }
+
     /// Whether `port` is served (else the router answers AMS error 6).
     pub fn serves(port: u16) -> bool {
         PORTS.contains(&port)

@@ -1,9 +1,11 @@
 //! The ADS/TCP server: accepts connections, frames requests, answers them through the object
 //! table, and pushes DeviceNotification frames.
 //!
-//! One thread per connection (at most `max_connections`, default 64; beyond that the
-//! connection quiet for longest gives its slot up, or the newcomer is closed: `slots.rs`),
-//! one writer thread per connection draining its bounded send queue, plus one notification
+//! One thread per connection answering its requests in order (at most `max_connections`,
+//! default 64; beyond that the connection quiet for longest gives its slot up, or the
+//! newcomer is closed: `slots.rs`), one reader thread per connection that stamps each
+//! request with its arrival ([`Inbox`]), one writer thread per connection draining its
+//! bounded send queue, plus one notification
 //! thread per connection that has notification handles. Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
@@ -559,6 +561,9 @@ enum ConnError {
     Io(#[from] io::Error),
     #[error("{0}: connection closed")]
     Idle(String),
+    /// The reader has ended and every frame it read is answered.
+    #[error("connection closed")]
+    Ended,
 }
 
 fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Result<(), ConnError> {
@@ -598,19 +603,197 @@ fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Res
     result
 }
 
+/// Frames read from one connection and not yet answered, each with the instant the read that
+/// completed it returned. The connection's reader thread keeps reading while a request waits
+/// for the runtime, so a request's reply deadline counts from its own arrival, not from the
+/// answer to the one before it (a client with 50 requests in flight through a runtime stall
+/// hears "busy" for each within `reply_timeout` of sending it). Bounded in bytes like the
+/// [`Outbox`]: past the limit the reader stops reading and TCP holds the client back.
+struct Inbox {
+    state: Mutex<InboxState>,
+    ready: Condvar,
+    limit_bytes: usize,
+}
+
+#[derive(Default)]
+struct InboxState {
+    frames: VecDeque<(Instant, Frame, usize)>,
+    /// Bytes of the frames in `frames`.
+    bytes: usize,
+    /// A frame has been taken and its answer is not written yet.
+    serving: bool,
+    /// The reader is done, and why (`Ok` for the client's or the server's clean close).
+    ended: Option<Result<(), ConnError>>,
+    /// The request loop is done: the reader stops.
+    closed: bool,
+}
+
+impl Inbox {
+    fn new(limit_bytes: usize) -> Self {
+        Inbox {
+            state: Mutex::new(InboxState::default()),
+            ready: Condvar::new(),
+            limit_bytes,
+        }
+    }
+
+    /// Queue a frame of `len` bytes, waiting while the inbox is full; `false` once the request
+    /// loop is gone.
+    fn push(&self, arrived: Instant, frame: Frame, len: usize) -> bool {
+        let mut st = lock(&self.state);
+        while !st.closed && !st.frames.is_empty() && st.bytes + len > self.limit_bytes {
+            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+        }
+        if st.closed {
+            return false;
+        }
+        st.bytes += len;
+        st.frames.push_back((arrived, frame, len));
+        self.ready.notify_all();
+        true
+    }
+
+    /// The next frame and its arrival, or why the reader ended once every frame is taken.
+    fn pop(&self) -> Result<(Instant, Frame), ConnError> {
+        let mut st = lock(&self.state);
+        st.serving = false;
+        loop {
+            if let Some((arrived, frame, len)) = st.frames.pop_front() {
+                st.bytes -= len;
+                st.serving = true;
+                self.ready.notify_all();
+                return Ok((arrived, frame));
+            }
+            if let Some(end) = st.ended.take() {
+                // Ended for good: the next pop says so again.
+                st.ended = Some(Ok(()));
+                return end.and(Err(ConnError::Ended));
+            }
+            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+        }
+    }
+
+    /// Frames wait or one is being answered: the client is not idle.
+    fn busy(&self) -> bool {
+        let st = lock(&self.state);
+        st.serving || !st.frames.is_empty()
+    }
+
+    fn end(&self, why: Result<(), ConnError>) {
+        lock(&self.state).ended.get_or_insert(why);
+        self.ready.notify_all();
+    }
+
+    fn close(&self) {
+        lock(&self.state).closed = true;
+        self.ready.notify_all();
+    }
+}
+
+/// Bytes of frames one connection may have read ahead of its answers ([`Inbox`]).
+const MAX_INBOX_BYTES: usize = 256 * 1024;
+
+/// Answer the frames the reader thread queues, in order, until the connection ends.
 fn request_loop(
-    mut stream: TcpStream,
+    stream: TcpStream,
     conn: &Conn,
     shared: &Arc<Shared>,
     writer: &Writer,
     notifs: &Arc<Notifications>,
 ) -> Result<(), ConnError> {
+    let inbox = Arc::new(Inbox::new(
+        MAX_INBOX_BYTES.max(shared.config.max_frame_bytes),
+    ));
+    let reader = {
+        let (s, w, n, i) = (
+            Arc::clone(shared),
+            Arc::clone(writer),
+            Arc::clone(notifs),
+            Arc::clone(&inbox),
+        );
+        let read_half = stream.try_clone()?;
+        std::thread::Builder::new()
+            .name("ads-read".into())
+            .spawn(move || i.end(read_loop(read_half, &s, &w, &n, &i)))?
+    };
+    let result = answer_loop(conn, shared, writer, notifs, &inbox);
+    inbox.close();
+    let _ = stream.shutdown(Shutdown::Read);
+    let _ = reader.join();
+    match result {
+        Err(ConnError::Ended) => Ok(()),
+        r => r,
+    }
+}
+
+fn answer_loop(
+    conn: &Conn,
+    shared: &Arc<Shared>,
+    writer: &Writer,
+    notifs: &Arc<Notifications>,
+    inbox: &Inbox,
+) -> Result<(), ConnError> {
     let (peer, ip_routed) = (conn.peer, conn.ip_routed);
+    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
+    loop {
+        let (arrived, frame) = inbox.pop()?;
+        match frame {
+            Frame::Ams { header, data } => {
+                let routed = ip_routed
+                    || shared
+                        .config
+                        .allow
+                        .contains(&RouteEntry::NetId(header.source.net_id));
+                if !routed {
+                    note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
+                    continue;
+                }
+                let late = shared.devices.overdue(arrived);
+                if let Some(reply) = handle_request(&header, &data, late, shared, writer, notifs) {
+                    send(writer, &reply)?;
+                    conn.progress.mark();
+                    if header.command == CommandId::AddDeviceNotification {
+                        arm_notifications(notifs);
+                    }
+                }
+            }
+            Frame::Router {
+                command: PORT_CLOSE,
+                body,
+            } => {
+                // The client's port is gone: its notifications end, and the connection
+                // is closed, as the TwinCAT router does, so the client's disconnect()
+                // (which waits for the close) returns at once.
+                close_port(shared, notifs, &body);
+                return Ok(());
+            }
+            Frame::Router { command, body } => {
+                if let Some(reply) = handle_router(command, &body, peer, shared) {
+                    send(writer, &reply)?;
+                    conn.progress.mark();
+                }
+            }
+        }
+        if let Some(c) = writer.closed() {
+            return Err(closed_error(c, writer.limit_bytes).into());
+        }
+    }
+}
+
+/// Read frames into `inbox`, each stamped with the instant its last bytes were read, until
+/// the client closes, sends a malformed frame, stays idle, or the answering side is gone.
+fn read_loop(
+    mut stream: TcpStream,
+    shared: &Shared,
+    writer: &Writer,
+    notifs: &Notifications,
+    inbox: &Inbox,
+) -> Result<(), ConnError> {
     let max = shared.config.max_frame_bytes;
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
-    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
     let mut last_frame = Instant::now();
+    let mut read_at = Instant::now();
     loop {
         // Cut every complete frame out of the buffer (rule 1) before reading more; the
         // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
@@ -619,41 +802,8 @@ fn request_loop(
         while let Some((frame, n)) = frame::decode(&buf[used..], max)? {
             used += n;
             last_frame = Instant::now();
-            match frame {
-                Frame::Ams { header, data } => {
-                    let routed = ip_routed
-                        || shared
-                            .config
-                            .allow
-                            .contains(&RouteEntry::NetId(header.source.net_id));
-                    if !routed {
-                        note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
-                        continue;
-                    }
-                    if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
-                        send(writer, &reply)?;
-                        conn.progress.mark();
-                        if header.command == CommandId::AddDeviceNotification {
-                            arm_notifications(notifs);
-                        }
-                    }
-                }
-                Frame::Router {
-                    command: PORT_CLOSE,
-                    body,
-                } => {
-                    // The client's port is gone: its notifications end, and the connection
-                    // is closed, as the TwinCAT router does, so the client's disconnect()
-                    // (which waits for the close) returns at once.
-                    close_port(shared, notifs, &body);
-                    return Ok(());
-                }
-                Frame::Router { command, body } => {
-                    if let Some(reply) = handle_router(command, &body, peer, shared) {
-                        send(writer, &reply)?;
-                        conn.progress.mark();
-                    }
-                }
+            if !inbox.push(read_at, frame, n) {
+                return Ok(());
             }
         }
         buf.drain(..used);
@@ -676,7 +826,9 @@ fn request_loop(
                     io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
                 ) =>
             {
-                check_idle(last_frame, &buf, shared, notifs)?;
+                if !inbox.busy() {
+                    check_idle(last_frame, &buf, shared, notifs)?;
+                }
                 continue;
             }
             Err(e) if shared.stopping.load(Ordering::SeqCst) => {
@@ -691,6 +843,7 @@ fn request_loop(
                 .into())
             }
         };
+        read_at = Instant::now();
         buf.extend_from_slice(&chunk[..n]);
     }
 }
@@ -818,6 +971,7 @@ fn version_numbers() -> (u8, u8, u16) {
 fn handle_request(
     header: &AmsHeader,
     data: &[u8],
+    late: bool,
     shared: &Arc<Shared>,
     writer: &Writer,
     notifs: &Arc<Notifications>,
@@ -847,6 +1001,14 @@ fn handle_request(
             response::result_only(AdsResult::SERVICE_NOT_SUPPORTED)
         }
         Some(Err(e)) => error_payload(header.command, e.result()),
+        // The runtime is stalled and this request's reply timeout, counted from its arrival,
+        // would pass while it waited: "busy, not applied" now, without asking the runtime.
+        Some(Ok(
+            Request::Read { .. }
+            | Request::Write { .. }
+            | Request::ReadWrite { .. }
+            | Request::AddNotification(_),
+        )) if late => error_payload(header.command, AdsResult::BUSY),
         Some(Ok(req)) => match req {
             Request::ReadDeviceInfo => match Devices::device_info(port) {
                 Some((major, minor, build, name)) => {
