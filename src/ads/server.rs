@@ -28,6 +28,7 @@ use super::objects::Devices;
 use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
 use super::slots::{Admission, Progress, Slots, EVICT_QUIET};
+use super::sum;
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
@@ -752,7 +753,7 @@ fn answer_loop(
                 if let Some(reply) = handle_request(&header, &data, late, shared, writer, notifs) {
                     send(writer, &reply)?;
                     conn.progress.mark();
-                    if header.command == CommandId::AddDeviceNotification {
+                    if adds_notifications(&header, &data) {
                         arm_notifications(notifs);
                     }
                 }
@@ -1042,6 +1043,23 @@ fn handle_request(
                 Err(r) => r,
             }),
             Request::ReadWrite {
+                group: group @ (sum::ADD_NOTIFICATIONS | sum::DELETE_NOTIFICATIONS),
+                offset: count,
+                read_length,
+                data,
+            } => {
+                let sums = SumNotifications {
+                    header,
+                    shared,
+                    writer,
+                    notifs,
+                };
+                match sums.serve(group, count, read_length, &data) {
+                    Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
+                    Err(r) => response::with_data(r, &[]),
+                }
+            }
+            Request::ReadWrite {
                 group,
                 offset,
                 read_length,
@@ -1055,17 +1073,58 @@ fn handle_request(
                 response::handle(result, handle)
             }
             Request::DelNotification { handle } => {
-                let removed = lock(&notifs.table).remove(&handle);
-                shared.release(removed.as_ref());
-                response::result_only(if removed.is_some() {
-                    AdsResult::OK
-                } else {
-                    AdsResult::INVALID_HANDLE
-                })
+                response::result_only(delete_notification(shared, notifs, handle))
             }
         },
     };
     Some(frame::encode(&header.response(0), &payload))
+}
+
+/// A sum add/delete notification request and the connection whose table it changes.
+struct SumNotifications<'a> {
+    header: &'a AmsHeader,
+    shared: &'a Arc<Shared>,
+    writer: &'a Writer,
+    notifs: &'a Arc<Notifications>,
+}
+
+impl SumNotifications<'_> {
+    /// Serve sum `group` (0xF085 or 0xF086) with `count` entries in `data`.
+    fn serve(
+        &self,
+        group: u32,
+        count: u32,
+        read_length: u32,
+        data: &[u8],
+    ) -> Result<Vec<u8>, AdsResult> {
+        let (header, shared, writer, notifs) = (self.header, self.shared, self.writer, self.notifs);
+        if group == sum::ADD_NOTIFICATIONS {
+            let mut add = |req| add_notification(header, req, shared, writer, notifs);
+            sum::add_notifications(count, read_length, data, &mut add)
+        } else {
+            let mut delete = |handle| delete_notification(shared, notifs, handle);
+            sum::delete_notifications(count, read_length, data, &mut delete)
+        }
+    }
+}
+
+/// Remove notification `handle` of this connection and give its budget back.
+fn delete_notification(shared: &Shared, notifs: &Notifications, handle: u32) -> AdsResult {
+    let removed = lock(&notifs.table).remove(&handle);
+    shared.release(removed.as_ref());
+    if removed.is_some() {
+        AdsResult::OK
+    } else {
+        AdsResult::INVALID_HANDLE
+    }
+}
+
+/// Whether the request makes notification handles (AddDeviceNotification, or a sum add
+/// notification ReadWrite): their first samples are planned once its response is queued.
+fn adds_notifications(header: &AmsHeader, data: &[u8]) -> bool {
+    header.command == CommandId::AddDeviceNotification
+        || (header.command == CommandId::ReadWrite
+            && data.get(..4) == Some(&sum::ADD_NOTIFICATIONS.to_le_bytes()[..]))
 }
 
 /// The error response shaped as the command's response (result alone, or result + zero).
