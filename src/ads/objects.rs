@@ -88,6 +88,31 @@ impl Devices {
         self.backend.overdue(arrived)
     }
 
+    /// Register `watch` (its encoder filled in here) to be evaluated in the cycle when
+    /// `(port, group, offset)` is an object encoded from one channel's status; false when it
+    /// is not, or the machine did not take it (the caller samples by reading then).
+    pub fn watch(
+        &self,
+        port: u16,
+        group: u32,
+        offset: u32,
+        length: u32,
+        make: impl FnOnce(u32, crate::machine::watch::Encode) -> crate::machine::watch::Watch,
+    ) -> bool {
+        if port != com::PORT {
+            return false;
+        }
+        let b = self.backend.as_ref();
+        let Some((ch, encode)) = com::channel_encoder(b, group, offset, length) else {
+            return false;
+        };
+        let slot = crate::machine::watch::WatchSlot::new(make(u32::from(ch), encode));
+        matches!(
+            b.call(ch, super::backend::Op::Watch(slot)),
+            Ok(super::backend::Reply::Done)
+        )
+    }
+
     /// Whether `port` is served (else the router answers AMS error 6).
     pub fn serves(port: u16) -> bool {
         PORTS.contains(&port)

@@ -29,6 +29,7 @@ use super::payload::{self, response, NotificationRequest, Request};
 use super::result::AdsResult;
 use super::slots::{Admission, Progress, Slots, EVICT_QUIET};
 use super::sum;
+use crate::machine::watch::{Delivery, Watch};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
@@ -543,6 +544,26 @@ struct Notification {
     /// False until the AddDeviceNotification response is written: no sample goes out before
     /// the client knows the handle.
     armed: bool,
+    /// Evaluated in the cycle (`machine::watch`) rather than polled by the notifier thread.
+    watch: Option<Arc<CycleWatch>>,
+}
+
+/// The server's half of a notification evaluated in the cycle: the flag that ends it and
+/// when its first sample may go out.
+struct CycleWatch {
+    alive: Arc<AtomicBool>,
+    /// Set once the AddDeviceNotification response is queued ([`arm_notifications`]).
+    first_sample_at: Mutex<Option<Instant>>,
+}
+
+impl Drop for Notification {
+    /// A handle removed from its connection's table (deleted, port closed, connection
+    /// ended) ends its watch: the next tick drops it.
+    fn drop(&mut self) {
+        if let Some(w) = &self.watch {
+            w.alive.store(false, Ordering::Relaxed);
+        }
+    }
 }
 
 /// Per-connection notification table, polled by the notifier thread.
@@ -925,6 +946,9 @@ fn arm_notifications(notifs: &Notifications) {
     for n in lock(&notifs.table).values_mut().filter(|n| !n.armed) {
         n.armed = true;
         n.next_due = due;
+        if let Some(w) = &n.watch {
+            *lock(&w.first_sample_at) = Some(due);
+        }
     }
     if let Some(h) = lock(&notifs.notifier).as_ref() {
         h.thread().unpark();
@@ -1155,7 +1179,7 @@ fn add_notification(
     };
     let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
         .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
-    let mut table = lock(&notifs.table);
+    let table = lock(&notifs.table);
     // 0x716 (no more handles) for the connection's limits (handles, samples a second) and the
     // whole server's budget: the one error a client already handles when a table is full.
     // The connection's rate is summed over its table (at most `max_notifications` handles).
@@ -1171,7 +1195,12 @@ fn add_notification(
         return (AdsResult::NO_MORE_HANDLES, 0);
     }
     let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);
-    table.insert(
+    // Only this connection's thread adds to its table, so nothing comes between the checks
+    // above and the insert below while the watch is registered through the runtime.
+    drop(table);
+    let watch = watch_in_cycle(header, &req, cycle, on_change, handle, shared, writer);
+    let in_cycle = watch.is_some();
+    lock(&notifs.table).insert(
         handle,
         Notification {
             client: header.source,
@@ -1183,11 +1212,11 @@ fn add_notification(
             next_due: Instant::now() + MAX_NOTIFICATION_CYCLE,
             last: None,
             armed: false,
+            watch,
         },
     );
-    drop(table);
     let mut notifier = lock(&notifs.notifier);
-    if notifier.is_none() {
+    if notifier.is_none() && !in_cycle {
         let (s, w, n) = (Arc::clone(shared), Arc::clone(writer), Arc::clone(notifs));
         *notifier = std::thread::Builder::new()
             .name("ads-notify".into())
@@ -1195,6 +1224,73 @@ fn add_notification(
             .ok();
     }
     (AdsResult::OK, handle)
+}
+
+/// Register the notification `handle` to be evaluated in the cycle when its object allows
+/// (`objects::Devices::watch`); `None` when it is sampled by the notifier thread instead.
+fn watch_in_cycle(
+    header: &AmsHeader,
+    req: &NotificationRequest,
+    cycle: Duration,
+    on_change: bool,
+    handle: u32,
+    shared: &Shared,
+    writer: &Writer,
+) -> Option<Arc<CycleWatch>> {
+    let state = Arc::new(CycleWatch {
+        alive: Arc::new(AtomicBool::new(true)),
+        first_sample_at: Mutex::new(None),
+    });
+    let (client, device) = (header.source, header.target);
+    let (w, st) = (Arc::clone(writer), Arc::clone(&state));
+    let deliver = move |bytes: &[u8]| {
+        if !st.alive.load(Ordering::Relaxed) {
+            return Delivery::Gone;
+        }
+        match *lock(&st.first_sample_at) {
+            Some(t) if Instant::now() >= t => {}
+            _ => return Delivery::NotYet,
+        }
+        match send(&w, &notification_frame(client, device, handle, bytes)) {
+            Ok(()) => Delivery::Sent,
+            Err(_) => Delivery::Gone,
+        }
+    };
+    let alive = Arc::clone(&state.alive);
+    let taken = shared.devices.watch(
+        device.port,
+        req.group,
+        req.offset,
+        req.length,
+        |channel, encode| Watch {
+            channel,
+            cycle,
+            on_change,
+            encode,
+            deliver: Box::new(deliver),
+            alive,
+        },
+    );
+    if !taken {
+        state.alive.store(false, Ordering::Relaxed);
+        return None;
+    }
+    Some(state)
+}
+
+/// One DeviceNotification frame of one sample. Flags 0x0004: a notification is a request
+/// the client does not answer.
+fn notification_frame(client: AmsAddr, device: AmsAddr, handle: u32, bytes: &[u8]) -> Vec<u8> {
+    let header = AmsHeader {
+        target: client,
+        source: device,
+        command: CommandId::DeviceNotification,
+        state_flags: FLAGS_REQUEST,
+        error: 0,
+        invoke_id: 0,
+    };
+    let payload = response::notification(filetime_now(), &[(handle, bytes)]);
+    frame::encode(&header, &payload)
 }
 
 fn filetime_now() -> u64 {
@@ -1214,7 +1310,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
         let mut next = now + Duration::from_millis(20);
         {
             let mut table = lock(&notifs.table);
-            for (&handle, n) in table.iter_mut() {
+            for (&handle, n) in table.iter_mut().filter(|(_, n)| n.watch.is_none()) {
                 if n.armed && n.next_due <= now {
                     n.next_due = now + n.cycle;
                     let read =
@@ -1223,17 +1319,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
                             .read(n.device.port, n.req.group, n.req.offset, n.req.length);
                     if let Ok(bytes) = read {
                         if !n.on_change || n.last.as_deref() != Some(bytes.as_slice()) {
-                            let header = AmsHeader {
-                                target: n.client,
-                                source: n.device,
-                                command: CommandId::DeviceNotification,
-                                state_flags: FLAGS_REQUEST,
-                                error: 0,
-                                invoke_id: 0,
-                            };
-                            let payload =
-                                response::notification(filetime_now(), &[(handle, &bytes)]);
-                            frames.push(frame::encode(&header, &payload));
+                            frames.push(notification_frame(n.client, n.device, handle, &bytes));
                             n.last = Some(bytes);
                         }
                     }

@@ -935,3 +935,52 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
     stop.stop();
     runtime.join().unwrap();
 }
+
+/// `cnc_tick_counter_r` (docs/ads.md): the tick index, one more every tick.
+const TICK_COUNTER: u32 = 0x251;
+
+#[test]
+fn a_1_ms_notification_sees_every_tick_and_a_cyclic_one_samples_every_cycle() {
+    let (srv, _b) = server();
+    let mut raw = Raw::connect(srv.local_addr());
+    // On change (4) checked every 1 ms, and cyclic (3) every 10 ms, on a value that changes
+    // every tick of the 1 ms cycle.
+    let on_change = request::add_notification(CH1, TICK_COUNTER, 4, 4, 0, 10_000);
+    let cyclic = request::add_notification(CH1, TICK_COUNTER, 4, 3, 0, 100_000);
+    let every = u32_at(&raw.call(ADD_NOTIFICATION, 1, &on_change).1, 4);
+    let mut tens = None;
+    let mut seen: std::collections::HashMap<u32, Vec<u32>> = Default::default();
+    raw.send(&request_bytes(
+        ADD_NOTIFICATION,
+        device(),
+        client_addr(40000),
+        2,
+        &cyclic,
+    ));
+    while seen.get(&every).map_or(0, Vec::len) < 1000
+        || tens.is_none_or(|t| seen.get(&t).map_or(0, Vec::len) < 50)
+    {
+        let (h, d) = raw.frame();
+        match h.command.to_u16() {
+            ADD_NOTIFICATION => tens = Some(u32_at(&d, 4)),
+            8 => {
+                for s in payload::decode_notification(&d).unwrap() {
+                    seen.entry(s.handle).or_default().push(u32_at(&s.data, 0));
+                }
+            }
+            _ => {}
+        }
+    }
+    let steps = |h: u32| -> Vec<u32> { seen[&h].windows(2).map(|w| w[1] - w[0]).collect() };
+    assert!(
+        steps(every).iter().all(|&d| d == 1),
+        "the 1 ms on-change handle saw every tick: {:?}",
+        steps(every)
+    );
+    let tens = tens.unwrap();
+    assert!(
+        steps(tens).iter().all(|&d| d == 10),
+        "the 10 ms cyclic handle sampled every 10th tick: {:?}",
+        steps(tens)
+    );
+}

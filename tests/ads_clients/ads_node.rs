@@ -65,9 +65,18 @@ fn node_ten_hmis_connect_beside_one_heavy_subscriber() {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/many_hmis_test.js");
     let (seen, _) = common::run_client(served, &node, script, &[]);
     println!("MANY HMIS {seen}");
-    assert_eq!(seen["heavy_handles"], 10, "ten 1 ms handles on one connection");
-    assert_eq!(seen["hmis_connected"], 10, "ten default connect()s beside it");
-    assert_eq!(seen["hmi_samples"], 10, "each HMI's own subscription samples");
+    assert_eq!(
+        seen["heavy_handles"], 10,
+        "ten 1 ms handles on one connection"
+    );
+    assert_eq!(
+        seen["hmis_connected"], 10,
+        "ten default connect()s beside it"
+    );
+    assert_eq!(
+        seen["hmi_samples"], 10,
+        "each HMI's own subscription samples"
+    );
     assert_eq!(
         seen["heavy_eleventh"], 0x716,
         "the heavy client's eleventh 1 ms handle is refused to it"
