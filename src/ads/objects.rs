@@ -271,3 +271,44 @@ pub fn markdown(objects: &[ObjectInfo]) -> String {
     }
     out
 }
+
+/// A channel count and nothing else: what resolving a COM channel object needs.
+struct Channels(u16);
+
+impl CncBackend for Channels {
+    fn channel_count(&self) -> u16 {
+        self.0
+    }
+
+    fn call(
+        &self,
+        _: u16,
+        _: super::backend::Op,
+    ) -> Result<super::backend::Reply, super::backend::DeviceError> {
+        Err(super::backend::DeviceError::NotReady)
+    }
+}
+
+/// `bench --load cycle --notifications`: a 1 ms on-change watch of channel `ch`'s
+/// `ncc_blocks_executed_r` with the object table's own encoder, counting its samples into
+/// `samples` where the ADS server queues a frame.
+pub(crate) fn bench_watch(
+    ch: u16,
+    samples: Arc<std::sync::atomic::AtomicU64>,
+) -> Option<crate::machine::watch::Watch> {
+    use crate::machine::watch::{Delivery, Watch};
+    let group = com::GROUP_CHANNEL + u32::from(ch);
+    let (channel, encode) = com::channel_encoder(&Channels(ch), group, offset::BLOCK_COUNTER, 8)?;
+    Some(Watch {
+        channel: u32::from(channel),
+        cycle: std::time::Duration::from_millis(1),
+        on_change: true,
+        encode,
+        deliver: Box::new(move |bytes: &[u8]| {
+            std::hint::black_box(bytes);
+            samples.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Delivery::Sent
+        }),
+        alive: Arc::new(std::sync::atomic::AtomicBool::new(true)),
+    })
+}

@@ -127,6 +127,12 @@ pub struct Machine {
 }
 
 impl Machine {
+    /// Evaluate `w` after every tick from now on; false when [`watch::MAX_WATCHES`] are
+    /// active.
+    pub fn watch(&mut self, w: watch::Watch) -> bool {
+        self.watches.add(&watch::WatchSlot::new(w))
+    }
+
     pub fn new(channels: Vec<Channel>, log: EventLog, stop_when: StopWhen) -> Self {
         let n = channels.len();
         Machine {
