@@ -1028,7 +1028,7 @@ fn handle_request(
         }
         Some(Err(e)) => error_payload(header.command, e.result()),
         // The runtime is stalled and this request's reply timeout, counted from its arrival,
-        // would pass while it waited: "busy, not applied" now, without asking the runtime.
+        // has passed: "busy, not applied" now, without asking the runtime.
         Some(Ok(
             Request::Read { .. }
             | Request::Write { .. }

@@ -29,9 +29,10 @@ pub(crate) use crate::vocab::ams::DEFAULT_REPLY_TIMEOUT as REPLY_TIMEOUT;
 /// While the runtime has left a call unanswered, later calls wait at most this long: a
 /// runtime that is back answers within a few periods. A request queued behind others on its
 /// connection (a client that sends several at once) whose reply timeout, counted from its
-/// arrival, would pass during such a wait is answered "busy" without one
+/// arrival, has passed by its turn is answered "busy" without a call
 /// ([`CncBackend::overdue`]), so every request in flight is answered within `reply_timeout`
-/// of its own arrival, not one `STALLED_WAIT` after the one before it.
+/// (and at most one `STALLED_WAIT`) of its own arrival, not one `STALLED_WAIT` after the one
+/// before it.
 const STALLED_WAIT: Duration = Duration::from_millis(50);
 
 pub struct ChannelBackend {
@@ -79,10 +80,11 @@ impl CncBackend for ChannelBackend {
     /// `reply_timeout` ([`STALLED_WAIT`] while an earlier call is unanswered). Once the runtime holds the claim its reply is waited for without a
     /// limit: it is being applied in the tick running now, and answering "busy" then would
     /// make a retrying client apply it twice.
-    /// Stalled, and a wait of [`STALLED_WAIT`] would end past `arrived` + `reply_timeout`.
+    /// Stalled, and `reply_timeout` has passed since `arrived`. A request still inside its
+    /// reply timeout makes its call (at most [`STALLED_WAIT`]), so a runtime that is back is
+    /// noticed even when `reply_timeout` is no longer than that wait.
     fn overdue(&self, arrived: Instant) -> bool {
-        self.stalled.load(Ordering::Relaxed)
-            && arrived.elapsed() + self.reply_timeout.min(STALLED_WAIT) >= self.reply_timeout
+        self.stalled.load(Ordering::Relaxed) && arrived.elapsed() >= self.reply_timeout
     }
 
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
@@ -185,9 +187,9 @@ pub trait CncBackend: Send + Sync + 'static {
     /// runtime is gone, [`DeviceError::NotFound`] for a channel that does not exist.
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError>;
     /// Whether a request that reached the caller at `arrived` should be answered "busy"
-    /// (0x708, not applied) without a call: the runtime is known to be stalled and a call
-    /// could not be answered before the request's reply timeout, counted from its arrival,
-    /// has passed. A backend that never stalls says no.
+    /// (0x708, not applied) without a call: the runtime is known to be stalled and the
+    /// request's reply timeout, counted from its arrival, has passed. A backend that never
+    /// stalls says no.
     fn overdue(&self, arrived: Instant) -> bool {
         let _ = arrived;
         false
