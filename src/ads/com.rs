@@ -346,6 +346,41 @@ fn find(scope: Scope, element: u32) -> Option<&'static Def> {
         .find(|d| d.scope == scope && d.element == element)
 }
 
+/// The encoder of the channel object `(group, offset)` for a notification evaluated in the
+/// cycle (`machine::watch`): its 1-based channel and the function that encodes it from that
+/// channel's status, exactly as [`read`] does (platform objects from channel 1's). `None` for
+/// objects that are not read from one channel's status (axis objects, the axis count, the
+/// description table), which are sampled by reading.
+pub(crate) fn channel_encoder(
+    backend: &dyn CncBackend,
+    group: u32,
+    offset: u32,
+    length: u32,
+) -> Option<(u16, crate::machine::watch::Encode)> {
+    if channel_in(group, GROUP_DESCRIPTION, GROUP_DESCRIPTION_INDEX).is_some() {
+        return None;
+    }
+    let t = resolve(backend, group, offset).ok()?;
+    if !t.def.access.readable() {
+        return None;
+    }
+    let (def, ch) = (t.def, t.ch);
+    match t.def.scope {
+        Scope::Channel => Some((
+            ch,
+            Box::new(move |v: &Status| read_channel(v, ch, def, length).ok()),
+        )),
+        Scope::Platform if def.field != Field::AxisCount => {
+            let channels = backend.channel_count();
+            Some((
+                1,
+                Box::new(move |v: &Status| platform_from_status(v, channels, def, length).ok()),
+            ))
+        }
+        _ => None,
+    }
+}
+
 /// Which object `(group, offset)` names, or 0x702/0x703.
 fn resolve(
     backend: &dyn CncBackend,
@@ -571,8 +606,26 @@ fn active_d(v: &Status) -> i32 {
 }
 
 fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec<u8>, AdsResult> {
-    let channels = backend.channel_count();
+    if def.field == Field::AxisCount {
+        return fixed(
+            (platform_axes(backend)?.len() as u32)
+                .to_le_bytes()
+                .to_vec(),
+            length,
+        );
+    }
     let v = backend.status(1).map_err(dev)?;
+    platform_from_status(&v, backend.channel_count(), def, length)
+}
+
+/// A platform object other than the axis count, from channel 1's status ("the first channel
+/// drives platform data", infosys 312764171) and the number of channels.
+fn platform_from_status(
+    v: &Status,
+    channels: u16,
+    def: &Def,
+    length: u32,
+) -> Result<Vec<u8>, AdsResult> {
     let t = v.cycle_times;
     let bytes = match def.field {
         Field::TickCounter => (v.tick as u32).to_le_bytes().to_vec(),
@@ -587,9 +640,6 @@ fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec
                 length,
             ))
         }
-        Field::AxisCount => (platform_axes(backend)?.len() as u32)
-            .to_le_bytes()
-            .to_vec(),
         Field::ChannelCount | Field::ChannelMax => channels.to_le_bytes().to_vec(),
         Field::AxisMax => (MAX_AXES_PER_CHANNEL * u32::from(channels))
             .to_le_bytes()
@@ -601,7 +651,7 @@ fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec
         Field::TimeAvg => duration_tenth_us(t.mean()).to_le_bytes().to_vec(),
         // "The first channel drives platform data" (infosys 312764171): ncchannel has no
         // errors outside its channels.
-        Field::PlatformErrorMessage => return Ok(text(&error_text(&v), def.size, length)),
+        Field::PlatformErrorMessage => return Ok(text(&error_text(v), def.size, length)),
         _ => return Err(AdsResult::ACCESS_DENIED),
     };
     fixed(bytes, length)

@@ -85,6 +85,37 @@ impl Devices {
         }
     }
 
+    /// Whether a request that reached the server at `arrived` is answered "busy" without
+    /// asking the runtime ([`CncBackend::overdue`]).
+    pub fn overdue(&self, arrived: std::time::Instant) -> bool {
+        self.backend.overdue(arrived)
+    }
+
+    /// Register `watch` (its encoder filled in here) to be evaluated in the cycle when
+    /// `(port, group, offset)` is an object encoded from one channel's status; false when it
+    /// is not, or the machine did not take it (the caller samples by reading then).
+    pub fn watch(
+        &self,
+        port: u16,
+        group: u32,
+        offset: u32,
+        length: u32,
+        make: impl FnOnce(u32, crate::machine::watch::Encode) -> crate::machine::watch::Watch,
+    ) -> bool {
+        if port != com::PORT {
+            return false;
+        }
+        let b = self.backend.as_ref();
+        let Some((ch, encode)) = com::channel_encoder(b, group, offset, length) else {
+            return false;
+        };
+        let slot = crate::machine::watch::WatchSlot::new(make(u32::from(ch), encode));
+        matches!(
+            b.call(ch, super::backend::Op::Watch(slot)),
+            Ok(super::backend::Reply::Done)
+        )
+    }
+
     /// Whether `port` is served (else the router answers AMS error 6).
     pub fn serves(port: u16) -> bool {
         PORTS.contains(&port)
@@ -313,4 +344,45 @@ pub fn markdown(objects: &[ObjectInfo]) -> String {
         out.push('\n');
     }
     out
+}
+
+/// A channel count and nothing else: what resolving a COM channel object needs.
+struct Channels(u16);
+
+impl CncBackend for Channels {
+    fn channel_count(&self) -> u16 {
+        self.0
+    }
+
+    fn call(
+        &self,
+        _: u16,
+        _: super::backend::Op,
+    ) -> Result<super::backend::Reply, super::backend::DeviceError> {
+        Err(super::backend::DeviceError::NotReady)
+    }
+}
+
+/// `bench --load cycle --notifications`: a 1 ms on-change watch of channel `ch`'s
+/// `ncc_blocks_executed_r` with the object table's own encoder, counting its samples into
+/// `samples` where the ADS server queues a frame.
+pub(crate) fn bench_watch(
+    ch: u16,
+    samples: Arc<std::sync::atomic::AtomicU64>,
+) -> Option<crate::machine::watch::Watch> {
+    use crate::machine::watch::{Delivery, Watch};
+    let group = com::GROUP_CHANNEL + u32::from(ch);
+    let (channel, encode) = com::channel_encoder(&Channels(ch), group, offset::BLOCK_COUNTER, 8)?;
+    Some(Watch {
+        channel: u32::from(channel),
+        cycle: std::time::Duration::from_millis(1),
+        on_change: true,
+        encode,
+        deliver: Box::new(move |bytes: &[u8]| {
+            std::hint::black_box(bytes);
+            samples.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Delivery::Sent
+        }),
+        alive: Arc::new(std::sync::atomic::AtomicBool::new(true)),
+    })
 }

@@ -1,10 +1,13 @@
 //! The ADS/TCP server: accepts connections, frames requests, answers them through the object
 //! table, and pushes DeviceNotification frames.
 //!
-//! One thread per connection (at most `max_connections`, default 64; beyond that the
-//! connection quiet for longest gives its slot up, or the newcomer is closed: `slots.rs`),
-//! one writer thread per connection draining its bounded send queue, plus one notification
-//! thread per connection that has notification handles. Channel calls may
+//! One thread per connection answering its requests in order (at most `max_connections`,
+//! default 64; beyond that the connection quiet for longest gives its slot up, or the
+//! newcomer is closed: `slots.rs`), one reader thread per connection that stamps each
+//! request with its arrival ([`Inbox`]), one writer thread per connection draining its
+//! bounded send queue, plus one notification
+//! thread per connection that has notification handles on objects not evaluated in the
+//! cycle (COM channel and platform objects are: `machine::watch`). Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
 //! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
@@ -28,10 +31,13 @@ use super::result::AdsResult;
 use super::route_service::{self, Identity, RouteService, ROUTE_SERVICE_PORT};
 use super::routes::RouteTable;
 use super::slots::{Admission, Progress, Slots, EVICT_QUIET, FIRST_REQUEST_GRACE};
+use super::sum;
+use crate::machine::watch::{Delivery, Watch};
 use crate::vocab::ams::{
     AmsNetId, RouteEntry, DEFAULT_BIND, DEFAULT_IDLE_TIMEOUT, DEFAULT_MAX_CONNECTIONS,
     DEFAULT_MAX_FRAME_BYTES, DEFAULT_MAX_NOTIFICATIONS, DEFAULT_MAX_NOTIFICATIONS_TOTAL,
     DEFAULT_NET_ID, DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+    DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION,
 };
 
 /// Default bound on the bytes waiting in one connection's send queue.
@@ -71,6 +77,9 @@ pub struct ServerConfig {
     /// Notification samples per second over all connections (each handle costs one sample
     /// per cycle time); a handle that would exceed it is answered 0x716.
     pub notification_samples_per_s: u64,
+    /// Notification samples per second of one connection; a handle that would exceed it is
+    /// answered 0x716 to that connection only.
+    pub notification_samples_per_s_per_connection: u64,
     /// A connection that has not completed a frame for this long is closed when it is in the
     /// middle of a frame (a slow or stalled sender) or holds no notification handles (an
     /// idle client holding a slot). A client with notifications may stay silent for ever.
@@ -97,6 +106,8 @@ impl Default for ServerConfig {
             max_notifications: DEFAULT_MAX_NOTIFICATIONS,
             max_notifications_total: DEFAULT_MAX_NOTIFICATIONS_TOTAL,
             notification_samples_per_s: DEFAULT_NOTIFICATION_SAMPLES_PER_S,
+            notification_samples_per_s_per_connection:
+                DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION,
             idle_timeout: DEFAULT_IDLE_TIMEOUT,
             max_send_queue_bytes: DEFAULT_MAX_SEND_QUEUE_BYTES,
             allow: Vec::new(),
@@ -601,6 +612,26 @@ struct Notification {
     /// False until the AddDeviceNotification response is written: no sample goes out before
     /// the client knows the handle.
     armed: bool,
+    /// Evaluated in the cycle (`machine::watch`) rather than polled by the notifier thread.
+    watch: Option<Arc<CycleWatch>>,
+}
+
+/// The server's half of a notification evaluated in the cycle: the flag that ends it and
+/// when its first sample may go out.
+struct CycleWatch {
+    alive: Arc<AtomicBool>,
+    /// Set once the AddDeviceNotification response is queued ([`arm_notifications`]).
+    first_sample_at: Mutex<Option<Instant>>,
+}
+
+impl Drop for Notification {
+    /// A handle removed from its connection's table (deleted, port closed, connection
+    /// ended) ends its watch: the next tick drops it.
+    fn drop(&mut self) {
+        if let Some(w) = &self.watch {
+            w.alive.store(false, Ordering::Relaxed);
+        }
+    }
 }
 
 /// Per-connection notification table, polled by the notifier thread.
@@ -620,6 +651,9 @@ enum ConnError {
     Io(#[from] io::Error),
     #[error("{0}: connection closed")]
     Idle(String),
+    /// The reader has ended and every frame it read is answered.
+    #[error("connection closed")]
+    Ended,
 }
 
 fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Result<(), ConnError> {
@@ -659,20 +693,200 @@ fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Res
     result
 }
 
+/// Frames read from one connection and not yet answered, each with the instant the read that
+/// completed it returned. The connection's reader thread keeps reading while a request waits
+/// for the runtime, so a request's reply deadline counts from its own arrival, not from the
+/// answer to the one before it (a client with 50 requests in flight through a runtime stall
+/// hears "busy" for each within `reply_timeout` of sending it). Bounded in bytes like the
+/// [`Outbox`]: past the limit the reader stops reading and TCP holds the client back.
+struct Inbox {
+    state: Mutex<InboxState>,
+    ready: Condvar,
+    limit_bytes: usize,
+}
+
+#[derive(Default)]
+struct InboxState {
+    frames: VecDeque<(Instant, Frame, usize)>,
+    /// Bytes of the frames in `frames`.
+    bytes: usize,
+    /// A frame has been taken and its answer is not written yet.
+    serving: bool,
+    /// The reader is done, and why (`Ok` for the client's or the server's clean close).
+    ended: Option<Result<(), ConnError>>,
+    /// The request loop is done: the reader stops.
+    closed: bool,
+}
+
+impl Inbox {
+    fn new(limit_bytes: usize) -> Self {
+        Inbox {
+            state: Mutex::new(InboxState::default()),
+            ready: Condvar::new(),
+            limit_bytes,
+        }
+    }
+
+    /// Queue a frame of `len` bytes, waiting while the inbox is full; `false` once the request
+    /// loop is gone.
+    fn push(&self, arrived: Instant, frame: Frame, len: usize) -> bool {
+        let mut st = lock(&self.state);
+        while !st.closed && !st.frames.is_empty() && st.bytes + len > self.limit_bytes {
+            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+        }
+        if st.closed {
+            return false;
+        }
+        st.bytes += len;
+        st.frames.push_back((arrived, frame, len));
+        self.ready.notify_all();
+        true
+    }
+
+    /// The next frame and its arrival, or why the reader ended once every frame is taken.
+    fn pop(&self) -> Result<(Instant, Frame), ConnError> {
+        let mut st = lock(&self.state);
+        st.serving = false;
+        loop {
+            if let Some((arrived, frame, len)) = st.frames.pop_front() {
+                st.bytes -= len;
+                st.serving = true;
+                self.ready.notify_all();
+                return Ok((arrived, frame));
+            }
+            if let Some(end) = st.ended.take() {
+                // Ended for good: the next pop says so again.
+                st.ended = Some(Ok(()));
+                return end.and(Err(ConnError::Ended));
+            }
+            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+        }
+    }
+
+    /// Frames wait or one is being answered: the client is not idle.
+    fn busy(&self) -> bool {
+        let st = lock(&self.state);
+        st.serving || !st.frames.is_empty()
+    }
+
+    fn end(&self, why: Result<(), ConnError>) {
+        lock(&self.state).ended.get_or_insert(why);
+        self.ready.notify_all();
+    }
+
+    fn close(&self) {
+        lock(&self.state).closed = true;
+        self.ready.notify_all();
+    }
+}
+
+/// Bytes of frames one connection may have read ahead of its answers ([`Inbox`]).
+const MAX_INBOX_BYTES: usize = 256 * 1024;
+
+/// Answer the frames the reader thread queues, in order, until the connection ends.
 fn request_loop(
-    mut stream: TcpStream,
+    stream: TcpStream,
     conn: &Conn,
     shared: &Arc<Shared>,
     writer: &Writer,
     notifs: &Arc<Notifications>,
 ) -> Result<(), ConnError> {
+    let inbox = Arc::new(Inbox::new(
+        MAX_INBOX_BYTES.max(shared.config.max_frame_bytes),
+    ));
+    let reader = {
+        let (s, w, n, i) = (
+            Arc::clone(shared),
+            Arc::clone(writer),
+            Arc::clone(notifs),
+            Arc::clone(&inbox),
+        );
+        let read_half = stream.try_clone()?;
+        std::thread::Builder::new()
+            .name("ads-read".into())
+            .spawn(move || i.end(read_loop(read_half, &s, &w, &n, &i)))?
+    };
+    let result = answer_loop(conn, shared, writer, notifs, &inbox);
+    inbox.close();
+    let _ = stream.shutdown(Shutdown::Read);
+    let _ = reader.join();
+    match result {
+        Err(ConnError::Ended) => Ok(()),
+        r => r,
+    }
+}
+
+fn answer_loop(
+    conn: &Conn,
+    shared: &Arc<Shared>,
+    writer: &Writer,
+    notifs: &Arc<Notifications>,
+    inbox: &Inbox,
+) -> Result<(), ConnError> {
     let (peer, ip_routed) = (conn.peer, conn.ip_routed);
+    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
+    let mut logged_foreign: Vec<AmsNetId> = Vec::new();
+    loop {
+        let (arrived, frame) = inbox.pop()?;
+        match frame {
+            Frame::Ams { header, data } => {
+                let routed = ip_routed || shared.routes.routes_net_id(header.source.net_id);
+                if !routed {
+                    note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
+                    continue;
+                }
+                if !serves_target(shared.config.net_id, header.target.net_id) {
+                    note_foreign_target(shared, peer, &mut logged_foreign, &header);
+                    let refusal = header.response(AMS_ERR_MACHINE_NOT_FOUND);
+                    send(writer, &frame::encode(&refusal, &[]))?;
+                    continue;
+                }
+                let late = shared.devices.overdue(arrived);
+                if let Some(reply) = handle_request(&header, &data, late, shared, writer, notifs) {
+                    send(writer, &reply)?;
+                    conn.progress.mark();
+                    if adds_notifications(&header, &data) {
+                        arm_notifications(notifs);
+                    }
+                }
+            }
+            Frame::Router {
+                command: PORT_CLOSE,
+                body,
+            } => {
+                // The client's port is gone: its notifications end, and the connection
+                // is closed, as the TwinCAT router does, so the client's disconnect()
+                // (which waits for the close) returns at once.
+                close_port(shared, notifs, &body);
+                return Ok(());
+            }
+            Frame::Router { command, body } => {
+                if let Some(reply) = handle_router(command, &body, peer, shared) {
+                    send(writer, &reply)?;
+                    conn.progress.mark();
+                }
+            }
+        }
+        if let Some(c) = writer.closed() {
+            return Err(closed_error(c, writer.limit_bytes).into());
+        }
+    }
+}
+
+/// Read frames into `inbox`, each stamped with the instant its last bytes were read, until
+/// the client closes, sends a malformed frame, stays idle, or the answering side is gone.
+fn read_loop(
+    mut stream: TcpStream,
+    shared: &Shared,
+    writer: &Writer,
+    notifs: &Notifications,
+    inbox: &Inbox,
+) -> Result<(), ConnError> {
     let max = shared.config.max_frame_bytes;
     let mut buf: Vec<u8> = Vec::with_capacity(8192);
     let mut chunk = [0u8; 8192];
-    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
-    let mut logged_foreign: Vec<AmsNetId> = Vec::new();
     let mut last_frame = Instant::now();
+    let mut read_at = Instant::now();
     loop {
         // Cut every complete frame out of the buffer (rule 1) before reading more; the
         // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
@@ -681,43 +895,8 @@ fn request_loop(
         while let Some((frame, n)) = frame::decode(&buf[used..], max)? {
             used += n;
             last_frame = Instant::now();
-            match frame {
-                Frame::Ams { header, data } => {
-                    let routed = ip_routed || shared.routes.routes_net_id(header.source.net_id);
-                    if !routed {
-                        note_unrouted(peer, &mut logged_unrouted, header.source.net_id);
-                        continue;
-                    }
-                    if !serves_target(shared.config.net_id, header.target.net_id) {
-                        note_foreign_target(shared, peer, &mut logged_foreign, &header);
-                        let refusal = header.response(AMS_ERR_MACHINE_NOT_FOUND);
-                        send(writer, &frame::encode(&refusal, &[]))?;
-                        continue;
-                    }
-                    if let Some(reply) = handle_request(&header, &data, shared, writer, notifs) {
-                        send(writer, &reply)?;
-                        conn.progress.mark();
-                        if header.command == CommandId::AddDeviceNotification {
-                            arm_notifications(notifs);
-                        }
-                    }
-                }
-                Frame::Router {
-                    command: PORT_CLOSE,
-                    body,
-                } => {
-                    // The client's port is gone: its notifications end, and the connection
-                    // is closed, as the TwinCAT router does, so the client's disconnect()
-                    // (which waits for the close) returns at once.
-                    close_port(shared, notifs, &body);
-                    return Ok(());
-                }
-                Frame::Router { command, body } => {
-                    if let Some(reply) = handle_router(command, &body, peer, shared) {
-                        send(writer, &reply)?;
-                        conn.progress.mark();
-                    }
-                }
+            if !inbox.push(read_at, frame, n) {
+                return Ok(());
             }
         }
         buf.drain(..used);
@@ -740,7 +919,9 @@ fn request_loop(
                     io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
                 ) =>
             {
-                check_idle(last_frame, &buf, shared, notifs)?;
+                if !inbox.busy() {
+                    check_idle(last_frame, &buf, shared, notifs)?;
+                }
                 continue;
             }
             Err(e) if shared.stopping.load(Ordering::SeqCst) => {
@@ -755,6 +936,7 @@ fn request_loop(
                 .into())
             }
         };
+        read_at = Instant::now();
         buf.extend_from_slice(&chunk[..n]);
     }
 }
@@ -861,6 +1043,9 @@ fn arm_notifications(notifs: &Notifications) {
     for n in lock(&notifs.table).values_mut().filter(|n| !n.armed) {
         n.armed = true;
         n.next_due = due;
+        if let Some(w) = &n.watch {
+            *lock(&w.first_sample_at) = Some(due);
+        }
     }
     if let Some(h) = lock(&notifs.notifier).as_ref() {
         h.thread().unpark();
@@ -905,6 +1090,7 @@ fn version_numbers() -> (u8, u8, u16) {
 fn handle_request(
     header: &AmsHeader,
     data: &[u8],
+    late: bool,
     shared: &Arc<Shared>,
     writer: &Writer,
     notifs: &Arc<Notifications>,
@@ -926,6 +1112,14 @@ fn handle_request(
             response::result_only(AdsResult::SERVICE_NOT_SUPPORTED)
         }
         Some(Err(e)) => error_payload(header.command, e.result()),
+        // The runtime is stalled and this request's reply timeout, counted from its arrival,
+        // has passed: "busy, not applied" now, without asking the runtime.
+        Some(Ok(
+            Request::Read { .. }
+            | Request::Write { .. }
+            | Request::ReadWrite { .. }
+            | Request::AddNotification(_),
+        )) if late => error_payload(header.command, AdsResult::BUSY),
         Some(Ok(req)) => match req {
             Request::ReadDeviceInfo => match Devices::device_info(port) {
                 Some((major, minor, build, name)) => {
@@ -963,6 +1157,23 @@ fn handle_request(
                 Err(r) => r,
             }),
             Request::ReadWrite {
+                group: group @ (sum::ADD_NOTIFICATIONS | sum::DELETE_NOTIFICATIONS),
+                offset: count,
+                read_length,
+                data,
+            } => {
+                let sums = SumNotifications {
+                    header,
+                    shared,
+                    writer,
+                    notifs,
+                };
+                match sums.serve(group, count, read_length, &data) {
+                    Ok(bytes) => response::with_data(AdsResult::OK, &bytes),
+                    Err(r) => response::with_data(r, &[]),
+                }
+            }
+            Request::ReadWrite {
                 group,
                 offset,
                 read_length,
@@ -976,17 +1187,58 @@ fn handle_request(
                 response::handle(result, handle)
             }
             Request::DelNotification { handle } => {
-                let removed = lock(&notifs.table).remove(&handle);
-                shared.release(removed.as_ref());
-                response::result_only(if removed.is_some() {
-                    AdsResult::OK
-                } else {
-                    AdsResult::INVALID_HANDLE
-                })
+                response::result_only(delete_notification(shared, notifs, handle))
             }
         },
     };
     Some(frame::encode(&header.response(0), &payload))
+}
+
+/// A sum add/delete notification request and the connection whose table it changes.
+struct SumNotifications<'a> {
+    header: &'a AmsHeader,
+    shared: &'a Arc<Shared>,
+    writer: &'a Writer,
+    notifs: &'a Arc<Notifications>,
+}
+
+impl SumNotifications<'_> {
+    /// Serve sum `group` (0xF085 or 0xF086) with `count` entries in `data`.
+    fn serve(
+        &self,
+        group: u32,
+        count: u32,
+        read_length: u32,
+        data: &[u8],
+    ) -> Result<Vec<u8>, AdsResult> {
+        let (header, shared, writer, notifs) = (self.header, self.shared, self.writer, self.notifs);
+        if group == sum::ADD_NOTIFICATIONS {
+            let mut add = |req| add_notification(header, req, shared, writer, notifs);
+            sum::add_notifications(count, read_length, data, &mut add)
+        } else {
+            let mut delete = |handle| delete_notification(shared, notifs, handle);
+            sum::delete_notifications(count, read_length, data, &mut delete)
+        }
+    }
+}
+
+/// Remove notification `handle` of this connection and give its budget back.
+fn delete_notification(shared: &Shared, notifs: &Notifications, handle: u32) -> AdsResult {
+    let removed = lock(&notifs.table).remove(&handle);
+    shared.release(removed.as_ref());
+    if removed.is_some() {
+        AdsResult::OK
+    } else {
+        AdsResult::INVALID_HANDLE
+    }
+}
+
+/// Whether the request makes notification handles (AddDeviceNotification, or a sum add
+/// notification ReadWrite): their first samples are planned once its response is queued.
+fn adds_notifications(header: &AmsHeader, data: &[u8]) -> bool {
+    header.command == CommandId::AddDeviceNotification
+        || (header.command == CommandId::ReadWrite
+            && data.get(..4) == Some(&sum::ADD_NOTIFICATIONS.to_le_bytes()[..]))
 }
 
 /// The error response shaped as the command's response (result alone, or result + zero).
@@ -1017,14 +1269,28 @@ fn add_notification(
     };
     let cycle = Duration::from_nanos(u64::from(req.cycle_time_100ns) * 100)
         .clamp(MIN_NOTIFICATION_CYCLE, MAX_NOTIFICATION_CYCLE);
-    let mut table = lock(&notifs.table);
-    // 0x716 (no more handles) both for the connection's limit and the whole server's budget:
-    // the one error a client already handles when a table is full.
-    if table.len() >= shared.config.max_notifications || !shared.reserve(cycle) {
+    let table = lock(&notifs.table);
+    // 0x716 (no more handles) for the connection's limits (handles, samples a second) and the
+    // whole server's budget: the one error a client already handles when a table is full.
+    // The connection's rate is summed over its table (at most `max_notifications` handles).
+    let conn_rate: u64 = table.values().map(|n| rate_mhz(n.cycle)).sum();
+    let conn_limit = shared
+        .config
+        .notification_samples_per_s_per_connection
+        .saturating_mul(1000);
+    if table.len() >= shared.config.max_notifications
+        || conn_rate.saturating_add(rate_mhz(cycle)) > conn_limit
+        || !shared.reserve(cycle)
+    {
         return (AdsResult::NO_MORE_HANDLES, 0);
     }
     let handle = notifs.next_handle.fetch_add(1, Ordering::SeqCst);
-    table.insert(
+    // Only this connection's thread adds to its table, so nothing comes between the checks
+    // above and the insert below while the watch is registered through the runtime.
+    drop(table);
+    let watch = watch_in_cycle(header, &req, cycle, on_change, handle, shared, writer);
+    let in_cycle = watch.is_some();
+    lock(&notifs.table).insert(
         handle,
         Notification {
             client: header.source,
@@ -1036,11 +1302,11 @@ fn add_notification(
             next_due: Instant::now() + MAX_NOTIFICATION_CYCLE,
             last: None,
             armed: false,
+            watch,
         },
     );
-    drop(table);
     let mut notifier = lock(&notifs.notifier);
-    if notifier.is_none() {
+    if notifier.is_none() && !in_cycle {
         let (s, w, n) = (Arc::clone(shared), Arc::clone(writer), Arc::clone(notifs));
         *notifier = std::thread::Builder::new()
             .name("ads-notify".into())
@@ -1048,6 +1314,73 @@ fn add_notification(
             .ok();
     }
     (AdsResult::OK, handle)
+}
+
+/// Register the notification `handle` to be evaluated in the cycle when its object allows
+/// (`objects::Devices::watch`); `None` when it is sampled by the notifier thread instead.
+fn watch_in_cycle(
+    header: &AmsHeader,
+    req: &NotificationRequest,
+    cycle: Duration,
+    on_change: bool,
+    handle: u32,
+    shared: &Shared,
+    writer: &Writer,
+) -> Option<Arc<CycleWatch>> {
+    let state = Arc::new(CycleWatch {
+        alive: Arc::new(AtomicBool::new(true)),
+        first_sample_at: Mutex::new(None),
+    });
+    let (client, device) = (header.source, header.target);
+    let (w, st) = (Arc::clone(writer), Arc::clone(&state));
+    let deliver = move |bytes: &[u8]| {
+        if !st.alive.load(Ordering::Relaxed) {
+            return Delivery::Gone;
+        }
+        match *lock(&st.first_sample_at) {
+            Some(t) if Instant::now() >= t => {}
+            _ => return Delivery::NotYet,
+        }
+        match send(&w, &notification_frame(client, device, handle, bytes)) {
+            Ok(()) => Delivery::Sent,
+            Err(_) => Delivery::Gone,
+        }
+    };
+    let alive = Arc::clone(&state.alive);
+    let taken = shared.devices.watch(
+        device.port,
+        req.group,
+        req.offset,
+        req.length,
+        |channel, encode| Watch {
+            channel,
+            cycle,
+            on_change,
+            encode,
+            deliver: Box::new(deliver),
+            alive,
+        },
+    );
+    if !taken {
+        state.alive.store(false, Ordering::Relaxed);
+        return None;
+    }
+    Some(state)
+}
+
+/// One DeviceNotification frame of one sample. Flags 0x0004: a notification is a request
+/// the client does not answer.
+fn notification_frame(client: AmsAddr, device: AmsAddr, handle: u32, bytes: &[u8]) -> Vec<u8> {
+    let header = AmsHeader {
+        target: client,
+        source: device,
+        command: CommandId::DeviceNotification,
+        state_flags: FLAGS_REQUEST,
+        error: 0,
+        invoke_id: 0,
+    };
+    let payload = response::notification(filetime_now(), &[(handle, bytes)]);
+    frame::encode(&header, &payload)
 }
 
 fn filetime_now() -> u64 {
@@ -1067,7 +1400,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
         let mut next = now + Duration::from_millis(20);
         {
             let mut table = lock(&notifs.table);
-            for (&handle, n) in table.iter_mut() {
+            for (&handle, n) in table.iter_mut().filter(|(_, n)| n.watch.is_none()) {
                 if n.armed && n.next_due <= now {
                     n.next_due = now + n.cycle;
                     let read =
@@ -1076,17 +1409,7 @@ fn notify_loop(shared: &Shared, writer: &Writer, notifs: &Notifications) {
                             .read(n.device.port, n.req.group, n.req.offset, n.req.length);
                     if let Ok(bytes) = read {
                         if !n.on_change || n.last.as_deref() != Some(bytes.as_slice()) {
-                            let header = AmsHeader {
-                                target: n.client,
-                                source: n.device,
-                                command: CommandId::DeviceNotification,
-                                state_flags: FLAGS_REQUEST,
-                                error: 0,
-                                invoke_id: 0,
-                            };
-                            let payload =
-                                response::notification(filetime_now(), &[(handle, &bytes)]);
-                            frames.push(frame::encode(&header, &payload));
+                            frames.push(notification_frame(n.client, n.device, handle, &bytes));
                             n.last = Some(bytes);
                         }
                     }

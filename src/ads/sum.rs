@@ -14,11 +14,17 @@
 //! | 0xF083 read ex | as 0xF080 | n × (result, length), then slots of the requested lengths |
 //! | 0xF084 read ex 2 | as 0xF080 | n × (result, length), then the data read |
 //!
+//! | 0xF085 add notifications | n × AddDeviceNotification request (group, offset, length, mode, max delay, cycle time, 16 reserved bytes) | n × (result, handle) |
+//! | 0xF086 delete notifications | n × handle | n × result |
+//!
 //! Handles go through these: 0xF082 with 0xF003 sub-requests creates many, 0xF081 with 0xF006
-//! releases many. 0xF085/0xF086 (sum add/delete device notification) are 0x701 here: the
-//! notification table belongs to the connection, which this layer does not see.
+//! releases many. 0xF085/0xF086 (AdsLib `ADSIGRP_SUMUP_ADDDEVNOTE`/`ADSIGRP_SUMUP_DELDEVNOTE`,
+//! the layout the `ads` crate's `Device::add_notification_multi` and
+//! `delete_notification_multi` write) reach the connection's notification table, which this
+//! layer does not see: [`add_notifications`] and [`delete_notifications`] take it as a closure,
+//! and [`execute`] answers them 0x701.
 
-use super::payload::Cursor;
+use super::payload::{Cursor, NotificationRequest};
 use super::result::AdsResult;
 
 pub(crate) const READ: u32 = 0xF080;
@@ -233,6 +239,75 @@ fn read_write(
     Ok(results)
 }
 
+/// Bytes of one 0xF085 sub-request: an AddDeviceNotification request with its 16 reserved
+/// bytes.
+const ADD_NOTIFICATION_BYTES: usize = 40;
+
+/// The sub-request count of a sum command checked, and the reply budget.
+fn sum_bounds(count: u32, read_length: u32) -> Result<usize, AdsResult> {
+    if count == 0 || count > MAX_SUB_REQUESTS {
+        return Err(AdsResult::INVALID_DATA);
+    }
+    Ok((read_length as usize).min(MAX_REPLY_BYTES))
+}
+
+/// Serve 0xF085 (sum add device notification): `add` makes each of the `count` handles
+/// written in `data` and gives its result and handle (0 when refused); each sub-request is
+/// answered with its own. A malformed request as a whole makes no handle.
+pub(crate) fn add_notifications(
+    count: u32,
+    read_length: u32,
+    data: &[u8],
+    add: &mut dyn FnMut(NotificationRequest) -> (AdsResult, u32),
+) -> Result<Vec<u8>, AdsResult> {
+    let budget = sum_bounds(count, read_length)?;
+    if data.len() != count as usize * ADD_NOTIFICATION_BYTES {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    check_budget(8 * count as usize, std::iter::empty(), budget)?;
+    let mut out = Vec::with_capacity(8 * count as usize);
+    for sub in data.chunks_exact(ADD_NOTIFICATION_BYTES) {
+        let mut c = Cursor::new(sub);
+        let short = |_| AdsResult::INVALID_SIZE;
+        let req = NotificationRequest {
+            group: c.u32().map_err(short)?,
+            offset: c.u32().map_err(short)?,
+            length: c.u32().map_err(short)?,
+            mode: c.u32().map_err(short)?,
+            max_delay_100ns: c.u32().map_err(short)?,
+            cycle_time_100ns: c.u32().map_err(short)?,
+        };
+        let (result, handle) = match nested(req.group) {
+            Some(e) => (e, 0),
+            None => add(req),
+        };
+        out.extend_from_slice(&result.0.to_le_bytes());
+        out.extend_from_slice(&handle.to_le_bytes());
+    }
+    Ok(out)
+}
+
+/// Serve 0xF086 (sum delete device notification): `delete` removes each of the `count`
+/// handles written in `data` and gives its result.
+pub(crate) fn delete_notifications(
+    count: u32,
+    read_length: u32,
+    data: &[u8],
+    delete: &mut dyn FnMut(u32) -> AdsResult,
+) -> Result<Vec<u8>, AdsResult> {
+    let budget = sum_bounds(count, read_length)?;
+    if data.len() != count as usize * 4 {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    check_budget(4 * count as usize, std::iter::empty(), budget)?;
+    let mut out = Vec::with_capacity(4 * count as usize);
+    for h in data.chunks_exact(4) {
+        let handle = u32::from_le_bytes([h[0], h[1], h[2], h[3]]);
+        out.extend_from_slice(&delete(handle).0.to_le_bytes());
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -321,6 +396,59 @@ mod tests {
         assert_eq!(
             execute(&m, ADD_NOTIFICATIONS, 1, 8, &words(&[1, 0, 1])),
             Err(AdsResult::SERVICE_NOT_SUPPORTED)
+        );
+    }
+
+    #[test]
+    fn sum_notifications_answer_each_entry_and_refuse_malformed_requests_whole() {
+        let entry = |group: u32| {
+            let mut e = words(&[group, 0, 8, 4, 0, 10_000]);
+            e.extend([0u8; 16]);
+            e
+        };
+        let data = [entry(0x120101), entry(0x120102)].concat();
+        let mut made = Vec::new();
+        let mut add = |req: NotificationRequest| {
+            made.push(req.group);
+            if req.group == 0x120101 {
+                (AdsResult::OK, 7)
+            } else {
+                (AdsResult::ACCESS_DENIED, 0)
+            }
+        };
+        assert_eq!(
+            add_notifications(2, 16, &data, &mut add),
+            Ok(words(&[0, 7, 0x704, 0]))
+        );
+        // Malformed as a whole: no entry reaches `add`.
+        assert_eq!(
+            add_notifications(2, 16, &data[..70], &mut add),
+            Err(AdsResult::INVALID_SIZE)
+        );
+        assert_eq!(
+            add_notifications(0, 16, &[], &mut add),
+            Err(AdsResult::INVALID_DATA)
+        );
+        assert_eq!(
+            add_notifications(2, 8, &data, &mut add),
+            Err(AdsResult::INVALID_SIZE),
+            "a reply beyond the client's buffer"
+        );
+        assert_eq!(made, [0x120101, 0x120102]);
+        let mut delete = |h: u32| {
+            if h == 7 {
+                AdsResult::OK
+            } else {
+                AdsResult::INVALID_HANDLE
+            }
+        };
+        assert_eq!(
+            delete_notifications(2, 8, &words(&[7, 8]), &mut delete),
+            Ok(words(&[0, 0x714]))
+        );
+        assert_eq!(
+            delete_notifications(2, 8, &words(&[7]), &mut delete),
+            Err(AdsResult::INVALID_SIZE)
         );
     }
 }

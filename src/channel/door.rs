@@ -74,6 +74,10 @@ pub enum Op {
     ObserveTechno(bool),
     /// The technology observations since the last drain ([`Reply::TechnoSeen`]).
     DrainTechno,
+    /// Evaluate this notification watch after every tick (`machine::watch`); answered
+    /// [`Reply::Done`] when it is active, `Reply::Value(None)` when the machine's watches
+    /// are full. Served by the machine, not by a channel.
+    Watch(crate::machine::watch::WatchSlot),
 }
 
 /// What `run` asks of the motion trace.

@@ -163,6 +163,8 @@ impl Channel {
             Op::ReadExternalTyped(name) => {
                 Reply::External(self.decoder.vars().external_value(&name))
             }
+            // Served by the machine (`machine::watch`), never by a channel.
+            Op::Watch(_) => Reply::NoChannel,
             Op::Status => {
                 let mut s = self.status();
                 s.tick = tick.index;

@@ -8,6 +8,8 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use super::out::Stdout;
@@ -63,6 +65,11 @@ pub struct BenchArgs {
     /// --load live-view: pages reading the event stream while measured.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=crate::http::MAX_PAGE_CONNECTIONS as u64))]
     pub pages: u64,
+    /// --load cycle: notification handles evaluated in the cycle while measured, 1 ms on
+    /// change on each channel's `ncc_blocks_executed_r` in turn (as the ADS server registers
+    /// them, samples counted instead of sent).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=crate::machine::watch::MAX_WATCHES as u64))]
+    pub notifications: u64,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -161,6 +168,26 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     // Runtime and bare loop alternate in slices of about a second, so a change of load on a
     // shared machine (another build starting) hits both alike.
     let mut bare = Histogram::new();
+    let mut cycle = cycle;
+    let samples = Arc::new(AtomicU64::new(0));
+    for k in 0..args.notifications {
+        let ch = (k % u64::from(args.channels)) as u16 + 1;
+        let Some(w) = crate::ads::objects::bench_watch(ch, Arc::clone(&samples)) else {
+            return usage("no encoder for ncc_blocks_executed_r".to_string());
+        };
+        if !cycle.machine_mut().watch(w) {
+            return usage(format!(
+                "more than {} notifications",
+                crate::machine::watch::MAX_WATCHES
+            ));
+        }
+    }
+    if args.notifications > 0 {
+        out.line(format_args!(
+            "notifications: {} handles, 1 ms on change, evaluated in the cycle",
+            args.notifications
+        ));
+    }
     let (mut rt, _tx) = Runtime::new(cycle, period, Clock::RealTime);
     let mut wall = Duration::ZERO;
     for k in 0..slices {
@@ -199,6 +226,12 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
         blocks as f64 / wall.max(1e-9),
         bytes as f64 / 1e6,
     ));
+    if args.notifications > 0 {
+        out.line(format_args!(
+            "notifications: {} samples queued",
+            samples.load(Ordering::Relaxed)
+        ));
+    }
     let t = &cycle.tallies;
     let violations = t.order.violations + t.errors.violations + t.limits.violations;
     if violations > 0 {

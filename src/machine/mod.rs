@@ -7,6 +7,7 @@
 pub mod plc;
 pub mod remote;
 pub mod rng;
+pub mod watch;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -121,9 +122,17 @@ pub struct Machine {
     /// Wall time the channels' ticks waited for the program loader with the clock stopped,
     /// not yet taken by the runtime ([`Cycle::take_clock_stopped`]).
     clock_stopped: Duration,
+    /// Notification watches evaluated after every tick (`watch`).
+    watches: watch::Watches,
 }
 
 impl Machine {
+    /// Evaluate `w` after every tick from now on; false when [`watch::MAX_WATCHES`] are
+    /// active.
+    pub fn watch(&mut self, w: watch::Watch) -> bool {
+        self.watches.add(&watch::WatchSlot::new(w))
+    }
+
     pub fn new(channels: Vec<Channel>, log: EventLog, stop_when: StopWhen) -> Self {
         let n = channels.len();
         Machine {
@@ -135,6 +144,7 @@ impl Machine {
             finishes: vec![None; n],
             cycle_times: CycleTimes::default(),
             clock_stopped: Duration::ZERO,
+            watches: watch::Watches::default(),
         }
     }
 
@@ -204,6 +214,16 @@ impl Machine {
             self.cycle_times = CycleTimes::default();
             return Reply::Done;
         }
+        if let Op::Watch(slot) = &op {
+            if self.channel_mut(channel).is_none() {
+                return Reply::NoChannel;
+            }
+            return if self.watches.add(slot) {
+                Reply::Done
+            } else {
+                Reply::Value(None)
+            };
+        }
         let times = self.cycle_times;
         let Some(c) = self.channel_mut(channel) else {
             return Reply::NoChannel;
@@ -258,6 +278,14 @@ impl Cycle for Machine {
                 self.finishes[i] = Some(f);
             }
         }
+        let mut watches = std::mem::take(&mut self.watches);
+        watches.evaluate(tick, self.channels.len(), |ch| {
+            match self.apply(tick, ch, Op::Status) {
+                Reply::Status(s) => Some(s),
+                _ => None,
+            }
+        });
+        self.watches = watches;
         self.publish();
         match self.stop_when {
             StopWhen::Never => Flow::Continue,

@@ -13,7 +13,7 @@
 use std::io;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use crossbeam_channel::{RecvTimeoutError, Sender};
 
@@ -27,9 +27,12 @@ use crate::runtime::{Clock, Runtime, StopHandle};
 pub(crate) use crate::vocab::ams::DEFAULT_REPLY_TIMEOUT as REPLY_TIMEOUT;
 
 /// While the runtime has left a call unanswered, later calls wait at most this long: a
-/// runtime that is back answers within a few periods, and a connection's requests queued
-/// behind each other (a client that sends several at once) are each answered "busy" within
-/// `reply_timeout` + n × this, not n × `reply_timeout`.
+/// runtime that is back answers within a few periods. A request queued behind others on its
+/// connection (a client that sends several at once) whose reply timeout, counted from its
+/// arrival, has passed by its turn is answered "busy" without a call
+/// ([`CncBackend::overdue`]), so every request in flight is answered within `reply_timeout`
+/// (and at most one `STALLED_WAIT`) of its own arrival, not one `STALLED_WAIT` after the one
+/// before it.
 const STALLED_WAIT: Duration = Duration::from_millis(50);
 
 pub struct ChannelBackend {
@@ -77,6 +80,13 @@ impl CncBackend for ChannelBackend {
     /// `reply_timeout` ([`STALLED_WAIT`] while an earlier call is unanswered). Once the runtime holds the claim its reply is waited for without a
     /// limit: it is being applied in the tick running now, and answering "busy" then would
     /// make a retrying client apply it twice.
+    /// Stalled, and `reply_timeout` has passed since `arrived`. A request still inside its
+    /// reply timeout makes its call (at most [`STALLED_WAIT`]), so a runtime that is back is
+    /// noticed even when `reply_timeout` is no longer than that wait.
+    fn overdue(&self, arrived: Instant) -> bool {
+        self.stalled.load(Ordering::Relaxed) && arrived.elapsed() >= self.reply_timeout
+    }
+
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
         let (tx, rx) = crossbeam_channel::bounded(1);
         let (req, claim) = Request::new(u32::from(ch), op, tx);
@@ -181,6 +191,14 @@ pub trait CncBackend: Send + Sync + 'static {
     /// time and never will be (docs/exactly-once.md), [`DeviceError::NotReady`] when the
     /// runtime is gone, [`DeviceError::NotFound`] for a channel that does not exist.
     fn call(&self, ch: u16, op: Op) -> Result<Reply, DeviceError>;
+    /// Whether a request that reached the caller at `arrived` should be answered "busy"
+    /// (0x708, not applied) without a call: the runtime is known to be stalled and the
+    /// request's reply timeout, counted from its arrival, has passed. A backend that never
+    /// stalls says no.
+    fn overdue(&self, arrived: Instant) -> bool {
+        let _ = arrived;
+        false
+    }
 }
 
 /// One entry of a channel's error history and how many errors it raised in all.

@@ -231,7 +231,8 @@ pub struct AdsConfig {
     pub(crate) max_notifications_per_connection: u32,
     /// Notification handles, all connections together (default 1024).
     pub(crate) max_notifications_total: u32,
-    /// Notification samples per second, all connections together (default 10000).
+    /// Notification samples per second, all connections together (default 40000; one
+    /// connection is held to `vocab::ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION`).
     pub(crate) notification_samples_per_s: u32,
     /// Seconds without a whole frame after which a connection in the middle of a frame, or
     /// without notification handles, is closed (default 60).

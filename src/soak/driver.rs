@@ -654,6 +654,13 @@ impl SoakCycle {
     }
 }
 
+impl SoakCycle {
+    /// The machine the soak ticks (the bench registers notification watches on it).
+    pub(crate) fn machine_mut(&mut self) -> &mut Machine {
+        &mut self.machine
+    }
+}
+
 impl Cycle for SoakCycle {
     /// The soak takes no requests from other threads.
     type Request = Infallible;

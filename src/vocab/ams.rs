@@ -19,10 +19,18 @@ pub const DEFAULT_MAX_CONNECTIONS: usize = 64;
 pub(crate) const DEFAULT_MAX_NOTIFICATIONS: usize = 256;
 /// Default bound on notification handles over the whole server.
 pub(crate) const DEFAULT_MAX_NOTIFICATIONS_TOTAL: usize = 1024;
-/// Default budget of notification samples per second over the whole server. Each sample is a
-/// read served by the runtime; 10 000/s is 10 reads a tick at 1 ms, well inside
-/// `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never cost the cycle its period.
-pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 = 10_000;
+/// Default budget of notification samples per second of one connection: ten 1 ms handles
+/// (each handle costs one sample per cycle time). What one client asks beyond it is refused
+/// (0x716) to that client only.
+pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION: u64 = 10_000;
+/// Default budget of notification samples per second over the whole server: four connections
+/// at their whole budget, so one client never holds more than a quarter of it (ten HMIs that
+/// each hold an ADS-state and a symbol-version handle at 1 ms, 2 000/s each, fit beside a
+/// tool with ten 1 ms handles). Each sample is a read served by the runtime; 40 000/s is 40
+/// reads a tick at 1 ms, inside `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never
+/// cost the cycle its period.
+pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 =
+    4 * DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION;
 /// Default idle timeout (`ads::server::ServerConfig::idle_timeout`).
 pub(crate) const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(60);
 /// Default time a request waits for the runtime before it is answered 0x708 "busy, not

@@ -228,3 +228,55 @@ fn symbol_and_type_uploads_decode_with_the_ads_crate() {
     dev.read_exact(group, offset, &mut v).unwrap();
     assert_eq!(u32::from_le_bytes(v), 3, "READY");
 }
+
+#[test]
+fn sum_add_and_delete_notifications_answer_each_sub_request() {
+    use ads::client::{AddNotifRequest, DelNotifRequest};
+    let (srv, _b) = server();
+    let client = connect(&srv, 40005);
+    let rx = client.get_notification_channel();
+    let dev = client.device(target());
+    let on_change = Attributes::new(
+        8,
+        TransmissionMode::ServerOnChange,
+        Duration::from_millis(1),
+        Duration::from_millis(1),
+    );
+    let cyclic = Attributes::new(
+        8,
+        TransmissionMode::ServerCycle,
+        Duration::from_millis(10),
+        Duration::from_millis(10),
+    );
+    let mut adds = [
+        AddNotifRequest::new(CH1, offset::MODE_STATE, &on_change),
+        // The stream object cannot be read: its own error, the others are made.
+        AddNotifRequest::new(CH1, offset::STREAM, &on_change),
+        AddNotifRequest::new(CH1, offset::BLOCK_COUNTER, &cyclic),
+    ];
+    dev.add_notification_multi(&mut adds).unwrap();
+    let mode = adds[0].handle().unwrap();
+    assert_eq!(ads_code(adds[1].handle().unwrap_err()), 0x704);
+    let blocks = adds[2].handle().unwrap();
+    assert_ne!(mode, blocks);
+    // Both handles send their first samples.
+    let mut seen = std::collections::BTreeSet::new();
+    while seen.len() < 2 {
+        let n = rx
+            .recv_timeout(Duration::from_secs(5))
+            .expect("first samples of both handles");
+        seen.extend(n.samples().map(|s| s.handle));
+    }
+    assert_eq!(seen, [mode, blocks].into_iter().collect());
+    let mut dels = [
+        DelNotifRequest::new(mode),
+        DelNotifRequest::new(blocks),
+        DelNotifRequest::new(blocks + 1000),
+    ];
+    dev.delete_notification_multi(&mut dels).unwrap();
+    dels[0].ensure().unwrap();
+    dels[1].ensure().unwrap();
+    assert_eq!(ads_code(dels[2].ensure().unwrap_err()), 0x714);
+    // Deleted: a single delete of the same handle is now refused.
+    assert_eq!(ads_code(dev.delete_notification(mode).unwrap_err()), 0x714);
+}

@@ -779,3 +779,211 @@ fn router_port_connect_hands_out_an_address() {
     assert_eq!(&reply[6..12], &[127, 0, 0, 1, 1, 1]);
     assert!(u16::from_le_bytes([reply[12], reply[13]]) >= 32768);
 }
+
+/// AddDeviceNotification result of one request on `raw` (skipping samples in between).
+fn add_result(raw: &mut Raw, invoke: u32, add: &[u8]) -> u32 {
+    raw.send(&request_bytes(
+        ADD_NOTIFICATION,
+        device(),
+        client_addr(40000),
+        invoke,
+        add,
+    ));
+    loop {
+        let (h, d) = raw.frame();
+        if h.command.to_u16() == ADD_NOTIFICATION && h.invoke_id == invoke {
+            return u32_at(&d, 0);
+        }
+    }
+}
+
+#[test]
+fn one_connection_spending_its_sample_budget_leaves_the_others_theirs() {
+    let (srv, _b) = server();
+    let mut greedy = Raw::connect(srv.local_addr());
+    // Cyclic at 1 ms: 1000 samples a second each; ten fill one connection's budget.
+    let one_ms = request::add_notification(CH1, offset::BLOCK_COUNTER, 8, 3, 0, 10_000);
+    let results: Vec<u32> = (1..=11)
+        .map(|i| add_result(&mut greedy, i, &one_ms))
+        .collect();
+    assert_eq!(results[..10], [0; 10], "ten 1 ms handles on one connection");
+    assert_eq!(results[10], 0x716, "the eleventh is beyond its own budget");
+    // Another client still gets a 100 ms handle and 1 ms handles of its own.
+    let mut other = Raw::connect(srv.local_addr());
+    let slow = request::add_notification(CH1, offset::MODE_STATE, 8, 4, 0, 1_000_000);
+    assert_eq!(add_result(&mut other, 1, &slow), 0);
+    assert_eq!(add_result(&mut other, 2, &one_ms), 0);
+    assert_eq!(add_result(&mut other, 3, &one_ms), 0);
+}
+
+/// The real machine with one tick, asked for by the test, that overruns by `STALL`: the shape
+/// of a tick doing work that grows with its input. It says on `began` when the stall starts.
+struct StallWhenAsked {
+    machine: ncchannel::machine::Machine,
+    ask: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    began: crossbeam_channel::Sender<()>,
+}
+
+const STALL: Duration = Duration::from_secs(4);
+
+impl ncchannel::runtime::Cycle for StallWhenAsked {
+    type Request = ncchannel::machine::Request;
+
+    fn serve(&mut self, req: Self::Request, tick: &ncchannel::runtime::Tick) {
+        self.machine.serve(req, tick);
+    }
+
+    fn step(&mut self, tick: &ncchannel::runtime::Tick) -> ncchannel::runtime::Flow {
+        if self.ask.swap(false, std::sync::atomic::Ordering::SeqCst) {
+            let _ = self.began.send(());
+            std::thread::sleep(STALL);
+        }
+        self.machine.step(tick)
+    }
+}
+
+#[test]
+fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_reply_timeout() {
+    use ncchannel::machine::{Machine, StopWhen};
+    use ncchannel::report::event::EventLog;
+    use ncchannel::runtime::{Clock, Runtime};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let params = crate::support::ads::Params::new(1);
+    let config = ncchannel::params::load(&params.startup()).unwrap();
+    let channels = ncchannel::channels(&config, true, &ncchannel::Loader::start()).unwrap();
+    let ask = Arc::new(AtomicBool::new(false));
+    let (began_tx, began) = crossbeam_channel::bounded(1);
+    let cycle = StallWhenAsked {
+        machine: Machine::new(channels, EventLog::disabled(), StopWhen::Never),
+        ask: Arc::clone(&ask),
+        began: began_tx,
+    };
+    let period = Duration::from_micros(config.runtime.cycle_period_us);
+    let (mut rt, tx) = Runtime::new(cycle, period, Clock::RealTime);
+    let stop = rt.stop_handle();
+    let runtime = std::thread::spawn(move || rt.run(None));
+    // As `serve` builds it: the default reply timeout (500 ms).
+    let backend = ncchannel::machine::remote::ChannelBackend::new(tx, 1);
+    let srv = ncchannel::ads::spawn(
+        ServerConfig {
+            bind: "127.0.0.1:0".parse().unwrap(),
+            ..ServerConfig::default()
+        },
+        Arc::new(backend),
+    )
+    .unwrap();
+    let mut raw = Raw::connect(srv.local_addr());
+    let line = b"N1\r\n";
+    let write = write_req(CH1, offset::STREAM, line);
+    assert_eq!(
+        raw.call(WRITE, 1, &write).1,
+        [0; 4],
+        "one line before the stall"
+    );
+    let (_, d) = raw.call(READ, 2, &request::read(CH1, offset::STREAM_FILL, 8));
+    let before = u32_at(&d, 4);
+
+    ask.store(true, Ordering::SeqCst);
+    began
+        .recv_timeout(Duration::from_secs(10))
+        .expect("the runtime stalls");
+    // 50 writes in flight at once, as an HMI's concurrent requests.
+    let n = 50;
+    let burst: Vec<u8> = (0..n)
+        .flat_map(|i| request_bytes(WRITE, device(), client_addr(40000), 100 + i, &write))
+        .collect();
+    let sent = Instant::now();
+    raw.send(&burst);
+    let mut answers = Vec::new();
+    while answers.len() < n as usize {
+        let (h, d) = raw.frame();
+        if h.command.to_u16() == WRITE {
+            answers.push((h.invoke_id, u32_at(&d, 0), sent.elapsed()));
+        }
+    }
+    let slowest = answers.iter().map(|a| a.2).max().unwrap();
+    println!("STALL 50 in flight: slowest answer after {slowest:?}");
+    assert!(
+        answers.iter().all(|a| a.1 == 0x708),
+        "every write in the stall answered busy: {answers:?}"
+    );
+    // Each within the reply timeout of its arrival (500 ms) plus scheduling slack, far below
+    // ads-client's 2000 ms; one after another 50 ms apart the last took 2950 ms.
+    assert!(
+        slowest < Duration::from_millis(1500),
+        "slowest answer {slowest:?}: {answers:?}"
+    );
+    let ids: std::collections::BTreeSet<u32> = answers.iter().map(|a| a.0).collect();
+    assert_eq!(ids.len(), n as usize, "each request answered once");
+
+    // After the stall: none of the 50 was applied, the next write is.
+    let mut invoke = 1000;
+    let fill = loop {
+        invoke += 1;
+        assert!(
+            invoke < 10_000,
+            "the runtime never answered after the stall"
+        );
+        let (_, d) = raw.call(READ, invoke, &request::read(CH1, offset::STREAM_FILL, 8));
+        if u32_at(&d, 0) == 0 {
+            break u32_at(&d, 4);
+        }
+    };
+    assert_eq!(fill, before, "none of the writes answered busy was applied");
+    assert_eq!(raw.call(WRITE, invoke + 1, &write).1, [0; 4]);
+    drop(raw);
+    srv.shutdown();
+    stop.stop();
+    runtime.join().unwrap();
+}
+
+/// `cnc_tick_counter_r` (docs/ads.md): the tick index, one more every tick.
+const TICK_COUNTER: u32 = 0x251;
+
+#[test]
+fn a_1_ms_notification_sees_every_tick_and_a_cyclic_one_samples_every_cycle() {
+    let (srv, _b) = server();
+    let mut raw = Raw::connect(srv.local_addr());
+    // On change (4) checked every 1 ms, and cyclic (3) every 10 ms, on a value that changes
+    // every tick of the 1 ms cycle.
+    let on_change = request::add_notification(CH1, TICK_COUNTER, 4, 4, 0, 10_000);
+    let cyclic = request::add_notification(CH1, TICK_COUNTER, 4, 3, 0, 100_000);
+    let every = u32_at(&raw.call(ADD_NOTIFICATION, 1, &on_change).1, 4);
+    let mut tens = None;
+    let mut seen: std::collections::HashMap<u32, Vec<u32>> = Default::default();
+    raw.send(&request_bytes(
+        ADD_NOTIFICATION,
+        device(),
+        client_addr(40000),
+        2,
+        &cyclic,
+    ));
+    while seen.get(&every).map_or(0, Vec::len) < 1000
+        || tens.is_none_or(|t| seen.get(&t).map_or(0, Vec::len) < 50)
+    {
+        let (h, d) = raw.frame();
+        match h.command.to_u16() {
+            ADD_NOTIFICATION => tens = Some(u32_at(&d, 4)),
+            8 => {
+                for s in payload::decode_notification(&d).unwrap() {
+                    seen.entry(s.handle).or_default().push(u32_at(&s.data, 0));
+                }
+            }
+            _ => {}
+        }
+    }
+    let steps = |h: u32| -> Vec<u32> { seen[&h].windows(2).map(|w| w[1] - w[0]).collect() };
+    assert!(
+        steps(every).iter().all(|&d| d == 1),
+        "the 1 ms on-change handle saw every tick: {:?}",
+        steps(every)
+    );
+    let tens = tens.unwrap();
+    assert!(
+        steps(tens).iter().all(|&d| d == 10),
+        "the 10 ms cyclic handle sampled every 10th tick: {:?}",
+        steps(tens)
+    );
+}

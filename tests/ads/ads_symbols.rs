@@ -318,7 +318,14 @@ fn malformed_sum_commands_are_one_clear_error_and_the_connection_lives() {
             0x705,
             "write data missing",
         ),
-        (0xF085, 1, 100, one.clone(), 0x701, "sum add notification"),
+        (
+            0xF085,
+            1,
+            100,
+            one.clone(),
+            0x705,
+            "sum add notification without a 40-byte entry",
+        ),
     ] {
         assert_eq!(
             read_write(&mut raw, 553, group, count, len, &data).0,

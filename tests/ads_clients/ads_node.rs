@@ -84,3 +84,30 @@ fn node_ads_client_controls_the_ads_states_and_reads_every_symbol_level() {
     );
     assert_eq!(seen["plc_after_restart"], "Run");
 }
+
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_ten_hmis_connect_beside_one_heavy_subscriber() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/many_hmis_test.js");
+    let (seen, _) = common::run_client(served, &node, script, &[]);
+    println!("MANY HMIS {seen}");
+    assert_eq!(
+        seen["heavy_handles"], 10,
+        "ten 1 ms handles on one connection"
+    );
+    assert_eq!(
+        seen["hmis_connected"], 10,
+        "ten default connect()s beside it"
+    );
+    assert_eq!(
+        seen["hmi_samples"], 10,
+        "each HMI's own subscription samples"
+    );
+    assert_eq!(
+        seen["heavy_eleventh"], 0x716,
+        "the heavy client's eleventh 1 ms handle is refused to it"
+    );
+}

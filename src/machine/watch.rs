@@ -1,0 +1,169 @@
+//! Notification watches evaluated in the cycle: after every tick the machine encodes each
+//! active watch's object from the channel's status of that tick, compares it with the bytes
+//! it last delivered (on change) or checks its cycle (cyclic), and hands a sample to the
+//! watch's sink, which queues it on the owning connection's bounded send queue and never
+//! waits. TwinCAT checks notification handles in the task cycle (Beckhoff InfoSys, ADS
+//! "AdsAddDeviceNotification": the server checks the variable every cycle time), so a 1 ms
+//! on-change handle sees every change of a value that changes every tick, and a cyclic one
+//! samples on its tick, without a read through the runtime's request queue.
+//!
+//! A watch is registered once through the request queue ([`Op::Watch`]) and ends when its
+//! owner drops the shared `alive` flag (no request): registration is a push, removal a flag,
+//! and the tick's work grows only with the number of active watches, at most [`MAX_WATCHES`].
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use super::Status;
+use crate::runtime::Tick;
+
+/// Watches the machine evaluates at most; one more is refused (the ADS server's 1024
+/// handles over all connections, `vocab::ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL`).
+pub const MAX_WATCHES: usize = crate::vocab::ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL;
+
+/// What the sink did with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delivery {
+    /// Queued for the client: it is the watch's last value now.
+    Sent,
+    /// Not yet wanted (the client does not know the handle yet): offered again next tick.
+    NotYet,
+    /// The owner is gone (handle deleted, connection closed or overflowed): the watch ends.
+    Gone,
+}
+
+/// The object's bytes from its channel's status, `None` when it cannot be encoded now.
+pub type Encode = Box<dyn Fn(&Status) -> Option<Vec<u8>> + Send>;
+/// Where a sample goes.
+pub type Deliver = Box<dyn FnMut(&[u8]) -> Delivery + Send>;
+
+/// One notification handle as the cycle sees it.
+pub struct Watch {
+    /// 1-based channel whose status the object is encoded from.
+    pub channel: u32,
+    /// Cyclic: a sample every `cycle`; on change: checked every `cycle`, sent when different.
+    pub cycle: Duration,
+    pub on_change: bool,
+    pub encode: Encode,
+    pub deliver: Deliver,
+    /// Cleared by the owner to end the watch.
+    pub alive: Arc<AtomicBool>,
+}
+
+/// A [`Watch`] handed to the machine through the request queue ([`Op::Watch`]): taken once.
+#[derive(Clone)]
+pub struct WatchSlot(pub Arc<Mutex<Option<Watch>>>);
+
+impl WatchSlot {
+    pub fn new(w: Watch) -> Self {
+        WatchSlot(Arc::new(Mutex::new(Some(w))))
+    }
+
+    fn take(&self) -> Option<Watch> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}
+
+impl std::fmt::Debug for WatchSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("WatchSlot")
+    }
+}
+
+impl PartialEq for WatchSlot {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+struct Active {
+    w: Watch,
+    last: Option<Vec<u8>>,
+    next_tick: u64,
+}
+
+/// The machine's active watches.
+#[derive(Default)]
+pub(crate) struct Watches {
+    list: Vec<Active>,
+    /// Per channel, the status of the tick being evaluated (filled on first use).
+    statuses: Vec<Option<Box<Status>>>,
+}
+
+impl Watches {
+    /// Take the watch out of `slot` and keep it; false when [`MAX_WATCHES`] are active or the
+    /// slot was empty.
+    pub(crate) fn add(&mut self, slot: &WatchSlot) -> bool {
+        if self.list.len() >= MAX_WATCHES {
+            return false;
+        }
+        let Some(w) = slot.take() else {
+            return false;
+        };
+        self.list.push(Active {
+            w,
+            last: None,
+            next_tick: 0,
+        });
+        true
+    }
+
+    /// Evaluate every watch due at `tick`; `status` gives channel `ch`'s status of this tick
+    /// (asked at most once per channel per tick).
+    pub(crate) fn evaluate(
+        &mut self,
+        tick: &Tick,
+        channels: usize,
+        mut status: impl FnMut(u32) -> Option<Box<Status>>,
+    ) {
+        if self.list.is_empty() {
+            return;
+        }
+        self.statuses.clear();
+        self.statuses.resize_with(channels, || None);
+        let period_ns = tick.period.as_nanos().max(1);
+        let statuses = &mut self.statuses;
+        self.list.retain_mut(|a| {
+            if !a.w.alive.load(Ordering::Relaxed) {
+                return false;
+            }
+            if tick.index < a.next_tick {
+                return true;
+            }
+            let Some(slot) = (a.w.channel as usize)
+                .checked_sub(1)
+                .and_then(|i| statuses.get_mut(i))
+            else {
+                return false;
+            };
+            if slot.is_none() {
+                *slot = status(a.w.channel);
+            }
+            let Some(bytes) = slot.as_deref().and_then(|s| (a.w.encode)(s)) else {
+                return true;
+            };
+            let changed = a.last.as_deref() != Some(bytes.as_slice());
+            if a.w.on_change && !changed {
+                a.next_tick = tick.index + ticks(a.w.cycle, period_ns);
+                return true;
+            }
+            match (a.w.deliver)(&bytes) {
+                Delivery::Sent => {
+                    a.last = Some(bytes);
+                    a.next_tick = tick.index + ticks(a.w.cycle, period_ns);
+                    true
+                }
+                Delivery::NotYet => true,
+                Delivery::Gone => false,
+            }
+        });
+    }
+}
+
+/// Whole ticks in `cycle`, at least one.
+fn ticks(cycle: Duration, period_ns: u128) -> u64 {
+    u64::try_from(cycle.as_nanos() / period_ns)
+        .unwrap_or(u64::MAX)
+        .max(1)
+}
