@@ -3,7 +3,8 @@
 //! serves it; the machine routes requests to channels, the ADS object tables and the soak build
 //! `Op`s. Defined here, beside the channel, so the channel needs nothing of the machine above it.
 
-use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use super::techno::{TechnoRefusal, TechnoSeen, TechnoStats, TechnoStatus, TechnoWrite};
@@ -77,7 +78,7 @@ pub enum Op {
     /// Evaluate this notification watch after every tick (`machine::watch`); answered
     /// [`Reply::Done`] when it is active, `Reply::Value(None)` when the machine's watches
     /// are full. Served by the machine, not by a channel.
-    Watch(crate::machine::watch::WatchSlot),
+    Watch(WatchSlot),
 }
 
 /// What `run` asks of the motion trace.
@@ -452,5 +453,63 @@ pub(crate) fn report_of(c: &Channel) -> ChannelReport {
         held_blocks: c.motion.held_blocks(),
         trace: c.motion.trace().cloned(),
         var_bytes: VAR_CLASSES.map(|class| c.decoder.vars().bytes(class)),
+    }
+}
+
+/// What the sink did with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delivery {
+    /// Queued for the client: it is the watch's last value now.
+    Sent,
+    /// Not yet wanted (the client does not know the handle yet): offered again next tick.
+    NotYet,
+    /// The owner is gone (handle deleted, connection closed or overflowed): the watch ends.
+    Gone,
+}
+
+/// The object's bytes from its channel's status, `None` when it cannot be encoded now.
+pub type Encode = Box<dyn Fn(&Status) -> Option<Vec<u8>> + Send>;
+/// Where a sample goes.
+pub type Deliver = Box<dyn FnMut(&[u8]) -> Delivery + Send>;
+
+/// One notification handle as the cycle sees it.
+pub struct Watch {
+    /// 1-based channel whose status the object is encoded from.
+    pub channel: u32,
+    /// Cyclic: a sample every `cycle`; on change: checked every `cycle`, sent when different.
+    pub cycle: Duration,
+    pub on_change: bool,
+    pub encode: Encode,
+    pub deliver: Deliver,
+    /// Cleared by the owner to end the watch.
+    pub alive: Arc<AtomicBool>,
+}
+
+/// A [`Watch`] handed to the machine through the request queue ([`Op::Watch`]): taken once.
+/// The watch types live here, with the door's vocabulary, so the channel that defines `Op`
+/// needs nothing of the machine; the machine evaluates them (`machine::watch`).
+#[derive(Clone)]
+pub struct WatchSlot(pub Arc<Mutex<Option<Watch>>>);
+
+impl WatchSlot {
+    pub fn new(w: Watch) -> Self {
+        WatchSlot(Arc::new(Mutex::new(Some(w))))
+    }
+
+    /// The watch, once: the machine takes it when it serves [`Op::Watch`].
+    pub(crate) fn take(&self) -> Option<Watch> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
+    }
+}
+
+impl std::fmt::Debug for WatchSlot {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("WatchSlot")
+    }
+}
+
+impl PartialEq for WatchSlot {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
     }
 }

@@ -11,71 +11,16 @@
 //! owner drops the shared `alive` flag (no request): registration is a push, removal a flag,
 //! and the tick's work grows only with the number of active watches, at most [`MAX_WATCHES`].
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use super::Status;
+pub use crate::channel::door::{Deliver, Delivery, Encode, Watch, WatchSlot};
 use crate::runtime::Tick;
 
 /// Watches the machine evaluates at most; one more is refused (the ADS server's 1024
 /// handles over all connections, `vocab::ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL`).
 pub const MAX_WATCHES: usize = crate::vocab::ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL;
-
-/// What the sink did with a sample.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Delivery {
-    /// Queued for the client: it is the watch's last value now.
-    Sent,
-    /// Not yet wanted (the client does not know the handle yet): offered again next tick.
-    NotYet,
-    /// The owner is gone (handle deleted, connection closed or overflowed): the watch ends.
-    Gone,
-}
-
-/// The object's bytes from its channel's status, `None` when it cannot be encoded now.
-pub type Encode = Box<dyn Fn(&Status) -> Option<Vec<u8>> + Send>;
-/// Where a sample goes.
-pub type Deliver = Box<dyn FnMut(&[u8]) -> Delivery + Send>;
-
-/// One notification handle as the cycle sees it.
-pub struct Watch {
-    /// 1-based channel whose status the object is encoded from.
-    pub channel: u32,
-    /// Cyclic: a sample every `cycle`; on change: checked every `cycle`, sent when different.
-    pub cycle: Duration,
-    pub on_change: bool,
-    pub encode: Encode,
-    pub deliver: Deliver,
-    /// Cleared by the owner to end the watch.
-    pub alive: Arc<AtomicBool>,
-}
-
-/// A [`Watch`] handed to the machine through the request queue ([`Op::Watch`]): taken once.
-#[derive(Clone)]
-pub struct WatchSlot(pub Arc<Mutex<Option<Watch>>>);
-
-impl WatchSlot {
-    pub fn new(w: Watch) -> Self {
-        WatchSlot(Arc::new(Mutex::new(Some(w))))
-    }
-
-    fn take(&self) -> Option<Watch> {
-        self.0.lock().unwrap_or_else(|p| p.into_inner()).take()
-    }
-}
-
-impl std::fmt::Debug for WatchSlot {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("WatchSlot")
-    }
-}
-
-impl PartialEq for WatchSlot {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
-}
 
 struct Active {
     w: Watch,
