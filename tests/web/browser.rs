@@ -33,6 +33,7 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
         bind: "127.0.0.1:0".parse().unwrap(),
         allow_non_loopback: false,
         controls: ControlAccess::Allowed,
+        allow_hosts: Vec::new(),
     };
     let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
     channels.command(2, Op::Start("streaming.nc".into()));
