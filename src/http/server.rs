@@ -58,6 +58,11 @@ struct Shared {
     stopping: AtomicBool,
     connections: AtomicUsize,
     streams: AtomicUsize,
+    /// Connections still reading their request head, oldest first, with their number: when
+    /// every connection slot is taken, the oldest of these is closed for the newcomer, so
+    /// clients trickling heads cannot lock pages out (slowloris).
+    heads: std::sync::Mutex<std::collections::VecDeque<(u64, TcpStream)>>,
+    next_id: std::sync::atomic::AtomicU64,
 }
 
 /// The running web view.
@@ -76,6 +81,11 @@ impl HttpHandle {
     /// Pages whose event stream is open now.
     pub fn pages_connected(&self) -> usize {
         self.shared.pages.connected()
+    }
+
+    /// Connections open now (pages, streams, requests still being read).
+    pub fn connections_open(&self) -> usize {
+        self.shared.connections.load(Ordering::SeqCst)
     }
 
     /// Stop accepting, stop the feed and end every page's stream.
@@ -128,6 +138,8 @@ pub fn spawn(
         stopping: AtomicBool::new(false),
         connections: AtomicUsize::new(0),
         streams: AtomicUsize::new(0),
+        heads: std::sync::Mutex::new(std::collections::VecDeque::new()),
+        next_id: std::sync::atomic::AtomicU64::new(0),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -173,8 +185,12 @@ fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
         }
         let Ok(stream) = stream else { continue };
         if !reserve(&shared.connections, MAX_CONNECTIONS) {
-            let _ = stream.shutdown(Shutdown::Both);
-            continue;
+            if !evict_oldest_head(shared) {
+                let _ = stream.shutdown(Shutdown::Both);
+                continue;
+            }
+            // The evicted connection's thread ends at once and gives its slot back.
+            shared.connections.fetch_add(1, Ordering::SeqCst);
         }
         let conn_shared = Arc::clone(shared);
         let spawned = std::thread::Builder::new()
@@ -192,9 +208,32 @@ fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
     }
 }
 
+/// Close the connection that has waited longest for its request head; false when none is
+/// waiting (every slot serves a page or a request).
+fn evict_oldest_head(shared: &Shared) -> bool {
+    let Ok(mut heads) = shared.heads.lock() else {
+        return false;
+    };
+    match heads.pop_front() {
+        Some((_, s)) => {
+            let _ = s.shutdown(Shutdown::Both);
+            true
+        }
+        None => false,
+    }
+}
+
 fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), RequestError> {
     socket.set_write_timeout(Some(WRITE_TIMEOUT))?;
-    let req = match read_request(&mut socket) {
+    let id = shared.next_id.fetch_add(1, Ordering::SeqCst);
+    if let (Ok(clone), Ok(mut heads)) = (socket.try_clone(), shared.heads.lock()) {
+        heads.push_back((id, clone));
+    }
+    let read = read_request(&mut socket);
+    if let Ok(mut heads) = shared.heads.lock() {
+        heads.retain(|(i, _)| *i != id);
+    }
+    let req = match read {
         Ok(r) => r,
         Err(
             e @ (RequestError::TooLarge

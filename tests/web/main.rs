@@ -11,6 +11,7 @@ mod browser;
 mod client;
 mod controls;
 mod feed;
+mod slowloris;
 mod techno;
 
 use std::sync::Arc;
