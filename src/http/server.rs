@@ -159,7 +159,8 @@ struct Slot<'a>(&'a AtomicUsize);
 impl<'a> Slot<'a> {
     /// Take one of `limit` slots, or `None` when all are taken.
     fn take(counter: &'a AtomicUsize, limit: usize) -> Option<Slot<'a>> {
-        reserve(counter, limit).then_some(Slot(counter))
+        // `then`, not `then_some`: a Slot built and dropped on refusal would give back a slot never taken.
+        reserve(counter, limit).then(|| Slot(counter))
     }
 }
 
