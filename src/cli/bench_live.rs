@@ -57,8 +57,10 @@ struct Page {
 impl Page {
     fn open(addr: SocketAddr, updates: Arc<AtomicU64>) -> std::io::Result<Page> {
         let mut socket = TcpStream::connect(addr)?;
-        socket.write_all(
-            b"GET /events HTTP/1.1\r\nHost: bench\r\nAccept: text/event-stream\r\n\r\n",
+        // The view answers only its own Host (DNS rebinding).
+        write!(
+            socket,
+            "GET /events HTTP/1.1\r\nHost: {addr}\r\nAccept: text/event-stream\r\n\r\n"
         )?;
         let mut lines = BufReader::new(socket.try_clone()?);
         let reader = std::thread::spawn(move || {
@@ -167,6 +169,7 @@ pub fn execute(b: &LiveBench<'_>) -> Result<ExitCode, String> {
         bind: SocketAddr::from(([127, 0, 0, 1], 0)),
         allow_non_loopback: false,
         controls: ControlAccess::Refused,
+        allow_hosts: Vec::new(),
     };
     let backend = Arc::new(ChannelBackend::new(requests, nch));
     let web = match crate::http::spawn(&view, backend, Some(rt.live_stats())) {

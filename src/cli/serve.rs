@@ -59,6 +59,14 @@ pub struct ServeArgs {
     /// channels; without it they are refused (HTTP 403).
     #[arg(long, requires = "http")]
     pub http_controls: bool,
+    /// A further `Host` name the web view answers (repeatable), e.g. the name a reverse proxy
+    /// forwards; other names than the bound address and loopback are refused with 421.
+    #[arg(
+        long = "http-allow-host",
+        value_name = "HOST[:PORT]",
+        requires = "http"
+    )]
+    pub http_allow_host: Vec<String>,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
@@ -201,6 +209,7 @@ fn spawn_web(
         bind,
         allow_non_loopback: args.allow_non_loopback,
         controls,
+        allow_hosts: args.http_allow_host.clone(),
     };
     let backend = Arc::new(ChannelBackend::new(requests, channels));
     match crate::http::spawn(&config, backend, Some(rt.live_stats())) {

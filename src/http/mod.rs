@@ -36,7 +36,9 @@ pub const FEED_PERIOD: Duration = Duration::from_millis(50);
 pub const PAGE_QUEUE_UPDATES: usize = 16;
 /// A write to a page that takes longer than this (the browser stopped reading) ends it.
 pub const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
-/// A request head that has not arrived within this is dropped.
+/// A request head (and its body) that has not arrived whole within this is dropped: one
+/// deadline for the whole request, not for each read, so a client trickling a byte at a time
+/// holds a connection slot no longer than this.
 pub const READ_TIMEOUT: Duration = Duration::from_secs(5);
 /// Largest request head and body, bytes: the page sends nothing bigger than a program name.
 pub const MAX_REQUEST_BYTES: usize = 8 * 1024;
@@ -57,6 +59,10 @@ pub struct HttpConfig {
     /// A non-loopback `bind` is refused unless this is set (`serve --allow-non-loopback`).
     pub allow_non_loopback: bool,
     pub controls: ControlAccess,
+    /// Further `Host` names (with or without `:port`) the view answers, for a reverse proxy
+    /// (`serve --http-allow-host`); the bound address, `localhost`, `127.0.0.1` and `[::1]`
+    /// with the bound port are always answered, any other `Host` gets 421 (DNS rebinding).
+    pub allow_hosts: Vec<String>,
 }
 
 /// The backend the view reads and commands, shared by the feed and the control requests.

@@ -8,6 +8,7 @@ use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
+use std::time::Instant;
 
 use super::controls::{self, CONTROL_HEADER};
 use super::feed::{Feed, Pages};
@@ -26,6 +27,10 @@ pub enum RequestError {
     Malformed(#[from] httparse::Error),
     #[error("connection closed before the request was complete")]
     Incomplete,
+    #[error("request not complete within the request deadline")]
+    TimedOut,
+    #[error("more than one Content-Length header")]
+    DuplicateLength,
     #[error(transparent)]
     Io(#[from] io::Error),
 }
@@ -35,16 +40,29 @@ struct Request {
     method: String,
     path: String,
     has_control_header: bool,
+    /// The `Host` header's value, if any.
+    host: Option<String>,
+    /// The `Origin` header's value, if any.
+    origin: Option<String>,
     body: String,
 }
 
 struct Shared {
     backend: Backend,
     controls: ControlAccess,
+    /// Every `Host` value answered (lower case).
+    hosts: Vec<String>,
+    /// Sources (peer IP and kind of refusal) already logged, so each is logged once.
+    refused_logged: std::sync::Mutex<Vec<(std::net::IpAddr, u16)>>,
     pages: Arc<Pages>,
     stopping: AtomicBool,
     connections: AtomicUsize,
     streams: AtomicUsize,
+    /// Connections still reading their request head, oldest first, with their number: when
+    /// every connection slot is taken, the oldest of these is closed for the newcomer, so
+    /// clients trickling heads cannot lock pages out (slowloris).
+    heads: std::sync::Mutex<std::collections::VecDeque<(u64, TcpStream)>>,
+    next_id: std::sync::atomic::AtomicU64,
 }
 
 /// The running web view.
@@ -63,6 +81,11 @@ impl HttpHandle {
     /// Pages whose event stream is open now.
     pub fn pages_connected(&self) -> usize {
         self.shared.pages.connected()
+    }
+
+    /// Connections open now (pages, streams, requests still being read).
+    pub fn connections_open(&self) -> usize {
+        self.shared.connections.load(Ordering::SeqCst)
     }
 
     /// Stop accepting, stop the feed and end every page's stream.
@@ -109,10 +132,14 @@ pub fn spawn(
     let shared = Arc::new(Shared {
         backend,
         controls: config.controls,
+        hosts: allowed_hosts(local_addr, &config.allow_hosts),
+        refused_logged: std::sync::Mutex::new(Vec::new()),
         pages: Arc::clone(&feed.pages),
         stopping: AtomicBool::new(false),
         connections: AtomicUsize::new(0),
         streams: AtomicUsize::new(0),
+        heads: std::sync::Mutex::new(std::collections::VecDeque::new()),
+        next_id: std::sync::atomic::AtomicU64::new(0),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -132,7 +159,8 @@ struct Slot<'a>(&'a AtomicUsize);
 impl<'a> Slot<'a> {
     /// Take one of `limit` slots, or `None` when all are taken.
     fn take(counter: &'a AtomicUsize, limit: usize) -> Option<Slot<'a>> {
-        reserve(counter, limit).then_some(Slot(counter))
+        // `then`, not `then_some`: a Slot built and dropped on refusal would give back a slot never taken.
+        reserve(counter, limit).then(|| Slot(counter))
     }
 }
 
@@ -158,8 +186,12 @@ fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
         }
         let Ok(stream) = stream else { continue };
         if !reserve(&shared.connections, MAX_CONNECTIONS) {
-            let _ = stream.shutdown(Shutdown::Both);
-            continue;
+            if !evict_oldest_head(shared) {
+                let _ = stream.shutdown(Shutdown::Both);
+                continue;
+            }
+            // The evicted connection's thread ends at once and gives its slot back.
+            shared.connections.fetch_add(1, Ordering::SeqCst);
         }
         let conn_shared = Arc::clone(shared);
         let spawned = std::thread::Builder::new()
@@ -177,12 +209,38 @@ fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
     }
 }
 
+/// Close the connection that has waited longest for its request head; false when none is
+/// waiting (every slot serves a page or a request).
+fn evict_oldest_head(shared: &Shared) -> bool {
+    let Ok(mut heads) = shared.heads.lock() else {
+        return false;
+    };
+    match heads.pop_front() {
+        Some((_, s)) => {
+            let _ = s.shutdown(Shutdown::Both);
+            true
+        }
+        None => false,
+    }
+}
+
 fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), RequestError> {
-    socket.set_read_timeout(Some(READ_TIMEOUT))?;
     socket.set_write_timeout(Some(WRITE_TIMEOUT))?;
-    let req = match read_request(&mut socket) {
+    let id = shared.next_id.fetch_add(1, Ordering::SeqCst);
+    if let (Ok(clone), Ok(mut heads)) = (socket.try_clone(), shared.heads.lock()) {
+        heads.push_back((id, clone));
+    }
+    let read = read_request(&mut socket);
+    if let Ok(mut heads) = shared.heads.lock() {
+        heads.retain(|(i, _)| *i != id);
+    }
+    let req = match read {
         Ok(r) => r,
-        Err(e @ (RequestError::TooLarge | RequestError::Malformed(_))) => {
+        Err(
+            e @ (RequestError::TooLarge
+            | RequestError::Malformed(_)
+            | RequestError::DuplicateLength),
+        ) => {
             respond(
                 &mut socket,
                 400,
@@ -193,7 +251,74 @@ fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), Reques
         }
         Err(e) => return Err(e),
     };
+    let text = "text/plain; charset=utf-8";
+    let host_ok = req
+        .host
+        .as_deref()
+        .is_some_and(|h| shared.hosts.iter().any(|a| a.eq_ignore_ascii_case(h)));
+    if !host_ok {
+        refused_once(&socket, shared, 421, req.host.as_deref().unwrap_or(""));
+        return Ok(respond(
+            &mut socket,
+            421,
+            text,
+            "unknown Host (see --http-allow-host)",
+        )?);
+    }
+    // A state-changing request from a page must come from this view's own origin.
+    if req.method != "GET" {
+        if let Some(origin) = req.origin.as_deref() {
+            let own = ["http://", "https://"].iter().any(|scheme| {
+                origin
+                    .strip_prefix(scheme)
+                    .is_some_and(|h| shared.hosts.iter().any(|a| a.eq_ignore_ascii_case(h)))
+            });
+            if !own {
+                refused_once(&socket, shared, 403, origin);
+                return Ok(respond(&mut socket, 403, text, "foreign Origin")?);
+            }
+        }
+    }
     route(socket, &req, shared)
+}
+
+/// Every `Host` value the view answers: the bound address, `localhost`, `127.0.0.1` and
+/// `[::1]`, each with the bound port, and `extra` (as given, and with the port when it has none).
+fn allowed_hosts(local: SocketAddr, extra: &[String]) -> Vec<String> {
+    let port = local.port();
+    let mut hosts = vec![
+        local.to_string(),
+        format!("localhost:{port}"),
+        format!("127.0.0.1:{port}"),
+        format!("[::1]:{port}"),
+    ];
+    for h in extra {
+        hosts.push(h.to_ascii_lowercase());
+        if !h.contains(':') || h.ends_with(']') {
+            hosts.push(format!("{}:{port}", h.to_ascii_lowercase()));
+        }
+    }
+    hosts
+}
+
+/// Log a refusal (421 wrong Host, 403 wrong Origin) once per peer address and kind; the
+/// list is bounded, so a flood of peers cannot grow it.
+fn refused_once(socket: &TcpStream, shared: &Shared, status: u16, value: &str) {
+    const MAX_LOGGED_SOURCES: usize = 256;
+    let Ok(peer) = socket.peer_addr() else { return };
+    let Ok(mut seen) = shared.refused_logged.lock() else {
+        return;
+    };
+    if seen.contains(&(peer.ip(), status)) || seen.len() >= MAX_LOGGED_SOURCES {
+        return;
+    }
+    seen.push((peer.ip(), status));
+    let what = if status == 421 { "Host" } else { "Origin" };
+    let value: String = value.chars().take(80).collect();
+    log::warn!(
+        "web view: refused {what} {value:?} from {} with {status} (DNS rebinding or a foreign page; logged once per source)",
+        peer.ip()
+    );
 }
 
 fn route(mut socket: TcpStream, req: &Request, shared: &Shared) -> Result<(), RequestError> {
@@ -236,11 +361,14 @@ fn route(mut socket: TcpStream, req: &Request, shared: &Shared) -> Result<(), Re
 }
 
 /// Read one request head and its body (both within [`MAX_REQUEST_BYTES`]).
+/// The whole request must arrive within [`READ_TIMEOUT`] of the connection's start: each
+/// read waits only for what is left of that one deadline.
 fn read_request(socket: &mut TcpStream) -> Result<Request, RequestError> {
+    let deadline = Instant::now() + READ_TIMEOUT;
     let mut buf = vec![0u8; MAX_REQUEST_BYTES];
     let mut filled = 0;
     loop {
-        let n = socket.read(&mut buf[filled..])?;
+        let n = read_before(socket, &mut buf[filled..], deadline)?;
         if n == 0 {
             return Err(RequestError::Incomplete);
         }
@@ -253,13 +381,22 @@ fn read_request(socket: &mut TcpStream) -> Result<Request, RequestError> {
                 .headers
                 .iter()
                 .any(|h| h.name.eq_ignore_ascii_case(CONTROL_HEADER));
+            let header = |name: &str| {
+                parsed
+                    .headers
+                    .iter()
+                    .find(|h| h.name.eq_ignore_ascii_case(name))
+                    .map(|h| String::from_utf8_lossy(h.value).trim().to_string())
+            };
+            let host = header("host");
+            let origin = header("origin");
             let method = parsed.method.unwrap_or_default().to_string();
             let path = parsed.path.unwrap_or_default();
             let path = path.split_once('?').map_or(path, |(p, _)| p).to_string();
             let end = head.checked_add(length).filter(|&e| e <= buf.len());
             let end = end.ok_or(RequestError::TooLarge)?;
             while filled < end {
-                let n = socket.read(&mut buf[filled..end])?;
+                let n = read_before(socket, &mut buf[filled..end], deadline)?;
                 if n == 0 {
                     return Err(RequestError::Incomplete);
                 }
@@ -270,6 +407,8 @@ fn read_request(socket: &mut TcpStream) -> Result<Request, RequestError> {
                 method,
                 path,
                 has_control_header,
+                host,
+                origin,
                 body,
             });
         }
@@ -279,11 +418,42 @@ fn read_request(socket: &mut TcpStream) -> Result<Request, RequestError> {
     }
 }
 
+/// One read that waits no later than `deadline`.
+fn read_before(
+    socket: &mut TcpStream,
+    buf: &mut [u8],
+    deadline: Instant,
+) -> Result<usize, RequestError> {
+    let left = deadline.saturating_duration_since(Instant::now());
+    if left.is_zero() {
+        return Err(RequestError::TimedOut);
+    }
+    socket.set_read_timeout(Some(left))?;
+    match socket.read(buf) {
+        Ok(n) => Ok(n),
+        Err(e)
+            if matches!(
+                e.kind(),
+                io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
+            ) =>
+        {
+            Err(RequestError::TimedOut)
+        }
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// The body's length; two `Content-Length` headers (even equal ones) are refused, as a
+/// proxy in front could have read the body by the other one (RFC 9112 §6.3).
 fn content_length(headers: &[httparse::Header<'_>]) -> Result<usize, RequestError> {
-    match headers
+    let mut lengths = headers
         .iter()
-        .find(|h| h.name.eq_ignore_ascii_case("content-length"))
-    {
+        .filter(|h| h.name.eq_ignore_ascii_case("content-length"));
+    let first = lengths.next();
+    if lengths.next().is_some() {
+        return Err(RequestError::DuplicateLength);
+    }
+    match first {
         None => Ok(0),
         Some(h) => std::str::from_utf8(h.value)
             .ok()
@@ -300,6 +470,7 @@ fn reason(status: u16) -> &'static str {
         404 => "Not Found",
         405 => "Method Not Allowed",
         409 => "Conflict",
+        421 => "Misdirected Request",
         503 => "Service Unavailable",
         _ => "Internal Server Error",
     }

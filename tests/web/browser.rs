@@ -33,6 +33,7 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
         bind: "127.0.0.1:0".parse().unwrap(),
         allow_non_loopback: false,
         controls: ControlAccess::Allowed,
+        allow_hosts: Vec::new(),
     };
     let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
     channels.command(2, Op::Start("streaming.nc".into()));
@@ -84,4 +85,53 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
         Value::Array(Vec::new()),
         "only the view's own address"
     );
+}
+
+/// A page served from a rebinding name resolved to loopback commands nothing, even with
+/// `--http-controls`: the page and its start are answered 421.
+#[test]
+#[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
+fn browser_on_a_rebinding_name_cannot_start_a_program() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/node/guarded_view_test.js"
+    );
+    let args = ["rebind".to_string(), web.local_addr().port().to_string()];
+    let seen = run_page_script(script, &args, |_| false);
+    assert_eq!(seen["page_status"], 421);
+    assert_eq!(seen["start_status"], 421);
+    let s = channels.status(1);
+    assert_eq!((s.state, s.program), (State::Ready, None));
+}
+
+/// A page answered 503 (every page slot taken) says it retries and goes live once a slot
+/// frees.
+#[test]
+#[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
+fn browser_refused_for_want_of_a_slot_retries_and_goes_live() {
+    let (web, _channels) = view(ControlAccess::Refused);
+    let addr = web.local_addr();
+    let mut held: Vec<_> = (0..ncchannel::http::MAX_PAGE_CONNECTIONS)
+        .map(|_| super::client::Events::open(addr))
+        .collect();
+    assert!(held.iter().all(|e| e.status == 200));
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/node/guarded_view_test.js"
+    );
+    let args = ["full".to_string(), format!("http://{addr}/")];
+    let seen = run_page_script(script, &args, |line| {
+        if line != "RETRYING" {
+            return false;
+        }
+        held.clear();
+        true
+    });
+    assert!(
+        seen["refused"].as_str().unwrap().contains("retrying in"),
+        "{seen}"
+    );
+    assert!(seen["retries"].as_u64().unwrap() >= 1);
+    assert_eq!(seen["last"], "live");
 }

@@ -31,7 +31,6 @@ fn connect(addr: SocketAddr) -> TcpStream {
 
 /// One request; `extra` are whole header lines.
 pub fn request(addr: SocketAddr, method: &str, path: &str, extra: &[&str], body: &str) -> Response {
-    let mut s = connect(addr);
     let mut head = format!(
         "{method} {path} HTTP/1.1\r\nHost: {addr}\r\nContent-Length: {}\r\n",
         body.len()
@@ -40,7 +39,13 @@ pub fn request(addr: SocketAddr, method: &str, path: &str, extra: &[&str], body:
         head.push_str(h);
         head.push_str("\r\n");
     }
-    write!(s, "{head}\r\n{body}").unwrap();
+    raw(addr, &format!("{head}\r\n{body}"))
+}
+
+/// Send `request` as it is (head and body) and read the whole response.
+pub fn raw(addr: SocketAddr, request: &str) -> Response {
+    let mut s = connect(addr);
+    s.write_all(request.as_bytes()).unwrap();
     let mut raw = String::new();
     s.read_to_string(&mut raw).unwrap();
     let (head, body) = raw.split_once("\r\n\r\n").unwrap();

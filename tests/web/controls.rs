@@ -74,3 +74,106 @@ fn allowed_controls_go_through_the_door() {
     assert_eq!(client::control(addr, 9, "hold", "").status, 404);
     assert_eq!(client::control(addr, 1, "launch", "").status, 400);
 }
+
+/// A page served from a rebinding name (its `Host` is that name, resolved to loopback) is
+/// answered 421 and commands nothing, even with `--http-controls`.
+#[test]
+fn a_rebinding_host_is_refused_and_executes_nothing() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let addr = web.local_addr();
+    let port = addr.port();
+    for host in [
+        format!("rebind.test:{port}"),
+        "rebind.test".to_string(),
+        String::new(),
+    ] {
+        let r = client::raw(
+            addr,
+            &format!(
+                "POST /control/1/start HTTP/1.1\r\nHost: {host}\r\nX-Ncchannel-Control: 1\r\n\
+                 Content-Length: 9\r\n\r\nsquare.nc"
+            ),
+        );
+        assert_eq!(r.status, 421, "{host}: {}", r.body);
+        let get = client::raw(
+            addr,
+            &format!("GET /events HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+        );
+        assert_eq!(get.status, 421, "{host}");
+    }
+    let s = channels.status(1);
+    assert_eq!((s.state, s.program), (State::Ready, None));
+    // Loopback names with the port are answered.
+    for host in [format!("localhost:{port}"), format!("127.0.0.1:{port}")] {
+        let r = client::raw(
+            addr,
+            &format!("GET /controls HTTP/1.1\r\nHost: {host}\r\n\r\n"),
+        );
+        assert_eq!((r.status, r.body.as_str()), (200, "on"), "{host}");
+    }
+}
+
+/// A name given for a reverse proxy is answered.
+#[test]
+fn an_allowed_proxy_host_is_answered() {
+    let params = super::Params::new(1);
+    let channels = super::Channels::from_params(params);
+    let config = ncchannel::http::HttpConfig {
+        bind: "127.0.0.1:0".parse().unwrap(),
+        allow_non_loopback: false,
+        controls: ControlAccess::Refused,
+        allow_hosts: vec!["cnc.example".to_string()],
+    };
+    let web = ncchannel::http::spawn(&config, std::sync::Arc::clone(&channels.backend), None)
+        .expect("web view starts");
+    let addr = web.local_addr();
+    let r = client::raw(addr, "GET /controls HTTP/1.1\r\nHost: cnc.example\r\n\r\n");
+    assert_eq!(r.status, 200);
+    let r = client::raw(
+        addr,
+        "GET /controls HTTP/1.1\r\nHost: other.example\r\n\r\n",
+    );
+    assert_eq!(r.status, 421);
+}
+
+/// A state-changing request whose `Origin` is not the view's own is refused 403.
+#[test]
+fn a_foreign_origin_is_refused() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let addr = web.local_addr();
+    let r = client::request(
+        addr,
+        "POST",
+        "/control/1/start",
+        &["X-Ncchannel-Control: 1", "Origin: http://rebind.test"],
+        "square.nc",
+    );
+    assert_eq!(r.status, 403, "{}", r.body);
+    assert!(r.body.contains("Origin"), "{}", r.body);
+    assert_eq!(channels.status(1).state, State::Ready);
+    let own = format!("Origin: http://{addr}");
+    let r = client::request(
+        addr,
+        "POST",
+        "/control/1/start",
+        &["X-Ncchannel-Control: 1", &own],
+        "square.nc",
+    );
+    assert_eq!((r.status, r.body.as_str()), (200, "done"));
+}
+
+/// Two `Content-Length` headers are refused with 400 and command nothing.
+#[test]
+fn two_content_lengths_are_refused() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let r = client::request(
+        web.local_addr(),
+        "POST",
+        "/control/1/start",
+        &["X-Ncchannel-Control: 1", "Content-Length: 9"],
+        "square.nc",
+    );
+    assert_eq!(r.status, 400, "{}", r.body);
+    assert!(r.body.contains("Content-Length"), "{}", r.body);
+    assert_eq!(channels.status(1).state, State::Ready);
+}

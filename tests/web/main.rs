@@ -11,6 +11,7 @@ mod browser;
 mod client;
 mod controls;
 mod feed;
+mod slowloris;
 mod techno;
 
 use std::sync::Arc;
@@ -32,6 +33,7 @@ pub fn view(controls: ControlAccess) -> (HttpHandle, Channels) {
         bind: "127.0.0.1:0".parse().unwrap(),
         allow_non_loopback: false,
         controls,
+        allow_hosts: Vec::new(),
     };
     let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
     (web, channels)

@@ -35,6 +35,7 @@ fn techno_view() -> (HttpHandle, Channels) {
         bind: "127.0.0.1:0".parse().unwrap(),
         allow_non_loopback: false,
         controls: ControlAccess::Refused,
+        allow_hosts: Vec::new(),
     };
     let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
     (web, channels)

@@ -29,11 +29,24 @@ function channelView(ch) {
 
 // ---- the event stream ----
 
+// A refused stream (503: every page slot taken) closes the EventSource for good; the page
+// then retries itself, waiting 1 s, 2 s, 4 s … up to 30 s, and says so.
+let retryDelayS = 1;
+
 function connect() {
   const es = new EventSource("/events");
   const link = document.getElementById("link");
-  es.onopen = () => { link.textContent = "live"; link.className = "link up"; };
-  es.onerror = () => { link.textContent = "reconnecting…"; link.className = "link down"; };
+  es.onopen = () => { retryDelayS = 1; link.textContent = "live"; link.className = "link up"; };
+  es.onerror = () => {
+    link.className = "link down";
+    if (es.readyState !== EventSource.CLOSED) { link.textContent = "reconnecting…"; return; }
+    es.close();
+    const wait = retryDelayS;
+    retryDelayS = Math.min(retryDelayS * 2, 30);
+    link.textContent = "refused (all page slots taken?) — retrying in " + wait + " s";
+    link.dataset.retries = String(Number(link.dataset.retries || 0) + 1);
+    setTimeout(connect, wait * 1000);
+  };
   es.addEventListener("status", (e) => onStatus(JSON.parse(e.data)));
   es.addEventListener("listing", (e) => onListing(JSON.parse(e.data)));
   es.addEventListener("nc-error", (e) => onError(JSON.parse(e.data)));
