@@ -164,6 +164,7 @@ pub(crate) fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
                     format!("parameter list is {bytes} bytes, more than the limit of {limit} bytes")
                 }
                 BoundedReadError::Io(e) => format!("cannot read parameter list: {e}"),
+                e @ BoundedReadError::NotRegular => format!("parameter list is {e}"),
             },
         )
     })?;
