@@ -273,6 +273,7 @@ fn read_text(path: &Path) -> Result<String, String> {
             format!("file has {bytes} bytes, more than the {limit} a program may have")
         }
         BoundedReadError::Io(e) => format!("cannot read file: {e}"),
+        e @ BoundedReadError::NotRegular => e.to_string(),
     })?;
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }

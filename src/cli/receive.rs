@@ -42,6 +42,10 @@ pub struct ReceiveArgs {
     /// Take transfers on a TCP port, one connection per transfer. `PORT` alone binds loopback.
     #[arg(long, value_name = "ADDR:PORT")]
     pub listen: Option<String>,
+    /// With --listen: accept a non-loopback ADDR (any host that reaches it can file programs),
+    /// as `serve --allow-non-loopback`.
+    #[arg(long, requires = "listen")]
+    pub allow_non_loopback: bool,
     /// With --listen: stop after this many transfers.
     #[arg(long, value_name = "N")]
     pub max_transfers: Option<usize>,
@@ -286,6 +290,16 @@ fn serve(
     total: &mut Totals,
 ) -> Result<dnc::StopLevel, Failure> {
     let addr = parse_listen(addr).map_err(Failure::Usage)?;
+    if !addr.ip().is_loopback() {
+        if !args.allow_non_loopback {
+            return Err(Failure::Usage(format!(
+                "refusing to listen on non-loopback address {addr} without --allow-non-loopback"
+            )));
+        }
+        say(format_args!(
+            "listening on non-loopback {addr}: any host that reaches it can file programs"
+        ));
+    }
     let listener =
         TcpListener::bind(addr).map_err(|e| Failure::Io(format!("listen on {addr}: {e}")))?;
     let local = listener

@@ -5,8 +5,8 @@
 //! The temporary file is the `tempfile` crate's `NamedTempFile`: it is removed when dropped
 //! (a broken transfer, a writer error, the receiver stopping), and `persist_noclobber` gives
 //! the final name only if nothing has it yet, atomically (no window between test and rename).
-//! Its name carries the receiving process's id ([`temp_files`]), so a later run can tell the
-//! files a killed receiver left from those of a receiver still running.
+//! The writer holds a lock on it while it writes ([`temp_files`]), so a later run can tell the
+//! files a killed receiver left from those of a receiver still running, in any PID namespace.
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};

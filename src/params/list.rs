@@ -164,9 +164,14 @@ pub(crate) fn read_list_text(file: &Path) -> Result<String, Diagnostic> {
                     format!("parameter list is {bytes} bytes, more than the limit of {limit} bytes")
                 }
                 BoundedReadError::Io(e) => format!("cannot read parameter list: {e}"),
+                e @ BoundedReadError::NotRegular => format!("parameter list is {e}"),
             },
         )
     })?;
+    // A NUL byte is in no text list, UTF-8 or Latin-1: the file is UTF-16 or binary.
+    if memchr::memchr(0, &bytes).is_some() {
+        return Err(file_error(file, "parameter list is not UTF-8 text"));
+    }
     Ok(match String::from_utf8(bytes) {
         Ok(s) => s,
         Err(e) => e.into_bytes().iter().map(|&b| char::from(b)).collect(),
@@ -605,6 +610,19 @@ fn number_kind(num: &str) -> Option<ValueKind> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_utf16_list_is_refused_as_not_utf8_text() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let p = dir.path().join("sda_mds1.lis");
+        let utf16: Vec<u8> = "kanal_id 1\n"
+            .encode_utf16()
+            .flat_map(u16::to_le_bytes)
+            .collect();
+        std::fs::write(&p, [&[0xFF, 0xFE][..], &utf16].concat()).expect("write");
+        let d = read_list_text(&p).expect_err("refused");
+        assert!(d.render().contains("not UTF-8 text"), "{}", d.render());
+    }
 
     fn one(line: &str) -> Entry {
         let (list, errs) = parse_list(Path::new("t.lis"), line);

@@ -433,6 +433,7 @@ pub(crate) fn read_runtime(file: &Path) -> Result<RuntimeConfig, Vec<Diagnostic>
                 format!("runtime.toml is {bytes} bytes, more than the limit of {limit} bytes")
             }
             BoundedReadError::Io(e) => format!("cannot read runtime.toml: {e}"),
+            e @ BoundedReadError::NotRegular => format!("runtime.toml is {e}"),
         })
     })?;
     let text = String::from_utf8(bytes)

@@ -194,10 +194,12 @@ impl Scenario {
                 path: p.clone(),
                 source,
             },
-            e @ BoundedReadError::TooLarge { .. } => ScenarioError::Invalid {
-                path: p.clone(),
-                msg: e.to_string(),
-            },
+            e @ (BoundedReadError::TooLarge { .. } | BoundedReadError::NotRegular) => {
+                ScenarioError::Invalid {
+                    path: p.clone(),
+                    msg: e.to_string(),
+                }
+            }
         })?;
         let text = String::from_utf8(bytes).map_err(|_| ScenarioError::Invalid {
             path: p.clone(),

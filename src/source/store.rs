@@ -409,6 +409,10 @@ fn read_error(e: BoundedReadError, name: &str) -> StoreError {
             name: name.to_string(),
             reason: e.to_string(),
         },
+        e @ BoundedReadError::NotRegular => StoreError::Unreadable {
+            name: name.to_string(),
+            reason: e.to_string(),
+        },
     }
 }
 

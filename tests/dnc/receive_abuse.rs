@@ -313,3 +313,26 @@ fn concurrent_transfers_of_unnamed_programs_get_distinct_numbers() {
         "every program filed under a number of its own"
     );
 }
+
+/// `--listen` on every interface without the opt-in is refused before anything binds, as
+/// `serve --bind` is; with `--allow-non-loopback` it listens and says so.
+#[test]
+fn listen_on_non_loopback_needs_the_opt_in() {
+    let root = tempfile::tempdir().expect("tempdir");
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["receive", "--listen", "0.0.0.0:0", "--out"])
+        .arg(root.path())
+        .stdin(Stdio::null())
+        .output()
+        .expect("run ncchannel receive");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(
+            "refusing to listen on non-loopback address 0.0.0.0:0 without --allow-non-loopback"
+        ),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("listening on"), "{stderr}");
+}

@@ -159,6 +159,9 @@ fn a_second_signal_stops_at_once_and_leaves_no_temporary_file() {
     assert!(!out.join("SLOW.mpf").exists());
 }
 
+/// A file counts as live while its writer holds its lock, whatever pid its name carries: one
+/// named for a running process but unlocked is stale, one named for no process but locked is
+/// live.
 #[test]
 fn a_run_removes_the_temporary_files_a_stopped_receiver_left_and_only_those() {
     let root = tempfile::tempdir().expect("tempdir");
@@ -169,12 +172,13 @@ fn a_run_removes_the_temporary_files_a_stopped_receiver_left_and_only_those() {
         .ok()
         .and_then(|s| s.trim().parse().ok())
         .unwrap_or(4_194_304);
-    let stale = out.join(format!(".ncchannel-receive-{}-Ab12Cd.tmp", pid_max + 1));
-    // This test process runs: its "receiver" is alive.
-    let live = out.join(format!(
+    // This test process runs, but holds no lock on it: its writer is gone.
+    let stale = out.join(format!(
         ".ncchannel-receive-{}-Ab12Cd.tmp",
         std::process::id()
     ));
+    // Named for no process here (a receiver in another PID namespace), but locked.
+    let live = out.join(format!(".ncchannel-receive-{}-Ab12Cd.tmp", pid_max + 1));
     let foreign = [
         out.join(".ncchannel-receive-Ab12Cd.tmp"),
         out.join("other.tmp"),
@@ -182,6 +186,9 @@ fn a_run_removes_the_temporary_files_a_stopped_receiver_left_and_only_those() {
     for f in [&stale, &live].into_iter().chain(&foreign) {
         std::fs::write(f, b"G01 X1\r\n").expect("write");
     }
+    let held = std::fs::File::open(&live).expect("open live");
+    rustix::fs::flock(&held, rustix::fs::FlockOperation::NonBlockingLockExclusive)
+        .expect("lock live");
     let input = root.path().join("in.txt");
     std::fs::write(&input, b"%_N_PART_MPF\r\nG01 X1\r\nM30\r\n").expect("input");
     let o = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
@@ -200,4 +207,84 @@ fn a_run_removes_the_temporary_files_a_stopped_receiver_left_and_only_those() {
         assert!(f.exists(), "{} is not ours and was kept", f.display());
     }
     assert!(err.contains("removed 1 temporary file(s)"), "{err}");
+    drop(held);
+}
+
+/// The `unshare` prefix that runs a command as pid 1 of a new PID namespace (with its own
+/// /proc), or why this machine cannot.
+fn pid_namespace_prefix() -> Result<Vec<&'static str>, String> {
+    let plain = vec!["--pid", "--fork", "--mount-proc", "--kill-child"];
+    let as_user = vec![
+        "--user",
+        "--map-root-user",
+        "--pid",
+        "--fork",
+        "--mount-proc",
+        "--kill-child",
+    ];
+    let mut why = String::new();
+    for prefix in [plain, as_user] {
+        match Command::new("unshare").args(&prefix).arg("true").output() {
+            Ok(o) if o.status.success() => return Ok(prefix),
+            Ok(o) => why = String::from_utf8_lossy(&o.stderr).trim().to_string(),
+            Err(e) => why = format!("unshare: {e}"),
+        }
+    }
+    Err(why)
+}
+
+/// Two receivers sharing a folder, each in its own PID namespace (two containers on one
+/// volume): both are pid 1 there, and neither sees the other in /proc. The second one's start
+/// leaves the first one's live temporary file alone, and the first files its program whole.
+#[test]
+fn a_receiver_in_another_pid_namespace_keeps_a_live_transfer() {
+    let prefix = match pid_namespace_prefix() {
+        Ok(p) => p,
+        Err(why) => {
+            println!("SKIPPED: no PID namespace here ({why})");
+            return;
+        }
+    };
+    let root = tempfile::tempdir().expect("tempdir");
+    let out = root.path().join("out");
+    std::fs::create_dir_all(&out).expect("out");
+    let mut cmd = Command::new("unshare");
+    cmd.args(&prefix)
+        .arg(env!("CARGO_BIN_EXE_ncchannel"))
+        .stdout(Stdio::null());
+    let (mut first, addr, _stderr) = abuse_common::receive_listening(cmd, &out, &[]);
+    let mut s = TcpStream::connect(addr).expect("connect");
+    s.write_all(b"%_N_LIVE_MPF\r\nG01 X1\r\n")
+        .expect("send the start");
+    wait_for("the live transfer's temporary file", || {
+        !temp_files(&out).is_empty()
+    });
+    assert_eq!(temp_files(&out).len(), 1, "the live transfer's file");
+
+    let input = root.path().join("in.txt");
+    std::fs::write(&input, b"%_N_OTHER_MPF\r\nG01 X2\r\nM30\r\n").expect("input");
+    let second = Command::new("unshare")
+        .args(&prefix)
+        .arg(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("receive")
+        .arg(&input)
+        .args(["--start", "%", "--end", "M30", "--out"])
+        .arg(&out)
+        .output()
+        .expect("second receiver runs");
+    let err = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(0), "{err}");
+    assert!(!err.contains("removed"), "{err}");
+    assert_eq!(temp_files(&out).len(), 1, "the live file is kept: {err}");
+
+    s.write_all(b"G01 X3\r\nM30\r\n").expect("send the rest");
+    s.shutdown(std::net::Shutdown::Write).expect("shutdown");
+    s.set_read_timeout(Some(DEADLINE)).expect("timeout");
+    // The receiver closes its side once the transfer is filed.
+    let _ = std::io::Read::read(&mut s, &mut [0u8; 16]);
+    let _ = first.kill();
+    let _ = first.wait();
+    let filed = std::fs::read(out.join("LIVE.mpf")).expect("LIVE.mpf is filed");
+    assert_eq!(filed, b"%_N_LIVE_MPF\r\nG01 X1\r\nG01 X3\r\nM30\r\n");
+    assert!(out.join("OTHER.mpf").is_file());
 }

@@ -426,3 +426,39 @@ fn serve_seconds_out_of_range_is_a_usage_error_not_a_panic() {
         assert!(err.contains("--seconds"), "--seconds {bad}: {err}");
     }
 }
+
+/// A FIFO given where a file is read (an NC program, runtime.toml) is refused with a line
+/// that says so, instead of `check` waiting for ever for a writer.
+#[cfg(unix)]
+#[test]
+fn check_refuses_a_fifo_instead_of_waiting_for_a_writer() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for name in ["prog.nc", "runtime.toml"] {
+        let fifo = dir.path().join(name);
+        let made = Process::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+        assert!(made.success());
+        let mut child = Process::new(env!("CARGO_BIN_EXE_ncchannel"))
+            .arg("check")
+            .arg(&fifo)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("check starts");
+        let until = std::time::Instant::now() + Duration::from_secs(60);
+        while child.try_wait().expect("wait").is_none() {
+            if std::time::Instant::now() > until {
+                let _ = child.kill();
+                panic!("check waited on the FIFO {name}");
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let out = child.wait_with_output().expect("output");
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_ne!(out.status.code(), Some(0), "{text}");
+        assert!(text.contains("not a regular file"), "{name}: {text}");
+    }
+}
