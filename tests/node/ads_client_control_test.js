@@ -9,25 +9,13 @@
 //
 // Prints one JSON line (what it saw); exits non-zero on a failed check.
 "use strict";
-const { Client } = require("ads-client");
-const { check } = require("./common");
+const { check, serverClient } = require("./common");
 
-const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
 const CH = "HLI_Global_Variables.gpCh[0]^";
 const MS = CH + ".channel_mc_control.mode_and_state";
 
 function client(raw, localAdsPort) {
-  return new Client({
-    targetAmsNetId: "127.0.0.1.1.1",
-    targetAdsPort: 851,
-    routerAddress: host,
-    routerTcpPort: Number(port),
-    localAmsNetId: "10.1.2.3.1.1",
-    localAdsPort,
-    autoReconnect: false,
-    hideConsoleWarnings: true,
-    rawClient: raw,
-  });
+  return serverClient(localAdsPort, { rawClient: raw });
 }
 
 async function main() {

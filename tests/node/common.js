@@ -27,4 +27,23 @@ function packets(lines) {
   return out;
 }
 
-module.exports = { check, sleep, packets };
+// An ads-client of the server at NCCHANNEL_ADS_ADDR (host:port), on the PLC port 851 by
+// default, with the fixed local NetId and port the test server routes; `extra` overrides or
+// adds any setting (`rawClient`, `targetAdsPort`, `timeoutDelay`).
+function serverClient(localAdsPort, extra) {
+  const { Client } = require("ads-client");
+  const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
+  return new Client({
+    targetAmsNetId: "127.0.0.1.1.1",
+    targetAdsPort: 851,
+    routerAddress: host,
+    routerTcpPort: Number(port),
+    localAmsNetId: "10.1.2.3.1.1",
+    localAdsPort,
+    autoReconnect: false,
+    hideConsoleWarnings: true,
+    ...extra,
+  });
+}
+
+module.exports = { check, sleep, packets, serverClient };

@@ -9,27 +9,14 @@
 //
 // Prints one JSON line (what it saw); exits non-zero on a failed check.
 "use strict";
-const { Client } = require("ads-client");
-const { check } = require("./common");
+const { check, serverClient } = require("./common");
 
-const [host, port] = process.env.NCCHANNEL_ADS_ADDR.split(":");
 const CH = 0x120101;
 const BLOCK_COUNTER = 0x8002;
 const MS = "HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r";
 
 function client(localAdsPort, extra) {
-  return new Client({
-    targetAmsNetId: "127.0.0.1.1.1",
-    targetAdsPort: 851,
-    routerAddress: host,
-    routerTcpPort: Number(port),
-    localAmsNetId: "10.1.2.3.1.1",
-    localAdsPort,
-    autoReconnect: false,
-    timeoutDelay: 5000,
-    hideConsoleWarnings: true,
-    ...extra,
-  });
+  return serverClient(localAdsPort, { timeoutDelay: 5000, ...extra });
 }
 
 async function main() {
