@@ -19,3 +19,16 @@ def wait_for(what, pred, timeout=20.0):
             return v
         time.sleep(0.01)
     check(False, "timed out waiting for " + what)
+
+
+def open_connections(netid, addr):
+    """pyads' router port with the test client's NetId, and an open connection to each port
+    of the server: the system service (10000), the PLC (851) and the CNC (553)."""
+    import pyads
+
+    pyads.open_port()
+    pyads.set_local_address("10.1.2.3.1.1")
+    conns = tuple(pyads.Connection(netid, port, addr) for port in (10000, 851, 553))
+    for c in conns:
+        c.open()
+    return conns

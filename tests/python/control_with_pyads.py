@@ -17,7 +17,7 @@ import os
 
 import pyads
 
-from checks import check
+from checks import check, open_connections
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -46,13 +46,7 @@ def start_streaming(com):
 
 
 def main():
-    pyads.open_port()
-    pyads.set_local_address("10.1.2.3.1.1")
-    system = pyads.Connection(NETID, 10000, ADDR)
-    plc = pyads.Connection(NETID, 851, ADDR)
-    com = pyads.Connection(NETID, 553, ADDR)
-    for c in (system, plc, com):
-        c.open()
+    system, plc, com = open_connections(NETID, ADDR)
     seen = {}
 
     # Levels of the type tree: inside a root, above the roots.

@@ -18,7 +18,7 @@ import os
 
 import pyads
 
-from checks import check, wait_for
+from checks import check, open_connections, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -31,13 +31,7 @@ MCM_ACTIVE_STATE = 0x109
 
 
 def main():
-    pyads.open_port()
-    pyads.set_local_address("10.1.2.3.1.1")
-    system = pyads.Connection(NETID, 10000, ADDR)
-    plc = pyads.Connection(NETID, 851, ADDR)
-    com = pyads.Connection(NETID, 553, ADDR)
-    for c in (system, plc, com):
-        c.open()
+    system, plc, com = open_connections(NETID, ADDR)
     seen = {}
 
     seen["system_state"] = list(system.read_state())
