@@ -45,7 +45,8 @@ pub(crate) const DEFAULT_MAX_SEND_QUEUE_BYTES: usize = 1 << 20;
 /// A write to a client that takes longer than this (its receive window stays shut) ends
 /// the connection.
 pub(crate) const WRITE_TIMEOUT: Duration = Duration::from_secs(5);
-/// Distinct unrouted source NetIds logged per connection; beyond that one summary line.
+/// Distinct source NetIds a connection logs a line about, for each kind of refused frame;
+/// beyond that one summary line at most.
 const MAX_LOGGED_UNROUTED: usize = 16;
 /// Notification cycle times are clamped to this range.
 pub(crate) const MIN_NOTIFICATION_CYCLE: Duration = Duration::from_millis(1);
@@ -824,8 +825,8 @@ fn answer_loop(
     inbox: &Inbox,
 ) -> Result<(), ConnError> {
     let (peer, ip_routed) = (conn.peer, conn.ip_routed);
-    let mut logged_unrouted: Vec<AmsNetId> = Vec::new();
-    let mut logged_foreign: Vec<AmsNetId> = Vec::new();
+    let mut logged_unrouted = LoggedNetIds::default();
+    let mut logged_foreign = LoggedNetIds::default();
     loop {
         let (arrived, frame) = inbox.pop()?;
         match frame {
@@ -941,20 +942,48 @@ fn read_loop(
     }
 }
 
+/// The source NetIds one connection has logged a line about, for one kind of refused frame:
+/// at most [`MAX_LOGGED_UNROUTED`], so a client cycling through NetIds cannot fill the log.
+#[derive(Default)]
+struct LoggedNetIds(Vec<AmsNetId>);
+
+/// What [`LoggedNetIds::note`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FirstSeen {
+    /// Not logged before: log it.
+    New,
+    /// The first NetId past the bound: say that no more are logged.
+    PastBound,
+    /// Logged before, or past the bound already: nothing to log.
+    Known,
+}
+
+impl LoggedNetIds {
+    fn note(&mut self, id: AmsNetId) -> FirstSeen {
+        if self.0.len() > MAX_LOGGED_UNROUTED || self.0.contains(&id) {
+            return FirstSeen::Known;
+        }
+        let past = self.0.len() == MAX_LOGGED_UNROUTED;
+        self.0.push(id);
+        if past {
+            FirstSeen::PastBound
+        } else {
+            FirstSeen::New
+        }
+    }
+}
+
 /// Log a frame dropped for want of a route, once per source NetId; past
 /// `MAX_LOGGED_UNROUTED` NetIds say so once and log no more (a flood cannot fill the log).
-fn note_unrouted(peer: SocketAddr, logged_unrouted: &mut Vec<AmsNetId>, id: AmsNetId) {
-    if logged_unrouted.len() <= MAX_LOGGED_UNROUTED && !logged_unrouted.contains(&id) {
-        if logged_unrouted.len() == MAX_LOGGED_UNROUTED {
-            log(format_args!(
-                "{peer}: more than {MAX_LOGGED_UNROUTED} unrouted source NetIds: no more are logged"
-            ));
-        } else {
-            log(format_args!(
-                "{peer}: no route for source NetId {id}: frames dropped"
-            ));
-        }
-        logged_unrouted.push(id);
+fn note_unrouted(peer: SocketAddr, logged: &mut LoggedNetIds, id: AmsNetId) {
+    match logged.note(id) {
+        FirstSeen::New => log(format_args!(
+            "{peer}: no route for source NetId {id}: frames dropped"
+        )),
+        FirstSeen::PastBound => log(format_args!(
+            "{peer}: more than {MAX_LOGGED_UNROUTED} unrouted source NetIds: no more are logged"
+        )),
+        FirstSeen::Known => {}
     }
 }
 
@@ -969,12 +998,11 @@ fn serves_target(device: Option<AmsNetId>, target: AmsNetId) -> bool {
 fn note_foreign_target(
     shared: &Shared,
     peer: SocketAddr,
-    logged: &mut Vec<AmsNetId>,
+    logged: &mut LoggedNetIds,
     header: &AmsHeader,
 ) {
     let source = header.source.net_id;
-    if logged.len() < MAX_LOGGED_UNROUTED && !logged.contains(&source) {
-        logged.push(source);
+    if logged.note(source) == FirstSeen::New {
         let own = shared.config.net_id.unwrap_or(DEFAULT_NET_ID);
         shared.target_log.log(format_args!(
             "{peer}: frames from {source} for AMS NetId {} answered AMS error 7: this device is {own} (or {})",

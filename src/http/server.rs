@@ -252,10 +252,7 @@ fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), Reques
         Err(e) => return Err(e),
     };
     let text = "text/plain; charset=utf-8";
-    let host_ok = req
-        .host
-        .as_deref()
-        .is_some_and(|h| shared.hosts.iter().any(|a| a.eq_ignore_ascii_case(h)));
+    let host_ok = req.host.as_deref().is_some_and(|h| answers_host(shared, h));
     if !host_ok {
         refused_once(&socket, shared, 421, req.host.as_deref().unwrap_or(""));
         return Ok(respond(
@@ -271,7 +268,7 @@ fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), Reques
             let own = ["http://", "https://"].iter().any(|scheme| {
                 origin
                     .strip_prefix(scheme)
-                    .is_some_and(|h| shared.hosts.iter().any(|a| a.eq_ignore_ascii_case(h)))
+                    .is_some_and(|h| answers_host(shared, h))
             });
             if !own {
                 refused_once(&socket, shared, 403, origin);
@@ -280,6 +277,11 @@ fn serve_connection(mut socket: TcpStream, shared: &Shared) -> Result<(), Reques
         }
     }
     route(socket, &req, shared)
+}
+
+/// Whether `host` (a `Host` header, or an `Origin` without its scheme) names this view.
+fn answers_host(shared: &Shared, host: &str) -> bool {
+    shared.hosts.iter().any(|a| a.eq_ignore_ascii_case(host))
 }
 
 /// Every `Host` value the view answers: the bound address, `localhost`, `127.0.0.1` and
