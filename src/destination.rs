@@ -20,6 +20,34 @@ pub(crate) fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
     }
 }
 
+/// Write `bytes` to `path` whole or not at all, or to standard output for `-`: into a
+/// temporary file in `path`'s folder, synced, then renamed over `path` (`tempfile`'s
+/// `persist`). A reader of `path` sees the old file or the new one, never part of one, even
+/// when the writer is killed.
+pub(crate) fn replace(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    if is_stdout(path) {
+        return write(path, bytes);
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".ncchannel-").suffix(".tmp");
+    // Readable as a file `std::fs::write` makes (0644 less the umask), not 0600: a report is
+    // read by other users (a merge on a shared volume).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    let mut tmp = builder.tempfile_in(dir)?;
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
 /// Open `path` for a stream of writes, or standard output for `-`.
 pub(crate) fn create(path: &Path) -> io::Result<Box<dyn Write + Send>> {
     if is_stdout(path) {

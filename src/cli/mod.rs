@@ -34,8 +34,9 @@ pub mod exit {
     pub(crate) const USAGE: u8 = 2;
     /// `--max-ticks` reached before the program ended.
     pub const MAX_TICKS: u8 = 3;
-    /// SIGINT or SIGTERM stopped `run --realtime` or `soak --realtime` before the end (the
-    /// log, report and summary are complete up to the stop).
+    /// SIGINT or SIGTERM stopped `run --realtime` before the end (the log and summary are
+    /// complete up to the stop). A soak a signal stops exits 128 + the signal's number
+    /// instead (130, 143), its report marked interrupted.
     pub(crate) const STOPPED: u8 = 4;
     /// A second SIGINT/SIGTERM during the orderly stop: exit at once, as a shell reports a
     /// process killed by SIGINT (128 + 2).

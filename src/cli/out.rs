@@ -90,10 +90,11 @@ pub(crate) fn log(msg: std::fmt::Arguments<'_>) {
     say(format_args!("{time} {msg}"));
 }
 
-/// Write a report file; false (after saying why) when it could not be written.
+/// Write a report file whole or not at all (`crate::destination::replace`); false (after
+/// saying why) when it could not be written.
 pub(crate) fn write_report(command: &str, path: &Path, json: &str) -> bool {
     let text = format!("{json}\n");
-    match crate::destination::write(path, text.as_bytes()) {
+    match crate::destination::replace(path, text.as_bytes()) {
         Err(e) if !reader_gone(&e) => {
             eprintln!("ncchannel {command}: --report {}: {e}", path.display());
             false

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use crate::soak::campaign::{CampaignReport, CampaignRun, CampaignSpec, Shard};
 use crate::soak::report::SoakReport;
-use crate::soak::scenario::{ClockSpec, Length, Scenario};
+use crate::soak::scenario::{Length, Scenario};
 use crate::soak::{run, Options};
 
 use super::exit;
@@ -49,9 +49,14 @@ pub struct SoakArgs {
     #[arg(long, short)]
     pub quiet: bool,
     /// Write the report JSON here (- for standard output; the human report then goes to
-    /// standard error).
+    /// standard error). Until the run ends the file holds an `incomplete` placeholder; the
+    /// report replaces it whole (docs/campaigns.md).
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// The campaign run this shard belongs to (a CI run number, a Job's uid), recorded in the
+    /// campaign report: `soak merge` refuses shard reports of different runs.
+    #[arg(long, env = "NCCHANNEL_SOAK_RUN_ID", value_name = "ID")]
+    pub run_id: Option<String>,
 }
 
 #[derive(Debug, Clone, clap::Subcommand)]
@@ -102,18 +107,14 @@ pub fn execute(args: SoakArgs) -> ExitCode {
             sim_seconds: None,
             wall_seconds: args.wall_seconds,
         });
-    // Virtual time runs to its end (seconds); real time stops in order on SIGINT/SIGTERM.
-    let realtime = args.realtime || scenarios.iter().any(|s| s.clock == ClockSpec::Realtime);
-    let signal = if realtime {
-        match super::signal::StopSignal::install() {
-            Ok(s) => Some(s),
-            Err(e) => {
-                eprintln!("ncchannel soak: cannot handle SIGINT/SIGTERM: {e}");
-                None
-            }
+    // SIGINT/SIGTERM stop the run in order, in virtual time as in real time: the report of
+    // what ran, marked interrupted, and the exit code of the signal.
+    let signal = match super::signal::StopSignal::install() {
+        Ok(s) => Some(s),
+        Err(e) => {
+            eprintln!("ncchannel soak: cannot handle SIGINT/SIGTERM: {e}");
+            None
         }
-    } else {
-        None
     };
     let opts = Options {
         stop: signal.as_ref().map(super::signal::StopSignal::flag),
@@ -130,7 +131,13 @@ pub fn execute(args: SoakArgs) -> ExitCode {
             Err(code) => return code,
         }
     } else {
-        let report = match run(&scenarios[0], &opts) {
+        let scenario = &scenarios[0];
+        let placeholder =
+            SoakReport::incomplete(&scenario.path, args.seed.unwrap_or(scenario.seed));
+        if !mark_incomplete(args.report.as_deref(), &placeholder.to_json()) {
+            return ExitCode::from(exit::USAGE);
+        }
+        let report = match run(scenario, &opts) {
             Ok(r) => r,
             Err(e) => return usage(e),
         };
@@ -142,13 +149,29 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         }
         report.all_held
     };
-    ExitCode::from(if held && stopped() {
-        exit::STOPPED
-    } else if held {
-        exit::OK
-    } else {
-        exit::CHANNEL_ERROR
-    })
+    match signal.as_ref().and_then(super::signal::StopSignal::which) {
+        // Stopped by a signal: the report says interrupted; the exit code is the one a shell
+        // gives a process the signal ended (130 for SIGINT), whatever the invariants did.
+        Some((name, code)) => {
+            eprintln!(
+                "ncchannel soak: interrupted by {name}; the report covers what ran until then"
+            );
+            ExitCode::from(code)
+        }
+        None if held => ExitCode::from(exit::OK),
+        None => ExitCode::from(exit::CHANNEL_ERROR),
+    }
+}
+
+/// At the start of a run, replace the report file it will write (if any, and not standard
+/// output) with the `incomplete` placeholder `json`: a run killed before its end leaves that,
+/// never the previous run's report. False (after saying why) when it cannot be written: the
+/// run would not be able to write its report either.
+fn mark_incomplete(report: Option<&Path>, json: &str) -> bool {
+    match report {
+        Some(p) if !crate::destination::is_stdout(p) => super::out::write_report("soak", p, json),
+        _ => true,
+    }
 }
 
 /// Run the campaign's runs of `--shard` (all without it), one after the other; write the
@@ -167,6 +190,11 @@ fn run_campaign(
     let spec = CampaignSpec::new(names, args.seed, args.seeds.unwrap_or(1)).map_err(usage)?;
     let shard = args.shard.unwrap_or(Shard::WHOLE);
     let plan = spec.plan(shard, |i| scenarios[i].seed);
+    let placeholder =
+        CampaignReport::incomplete(spec.clone(), shard).with_run_id(args.run_id.clone());
+    if !mark_incomplete(args.report.as_deref(), &placeholder.to_json()) {
+        return Err(ExitCode::from(exit::USAGE));
+    }
     let mut out = human_out(args.report.as_deref());
     let mut runs = Vec::new();
     for p in &plan {
@@ -181,7 +209,8 @@ fn run_campaign(
             report,
         });
     }
-    let report = CampaignReport::new(spec, shard, plan.len(), runs);
+    let report =
+        CampaignReport::new(spec, shard, plan.len(), runs).with_run_id(args.run_id.clone());
     let _ = report.print_human(&mut *out);
     if let Some(p) = &args.report {
         if !super::out::write_report("soak", p, &report.to_json()) {

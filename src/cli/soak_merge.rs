@@ -21,6 +21,10 @@ pub struct MergeArgs {
     /// goes to standard error).
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Merge only reports of this campaign run (`soak --run-id`); without it, every report
+    /// must be of the first one's run. A report of another run is stale: no verdict.
+    #[arg(long, env = "NCCHANNEL_SOAK_RUN_ID", value_name = "ID")]
+    pub run_id: Option<String>,
 }
 
 fn usage(msg: impl std::fmt::Display) -> ExitCode {
@@ -48,7 +52,7 @@ pub fn execute(args: MergeArgs) -> ExitCode {
             Err(msg) => return usage(msg),
         }
     }
-    let merged = match merge(reports) {
+    let merged = match merge(reports, args.run_id.as_deref()) {
         Ok(m) => m,
         Err(e) => return usage(e),
     };

@@ -9,7 +9,7 @@ use std::str::FromStr;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::report::SoakReport;
+use super::report::{RunStatus, SoakReport};
 
 /// Shards a campaign may be cut into at most (a bound on the merge's bookkeeping).
 pub const MAX_SHARDS: u32 = 100_000;
@@ -132,6 +132,12 @@ pub struct CampaignRun {
 /// The report of a campaign, a shard of one, or several shards merged.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CampaignReport {
+    /// Complete (every planned run ran), interrupted by a signal, or the placeholder written
+    /// when the shard started; merge takes complete reports only.
+    pub status: RunStatus,
+    /// The campaign run this report belongs to (`soak --run-id`): every shard of one run of a
+    /// campaign carries the same; merge refuses a report of another (a stale one).
+    pub run_id: Option<String>,
     pub campaign: CampaignSpec,
     /// The shards this report covers (one for a shard's own report), all of one count.
     pub shards: Vec<Shard>,
@@ -157,6 +163,16 @@ pub enum MergeError {
     },
     #[error("shard(s) {0} missing: the campaign is not complete")]
     Missing(String),
+    #[error("{0}: the shard never finished (its run was killed, or is still running): no verdict from it")]
+    Incomplete(String),
+    #[error("{0}: the shard was interrupted (SIGINT/SIGTERM) after {1} of its runs: run it again")]
+    Interrupted(String, usize),
+    #[error("{name} is stale: it is of campaign run {found}, not {wanted} (give every shard of one run the same --run-id)")]
+    Stale {
+        name: String,
+        found: String,
+        wanted: String,
+    },
     #[error("{name}: run {index} {why}")]
     BadRun {
         name: String,
@@ -174,13 +190,40 @@ impl CampaignReport {
         planned: usize,
         runs: Vec<CampaignRun>,
     ) -> Self {
-        let all_held = runs.len() == planned && runs.iter().all(|r| r.report.all_held);
+        let complete =
+            runs.len() == planned && runs.iter().all(|r| r.report.status == RunStatus::Complete);
+        let all_held = complete && runs.iter().all(|r| r.report.all_held);
         CampaignReport {
+            status: if complete {
+                RunStatus::Complete
+            } else {
+                RunStatus::Interrupted
+            },
+            run_id: None,
             campaign,
             shards: vec![shard],
             all_held,
             runs,
         }
+    }
+
+    /// The placeholder a shard writes to its report file when it starts: no runs, no
+    /// verdict, until the finished report replaces it.
+    pub fn incomplete(campaign: CampaignSpec, shard: Shard) -> Self {
+        CampaignReport {
+            status: RunStatus::Incomplete,
+            run_id: None,
+            campaign,
+            shards: vec![shard],
+            all_held: false,
+            runs: Vec::new(),
+        }
+    }
+
+    /// The same report, of campaign run `run_id`.
+    pub fn with_run_id(mut self, run_id: Option<String>) -> Self {
+        self.run_id = run_id;
+        self
     }
 
     pub fn to_json(&self) -> String {
@@ -215,11 +258,14 @@ impl CampaignReport {
         let violated = self.runs.iter().filter(|r| !r.report.all_held).count();
         writeln!(
             w,
-            "result:   {}",
+            "result:   {}{}",
+            self.status.verdict_prefix(),
             if self.all_held {
                 "every invariant held in every run".to_string()
             } else if violated > 0 {
                 format!("{violated} run(s) violated an invariant")
+            } else if self.status == RunStatus::Incomplete {
+                "no verdict (the shard never finished)".to_string()
             } else {
                 "runs are missing (stopped early)".to_string()
             }
@@ -230,16 +276,36 @@ impl CampaignReport {
 /// Join shard reports (`name`, report) into the report of the whole campaign: all of one
 /// campaign and one shard count, every shard exactly once, each shard's runs exactly the runs
 /// the shard plans. Holds when every run held.
-pub fn merge(reports: Vec<(String, CampaignReport)>) -> Result<CampaignReport, MergeError> {
+pub fn merge(
+    reports: Vec<(String, CampaignReport)>,
+    run_id: Option<&str>,
+) -> Result<CampaignReport, MergeError> {
     let Some((first_name, first)) = reports.first() else {
         return Err(MergeError::Empty);
     };
+    // The run every report must be of: the one asked for, else the first report's.
+    let wanted = run_id.map(str::to_string).or_else(|| first.run_id.clone());
     let campaign = first.campaign.clone();
     let count = first.shards.first().map_or(1, |s| s.count);
     let mut seen: Vec<(Shard, &str)> = Vec::new();
     let mut runs = Vec::new();
     let mut all_held = true;
     for (name, r) in &reports {
+        match r.status {
+            RunStatus::Complete => {}
+            RunStatus::Incomplete => return Err(MergeError::Incomplete(name.clone())),
+            RunStatus::Interrupted => {
+                return Err(MergeError::Interrupted(name.clone(), r.runs.len()))
+            }
+        }
+        if r.run_id != wanted {
+            let shown = |id: &Option<String>| id.clone().unwrap_or_else(|| "(none)".into());
+            return Err(MergeError::Stale {
+                name: name.clone(),
+                found: shown(&r.run_id),
+                wanted: shown(&wanted),
+            });
+        }
         if r.campaign != campaign {
             return Err(MergeError::OtherCampaign(name.clone(), first_name.clone()));
         }
@@ -277,6 +343,8 @@ pub fn merge(reports: Vec<(String, CampaignReport)>) -> Result<CampaignReport, M
     let mut shards: Vec<Shard> = seen.into_iter().map(|(s, _)| s).collect();
     shards.sort();
     Ok(CampaignReport {
+        status: RunStatus::Complete,
+        run_id: wanted,
         campaign,
         shards,
         all_held,
@@ -367,24 +435,54 @@ mod tests {
                 .map(|i| named(i, report_of(&c, shard(i), held)))
                 .collect::<Vec<_>>()
         };
-        let merged = merge(all(&|_| true)).unwrap();
+        let merged = merge(all(&|_| true), None).unwrap();
         assert!(merged.all_held);
         assert_eq!(merged.runs.len(), 6);
         assert!(merged.runs.windows(2).all(|w| w[0].index < w[1].index));
         assert!(
-            !merge(all(&|i| i != 4)).unwrap().all_held,
+            !merge(all(&|i| i != 4), None).unwrap().all_held,
             "a failing run fails the merge"
         );
         let mut two = all(&|_| true);
         two.remove(1);
-        assert!(matches!(merge(two), Err(MergeError::Missing(m)) if m == "2/3"));
+        assert!(matches!(merge(two, None), Err(MergeError::Missing(m)) if m == "2/3"));
         let mut dup = all(&|_| true);
         dup.push(dup[0].clone());
-        assert!(matches!(merge(dup), Err(MergeError::Twice { .. })));
+        assert!(matches!(merge(dup, None), Err(MergeError::Twice { .. })));
         let mut other = all(&|_| true);
         other[2].1.campaign.seeds = 4;
-        assert!(matches!(merge(other), Err(MergeError::OtherCampaign(..))));
+        assert!(matches!(
+            merge(other, None),
+            Err(MergeError::OtherCampaign(..))
+        ));
         // A merged report merges again, alone.
-        assert_eq!(merge(vec![named(0, merged.clone())]).unwrap(), merged);
+        assert_eq!(merge(vec![named(0, merged.clone())], None).unwrap(), merged);
+        // An incomplete or interrupted shard, or one of another campaign run: no verdict.
+        let mut killed = all(&|_| true);
+        killed[1].1 = CampaignReport::incomplete(c.clone(), shard(2));
+        assert!(matches!(merge(killed, None), Err(MergeError::Incomplete(n)) if n == "r2.json"));
+        let mut stopped = all(&|_| true);
+        stopped[2].1.runs.pop();
+        stopped[2].1 = CampaignReport::new(c.clone(), shard(3), 2, stopped[2].1.runs.clone());
+        assert!(matches!(
+            merge(stopped, None),
+            Err(MergeError::Interrupted(..))
+        ));
+        let of_run = |id: &str| {
+            all(&|_| true)
+                .into_iter()
+                .map(|(n, r)| (n, r.with_run_id(Some(id.into()))))
+                .collect::<Vec<_>>()
+        };
+        assert!(merge(of_run("42"), Some("42")).is_ok());
+        assert!(matches!(
+            merge(of_run("41"), Some("42")),
+            Err(MergeError::Stale { .. })
+        ));
+        let mut mixed = of_run("42");
+        mixed[2].1.run_id = Some("41".into());
+        assert!(
+            matches!(merge(mixed, None), Err(MergeError::Stale { name, .. }) if name == "r3.json")
+        );
     }
 }

@@ -237,6 +237,7 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
 
     let start = Instant::now();
     let mut warmup_kib = None;
+    let mut interrupted = false;
     loop {
         let n = tick_limit.map_or(chunk, |t| chunk.min(t.saturating_sub(rt.ticks())));
         if n == 0 {
@@ -248,6 +249,7 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         if warmup_kib.is_none() && f >= scenario.invariants.warmup {
             warmup_kib = resident_kib();
         }
+        interrupted = s.end == RunEnd::StopRequested;
         if matches!(s.end, RunEnd::Stopped | RunEnd::StopRequested)
             || wall_limit.is_some_and(|w| wall >= w)
         {
@@ -271,7 +273,13 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
     };
     let (mut cycle, stats) = rt.into_inner();
     cycle.end_checks();
-    Ok(report_of(&cycle, &stats, scenario, run, warmup_kib, period))
+    let report = report_of(&cycle, &stats, scenario, run, warmup_kib, period);
+    // The stop flag (SIGINT/SIGTERM) ended it before its length: the report of what ran.
+    Ok(if interrupted {
+        report.interrupted()
+    } else {
+        report
+    })
 }
 
 /// The report of a finished run (`warmup_kib`: resident set after warm-up).

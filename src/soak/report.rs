@@ -59,8 +59,36 @@ pub struct MemoryReport {
     pub(crate) growth_kib: Option<i64>,
 }
 
+/// Whether a report covers what it set out to: a run that ran to its length, one a signal
+/// stopped before, or the placeholder a run writes at its start (so that a run killed before
+/// it could write its report leaves this, never the previous run's report).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunStatus {
+    /// The run (every run of a campaign shard) ran to its length.
+    #[default]
+    Complete,
+    /// SIGINT or SIGTERM stopped it; the report covers what ran until then.
+    Interrupted,
+    /// Written when the run started: it never finished (killed, or still running).
+    Incomplete,
+}
+
+impl RunStatus {
+    /// The verdict line's word for a report that is not complete ("" for a complete one).
+    pub(crate) fn verdict_prefix(self) -> &'static str {
+        match self {
+            RunStatus::Complete => "",
+            RunStatus::Interrupted => "INTERRUPTED, ",
+            RunStatus::Incomplete => "INCOMPLETE, ",
+        }
+    }
+}
+
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SoakReport {
+    /// Complete, interrupted by a signal, or the placeholder of a run that never finished.
+    pub status: RunStatus,
     pub scenario: String,
     pub seed: u64,
     pub(crate) clock: String,
@@ -69,6 +97,8 @@ pub struct SoakReport {
     pub(crate) wall_seconds: f64,
     pub blocks: u64,
     pub(crate) blocks_per_wall_second: f64,
+    /// The run completed and every invariant held (false for an interrupted run whatever its
+    /// invariants say, so that a reader of this field alone never takes it for a pass).
     pub all_held: bool,
     pub invariants: Vec<Verdict>,
     pub channels: Vec<SoakCounters>,
@@ -99,6 +129,7 @@ impl SoakReport {
         cycle: CycleFigures,
     ) -> Self {
         SoakReport {
+            status: RunStatus::Complete,
             scenario: scenario.display().to_string(),
             seed: run.seed,
             clock: if run.realtime { "real" } else { "virtual" }.into(),
@@ -113,6 +144,25 @@ impl SoakReport {
             memory,
             cycle,
         }
+    }
+
+    /// The placeholder a run of `scenario` with `seed` writes to its report file when it
+    /// starts: incomplete, not held, until the finished report replaces it.
+    pub fn incomplete(scenario: &std::path::Path, seed: u64) -> Self {
+        SoakReport {
+            status: RunStatus::Incomplete,
+            scenario: scenario.display().to_string(),
+            seed,
+            all_held: false,
+            ..SoakReport::default()
+        }
+    }
+
+    /// Mark the report of a run a signal stopped: interrupted, and not a pass.
+    pub(crate) fn interrupted(mut self) -> Self {
+        self.status = RunStatus::Interrupted;
+        self.all_held = false;
+        self
     }
 
     pub fn to_json(&self) -> String {
@@ -173,14 +223,15 @@ impl SoakReport {
                 writeln!(w, "          {d}")?;
             }
         }
-        writeln!(
-            w,
-            "result:    {}",
-            if self.all_held {
-                "every invariant held"
-            } else {
-                "an invariant was violated"
-            }
-        )
+        // `all_held` is false for a run that did not complete; the verdict line still says
+        // whether the invariants held as far as it ran.
+        let held = self.invariants.iter().all(|v| v.held);
+        let verdict = match (self.status, held) {
+            (RunStatus::Complete, _) if self.all_held => "every invariant held",
+            (RunStatus::Interrupted, true) => "every invariant held so far",
+            (RunStatus::Incomplete, _) => "no verdict (the run never finished)",
+            _ => "an invariant was violated",
+        };
+        writeln!(w, "result:    {}{verdict}", self.status.verdict_prefix())
     }
 }

@@ -199,3 +199,136 @@ fn a_failing_shard_fails_the_merge_as_it_fails_the_whole_campaign() {
         "{out}"
     );
 }
+
+/// A campaign of a quick run (500 blocks) and one that would run for hours, in `dir`: a
+/// test waits for the quick run's report on standard output, then signals the soak while the
+/// long run goes on.
+fn quick_then_endless(dir: &Path) -> [String; 2] {
+    let shipped = std::fs::read_to_string(scenario("stream_resets.toml")).unwrap();
+    let params = format!("params = {:?}", scenario("startup.lis"));
+    ["500", "1_000_000_000"].map(|blocks| {
+        let body = shipped
+            .replace("params = \"startup.lis\"", &params)
+            .replace("blocks = 10_000_000", &format!("blocks = {blocks}"));
+        assert_ne!(body, shipped, "stream_resets.toml changed shape");
+        let p = dir.join(format!("blocks_{blocks}.toml"));
+        std::fs::write(&p, body).unwrap();
+        p.display().to_string()
+    })
+}
+
+/// Start `soak SCENARIOS -q --report REPORT` and return it once the first run's verdict line
+/// is on its standard output (the first run is over, the second about to run or running), with
+/// the output so far and the thread that reads the rest.
+fn soak_past_its_first_run(
+    scenarios: &[String],
+    report: &Path,
+) -> (std::process::Child, String, std::thread::JoinHandle<String>) {
+    use std::io::{BufRead, BufReader};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("soak")
+        .args(scenarios)
+        .args(["-q", "--report"])
+        .arg(report)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut seen = String::new();
+    while !seen.contains("result:") {
+        let mut line = String::new();
+        assert!(out.read_line(&mut line).unwrap() > 0, "soak ended: {seen}");
+        seen.push_str(&line);
+    }
+    // The rest of standard output is read on as it comes, so the soak never blocks on it.
+    let rest = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = std::io::Read::read_to_string(&mut out, &mut s);
+        s
+    });
+    (child, seen, rest)
+}
+
+#[test]
+fn a_killed_soak_leaves_no_passing_report_and_merge_refuses_what_it_left() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenarios = quick_then_endless(dir.path());
+    let report = dir.path().join("report.json");
+    // Last run's report: passing.
+    let mut args = vec![
+        "soak",
+        &scenarios[0],
+        &scenarios[1],
+        "-q",
+        "--blocks",
+        "500",
+    ];
+    args.extend(["--report", report.to_str().unwrap()]);
+    let (code, out) = ncchannel(&args);
+    assert_eq!(code, 0, "{out}");
+    assert_eq!(read(&report)["all_held"], true);
+
+    let (mut child, seen, _rest) = soak_past_its_first_run(&scenarios, &report);
+    child.kill().unwrap(); // SIGKILL: no handler runs
+    child.wait().unwrap();
+    let left = read(&report);
+    assert_eq!(left["status"], "incomplete", "{seen}");
+    assert_eq!(left["all_held"], false);
+    assert_eq!(left["runs"].as_array().map(Vec::len), Some(0));
+    let (code, out) = ncchannel(&["soak", "merge", report.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}");
+    assert!(
+        out.contains("report.json: the shard never finished"),
+        "{out}"
+    );
+    // Nothing but the report itself in its folder: the temporary files were renamed.
+    let stray: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
+}
+
+/// SIGINT (Ctrl-C) and SIGTERM on a virtual-time soak: the report of what ran, marked
+/// interrupted in the file and on the verdict line, and the exit code a shell gives for the
+/// signal; merge takes no verdict from it.
+#[test]
+fn a_signal_finishes_the_report_of_what_ran_marked_interrupted() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenarios = quick_then_endless(dir.path());
+    for (signal, code) in [("-INT", 130), ("-TERM", 143)] {
+        let report = dir.path().join(format!("report{signal}.json"));
+        let (mut child, _, rest) = soak_past_its_first_run(&scenarios, &report);
+        let sent = Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "{signal}: {stderr}");
+        assert!(stderr.contains("interrupted by SIG"), "{stderr}");
+        let out = rest.join().unwrap();
+        assert!(out.contains("result:   INTERRUPTED, "), "{out}");
+        let r = read(&report);
+        assert_eq!(r["status"], "interrupted", "{signal}");
+        assert_eq!(r["all_held"], false, "an interrupted run is no pass");
+        // The quick run, and the endless one if the signal came after it had begun.
+        let runs = r["runs"].as_array().unwrap();
+        assert_eq!(runs[0]["report"]["status"], "complete");
+        assert_eq!(runs[0]["report"]["all_held"], true);
+        if let Some(stopped) = runs.get(1) {
+            assert_eq!(stopped["report"]["status"], "interrupted");
+            assert!(
+                out.contains("result:    INTERRUPTED, every invariant held so far"),
+                "{out}"
+            );
+        }
+        let (code, out) = ncchannel(&["soak", "merge", report.to_str().unwrap()]);
+        assert_eq!(code, 2, "{out}");
+        assert!(out.contains("was interrupted"), "{out}");
+    }
+}
