@@ -17,8 +17,8 @@ use std::time::Duration;
 use super::receive_stop;
 
 use crate::dnc::{
-    self, Anchor, Disposition, Markers, NameTemplate, ProgramWriter, ReceivedProgram, Splitter,
-    TransferEnd, TransferReport, WriterConfig,
+    self, Anchor, Disposition, Markers, NameKind, NameTemplate, ProgramWriter, ReceivedProgram,
+    Splitter, TransferEnd, TransferReport, WriterConfig,
 };
 
 use super::exit;
@@ -397,10 +397,21 @@ fn log_line(p: &ReceivedProgram) {
         p.last_line
     );
     let _ = out.flush();
+    // What became of the program, not what might have: a refused workpiece folder files the
+    // program at the top under its own name, a refused program name numbers it.
     for name in &p.rejected_names {
+        let what = match name.kind {
+            NameKind::Program => "program name",
+            NameKind::Workpiece => "workpiece folder name",
+        };
+        let outcome = if p.is_filed() {
+            format!("filed as {} instead", p.path.display())
+        } else {
+            "not used".to_string()
+        };
         log(format_args!(
-            "ncchannel receive: name `{name}` in lines {}-{} is not a plain file name; numbered instead",
-            p.first_line, p.last_line
+            "ncchannel receive: {what} `{}` in lines {}-{} is not a plain name; {outcome}",
+            name.text, p.first_line, p.last_line
         ));
     }
     match p.disposition {

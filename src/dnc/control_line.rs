@@ -25,6 +25,25 @@ pub struct SinumerikName {
     pub kind: Option<String>,
 }
 
+/// What a refused name from the data would have named.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NameKind {
+    /// The program's own file name (`%_N_<NAME>_<TYPE>`, ISG `%name`): the program is
+    /// numbered instead, unless another name line of it names it.
+    Program,
+    /// The workpiece folder (`;$PATH=/_N_WKS_DIR/_N_<WP>_WPD`): the program is filed at the top
+    /// of the program directory under its own name, as `/_N_MPF_DIR` would file it.
+    Workpiece,
+}
+
+/// A name from the data refused as unsafe: what it named, and an excerpt (lossy UTF-8,
+/// escaped) for the operator message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RejectedName {
+    pub kind: NameKind,
+    pub text: String,
+}
+
 /// What the name lines of one program said.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct NameInfo {
@@ -34,8 +53,8 @@ pub struct NameInfo {
     pub workpiece: Option<String>,
     /// From the first ISG `%name` line (not `%L`, not `%_N_`).
     pub isg: Option<String>,
-    /// Names refused as unsafe (excerpts, lossy UTF-8), for the operator message.
-    pub rejected: Vec<String>,
+    /// Names refused as unsafe, for the operator message.
+    pub rejected: Vec<RejectedName>,
     path_seen: bool,
     /// A `%_N_` line was seen, accepted or refused: the next one starts another program.
     sinumerik_seen: bool,
@@ -62,7 +81,7 @@ impl NameInfo {
                 self.sinumerik_seen = true;
                 match parse_sinumerik(rest) {
                     Some(n) => self.sinumerik = Some(n),
-                    None => self.reject(rest),
+                    None => self.reject(NameKind::Program, rest),
                 }
             }
         } else if let Some(path) = line.strip_prefix(b";$PATH=") {
@@ -71,7 +90,7 @@ impl NameInfo {
                 if let Some(wp) = workpiece_of(path) {
                     match safe_name(wp) {
                         Some(w) => self.workpiece = Some(w),
-                        None => self.reject(wp),
+                        None => self.reject(NameKind::Workpiece, wp),
                     }
                 }
             }
@@ -90,7 +109,7 @@ impl NameInfo {
                 if !local && !word.is_empty() {
                     match safe_name(word) {
                         Some(w) => self.isg = Some(w),
-                        None => self.reject(word),
+                        None => self.reject(NameKind::Program, word),
                     }
                 }
             }
@@ -124,11 +143,13 @@ impl NameInfo {
         })
     }
 
-    fn reject(&mut self, raw: &[u8]) {
+    fn reject(&mut self, kind: NameKind, raw: &[u8]) {
         if self.rejected.len() < MAX_REJECTED {
             let cut = &raw[..raw.len().min(REJECTED_EXCERPT)];
-            self.rejected
-                .push(String::from_utf8_lossy(cut).escape_debug().to_string());
+            self.rejected.push(RejectedName {
+                kind,
+                text: String::from_utf8_lossy(cut).escape_debug().to_string(),
+            });
         }
     }
 }
@@ -254,6 +275,7 @@ mod tests {
         let n = info(&["%_N_P_MPF", ";$PATH=/_N_WKS_DIR/_N_.._WPD"]);
         assert_eq!(n.file_name(), Some((None, "P.mpf".into())));
         assert_eq!(n.rejected.len(), 1);
+        assert_eq!(n.rejected[0].kind, NameKind::Workpiece);
         assert_eq!(safe_name(&[b'A'; MAX_NAME_LEN + 1]), None);
     }
 }

@@ -15,7 +15,7 @@ pub mod temp_files;
 pub(crate) mod transfer;
 pub(crate) mod writer;
 
-pub use control_line::{NameInfo, SinumerikName};
+pub use control_line::{NameInfo, NameKind, RejectedName, SinumerikName};
 pub use error::DncError;
 pub use listen::{Listener, TransferResult};
 pub use markers::{Anchor, Markers, Mode, LINE_WINDOW, MAX_MARKERS};

@@ -142,7 +142,7 @@ pub struct ReceivedProgram {
     pub last_line: u64,
     pub disposition: Disposition,
     /// Names from the data refused as unsafe.
-    pub rejected_names: Vec<String>,
+    pub rejected_names: Vec<super::control_line::RejectedName>,
     /// Why the program was not filed ([`Disposition::NameUnusable`], [`Disposition::OverLimit`],
     /// [`Disposition::WriteFailed`]).
     pub reason: Option<String>,

@@ -329,6 +329,50 @@ fn cli_files_an_archive_from_a_file() {
     assert_eq!(tree(&out).len(), 3);
 }
 
+/// A refused name is reported with what was done instead: a refused workpiece folder files the
+/// program at the top under its own name (not numbered), a refused program name numbers it.
+#[test]
+fn cli_says_where_a_program_with_a_refused_name_went() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.txt");
+    std::fs::write(
+        &input,
+        "%_N_PART_MPF\n;$PATH=/_N_WKS_DIR/_N_.._WPD\nN10 G0 X1\nM30\n%_N_../EVIL_MPF\nM30\n",
+    )
+    .unwrap();
+    let out = dir.path().join("prog");
+    let o = bin()
+        .arg("receive")
+        .arg(&input)
+        .args(["--start", "%", "--end", "M30", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert_eq!(
+        tree(&out).keys().collect::<Vec<_>>(),
+        ["PART.mpf", "received_001.nc"]
+    );
+    let part = out.join("PART.mpf");
+    assert!(
+        stderr.contains(&format!(
+            "workpiece folder name `..` in lines 1-4 is not a plain name; filed as {} instead",
+            part.display()
+        )),
+        "{stderr}"
+    );
+    let numbered = out.join("received_001.nc");
+    assert!(
+        stderr.contains(&format!(
+            "program name `../EVIL_MPF` in lines 5-6 is not a plain name; filed as {} instead",
+            numbered.display()
+        )),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("numbered instead"), "{stderr}");
+}
+
 #[test]
 fn cli_start_only_without_a_start_discards_all_and_exits_1() {
     let dir = tempfile::tempdir().unwrap();
