@@ -6,6 +6,26 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// Longest source line a diagnostic shows under its message, bytes (an NC block is at most
+/// 4000 characters). A longer line (a 5 MB "name" in a list) is not echoed: the message
+/// names the place, with an [`excerpt`] of what is there.
+const MAX_SOURCE_LINE_BYTES: usize = 16 * 1024;
+
+/// Characters of outside text a message quotes at most: [`excerpt`].
+pub(crate) const EXCERPT_CHARS: usize = 64;
+
+/// `text` for a message: whole when it has at most [`EXCERPT_CHARS`] characters, else its
+/// first ones, `…` and its length (`AAAA…(5000000 bytes)`), so that text from outside costs a
+/// message a bounded number of bytes.
+pub(crate) fn excerpt(text: &str) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(EXCERPT_CHARS) {
+        None => std::borrow::Cow::Borrowed(text),
+        Some((cut, _)) => {
+            std::borrow::Cow::Owned(format!("{}…({} bytes)", &text[..cut], text.len()))
+        }
+    }
+}
+
 /// How bad a diagnostic is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Severity {
@@ -59,9 +79,13 @@ impl Diagnostic {
         }
     }
 
-    /// Attach the offending line so `render` can show it with a caret.
+    /// Attach the offending line so `render` can show it with a caret (not one longer than
+    /// [`MAX_SOURCE_LINE_BYTES`]: the message alone then says what is wrong).
     pub(crate) fn with_source(mut self, line_text: &str) -> Self {
-        self.source_line = Some(line_text.trim_end_matches(['\r', '\n']).to_string());
+        let line = line_text.trim_end_matches(['\r', '\n']);
+        if line.len() <= MAX_SOURCE_LINE_BYTES {
+            self.source_line = Some(line.to_string());
+        }
         self
     }
 
@@ -108,6 +132,14 @@ impl fmt::Display for Diagnostic {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn excerpts_are_bounded_and_say_the_length() {
+        assert_eq!(excerpt("kenngr.swe_pos"), "kenngr.swe_pos");
+        let long = "é".repeat(100);
+        let e = excerpt(&long);
+        assert_eq!(e, format!("{}…(200 bytes)", "é".repeat(EXCERPT_CHARS)));
+    }
 
     #[test]
     fn render_puts_caret_under_column() {

@@ -102,7 +102,7 @@ impl Tally {
                 e.name_pos,
                 format!(
                     "unknown parameter {}: kept, but the emulator does not use it",
-                    e.name.text
+                    crate::diag::excerpt(&e.name.text)
                 ),
             ));
         }

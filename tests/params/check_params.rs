@@ -141,6 +141,32 @@ fn check_of_the_example_installation_counts_each_lists_entries() {
     assert!(stderr.contains("0 error(s), 0 warning(s)"), "{stderr}");
 }
 
+/// A 5 MB unknown name is quoted once, as a bounded excerpt with its length: neither the
+/// message nor the source line under it echoes it whole.
+#[test]
+fn a_huge_unknown_name_is_quoted_once_as_an_excerpt() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("achsmds1.lis");
+    let name = "k".repeat(5_000_000);
+    std::fs::write(&p, format!("kopf.achs_nr 1\n{name} 5\nEnde\n")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .arg("check")
+        .arg(&p)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(stdout.len() < 1000, "{} bytes of findings", stdout.len());
+    let excerpt = format!("{}…(5000000 bytes)", "k".repeat(64));
+    assert!(
+        stdout.contains(&format!(
+            "achsmds1.lis:2:1: warning: unknown parameter {excerpt}: kept"
+        )),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches(&"k".repeat(64)).count(), 1, "{stdout}");
+}
+
 #[test]
 fn unknown_entries_are_counted_and_warned_about() {
     let d = tempfile::tempdir().unwrap();
