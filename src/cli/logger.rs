@@ -81,12 +81,6 @@ pub(crate) fn line(msg: std::fmt::Arguments<'_>) {
     enqueue(format!("{time} {msg}\n"));
 }
 
-/// The one line a supervisor or test parses to find the server (`listening on ADDR …`):
-/// first, and without a time, so it reads the same as it always has.
-pub(crate) fn handshake(msg: std::fmt::Arguments<'_>) {
-    enqueue(format!("{msg}\n"));
-}
-
 /// Wait until every queued line is written, at most `within` (a reader that does not read
 /// costs the caller no more than that).
 pub(crate) fn flush(within: Duration) {
@@ -153,8 +147,9 @@ pub fn init() {
 }
 
 /// The first stderr line of every serve, plain or `--soak` (`soak` is `soak FILE, ` or
-/// empty): where the server listens and which NetId it answers, the route service's UDP
-/// address, the channels and the cycle. Tests and supervisors parse it.
+/// empty), after its time as every serve line: where the server listens and which NetId it
+/// answers, the route service's UDP address, the channels and the cycle. Tests and
+/// supervisors parse it: the second word on is `listening on ADDR (…`.
 pub(super) fn listening_line(
     server: &crate::ads::ServerHandle,
     net_id: Option<crate::vocab::ams::AmsNetId>,

@@ -86,8 +86,12 @@ pub(crate) fn say(msg: std::fmt::Arguments<'_>) {
 /// A log line on standard error (something that happened while the command ran, as opposed
 /// to a usage error or a summary), led by its RFC 3339 time in UTC (`humantime`), best effort.
 pub(crate) fn log(msg: std::fmt::Arguments<'_>) {
-    let time = humantime::format_rfc3339_millis(std::time::SystemTime::now());
-    say(format_args!("{time} {msg}"));
+    say(format_args!("{} {msg}", now()));
+}
+
+/// The time that leads every log line: now, RFC 3339 in UTC with milliseconds.
+pub(crate) fn now() -> humantime::Rfc3339Timestamp {
+    humantime::format_rfc3339_millis(std::time::SystemTime::now())
 }
 
 /// Write a report file whole or not at all (`crate::destination::replace`); false (after

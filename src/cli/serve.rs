@@ -214,7 +214,7 @@ fn spawn_web(
     let backend = Arc::new(ChannelBackend::new(requests, channels));
     match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
         Ok(h) => {
-            say(format_args!(
+            super::logger::line(format_args!(
                 "web view on http://{}/ (controls {})",
                 h.local_addr(),
                 if args.http_controls { "on" } else { "off" }
@@ -301,7 +301,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // From here on stderr is written through the logger's queue: a supervisor that stops
     // reading it (a full pipe) must hold up neither the server nor the stop.
     let line = super::logger::listening_line(&server, net_id, "", nch, period);
-    super::logger::handshake(format_args!("{line}"));
+    super::logger::line(format_args!("{line}"));
     match super::signal::StopSignal::install() {
         Ok(sig) => rt.stop_on(sig.flag()),
         Err(e) => super::logger::line(format_args!(

@@ -52,7 +52,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     };
     let soak = format!("soak {}, ", scenario.path.display());
     let line = super::logger::listening_line(&server, net_id, &soak, nch, period);
-    say(format_args!("{line}"));
+    super::out::log(format_args!("{line}"));
     let signal = super::signal::StopSignal::install().ok();
     if let Some(s) = &signal {
         rt.stop_on(s.flag());
@@ -102,16 +102,12 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     let all_held = report.all_held;
     let mut machine = cycle.into_machine();
     if let Err(e) = machine.finish_log() {
-        say(format_args!("ncchannel serve: event log: {e}"));
+        super::out::log(format_args!("ncchannel serve: event log: {e}"));
     }
     say(format_args!(""));
     let _ = report.print_human(&mut std::io::stdout());
     if let Some(p) = &report_path {
-        if let Err(e) = std::fs::write(p, report.to_json() + "\n") {
-            say(format_args!(
-                "ncchannel serve: --report {}: {e}",
-                p.display()
-            ));
+        if !super::out::write_report("serve", p, &report.to_json()) {
             return ExitCode::from(exit::USAGE);
         }
     }
@@ -174,14 +170,19 @@ fn announce_resets(rt: &mut Runtime<Supervised>, period: Duration, live: bool) {
         });
         let _ = writeln!(
             err,
-            "{clear}serve --soak: {:.3} s: channel {} reset ({why}): {} accepted line(s) dropped unexecuted{restart}",
+            "{clear}{} serve --soak: {:.3} s: channel {} reset ({why}): {} accepted line(s) dropped unexecuted{restart}",
+            super::out::now(),
             secs(n.tick),
             n.channel,
             n.lines_dropped
         );
     }
     if lost > 0 {
-        let _ = writeln!(err, "serve --soak: {lost} more reset(s) not shown");
+        let _ = writeln!(
+            err,
+            "{} serve --soak: {lost} more reset(s) not shown",
+            super::out::now()
+        );
     }
 }
 
@@ -197,7 +198,8 @@ fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {
         .map(|v| v.violations)
         .sum();
     let line = format!(
-        "serve --soak: {:.0} s, {lines} lines accepted, {blocks} blocks, {resets} resets, {violations} violations",
+        "{} serve --soak: {:.0} s, {lines} lines accepted, {blocks} blocks, {resets} resets, {violations} violations",
+        super::out::now(),
         wall.as_secs_f64()
     );
     let mut err = std::io::stderr().lock();

@@ -85,8 +85,8 @@ impl Serve {
         stderr: Arc<Mutex<String>>,
     ) -> Serve {
         let stdout = child.stdout.take();
-        // "listening on 127.0.0.1:PORT (AMS NetId a.b.c.d.e.f, port 553, N channel(s), cycle P µs)"
-        let words: Vec<&str> = first.split_whitespace().collect();
+        // "<time> listening on 127.0.0.1:PORT (AMS NetId a.b.c.d.e.f, port 553, N channel(s), cycle P µs)"
+        let words: Vec<&str> = abuse_common::unstamped(first).split_whitespace().collect();
         assert_eq!(words.get(..2), Some(&["listening", "on"][..]), "{first}");
         let addr: SocketAddr = words[2].parse().expect("address");
         let net_id: AmsNetId = words[5].trim_end_matches(',').parse().expect("NetId");

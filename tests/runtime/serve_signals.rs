@@ -22,7 +22,9 @@ fn serve(rig: &Rig, events: &std::path::Path) -> (Child, Instant, std::thread::J
     let mut first = String::new();
     err.read_line(&mut first).unwrap();
     let listening = Instant::now();
-    assert!(first.starts_with("listening on"), "{first}");
+    // Led by its time, as every serve line.
+    let listening_on = crate::support::abuse::unstamped(&first);
+    assert!(listening_on.starts_with("listening on"), "{first}");
     let rest = std::thread::spawn(move || {
         let mut s = String::new();
         let _ = err.read_to_string(&mut s);
@@ -115,6 +117,10 @@ fn stopped_by(signal: &str) {
     let status = wait(&mut child, Duration::from_secs(30));
     let stderr = stderr.join().unwrap();
     assert_eq!(status.code(), Some(0), "orderly stop exits 0: {stderr}");
+    // Every line after the first is led by its time too (the first was checked on reading).
+    for line in stderr.lines() {
+        crate::support::abuse::unstamped(line);
+    }
     let log = std::fs::read_to_string(&events).unwrap();
     check_stopped_log(&log, &stderr);
 }

@@ -72,7 +72,10 @@ fn serve_soak(
         first.contains("(AMS NetId 127.0.0.2.1.1, port 553, also as 127.0.0.1.1.1, route service UDP 127.0.0.1:"),
         "{first}"
     );
-    let addr = first
+    // "<RFC 3339 time> listening on ADDR (…": led by its time, as every serve line.
+    let (time, listening) = first.split_once(' ').unwrap_or_else(|| panic!("{first}"));
+    assert!(humantime::parse_rfc3339(time).is_ok(), "{first}");
+    let addr = listening
         .strip_prefix("listening on ")
         .and_then(|r| r.split(' ').next())
         .unwrap_or_else(|| panic!("{first}"))
@@ -230,13 +233,16 @@ fn scenario_keys_of_the_built_in_client_are_refused_by_name() {
     assert!(err.contains("feeder") && err.contains("length"), "{err}");
 }
 
-/// Channel time, s, of every reset `serve --soak` announced on stderr.
+/// Channel time, s, of every reset `serve --soak` announced on stderr
+/// (`<RFC 3339 time> serve --soak: 2.227 s: channel 1 reset (injected): …`).
 fn reset_times(stderr: &str) -> impl Iterator<Item = f64> + '_ {
     stderr
         .lines()
         .filter(|l| l.contains(" reset ("))
         .filter_map(|l| {
-            l.strip_prefix("serve --soak: ")?
+            let (time, rest) = l.split_once(' ')?;
+            assert!(humantime::parse_rfc3339(time).is_ok(), "{l}");
+            rest.strip_prefix("serve --soak: ")?
                 .split(" s:")
                 .next()?
                 .parse()

@@ -38,6 +38,16 @@ pub fn collect(err: impl Read + Send + 'static) -> (String, Arc<Mutex<String>>) 
     (first, text)
 }
 
+/// A `serve` stderr line without the RFC 3339 UTC time that leads it (asserted: every serve
+/// line has one), e.g. `listening on 127.0.0.1:PORT (AMS NetId …`.
+pub fn unstamped(line: &str) -> &str {
+    let (time, rest) = line
+        .split_once(' ')
+        .unwrap_or_else(|| panic!("no time: {line}"));
+    humantime::parse_rfc3339(time).unwrap_or_else(|e| panic!("{e}: {line}"));
+    rest
+}
+
 /// `receive --listen` on a loopback port splitting by `%` … `M30` into `out`, with `extra`
 /// options, run by `cmd` (the binary itself, or a shell that sets limits and execs it; its
 /// standard output as `cmd` says): the process, the address its first stderr line names, and
