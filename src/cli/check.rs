@@ -23,6 +23,8 @@ pub struct CheckArgs {
     /// start-up list (its channel --channel) or a channel list. Each M/H number the channel
     /// does not define (`m_synch[i]` P-CHAN-00041, `h_synch[i]` P-CHAN-00027, the spindle's
     /// M3/M4/M5/M19, the kernel's internal M functions) is an error, 20157 (M) / 20162 (H).
+    /// End points at a program's start are checked against its axes' software limits (21897);
+    /// without --params, against those of the start-up list `run` reads.
     #[arg(long, value_name = "LIST")]
     pub params: Option<PathBuf>,
     /// Channel (1-based) of the --params start-up list whose functions the programs use.
@@ -56,14 +58,19 @@ pub fn execute(args: CheckArgs) -> ExitCode {
                 None
             }
         });
+    // End points at a program's start against the limits `run` would apply.
+    let limits = limits_list(&args).and_then(|p| start_limits(&p, args.channel));
     // Each list's counts once, also when a start-up list and a folder walk both reach it.
     let mut summaries: Vec<crate::params::catalog::ListSummary> = Vec::new();
     for file in &files {
         let (found, lists) = check_file_summarized(file);
         diags.extend(found);
-        if let Some(t) = &techno {
-            if !PARAM_EXTENSIONS.contains(&extension(file).as_str()) {
+        if !PARAM_EXTENSIONS.contains(&extension(file).as_str()) {
+            if let Some(t) = &techno {
                 diags.extend(check_functions_file(file, t));
+            }
+            if let Some(l) = &limits {
+                diags.extend(check_start_file(file, l));
             }
         }
         for l in lists {
@@ -358,6 +365,143 @@ fn check_functions_file(path: &Path, techno: &TechnoTable) -> Vec<Diagnostic> {
     diags
 }
 
+/// The software limits a program's start is checked against: the channel's axes that a
+/// letter names (`X` for the channel's X), by `AXIS_LETTERS` index, and their limits.
+struct StartLimits {
+    axes: [bool; crate::vocab::axis::MAX_AXES],
+    limits: [crate::geometry::SoftLimits; crate::vocab::axis::MAX_AXES],
+}
+
+/// The limits of channel `channel` of the start-up list `params` (as `run` sets the channel
+/// up), or `None` when it is no start-up list that loads (its errors are reported elsewhere
+/// when it was named).
+fn start_limits(params: &Path, channel: u32) -> Option<StartLimits> {
+    let config = crate::params::load(params).ok()?;
+    let ch = config
+        .channels
+        .get(usize::try_from(channel.checked_sub(1)?).ok()?)?;
+    let settings = crate::setup::channel_settings(&config, ch).ok()?;
+    let d = &settings.decoder;
+    let letters = crate::decoder::letter_names();
+    let mut axes = d.axes;
+    for (i, on) in axes.iter_mut().enumerate() {
+        // An axis renamed in the lists (`X1`) is not the one a letter word moves.
+        *on &= d.axis_names[i] == letters[i];
+    }
+    Some(StartLimits {
+        axes,
+        limits: d.soft_limits_mm,
+    })
+}
+
+/// The start-up list whose limits `check` applies: `--params`, else the one `run` reads
+/// (`$NCCHANNEL_PARAMS`, else ./params/startup.lis, else the built-in set).
+fn limits_list(args: &CheckArgs) -> Option<PathBuf> {
+    match &args.params {
+        Some(p) => Some(p.clone()),
+        None => {
+            let default = std::env::var_os("NCCHANNEL_PARAMS")
+                .map_or_else(|| PathBuf::from("params/startup.lis"), PathBuf::from);
+            crate::params::shipped::locate(&default).ok()
+        }
+    }
+}
+
+/// G functions that leave a program's start frame as it is (motion, dwell, plane, exact stop,
+/// absolute, feed modes): the start region goes on through them.
+const START_FRAME_G: &[u32] = &[0, 1, 2, 3, 4, 9, 17, 18, 19, 60, 61, 90, 94, 95];
+
+/// End points outside the software limits at the start of an NC program, which a run refuses
+/// with 21897 before the axis moves. A program starts in absolute mode with no zero offset,
+/// no G92 shift, no tool offset and no transformation, so its literal axis values there are
+/// machine positions; the check reads the blocks from the start up to the first that may
+/// change that frame or the path through the program (any other G function, D or T, an
+/// assignment, a `#` command other than `#MSG` and `#TIME`, a `$` statement, a call, a
+/// second program head, a skippable block), and no further.
+fn check_start_file(path: &Path, limits: &StartLimits) -> Vec<Diagnostic> {
+    use crate::geometry::arc::LimitBreach;
+    use crate::lang::{Body, Command, Item, Value};
+    use crate::vocab::axis::AXIS_LETTERS;
+    let Ok(text) = read_text(path) else {
+        return Vec::new();
+    };
+    let lines: Vec<&str> = text.lines().collect();
+    let mut diags = Vec::new();
+    let mut started = false;
+    walk_blocks(&text, |block, line, joined| {
+        if block.skip_level.is_some() {
+            return false;
+        }
+        let items = match &block.body {
+            Body::ProgramHead { .. } => return !std::mem::replace(&mut started, true),
+            Body::Command(Command::Msg(_) | Command::Time(_)) => {
+                started = true;
+                return true;
+            }
+            Body::Items(items) => items,
+            _ => return false,
+        };
+        started = true;
+        let mut dwell = false;
+        for it in items {
+            match it {
+                Item::Word(w) if w.letter == b'G' => match w.value {
+                    Value::Num(g) if START_FRAME_G.iter().any(|&k| f64::from(k) == g) => {
+                        dwell |= g == 4.0;
+                    }
+                    _ => return false,
+                },
+                Item::GValue { g: 4, .. } => dwell = true,
+                Item::Word(w) if matches!(w.letter, b'D' | b'T') => return false,
+                Item::Word(_) | Item::FunctionValue { .. } => {}
+                _ => return false,
+            }
+        }
+        if dwell {
+            // `G04 X2`: X is the time.
+            return true;
+        }
+        for it in items {
+            let Item::Word(w) = it else { continue };
+            let (Some(i), Value::Num(v)) =
+                (AXIS_LETTERS.iter().position(|&l| l == w.letter), &w.value)
+            else {
+                continue;
+            };
+            if !limits.axes[i] {
+                continue;
+            }
+            let l = limits.limits[i];
+            let below = *v < l.min_mm - crate::geometry::arc::SOFT_LIMIT_SLACK_MM;
+            if !below && *v <= l.max_mm + crate::geometry::arc::SOFT_LIMIT_SLACK_MM {
+                continue;
+            }
+            let breach = LimitBreach {
+                axis: i,
+                value_mm: *v,
+                below,
+                at_end: true,
+                limits: l,
+            };
+            let (d, c) = joined.map_or((0, w.col), |j| j.position(w.col));
+            let at = line + d as usize;
+            let diag = Diagnostic::error(
+                path,
+                at,
+                c as usize,
+                Some(crate::lang::codes::SOFT_LIMIT),
+                breach.message("end point"),
+            );
+            diags.push(match lines.get(at.wrapping_sub(1)) {
+                Some(src) => diag.with_source(src),
+                None => diag,
+            });
+        }
+        true
+    });
+    diags
+}
+
 /// An M or H number a program uses that its channel does not define.
 struct UndefinedFunction {
     letter: u8,
@@ -368,9 +512,9 @@ struct UndefinedFunction {
 }
 
 /// Walk the program's blocks as the checker does (`\` continuations joined, `#COMMENT` and
-/// `#VAR` sections skipped) and gather the M and H words `techno` does not define, by first use.
+/// `#VAR` sections skipped, blocks that do not parse left to the program check) and gather
+/// the M and H words `techno` does not define, by first use.
 fn undefined_functions(text: &str, techno: &TechnoTable) -> Vec<UndefinedFunction> {
-    use crate::lang::{continuation, is_comment_end, parse_var_line, Joiner, VarLine};
     let mut found: Vec<UndefinedFunction> = Vec::new();
     let mut note = |letter: u8, number: u32, line: usize, col: usize| {
         let defined = match letter {
@@ -394,7 +538,37 @@ fn undefined_functions(text: &str, techno: &TechnoTable) -> Vec<UndefinedFunctio
             }),
         }
     };
+    walk_blocks(text, |block, line, joined| {
+        block_functions(block, line, joined, &mut note);
+        true
+    });
+    found
+}
+
+/// Hand every block of a program to `visit` with its first line and, for a block written over
+/// several lines, its joiner (for the line and column of a word), as the checker reads them:
+/// `\` continuations joined, `#COMMENT` and `#VAR` sections skipped, blocks that do not parse
+/// left out (they are the program check's findings). `visit` answers whether to go on.
+fn walk_blocks(
+    text: &str,
+    mut visit: impl FnMut(&crate::lang::Block, usize, Option<&crate::lang::Joiner>) -> bool,
+) {
+    use crate::lang::{
+        continuation, is_comment_end, parse_block, parse_var_line, Body, Command, Joiner, VarLine,
+    };
     let mut state = Sections::default();
+    // One block: false when `visit` has had enough.
+    let mut block = |raw: &str, line: usize, joined: Option<&Joiner>, state: &mut Sections| {
+        let Ok(block) = parse_block(raw) else {
+            return true;
+        };
+        match block.body {
+            Body::Command(Command::CommentBegin) => state.in_comment = true,
+            Body::Command(Command::Var) => state.in_var = true,
+            _ => return visit(&block, line, joined),
+        }
+        true
+    };
     let mut joiner = Joiner::default();
     let mut first = 0;
     for (idx, raw) in text.lines().enumerate() {
@@ -418,17 +592,18 @@ fn undefined_functions(text: &str, techno: &TechnoTable) -> Vec<UndefinedFunctio
             if !joiner.is_open() {
                 first = line;
             }
-            if joiner.push(raw) {
-                block_functions(joiner.text(), first, Some(&joiner), &mut state, &mut note);
+            if joiner.push(raw) && !block(joiner.text(), first, Some(&joiner), &mut state) {
+                return;
             }
             continue;
         }
-        block_functions(raw, line, None, &mut state, &mut note);
+        if !block(raw, line, None, &mut state) {
+            return;
+        }
     }
     if joiner.is_open() {
-        block_functions(joiner.text(), first, Some(&joiner), &mut state, &mut note);
+        block(joiner.text(), first, Some(&joiner), &mut state);
     }
-    found
 }
 
 /// Whether the lines that follow are inside `#COMMENT BEGIN … END` or `#VAR … #ENDVAR`.
@@ -439,33 +614,19 @@ struct Sections {
 }
 
 /// The M and H words of one block (`line` is its first line), handed to `note` with their
-/// line and column; a `#COMMENT BEGIN` or `#VAR` block opens its section.
+/// line and column.
 fn block_functions(
-    text: &str,
+    block: &crate::lang::Block,
     line: usize,
     joined: Option<&crate::lang::Joiner>,
-    state: &mut Sections,
     note: &mut impl FnMut(u8, u32, usize, usize),
 ) {
-    use crate::lang::{parse_block, Body, Command, Item, Value, Word};
-    // A block that does not parse is the program check's finding.
-    let Ok(block) = parse_block(text) else {
+    use crate::lang::{Body, Item, Value, Word};
+    let Body::Items(items) = &block.body else {
         return;
     };
-    let items = match block.body {
-        Body::Command(Command::CommentBegin) => {
-            state.in_comment = true;
-            return;
-        }
-        Body::Command(Command::Var) => {
-            state.in_var = true;
-            return;
-        }
-        Body::Items(items) => items,
-        _ => return,
-    };
     for item in items {
-        let (letter, number, col) = match item {
+        let (letter, number, col) = match *item {
             Item::Word(Word {
                 letter: l @ (b'M' | b'H'),
                 value: Value::Num(v),

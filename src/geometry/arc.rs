@@ -222,7 +222,7 @@ pub(crate) fn extent(mv: &Move) -> (Position, Position) {
 /// How far a computed position may pass a software limit by rounding alone, mm: an arc's
 /// quadrant point computed as centre + radius may lie 1e-13 mm beyond an end point exactly
 /// on the limit, which is allowed (moving *to* a limit is). Far below the 0.1 µm resolution.
-const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
+pub(crate) const SOFT_LIMIT_SLACK_MM: f64 = 1e-6;
 
 /// The first axis `mv` takes outside its software limits (21897), if any.
 ///

@@ -9,9 +9,14 @@
 use std::collections::{HashMap, HashSet};
 
 use super::block::{Body, Command, Control, GotoTarget, Label};
-use super::codes::{StrayKind, LABEL_NOT_FOUND, LABEL_TWICE, OPEN_CONTROL_BLOCK, SYNTAX};
+use super::block::{Expr, Item, UnOp, Value};
+use super::codes::{
+    StrayKind, DWELL_RANGE_G04, DWELL_RANGE_TIME, LABEL_NOT_FOUND, LABEL_TWICE, OPEN_CONTROL_BLOCK,
+    SYNTAX,
+};
 use super::join::{continuation, Joiner};
 use super::parse::{is_comment_end, parse_block, parse_var_line, VarLine};
+use super::range::dwell_time;
 
 /// Most findings one check lists. A file of garbage (a binary, a log passed by mistake) has
 /// one finding a line; listing millions of them helps nobody and cost gigabytes, so the
@@ -223,6 +228,34 @@ impl Level {
     }
 }
 
+/// The value of a literal (`2.5`, `-2.5`), not of an expression a run evaluates.
+fn literal(v: &Value) -> Option<f64> {
+    match v {
+        Value::Num(n) => Some(*n),
+        Value::Expr(Expr::Unary(UnOp::Neg, e)) => match **e {
+            Expr::Num(n) => Some(-n),
+            _ => None,
+        },
+        Value::Expr(_) => None,
+    }
+}
+
+/// A `G04` block's literal dwell time and the column of the word that gives it: `G04 2.5`
+/// (the G's column) or `G04 X2.5` (the X's), as the decoder reads them.
+fn literal_dwell(items: &[Item]) -> Option<(usize, f64)> {
+    let mut dwell = false;
+    let mut x = None;
+    for it in items {
+        match it {
+            Item::GValue { g: 4, value, col } => return Some((*col as usize, literal(value)?)),
+            Item::Word(w) if w.letter == b'G' && w.value == Value::Num(4.0) => dwell = true,
+            Item::Word(w) if w.letter == b'X' => x = literal(&w.value).map(|v| (w.col as usize, v)),
+            _ => {}
+        }
+    }
+    x.filter(|_| dwell)
+}
+
 /// 1-based character column of the first `needle` in `line` (case-insensitive ASCII), or 1.
 fn col_of(line: &str, needle: &str) -> usize {
     let upper = line.to_ascii_uppercase();
@@ -348,6 +381,18 @@ impl Checker {
                 };
                 let (line, col) = place(line, col, joined);
                 self.level.control(c, line, col, &mut self.diags);
+            }
+            Body::Command(Command::Time(v)) => {
+                if let Some(Err(e)) = literal(v).map(|s| dwell_time(s, DWELL_RANGE_TIME)) {
+                    self.push(line, col_of(raw, "#"), joined, e.code, e.message);
+                }
+            }
+            Body::Items(items) => {
+                if let Some((col, Err(e))) =
+                    literal_dwell(items).map(|(c, s)| (c, dwell_time(s, DWELL_RANGE_G04)))
+                {
+                    self.push(line, col, joined, e.code, e.message);
+                }
             }
             _ => {}
         }

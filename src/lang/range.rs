@@ -52,6 +52,21 @@ pub fn word_value(letter: u8, v: f64) -> Result<(), RangeError> {
     }
 }
 
+/// A programmed dwell time, s: refused when negative, with `code` (20752 after G04, 20751 after
+/// `#TIME`; TF5200 diagnosis "Dwell time is out of range of permissible values", whose
+/// parameters are the value and the limits in µs). The decoder refuses an evaluated time with
+/// it, `ncchannel check` a literal one.
+pub fn dwell_time(seconds: f64, code: u32) -> Result<f64, RangeError> {
+    if seconds >= 0.0 {
+        return Ok(seconds);
+    }
+    let us = (seconds * 1e6).round();
+    Err(RangeError {
+        code,
+        message: format!("dwell time {us} µs out of the permissible range (lower limit 0 µs)"),
+    })
+}
+
 /// `v` as a whole number 0..=u32::MAX, if it is one (within 1e-9, as `G01` written `G1.0`).
 pub(crate) fn whole_u32(v: f64) -> Option<u32> {
     let r = v.round();

@@ -290,3 +290,68 @@ fn cli_check_broken_file_reports_position_and_caret() {
     assert_eq!(code, 1);
     assert!(out.contains("missing.nc"), "{out}");
 }
+
+/// `ncchannel check FILE` and `ncchannel run FILE` from the clone's root, with the start-up
+/// list both read by default: (check's exit code and output, run's output).
+fn check_and_run(file: &Path) -> ((i32, String), String) {
+    let cmd = |what: &str| {
+        let out = Process::new(env!("CARGO_BIN_EXE_ncchannel"))
+            .arg(what)
+            .arg(file)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env_remove("NCCHANNEL_PARAMS")
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
+        (out.status.code().unwrap(), text)
+    };
+    (cmd("check"), cmd("run").1)
+}
+
+/// A negative literal dwell: `run` refuses it with 20752 (G04) or 20751 (#TIME) when it
+/// decodes the block; `check` finds it with the same id, at the time's word.
+#[test]
+fn check_refuses_negative_dwells_with_runs_ids() {
+    assert_eq!(codes("N10 G04 X-1\n"), [(1, 9, 20752)]);
+    assert_eq!(codes("N10 G04 -0.5\n"), [(1, 5, 20752)]);
+    assert_eq!(codes("N10 #TIME -2\n"), [(1, 5, 20751)]);
+    // Not negative, or known only when it runs: nothing to say.
+    assert_eq!(
+        codes("G04 X0.5\nG04 2\n#TIME 1\nG04 X[P1]\n#TIME P1\nG01 X-1\n"),
+        []
+    );
+    let dir = tempfile::tempdir().unwrap();
+    for (text, id, col) in [("G04 X-1\nM30\n", 20752, 5), ("#TIME -2\nM30\n", 20751, 1)] {
+        let f = dir.path().join("dwell.nc");
+        std::fs::write(&f, text).unwrap();
+        let ((code, check), run) = check_and_run(&f);
+        assert_eq!(code, 1, "{check}");
+        assert!(
+            check.contains(&format!("dwell.nc:1:{col}: error {id}: dwell time -")),
+            "{check}"
+        );
+        assert!(run.contains(&format!("error {id}: dwell time -")), "{run}");
+    }
+}
+
+/// An end point outside the software limits at the program's start (absolute, no offsets):
+/// `run` refuses it with 21897 before the axis moves; `check` finds it with the same id and
+/// text, at the axis word, against the limits of the start-up list `run` reads.
+#[test]
+fn check_refuses_a_start_position_outside_the_soft_limits_as_run_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("start.nc");
+    std::fs::write(&f, "%start\nN10 G90 G00 X5000 Y10\nN20 G91 X5000\nM30\n").unwrap();
+    let ((code, check), run) = check_and_run(&f);
+    let text = "error 21897: axis X end point 5000 mm, above the upper software limit (limits -1000 to 1000 mm)";
+    assert_eq!(code, 1, "{check}");
+    assert!(check.contains(&format!("start.nc:2:13: {text}")), "{check}");
+    assert!(run.contains(text), "{run}");
+    // After G91 the frame is the program's business: nothing more is said (one error).
+    assert!(check.contains("1 error(s)"), "{check}");
+    // Inside the limits: clean.
+    std::fs::write(&f, "N10 G00 X500 Y-999.5\nM30\n").unwrap();
+    let ((code, check), _) = check_and_run(&f);
+    assert_eq!(code, 0, "{check}");
+}

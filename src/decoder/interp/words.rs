@@ -877,15 +877,7 @@ fn push_function(
 }
 
 /// A programmed dwell time, s: refused when negative (`code`: 20752 after G04, 20751 after
-/// `#TIME`; TF5200 diagnosis "Dwell time is out of range of permissible values", whose
-/// parameters are the value and the limits in µs).
+/// `#TIME`), as `ncchannel check` refuses a literal one (`crate::lang::range::dwell_time`).
 pub(super) fn dwell_seconds(seconds: f64, code: u32) -> Result<f64, DecodeError> {
-    if seconds >= 0.0 {
-        return Ok(seconds);
-    }
-    let us = (seconds * 1e6).round();
-    Err(DecodeError::new(
-        code,
-        format!("dwell time {us} µs out of the permissible range (lower limit 0 µs)"),
-    ))
+    crate::lang::range::dwell_time(seconds, code).map_err(|e| DecodeError::new(e.code, e.message))
 }
