@@ -106,3 +106,14 @@ pub(crate) fn write_report(command: &str, path: &Path, json: &str) -> bool {
         _ => true,
     }
 }
+
+/// At the start of a run, replace the report file it will write (if any, and not standard
+/// output) with the `incomplete` placeholder `json`: a run killed before its end leaves that,
+/// never the previous run's report. False (after saying why) when it cannot be written: the
+/// run would not be able to write its report either.
+pub(crate) fn mark_report_incomplete(command: &str, report: Option<&Path>, json: &str) -> bool {
+    match report {
+        Some(p) if !crate::destination::is_stdout(p) => write_report(command, p, json),
+        _ => true,
+    }
+}

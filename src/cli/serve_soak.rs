@@ -41,6 +41,12 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         reply_timeout,
     } = soak;
     let net_id = server_config.net_id;
+    // Until the end the report file says the run is under way (see `ncchannel soak`).
+    let placeholder = SoakReport::incomplete(&scenario.path, scenario.seed);
+    if !super::out::mark_report_incomplete("serve", report_path.as_deref(), &placeholder.to_json())
+    {
+        return ExitCode::from(exit::USAGE);
+    }
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
     let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
     let server = match crate::ads::spawn(server_config, Arc::new(backend)) {

@@ -134,7 +134,11 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         let scenario = &scenarios[0];
         let placeholder =
             SoakReport::incomplete(&scenario.path, args.seed.unwrap_or(scenario.seed));
-        if !mark_incomplete(args.report.as_deref(), &placeholder.to_json()) {
+        if !super::out::mark_report_incomplete(
+            "soak",
+            args.report.as_deref(),
+            &placeholder.to_json(),
+        ) {
             return ExitCode::from(exit::USAGE);
         }
         let report = match run(scenario, &opts) {
@@ -163,17 +167,6 @@ pub fn execute(args: SoakArgs) -> ExitCode {
     }
 }
 
-/// At the start of a run, replace the report file it will write (if any, and not standard
-/// output) with the `incomplete` placeholder `json`: a run killed before its end leaves that,
-/// never the previous run's report. False (after saying why) when it cannot be written: the
-/// run would not be able to write its report either.
-fn mark_incomplete(report: Option<&Path>, json: &str) -> bool {
-    match report {
-        Some(p) if !crate::destination::is_stdout(p) => super::out::write_report("soak", p, json),
-        _ => true,
-    }
-}
-
 /// Run the campaign's runs of `--shard` (all without it), one after the other; write the
 /// campaign report. Ok(every run held) or the exit code of a usage error.
 fn run_campaign(
@@ -192,7 +185,7 @@ fn run_campaign(
     let plan = spec.plan(shard, |i| scenarios[i].seed);
     let placeholder =
         CampaignReport::incomplete(spec.clone(), shard).with_run_id(args.run_id.clone());
-    if !mark_incomplete(args.report.as_deref(), &placeholder.to_json()) {
+    if !super::out::mark_report_incomplete("soak", args.report.as_deref(), &placeholder.to_json()) {
         return Err(ExitCode::from(exit::USAGE));
     }
     let mut out = human_out(args.report.as_deref());
