@@ -332,3 +332,43 @@ fn a_signal_finishes_the_report_of_what_ran_marked_interrupted() {
         assert!(out.contains("was interrupted"), "{out}");
     }
 }
+
+/// A shard report left from another run of the same campaign is stale: merge tells it by the
+/// run id every shard records (`--run-id`) and takes no verdict from a mix.
+#[test]
+fn merge_refuses_a_shard_report_of_another_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = scenario("stream_resets.toml");
+    let shard = |i: u32, run: &str| {
+        let p = dir.path().join(format!("shard{i}.json"));
+        let (code, out) = campaign(
+            &[&a],
+            &[
+                "--blocks",
+                "300",
+                "--shard",
+                &format!("{i}/3"),
+                "--run-id",
+                run,
+                "--report",
+                p.to_str().unwrap(),
+            ],
+        );
+        assert_eq!(code, 0, "{out}");
+        assert_eq!(read(&p)["run_id"], run);
+        p.display().to_string()
+    };
+    let (one, two, three) = (shard(1, "run-7"), shard(2, "run-6"), shard(3, "run-7"));
+    let (code, out) = ncchannel(&["soak", "merge", &one, &two, &three]);
+    assert_eq!(code, 2, "{out}");
+    assert!(
+        out.contains("shard2.json is stale: it is of campaign run run-6, not run-7"),
+        "{out}"
+    );
+    let (code, out) = ncchannel(&["soak", "merge", "--run-id", "run-8", &one, &two, &three]);
+    assert_eq!(code, 2, "{out}");
+    assert!(out.contains("shard1.json is stale"), "{out}");
+    let two = shard(2, "run-7");
+    let (code, out) = ncchannel(&["soak", "merge", "--run-id", "run-7", &one, &two, &three]);
+    assert_eq!(code, 0, "{out}");
+}
