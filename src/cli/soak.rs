@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use crate::soak::campaign::{CampaignReport, CampaignRun, CampaignSpec, Shard};
-use crate::soak::report::SoakReport;
+use crate::soak::report::{RunStatus, SoakReport};
 use crate::soak::scenario::{Length, Scenario};
 use crate::soak::{run, Options};
 
@@ -125,9 +125,9 @@ pub fn execute(args: SoakArgs) -> ExitCode {
     };
     let stopped = || signal.as_ref().is_some_and(|s| s.raised());
     let campaign = scenarios.len() > 1 || args.seeds.is_some() || args.shard.is_some();
-    let held = if campaign {
+    let (held, interrupted) = if campaign {
         match run_campaign(&args, &scenarios, opts, &stopped) {
-            Ok(held) => held,
+            Ok(r) => r,
             Err(code) => return code,
         }
     } else {
@@ -151,30 +151,30 @@ pub fn execute(args: SoakArgs) -> ExitCode {
                 return ExitCode::from(exit::USAGE);
             }
         }
-        report.all_held
+        (report.all_held, report.status != RunStatus::Complete)
     };
-    match signal.as_ref().and_then(super::signal::StopSignal::which) {
+    if interrupted {
         // Stopped by a signal: the report says interrupted; the exit code is the one a shell
         // gives a process the signal ended (130 for SIGINT), whatever the invariants did.
-        Some((name, code)) => {
-            eprintln!(
-                "ncchannel soak: interrupted by {name}; the report covers what ran until then"
-            );
-            ExitCode::from(code)
-        }
-        None if held => ExitCode::from(exit::OK),
-        None => ExitCode::from(exit::CHANNEL_ERROR),
+        let (name, code) = signal
+            .as_ref()
+            .and_then(super::signal::StopSignal::which)
+            .unwrap_or(("a signal", exit::SECOND_SIGNAL));
+        eprintln!("ncchannel soak: interrupted by {name}; the report covers what ran until then");
+        return ExitCode::from(code);
     }
+    ExitCode::from(if held { exit::OK } else { exit::CHANNEL_ERROR })
 }
 
 /// Run the campaign's runs of `--shard` (all without it), one after the other; write the
-/// campaign report. Ok(every run held) or the exit code of a usage error.
+/// campaign report. Ok((every run held, a signal stopped it)) or the exit code of a usage
+/// error.
 fn run_campaign(
     args: &SoakArgs,
     scenarios: &[Scenario],
     mut opts: Options,
     stopped: &dyn Fn() -> bool,
-) -> Result<bool, ExitCode> {
+) -> Result<(bool, bool), ExitCode> {
     let names = args
         .scenarios
         .iter()
@@ -210,5 +210,5 @@ fn run_campaign(
             return Err(ExitCode::from(exit::USAGE));
         }
     }
-    Ok(report.all_held)
+    Ok((report.all_held, report.status != RunStatus::Complete))
 }
