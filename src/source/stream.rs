@@ -273,16 +273,30 @@ mod tests {
     #[test]
     fn a_shared_packet_offered_again_gets_the_same_answers() {
         let mut b = StreamBuffer::new();
-        let big: Arc<[u8]> = Arc::from(vec![b'X'; 990].into_iter().chain(*b"\r\n").collect::<Vec<u8>>());
+        let big: Arc<[u8]> = Arc::from(
+            vec![b'X'; 990]
+                .into_iter()
+                .chain(*b"\r\n")
+                .collect::<Vec<u8>>(),
+        );
         for _ in 0..4 {
             b.write_shared(&big).unwrap();
         }
-        assert_eq!(b.write_shared(&big), Err(StreamWriteError::Full { free: 126 }));
-        assert_eq!(b.write_shared(&big), Err(StreamWriteError::Full { free: 126 }));
+        assert_eq!(
+            b.write_shared(&big),
+            Err(StreamWriteError::Full { free: 126 })
+        );
+        assert_eq!(
+            b.write_shared(&big),
+            Err(StreamWriteError::Full { free: 126 })
+        );
         // A malformed packet is malformed whatever the fill level, on every attempt.
         let bad: Arc<[u8]> = Arc::from(&b"N10\nN20\r\n"[..]);
         for _ in 0..2 {
-            assert_eq!(b.write_shared(&bad), Err(StreamWriteError::NoLineEnd { offset: 3 }));
+            assert_eq!(
+                b.write_shared(&bad),
+                Err(StreamWriteError::NoLineEnd { offset: 3 })
+            );
         }
         let mut out = Vec::new();
         b.take_segment(&mut out);
