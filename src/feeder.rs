@@ -11,7 +11,7 @@ use std::ops::Range;
 
 use thiserror::Error;
 
-use crate::source::packets::{lines, LineTooLong, Packer};
+use crate::source::packets::{is_packed_form, lines, LineTooLong, Packer};
 
 /// Why a file cannot be fed.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -81,7 +81,7 @@ impl Feeder {
                 .collect();
             (text, items)
         } else {
-            cut_lines(&text, packet_max)?
+            cut_lines(text, packet_max)?
         };
         let mut f = Feeder {
             data,
@@ -182,13 +182,26 @@ impl Feeder {
     }
 }
 
+/// The form feed that starts a pause line (module header).
+const PAUSE: u8 = 0x0c;
+
 /// Normalise `text` to CR LF lines and cut it into packets of whole lines and pauses
-/// (form-feed lines, see the module header).
-fn cut_lines(text: &[u8], packet_max: usize) -> Result<(Vec<u8>, Vec<Item>), FeederError> {
+/// (form-feed lines, see the module header). A text already in CR LF lines without pauses is
+/// kept as it is, not copied: a streamed file is held once, not twice.
+fn cut_lines(text: Vec<u8>, packet_max: usize) -> Result<(Vec<u8>, Vec<Item>), FeederError> {
+    if is_packed_form(&text, PAUSE) {
+        let mut packer = Packer::counting(packet_max);
+        let mut items = Vec::new();
+        for (line_no, content) in lines(&text) {
+            items.extend(packer.push(line_no, content)?.map(Item::Packet));
+        }
+        items.extend(packer.close().map(Item::Packet));
+        return Ok((text, items));
+    }
     let mut packer = Packer::new(packet_max, text.len());
     let mut items = Vec::new();
-    for (line_no, content) in lines(text) {
-        if let Some(after) = content.strip_prefix(b"\x0c") {
+    for (line_no, content) in lines(&text) {
+        if let Some(after) = content.strip_prefix(&[PAUSE]) {
             let arg = std::str::from_utf8(after)
                 .map_err(|_| FeederError::BadPause { line: line_no })?
                 .trim();

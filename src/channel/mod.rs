@@ -406,8 +406,12 @@ impl Channel {
     }
 
     /// A client writes NC lines into the stream interface (`mc_program_stream_w`).
-    fn write_stream(&mut self, tick: &Tick, packet: &[u8]) -> Result<(), StreamWriteError> {
-        let r = self.stream.write(packet);
+    fn write_stream(
+        &mut self,
+        tick: &Tick,
+        packet: &std::sync::Arc<[u8]>,
+    ) -> Result<(), StreamWriteError> {
+        let r = self.stream.write_shared(packet);
         if !self.log.write(tick, packet.len(), &r) {
             return r;
         }

@@ -14,6 +14,21 @@ use crate::report::event::EventLog;
 use crate::source::loader::Loader;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
+/// The generated program of the load: parameter blocks only. The soak's mix of 0.05 mm moves
+/// in random directions stops at nearly every corner and waits 20 ms for each M8/M9
+/// acknowledgement, so a channel ran about 45 blocks a second and its stream stood full: the
+/// writer had a packet taken every few hundred ticks. Blocks that do not move are decoded as
+/// fast as they arrive, so every tick takes about one 992-byte packet per channel.
+fn load_program() -> ProgramSpec {
+    ProgramSpec {
+        moves: 0,
+        arcs: 0,
+        params: 1,
+        m_functions: 0,
+        ..ProgramSpec::default()
+    }
+}
+
 /// `n` channels built from the start-up list, each fed its own endless generated program by
 /// a client writing 992-byte packets every tick: the soak cycle without faults.
 pub fn streaming_channels(
@@ -47,7 +62,7 @@ pub fn streaming_channels(
                 ..FeederSpec::default()
             },
             r.fork(2),
-            Source::Generated(Generator::new(ProgramSpec::default(), r.fork(1))),
+            Source::Generated(Generator::new(load_program(), r.fork(1))),
         );
         channels.push(crate::channel::Channel::new(
             settings,
@@ -68,4 +83,35 @@ pub fn streaming_channels(
         SoakCycle::new(machine, slots, Faults::default(), Vec::new(), None),
         period,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::streaming_channels;
+    use crate::runtime::{Clock, Runtime};
+    use crate::source::loader::Loader;
+
+    /// The bench's load streams: each channel takes a packet nearly every tick, where the
+    /// soak's program left the buffer standing full (a packet taken every few hundred ticks).
+    #[test]
+    fn the_load_takes_a_packet_nearly_every_tick() {
+        let params =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
+        let (cycle, period) = streaming_channels(&params, 2, 1, &Loader::start()).unwrap();
+        let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
+        rt.run(Some(1000));
+        let (cycle, _) = rt.into_inner();
+        for c in cycle.feed_counters() {
+            assert!(
+                c.writes_ok >= 800,
+                "{} packets taken in 1000 ticks",
+                c.writes_ok
+            );
+        }
+        assert!(
+            cycle.total_blocks >= 2 * 800 * 20,
+            "{} blocks",
+            cycle.total_blocks
+        );
+    }
 }

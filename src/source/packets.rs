@@ -37,13 +37,17 @@ pub fn lines(text: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
 }
 
 /// Packs CR LF lines into packets of at most `max` bytes, all in one buffer: a packet is a
-/// range of [`Packer::data`].
+/// range of [`Packer::data`]. A counting packer ([`Packer::counting`]) copies nothing: for a
+/// text already in CR LF lines, whose ranges are the text's own.
 #[derive(Debug)]
 pub(crate) struct Packer {
     data: Vec<u8>,
-    /// Start of the open packet in `data`.
+    /// Bytes packed so far (`data.len()` unless counting).
+    end: usize,
+    /// Start of the open packet.
     start: usize,
     max: usize,
+    copy: bool,
 }
 
 impl Packer {
@@ -51,8 +55,21 @@ impl Packer {
     pub fn new(max: usize, capacity: usize) -> Self {
         Packer {
             data: Vec::with_capacity(capacity + capacity / 16 + 2),
+            end: 0,
             start: 0,
             max,
+            copy: true,
+        }
+    }
+
+    /// A packer that only counts: its ranges point into a text that is its own output.
+    pub fn counting(max: usize) -> Self {
+        Packer {
+            data: Vec::new(),
+            end: 0,
+            start: 0,
+            max,
+            copy: false,
         }
     }
 
@@ -71,25 +88,28 @@ impl Packer {
                 max: self.max,
             });
         }
-        let closed = if self.data.len() + len - self.start > self.max {
+        let closed = if self.end + len - self.start > self.max {
             self.close()
         } else {
             None
         };
-        self.data.extend_from_slice(content);
-        self.data.extend_from_slice(b"\r\n");
+        if self.copy {
+            self.data.extend_from_slice(content);
+            self.data.extend_from_slice(b"\r\n");
+        }
+        self.end += len;
         Ok(closed)
     }
 
     /// Close the open packet; `None` when it holds nothing.
     pub fn close(&mut self) -> Option<Range<usize>> {
-        let end = self.data.len();
+        let end = self.end;
         let r = (end > self.start).then_some(self.start..end);
         self.start = end;
         r
     }
 
-    /// The normalised text all packets point into.
+    /// The normalised text all packets point into (empty for a counting packer).
     pub fn data(&self) -> &[u8] {
         &self.data
     }
@@ -97,6 +117,20 @@ impl Packer {
     pub(crate) fn into_data(self) -> Vec<u8> {
         self.data
     }
+}
+
+/// True when `text` is already what packing makes of it: every line ended by CR LF (the last
+/// one too) and none starting with `skip` (a byte whose lines packing drops, the feeder's
+/// form feed). Such a text can be packed by a counting [`Packer`] without a copy.
+pub(crate) fn is_packed_form(text: &[u8], skip: u8) -> bool {
+    if text.is_empty() {
+        return true;
+    }
+    if !text.ends_with(b"\n") || text[0] == skip {
+        return false;
+    }
+    memchr::memchr_iter(b'\n', text)
+        .all(|at| at > 0 && text[at - 1] == b'\r' && text.get(at + 1).is_none_or(|&b| b != skip))
 }
 
 /// Cut `text` into packets of whole CR LF lines of at most `max` bytes each.
@@ -135,6 +169,12 @@ mod tests {
         assert_eq!(p, vec![b"AAAA\r\nBBBB\r\n".to_vec(), b"CCCC\r\n".to_vec()]);
         assert_eq!(packets(b"", 992).unwrap(), Vec::<Vec<u8>>::new());
         assert_eq!(packets(b"\n\n", 992).unwrap(), vec![b"\r\n\r\n".to_vec()]);
+        assert!(is_packed_form(b"A\r\nB\r\n", 0x0c));
+        assert!(is_packed_form(b"", 0x0c));
+        assert!(!is_packed_form(b"A\r\nB\n", 0x0c));
+        assert!(!is_packed_form(b"A\r\nB", 0x0c));
+        assert!(!is_packed_form(b"A\r\n\x0c 5\r\n", 0x0c));
+        assert!(!is_packed_form(b"\n", 0x0c));
         let e = packets(b"ok\nTOO LONG LINE\n", 8).unwrap_err();
         assert_eq!(
             e,

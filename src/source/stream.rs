@@ -9,6 +9,8 @@
 //! The buffer only validates and stores; raising warning 11012 or error 21476 in the channel is
 //! the caller's job, told apart by [`StreamWriteError`].
 
+use std::sync::Arc;
+
 use thiserror::Error;
 
 /// Capacity of the stream buffer in bytes (`MAX_PROGRAM_STREAM_SIZE`).
@@ -90,6 +92,11 @@ impl StreamCounters {
 pub struct StreamBuffer {
     data: Vec<u8>,
     counters: StreamCounters,
+    /// The last shared packet that passed the size and line-end checks and found no room. A
+    /// client offers the same shared packet again until it fits (`machine::Offer`), and a
+    /// full buffer refuses most attempts: its checks are not run again. Holding the `Arc`
+    /// keeps those bytes alive and unchanged, so the same pointer means the same bytes.
+    checked: Option<Arc<[u8]>>,
 }
 
 impl Default for StreamBuffer {
@@ -104,20 +111,56 @@ impl StreamBuffer {
         StreamBuffer {
             data: Vec::with_capacity(MAX_PROGRAM_STREAM_SIZE),
             counters: StreamCounters::default(),
+            checked: None,
         }
     }
 
     /// Offer one packet. Accepted whole or refused whole; see [`StreamWriteError`] for the
     /// order in which the checks run.
     pub fn write(&mut self, packet: &[u8]) -> Result<(), StreamWriteError> {
-        let checked = check_packet(packet).and_then(|()| {
-            let free = self.free();
-            if packet.len() > free {
-                Err(StreamWriteError::Full { free })
-            } else {
-                Ok(())
+        let checked = check_packet(packet).and_then(|()| self.room_for(packet));
+        self.count(packet, checked)
+    }
+
+    /// [`StreamBuffer::write`] of a shared packet, with the same answers. A packet offered
+    /// again after it found no room (the same allocation) only has its room checked: its
+    /// size and line ends passed before and cannot have changed.
+    pub fn write_shared(&mut self, packet: &Arc<[u8]>) -> Result<(), StreamWriteError> {
+        let known = self
+            .checked
+            .as_ref()
+            .is_some_and(|c| Arc::ptr_eq(c, packet));
+        let checked = if known {
+            self.room_for(packet)
+        } else {
+            check_packet(packet).and_then(|()| self.room_for(packet))
+        };
+        if matches!(checked, Err(StreamWriteError::Full { .. })) {
+            if !known {
+                self.checked = Some(Arc::clone(packet));
             }
-        });
+        } else {
+            self.checked = None;
+        }
+        self.count(packet, checked)
+    }
+
+    /// `Full` when `packet` does not fit into the free room.
+    fn room_for(&self, packet: &[u8]) -> Result<(), StreamWriteError> {
+        let free = self.free();
+        if packet.len() > free {
+            Err(StreamWriteError::Full { free })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// Store a packet that passed its checks, count the outcome either way.
+    fn count(
+        &mut self,
+        packet: &[u8],
+        checked: Result<(), StreamWriteError>,
+    ) -> Result<(), StreamWriteError> {
         match checked {
             Ok(()) => {
                 self.data.extend_from_slice(packet);
@@ -225,6 +268,42 @@ mod tests {
         assert_eq!(b.take_segment(&mut out), 0);
         assert!(out.is_empty());
         assert_eq!(b.counters().segments, 1);
+    }
+
+    #[test]
+    fn a_shared_packet_offered_again_gets_the_same_answers() {
+        let mut b = StreamBuffer::new();
+        let big: Arc<[u8]> = Arc::from(
+            vec![b'X'; 990]
+                .into_iter()
+                .chain(*b"\r\n")
+                .collect::<Vec<u8>>(),
+        );
+        for _ in 0..4 {
+            b.write_shared(&big).unwrap();
+        }
+        assert_eq!(
+            b.write_shared(&big),
+            Err(StreamWriteError::Full { free: 126 })
+        );
+        assert_eq!(
+            b.write_shared(&big),
+            Err(StreamWriteError::Full { free: 126 })
+        );
+        // A malformed packet is malformed whatever the fill level, on every attempt.
+        let bad: Arc<[u8]> = Arc::from(&b"N10\nN20\r\n"[..]);
+        for _ in 0..2 {
+            assert_eq!(
+                b.write_shared(&bad),
+                Err(StreamWriteError::NoLineEnd { offset: 3 })
+            );
+        }
+        let mut out = Vec::new();
+        b.take_segment(&mut out);
+        b.write_shared(&big).unwrap();
+        assert_eq!(b.counters().writes_full, 2);
+        assert_eq!(b.counters().writes_invalid, 2);
+        assert_eq!(b.counters().writes_ok, 5);
     }
 
     #[test]

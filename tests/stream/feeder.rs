@@ -33,6 +33,24 @@ fn lines_are_normalised_to_cr_lf_and_packed_whole() {
 }
 
 #[test]
+fn a_text_already_in_cr_lf_lines_is_packed_as_an_lf_text_is() {
+    // The CR LF text is kept as it is (not copied); its packets must be those of the same
+    // lines written with LF.
+    let lf = b"N10 X1\nN20 X2\nN30 X3\nN40 M30\n".to_vec();
+    let crlf = b"N10 X1\r\nN20 X2\r\nN30 X3\r\nN40 M30\r\n".to_vec();
+    let mut a = Feeder::new(lf, 17, 1, false).unwrap();
+    let mut b = Feeder::new(crlf, 17, 1, false).unwrap();
+    assert_eq!(a.packets(), 2);
+    assert_eq!(a.total_bytes(), b.total_bytes());
+    assert_eq!(run(&mut a, 10), run(&mut b, 10));
+    let long = b"N10 X1\r\nN20 X2 Y3 Z4 A5 B6 C7\r\n".to_vec();
+    assert!(matches!(
+        Feeder::new(long, 17, 1, false),
+        Err(FeederError::LineTooLong(LineTooLong { line: 2, .. }))
+    ));
+}
+
+#[test]
 fn packets_never_exceed_the_maximum_and_never_split_a_line() {
     let mut text = String::new();
     for i in 0..500 {
