@@ -1375,20 +1375,17 @@ fn watch_in_cycle(
         }
     };
     let alive = Arc::clone(&state.alive);
-    let taken = shared.devices.watch(
-        device.port,
-        req.group,
-        req.offset,
-        req.length,
-        |channel, encode| Watch {
-            channel,
-            cycle,
-            on_change,
-            encode,
-            deliver: Box::new(deliver),
-            alive,
-        },
-    );
+    let taken = shared
+        .devices
+        .watch(device.port, req.group, req.offset, req.length, |encode| {
+            Watch {
+                cycle,
+                on_change,
+                encode,
+                deliver: Box::new(deliver),
+                alive,
+            }
+        });
     if !taken {
         state.alive.store(false, Ordering::Relaxed);
         return None;

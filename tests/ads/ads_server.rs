@@ -987,3 +987,124 @@ fn a_1_ms_notification_sees_every_tick_and_a_cyclic_one_samples_every_cycle() {
         steps(tens)
     );
 }
+
+/// GEO's position-controller tick counter (port 551, group 0x120300, element 0x07).
+const GEO_TICK_COUNTER: (u32, u32) = (0x12_0300, 0x07);
+
+/// Send `data` as `command` to `port` of the device and return the response's data.
+fn call_port(raw: &mut Raw, port: u16, command: u16, invoke: u32, data: &[u8]) -> Vec<u8> {
+    let target = AmsAddr { port, ..device() };
+    raw.send(&request_bytes(
+        command,
+        target,
+        client_addr(40000),
+        invoke,
+        data,
+    ));
+    loop {
+        let (h, d) = raw.frame();
+        if h.invoke_id == invoke && h.command.to_u16() == command {
+            return d;
+        }
+    }
+}
+
+#[test]
+fn notifications_on_geo_hli_and_sda_objects_are_evaluated_in_the_cycle() {
+    let (srv, _b) = server();
+    let mut raw = Raw::connect(srv.local_addr());
+    // An HLI symbol by handle (port 851) and an SDA zero offset by handle (port 552): cyclic
+    // every 1 ms. GEO's tick counter (port 551): on change every 1 ms.
+    let state_r = b"HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r\0";
+    let d = call_port(
+        &mut raw,
+        851,
+        READ_WRITE,
+        1,
+        &request::read_write(0xF003, 0, 4, state_r),
+    );
+    assert_eq!(u32_at(&d, 0), 0, "handle of state_r");
+    let hli_handle = u32_at(&d, 8);
+    let d = call_port(
+        &mut raw,
+        552,
+        READ_WRITE,
+        2,
+        &request::read_write(0x12_2301, 0x46, 4, b"V.G.NP[1].V"),
+    );
+    assert_eq!(u32_at(&d, 0), 0, "handle of V.G.NP[1].V");
+    let sda_handle = u32_at(&d, 8);
+    let (geo, hli, sda) = (
+        u32_at(
+            &call_port(
+                &mut raw,
+                551,
+                ADD_NOTIFICATION,
+                3,
+                &request::add_notification(GEO_TICK_COUNTER.0, GEO_TICK_COUNTER.1, 4, 4, 0, 10_000),
+            ),
+            4,
+        ),
+        u32_at(
+            &call_port(
+                &mut raw,
+                851,
+                ADD_NOTIFICATION,
+                4,
+                &request::add_notification(0xF005, hli_handle, 8, 3, 0, 10_000),
+            ),
+            4,
+        ),
+        u32_at(
+            &call_port(
+                &mut raw,
+                552,
+                ADD_NOTIFICATION,
+                5,
+                &request::add_notification(0x12_2301, sda_handle, 12, 3, 0, 10_000),
+            ),
+            4,
+        ),
+    );
+    // Samples in the order they arrive: every due watch of a tick is evaluated in that tick,
+    // in the order the handles were added, and queued in order.
+    let mut order = Vec::new();
+    while order.iter().filter(|(h, _)| *h == geo).count() < 500 {
+        let (h, d) = raw.frame();
+        if h.command.to_u16() == 8 {
+            for s in payload::decode_notification(&d).unwrap() {
+                order.push((s.handle, s.data));
+            }
+        }
+    }
+    let ticks: Vec<u32> = order
+        .iter()
+        .filter(|(h, _)| *h == geo)
+        .map(|(_, d)| u32_at(d, 0))
+        .collect();
+    assert!(
+        ticks.windows(2).all(|w| w[1] == w[0] + 1),
+        "the 1 ms on-change GEO handle saw every tick: {ticks:?}"
+    );
+    // Once all three sample, each tick gives one sample of each, GEO's first.
+    let first_sda = order.iter().position(|(h, _)| *h == sda).unwrap();
+    let start = first_sda
+        + order[first_sda..]
+            .iter()
+            .position(|(h, _)| *h == geo)
+            .unwrap();
+    let settled: Vec<u32> = order[start..].iter().map(|(h, _)| *h).collect();
+    for tick in settled.chunks_exact(3) {
+        assert_eq!(
+            tick,
+            [geo, hli, sda],
+            "one sample of each per tick: {settled:?}"
+        );
+    }
+    let (hli_bytes, sda_bytes) = (
+        &order.iter().find(|(h, _)| *h == hli).unwrap().1,
+        &order.iter().find(|(h, _)| *h == sda).unwrap().1,
+    );
+    assert_eq!(hli_bytes.len(), 8, "state_r: mode and state");
+    assert_eq!(sda_bytes.len(), 12, "V.G.NP[1].V: one DINT per axis");
+}
