@@ -6,8 +6,9 @@
 //! newcomer is closed: `slots.rs`), one reader thread per connection that stamps each
 //! request with its arrival ([`Inbox`]), one writer thread per connection draining its
 //! bounded send queue, plus one notification
-//! thread per connection that has notification handles on objects not evaluated in the
-//! cycle (COM channel and platform objects are: `machine::watch`). Channel calls may
+//! thread per connection that has notification handles on what is not evaluated in the
+//! cycle (every object of the COM, GEO, SDA and HLI tables is, `machine::watch`; the
+//! description table, the uploads and the system service are read whole). Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
 //! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
