@@ -1363,6 +1363,29 @@ impl Hli {
 /// 0xF003's reply: the handle; a client that asks for more (`jisotalo/ads-client`
 /// `createVariableHandle` asks for any length) also gets the symbol's size, the type
 /// decoration (0: no decoration), the type name's length (u16) and the type name with NUL.
+/// The encoder of symbol `i` of `img`, `length` bytes at a time.
+fn symbol_encoder(img: &Arc<Image>, i: usize, length: u32) -> ObjectEncoder {
+    let img = Arc::clone(img);
+    Box::new(move |s: &mut dyn Source| img.read_symbol(i, length, s))
+}
+
+/// `bench --load cycle --notify-on hli`: the encoders of `count` handles on the channels'
+/// `…mode_and_state.state_r` in turn (a live symbol: the tick's mode and state written into
+/// the image, then copied out), over one image of `channels` channels (their symbols only).
+pub(crate) fn bench_encoders(channels: usize, count: usize) -> Vec<ObjectEncoder> {
+    let img = Arc::new(Image::build(&vec![0; channels]));
+    (0..count)
+        .filter_map(|k| {
+            let name = format!(
+                "hli_global_variables.gpch[{}]^.channel_mc_control.mode_and_state.state_r",
+                k % channels.max(1)
+            );
+            let i = *img.by_name.get(&name)?;
+            Some(symbol_encoder(&img, i, 8))
+        })
+        .collect()
+}
+
 /// A technology root's bytes, encoded from the channel's status in `source`; `None` for the
 /// other roles.
 fn techno_root(role: Role, source: &mut dyn Source) -> Result<Option<Vec<u8>>, AdsResult> {

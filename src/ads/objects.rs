@@ -396,6 +396,20 @@ pub(crate) fn bench_watch(
     Some(bench_counting(super::backend::in_cycle(encode), samples))
 }
 
+/// `bench --load cycle --notifications N --notify-on hli`: `count` 1 ms on-change watches of
+/// the channels' HLI `…mode_and_state.state_r` in turn, with the symbol table's own encoder,
+/// counting their samples into `samples`.
+pub(crate) fn bench_hli_watches(
+    channels: u16,
+    count: usize,
+    samples: &Arc<std::sync::atomic::AtomicU64>,
+) -> Vec<crate::machine::watch::Watch> {
+    hli::bench_encoders(usize::from(channels), count)
+        .into_iter()
+        .map(|e| bench_counting(super::backend::in_cycle(e), Arc::clone(samples)))
+        .collect()
+}
+
 /// A 1 ms on-change watch with `encode`, counting its samples into `samples`.
 fn bench_counting(
     encode: crate::machine::watch::Encode,
