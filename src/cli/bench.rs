@@ -162,6 +162,40 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     }
 }
 
+/// `--notifications` handles on `--notify-on` objects of the channels in turn, counting their
+/// samples into `samples`.
+fn add_watches(
+    args: &BenchArgs,
+    cycle: &mut crate::soak::driver::SoakCycle,
+    samples: &Arc<AtomicU64>,
+) -> Result<(), String> {
+    let watches = match args.notify_on {
+        NotifyOn::Com => (0..args.notifications)
+            .filter_map(|k| {
+                let ch = (k % u64::from(args.channels)) as u16 + 1;
+                crate::ads::objects::bench_watch(ch, Arc::clone(samples))
+            })
+            .collect(),
+        NotifyOn::Hli => crate::ads::objects::bench_hli_watches(
+            args.channels as u16,
+            args.notifications as usize,
+            samples,
+        ),
+    };
+    if watches.len() as u64 != args.notifications {
+        return Err(format!("no encoder for {:?}", args.notify_on));
+    }
+    for w in watches {
+        if !cycle.machine_mut().watch(w) {
+            return Err(format!(
+                "more than {} notifications",
+                crate::machine::watch::MAX_WATCHES
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// `--load cycle`: the runtime with channels streaming in-process against a bare loop.
 fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let loader = crate::source::loader::Loader::start();
@@ -184,29 +218,8 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let mut bare = Histogram::new();
     let mut cycle = cycle;
     let samples = Arc::new(AtomicU64::new(0));
-    let watches = match args.notify_on {
-        NotifyOn::Com => (0..args.notifications)
-            .filter_map(|k| {
-                let ch = (k % u64::from(args.channels)) as u16 + 1;
-                crate::ads::objects::bench_watch(ch, Arc::clone(&samples))
-            })
-            .collect(),
-        NotifyOn::Hli => crate::ads::objects::bench_hli_watches(
-            args.channels as u16,
-            args.notifications as usize,
-            &samples,
-        ),
-    };
-    if watches.len() as u64 != args.notifications {
-        return usage(format!("no encoder for {:?}", args.notify_on));
-    }
-    for w in watches {
-        if !cycle.machine_mut().watch(w) {
-            return usage(format!(
-                "more than {} notifications",
-                crate::machine::watch::MAX_WATCHES
-            ));
-        }
+    if let Err(msg) = add_watches(args, &mut cycle, &samples) {
+        return usage(msg);
     }
     if args.notifications > 0 {
         out.line(format_args!(
