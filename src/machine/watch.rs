@@ -1,5 +1,6 @@
 //! Notification watches evaluated in the cycle: after every tick the machine encodes each
-//! active watch's object from the channel's status of that tick, compares it with the bytes
+//! active watch's object with its table's encoder, reading the tick itself as the encoder's
+//! [`Source`] (each channel's status built once per tick), compares it with the bytes
 //! it last delivered (on change) or checks its cycle (cyclic), and hands a sample to the
 //! watch's sink, which queues it on the owning connection's bounded send queue and never
 //! waits. TwinCAT checks notification handles in the task cycle (Beckhoff InfoSys, ADS
