@@ -727,6 +727,9 @@ struct InboxState {
     serving_since: Option<Instant>,
     /// The helper holds (or is about to take) the read side.
     helper_reading: bool,
+    /// The helper waits without a deadline (nothing was being answered): the answering
+    /// thread wakes it when it takes a frame, so it can time that answer.
+    helper_parked: bool,
     /// The reading is done, and why (`Ok` for the client's or the server's clean close);
     /// taken by the answering thread once every frame is answered.
     ended: Option<Result<(), ConnError>>,
@@ -786,8 +789,9 @@ impl Inbox {
                     if let Some((arrived, frame, len)) = st.frames.pop_front() {
                         st.bytes -= len;
                         st.serving_since = Some(Instant::now());
-                        if st.helper_reading {
-                            // It may wait for room, or for this answer to take long.
+                        if st.helper_reading || st.helper_parked {
+                            // It may wait for room, or time this answer.
+                            st.helper_parked = false;
                             self.ready.notify_all();
                         }
                         return Ok((arrived, frame));
@@ -828,7 +832,10 @@ impl Inbox {
                                 .unwrap_or_else(|p| p.into_inner())
                                 .0
                         }
-                        None => st = self.wait(st),
+                        None => {
+                            st.helper_parked = true;
+                            st = self.wait(st);
+                        }
                     }
                 }
                 st.helper_reading = true;

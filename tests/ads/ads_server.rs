@@ -844,6 +844,19 @@ impl ncchannel::runtime::Cycle for StallWhenAsked {
 
 #[test]
 fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_reply_timeout() {
+    requests_in_flight_through_a_stall(false);
+}
+
+/// The same, with the 49 behind the first sent while it already waits on the stalled runtime:
+/// they are read (and stamped) while it waits, not when it is answered.
+#[test]
+fn requests_sent_behind_one_waiting_on_a_stall_are_stamped_as_they_arrive() {
+    requests_in_flight_through_a_stall(true);
+}
+
+/// 50 stream writes in flight through a 4 s stall; `first_alone`: the first is sent 20 ms
+/// before the other 49.
+fn requests_in_flight_through_a_stall(first_alone: bool) {
     use ncchannel::machine::{Machine, StopWhen};
     use ncchannel::report::event::EventLog;
     use ncchannel::runtime::{Clock, Runtime};
@@ -864,8 +877,15 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
     let (mut rt, tx) = Runtime::new(cycle, period, Clock::RealTime);
     let stop = rt.stop_handle();
     let runtime = std::thread::spawn(move || rt.run(None));
-    // As `serve` builds it: the default reply timeout (500 ms).
+    // As `serve` builds it: the default reply timeout (500 ms); 1 s when the first is sent
+    // alone, so an answer counted from when the first was answered (about 2 s) stands apart
+    // from one counted from its own arrival (about 1 s).
     let backend = ncchannel::machine::remote::ChannelBackend::new(tx, 1);
+    let backend = if first_alone {
+        backend.with_reply_timeout(Duration::from_secs(1))
+    } else {
+        backend
+    };
     let srv = ncchannel::ads::spawn(
         ServerConfig {
             bind: "127.0.0.1:0".parse().unwrap(),
@@ -895,7 +915,14 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
         .flat_map(|i| request_bytes(WRITE, device(), client_addr(40000), 100 + i, &write))
         .collect();
     let sent = Instant::now();
-    raw.send(&burst);
+    if first_alone {
+        let first = request_bytes(WRITE, device(), client_addr(40000), 100, &write).len();
+        raw.send(&burst[..first]);
+        std::thread::sleep(Duration::from_millis(20));
+        raw.send(&burst[first..]);
+    } else {
+        raw.send(&burst);
+    }
     let mut answers = Vec::new();
     while answers.len() < n as usize {
         let (h, d) = raw.frame();
@@ -910,11 +937,10 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
         "every write in the stall answered busy: {answers:?}"
     );
     // Each within the reply timeout of its arrival (500 ms) plus scheduling slack, far below
-    // ads-client's 2000 ms; one after another 50 ms apart the last took 2950 ms.
-    assert!(
-        slowest < Duration::from_millis(1500),
-        "slowest answer {slowest:?}: {answers:?}"
-    );
+    // ads-client's 2000 ms; one after another 50 ms apart the last took 2950 ms. Sent behind
+    // the first (1 s timeout): about 1.05 s; read only once the first is answered, 2 s.
+    let bound = Duration::from_millis(if first_alone { 1600 } else { 1500 });
+    assert!(slowest < bound, "slowest answer {slowest:?}: {answers:?}");
     let ids: std::collections::BTreeSet<u32> = answers.iter().map(|a| a.0).collect();
     assert_eq!(ids.len(), n as usize, "each request answered once");
 
