@@ -43,3 +43,16 @@ pub(crate) fn write_stream(backend: &dyn CncBackend, ch: u16, data: &[u8]) -> Ad
         Err(e) => e.into(),
     }
 }
+
+pub use crate::machine::remote::Live;
+pub use crate::machine::watch::{Encode, Source};
+
+/// An object's encoder as its table builds it: the bytes read from a [`Source`], or why not.
+/// A Read runs it once on [`Live`]; a notification evaluated in the cycle runs it every due
+/// tick ([`in_cycle`]).
+pub(crate) type ObjectEncoder = Box<dyn Fn(&mut dyn Source) -> Result<Vec<u8>, AdsResult> + Send>;
+
+/// The watch's encoder of an object's encoder: a failure is "nothing to send now".
+pub(crate) fn in_cycle(e: ObjectEncoder) -> Encode {
+    Box::new(move |s: &mut dyn Source| e(s).ok())
+}

@@ -13,7 +13,7 @@
 //! kernel: "the first channel drives platform data"). What ncchannel does not model is
 //! absent (0x703), never a made-up value.
 
-use super::backend::{CncBackend, DeviceError, HmiOp, Op, Status};
+use super::backend::{CncBackend, DeviceError, HmiOp, Live, ObjectEncoder, Op, Source, Status};
 use super::description::{self, Access, AdsType, ObjectInfo};
 use super::hli::{Hli, HmiRequest};
 use super::result::AdsResult;
@@ -321,10 +321,10 @@ struct PlatformAxis {
 
 /// Platform axes are the channels' axes in channel order (ncchannel has no axes outside
 /// channels and no axis exchange).
-fn platform_axes(backend: &dyn CncBackend) -> Result<Vec<PlatformAxis>, AdsResult> {
+fn platform_axes(source: &mut dyn Source) -> Result<Vec<PlatformAxis>, AdsResult> {
     let mut out = Vec::new();
-    for ch in 1..=backend.channel_count() {
-        let n = backend.status(ch).map_err(AdsResult::from)?.positions.len();
+    for ch in 1..=source.channel_count() {
+        let n = source.status(ch).map_err(AdsResult::from)?.positions.len();
         out.extend((0..n).map(|index| PlatformAxis { ch, index }));
     }
     Ok(out)
@@ -346,48 +346,9 @@ fn find(scope: Scope, element: u32) -> Option<&'static Def> {
         .find(|d| d.scope == scope && d.element == element)
 }
 
-/// The encoder of the channel object `(group, offset)` for a notification evaluated in the
-/// cycle (`machine::watch`): its 1-based channel and the function that encodes it from that
-/// channel's status, exactly as [`read`] does (platform objects from channel 1's). `None` for
-/// objects that are not read from one channel's status (axis objects, the axis count, the
-/// description table), which are sampled by reading.
-pub(crate) fn channel_encoder(
-    backend: &dyn CncBackend,
-    group: u32,
-    offset: u32,
-    length: u32,
-) -> Option<(u16, crate::machine::watch::Encode)> {
-    if channel_in(group, GROUP_DESCRIPTION, GROUP_DESCRIPTION_INDEX).is_some() {
-        return None;
-    }
-    let t = resolve(backend, group, offset).ok()?;
-    if !t.def.access.readable() {
-        return None;
-    }
-    let (def, ch) = (t.def, t.ch);
-    match t.def.scope {
-        Scope::Channel => Some((
-            ch,
-            Box::new(move |v: &Status| read_channel(v, ch, def, length).ok()),
-        )),
-        Scope::Platform if def.field != Field::AxisCount => {
-            let channels = backend.channel_count();
-            Some((
-                1,
-                Box::new(move |v: &Status| platform_from_status(v, channels, def, length).ok()),
-            ))
-        }
-        _ => None,
-    }
-}
-
 /// Which object `(group, offset)` names, or 0x702/0x703.
-fn resolve(
-    backend: &dyn CncBackend,
-    group: u32,
-    offset: u32,
-) -> Result<Target<'static>, AdsResult> {
-    let count = u32::from(backend.channel_count());
+fn resolve(channels: u16, group: u32, offset: u32) -> Result<Target<'static>, AdsResult> {
+    let count = u32::from(channels);
     if let Some(ch) = channel_in(group, GROUP_CHANNEL, GROUP_CHANNEL_INDEX) {
         if ch > count {
             return Err(AdsResult::INVALID_GROUP);
@@ -438,9 +399,10 @@ fn resolve(
 /// platform axes), names unique. `ch` 0 lists channel 1.
 pub fn objects(backend: &dyn CncBackend, ch: u16) -> Result<Vec<ObjectInfo>, AdsResult> {
     let ch = ch.max(1);
-    let view = backend.status(ch).map_err(AdsResult::from)?;
+    let mut live = Live::new(backend);
+    let axes = platform_axes(&mut live)?;
+    let view = live.status(ch).map_err(AdsResult::from)?;
     let group = GROUP_CHANNEL + u32::from(ch);
-    let axes = platform_axes(backend)?;
     let mut out = Vec::with_capacity(TABLE.len() + 16 * axes.len());
     for def in TABLE {
         let info = |name: std::string::String, group: u32, offset: u32, size: u32| ObjectInfo {
@@ -565,57 +527,78 @@ pub fn read(
         }
         return description::read_table(&objects(backend, ch as u16)?, offset, length);
     }
-    let t = resolve(backend, group, offset)?;
+    let mut live = Live::new(backend);
+    encoder(&mut live, group, offset, length)?(&mut live)
+}
+
+/// The encoder of object `(group, offset)`, read `length` bytes at a time: what [`read`] runs
+/// once and a notification evaluated in the cycle runs every due tick (`machine::watch`).
+/// Which object, channel and axis it is is settled here, from `source` (the axes are fixed
+/// while serving); the encoder reads only the status it shows. `Err` for an address that
+/// names no readable object and for the description table (read whole, by [`read`]).
+pub(crate) fn encoder(
+    source: &mut dyn Source,
+    group: u32,
+    offset: u32,
+    length: u32,
+) -> Result<ObjectEncoder, AdsResult> {
+    if channel_in(group, GROUP_DESCRIPTION, GROUP_DESCRIPTION_INDEX).is_some() {
+        return Err(AdsResult::ACCESS_DENIED);
+    }
+    let channels = source.channel_count();
+    let t = resolve(channels, group, offset)?;
     if !t.def.access.readable() {
         return Err(AdsResult::ACCESS_DENIED);
     }
-    match t.def.scope {
-        Scope::Platform => read_platform(backend, t.def, length),
+    let def = t.def;
+    Ok(match def.scope {
+        Scope::Platform if def.field == Field::AxisCount => Box::new(move |s: &mut dyn Source| {
+            fixed(
+                (platform_axes(s)?.len() as u32).to_le_bytes().to_vec(),
+                length,
+            )
+        }),
+        Scope::Platform => Box::new(move |s: &mut dyn Source| {
+            platform_from_status(s.status(1).map_err(dev)?, channels, def, length)
+        }),
         Scope::Channel => {
-            let v = backend.status(t.ch).map_err(dev)?;
-            read_channel(&v, t.ch, t.def, length)
+            let ch = t.ch;
+            Box::new(move |s: &mut dyn Source| {
+                read_channel(s.status(ch).map_err(dev)?, ch, def, length)
+            })
         }
         Scope::ChannelAxis => {
-            let v = backend.status(t.ch).map_err(dev)?;
+            let ch = t.ch;
+            let axes = source.status(ch).map_err(dev)?.positions.len();
             let i = (t.axis as usize)
                 .checked_sub(1)
-                .filter(|&i| i < v.positions.len())
+                .filter(|&i| i < axes)
                 .ok_or(AdsResult::INVALID_OFFSET)?;
-            let axes = platform_axes(backend)?;
-            let logical = axes
+            let logical = platform_axes(source)?
                 .iter()
-                .position(|a| a.ch == t.ch && a.index == i)
-                .map_or(0, |p| p + 1);
-            read_axis(&v, t.ch, i, logical as u16, t.def, length)
+                .position(|a| a.ch == ch && a.index == i)
+                .map_or(0, |p| p + 1) as u16;
+            Box::new(move |s: &mut dyn Source| {
+                read_axis(s.status(ch).map_err(dev)?, ch, i, logical, def, length)
+            })
         }
         Scope::PlatformAxis => {
-            let axes = platform_axes(backend)?;
+            let axes = platform_axes(source)?;
             let a = (t.axis as usize)
                 .checked_sub(1)
                 .and_then(|i| axes.get(i))
                 .ok_or(AdsResult::INVALID_OFFSET)?;
-            let v = backend.status(a.ch).map_err(dev)?;
-            read_axis(&v, a.ch, a.index, t.axis as u16, t.def, length)
+            let (ch, index, logical) = (a.ch, a.index, t.axis as u16);
+            Box::new(move |s: &mut dyn Source| {
+                read_axis(s.status(ch).map_err(dev)?, ch, index, logical, def, length)
+            })
         }
-    }
+    })
 }
 
 /// The active D as the kernel's DINT tool number.
 fn active_d(v: &Status) -> i32 {
     i32::try_from(v.active_tool.0).unwrap_or(i32::MAX)
-}
-
-fn read_platform(backend: &dyn CncBackend, def: &Def, length: u32) -> Result<Vec<u8>, AdsResult> {
-    if def.field == Field::AxisCount {
-        return fixed(
-            (platform_axes(backend)?.len() as u32)
-                .to_le_bytes()
-                .to_vec(),
-            length,
-        );
-    }
-    let v = backend.status(1).map_err(dev)?;
-    platform_from_status(&v, backend.channel_count(), def, length)
 }
 
 /// A platform object other than the axis count, from channel 1's status ("the first channel
@@ -850,7 +833,7 @@ pub fn write(
     if channel_in(group, GROUP_DESCRIPTION, GROUP_DESCRIPTION_INDEX).is_some() {
         return Err(AdsResult::ACCESS_DENIED);
     }
-    let t = resolve(backend, group, offset)?;
+    let t = resolve(backend.channel_count(), group, offset)?;
     if !t.def.access.writable() {
         return Err(AdsResult::ACCESS_DENIED);
     }

@@ -16,7 +16,9 @@
 //! read the channel's technology units
 //! (`Status.techno`, src/channel/techno.rs), as the HLI symbols do; they are read-only here.
 
-use super::backend::{CncBackend, Status};
+use std::sync::Arc;
+
+use super::backend::{CncBackend, Live, ObjectEncoder, Source, Status};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::hli::{Hli, Unit};
 use super::result::AdsResult;
@@ -280,11 +282,7 @@ fn writable(field: Field) -> bool {
 }
 
 /// Find channel `ch`'s table entry of a logical group, or the error a Read or Write gets.
-fn locate(
-    backend: &dyn CncBackend,
-    group: u32,
-    offset: u32,
-) -> Result<(u16, &'static Def), AdsResult> {
+fn locate(channels: u16, group: u32, offset: u32) -> Result<(u16, &'static Def), AdsResult> {
     let group = logical(group);
     let (class, ch) = if group == GROUP_POS_CTRL {
         (Class::PosCtrl, 1)
@@ -297,7 +295,7 @@ fn locate(
     } else {
         return Err(AdsResult::INVALID_GROUP);
     };
-    if ch > u32::from(backend.channel_count()) {
+    if ch > u32::from(channels) {
         return Err(AdsResult::INVALID_GROUP);
     }
     let def = all_defs()
@@ -316,7 +314,7 @@ pub fn write(
     offset: u32,
     data: &[u8],
 ) -> Result<(), AdsResult> {
-    let (ch, def) = locate(backend, group, offset)?;
+    let (ch, def) = locate(backend.channel_count(), group, offset)?;
     match def.field {
         Field::Unit(unit, at) if writable(def.field) => {
             if data.is_empty() || data.len() > def.size as usize {
@@ -351,21 +349,41 @@ pub fn read(
     offset: u32,
     length: u32,
 ) -> Result<Vec<u8>, AdsResult> {
-    let (ch, def) = locate(backend, group, offset)?;
+    encoder(backend.channel_count(), hli, group, offset, length)?(&mut Live::new(backend))
+}
+
+/// The encoder of element `(group, offset)`, read `length` bytes at a time: what [`read`]
+/// runs once and a notification evaluated in the cycle runs every due tick
+/// (`machine::watch`). The HLD's mode-and-state elements read the HLI image.
+pub(crate) fn encoder(
+    channels: u16,
+    hli: &Hli,
+    group: u32,
+    offset: u32,
+    length: u32,
+) -> Result<ObjectEncoder, AdsResult> {
+    let (ch, def) = locate(channels, group, offset)?;
     let class = def.class;
     if let Field::Unit(unit, at) = def.field {
-        let bytes = hli.unit_bytes(ch, unit, at as usize, def.size as usize)?;
-        return fixed(bytes, length);
+        let img = Arc::clone(hli.image()?);
+        let (at, size) = (at as usize, def.size as usize);
+        return Ok(Box::new(move |_: &mut dyn Source| {
+            fixed(img.unit_bytes(ch, unit, at, size)?, length)
+        }));
     }
-    let v = backend.status(ch).map_err(AdsResult::from)?;
     if def.field == Field::PlatformAxes {
-        let mut n = 0usize;
-        for c in 1..=backend.channel_count() {
-            n += backend.status(c).map_err(AdsResult::from)?.positions.len();
-        }
-        return fixed((n as u16).to_le_bytes().to_vec(), length);
+        return Ok(Box::new(move |s: &mut dyn Source| {
+            let mut n = 0usize;
+            for c in 1..=s.channel_count() {
+                n += s.status(c).map_err(AdsResult::from)?.positions.len();
+            }
+            fixed((n as u16).to_le_bytes().to_vec(), length)
+        }));
     }
-    fixed(value(&v, class, def.field)?, length)
+    Ok(Box::new(move |s: &mut dyn Source| {
+        let v = s.status(ch).map_err(AdsResult::from)?;
+        fixed(value(v, class, def.field)?, length)
+    }))
 }
 
 fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {

@@ -35,7 +35,7 @@ use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::{AtomicU16, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
-use super::backend::{CncBackend, DeviceError, Op, Reply};
+use super::backend::{CncBackend, DeviceError, Live, ObjectEncoder, Op, Reply, Source};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::plc_types::DataType;
 use super::result::AdsResult;
@@ -190,7 +190,7 @@ impl ChannelAreas {
 }
 
 /// The symbol table and its memory, built once the channels are known.
-struct Image {
+pub(crate) struct Image {
     symbols: Vec<Symbol>,
     /// The symbols the object map and the upload list (`symbols[..listed]`); the rest are
     /// the levels [`Builder::derive`] names.
@@ -718,6 +718,102 @@ impl Image {
         }
     }
 
+    /// Read symbol `i`: its bytes, or the first `length` of them (TwinSharp reads
+    /// `[MAXIDX]` elements of an array). The live roles read `source`: a Read asks the
+    /// runtime, a notification evaluated in the cycle reads its tick.
+    fn read_symbol(
+        &self,
+        i: usize,
+        length: u32,
+        source: &mut dyn Source,
+    ) -> Result<Vec<u8>, AdsResult> {
+        let s = &self.symbols[i];
+        let n = s.size.min(length as usize);
+        if let Some(c) = &s.composite {
+            let mut out = Vec::with_capacity(n);
+            for &p in &c.parts {
+                let Some(left) = n.checked_sub(out.len()).filter(|&l| l > 0) else {
+                    break;
+                };
+                out.extend(self.read_symbol(p, u32::try_from(left).unwrap_or(u32::MAX), source)?);
+            }
+            return Ok(out);
+        }
+        if let Some(bytes) = techno_root(self.roles[s.root], source)? {
+            return bytes
+                .get(s.at..s.at + n)
+                .map(<[u8]>::to_vec)
+                .ok_or(AdsResult::INVALID_SIZE);
+        }
+        match self.roles[s.root] {
+            Role::ModeState(ch) => {
+                let st = source.status(ch).map_err(AdsResult::from)?;
+                let (mode, state) = (st.mode as u32, st.state as u32);
+                let mut mem = self.memory();
+                mem[s.root][0..4].copy_from_slice(&mode.to_le_bytes());
+                mem[s.root][4..8].copy_from_slice(&state.to_le_bytes());
+            }
+            Role::ErrorRecord(ch) | Role::ErrorSemaphore(ch) => self.post_error(ch, source)?,
+            _ => {}
+        }
+        let mem = self.memory();
+        Ok(mem[s.root][s.at..s.at + n].to_vec())
+    }
+
+    /// Post the channel's next error into `mc_error.satz_r` when the semaphore is FALSE.
+    fn post_error(&self, ch: u16, source: &mut dyn Source) -> Result<(), AdsResult> {
+        let areas = self.areas(ch)?;
+        if self.memory()[areas.error_semaphore][0] != 0 {
+            return Ok(());
+        }
+        let i = usize::from(ch) - 1;
+        let refusal = self.refused.lock().unwrap_or_else(|p| p.into_inner())[i].pop_front();
+        if let Some(code) = refusal {
+            let tick = source.status(ch).map_err(AdsResult::from)?.tick;
+            let mut mem = self.memory();
+            mem[areas.error_record].copy_from_slice(&error_record(code, ch, tick));
+            mem[areas.error_semaphore][0] = 1;
+            return Ok(());
+        }
+        let next = self.posted.lock().unwrap_or_else(|p| p.into_inner())[i];
+        let mut rec = source.error_record(ch, next).map_err(AdsResult::from)?;
+        if next >= rec.total {
+            return Ok(());
+        }
+        let mut index = next;
+        if rec.error.is_none() {
+            // No longer kept: skip to the newest.
+            index = rec.total - 1;
+            rec = source.error_record(ch, index).map_err(AdsResult::from)?;
+        }
+        let tick = source.status(ch).map_err(AdsResult::from)?.tick;
+        let code = rec.error.as_ref().map_or(0, |(c, _)| *c);
+        let record = error_record(code, ch, tick);
+        let mut mem = self.memory();
+        mem[areas.error_record].copy_from_slice(&record);
+        mem[areas.error_semaphore][0] = 1;
+        drop(mem);
+        self.posted.lock().unwrap_or_else(|p| p.into_inner())[i] = index + 1;
+        Ok(())
+    }
+
+    /// Bytes `[at, at + size)` of a channel's mode-and-state `unit` (for the GEO mirror).
+    pub(crate) fn unit_bytes(
+        &self,
+        ch: u16,
+        unit: Unit,
+        at: usize,
+        size: usize,
+    ) -> Result<Vec<u8>, AdsResult> {
+        let a = self.areas(ch)?;
+        let root = a.unit_root(unit);
+        let mem = self.memory();
+        let area = &mem[root];
+        let mut out = area[at.min(area.len())..(at + size).min(area.len())].to_vec();
+        out.resize(size, 0);
+        Ok(out)
+    }
+
     fn memory(&self) -> MutexGuard<'_, Vec<Vec<u8>>> {
         self.memory.lock().unwrap_or_else(|p| p.into_inner())
     }
@@ -736,7 +832,7 @@ pub struct Hli {
     backend: Arc<dyn CncBackend>,
     /// The PLC runtime's ADS state: RUN, or STOP after WriteControl STOP or RESET.
     state: AtomicU16,
-    image: OnceLock<Image>,
+    image: OnceLock<Arc<Image>>,
     uploads: OnceLock<Uploads>,
 }
 
@@ -811,7 +907,7 @@ impl Hli {
         }
     }
 
-    fn image(&self) -> Result<&Image, AdsResult> {
+    pub(crate) fn image(&self) -> Result<&Arc<Image>, AdsResult> {
         if let Some(img) = self.image.get() {
             return Ok(img);
         }
@@ -825,7 +921,7 @@ impl Hli {
                     .len(),
             );
         }
-        Ok(self.image.get_or_init(|| Image::build(&axes)))
+        Ok(self.image.get_or_init(|| Arc::new(Image::build(&axes))))
     }
 
     /// Every symbol, for the object map (`group` 0xF005 and `offset` = its handle).
@@ -869,59 +965,6 @@ impl Hli {
         } else {
             Err(SYMBOL_NOT_FOUND)
         }
-    }
-
-    /// Read a symbol: its bytes, or the first `length` of them (TwinSharp reads
-    /// `[MAXIDX]` elements of an array).
-    fn read_symbol(&self, i: usize, length: u32) -> Result<Vec<u8>, AdsResult> {
-        let img = self.image()?;
-        let s = &img.symbols[i];
-        let n = s.size.min(length as usize);
-        if let Some(c) = &s.composite {
-            let mut out = Vec::with_capacity(n);
-            for &p in &c.parts {
-                let Some(left) = n.checked_sub(out.len()).filter(|&l| l > 0) else {
-                    break;
-                };
-                out.extend(self.read_symbol(p, u32::try_from(left).unwrap_or(u32::MAX))?);
-            }
-            return Ok(out);
-        }
-        if let Some(bytes) = self.techno_root(img.roles[s.root])? {
-            return bytes
-                .get(s.at..s.at + n)
-                .map(<[u8]>::to_vec)
-                .ok_or(AdsResult::INVALID_SIZE);
-        }
-        match img.roles[s.root] {
-            Role::ModeState(ch) => {
-                let st = self.backend.status(ch).map_err(AdsResult::from)?;
-                let mut mem = img.memory();
-                mem[s.root][0..4].copy_from_slice(&(st.mode as u32).to_le_bytes());
-                mem[s.root][4..8].copy_from_slice(&(st.state as u32).to_le_bytes());
-            }
-            Role::ErrorRecord(ch) | Role::ErrorSemaphore(ch) => self.post_error(img, ch)?,
-            _ => {}
-        }
-        let mem = img.memory();
-        Ok(mem[s.root][s.at..s.at + n].to_vec())
-    }
-
-    /// A technology root's bytes, encoded from the channel's status now; `None` for the
-    /// other roles.
-    fn techno_root(&self, role: Role) -> Result<Option<Vec<u8>>, AdsResult> {
-        let (ch, f): (u16, fn(&TechnoStatus) -> Vec<u8>) = match role {
-            Role::TechnoUnits(ch, UnitSet::Std) => (ch, |t| encode_units(&t.std, TECHNO_UNITS)),
-            Role::TechnoUnits(ch, UnitSet::Late) => {
-                (ch, |t| encode_units(&t.late, TECHNO_UNITS_LATE))
-            }
-            Role::TechnoUsed(ch, UnitSet::Std) => (ch, |t| t.used_std.to_le_bytes().to_vec()),
-            Role::TechnoUsed(ch, UnitSet::Late) => (ch, |t| t.used_late.to_le_bytes().to_vec()),
-            Role::PlcPresent(ch) => (ch, |t| vec![u8::from(t.plc_present)]),
-            _ => return Ok(None),
-        };
-        let st = self.backend.status(ch).map_err(AdsResult::from)?;
-        Ok(Some(f(&st.techno)))
     }
 
     /// A write into a technology symbol: one byte on a unit's `please_rw` or `done_w`, or
@@ -1057,7 +1100,7 @@ impl Hli {
         }
         img.memory()[areas.command_semaphore][0] = 0;
         // Shown at once when the PLC has taken the last record (else on its next read).
-        let _ = self.post_error(img, ch);
+        let _ = img.post_error(ch, &mut Live::new(self.backend.as_ref()));
     }
 
     /// A mode or state command of channel `ch` that the HMI gave through COM was refused by
@@ -1075,50 +1118,7 @@ impl Hli {
                 _ => return,
             }
         }
-        let _ = self.post_error(img, ch);
-    }
-
-    /// Post the channel's next error into `mc_error.satz_r` when the semaphore is FALSE.
-    fn post_error(&self, img: &Image, ch: u16) -> Result<(), AdsResult> {
-        let areas = img.areas(ch)?;
-        if img.memory()[areas.error_semaphore][0] != 0 {
-            return Ok(());
-        }
-        let i = usize::from(ch) - 1;
-        let refusal = img.refused.lock().unwrap_or_else(|p| p.into_inner())[i].pop_front();
-        if let Some(code) = refusal {
-            let tick = self.backend.status(ch).map_err(AdsResult::from)?.tick;
-            let mut mem = img.memory();
-            mem[areas.error_record].copy_from_slice(&error_record(code, ch, tick));
-            mem[areas.error_semaphore][0] = 1;
-            return Ok(());
-        }
-        let next = img.posted.lock().unwrap_or_else(|p| p.into_inner())[i];
-        let mut rec = self
-            .backend
-            .error_record(ch, next)
-            .map_err(AdsResult::from)?;
-        if next >= rec.total {
-            return Ok(());
-        }
-        let mut index = next;
-        if rec.error.is_none() {
-            // No longer kept: skip to the newest.
-            index = rec.total - 1;
-            rec = self
-                .backend
-                .error_record(ch, index)
-                .map_err(AdsResult::from)?;
-        }
-        let tick = self.backend.status(ch).map_err(AdsResult::from)?.tick;
-        let code = rec.error.as_ref().map_or(0, |(c, _)| *c);
-        let record = error_record(code, ch, tick);
-        let mut mem = img.memory();
-        mem[areas.error_record].copy_from_slice(&record);
-        mem[areas.error_semaphore][0] = 1;
-        drop(mem);
-        img.posted.lock().unwrap_or_else(|p| p.into_inner())[i] = index + 1;
-        Ok(())
+        let _ = img.post_error(ch, &mut Live::new(self.backend.as_ref()));
     }
 
     /// infosys 174725259: with `enable_w` TRUE "the PLC operates this command": an HMI's mode
@@ -1169,24 +1169,6 @@ impl Hli {
             }
         }
         Some(Ok(()))
-    }
-
-    /// Bytes `[at, at + size)` of a channel's mode-and-state unit (for the GEO mirror).
-    pub(crate) fn unit_bytes(
-        &self,
-        ch: u16,
-        unit: Unit,
-        at: usize,
-        size: usize,
-    ) -> Result<Vec<u8>, AdsResult> {
-        let img = self.image()?;
-        let a = img.areas(ch)?;
-        let root = a.unit_root(unit);
-        let mem = img.memory();
-        let area = &mem[root];
-        let mut out = area[at.min(area.len())..(at + size).min(area.len())].to_vec();
-        out.resize(size, 0);
-        Ok(out)
     }
 
     /// Write `data` at byte `at` of channel `ch`'s mode-and-state `unit` (the HLD's view of
@@ -1265,10 +1247,34 @@ impl Hli {
         }))
     }
 
+    /// The encoder of a symbol's value by handle (`offset`), read `length` bytes at a time:
+    /// what a Read by handle runs once and a notification evaluated in the cycle runs every
+    /// due tick (`machine::watch`). `Err` for the other groups (uploads, info, device data),
+    /// which are read whole.
+    pub(crate) fn encoder(
+        &self,
+        group: u32,
+        offset: u32,
+        length: u32,
+    ) -> Result<ObjectEncoder, AdsResult> {
+        if group != GROUP_VALUE_BY_HANDLE {
+            return Err(AdsResult::ACCESS_DENIED);
+        }
+        let i = self.symbol_by_handle(offset)?;
+        let img = Arc::clone(self.image()?);
+        Ok(Box::new(move |s: &mut dyn Source| {
+            img.read_symbol(i, length, s)
+        }))
+    }
+
     /// ADS Read on port 851.
     pub fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
         match group {
-            GROUP_VALUE_BY_HANDLE => self.read_symbol(self.symbol_by_handle(offset)?, length),
+            GROUP_VALUE_BY_HANDLE => self.image()?.read_symbol(
+                self.symbol_by_handle(offset)?,
+                length,
+                &mut Live::new(self.backend.as_ref()),
+            ),
             GROUP_SYMBOL_VERSION => symbols::symbol_version(length),
             GROUP_DEVICE_DATA => symbols::device_data(self.ads_state(), offset, length),
             GROUP_UPLOAD_INFO => symbols::fit(self.uploads()?.info.v1(), length),
@@ -1320,7 +1326,11 @@ impl Hli {
                 reply.truncate(read_length as usize);
                 Ok(reply)
             }
-            GROUP_VALUE_BY_NAME => self.read_symbol(self.symbol_by_name(data)?, read_length),
+            GROUP_VALUE_BY_NAME => self.image()?.read_symbol(
+                self.symbol_by_name(data)?,
+                read_length,
+                &mut Live::new(self.backend.as_ref()),
+            ),
             GROUP_INFO_BY_NAME => {
                 let i = self.symbol_by_name(data)?;
                 let entry = symbol_entry(&self.info(self.image()?, i));
@@ -1353,6 +1363,44 @@ impl Hli {
 /// 0xF003's reply: the handle; a client that asks for more (`jisotalo/ads-client`
 /// `createVariableHandle` asks for any length) also gets the symbol's size, the type
 /// decoration (0: no decoration), the type name's length (u16) and the type name with NUL.
+/// The encoder of symbol `i` of `img`, `length` bytes at a time.
+fn symbol_encoder(img: &Arc<Image>, i: usize, length: u32) -> ObjectEncoder {
+    let img = Arc::clone(img);
+    Box::new(move |s: &mut dyn Source| img.read_symbol(i, length, s))
+}
+
+/// `bench --load cycle --notify-on hli`: the encoders of `count` handles on the channels'
+/// `…mode_and_state.state_r` in turn (a live symbol: the tick's mode and state written into
+/// the image, then copied out), over one image of `channels` channels (their symbols only).
+pub(crate) fn bench_encoders(channels: usize, count: usize) -> Vec<ObjectEncoder> {
+    let img = Arc::new(Image::build(&vec![0; channels]));
+    (0..count)
+        .filter_map(|k| {
+            let name = format!(
+                "hli_global_variables.gpch[{}]^.channel_mc_control.mode_and_state.state_r",
+                k % channels.max(1)
+            );
+            let i = *img.by_name.get(&name)?;
+            Some(symbol_encoder(&img, i, 8))
+        })
+        .collect()
+}
+
+/// A technology root's bytes, encoded from the channel's status in `source`; `None` for the
+/// other roles.
+fn techno_root(role: Role, source: &mut dyn Source) -> Result<Option<Vec<u8>>, AdsResult> {
+    let (ch, f): (u16, fn(&TechnoStatus) -> Vec<u8>) = match role {
+        Role::TechnoUnits(ch, UnitSet::Std) => (ch, |t| encode_units(&t.std, TECHNO_UNITS)),
+        Role::TechnoUnits(ch, UnitSet::Late) => (ch, |t| encode_units(&t.late, TECHNO_UNITS_LATE)),
+        Role::TechnoUsed(ch, UnitSet::Std) => (ch, |t| t.used_std.to_le_bytes().to_vec()),
+        Role::TechnoUsed(ch, UnitSet::Late) => (ch, |t| t.used_late.to_le_bytes().to_vec()),
+        Role::PlcPresent(ch) => (ch, |t| vec![u8::from(t.plc_present)]),
+        _ => return Ok(None),
+    };
+    let st = source.status(ch).map_err(AdsResult::from)?;
+    Ok(Some(f(&st.techno)))
+}
+
 fn handle_reply(s: &Symbol, handle: u32) -> Vec<u8> {
     let ty = s.type_name();
     let mut out = Vec::with_capacity(15 + ty.len());

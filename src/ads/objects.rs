@@ -92,28 +92,45 @@ impl Devices {
     }
 
     /// Register `watch` (its encoder filled in here) to be evaluated in the cycle when
-    /// `(port, group, offset)` is an object encoded from one channel's status; false when it
-    /// is not, or the machine did not take it (the caller samples by reading then).
+    /// `(port, group, offset)` is one object of a table (a COM object, a GEO element, an SDA
+    /// variable handle, an HLI symbol handle), with the encoder a Read of it runs; false for
+    /// what is read whole (the description table, the uploads, the system service) or when
+    /// the machine did not take it: the caller samples by reading then.
     pub fn watch(
         &self,
         port: u16,
         group: u32,
         offset: u32,
         length: u32,
-        make: impl FnOnce(u32, crate::machine::watch::Encode) -> crate::machine::watch::Watch,
+        make: impl FnOnce(crate::machine::watch::Encode) -> crate::machine::watch::Watch,
     ) -> bool {
-        if port != com::PORT {
-            return false;
-        }
-        let b = self.backend.as_ref();
-        let Some((ch, encode)) = com::channel_encoder(b, group, offset, length) else {
+        let Some(encode) = self.encoder(port, group, offset, length) else {
             return false;
         };
-        let slot = crate::machine::watch::WatchSlot::new(make(u32::from(ch), encode));
+        let slot = crate::machine::watch::WatchSlot::new(make(super::backend::in_cycle(encode)));
         matches!(
-            b.call(ch, super::backend::Op::Watch(slot)),
+            self.backend.call(1, Op::Watch(slot)),
             Ok(super::backend::Reply::Done)
         )
+    }
+
+    /// The encoder a Read of `(port, group, offset)` runs, for the objects of a table.
+    fn encoder(
+        &self,
+        port: u16,
+        group: u32,
+        offset: u32,
+        length: u32,
+    ) -> Option<super::backend::ObjectEncoder> {
+        let b = self.backend.as_ref();
+        match port {
+            com::PORT => com::encoder(&mut super::backend::Live::new(b), group, offset, length),
+            geo::PORT => geo::encoder(b.channel_count(), &self.hli, group, offset, length),
+            sda::PORT => self.sda.encoder(group, offset, length),
+            hli::PORT => self.hli.encoder(group, offset, length),
+            _ => return None,
+        }
+        .ok()
     }
 
     /// Whether `port` is served (else the router answers AMS error 6).
@@ -349,15 +366,19 @@ pub fn markdown(objects: &[ObjectInfo]) -> String {
 /// A channel count and nothing else: what resolving a COM channel object needs.
 struct Channels(u16);
 
-impl CncBackend for Channels {
+impl super::backend::Source for Channels {
     fn channel_count(&self) -> u16 {
         self.0
     }
 
+    fn status(&mut self, _: u16) -> Result<&super::backend::Status, super::backend::DeviceError> {
+        Err(super::backend::DeviceError::NotReady)
+    }
+
     fn call(
-        &self,
+        &mut self,
         _: u16,
-        _: super::backend::Op,
+        _: Op,
     ) -> Result<super::backend::Reply, super::backend::DeviceError> {
         Err(super::backend::DeviceError::NotReady)
     }
@@ -370,11 +391,32 @@ pub(crate) fn bench_watch(
     ch: u16,
     samples: Arc<std::sync::atomic::AtomicU64>,
 ) -> Option<crate::machine::watch::Watch> {
-    use crate::machine::watch::{Delivery, Watch};
     let group = com::GROUP_CHANNEL + u32::from(ch);
-    let (channel, encode) = com::channel_encoder(&Channels(ch), group, offset::BLOCK_COUNTER, 8)?;
-    Some(Watch {
-        channel: u32::from(channel),
+    let encode = com::encoder(&mut Channels(ch), group, offset::BLOCK_COUNTER, 8).ok()?;
+    Some(bench_counting(super::backend::in_cycle(encode), samples))
+}
+
+/// `bench --load cycle --notifications N --notify-on hli`: `count` 1 ms on-change watches of
+/// the channels' HLI `…mode_and_state.state_r` in turn, with the symbol table's own encoder,
+/// counting their samples into `samples`.
+pub(crate) fn bench_hli_watches(
+    channels: u16,
+    count: usize,
+    samples: &Arc<std::sync::atomic::AtomicU64>,
+) -> Vec<crate::machine::watch::Watch> {
+    hli::bench_encoders(usize::from(channels), count)
+        .into_iter()
+        .map(|e| bench_counting(super::backend::in_cycle(e), Arc::clone(samples)))
+        .collect()
+}
+
+/// A 1 ms on-change watch with `encode`, counting its samples into `samples`.
+fn bench_counting(
+    encode: crate::machine::watch::Encode,
+    samples: Arc<std::sync::atomic::AtomicU64>,
+) -> crate::machine::watch::Watch {
+    use crate::machine::watch::{Delivery, Watch};
+    Watch {
         cycle: std::time::Duration::from_millis(1),
         on_change: true,
         encode,
@@ -384,5 +426,5 @@ pub(crate) fn bench_watch(
             Delivery::Sent
         }),
         alive: Arc::new(std::sync::atomic::AtomicBool::new(true)),
-    })
+    }
 }

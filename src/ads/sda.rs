@@ -21,7 +21,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::backend::{CncBackend, DeviceError};
+use super::backend::{CncBackend, DeviceError, Live, ObjectEncoder, Source, Status};
 use super::description::{Access, AdsType, ObjectInfo};
 use super::result::AdsResult;
 use crate::decoder::vars::ExternalValue;
@@ -254,40 +254,6 @@ impl Sda {
         Ok(HANDLE_BASE + i as u32)
     }
 
-    fn value(&self, ch: u16, var: &Var, read_length: u32) -> Result<Vec<u8>, AdsResult> {
-        let bytes = match var {
-            Var::External(name) => encode(
-                &self
-                    .backend
-                    .read_ve_typed(ch, name)
-                    .map_err(AdsResult::from)?,
-            ),
-            Var::ZeroOffset(i) => self.zero_offset(ch, *i)?,
-        };
-        if (read_length as usize) < bytes.len() {
-            return Err(AdsResult::INVALID_SIZE);
-        }
-        Ok(bytes)
-    }
-
-    /// `V.G.NP[i].V`: one DINT (0.1 µm, saturating) per configured axis of the channel, in
-    /// the channel's axis order.
-    fn zero_offset(&self, ch: u16, i: usize) -> Result<Vec<u8>, AdsResult> {
-        let v = self.backend.status(ch).map_err(AdsResult::from)?;
-        let table = match i.checked_sub(1) {
-            None => &[0.0; crate::vocab::axis::MAX_AXES],
-            Some(row) => v.zero_offsets.get(row).ok_or(AdsResult::NOT_FOUND)?,
-        };
-        Ok(v.positions
-            .iter()
-            .filter_map(|(letter, _)| u8::try_from(*letter).ok().and_then(slot_of))
-            .flat_map(|slot| {
-                let tenth_um = (table[slot] * TENTH_UM_PER_MM).round();
-                (tenth_um.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32).to_le_bytes()
-            })
-            .collect())
-    }
-
     /// Zero offsets are read only: the decoder takes its table from the parameter lists at
     /// the start and runs ahead of execution by the lookahead (docs/ads.md).
     fn store(&self, ch: u16, var: &Var, data: &[u8]) -> Result<(), AdsResult> {
@@ -331,11 +297,30 @@ impl Sda {
 
     /// ADS Read on port 552: a variable's value at its handle.
     pub fn read(&self, group: u32, offset: u32, length: u32) -> Result<Vec<u8>, AdsResult> {
+        self.encoder(group, offset, length)?(&mut self.live())
+    }
+
+    /// The encoder of the variable at handle `offset` of `group`, read `length` bytes at a
+    /// time: what a Read runs once and a notification evaluated in the cycle runs every due
+    /// tick (`machine::watch`). The handle is resolved here, once.
+    pub(crate) fn encoder(
+        &self,
+        group: u32,
+        offset: u32,
+        length: u32,
+    ) -> Result<ObjectEncoder, AdsResult> {
         let ch = self.channel(group)?;
         if offset < HANDLE_BASE {
             return Err(AdsResult::INVALID_OFFSET);
         }
-        self.value(ch, &self.name_of(offset)?, length)
+        let var = self.name_of(offset)?;
+        Ok(Box::new(move |s: &mut dyn Source| {
+            value(s, ch, &var, length)
+        }))
+    }
+
+    fn live(&self) -> Live<'_> {
+        Live::new(self.backend.as_ref())
     }
 
     /// ADS Write on port 552.
@@ -379,13 +364,47 @@ impl Sda {
             }
             READ_BY_HANDLE => {
                 let (handle, _) = Self::handle_head(data)?;
-                self.value(ch, &self.name_of(handle)?, read_length)
+                value(&mut self.live(), ch, &self.name_of(handle)?, read_length)
             }
-            READ_BY_NAME => self.value(ch, &var_name(data)?, read_length),
+            READ_BY_NAME => value(&mut self.live(), ch, &var_name(data)?, read_length),
             WRITE_BY_HANDLE | WRITE_BY_NAME => Err(AdsResult::ACCESS_DENIED),
             _ => Err(AdsResult::INVALID_OFFSET),
         }
     }
+}
+
+/// Variable `var` of channel `ch` read from `source`, at most `read_length` bytes asked for.
+fn value(
+    source: &mut dyn Source,
+    ch: u16,
+    var: &Var,
+    read_length: u32,
+) -> Result<Vec<u8>, AdsResult> {
+    let bytes = match var {
+        Var::External(name) => encode(&source.read_ve_typed(ch, name).map_err(AdsResult::from)?),
+        Var::ZeroOffset(i) => zero_offset(source.status(ch).map_err(AdsResult::from)?, *i)?,
+    };
+    if (read_length as usize) < bytes.len() {
+        return Err(AdsResult::INVALID_SIZE);
+    }
+    Ok(bytes)
+}
+
+/// `V.G.NP[i].V`: one DINT (0.1 µm, saturating) per configured axis of the channel, in
+/// the channel's axis order.
+fn zero_offset(v: &Status, i: usize) -> Result<Vec<u8>, AdsResult> {
+    let table = match i.checked_sub(1) {
+        None => &[0.0; crate::vocab::axis::MAX_AXES],
+        Some(row) => v.zero_offsets.get(row).ok_or(AdsResult::NOT_FOUND)?,
+    };
+    Ok(v.positions
+        .iter()
+        .filter_map(|(letter, _)| u8::try_from(*letter).ok().and_then(slot_of))
+        .flat_map(|slot| {
+            let tenth_um = (table[slot] * TENTH_UM_PER_MM).round();
+            (tenth_um.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32).to_le_bytes()
+        })
+        .collect())
 }
 
 #[cfg(test)]

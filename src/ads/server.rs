@@ -3,11 +3,13 @@
 //!
 //! One thread per connection answering its requests in order (at most `max_connections`,
 //! default 64; beyond that the connection quiet for longest gives its slot up, or the
-//! newcomer is closed: `slots.rs`), one reader thread per connection that stamps each
-//! request with its arrival ([`Inbox`]), one writer thread per connection draining its
+//! newcomer is closed: `slots.rs`) and reading them while it has nothing to answer, one
+//! helper thread per connection that reads the requests behind an answer that takes long,
+//! stamping each with its arrival ([`Inbox`]), one writer thread per connection draining its
 //! bounded send queue, plus one notification
-//! thread per connection that has notification handles on objects not evaluated in the
-//! cycle (COM channel and platform objects are: `machine::watch`). Channel calls may
+//! thread per connection that has notification handles on what is not evaluated in the
+//! cycle (every object of the COM, GEO, SDA and HLI tables is, `machine::watch`; the
+//! description table, the uploads and the system service are read whole). Channel calls may
 //! block for up to a runtime tick; that only holds up the connection that asked. The limits
 //! that keep a hostile or careless client from hurting the others or the cycle are explained
 //! in docs/ads-limits.md. Compatibility rules are in docs/ads-wire.md; each is marked `rule n` below.
@@ -694,89 +696,276 @@ fn serve_connection(stream: TcpStream, conn: &Conn, shared: &Arc<Shared>) -> Res
     result
 }
 
-/// Frames read from one connection and not yet answered, each with the instant the read that
-/// completed it returned. The connection's reader thread keeps reading while a request waits
-/// for the runtime, so a request's reply deadline counts from its own arrival, not from the
-/// answer to the one before it (a client with 50 requests in flight through a runtime stall
-/// hears "busy" for each within `reply_timeout` of sending it). Bounded in bytes like the
-/// [`Outbox`]: past the limit the reader stops reading and TCP holds the client back.
+/// Frames read from one connection and not yet answered, each stamped with the instant the
+/// read that completed it returned, and the socket's read side, which whoever holds it reads.
+/// The answering thread reads the socket itself whenever it has nothing to answer, so a
+/// client that waits for each answer costs no hand-over between threads. A helper thread
+/// takes the reading over only while one answer has taken longer than [`HELP_AFTER`] (a
+/// runtime call waiting on a stalled tick): requests pipelined behind it are read and stamped
+/// then, so each one's reply deadline counts from its own arrival (at most [`HELP_AFTER`]
+/// late), not from the answer to the one before it (a client with 50 requests in flight
+/// through a runtime stall hears "busy" for each within `reply_timeout` of sending it).
+/// Bounded in bytes like the [`Outbox`]: past the limit the helper stops reading and TCP
+/// holds the client back.
 struct Inbox {
     state: Mutex<InboxState>,
     ready: Condvar,
+    read: Mutex<ReadSide>,
     limit_bytes: usize,
 }
+
+/// How long an answer may take before the helper thread reads the requests behind it.
+const HELP_AFTER: Duration = Duration::from_millis(5);
 
 #[derive(Default)]
 struct InboxState {
     frames: VecDeque<(Instant, Frame, usize)>,
     /// Bytes of the frames in `frames`.
     bytes: usize,
-    /// A frame has been taken and its answer is not written yet.
-    serving: bool,
-    /// The reader is done, and why (`Ok` for the client's or the server's clean close).
+    /// When the answering thread took the frame it is answering; `None` while it waits for
+    /// one or reads.
+    serving_since: Option<Instant>,
+    /// The helper holds (or is about to take) the read side.
+    helper_reading: bool,
+    /// The helper waits without a deadline (nothing was being answered): the answering
+    /// thread wakes it when it takes a frame, so it can time that answer.
+    helper_parked: bool,
+    /// The reading is done, and why (`Ok` for the client's or the server's clean close);
+    /// taken by the answering thread once every frame is answered.
     ended: Option<Result<(), ConnError>>,
-    /// The request loop is done: the reader stops.
+    /// No more reads: the reading ended or the answering side is gone.
     closed: bool,
 }
 
+/// The socket's read side and what it has read of a frame not yet complete.
+struct ReadSide {
+    stream: TcpStream,
+    buf: Vec<u8>,
+    last_frame: Instant,
+    read_at: Instant,
+}
+
+/// What one connection's reading needs of the rest of the server.
+#[derive(Clone, Copy)]
+struct ReadCtx<'a> {
+    shared: &'a Shared,
+    writer: &'a Writer,
+    notifs: &'a Notifications,
+}
+
 impl Inbox {
-    fn new(limit_bytes: usize) -> Self {
+    fn new(stream: TcpStream, limit_bytes: usize) -> Self {
+        let now = Instant::now();
         Inbox {
             state: Mutex::new(InboxState::default()),
             ready: Condvar::new(),
+            read: Mutex::new(ReadSide {
+                stream,
+                buf: Vec::with_capacity(8192),
+                last_frame: now,
+                read_at: now,
+            }),
             limit_bytes,
         }
     }
 
-    /// Queue a frame of `len` bytes, waiting while the inbox is full; `false` once the request
-    /// loop is gone.
-    fn push(&self, arrived: Instant, frame: Frame, len: usize) -> bool {
-        let mut st = lock(&self.state);
-        while !st.closed && !st.frames.is_empty() && st.bytes + len > self.limit_bytes {
-            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+    fn state(&self) -> MutexGuard<'_, InboxState> {
+        lock(&self.state)
+    }
+
+    fn wait<'g>(&self, g: MutexGuard<'g, InboxState>) -> MutexGuard<'g, InboxState> {
+        self.ready.wait(g).unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The next frame and its arrival, read by this (the answering) thread when none is
+    /// waiting and the helper is not reading; or why the reading ended once every frame is
+    /// answered.
+    fn next(&self, ctx: ReadCtx<'_>) -> Result<(Instant, Frame), ConnError> {
+        loop {
+            {
+                let mut st = self.state();
+                st.serving_since = None;
+                loop {
+                    if let Some((arrived, frame, len)) = st.frames.pop_front() {
+                        st.bytes -= len;
+                        st.serving_since = Some(Instant::now());
+                        if st.helper_reading || st.helper_parked {
+                            // It may wait for room, or time this answer.
+                            st.helper_parked = false;
+                            self.ready.notify_all();
+                        }
+                        return Ok((arrived, frame));
+                    }
+                    if let Some(end) = st.ended.take() {
+                        // Ended for good: the next call says so again.
+                        st.ended = Some(Ok(()));
+                        return end.and(Err(ConnError::Ended));
+                    }
+                    if !st.helper_reading {
+                        break;
+                    }
+                    st = self.wait(st);
+                }
+            }
+            // The helper never holds the read side without `helper_reading`, so it is free.
+            let mut rs = lock(&self.read);
+            self.read_once(&mut rs, ctx, false);
+        }
+    }
+
+    /// The helper thread: read while an answer has taken longer than [`HELP_AFTER`], until
+    /// the reading ends.
+    fn help(&self, ctx: ReadCtx<'_>) {
+        loop {
+            {
+                let mut st = self.state();
+                loop {
+                    if st.closed {
+                        return;
+                    }
+                    match st.serving_since.map(|t| t.elapsed()) {
+                        Some(d) if d >= HELP_AFTER => break,
+                        Some(d) => {
+                            st = self
+                                .ready
+                                .wait_timeout(st, HELP_AFTER - d)
+                                .unwrap_or_else(|p| p.into_inner())
+                                .0
+                        }
+                        None => {
+                            st.helper_parked = true;
+                            st = self.wait(st);
+                        }
+                    }
+                }
+                st.helper_reading = true;
+            }
+            {
+                let mut rs = lock(&self.read);
+                self.read_once(&mut rs, ctx, true);
+            }
+            self.state().helper_reading = false;
+            self.ready.notify_all();
+        }
+    }
+
+    /// Read once (at most the socket's read timeout) and queue every frame completed; on
+    /// the end of the reading, record why. `helper`: frames are queued for the answering
+    /// thread (woken, and waited for while the inbox is full); else the caller is it.
+    fn read_once(&self, rs: &mut ReadSide, ctx: ReadCtx<'_>, helper: bool) {
+        if self.state().closed {
+            return;
+        }
+        if let Err(why) = self.read_frames(rs, ctx, helper) {
+            let mut st = self.state();
+            st.closed = true;
+            st.ended.get_or_insert(Err(why));
+            drop(st);
+            self.ready.notify_all();
+        }
+    }
+
+    /// Cut every complete frame out of the buffer (rule 1) into the queue, then read one
+    /// chunk; `Err` when the client closes, sends a malformed frame, stays idle, or the
+    /// answering side is gone (`Ok` end). The decoder rejects a hostile length before we
+    /// would ever wait for its bytes, so `buf` stays below max_frame_bytes + 6 + one chunk.
+    fn read_frames(
+        &self,
+        rs: &mut ReadSide,
+        ctx: ReadCtx<'_>,
+        helper: bool,
+    ) -> Result<(), ConnError> {
+        let (shared, writer) = (ctx.shared, ctx.writer);
+        let max = shared.config.max_frame_bytes;
+        let mut used = 0;
+        while let Some((frame, n)) = frame::decode(&rs.buf[used..], max)? {
+            used += n;
+            rs.last_frame = Instant::now();
+            if !self.push(rs.read_at, frame, n, helper) {
+                return Err(ConnError::Ended);
+            }
+        }
+        rs.buf.drain(..used);
+        if used > 0 && !helper {
+            // Frames to answer first: read more once they are answered.
+            return Ok(());
+        }
+        if let Some(c) = writer.closed() {
+            return Err(closed_error(c, writer.limit_bytes).into());
+        }
+        let mut chunk = [0u8; 8192];
+        let n = match rs.stream.read(&mut chunk) {
+            // The writer shut the socket (write stall): say why, not just "closed".
+            Ok(0) => {
+                return match writer.closed() {
+                    Some(c) if c != Closed::Done => Err(closed_error(c, writer.limit_bytes).into()),
+                    _ => Err(ConnError::Ended),
+                }
+            }
+            Ok(n) => n,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => return Ok(()),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
+                ) =>
+            {
+                if !self.busy() {
+                    check_idle(rs.last_frame, &rs.buf, shared, ctx.notifs)?;
+                }
+                return Ok(());
+            }
+            Err(_) if shared.stopping.load(Ordering::SeqCst) => return Err(ConnError::Ended),
+            Err(e) => {
+                return Err(match writer.closed() {
+                    Some(c) if c != Closed::Done => closed_error(c, writer.limit_bytes),
+                    _ => e,
+                }
+                .into())
+            }
+        };
+        rs.read_at = Instant::now();
+        rs.buf.extend_from_slice(&chunk[..n]);
+        let mut used = 0;
+        while let Some((frame, n)) = frame::decode(&rs.buf[used..], max)? {
+            used += n;
+            rs.last_frame = Instant::now();
+            if !self.push(rs.read_at, frame, n, helper) {
+                return Err(ConnError::Ended);
+            }
+        }
+        rs.buf.drain(..used);
+        Ok(())
+    }
+
+    /// Queue a frame of `len` bytes; the helper waits while the inbox is full (the answering
+    /// thread only reads when it is empty). `false` once the answering side is gone.
+    fn push(&self, arrived: Instant, frame: Frame, len: usize, helper: bool) -> bool {
+        let mut st = self.state();
+        while helper && !st.closed && !st.frames.is_empty() && st.bytes + len > self.limit_bytes {
+            st = self.wait(st);
         }
         if st.closed {
             return false;
         }
         st.bytes += len;
         st.frames.push_back((arrived, frame, len));
-        self.ready.notify_all();
-        true
-    }
-
-    /// The next frame and its arrival, or why the reader ended once every frame is taken.
-    fn pop(&self) -> Result<(Instant, Frame), ConnError> {
-        let mut st = lock(&self.state);
-        st.serving = false;
-        loop {
-            if let Some((arrived, frame, len)) = st.frames.pop_front() {
-                st.bytes -= len;
-                st.serving = true;
-                self.ready.notify_all();
-                return Ok((arrived, frame));
-            }
-            if let Some(end) = st.ended.take() {
-                // Ended for good: the next pop says so again.
-                st.ended = Some(Ok(()));
-                return end.and(Err(ConnError::Ended));
-            }
-            st = self.ready.wait(st).unwrap_or_else(|p| p.into_inner());
+        drop(st);
+        if helper {
+            self.ready.notify_all();
         }
+        true
     }
 
     /// Frames wait or one is being answered: the client is not idle.
     fn busy(&self) -> bool {
-        let st = lock(&self.state);
-        st.serving || !st.frames.is_empty()
+        let st = self.state();
+        st.serving_since.is_some() || !st.frames.is_empty()
     }
 
-    fn end(&self, why: Result<(), ConnError>) {
-        lock(&self.state).ended.get_or_insert(why);
-        self.ready.notify_all();
-    }
-
+    /// The answering side is gone: the helper stops.
     fn close(&self) {
-        lock(&self.state).closed = true;
+        self.state().closed = true;
         self.ready.notify_all();
     }
 }
@@ -784,7 +973,8 @@ impl Inbox {
 /// Bytes of frames one connection may have read ahead of its answers ([`Inbox`]).
 const MAX_INBOX_BYTES: usize = 256 * 1024;
 
-/// Answer the frames the reader thread queues, in order, until the connection ends.
+/// Answer the frames of the connection in order until it ends; a helper thread reads the
+/// requests behind an answer that takes long ([`Inbox`]).
 fn request_loop(
     stream: TcpStream,
     conn: &Conn,
@@ -793,24 +983,35 @@ fn request_loop(
     notifs: &Arc<Notifications>,
 ) -> Result<(), ConnError> {
     let inbox = Arc::new(Inbox::new(
+        stream.try_clone()?,
         MAX_INBOX_BYTES.max(shared.config.max_frame_bytes),
     ));
-    let reader = {
+    let helper = {
         let (s, w, n, i) = (
             Arc::clone(shared),
             Arc::clone(writer),
             Arc::clone(notifs),
             Arc::clone(&inbox),
         );
-        let read_half = stream.try_clone()?;
         std::thread::Builder::new()
             .name("ads-read".into())
-            .spawn(move || i.end(read_loop(read_half, &s, &w, &n, &i)))?
+            .spawn(move || {
+                i.help(ReadCtx {
+                    shared: &s,
+                    writer: &w,
+                    notifs: &n,
+                })
+            })?
     };
-    let result = answer_loop(conn, shared, writer, notifs, &inbox);
+    let ctx = ReadCtx {
+        shared,
+        writer,
+        notifs,
+    };
+    let result = answer_loop(conn, shared, writer, notifs, &inbox, ctx);
     inbox.close();
     let _ = stream.shutdown(Shutdown::Read);
-    let _ = reader.join();
+    let _ = helper.join();
     match result {
         Err(ConnError::Ended) => Ok(()),
         r => r,
@@ -823,12 +1024,13 @@ fn answer_loop(
     writer: &Writer,
     notifs: &Arc<Notifications>,
     inbox: &Inbox,
+    ctx: ReadCtx<'_>,
 ) -> Result<(), ConnError> {
     let (peer, ip_routed) = (conn.peer, conn.ip_routed);
     let mut logged_unrouted = LoggedNetIds::default();
     let mut logged_foreign = LoggedNetIds::default();
     loop {
-        let (arrived, frame) = inbox.pop()?;
+        let (arrived, frame) = inbox.next(ctx)?;
         match frame {
             Frame::Ams { header, data } => {
                 let routed = ip_routed || shared.routes.routes_net_id(header.source.net_id);
@@ -871,74 +1073,6 @@ fn answer_loop(
         if let Some(c) = writer.closed() {
             return Err(closed_error(c, writer.limit_bytes).into());
         }
-    }
-}
-
-/// Read frames into `inbox`, each stamped with the instant its last bytes were read, until
-/// the client closes, sends a malformed frame, stays idle, or the answering side is gone.
-fn read_loop(
-    mut stream: TcpStream,
-    shared: &Shared,
-    writer: &Writer,
-    notifs: &Notifications,
-    inbox: &Inbox,
-) -> Result<(), ConnError> {
-    let max = shared.config.max_frame_bytes;
-    let mut buf: Vec<u8> = Vec::with_capacity(8192);
-    let mut chunk = [0u8; 8192];
-    let mut last_frame = Instant::now();
-    let mut read_at = Instant::now();
-    loop {
-        // Cut every complete frame out of the buffer (rule 1) before reading more; the
-        // decoder rejects a hostile length before we would ever wait for its bytes, so `buf`
-        // stays below max_frame_bytes + 6 + one chunk.
-        let mut used = 0;
-        while let Some((frame, n)) = frame::decode(&buf[used..], max)? {
-            used += n;
-            last_frame = Instant::now();
-            if !inbox.push(read_at, frame, n) {
-                return Ok(());
-            }
-        }
-        buf.drain(..used);
-        if let Some(c) = writer.closed() {
-            return Err(closed_error(c, writer.limit_bytes).into());
-        }
-        let n = match stream.read(&mut chunk) {
-            // The writer shut the socket (write stall): say why, not just "closed".
-            Ok(0) => {
-                return match writer.closed() {
-                    Some(c) if c != Closed::Done => Err(closed_error(c, writer.limit_bytes).into()),
-                    _ => Ok(()),
-                }
-            }
-            Ok(n) => n,
-            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    io::ErrorKind::WouldBlock | io::ErrorKind::TimedOut
-                ) =>
-            {
-                if !inbox.busy() {
-                    check_idle(last_frame, &buf, shared, notifs)?;
-                }
-                continue;
-            }
-            Err(e) if shared.stopping.load(Ordering::SeqCst) => {
-                let _ = e;
-                return Ok(());
-            }
-            Err(e) => {
-                return Err(match writer.closed() {
-                    Some(c) if c != Closed::Done => closed_error(c, writer.limit_bytes),
-                    _ => e,
-                }
-                .into())
-            }
-        };
-        read_at = Instant::now();
-        buf.extend_from_slice(&chunk[..n]);
     }
 }
 
@@ -1375,20 +1509,17 @@ fn watch_in_cycle(
         }
     };
     let alive = Arc::clone(&state.alive);
-    let taken = shared.devices.watch(
-        device.port,
-        req.group,
-        req.offset,
-        req.length,
-        |channel, encode| Watch {
-            channel,
-            cycle,
-            on_change,
-            encode,
-            deliver: Box::new(deliver),
-            alive,
-        },
-    );
+    let taken = shared
+        .devices
+        .watch(device.port, req.group, req.offset, req.length, |encode| {
+            Watch {
+                cycle,
+                on_change,
+                encode,
+                deliver: Box::new(deliver),
+                alive,
+            }
+        });
     if !taken {
         state.alive.store(false, Ordering::Relaxed);
         return None;

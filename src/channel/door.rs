@@ -467,15 +467,48 @@ pub enum Delivery {
     Gone,
 }
 
-/// The object's bytes from its channel's status, `None` when it cannot be encoded now.
-pub type Encode = Box<dyn Fn(&Status) -> Option<Vec<u8>> + Send>;
+/// Why a channel request failed (the ADS server maps each to one ADS result code).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum DeviceError {
+    /// The channel cannot do that in its current mode/state (0x707).
+    #[error("device not ready")]
+    NotReady,
+    /// Try again shortly (0x708).
+    #[error("device busy")]
+    Busy,
+    /// The channel's mode and state do not allow the command: retrying cannot help until
+    /// something else changes them, e.g. a start while in ERROR or a mode change while ACTIVE
+    /// (0x707; the HLI posts the kernel's 270061 in `mc_error`).
+    #[error("not permitted in the channel's mode and state")]
+    Refused,
+    /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
+    #[error("invalid parameter value")]
+    InvalidValue,
+    /// A named thing does not exist, e.g. an unknown V.E. variable (0x70C).
+    #[error("not found")]
+    NotFound,
+}
+
+/// What an object's encoder reads: channels' status and the answers of read-only requests.
+/// A read through the runtime asks it now (`ads::backend::Live`); a watch evaluated in the
+/// cycle reads the tick being evaluated (`machine::watch`). Either way a channel's status is
+/// built at most once per encoding. `ch` is 1-based.
+pub trait Source {
+    /// Number of channels (`1..=channel_count()`).
+    fn channel_count(&self) -> u16;
+    /// Channel `ch`'s status.
+    fn status(&mut self, ch: u16) -> Result<&Status, DeviceError>;
+    /// Apply a read-only `op` to channel `ch` (an encoder never asks for a change).
+    fn call(&mut self, ch: u16, op: Op) -> Result<Reply, DeviceError>;
+}
+
+/// The object's bytes read from `source`, `None` when it cannot be encoded now.
+pub type Encode = Box<dyn Fn(&mut dyn Source) -> Option<Vec<u8>> + Send>;
 /// Where a sample goes.
 pub type Deliver = Box<dyn FnMut(&[u8]) -> Delivery + Send>;
 
 /// One notification handle as the cycle sees it.
 pub struct Watch {
-    /// 1-based channel whose status the object is encoded from.
-    pub channel: u32,
     /// Cyclic: a sample every `cycle`; on change: checked every `cycle`, sent when different.
     pub cycle: Duration,
     pub on_change: bool,

@@ -66,10 +66,15 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=crate::http::MAX_PAGE_CONNECTIONS as u64))]
     pub pages: u64,
     /// --load cycle: notification handles evaluated in the cycle while measured, 1 ms on
-    /// change on each channel's `ncc_blocks_executed_r` in turn (as the ADS server registers
+    /// change on each channel's object of --notify-on in turn (as the ADS server registers
     /// them, samples counted instead of sent).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=crate::machine::watch::MAX_WATCHES as u64))]
     pub notifications: u64,
+    /// --load cycle: what the --notifications handles watch: COM `ncc_blocks_executed_r`, or
+    /// the HLI symbol `…mode_and_state.state_r` (by handle, as pyads and ads-client subscribe
+    /// a symbol by name).
+    #[arg(long, value_enum, default_value_t = NotifyOn::Com)]
+    pub notify_on: NotifyOn,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -77,6 +82,15 @@ pub struct BenchArgs {
     /// FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+}
+
+/// What `--notifications` handles watch (`--notify-on`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum NotifyOn {
+    /// COM `ncc_blocks_executed_r` of each channel (changes as blocks execute).
+    Com,
+    /// HLI `…mode_and_state.state_r` of each channel (a symbol read live from the status).
+    Hli,
 }
 
 fn print_hist(out: &mut Stdout, name: &str, h: &Histogram) {
@@ -148,6 +162,40 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     }
 }
 
+/// `--notifications` handles on `--notify-on` objects of the channels in turn, counting their
+/// samples into `samples`.
+fn add_watches(
+    args: &BenchArgs,
+    cycle: &mut crate::soak::driver::SoakCycle,
+    samples: &Arc<AtomicU64>,
+) -> Result<(), String> {
+    let watches = match args.notify_on {
+        NotifyOn::Com => (0..args.notifications)
+            .filter_map(|k| {
+                let ch = (k % u64::from(args.channels)) as u16 + 1;
+                crate::ads::objects::bench_watch(ch, Arc::clone(samples))
+            })
+            .collect(),
+        NotifyOn::Hli => crate::ads::objects::bench_hli_watches(
+            args.channels as u16,
+            args.notifications as usize,
+            samples,
+        ),
+    };
+    if watches.len() as u64 != args.notifications {
+        return Err(format!("no encoder for {:?}", args.notify_on));
+    }
+    for w in watches {
+        if !cycle.machine_mut().watch(w) {
+            return Err(format!(
+                "more than {} notifications",
+                crate::machine::watch::MAX_WATCHES
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// `--load cycle`: the runtime with channels streaming in-process against a bare loop.
 fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let loader = crate::source::loader::Loader::start();
@@ -170,22 +218,13 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let mut bare = Histogram::new();
     let mut cycle = cycle;
     let samples = Arc::new(AtomicU64::new(0));
-    for k in 0..args.notifications {
-        let ch = (k % u64::from(args.channels)) as u16 + 1;
-        let Some(w) = crate::ads::objects::bench_watch(ch, Arc::clone(&samples)) else {
-            return usage("no encoder for ncc_blocks_executed_r".to_string());
-        };
-        if !cycle.machine_mut().watch(w) {
-            return usage(format!(
-                "more than {} notifications",
-                crate::machine::watch::MAX_WATCHES
-            ));
-        }
+    if let Err(msg) = add_watches(args, &mut cycle, &samples) {
+        return usage(msg);
     }
     if args.notifications > 0 {
         out.line(format_args!(
-            "notifications: {} handles, 1 ms on change, evaluated in the cycle",
-            args.notifications
+            "notifications: {} handles on {:?} objects, 1 ms on change, evaluated in the cycle",
+            args.notifications, args.notify_on
         ));
     }
     let (mut rt, _tx) = Runtime::new(cycle, period, Clock::RealTime);

@@ -95,6 +95,9 @@ fn server_config(args: &ServeArgs, config: &crate::params::Config) -> ServerConf
         max_notifications: ads.max_notifications_per_connection as usize,
         max_notifications_total: ads.max_notifications_total as usize,
         notification_samples_per_s: u64::from(ads.notification_samples_per_s),
+        notification_samples_per_s_per_connection: u64::from(
+            ads.notification_samples_per_s_per_connection,
+        ),
         idle_timeout: args
             .ads_idle_timeout
             .and_then(|s| Duration::try_from_secs_f64(s).ok())

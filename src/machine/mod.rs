@@ -279,12 +279,7 @@ impl Cycle for Machine {
             }
         }
         let mut watches = std::mem::take(&mut self.watches);
-        watches.evaluate(tick, self.channels.len(), |ch| {
-            match self.apply(tick, ch, Op::Status) {
-                Reply::Status(s) => Some(s),
-                _ => None,
-            }
-        });
+        watches.evaluate(tick, self.channels.len(), |ch, op| self.apply(tick, ch, op));
         self.watches = watches;
         self.publish();
         match self.stop_when {

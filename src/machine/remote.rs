@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 use crossbeam_channel::{RecvTimeoutError, Sender};
 
 use super::{Machine, Op, Reply, Request, Status};
+pub use crate::channel::door::{DeviceError, Source};
 use crate::channel::CommandError;
 use crate::runtime::{Clock, Runtime, StopHandle};
 
@@ -159,28 +160,6 @@ impl Drop for Ticking {
     }
 }
 
-/// Why a channel request failed (the ADS server maps each to one ADS result code).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum DeviceError {
-    /// The channel cannot do that in its current mode/state (0x707).
-    #[error("device not ready")]
-    NotReady,
-    /// Try again shortly (0x708).
-    #[error("device busy")]
-    Busy,
-    /// The channel's mode and state do not allow the command: retrying cannot help until
-    /// something else changes them, e.g. a start while in ERROR or a mode change while ACTIVE
-    /// (0x707; the HLI posts the kernel's 270061 in `mc_error`).
-    #[error("not permitted in the channel's mode and state")]
-    Refused,
-    /// The value is out of range or unknown, e.g. mode 9 or override 250 % (0x706).
-    #[error("invalid parameter value")]
-    InvalidValue,
-    /// A named thing does not exist, e.g. an unknown V.E. variable (0x70C).
-    #[error("not found")]
-    NotFound,
-}
-
 /// The remote handle of the channels, shared by the ADS object table and the web view.
 /// `ch` is 1-based.
 pub trait CncBackend: Send + Sync + 'static {
@@ -254,10 +233,7 @@ impl dyn CncBackend {
         ch: u16,
         name: &str,
     ) -> Result<crate::channel::ExternalValue, DeviceError> {
-        match self.call(ch, Op::ReadExternalTyped(name.to_string()))? {
-            Reply::External(Some(v)) => Ok(v),
-            _ => Err(DeviceError::NotFound),
-        }
+        (&mut Live::new(self) as &mut dyn Source).read_ve_typed(ch, name)
     }
 
     /// Write a string into `V.E.<name>`.
@@ -270,6 +246,27 @@ impl dyn CncBackend {
 
     /// The `index`-th error the channel raised (0 = first), if still kept.
     pub(crate) fn error_record(&self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
+        (&mut Live::new(self) as &mut dyn Source).error_record(ch, index)
+    }
+}
+
+/// The read-only requests an encoder makes, translated once for every [`Source`].
+impl dyn Source + '_ {
+    /// Read `V.E.<name>` (given without the `V.E.` prefix) with its declared type (numbers)
+    /// or length (strings).
+    pub(crate) fn read_ve_typed(
+        &mut self,
+        ch: u16,
+        name: &str,
+    ) -> Result<crate::channel::ExternalValue, DeviceError> {
+        match self.call(ch, Op::ReadExternalTyped(name.to_string()))? {
+            Reply::External(Some(v)) => Ok(v),
+            _ => Err(DeviceError::NotFound),
+        }
+    }
+
+    /// The `index`-th error the channel raised (0 = first), if still kept.
+    pub(crate) fn error_record(&mut self, ch: u16, index: u64) -> Result<ErrorRecord, DeviceError> {
         match self.call(ch, Op::ErrorRecord(index))? {
             Reply::ErrorRecord { total, record } => Ok(ErrorRecord {
                 total,
@@ -277,5 +274,48 @@ impl dyn CncBackend {
             }),
             _ => Err(DeviceError::NotReady),
         }
+    }
+}
+
+/// The runtime asked now as an encoder's [`Source`] (an ADS Read, the notifier thread): each
+/// channel's status asked at most once per encoding.
+pub struct Live<'b> {
+    backend: &'b dyn CncBackend,
+    statuses: Vec<Option<Box<Status>>>,
+}
+
+impl<'b> Live<'b> {
+    pub fn new(backend: &'b dyn CncBackend) -> Self {
+        Live {
+            backend,
+            statuses: Vec::new(),
+        }
+    }
+}
+
+impl Source for Live<'_> {
+    fn channel_count(&self) -> u16 {
+        self.backend.channel_count()
+    }
+
+    fn status(&mut self, ch: u16) -> Result<&Status, DeviceError> {
+        let i = usize::from(ch)
+            .checked_sub(1)
+            .filter(|&i| i < usize::from(self.backend.channel_count()))
+            .ok_or(DeviceError::NotFound)?;
+        if self.statuses.len() <= i {
+            self.statuses.resize_with(i + 1, || None);
+        }
+        if self.statuses[i].is_none() {
+            match self.backend.call(ch, Op::Status)? {
+                Reply::Status(s) => self.statuses[i] = Some(s),
+                _ => return Err(DeviceError::NotReady),
+            }
+        }
+        self.statuses[i].as_deref().ok_or(DeviceError::NotReady)
+    }
+
+    fn call(&mut self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
+        self.backend.call(ch, op)
     }
 }

@@ -1,5 +1,6 @@
 //! Notification watches evaluated in the cycle: after every tick the machine encodes each
-//! active watch's object from the channel's status of that tick, compares it with the bytes
+//! active watch's object with its table's encoder, reading the tick itself as the encoder's
+//! [`Source`] (each channel's status built once per tick), compares it with the bytes
 //! it last delivered (on change) or checks its cycle (cyclic), and hands a sample to the
 //! watch's sink, which queues it on the owning connection's bounded send queue and never
 //! waits. TwinCAT checks notification handles in the task cycle (Beckhoff InfoSys, ADS
@@ -14,8 +15,8 @@
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
-use super::Status;
-pub use crate::channel::door::{Deliver, Delivery, Encode, Watch, WatchSlot};
+use super::{Op, Reply, Status};
+pub use crate::channel::door::{Deliver, Delivery, DeviceError, Encode, Source, Watch, WatchSlot};
 use crate::runtime::Tick;
 
 /// Watches the machine evaluates at most; one more is refused (the ADS server's 1024
@@ -54,13 +55,13 @@ impl Watches {
         true
     }
 
-    /// Evaluate every watch due at `tick`; `status` gives channel `ch`'s status of this tick
-    /// (asked at most once per channel per tick).
+    /// Evaluate every watch due at `tick`; `apply` answers a read-only request of channel
+    /// `ch` in this tick (a status is asked at most once per channel per tick).
     pub(crate) fn evaluate(
         &mut self,
         tick: &Tick,
         channels: usize,
-        mut status: impl FnMut(u32) -> Option<Box<Status>>,
+        mut apply: impl FnMut(u32, Op) -> Reply,
     ) {
         if self.list.is_empty() {
             return;
@@ -68,7 +69,10 @@ impl Watches {
         self.statuses.clear();
         self.statuses.resize_with(channels, || None);
         let period_ns = tick.period.as_nanos().max(1);
-        let statuses = &mut self.statuses;
+        let mut source = InTick {
+            statuses: &mut self.statuses,
+            apply: &mut apply,
+        };
         self.list.retain_mut(|a| {
             if !a.w.alive.load(Ordering::Relaxed) {
                 return false;
@@ -76,16 +80,7 @@ impl Watches {
             if tick.index < a.next_tick {
                 return true;
             }
-            let Some(slot) = (a.w.channel as usize)
-                .checked_sub(1)
-                .and_then(|i| statuses.get_mut(i))
-            else {
-                return false;
-            };
-            if slot.is_none() {
-                *slot = status(a.w.channel);
-            }
-            let Some(bytes) = slot.as_deref().and_then(|s| (a.w.encode)(s)) else {
+            let Some(bytes) = (a.w.encode)(&mut source) else {
                 return true;
             };
             let changed = a.last.as_deref() != Some(bytes.as_slice());
@@ -103,6 +98,40 @@ impl Watches {
                 Delivery::Gone => false,
             }
         });
+    }
+}
+
+/// The tick being evaluated as an encoder's [`Source`]: each channel's status built once,
+/// other read-only requests answered at once.
+struct InTick<'a, F> {
+    statuses: &'a mut [Option<Box<Status>>],
+    apply: &'a mut F,
+}
+
+impl<F: FnMut(u32, Op) -> Reply> Source for InTick<'_, F> {
+    fn channel_count(&self) -> u16 {
+        u16::try_from(self.statuses.len()).unwrap_or(u16::MAX)
+    }
+
+    fn status(&mut self, ch: u16) -> Result<&Status, DeviceError> {
+        let slot = usize::from(ch)
+            .checked_sub(1)
+            .and_then(|i| self.statuses.get_mut(i))
+            .ok_or(DeviceError::NotFound)?;
+        if slot.is_none() {
+            match (self.apply)(u32::from(ch), Op::Status) {
+                Reply::Status(s) => *slot = Some(s),
+                _ => return Err(DeviceError::NotReady),
+            }
+        }
+        slot.as_deref().ok_or(DeviceError::NotReady)
+    }
+
+    fn call(&mut self, ch: u16, op: Op) -> Result<Reply, DeviceError> {
+        match (self.apply)(u32::from(ch), op) {
+            Reply::NoChannel => Err(DeviceError::NotFound),
+            r => Ok(r),
+        }
     }
 }
 

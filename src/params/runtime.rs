@@ -231,9 +231,12 @@ pub struct AdsConfig {
     pub(crate) max_notifications_per_connection: u32,
     /// Notification handles, all connections together (default 1024).
     pub(crate) max_notifications_total: u32,
-    /// Notification samples per second, all connections together (default 40000; one
-    /// connection is held to `vocab::ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION`).
+    /// Notification samples per second, all connections together (default 40000); at least
+    /// `notification_samples_per_s_per_connection`.
     pub(crate) notification_samples_per_s: u32,
+    /// Notification samples per second of one connection (default 10000, ten 1 ms handles);
+    /// a handle beyond it is refused 0x716 to that connection only.
+    pub(crate) notification_samples_per_s_per_connection: u32,
     /// Seconds without a whole frame after which a connection in the middle of a frame, or
     /// without notification handles, is closed (default 60).
     pub(crate) idle_timeout_s: u32,
@@ -263,6 +266,8 @@ impl Default for AdsConfig {
             max_notifications_per_connection: ams::DEFAULT_MAX_NOTIFICATIONS as u32,
             max_notifications_total: ams::DEFAULT_MAX_NOTIFICATIONS_TOTAL as u32,
             notification_samples_per_s: ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S as u32,
+            notification_samples_per_s_per_connection:
+                ams::DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION as u32,
             idle_timeout_s: ams::DEFAULT_IDLE_TIMEOUT.as_secs() as u32,
             reply_timeout_ms: ams::DEFAULT_REPLY_TIMEOUT.as_millis() as u32,
         }
@@ -751,12 +756,30 @@ fn validate_ads(cfg: &RuntimeConfig, fail: &mut impl FnMut(&str, Option<usize>, 
             cfg.ads.notification_samples_per_s,
             1_000_000,
         ),
+        (
+            "notification_samples_per_s_per_connection",
+            cfg.ads.notification_samples_per_s_per_connection,
+            1_000_000,
+        ),
         ("idle_timeout_s", cfg.ads.idle_timeout_s, 86_400),
         ("reply_timeout_ms", cfg.ads.reply_timeout_ms, 60_000),
     ] {
         if !(1..=max).contains(&v) {
             fail("ads", None, key, format!("{v} is not in 1 ... {max}"));
         }
+    }
+    // One connection's budget is part of the server's: a total below it could never be met.
+    let (per, total) = (
+        cfg.ads.notification_samples_per_s_per_connection,
+        cfg.ads.notification_samples_per_s,
+    );
+    if per > total {
+        fail(
+            "ads",
+            None,
+            "notification_samples_per_s_per_connection",
+            format!("{per} is above notification_samples_per_s ({total})"),
+        );
     }
 }
 
@@ -796,6 +819,30 @@ mod tests {
             errs[0].message
         );
         assert_eq!((errs[0].line, errs[0].col), (6, 1));
+    }
+
+    #[test]
+    fn notification_budgets_are_keys_and_one_connection_fits_in_the_total() {
+        let text = "[ads]\nnotification_samples_per_s = 20000\nnotification_samples_per_s_per_connection = 5000\n";
+        let cfg = parse_runtime(Path::new("r.toml"), text).unwrap();
+        assert_eq!(cfg.ads.notification_samples_per_s, 20_000);
+        assert_eq!(cfg.ads.notification_samples_per_s_per_connection, 5_000);
+        let text = "[ads]\nnotification_samples_per_s = 20000\nnotification_samples_per_s_per_connection = 20001\n";
+        let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
+        assert_eq!(errs.len(), 1, "{errs:?}");
+        assert!(
+            errs[0].message.starts_with(
+                "ads.notification_samples_per_s_per_connection: 20001 is above notification_samples_per_s (20000)"
+            ),
+            "{}",
+            errs[0].message
+        );
+        let text = "[ads]\nnotification_samples_per_s_per_connection = 0\n";
+        let errs = parse_runtime(Path::new("r.toml"), text).unwrap_err();
+        assert!(
+            errs[0].message.contains("0 is not in 1 ... 1000000"),
+            "{errs:?}"
+        );
     }
 
     #[test]

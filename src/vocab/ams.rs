@@ -26,9 +26,8 @@ pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION: u64 = 10_000;
 /// Default budget of notification samples per second over the whole server: four connections
 /// at their whole budget, so one client never holds more than a quarter of it (ten HMIs that
 /// each hold an ADS-state and a symbol-version handle at 1 ms, 2 000/s each, fit beside a
-/// tool with ten 1 ms handles). Each sample is a read served by the runtime; 40 000/s is 40
-/// reads a tick at 1 ms, inside `runtime::MAX_REQUESTS_PER_TICK`, so notifications can never
-/// cost the cycle its period.
+/// tool with ten 1 ms handles). runtime.toml `ads.notification_samples_per_s` and
+/// `ads.notification_samples_per_s_per_connection` set both.
 pub const DEFAULT_NOTIFICATION_SAMPLES_PER_S: u64 =
     4 * DEFAULT_NOTIFICATION_SAMPLES_PER_S_PER_CONNECTION;
 /// Default idle timeout (`ads::server::ServerConfig::idle_timeout`).

@@ -690,6 +690,52 @@ fn frames_from_thousands_of_unrouted_net_ids_are_dropped_with_a_bounded_log() {
 }
 
 #[test]
+fn the_notification_budgets_are_runtime_toml_keys() {
+    // Two 1 ms handles a connection, four over the server.
+    let rig = common::Rig::with_runtime(
+        "[ads]\nnotification_samples_per_s_per_connection = 2000\nnotification_samples_per_s = 4000\n",
+    );
+    let srv = Serve::start_with(&rig.startup(), &[]);
+    let add = add_notification_payload(10_000); // 1 ms
+    let results = |c: &mut Conn, n: usize| -> Vec<u32> {
+        (0..n)
+            .map(|_| {
+                let d = c
+                    .call(CommandId::AddDeviceNotification, &add)
+                    .expect("answered");
+                u32_at(&d, 0)
+            })
+            .collect()
+    };
+    let (mut first, mut second, mut third) = (srv.connect(), srv.connect(), srv.connect());
+    assert_eq!(results(&mut first, 3), [0, 0, 0x716], "two a connection");
+    assert_eq!(results(&mut second, 3), [0, 0, 0x716], "two a connection");
+    assert_eq!(results(&mut third, 1), [0x716], "four over the server");
+
+    // A connection's budget above the server's is refused when the file is read.
+    let rig =
+        common::Rig::with_runtime("[ads]\nnotification_samples_per_s_per_connection = 50000\n");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_ncchannel"))
+        .args([
+            "serve",
+            "--bind",
+            "127.0.0.1:0",
+            "--seconds",
+            "1",
+            "--params",
+        ])
+        .arg(rig.startup())
+        .output()
+        .expect("serve runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("ads.notification_samples_per_s_per_connection: 50000 is above notification_samples_per_s (40000)"),
+        "{err}"
+    );
+}
+
+#[test]
 fn a_client_that_never_reads_its_notifications_is_dropped() {
     let srv = Serve::start(&[]);
     let rss = srv.rss_kib();

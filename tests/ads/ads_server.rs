@@ -844,6 +844,19 @@ impl ncchannel::runtime::Cycle for StallWhenAsked {
 
 #[test]
 fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_reply_timeout() {
+    requests_in_flight_through_a_stall(false);
+}
+
+/// The same, with the 49 behind the first sent while it already waits on the stalled runtime:
+/// they are read (and stamped) while it waits, not when it is answered.
+#[test]
+fn requests_sent_behind_one_waiting_on_a_stall_are_stamped_as_they_arrive() {
+    requests_in_flight_through_a_stall(true);
+}
+
+/// 50 stream writes in flight through a 4 s stall; `first_alone`: the first is sent 20 ms
+/// before the other 49.
+fn requests_in_flight_through_a_stall(first_alone: bool) {
     use ncchannel::machine::{Machine, StopWhen};
     use ncchannel::report::event::EventLog;
     use ncchannel::runtime::{Clock, Runtime};
@@ -864,8 +877,15 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
     let (mut rt, tx) = Runtime::new(cycle, period, Clock::RealTime);
     let stop = rt.stop_handle();
     let runtime = std::thread::spawn(move || rt.run(None));
-    // As `serve` builds it: the default reply timeout (500 ms).
+    // As `serve` builds it: the default reply timeout (500 ms); 1 s when the first is sent
+    // alone, so an answer counted from when the first was answered (about 2 s) stands apart
+    // from one counted from its own arrival (about 1 s).
     let backend = ncchannel::machine::remote::ChannelBackend::new(tx, 1);
+    let backend = if first_alone {
+        backend.with_reply_timeout(Duration::from_secs(1))
+    } else {
+        backend
+    };
     let srv = ncchannel::ads::spawn(
         ServerConfig {
             bind: "127.0.0.1:0".parse().unwrap(),
@@ -895,7 +915,14 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
         .flat_map(|i| request_bytes(WRITE, device(), client_addr(40000), 100 + i, &write))
         .collect();
     let sent = Instant::now();
-    raw.send(&burst);
+    if first_alone {
+        let first = request_bytes(WRITE, device(), client_addr(40000), 100, &write).len();
+        raw.send(&burst[..first]);
+        std::thread::sleep(Duration::from_millis(20));
+        raw.send(&burst[first..]);
+    } else {
+        raw.send(&burst);
+    }
     let mut answers = Vec::new();
     while answers.len() < n as usize {
         let (h, d) = raw.frame();
@@ -910,11 +937,10 @@ fn fifty_requests_in_flight_through_a_stall_are_each_answered_busy_within_the_re
         "every write in the stall answered busy: {answers:?}"
     );
     // Each within the reply timeout of its arrival (500 ms) plus scheduling slack, far below
-    // ads-client's 2000 ms; one after another 50 ms apart the last took 2950 ms.
-    assert!(
-        slowest < Duration::from_millis(1500),
-        "slowest answer {slowest:?}: {answers:?}"
-    );
+    // ads-client's 2000 ms; one after another 50 ms apart the last took 2950 ms. Sent behind
+    // the first (1 s timeout): about 1.05 s; read only once the first is answered, 2 s.
+    let bound = Duration::from_millis(if first_alone { 1600 } else { 1500 });
+    assert!(slowest < bound, "slowest answer {slowest:?}: {answers:?}");
     let ids: std::collections::BTreeSet<u32> = answers.iter().map(|a| a.0).collect();
     assert_eq!(ids.len(), n as usize, "each request answered once");
 
@@ -986,4 +1012,125 @@ fn a_1_ms_notification_sees_every_tick_and_a_cyclic_one_samples_every_cycle() {
         "the 10 ms cyclic handle sampled every 10th tick: {:?}",
         steps(tens)
     );
+}
+
+/// GEO's position-controller tick counter (port 551, group 0x120300, element 0x07).
+const GEO_TICK_COUNTER: (u32, u32) = (0x12_0300, 0x07);
+
+/// Send `data` as `command` to `port` of the device and return the response's data.
+fn call_port(raw: &mut Raw, port: u16, command: u16, invoke: u32, data: &[u8]) -> Vec<u8> {
+    let target = AmsAddr { port, ..device() };
+    raw.send(&request_bytes(
+        command,
+        target,
+        client_addr(40000),
+        invoke,
+        data,
+    ));
+    loop {
+        let (h, d) = raw.frame();
+        if h.invoke_id == invoke && h.command.to_u16() == command {
+            return d;
+        }
+    }
+}
+
+#[test]
+fn notifications_on_geo_hli_and_sda_objects_are_evaluated_in_the_cycle() {
+    let (srv, _b) = server();
+    let mut raw = Raw::connect(srv.local_addr());
+    // An HLI symbol by handle (port 851) and an SDA zero offset by handle (port 552): cyclic
+    // every 1 ms. GEO's tick counter (port 551): on change every 1 ms.
+    let state_r = b"HLI_Global_Variables.gpCh[0]^.channel_mc_control.mode_and_state.state_r\0";
+    let d = call_port(
+        &mut raw,
+        851,
+        READ_WRITE,
+        1,
+        &request::read_write(0xF003, 0, 4, state_r),
+    );
+    assert_eq!(u32_at(&d, 0), 0, "handle of state_r");
+    let hli_handle = u32_at(&d, 8);
+    let d = call_port(
+        &mut raw,
+        552,
+        READ_WRITE,
+        2,
+        &request::read_write(0x12_2301, 0x46, 4, b"V.G.NP[1].V"),
+    );
+    assert_eq!(u32_at(&d, 0), 0, "handle of V.G.NP[1].V");
+    let sda_handle = u32_at(&d, 8);
+    let (geo, hli, sda) = (
+        u32_at(
+            &call_port(
+                &mut raw,
+                551,
+                ADD_NOTIFICATION,
+                3,
+                &request::add_notification(GEO_TICK_COUNTER.0, GEO_TICK_COUNTER.1, 4, 4, 0, 10_000),
+            ),
+            4,
+        ),
+        u32_at(
+            &call_port(
+                &mut raw,
+                851,
+                ADD_NOTIFICATION,
+                4,
+                &request::add_notification(0xF005, hli_handle, 8, 3, 0, 10_000),
+            ),
+            4,
+        ),
+        u32_at(
+            &call_port(
+                &mut raw,
+                552,
+                ADD_NOTIFICATION,
+                5,
+                &request::add_notification(0x12_2301, sda_handle, 12, 3, 0, 10_000),
+            ),
+            4,
+        ),
+    );
+    // Samples in the order they arrive: every due watch of a tick is evaluated in that tick,
+    // in the order the handles were added, and queued in order.
+    let mut order = Vec::new();
+    while order.iter().filter(|(h, _)| *h == geo).count() < 500 {
+        let (h, d) = raw.frame();
+        if h.command.to_u16() == 8 {
+            for s in payload::decode_notification(&d).unwrap() {
+                order.push((s.handle, s.data));
+            }
+        }
+    }
+    let ticks: Vec<u32> = order
+        .iter()
+        .filter(|(h, _)| *h == geo)
+        .map(|(_, d)| u32_at(d, 0))
+        .collect();
+    assert!(
+        ticks.windows(2).all(|w| w[1] == w[0] + 1),
+        "the 1 ms on-change GEO handle saw every tick: {ticks:?}"
+    );
+    // Once all three sample, each tick gives one sample of each, GEO's first.
+    let first_sda = order.iter().position(|(h, _)| *h == sda).unwrap();
+    let start = first_sda
+        + order[first_sda..]
+            .iter()
+            .position(|(h, _)| *h == geo)
+            .unwrap();
+    let settled: Vec<u32> = order[start..].iter().map(|(h, _)| *h).collect();
+    for tick in settled.chunks_exact(3) {
+        assert_eq!(
+            tick,
+            [geo, hli, sda],
+            "one sample of each per tick: {settled:?}"
+        );
+    }
+    let (hli_bytes, sda_bytes) = (
+        &order.iter().find(|(h, _)| *h == hli).unwrap().1,
+        &order.iter().find(|(h, _)| *h == sda).unwrap().1,
+    );
+    assert_eq!(hli_bytes.len(), 8, "state_r: mode and state");
+    assert_eq!(sda_bytes.len(), 12, "V.G.NP[1].V: one DINT per axis");
 }

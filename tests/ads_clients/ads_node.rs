@@ -111,3 +111,20 @@ fn node_ten_hmis_connect_beside_one_heavy_subscriber() {
         "the heavy client's eleventh 1 ms handle is refused to it"
     );
 }
+
+/// ads-client 1 ms subscriptions counted against the tick counter: an on-change one on COM's
+/// `cnc_tick_counter_r` and a cyclic one on GEO's tick counter each see 500 consecutive ticks.
+#[test]
+#[ignore = "needs Node and tests/node/node_modules: npm install --prefix tests/node"]
+fn node_1_ms_subscriptions_see_every_tick() {
+    let node = std::env::var("NCCHANNEL_NODE").unwrap_or_else(|_| "node".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/node/tick_notifications_test.js"
+    );
+    let (seen, _) = common::run_client(served, &node, script, &[]);
+    assert_eq!(seen["on_change"], serde_json::json!([500, 499]), "{seen}");
+    assert_eq!(seen["cyclic"], serde_json::json!([500, 499]), "{seen}");
+}

@@ -153,3 +153,20 @@ fn pyads_controls_the_ads_states_and_reaches_every_symbol_level() {
     assert_eq!(seen["plc_in_config"], 6);
     assert_eq!(seen["after_restart"], serde_json::json!([5, 5, 3]));
 }
+
+/// pyads 1 ms notifications counted against the tick counter: an on-change handle on COM's
+/// `cnc_tick_counter_r` and a cyclic one on GEO's tick counter each see 500 consecutive ticks.
+#[test]
+#[ignore = "needs Python with pyads: NCCHANNEL_PYTHON=… cargo test --test ads_clients -- --ignored ads_pyads"]
+fn pyads_1_ms_notifications_see_every_tick() {
+    let python = std::env::var("NCCHANNEL_PYTHON").unwrap_or_else(|_| "python3".into());
+    let rig = common::Rig::new();
+    let served = common::Served::start(&rig);
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/python/tick_notifications_with_pyads.py"
+    );
+    let (seen, _events) = common::run_client(served, &python, script, &[]);
+    assert_eq!(seen["on_change"], serde_json::json!([500, 499]), "{seen}");
+    assert_eq!(seen["cyclic"], serde_json::json!([500, 499]), "{seen}");
+}
