@@ -168,6 +168,11 @@ pub fn execute(args: BenchArgs) -> ExitCode {
             params: &params,
             scale: args.scale,
             max_ticks: args.max_ticks,
+            mode: args.rt.over(
+                &crate::params::load(&params)
+                    .map(|c| c.runtime.realtime)
+                    .unwrap_or_default(),
+            ),
         })
         .unwrap_or_else(usage),
     }
