@@ -287,9 +287,12 @@ fn stdout_outputs(args: &RunArgs) -> Vec<&'static str> {
     .collect()
 }
 
-/// The output options checked before the run: a picture format the extension names, and at
-/// most one output on standard output.
+/// The options checked before the run: the real-time mode's only with `--realtime`, a picture
+/// format the extension names, and at most one output on standard output.
 fn check_outputs(args: &RunArgs) -> Result<(), String> {
+    if args.rt.any() && !args.realtime {
+        return Err("the --rt-… options of the real-time mode need --realtime".into());
+    }
     if let Some(p) = &args.plot {
         crate::report::picture::Format::of(p).map_err(|e| format!("--plot {e}"))?;
     }
@@ -306,9 +309,6 @@ fn check_outputs(args: &RunArgs) -> Result<(), String> {
 pub fn execute(mut args: RunArgs) -> ExitCode {
     if let Err(msg) = check_outputs(&args).and_then(|()| locate_files(&mut args)) {
         return usage(msg);
-    }
-    if args.rt.any() && !args.realtime {
-        return usage("the --rt-… options of the real-time mode need --realtime");
     }
     let mut config = match load_config(&args.params) {
         Ok(c) => c,
@@ -366,14 +366,7 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
     if let Err(msg) = attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
         return usage(msg);
     }
-    // runtime.toml's `[realtime]` applies to real-time runs only: a virtual-time run at a
-    // real-time priority would hold its CPU for the whole run.
-    let mode = if args.realtime {
-        args.rt.over(&config.runtime.realtime)
-    } else {
-        crate::runtime::realtime::RealtimeConfig::default()
-    };
-    let (rt, summary) = match run_program(machine, &args, &program, period, &mode) {
+    let (rt, summary) = match run_program(machine, &args, &program, period, &config) {
         Ok(r) => r,
         Err(code) => return code,
     };
@@ -425,7 +418,7 @@ fn run_program(
     args: &RunArgs,
     program: &str,
     period: Duration,
-    mode: &crate::runtime::realtime::RealtimeConfig,
+    config: &crate::params::Config,
 ) -> Result<(Runtime<Machine>, Option<crate::runtime::RunSummary>), ExitCode> {
     let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
@@ -453,7 +446,12 @@ fn run_program(
     let summary = if start_failed {
         None
     } else {
-        super::enter_realtime(mode, "run", |m| eprintln!("{m}"))?;
+        // runtime.toml's `[realtime]` applies to real-time runs only: a virtual-time run at a
+        // real-time priority would hold its CPU for the whole run.
+        if args.realtime {
+            let mode = args.rt.over(&config.runtime.realtime);
+            super::enter_realtime(&mode, "run", |m| eprintln!("{m}"))?;
+        }
         Some(rt.run(args.max_ticks))
     };
     Ok((rt, summary))

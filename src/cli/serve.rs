@@ -322,7 +322,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     // Every other thread (ADS, web view, loader, logger, the limit's timer) runs by now: the
     // real-time mode keeps them off the runtime's CPU.
     let mode = args.rt.over(&config.runtime.realtime);
-    if let Err(code) = super::enter_realtime(&mode, "serve", |m| super::logger::line(m)) {
+    if let Err(code) = super::enter_realtime(&mode, "serve", super::logger::line) {
         server.shutdown();
         drop(web);
         super::logger::flush(FINAL_LINES_WAIT);

@@ -64,7 +64,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         l.mul_f64(scenario.invariants.warmup)
     });
     let chunk = ((0.05 / period.as_secs_f64()) as u64).max(1);
-    if let Err(code) = super::enter_realtime(&realtime, "serve", |m| say(m)) {
+    if let Err(code) = super::enter_realtime(&realtime, "serve", say) {
         server.shutdown();
         return code;
     }

@@ -39,7 +39,7 @@ pub struct RuntimeConfig {
     /// channel acknowledges its own units after the functions' process times.
     pub plc: Option<PlcSettings>,
     /// The runtime thread's real-time mode (`[realtime]`; default off), README "Real-time mode".
-    pub realtime: crate::runtime::realtime::RealtimeConfig,
+    pub realtime: crate::vocab::realtime::RealtimeConfig,
 }
 
 impl Default for RuntimeConfig {
@@ -57,7 +57,7 @@ impl Default for RuntimeConfig {
             planner: PlannerConfig::default(),
             ads: AdsConfig::default(),
             plc: None,
-            realtime: crate::runtime::realtime::RealtimeConfig::default(),
+            realtime: crate::vocab::realtime::RealtimeConfig::default(),
         }
     }
 }
@@ -790,7 +790,7 @@ mod tests {
 
     #[test]
     fn realtime_keys_are_read_and_checked() {
-        use crate::runtime::realtime::Policy;
+        use crate::vocab::realtime::Policy;
         let text = "[realtime]\npolicy = \"rr\"\npriority = 80\ncpu = 1\nlock_memory = true\nrequired = true\n";
         let rt = parse_runtime(Path::new("r.toml"), text).unwrap().realtime;
         assert_eq!(rt.policy, Policy::Rr);
