@@ -47,10 +47,10 @@ struct Input {
 fn inputs(scale: f64) -> Vec<Input> {
     let n = |full: usize| ((full as f64 * scale) as usize).max(1);
     vec![
+        storm(n(STORM_BLOCKS)),
         labels(n(LABELS)),
         subprogram(n(SUBPROGRAM_BYTES)),
         variables(n(VARIABLES)),
-        storm(n(STORM_BLOCKS)),
     ]
 }
 
