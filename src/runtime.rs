@@ -5,6 +5,8 @@
 //! The runtime knows nothing of NC: it ticks whatever implements [`Cycle`] (the channels, or
 //! the synthetic load of `ncchannel bench`).
 
+pub mod realtime;
+
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};

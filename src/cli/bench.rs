@@ -12,7 +12,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::out::Stdout;
+use super::out::{say, Stdout};
+use crate::runtime::realtime::{RealtimeArgs, RealtimeConfig, ThreadSched};
 use crate::runtime::{bare_loop, Clock, Runtime};
 use crate::soak::load::streaming_channels;
 use crate::vocab::stats::Histogram;
@@ -33,6 +34,11 @@ pub enum BenchLoad {
     /// with --pages pages on the event stream, alternating, and the update rate a page gets
     /// (default start-up list params/startup.lis).
     LiveView,
+    /// The inputs that cost a tick the most (4 M labels under a `$GOTO`, a 200 MB
+    /// subprogram, 90,000 variable declarations, every notification handle at 1 ms), each
+    /// on channel 1 with its worst tick and what it was doing (default start-up list
+    /// params/startup.lis).
+    Worst,
 }
 
 #[derive(Debug, clap::Args)]
@@ -75,13 +81,23 @@ pub struct BenchArgs {
     /// a symbol by name).
     #[arg(long, value_enum, default_value_t = NotifyOn::Com)]
     pub notify_on: NotifyOn,
+    /// --load worst: the inputs' size, a fraction of the full one (1 = 4 M labels, 200 MB, ...).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// --load worst: most ticks each input runs.
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_ticks: u64,
     /// Seed of the generated programs and packet sizes.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Write a lateness histogram (runtime and bare loop) here: SVG for FILE.svg, PNG for
-    /// FILE.png.
+    /// Write a lateness histogram (runtime, bare loop and cyclictest) here: SVG for
+    /// FILE.svg, PNG for FILE.png.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// The real-time mode of the runtime thread, the bare loop and cyclictest (over the
+    /// start-up list's runtime.toml `[realtime]`).
+    #[command(flatten)]
+    pub rt: RealtimeArgs,
 }
 
 /// What `--notifications` handles watch (`--notify-on`).
@@ -115,6 +131,9 @@ fn check_args(args: &BenchArgs) -> Result<(), String> {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
         return Err("--seconds must be in (0, 3600]".into());
     }
+    if !(args.scale.is_finite() && args.scale > 0.0 && args.scale <= 1.0) {
+        return Err("--scale must be in (0, 1]".into());
+    }
     Ok(())
 }
 
@@ -139,7 +158,7 @@ pub fn execute(args: BenchArgs) -> ExitCode {
     }
     let default_list = match args.load {
         BenchLoad::Cycle => "params/soak/startup4.lis",
-        BenchLoad::AdsStream | BenchLoad::LiveView => "params/startup.lis",
+        BenchLoad::AdsStream | BenchLoad::LiveView | BenchLoad::Worst => "params/startup.lis",
     };
     let params = match start_list(&args, default_list) {
         Ok(p) => p,
@@ -157,6 +176,17 @@ pub fn execute(args: BenchArgs) -> ExitCode {
             params: &params,
             seconds: args.seconds,
             pages: args.pages as usize,
+        })
+        .unwrap_or_else(usage),
+        BenchLoad::Worst => super::bench_worst::execute(&super::bench_worst::WorstBench {
+            params: &params,
+            scale: args.scale,
+            max_ticks: args.max_ticks,
+            mode: args.rt.over(
+                &crate::params::load(&params)
+                    .map(|c| c.runtime.realtime)
+                    .unwrap_or_default(),
+            ),
         })
         .unwrap_or_else(usage),
     }
@@ -196,7 +226,9 @@ fn add_watches(
     Ok(())
 }
 
-/// `--load cycle`: the runtime with channels streaming in-process against a bare loop.
+/// `--load cycle`: the runtime with channels streaming in-process against a bare loop and,
+/// when installed, cyclictest, in slices of about a second taking turns, so a change of load
+/// on a shared machine (another build starting) hits all alike.
 fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let loader = crate::source::loader::Loader::start();
     let (cycle, _) = match streaming_channels(params, args.channels, args.seed, &loader) {
@@ -209,15 +241,15 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
         .max(1.0) as u64;
     let slices = (ticks / (1_000_000 / args.period_us).max(1)).clamp(1, 3600);
     let mut out = Stdout::new();
+    let cyclictest = super::bench_cyclictest::find();
     out.line(format_args!(
-        "bench: period {} µs, {} channels streaming, {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop, alternating in {slices} slices",
-        args.period_us, args.channels
+        "bench: period {} µs, {} channels streaming, {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop{}, taking turns in {slices} slices",
+        args.period_us,
+        args.channels,
+        if cyclictest.is_some() { format!(" + {ticks} cyclictest loops") } else { String::new() }
     ));
-    // Runtime and bare loop alternate in slices of about a second, so a change of load on a
-    // shared machine (another build starting) hits both alike.
-    let mut bare = Histogram::new();
-    let mut cycle = cycle;
     let samples = Arc::new(AtomicU64::new(0));
+    let mut cycle = cycle;
     if let Err(msg) = add_watches(args, &mut cycle, &samples) {
         return usage(msg);
     }
@@ -227,31 +259,163 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
             args.notifications, args.notify_on
         ));
     }
+    // Every thread of the bench runs by now (the loader): the real-time mode keeps them off
+    // the runtime's CPU; the bare loop and cyclictest get the same mode.
+    let file_mode = crate::params::load(params)
+        .map(|c| c.runtime.realtime)
+        .unwrap_or_default();
+    let entered =
+        match crate::runtime::realtime::enter_saying(&args.rt.over(&file_mode), "bench", say) {
+            Ok(e) => e,
+            Err(_) => return ExitCode::from(super::exit::REALTIME_REFUSED),
+        };
+    out.line(format_args!(
+        "real-time mode: {}",
+        entered.summary().map_or_else(
+            || "off (--rt-priority, --rt-cpu, --rt-lock-memory; README \"The cycle\")".to_string(),
+            |s| s.trim_start_matches("real-time mode: ").to_string()
+        )
+    ));
     let (mut rt, _tx) = Runtime::new(cycle, period, Clock::RealTime);
-    let mut wall = Duration::ZERO;
+    let plan = Slices {
+        period,
+        ticks,
+        slices,
+        mode: &entered.effective,
+        cyclictest: cyclictest.as_deref(),
+    };
+    let m = match measure(&mut rt, &plan) {
+        Ok(m) => m,
+        Err(msg) => return usage(msg),
+    };
+    let (cycle, stats) = rt.into_inner();
+    print_figures(&mut out, &stats, &m, cyclictest.is_some());
+    print_load(&mut out, &cycle, m.wall, args, &samples);
+    if let Some(p) = &args.plot {
+        let picture = crate::report::lateness::Lateness {
+            runtime: &stats.lateness,
+            bare: &m.bare,
+            cyclictest: cyclictest.is_some().then_some(&m.cyclictest),
+            period,
+        };
+        if let Err(e) = crate::report::picture::write(p, &picture) {
+            return usage(format!("--plot {e}"));
+        }
+        out.line(format_args!("histogram written to {}", p.display()));
+    }
+    out.finish_or_say("ncchannel bench");
+    ExitCode::from(super::exit::OK)
+}
+
+/// How the measured time is cut: `ticks` of each of the runtime, the bare loop and cyclictest
+/// (when found), in `slices` turns.
+struct Slices<'a> {
+    period: Duration,
+    ticks: u64,
+    slices: u64,
+    mode: &'a RealtimeConfig,
+    cyclictest: Option<&'a Path>,
+}
+
+/// What the slices measured besides the runtime's own statistics.
+struct Measured {
+    bare: Histogram,
+    cyclictest: Histogram,
+    /// Wall time of the runtime's slices.
+    wall: Duration,
+    /// Minor page faults of the runtime thread during its slices.
+    page_faults: Option<u64>,
+}
+
+fn measure(
+    rt: &mut Runtime<crate::soak::driver::SoakCycle>,
+    plan: &Slices<'_>,
+) -> Result<Measured, String> {
+    let mut m = Measured {
+        bare: Histogram::new(),
+        cyclictest: Histogram::new(),
+        wall: Duration::ZERO,
+        page_faults: Some(0),
+    };
+    let (ticks, slices) = (plan.ticks, plan.slices);
     for k in 0..slices {
         let n = ticks * (k + 1) / slices - ticks * k / slices;
-        bare.merge(&bare_loop(period, n));
+        m.bare.merge(&bare_loop(plan.period, n));
+        if let Some(program) = plan.cyclictest {
+            let period_us = plan.period.as_micros() as u64;
+            super::bench_cyclictest::run_slice(
+                program,
+                period_us,
+                n,
+                plan.mode,
+                &mut m.cyclictest,
+            )?;
+        }
         // The bare loop ran in between: this slice keeps no schedule from the last one.
         rt.restart_schedule();
-        wall += rt.run(Some(n)).wall;
+        let before = ThreadSched::current();
+        m.wall += rt.run(Some(n)).wall;
+        let after = ThreadSched::current();
+        m.page_faults = match (m.page_faults, before, after) {
+            (Some(sum), Some(b), Some(a)) => {
+                Some(sum + a.minor_faults.saturating_sub(b.minor_faults))
+            }
+            _ => None,
+        };
     }
-    let (cycle, stats) = rt.into_inner();
+    Ok(m)
+}
 
+/// p99 and max of `a` over those of `b` (NaN when `b`'s are 0).
+fn ratios(a: &Histogram, b: &Histogram) -> (f64, f64) {
+    let r = |x: f64, y: f64| if y > 0.0 { x / y } else { f64::NAN };
+    (
+        r(a.quantile_us(0.99), b.quantile_us(0.99)),
+        r(a.max_us(), b.max_us()),
+    )
+}
+
+fn print_figures(
+    out: &mut Stdout,
+    stats: &crate::vocab::stats::CycleStats,
+    m: &Measured,
+    cyclictest: bool,
+) {
     out.line("all figures in µs");
-    print_hist(&mut out, "tick work", &stats.work);
-    print_hist(&mut out, "tick lateness", &stats.lateness);
-    print_hist(&mut out, "bare loop lateness", &bare);
-    let bare_p99 = bare.quantile_us(0.99);
-    let ratio = if bare_p99 > 0.0 {
-        stats.lateness.quantile_us(0.99) / bare_p99
-    } else {
-        f64::NAN
-    };
+    print_hist(out, "tick work", &stats.work);
+    print_hist(out, "tick lateness", &stats.lateness);
+    print_hist(out, "bare loop lateness", &m.bare);
+    if cyclictest {
+        print_hist(out, "cyclictest latency", &m.cyclictest);
+    }
     out.line(format_args!("overruns             {}", stats.overruns));
+    let (p99, max) = ratios(&stats.lateness, &m.bare);
     out.line(format_args!(
-        "lateness p99 ratio runtime / bare loop: {ratio:.2} (target ≤ 1.2)"
+        "lateness ratio runtime / bare loop: p99 {p99:.2} (target ≤ 1.2), max {max:.2}"
     ));
+    if cyclictest {
+        let (p99, max) = ratios(&stats.lateness, &m.cyclictest);
+        out.line(format_args!(
+            "lateness ratio runtime / cyclictest: p99 {p99:.2}, max {max:.2}"
+        ));
+    } else {
+        out.line(super::bench_cyclictest::INSTALL_HINT);
+    }
+    if let Some(f) = m.page_faults {
+        out.line(format_args!(
+            "page faults of the runtime thread during its ticks: {f}"
+        ));
+    }
+}
+
+/// The streaming load the runtime carried, its worst tick and the invariants.
+fn print_load(
+    out: &mut Stdout,
+    cycle: &crate::soak::driver::SoakCycle,
+    wall: Duration,
+    args: &BenchArgs,
+    samples: &AtomicU64,
+) {
     let blocks = cycle.total_blocks;
     let (mut ok, mut rejected, mut bytes) = (0, 0, 0);
     for c in cycle.feed_counters() {
@@ -265,6 +429,9 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
         blocks as f64 / wall.max(1e-9),
         bytes as f64 / 1e6,
     ));
+    if let Some(w) = cycle.machine().worst_tick() {
+        out.line(format_args!("worst tick of the machine: {w}"));
+    }
     if args.notifications > 0 {
         out.line(format_args!(
             "notifications: {} samples queued",
@@ -278,17 +445,4 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
             "invariant violations during the bench: {violations}"
         ));
     }
-    if let Some(p) = &args.plot {
-        let picture = crate::report::lateness::Lateness {
-            runtime: &stats.lateness,
-            bare: &bare,
-            period,
-        };
-        if let Err(e) = crate::report::picture::write(p, &picture) {
-            return usage(format!("--plot {e}"));
-        }
-        out.line(format_args!("histogram written to {}", p.display()));
-    }
-    out.finish_or_say("ncchannel bench");
-    ExitCode::from(super::exit::OK)
 }

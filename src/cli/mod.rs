@@ -8,7 +8,9 @@ use clap::{Parser, Subcommand};
 
 pub(crate) mod bench;
 pub(crate) mod bench_ads;
+mod bench_cyclictest;
 pub(crate) mod bench_live;
+mod bench_worst;
 pub mod check;
 pub(crate) mod init;
 mod logger;
@@ -38,9 +40,28 @@ pub mod exit {
     /// complete up to the stop). A soak a signal stops exits 128 + the signal's number
     /// instead (130, 143), its report marked interrupted.
     pub(crate) const STOPPED: u8 = 4;
+    /// `--rt-required` (runtime.toml `realtime.required`): the system refused a part of the
+    /// real-time mode; nothing ran.
+    pub(crate) const REALTIME_REFUSED: u8 = 5;
     /// A second SIGINT/SIGTERM during the orderly stop: exit at once, as a shell reports a
     /// process killed by SIGINT (128 + 2).
     pub(crate) const SECOND_SIGNAL: u8 = 130;
+}
+
+/// The real-time mode entered on the calling thread (the runtime's, after the command's other
+/// threads started): refusals and the mode's line said through `say`; with `required`, a
+/// refusal is [`exit::REALTIME_REFUSED`] for the command to return.
+pub(crate) fn enter_realtime(
+    mode: &crate::runtime::realtime::RealtimeConfig,
+    command: &str,
+    mut say: impl FnMut(std::fmt::Arguments<'_>),
+) -> Result<crate::runtime::realtime::Entered, ExitCode> {
+    let done = crate::runtime::realtime::enter_saying(mode, command, &mut say)
+        .map_err(|_| ExitCode::from(exit::REALTIME_REFUSED))?;
+    if let Some(line) = done.summary() {
+        say(format_args!("{line}"));
+    }
+    Ok(done)
 }
 
 #[derive(Debug, Parser)]

@@ -54,6 +54,10 @@ pub struct RunArgs {
     /// Run at the cycle period in wall-clock time instead of virtual time.
     #[arg(long)]
     pub(crate) realtime: bool,
+    /// The real-time mode of the runtime thread (with --realtime; over runtime.toml's
+    /// `[realtime]`).
+    #[command(flatten)]
+    pub(crate) rt: crate::runtime::realtime::RealtimeArgs,
     /// Stop after this many ticks (exit code 3).
     #[arg(long)]
     pub max_ticks: Option<u64>,
@@ -98,6 +102,7 @@ impl RunArgs {
             every: 250,
             raw: false,
             realtime: false,
+            rt: crate::runtime::realtime::RealtimeArgs::default(),
             max_ticks: None,
             search: None,
             skip_mask: 0,
@@ -282,9 +287,12 @@ fn stdout_outputs(args: &RunArgs) -> Vec<&'static str> {
     .collect()
 }
 
-/// The output options checked before the run: a picture format the extension names, and at
-/// most one output on standard output.
+/// The options checked before the run: the real-time mode's only with `--realtime`, a picture
+/// format the extension names, and at most one output on standard output.
 fn check_outputs(args: &RunArgs) -> Result<(), String> {
+    if args.rt.any() && !args.realtime {
+        return Err("the --rt-… options of the real-time mode need --realtime".into());
+    }
     if let Some(p) = &args.plot {
         crate::report::picture::Format::of(p).map_err(|e| format!("--plot {e}"))?;
     }
@@ -358,7 +366,10 @@ pub fn execute(mut args: RunArgs) -> ExitCode {
     if let Err(msg) = attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
         return usage(msg);
     }
-    let (rt, summary) = run_program(machine, &args, &program, period);
+    let (rt, summary) = match run_program(machine, &args, &program, period, &config) {
+        Ok(r) => r,
+        Err(code) => return code,
+    };
     let ticks = rt.ticks();
     let end_time = rt.time();
     let time_s = end_time.as_secs_f64();
@@ -407,7 +418,8 @@ fn run_program(
     args: &RunArgs,
     program: &str,
     period: Duration,
-) -> (Runtime<Machine>, Option<crate::runtime::RunSummary>) {
+    config: &crate::params::Config,
+) -> Result<(Runtime<Machine>, Option<crate::runtime::RunSummary>), ExitCode> {
     let tick0 = Tick::first(period, Clock::Virtual);
     let ch = args.channel;
     machine.apply(&tick0, ch, Op::SearchAt(args.search));
@@ -434,9 +446,15 @@ fn run_program(
     let summary = if start_failed {
         None
     } else {
+        // runtime.toml's `[realtime]` applies to real-time runs only: a virtual-time run at a
+        // real-time priority would hold its CPU for the whole run.
+        if args.realtime {
+            let mode = args.rt.over(&config.runtime.realtime);
+            super::enter_realtime(&mode, "run", |m| eprintln!("{m}"))?;
+        }
         Some(rt.run(args.max_ticks))
     };
-    (rt, summary)
+    Ok((rt, summary))
 }
 
 /// `--trace`: the CSV file's last rows written out, at the tick the run ended.

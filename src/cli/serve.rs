@@ -67,6 +67,9 @@ pub struct ServeArgs {
         requires = "http"
     )]
     pub http_allow_host: Vec<String>,
+    /// The real-time mode of the runtime thread (over runtime.toml's `[realtime]`).
+    #[command(flatten)]
+    pub rt: crate::runtime::realtime::RealtimeArgs,
     /// With --soak: write the report as JSON here.
     #[arg(long, requires = "soak")]
     pub report: Option<PathBuf>,
@@ -285,6 +288,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             period,
             channels: nch,
             reply_timeout: config.runtime.ads.reply_timeout(),
+            realtime: args.rt.over(&config.runtime.realtime),
         };
         return super::serve_soak::run(cycle, &sc, soak);
     }
@@ -317,6 +321,15 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
             std::thread::sleep(d);
             stop.stop();
         });
+    }
+    // Every other thread (ADS, web view, loader, logger, the limit's timer) runs by now: the
+    // real-time mode keeps them off the runtime's CPU.
+    let mode = args.rt.over(&config.runtime.realtime);
+    if let Err(code) = super::enter_realtime(&mode, "serve", super::logger::line) {
+        server.shutdown();
+        drop(web);
+        super::logger::flush(FINAL_LINES_WAIT);
+        return code;
     }
     let summary = rt.run(None);
     // The tick in progress has finished; close the sockets, then write out the log.

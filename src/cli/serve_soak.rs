@@ -29,6 +29,8 @@ pub struct SoakServe {
     /// runtime.toml `ads.reply_timeout_ms`: when a request the runtime has not answered is
     /// refused 0x708.
     pub reply_timeout: Duration,
+    /// The runtime thread's real-time mode (`--rt-…` over runtime.toml's `[realtime]`).
+    pub realtime: crate::runtime::realtime::RealtimeConfig,
 }
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
@@ -39,6 +41,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         period,
         channels: nch,
         reply_timeout,
+        realtime,
     } = soak;
     let net_id = server_config.net_id;
     // Until the end the report file says the run is under way (see `ncchannel soak`).
@@ -67,6 +70,10 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         l.mul_f64(scenario.invariants.warmup)
     });
     let chunk = ((0.05 / period.as_secs_f64()) as u64).max(1);
+    if let Err(code) = super::enter_realtime(&realtime, "serve", say) {
+        server.shutdown();
+        return code;
+    }
     let live = std::io::stderr().is_terminal();
     let start = Instant::now();
     let mut last_status = start;

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use crate::soak::campaign::{CampaignReport, CampaignRun, CampaignSpec, Shard};
 use crate::soak::report::{RunStatus, SoakReport};
-use crate::soak::scenario::{Length, Scenario};
+use crate::soak::scenario::{ClockSpec, Length, Scenario};
 use crate::soak::{run, Options};
 
 use super::exit;
@@ -26,6 +26,9 @@ pub struct SoakArgs {
     /// Run at the cycle period in wall-clock time instead of virtual time.
     #[arg(long)]
     pub(crate) realtime: bool,
+    /// The real-time mode of the runtime thread (real-time runs only).
+    #[command(flatten)]
+    pub(crate) rt: crate::runtime::realtime::RealtimeArgs,
     /// Replace the scenario's length: stop after this many executed blocks.
     #[arg(long)]
     pub blocks: Option<u64>,
@@ -71,6 +74,15 @@ fn usage(msg: impl std::fmt::Display) -> ExitCode {
     ExitCode::from(exit::USAGE)
 }
 
+/// A run that could not start: a usage error (exit 2), or the real-time mode refused under
+/// `--rt-required` (exit 5, already said).
+fn failed(e: crate::soak::SoakError) -> ExitCode {
+    match e {
+        crate::soak::SoakError::Realtime(_) => ExitCode::from(exit::REALTIME_REFUSED),
+        e => usage(e),
+    }
+}
+
 /// The human report's stream: standard error when the JSON report goes to standard output.
 fn human_out(report: Option<&Path>) -> Box<dyn std::io::Write> {
     if report.is_some_and(crate::destination::is_stdout) {
@@ -109,6 +121,12 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         });
     // SIGINT/SIGTERM stop the run in order, in virtual time as in real time: the report of
     // what ran, marked interrupted, and the exit code of the signal.
+    let realtime = args.realtime || scenarios.iter().any(|s| s.clock == ClockSpec::Realtime);
+    if args.rt.any() && !realtime {
+        return usage(
+            "the --rt-… options of the real-time mode need --realtime (or a real-time scenario)",
+        );
+    }
     let signal = match super::signal::StopSignal::install() {
         Ok(s) => Some(s),
         Err(e) => {
@@ -122,6 +140,7 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         progress: !args.quiet,
         length,
         seed: args.seed,
+        rt: args.rt.clone(),
     };
     let stopped = || signal.as_ref().is_some_and(|s| s.raised());
     let campaign = scenarios.len() > 1 || args.seeds.is_some() || args.shard.is_some();
@@ -143,7 +162,7 @@ pub fn execute(args: SoakArgs) -> ExitCode {
         }
         let report = match run(scenario, &opts) {
             Ok(r) => r,
-            Err(e) => return usage(e),
+            Err(e) => return failed(e),
         };
         let _ = report.print_human(&mut *human_out(args.report.as_deref()));
         if let Some(p) = &args.report {
@@ -195,7 +214,7 @@ fn run_campaign(
             break;
         }
         opts.seed = Some(p.seed);
-        let report: SoakReport = run(&scenarios[p.scenario], &opts).map_err(usage)?;
+        let report: SoakReport = run(&scenarios[p.scenario], &opts).map_err(failed)?;
         let _ = report.print_human(&mut *out);
         runs.push(CampaignRun {
             index: p.index,

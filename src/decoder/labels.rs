@@ -195,8 +195,10 @@ impl LabelScan {
     }
 
     /// The first item of a kind that found no room: warn once per kind (string labels have
-    /// the kernel's id, block-number labels and `%L` sections ours).
-    fn no_room(&mut self, string: bool, what: String) {
+    /// the kernel's id, block-number labels and `%L` sections ours). `what` names the item;
+    /// it is only called for the warning, not for every later item without room (4 M labels
+    /// past a full index built 4 M names a tick for nothing).
+    fn no_room(&mut self, string: bool, what: impl FnOnce() -> String) {
         let (warned, code) = if string {
             (&mut self.warned_string, codes::STRING_LABEL_INDEX_FULL)
         } else {
@@ -208,7 +210,8 @@ impl LabelScan {
         self.warnings.push(ScanWarning {
             code,
             msg: format!(
-                "more than {MAX_INDEXED_LABELS} for the label index: {what} (line {}) and later ones are searched at each jump or call",
+                "more than {MAX_INDEXED_LABELS} for the label index: {} (line {}) and later ones are searched at each jump or call",
+                what(),
                 self.line_no
             ),
         });
@@ -294,7 +297,7 @@ impl LabelScan {
                     _ => true,
                 };
                 if !indexed {
-                    self.no_room(false, format!("%L {name}"));
+                    self.no_room(false, || format!("%L {name}"));
                 }
             }
             Body::Control(c) => match nesting(c) {
@@ -323,7 +326,7 @@ impl LabelScan {
                 }
                 if !self.index.insert_label(l, at) {
                     let string = matches!(l, Label::Name(_));
-                    self.no_room(string, format!("label {}", label_text(l)));
+                    self.no_room(string, || format!("label {}", label_text(l)));
                 }
                 Ok(None)
             }
@@ -347,4 +350,25 @@ impl LabelScan {
 fn may_matter(line: &str) -> bool {
     line.bytes()
         .any(|b| matches!(b, b'[' | b':' | b'$' | b'#' | b'%'))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Past a full index only the first item of a kind is named (the warning's text); every
+    /// later one costs no string.
+    #[test]
+    fn only_the_first_item_without_room_is_named() {
+        let mut scan = LabelScan::new(Arc::new(Vec::new()), ScanGoal::Index);
+        scan.no_room(true, || "label [L65537]".to_string());
+        scan.no_room(true, || panic!("a second string label named"));
+        scan.no_room(false, || "label N70000".to_string());
+        scan.no_room(false, || panic!("a second block-number label named"));
+        let w = scan.take_warnings();
+        assert_eq!(w.len(), 2);
+        assert_eq!(w[0].code, codes::STRING_LABEL_INDEX_FULL);
+        assert!(w[0].msg.contains("label [L65537] (line 0)"), "{}", w[0].msg);
+        assert_eq!(w[1].code, codes::LABEL_INDEX_FULL);
+    }
 }

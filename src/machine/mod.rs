@@ -8,6 +8,7 @@ pub mod plc;
 pub mod remote;
 pub mod rng;
 pub mod watch;
+pub mod worst;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -124,6 +125,9 @@ pub struct Machine {
     clock_stopped: Duration,
     /// Notification watches evaluated after every tick (`watch`).
     watches: watch::Watches,
+    /// The phases of the tick in progress, and the longest tick so far (`worst`).
+    phases: worst::TickPhases,
+    worst: Option<worst::WorstTick>,
 }
 
 impl Machine {
@@ -145,6 +149,8 @@ impl Machine {
             cycle_times: CycleTimes::default(),
             clock_stopped: Duration::ZERO,
             watches: watch::Watches::default(),
+            phases: worst::TickPhases::new(n),
+            worst: None,
         }
     }
 
@@ -181,6 +187,11 @@ impl Machine {
     /// The channel by number; commands reach it only through [`Machine::apply`].
     fn channel_mut(&mut self, number: u32) -> Option<&mut Channel> {
         self.channels.get_mut((number as usize).checked_sub(1)?)
+    }
+
+    /// The longest tick so far, split into its phases, with what its slowest channel did.
+    pub fn worst_tick(&self) -> Option<&worst::WorstTick> {
+        self.worst.as_ref()
     }
 
     pub fn finishes(&self) -> &[Option<Finish>] {
@@ -252,6 +263,7 @@ impl Cycle for Machine {
     }
 
     fn step(&mut self, tick: &Tick) -> Flow {
+        let mut clock = worst::PhaseClock::start();
         // The PLCs answer before the channels step, as the requests of the tick are served.
         for p in &mut self.plcs {
             if let Some(c) = self
@@ -272,16 +284,25 @@ impl Cycle for Machine {
                 a.feeder.result(a.offer.answered(&reply));
             }
         }
+        self.phases.plcs_and_feeders = clock.lap();
         for (i, c) in self.channels.iter_mut().enumerate() {
-            self.clock_stopped += c.step(tick);
+            let stopped = c.step(tick);
+            self.clock_stopped += stopped;
             if let Some(f) = c.take_finish() {
                 self.finishes[i] = Some(f);
+            }
+            // Virtual time: a wait for the loader is not the channel's work (runtime.rs).
+            if let Some(d) = self.phases.channels.get_mut(i) {
+                *d = clock.lap().saturating_sub(stopped);
             }
         }
         let mut watches = std::mem::take(&mut self.watches);
         watches.evaluate(tick, self.channels.len(), |ch, op| self.apply(tick, ch, op));
         self.watches = watches;
+        self.phases.watches = clock.lap();
         self.publish();
+        self.phases.events = clock.lap();
+        worst::WorstTick::consider(&mut self.worst, tick.index, &self.phases, &self.channels);
         match self.stop_when {
             StopWhen::Never => Flow::Continue,
             StopWhen::ProgramsFinished => {

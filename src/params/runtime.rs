@@ -38,6 +38,8 @@ pub struct RuntimeConfig {
     /// A simulated PLC answering the technology functions (`[plc]`); absent = none, the
     /// channel acknowledges its own units after the functions' process times.
     pub plc: Option<PlcSettings>,
+    /// The runtime thread's real-time mode (`[realtime]`; default off), README "Real-time mode".
+    pub realtime: crate::vocab::realtime::RealtimeConfig,
 }
 
 impl Default for RuntimeConfig {
@@ -55,6 +57,7 @@ impl Default for RuntimeConfig {
             planner: PlannerConfig::default(),
             ads: AdsConfig::default(),
             plc: None,
+            realtime: crate::vocab::realtime::RealtimeConfig::default(),
         }
     }
 }
@@ -572,6 +575,9 @@ fn validate(cfg: &RuntimeConfig, file: &Path, text: &str) -> Vec<Diagnostic> {
     validate_axes(cfg, &mut fail);
     validate_decoder_planner(cfg, &mut fail);
     validate_ads(cfg, &mut fail);
+    if let Err((key, why)) = cfg.realtime.check() {
+        fail("realtime", None, key, why);
+    }
     if let Some(Err((key, why))) = cfg.plc.as_ref().map(PlcSettings::check) {
         let (key, sub) = match key.split_once('.') {
             Some((k, sub)) => (k.to_string(), format!("{sub}: {why}")),
@@ -803,6 +809,34 @@ mod tests {
         let cfg = parse_runtime(Path::new("r.toml"), "").unwrap();
         assert_eq!(cfg, RuntimeConfig::default());
         assert_eq!(cfg.axes.len(), 3);
+    }
+
+    #[test]
+    fn realtime_keys_are_read_and_checked() {
+        use crate::vocab::realtime::Policy;
+        let text = "[realtime]\npolicy = \"rr\"\npriority = 80\ncpu = 1\nlock_memory = true\nrequired = true\n";
+        let rt = parse_runtime(Path::new("r.toml"), text).unwrap().realtime;
+        assert_eq!(rt.policy, Policy::Rr);
+        assert_eq!(
+            (rt.priority, rt.cpu, rt.lock_memory, rt.required),
+            (Some(80), Some(1), true, true)
+        );
+        let errs = parse_runtime(Path::new("r.toml"), "[realtime]\npriority = 0\n").unwrap_err();
+        assert!(
+            errs[0]
+                .message
+                .starts_with("realtime.priority: 0 is not in 1 ... 99"),
+            "{}",
+            errs[0].message
+        );
+        assert_eq!(errs[0].line, 2);
+        let errs =
+            parse_runtime(Path::new("r.toml"), "[realtime]\npolicy = \"idle\"\n").unwrap_err();
+        assert!(
+            errs[0].message.contains("realtime.policy"),
+            "{}",
+            errs[0].message
+        );
     }
 
     #[test]

@@ -1,5 +1,6 @@
-//! The lateness histogram of `bench --plot`: runtime and bare loop on one log-scaled time axis
-//! with decade ticks, units and a legend, each p99 marked.
+//! The lateness histogram of `bench --plot`: runtime, bare loop and (when installed)
+//! cyclictest on one log-scaled time axis with decade ticks, units and a legend, each p99
+//! marked.
 
 use std::time::Duration;
 
@@ -17,11 +18,14 @@ const PER_DECADE: f64 = 10.0;
 const LOWEST_US: f64 = 0.1;
 const RUNTIME: RGBColor = RGBColor(214, 39, 40);
 const BARE: RGBColor = RGBColor(31, 95, 191);
+const CYCLICTEST: RGBColor = RGBColor(44, 160, 44);
 
-/// The two lateness distributions of a bench run.
+/// The lateness distributions of a bench run.
 pub(crate) struct Lateness<'a> {
     pub runtime: &'a Histogram,
     pub bare: &'a Histogram,
+    /// cyclictest's wake-up latency at the same period, policy and CPU, when it ran.
+    pub cyclictest: Option<&'a Histogram>,
     pub period: Duration,
 }
 
@@ -49,14 +53,21 @@ impl Picture for Lateness<'_> {
     {
         let (runtime, bare) = (self.runtime, self.bare);
         root.fill(&WHITE)?;
-        let max_us = runtime.max_us().max(bare.max_us()).max(1.0);
+        let max_us = runtime
+            .max_us()
+            .max(bare.max_us())
+            .max(self.cyclictest.map_or(0.0, Histogram::max_us))
+            .max(1.0);
         let decades = (max_us / LOWEST_US).log10().ceil().max(1.0);
         let hi_us = LOWEST_US * 10f64.powf(decades);
         let bins = (decades * PER_DECADE) as usize;
-        let series = [
+        let mut series = vec![
             ("runtime", RUNTIME, shares(runtime, bins), runtime),
             ("bare spin_sleep loop", BARE, shares(bare, bins), bare),
         ];
+        if let Some(c) = self.cyclictest {
+            series.push(("cyclictest", CYCLICTEST, shares(c, bins), c));
+        }
         let top_pct = series
             .iter()
             .flat_map(|s| s.2.iter())
@@ -128,9 +139,11 @@ mod tests {
             a.record_ns(1000 + i * 10);
             b.record_ns(500 + i);
         }
+        let c = b.clone();
         let pic = Lateness {
             runtime: &a,
             bare: &b,
+            cyclictest: Some(&c),
             period: Duration::from_millis(1),
         };
         let svg = String::from_utf8(encode(&pic, Format::Svg).unwrap()).unwrap();
@@ -141,6 +154,7 @@ mod tests {
             "µs, log scale",
             "runtime p99",
             "bare spin_sleep loop p99",
+            "cyclictest p99",
         ] {
             assert!(svg.contains(label), "{label} missing");
         }

@@ -655,6 +655,11 @@ impl SoakCycle {
 }
 
 impl SoakCycle {
+    /// The machine the soak ticks (the bench reads its worst tick).
+    pub(crate) fn machine(&self) -> &Machine {
+        &self.machine
+    }
+
     /// The machine the soak ticks (the bench registers notification watches on it).
     pub(crate) fn machine_mut(&mut self) -> &mut Machine {
         &mut self.machine

@@ -43,6 +43,9 @@ pub enum SoakError {
     Params { path: String, msg: String },
     #[error("{0}")]
     Setup(String),
+    /// `--rt-required`: the system refused a part of the real-time mode.
+    #[error("{0}")]
+    Realtime(String),
 }
 
 /// Command-line choices that override the scenario.
@@ -56,6 +59,9 @@ pub struct Options {
     pub seed: Option<u64>,
     /// Stop early when this flag is set (SIGINT/SIGTERM); the report covers the run so far.
     pub stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// The real-time mode's options, over the scenario's runtime.toml `[realtime]`; applied
+    /// to real-time runs only.
+    pub rt: crate::runtime::realtime::RealtimeArgs,
 }
 
 /// Build the cycle of a scenario: its channels, clients and fault schedules.
@@ -185,6 +191,14 @@ fn progress_bar(enabled: bool) -> ProgressBar {
     }
 }
 
+/// runtime.toml's `[realtime]` of the scenario's lists (default off when it cannot be read:
+/// `build` has read and checked it already).
+fn realtime_file(scenario: &Scenario) -> crate::runtime::realtime::RealtimeConfig {
+    crate::params::load(&scenario.params_path())
+        .map(|c| c.runtime.realtime)
+        .unwrap_or_default()
+}
+
 /// Run a scenario to its end and report.
 pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError> {
     let length = opts
@@ -202,6 +216,14 @@ pub fn run(scenario: &Scenario, opts: &Options) -> Result<SoakReport, SoakError>
         Clock::Virtual
     };
     let (mut rt, _tx) = Runtime::new(cycle, period, clock);
+    if realtime {
+        let mode = opts.rt.over(&realtime_file(scenario));
+        let done = crate::runtime::realtime::enter_saying(&mode, "soak", |m| eprintln!("{m}"))
+            .map_err(SoakError::Realtime)?;
+        if let Some(line) = done.summary() {
+            eprintln!("{line}");
+        }
+    }
     if let Some(flag) = &opts.stop {
         rt.stop_on(std::sync::Arc::clone(flag));
     }

@@ -67,6 +67,18 @@ impl Histogram {
         self.max_ns = self.max_ns.max(ns);
     }
 
+    /// Record `n` values of `ns` nanoseconds each (a histogram read from elsewhere, as
+    /// cyclictest's per-microsecond counts).
+    pub(crate) fn record_ns_n(&mut self, ns: u64, n: u64) {
+        if n == 0 {
+            return;
+        }
+        self.hdr.saturating_record_n(ns.max(1), n);
+        self.sum_ns += u128::from(ns) * u128::from(n);
+        self.min_ns = self.min_ns.min(ns);
+        self.max_ns = self.max_ns.max(ns);
+    }
+
     /// Record one duration (saturating at `u64::MAX` ns, 584 years).
     pub fn record(&mut self, d: Duration) {
         self.record_ns(u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));

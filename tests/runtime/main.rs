@@ -11,6 +11,7 @@ mod closed_stdout;
 mod event_log_cuts;
 mod plc;
 mod program_loader;
+mod realtime;
 mod runtime;
 mod runtime_events;
 mod serve_signals;
