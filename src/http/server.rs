@@ -345,6 +345,15 @@ fn route(mut socket: TcpStream, req: &Request, shared: &Shared) -> Result<(), Re
             );
             Ok(respond(&mut socket, a.status, text, &a.text)?)
         }
+        ("GET", "/snapshot.json") => match shared.pages.snapshot() {
+            Some(json) => Ok(respond(
+                &mut socket,
+                200,
+                "application/json; charset=utf-8",
+                &json,
+            )?),
+            None => Ok(respond(&mut socket, 503, text, "no update yet")?),
+        },
         ("GET", "/controls") => {
             let on = shared.controls == ControlAccess::Allowed;
             Ok(respond(

@@ -4,6 +4,7 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+pub mod live;
 pub mod plc;
 pub mod remote;
 pub mod rng;
@@ -124,6 +125,8 @@ pub struct Machine {
     clock_stopped: Duration,
     /// Notification watches evaluated after every tick (`watch`).
     watches: watch::Watches,
+    /// Per channel: the live view's record (off until the view drains it).
+    live: Vec<live::ChannelRecord>,
 }
 
 impl Machine {
@@ -145,6 +148,9 @@ impl Machine {
             cycle_times: CycleTimes::default(),
             clock_stopped: Duration::ZERO,
             watches: watch::Watches::default(),
+            live: std::iter::repeat_with(live::ChannelRecord::default)
+                .take(n)
+                .collect(),
         }
     }
 
@@ -225,13 +231,27 @@ impl Machine {
             };
         }
         let times = self.cycle_times;
-        let Some(c) = self.channel_mut(channel) else {
+        let i = (channel as usize).wrapping_sub(1);
+        let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
             return Reply::NoChannel;
+        };
+        if op == Op::DrainLive {
+            return Reply::Live(Box::new(record.drain(c)));
+        }
+        let written = match &op {
+            Op::WriteStream(p) => Some(Arc::clone(p)),
+            _ => None,
         };
         match c.apply(tick, op) {
             Reply::Status(mut s) => {
                 s.cycle_times = times;
                 Reply::Status(s)
+            }
+            r @ Reply::Stream(Ok(())) => {
+                if let Some(p) = written {
+                    record.stream_written(&p, c);
+                }
+                r
             }
             r => r,
         }
@@ -262,18 +282,23 @@ impl Cycle for Machine {
             }
         }
         for a in &mut self.feeders {
-            let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
+            let i = (a.channel as usize).wrapping_sub(1);
+            let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
                 continue;
             };
             if let Some(packet) = a.feeder.poll(tick.index) {
                 // Through the door like any client's write; a write the channel cannot take
                 // (ERROR, no streaming program) is a refusal the feeder retries.
                 let reply = c.apply(tick, a.offer.write(packet));
+                if reply == Reply::Stream(Ok(())) {
+                    record.stream_written(packet, c);
+                }
                 a.feeder.result(a.offer.answered(&reply));
             }
         }
-        for (i, c) in self.channels.iter_mut().enumerate() {
+        for ((i, c), record) in self.channels.iter_mut().enumerate().zip(&mut self.live) {
             self.clock_stopped += c.step(tick);
+            record.tick(tick, c);
             if let Some(f) = c.take_finish() {
                 self.finishes[i] = Some(f);
             }
