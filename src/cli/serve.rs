@@ -264,6 +264,9 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, log, StopWhen::Never);
+    if args.http.is_some() {
+        machine.record_live();
+    }
     if let Err(msg) = super::run::attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
         return usage(msg);
     }

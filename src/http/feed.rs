@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use super::path::{PathStore, StreamLines};
 use super::snapshot::{
-    channel_view, cycle_view, ErrorView, Listing, ListingView, Times, Update, WindowView,
+    channel_view, cycle_view, ErrorView, Listing, ListingView, Recorded, Update, WindowView,
 };
 use super::{Backend, FEED_PERIOD, PAGE_QUEUE_UPDATES};
 use crate::machine::live::LiveDrain;
@@ -178,6 +178,7 @@ struct Seen {
     /// Ticks of the present program's start and stop, from the channel's live record.
     started_tick: Option<u64>,
     stopped_tick: Option<u64>,
+    executed: crate::machine::live::Executed,
 }
 
 /// Seconds of cycle history the window statistics cover.
@@ -289,10 +290,13 @@ impl Poller {
     }
 
     /// Elapsed and estimated remaining time of channel `i`'s program.
-    fn times(&self, i: usize, s: &Status) -> Times {
+    fn times(&self, i: usize, s: &Status) -> Recorded {
         let seen = &self.seen[i];
         let Some(start) = seen.started_tick else {
-            return Times::default();
+            return Recorded {
+                executed: seen.executed,
+                ..Recorded::default()
+            };
         };
         let end = seen.stopped_tick.unwrap_or(s.tick).max(start);
         let elapsed_s = (end - start) as f64 * s.period.as_secs_f64();
@@ -307,9 +311,10 @@ impl Poller {
             Some(f) if f > 0.01 => Some(elapsed_s * (1.0 - f) / f),
             _ => None,
         };
-        Times {
+        Recorded {
             elapsed_s: Some(elapsed_s),
             remaining_s,
+            executed: seen.executed,
         }
     }
 
@@ -321,6 +326,7 @@ impl Poller {
         let seen = &mut self.seen[i];
         seen.started_tick = drain.started_tick;
         seen.stopped_tick = drain.stopped_tick;
+        seen.executed = drain.executed;
         if let Some(text) = drain.stream.take() {
             let lines = StreamLines::new(ch, &text);
             if let Some(e) = event("stream", &lines) {

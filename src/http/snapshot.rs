@@ -63,8 +63,10 @@ pub struct ChannelView {
     /// whether it is a rapid; `feed_mm_per_min` is the decoder's, ahead by the lookahead.
     pub executing_feed_mm_per_min: Option<f64>,
     pub executing_rapid: bool,
+    /// As the executed M3/M4/M5 and S left it (as decoded before any has run).
     pub spindle: SpindleView,
-    /// Tool (T) and tool data set (D) as decoded.
+    /// Tool (T) as the executed T left it (as decoded before), and the tool data set (D)
+    /// as decoded.
     pub tool: u32,
     pub tool_offset: u32,
     /// The decoder's modal G codes: motion, plane, dimensions, units, feed mode, radius
@@ -81,7 +83,7 @@ pub struct ChannelView {
     pub stream_refused_full: u64,
 }
 
-/// The spindle as decoded: M3 / M4 / M5 and the programmed speed.
+/// The spindle: M3 / M4 / M5 and the programmed speed.
 #[derive(Debug, Clone, Serialize)]
 pub struct SpindleView {
     /// `cw` (M3), `ccw` (M4) or `off` (M5).
@@ -89,11 +91,13 @@ pub struct SpindleView {
     pub rpm: f64,
 }
 
-/// Program times the feed knows from the channel's live record (`machine::live`).
+/// What the feed knows from the channel's live record (`machine::live`): the program's
+/// times and the spindle and tool the executed functions set.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Times {
+pub struct Recorded {
     pub elapsed_s: Option<f64>,
     pub remaining_s: Option<f64>,
+    pub executed: crate::machine::live::Executed,
 }
 
 /// The modal G codes of `m`, in the order the page lists them.
@@ -374,7 +378,12 @@ impl Listing {
 }
 
 /// One channel's view; `listing` is the text the page shows for it, if any.
-pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>, times: Times) -> ChannelView {
+pub fn channel_view(
+    ch: u16,
+    s: &Status,
+    listing: Option<&Listing>,
+    recorded: Recorded,
+) -> ChannelView {
     let block = s.active_block.as_ref();
     let line = match (block, listing) {
         (Some(b), Some(l)) if *b.prog == *l.program => Some(l.line_of(b.offset)),
@@ -423,14 +432,14 @@ pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>, times: Times
         executing_feed_mm_per_min: s.executing_feed_mm_per_min,
         executing_rapid: s.executing_rapid,
         spindle: SpindleView {
-            direction: match s.modal.spindle {
+            direction: match recorded.executed.spindle.unwrap_or(s.modal.spindle) {
                 crate::decoder::modal::Spindle::Cw => "cw",
                 crate::decoder::modal::Spindle::Ccw => "ccw",
                 crate::decoder::modal::Spindle::Off => "off",
             },
-            rpm: s.modal.spindle_rpm,
+            rpm: recorded.executed.spindle_rpm.unwrap_or(s.modal.spindle_rpm),
         },
-        tool: s.modal.tool,
+        tool: recorded.executed.tool.unwrap_or(s.modal.tool),
         tool_offset: s.modal.tool_offset,
         g_codes: g_codes(&s.modal),
         work_offset_mm: {
@@ -443,8 +452,8 @@ pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>, times: Times
                 .unwrap_or_default();
             [o[0], o[1], o[2]]
         },
-        elapsed_s: times.elapsed_s,
-        remaining_s: times.remaining_s,
+        elapsed_s: recorded.elapsed_s,
+        remaining_s: recorded.remaining_s,
         stream_refused_full: s.stream_writes_full,
     }
 }

@@ -1,8 +1,10 @@
 //! What the live view (`serve --http`) needs of each channel beyond its status, recorded by
 //! the machine from what every tick already produced: the path the interpolator moved since
 //! the program started, decimated by a tolerance (not by time), and the stream bytes around
-//! the executing block. The view's feed drains it through [`crate::machine::Op::DrainLive`];
-//! the first drain turns a channel's record on, so a runtime without the view records nothing.
+//! the executing block. The view's feed drains it through [`crate::machine::Op::DrainLive`].
+//! `serve --http` turns the records on before the first tick (`Machine::record_live`), else
+//! the first drain does, so a runtime without the view records nothing. A record turned on
+//! while a program runs knows its path from then on and its stream lines from the next start.
 //!
 //! Memory is bounded: a channel keeps at most [`PENDING_POINTS`] path points and
 //! [`STREAM_TEXT_BYTES`] of stream text between two drains (the feed drains every 50 ms);
@@ -12,8 +14,10 @@
 use std::collections::VecDeque;
 
 use crate::channel::Channel;
+use crate::decoder::modal::Spindle;
 use crate::vocab::axis::AXIS_LETTERS;
 use crate::vocab::mode::State;
+use crate::vocab::techno::{TechnoKind, TechnoSeq};
 use crate::vocab::tick::Tick;
 
 /// Largest distance, mm, of any interpolated position from the recorded polyline: an arc
@@ -70,6 +74,17 @@ pub struct LiveDrain {
     pub stream: Option<StreamText>,
     /// Software limits of X Y Z, mm (`None`: the axis is not configured).
     pub soft_limits_mm: [Option<(f64, f64)>; 3],
+    /// What the executed technology functions set (M3/M4/M5, S, T), where one has run
+    /// since the record began; the decoder's modal state runs ahead by the lookahead.
+    pub executed: Executed,
+}
+
+/// The spindle and tool as the executed technology functions left them.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Executed {
+    pub spindle: Option<Spindle>,
+    pub spindle_rpm: Option<f64>,
+    pub tool: Option<u32>,
 }
 
 /// The online decimation, constant work a position: a run of positions from the last kept
@@ -198,8 +213,15 @@ pub struct ChannelRecord {
     stream_start: u64,
     /// Bytes taken from the stream by the end of the last tick.
     taken_before: u64,
+    /// `stream_start` is known: the record saw the present program start.
+    stream_start_known: bool,
     /// The executing offset and the stream end of the last drain's text.
     sent: Option<(Option<u64>, u64)>,
+    executed: Executed,
+    /// Technology functions output by the end of the last tick, and the next sequence
+    /// number not yet looked at.
+    techno_output: u64,
+    techno_next: TechnoSeq,
 }
 
 impl ChannelRecord {
@@ -223,11 +245,13 @@ impl ChannelRecord {
                 .stream_written()
                 .saturating_sub(used as u64)
                 .saturating_sub(taken_now);
+            self.stream_start_known = true;
         } else if !running && self.running {
             self.stopped_tick = Some(tick.index);
         }
         self.running = running;
         self.taken_before = taken;
+        self.follow_techno(c);
         let p = c.position();
         let pending = &mut self.pending;
         let lost = &mut self.points_lost;
@@ -243,6 +267,44 @@ impl ChannelRecord {
                 }
             },
         );
+    }
+
+    /// Technology functions output this tick (still open in their units: acknowledgement
+    /// comes a tick later at the earliest): the spindle and tool they set. Looked at only in
+    /// a tick that output some, over the units (a fixed number).
+    fn follow_techno(&mut self, c: &Channel) {
+        let t = c.techno();
+        let output = t.stats().output;
+        if output == self.techno_output {
+            return;
+        }
+        self.techno_output = output;
+        let mut next = self.techno_next;
+        let mut newest = [None::<TechnoSeq>; 3];
+        for (_, _, f, _) in t.open_units() {
+            if f.seq < self.techno_next {
+                continue;
+            }
+            next = next.max(f.seq + 1);
+            let (slot, newer) = match (f.kind, f.number) {
+                (TechnoKind::M, 3..=5) => (0, newest[0].is_none_or(|s| f.seq > s)),
+                (TechnoKind::S, _) => (1, newest[1].is_none_or(|s| f.seq > s)),
+                (TechnoKind::T, _) => (2, newest[2].is_none_or(|s| f.seq > s)),
+                _ => continue,
+            };
+            if !newer {
+                continue;
+            }
+            newest[slot] = Some(f.seq);
+            match (f.kind, f.number) {
+                (TechnoKind::M, 3) => self.executed.spindle = Some(Spindle::Cw),
+                (TechnoKind::M, 4) => self.executed.spindle = Some(Spindle::Ccw),
+                (TechnoKind::M, _) => self.executed.spindle = Some(Spindle::Off),
+                (TechnoKind::S, _) => self.executed.spindle_rpm = Some(f64::from(f.add_value)),
+                _ => self.executed.tool = Some(f.number),
+            }
+        }
+        self.techno_next = next;
     }
 
     /// A stream write the channel took: keep its bytes (the last [`STREAM_TEXT_BYTES`]).
@@ -270,13 +332,20 @@ impl ChannelRecord {
         }
     }
 
+    /// Start recording (again nothing when on already).
+    pub fn turn_on(&mut self, c: &Channel) {
+        if self.on {
+            return;
+        }
+        self.on = true;
+        self.running = matches!(c.state(), State::Active | State::Hold);
+        self.stream_start_known = !self.running;
+        self.taken_before = c.stream_fill().1;
+    }
+
     /// Hand out what was recorded since the last drain (and turn the record on).
     pub fn drain(&mut self, c: &Channel) -> LiveDrain {
-        if !self.on {
-            self.on = true;
-            self.running = false;
-            self.taken_before = c.stream_fill().1;
-        }
+        self.turn_on(c);
         let mut soft_limits_mm = [None; 3];
         for a in c.axis_limits() {
             if let Some(slot) = soft_limits_mm.get_mut(a.index) {
@@ -293,6 +362,7 @@ impl ChannelRecord {
             points_lost: self.points_lost,
             stream: self.stream_text(c),
             soft_limits_mm,
+            executed: self.executed,
         }
     }
 
@@ -300,7 +370,7 @@ impl ChannelRecord {
     fn stream_text(&mut self, c: &Channel) -> Option<StreamText> {
         let executing = c
             .active_block()
-            .filter(|b| b.stream)
+            .filter(|b| b.stream && self.stream_start_known)
             .map(|b| self.stream_start + b.offset);
         let end = self.text_from + self.text.len() as u64;
         if self.text.is_empty() || self.sent == Some((executing, end)) {

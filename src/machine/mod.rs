@@ -154,6 +154,14 @@ impl Machine {
         }
     }
 
+    /// Record every channel's path and stream text for the live view from now on
+    /// (`serve --http`, before the first tick: a page that connects late sees everything).
+    pub fn record_live(&mut self) {
+        for (c, r) in self.channels.iter().zip(&mut self.live) {
+            r.turn_on(c);
+        }
+    }
+
     pub fn set_stop_when(&mut self, w: StopWhen) {
         self.stop_when = w;
     }

@@ -106,6 +106,7 @@ function errorText(e) {
 
 function showWindow(w) {
   const box = document.getElementById("window");
+  box.hidden = false;
   for (const el of box.querySelectorAll("[data-w]")) {
     const k = el.dataset.w;
     el.textContent = k === "seconds" || k === "overruns" ? String(w[k]) : fmt(w[k], 1);
@@ -114,7 +115,7 @@ function showWindow(w) {
   const t = document.getElementById("trend");
   const g = t.getContext("2d");
   g.clearRect(0, 0, t.width, t.height);
-  const max = Math.max(...w.p99_trend_us, 1);
+  const max = w.p99_trend_us.reduce((a, b) => Math.max(a, b), 1);
   const bw = t.width / 60;
   w.p99_trend_us.forEach((p, i) => {
     const h = (p / max) * (t.height - 2);
@@ -464,6 +465,11 @@ function drawPlot(v) {
   canvas.dataset.rapidSegments = rapids;
   canvas.dataset.cutSegments = cuts;
   canvas.dataset.points = v.path.length;
+  if (v.path.length) {
+    const b = [Infinity, Infinity, -Infinity, -Infinity];
+    for (const p of v.path) { b[0] = Math.min(b[0], p[0]); b[1] = Math.min(b[1], p[1]); b[2] = Math.max(b[2], p[0]); b[3] = Math.max(b[3], p[1]); }
+    canvas.dataset.bounds = b.map((x) => x.toFixed(3)).join(",");
+  }
   const at = tail || pts[pts.length - 1];
   if (at) {
     g.fillStyle = "#e8590c";
