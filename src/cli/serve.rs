@@ -53,7 +53,7 @@ pub struct ServeArgs {
     pub(crate) ads_idle_timeout: Option<f64>,
     /// Serve the live web view on this address (default 127.0.0.1:8080; loopback unless
     /// --allow-non-loopback). Port 0 picks one.
-    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080", conflicts_with = "soak")]
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub http: Option<SocketAddr>,
     /// Let the web view's operator controls (start, hold, resume, reset, override) command the
     /// channels; without it they are refused (HTTP 403).
@@ -191,9 +191,9 @@ pub(super) fn start_at_first_tick(
 }
 
 /// `--http`: the live web view over its own backend into the same runtime as ADS.
-fn spawn_web(
+pub(crate) fn spawn_web<C: crate::runtime::Cycle>(
     args: &ServeArgs,
-    rt: &mut Runtime<Machine>,
+    rt: &mut Runtime<C>,
     requests: crossbeam_channel::Sender<crate::machine::Request>,
     channels: u16,
 ) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
@@ -277,8 +277,12 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         }
     }
     if let Some(sc) = scenario {
+        if args.http.is_some() {
+            machine.record_live();
+        }
         let cycle = supervised(machine, &sc, &config);
         let soak = super::serve_soak::SoakServe {
+            args: args.clone(),
             server_config: server_config(&args, &config),
             limit,
             report: args.report.clone(),

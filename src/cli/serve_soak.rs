@@ -21,6 +21,8 @@ use super::out::say;
 /// What `serve` settled before handing over: the ADS endpoint, the run limit, the report
 /// file, the cycle time and the channel count.
 pub struct SoakServe {
+    /// The command line, for `--http` (the live view beside the soak).
+    pub args: super::serve::ServeArgs,
     pub(crate) server_config: ServerConfig,
     pub limit: Option<Duration>,
     pub report: Option<PathBuf>,
@@ -33,6 +35,7 @@ pub struct SoakServe {
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
     let SoakServe {
+        args,
         server_config,
         limit,
         report: report_path,
@@ -42,6 +45,10 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     } = soak;
     let net_id = server_config.net_id;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
+    let web = match super::serve::spawn_web(&args, &mut rt, requests.clone(), nch) {
+        Ok(w) => w,
+        Err(code) => return code,
+    };
     let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
     let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
         Ok(s) => s,
@@ -65,6 +72,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     let start = Instant::now();
     let mut last_status = start;
     let mut warm_kib = None;
+    let mut last_published = start;
     loop {
         let s = rt.run(Some(chunk));
         let wall = start.elapsed();
@@ -75,6 +83,12 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         if s.end == RunEnd::StopRequested || limit.is_some_and(|l| wall >= l) {
             break;
         }
+        if let Some(w) = &web {
+            if last_published.elapsed() >= SOAK_VIEW_PERIOD {
+                last_published = Instant::now();
+                w.publish_soak(soak_view(&rt, wall));
+            }
+        }
         let every = if live { 500 } else { 5_000 };
         if last_status.elapsed() >= Duration::from_millis(every) {
             last_status = Instant::now();
@@ -82,6 +96,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         }
     }
     server.shutdown();
+    drop(web); // the web view stops polling and ends its pages' streams
     let wall = start.elapsed().as_secs_f64();
     let ticks = rt.ticks();
     let sim_seconds = rt.time().as_secs_f64();
@@ -183,6 +198,22 @@ fn announce_resets(rt: &mut Runtime<Supervised>, period: Duration, live: bool) {
     if lost > 0 {
         let _ = writeln!(err, "serve --soak: {lost} more reset(s) not shown");
     }
+}
+
+/// How often `serve --soak --http` hands the soak's counters to the live view: the
+/// invariants' verdicts are worked out on the runtime's thread between ticks, so not at the
+/// view's 20 Hz.
+const SOAK_VIEW_PERIOD: Duration = Duration::from_millis(500);
+
+/// The soak as the live view shows it: run time, each channel's counters and the
+/// invariants' verdicts so far (the report's words).
+fn soak_view(rt: &Runtime<Supervised>, wall: Duration) -> serde_json::Value {
+    serde_json::json!({
+        "seconds": wall.as_secs_f64(),
+        "blocks": rt.cycle().blocks(),
+        "channels": rt.cycle().counters(),
+        "invariants": rt.cycle().verdicts(None, 0),
+    })
 }
 
 fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {

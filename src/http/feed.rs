@@ -65,6 +65,8 @@ struct Greeting {
     streams: Vec<Option<Event>>,
     /// The latest update as JSON (`GET /snapshot.json`).
     snapshot: Option<Arc<str>>,
+    /// What `serve --soak --http` last published of the soak (counters and invariants).
+    soak: Option<serde_json::Value>,
 }
 
 impl Pages {
@@ -95,6 +97,11 @@ impl Pages {
         }
         lock(&self.queues).push(tx);
         rx
+    }
+
+    /// The soak's counters and invariants for the next updates (`serve --soak --http`).
+    pub fn publish_soak(&self, soak: serde_json::Value) {
+        lock(&self.greeting).soak = Some(soak);
     }
 
     /// The latest update as JSON, once the feed has polled.
@@ -227,11 +234,13 @@ impl Poller {
         }
         self.seq += 1;
         let window = self.cycle_window();
+        let soak = lock(&self.pages.greeting).soak.clone();
         let update = Update {
             seq: self.seq,
             cycle,
             window,
             channels,
+            soak,
         };
         if let Ok(json) = serde_json::to_string(&update) {
             lock(&self.pages.greeting).snapshot = Some(Arc::from(json.as_str()));

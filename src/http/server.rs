@@ -78,6 +78,11 @@ impl HttpHandle {
         self.local_addr
     }
 
+    /// Show the soak's counters and invariants on the page from the next update on.
+    pub fn publish_soak(&self, soak: serde_json::Value) {
+        self.shared.pages.publish_soak(soak);
+    }
+
     /// Pages whose event stream is open now.
     pub fn pages_connected(&self) -> usize {
         self.shared.pages.connected()

@@ -278,6 +278,10 @@ pub struct Update {
     /// Over the last seconds (`None` without the runtime's live statistics).
     pub window: Option<WindowView>,
     pub channels: Vec<ChannelView>,
+    /// `serve --soak --http`: the soak's counters per channel and its invariants so far
+    /// (as the soak's report has them), published twice a second.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub soak: Option<serde_json::Value>,
 }
 
 /// A channel's program text for the listing: the `listing` event.

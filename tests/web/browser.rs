@@ -255,3 +255,79 @@ fn browser_shows_a_stream_its_path_since_the_start_and_every_channel() {
     assert_eq!(seen["feed"], "F300 mm/min", "the executing block's F");
     assert_eq!(seen["start_disabled"], true);
 }
+
+/// `serve --soak --http`: the page shows the soak's counters and invariants while an
+/// `ncchannel stream` client feeds the soaked channel.
+#[test]
+#[ignore = "needs chromium and tests/node/node_modules: .ci/run installs them"]
+fn browser_watches_a_soak() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+    let bin = env!("CARGO_BIN_EXE_ncchannel");
+    let dir = tempfile::tempdir().unwrap();
+    let params = concat!(env!("CARGO_MANIFEST_DIR"), "/params/soak/startup.lis");
+    let sc = dir.path().join("soak.toml");
+    std::fs::write(
+        &sc,
+        format!("params = {params:?}\nseed = 3\n[invariants]\nexpected_errors = []\n"),
+    )
+    .unwrap();
+    let mut nc = String::new();
+    for n in 1..=3000 {
+        nc.push_str(&format!(
+            "N{n} G01 X{:.2} Y0 F20000\n",
+            f64::from(n % 40) * 0.05
+        ));
+    }
+    let file = dir.path().join("client.nc");
+    std::fs::write(&file, nc).unwrap();
+    let mut serve = Command::new(bin)
+        .args(["serve", "--bind", "127.0.0.1:0", "--http", "127.0.0.1:0"])
+        .arg("--soak")
+        .arg(&sc)
+        .args(["--seconds", "60"])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(serve.stderr.take().unwrap());
+    let (mut web, mut ads) = (None, None);
+    let mut line = String::new();
+    while web.is_none() || ads.is_none() {
+        line.clear();
+        assert!(err.read_line(&mut line).unwrap() > 0, "serve ended early");
+        if let Some(rest) = line.split("web view on ").nth(1) {
+            web = rest.split(' ').next().map(str::to_string);
+        }
+        if let Some(rest) = line.split("listening on ").nth(1) {
+            ads = rest.split(' ').next().map(str::to_string);
+        }
+    }
+    // The rest of stderr drained, so serve never blocks on it.
+    let drain = std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
+    let mut client = Command::new(bin)
+        .args(["stream", "--target", &ads.unwrap()])
+        .arg(&file)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/soak_view_test.js");
+    let seen = run_page_script(script, &[web.unwrap()], |_| false);
+    // The test's own children, by their handles.
+    let _ = client.kill();
+    let _ = client.wait();
+    let _ = serve.kill();
+    let _ = serve.wait();
+    let _ = drain.join();
+    let number = |k: &str| seen[k].as_str().unwrap().parse::<u64>().unwrap();
+    assert!(number("blocks") > 100, "{seen}");
+    assert!(number("lines") >= number("blocks"), "{seen}");
+    let invariants = seen["invariants"].as_array().unwrap();
+    assert!(
+        invariants
+            .iter()
+            .all(|v| v.as_str().unwrap().starts_with("holds: ")),
+        "{seen}"
+    );
+}

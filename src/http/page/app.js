@@ -68,6 +68,7 @@ function onStatus(u) {
   rateEl.dataset.seq = u.seq;
   if (u.cycle) showCycle(u.cycle);
   if (u.window) showWindow(u.window);
+  if (u.soak) showSoak(u.soak);
   for (const c of u.channels) showChannel(channelView(c.ch), c);
 }
 
@@ -102,6 +103,40 @@ function blockText(c) {
 function errorText(e) {
   const at = e.program ? " (" + e.program + (e.line ? " line " + e.line : "") + ")" : "";
   return e.code + ": " + e.text + at;
+}
+
+// ---- serve --soak --http: the soak's counters and invariants ----
+
+function showSoak(s) {
+  const box = document.getElementById("soak");
+  box.hidden = false;
+  $(box, ".soak-time").textContent = "· " + duration(s.seconds) + " · " + s.blocks + " blocks checked";
+  const body = $(box, ".soak-channels tbody");
+  body.textContent = "";
+  for (const c of s.channels) {
+    const row = document.createElement("tr");
+    row.dataset.channel = c.number;
+    const errors = Object.entries(c.errors || {}).map(([k, n]) => k + "×" + n).join(" ") || "–";
+    const cells = [c.number, c.program || "–", c.blocks, c.lines_accepted, c.writes_rejected, c.resets, c.lines_dropped, c.restarts, errors];
+    const names = ["number", "program", "blocks", "lines", "rejected", "resets", "dropped", "restarts", "errors"];
+    cells.forEach((text, i) => {
+      const td = document.createElement("td");
+      td.className = names[i];
+      td.textContent = String(text);
+      row.appendChild(td);
+    });
+    body.appendChild(row);
+  }
+  const ul = $(box, ".invariants");
+  ul.textContent = "";
+  for (const v of s.invariants) {
+    const li = document.createElement("li");
+    li.className = v.held ? "held" : "violated";
+    li.dataset.name = v.name;
+    li.textContent = (v.held ? "holds: " : "VIOLATED (" + v.violations + "): ") + v.name
+      + (v.details && v.details.length ? " — " + v.details[0] : "");
+    ul.appendChild(li);
+  }
 }
 
 function showWindow(w) {
