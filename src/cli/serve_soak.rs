@@ -83,12 +83,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         if s.end == RunEnd::StopRequested || limit.is_some_and(|l| wall >= l) {
             break;
         }
-        if let Some(w) = &web {
-            if last_published.elapsed() >= SOAK_VIEW_PERIOD {
-                last_published = Instant::now();
-                w.publish_soak(soak_view(&rt, wall));
-            }
-        }
+        publish_soak(web.as_ref(), &rt, wall, &mut last_published);
         let every = if live { 500 } else { 5_000 };
         if last_status.elapsed() >= Duration::from_millis(every) {
             last_status = Instant::now();
@@ -204,6 +199,21 @@ fn announce_resets(rt: &mut Runtime<Supervised>, period: Duration, live: bool) {
 /// invariants' verdicts are worked out on the runtime's thread between ticks, so not at the
 /// view's 20 Hz.
 const SOAK_VIEW_PERIOD: Duration = Duration::from_millis(500);
+
+/// Hand the soak to the live view when [`SOAK_VIEW_PERIOD`] has passed since `last`.
+fn publish_soak(
+    web: Option<&crate::http::HttpHandle>,
+    rt: &Runtime<Supervised>,
+    wall: Duration,
+    last: &mut Instant,
+) {
+    if let Some(w) = web {
+        if last.elapsed() >= SOAK_VIEW_PERIOD {
+            *last = Instant::now();
+            w.publish_soak(soak_view(rt, wall));
+        }
+    }
+}
 
 /// The soak as the live view shows it: run time, each channel's counters and the
 /// invariants' verdicts so far (the report's words).

@@ -257,7 +257,7 @@ impl Poller {
     fn cycle_window(&mut self) -> Option<WindowView> {
         let live = self.live.as_ref()?;
         let per_s = (1.0 / FEED_PERIOD.as_secs_f64()).round() as u64;
-        if self.cycle_history.is_empty() || self.seq % per_s.max(1) == 0 {
+        if self.cycle_history.is_empty() || self.seq.is_multiple_of(per_s.max(1)) {
             let r = live.read();
             let reading = CycleReading {
                 buckets: live.work_buckets(),
