@@ -6,8 +6,10 @@
 //! only without custom headers (a "simple" cross-origin request; Fetch standard, "CORS
 //! protocol"), so that site cannot command the channels through a user's browser.
 
+use super::snapshot::Listing;
 use super::{Backend, ControlAccess};
 use crate::machine::remote::DeviceError;
+use crate::machine::SearchTarget;
 use crate::machine::{Op, Reply};
 use crate::vocab::mode::State;
 
@@ -26,6 +28,21 @@ pub enum Action {
     Reset,
     /// Feed override, percent.
     Override(f64),
+    /// Start `program` from a block on: a line of its listing or an N number, by the
+    /// channel's block search (as `run --search` does).
+    RunFrom {
+        program: String,
+        from: From,
+    },
+}
+
+/// Where a run from a line starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum From {
+    /// 1-based line of the program's listing.
+    Line(usize),
+    /// The first block with this N number.
+    BlockNumber(u32),
 }
 
 /// The HTTP answer to a control request: status code and a line of text.
@@ -53,6 +70,25 @@ pub fn parse_action(name: &str, body: &str) -> Result<Action, String> {
         "hold" => Action::Hold,
         "resume" => Action::Resume,
         "reset" => Action::Reset,
+        "run-from-line" => {
+            let (program, at) = body.split_once('\n').ok_or(
+                "run-from-line: the body is the program, a line feed, and a line or N number",
+            )?;
+            let at = at.trim();
+            let from = match at.strip_prefix(['N', 'n']) {
+                Some(n) => n.parse().map(From::BlockNumber),
+                None => at.parse().map(From::Line),
+            }
+            .ok()
+            .filter(|f| *f != From::Line(0))
+            .ok_or_else(|| {
+                format!("run-from-line: '{at}' is neither a line (1, 2 …) nor an N number")
+            })?;
+            Action::RunFrom {
+                program: program.trim().to_string(),
+                from,
+            }
+        }
         "override" => match body.parse::<f64>() {
             Ok(p) if p.is_finite() => Action::Override(p),
             _ => return Err(format!("override: '{body}' is not a percentage")),
@@ -63,6 +99,8 @@ pub fn parse_action(name: &str, body: &str) -> Result<Action, String> {
 
 fn op(action: Action) -> Op {
     match action {
+        // Applied in steps by `run_from` (the search target, then the start).
+        Action::RunFrom { program, .. } => Op::Start(program),
         Action::Start => Op::CommandState(State::Active as i32),
         Action::StartProgram(p) => Op::Start(p),
         Action::Hold => Op::Hold,
@@ -102,12 +140,48 @@ pub fn handle(
         Ok(a) => a,
         Err(msg) => return Answer::new(400, msg),
     };
+    if let Action::RunFrom { program, from } = &action {
+        if let Err(a) = search_target(backend, ch, program, *from) {
+            return a;
+        }
+    }
     match backend.call(ch, op(action)) {
         Ok(Reply::Done | Reply::Command(Ok(()))) => Answer::new(200, "done"),
         Ok(Reply::Command(Err(e))) => Answer::new(409, e.to_string()),
         Ok(_) => Answer::new(500, "unexpected answer from the channel"),
         Err(DeviceError::NotFound) => Answer::new(404, format!("no channel {ch}")),
         Err(e) => Answer::new(503, format!("not applied: {e}")),
+    }
+}
+
+/// Set the channel's block search target for a run from `from` (`Op::SearchAt`, the door
+/// `run --search` uses): a line becomes the byte offset of its start in the program's text,
+/// which the channel knows once the program has run (its listing).
+fn search_target(backend: &Backend, ch: u16, program: &str, from: From) -> Result<(), Answer> {
+    let target = match from {
+        From::BlockNumber(n) => SearchTarget::BlockNumber(n),
+        From::Line(line) => {
+            let text = match backend.call(ch, Op::ProgramText(std::sync::Arc::from(program))) {
+                Ok(Reply::ProgramText(Some(t))) => t,
+                _ => {
+                    return Err(Answer::new(
+                        409,
+                        format!("the channel has no text of {program} yet (it has not run): run from its N number instead"),
+                    ))
+                }
+            };
+            let listing = Listing::new(std::sync::Arc::from(program), text);
+            let Some(offset) = listing.line_start(line) else {
+                return Err(Answer::new(409, format!("{program} has no line {line}")));
+            };
+            SearchTarget::Offset(offset)
+        }
+    };
+    match backend.call(ch, Op::SearchAt(Some(target))) {
+        Ok(Reply::Done) => Ok(()),
+        Ok(_) => Err(Answer::new(500, "unexpected answer from the channel")),
+        Err(DeviceError::NotFound) => Err(Answer::new(404, format!("no channel {ch}"))),
+        Err(e) => Err(Answer::new(503, format!("not applied: {e}"))),
     }
 }
 
@@ -125,5 +199,21 @@ mod tests {
         assert_eq!(parse_action("override", "50"), Ok(Action::Override(50.0)));
         assert!(parse_action("override", "NaN").is_err());
         assert!(parse_action("launch", "").is_err());
+        assert_eq!(
+            parse_action("run-from-line", "square.nc\n5"),
+            Ok(Action::RunFrom {
+                program: "square.nc".into(),
+                from: From::Line(5)
+            })
+        );
+        assert_eq!(
+            parse_action("run-from-line", "square.nc\nN40"),
+            Ok(Action::RunFrom {
+                program: "square.nc".into(),
+                from: From::BlockNumber(40)
+            })
+        );
+        assert!(parse_action("run-from-line", "square.nc\n0").is_err());
+        assert!(parse_action("run-from-line", "square.nc").is_err());
     }
 }

@@ -320,6 +320,12 @@ impl Listing {
         }
     }
 
+    /// Byte offset where 1-based `line` starts.
+    pub fn line_start(&self, line: usize) -> Option<u64> {
+        let i = line.checked_sub(1)?;
+        self.line_starts.get(i).map(|&s| s as u64)
+    }
+
     /// 1-based line holding byte `offset`.
     pub fn line_of(&self, offset: u64) -> usize {
         let offset = usize::try_from(offset).unwrap_or(usize::MAX);

@@ -177,3 +177,40 @@ fn two_content_lengths_are_refused() {
     assert!(r.body.contains("Content-Length"), "{}", r.body);
     assert_eq!(channels.status(1).state, State::Ready);
 }
+
+/// Run from line: by an N number before the program ever ran, by a listing line after; the
+/// first block that runs is the one asked for (block search), and the line is refused with
+/// the reason before the channel has the text.
+#[test]
+fn run_from_line_starts_at_the_block_asked_for() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let addr = web.local_addr();
+    let early = client::control(addr, 1, "run-from-line", "square.nc\n5");
+    assert_eq!(early.status, 409, "{}", early.body);
+    assert!(early.body.contains("N number"), "{}", early.body);
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\nN40").status,
+        200
+    );
+    let first_block = |events: &mut Events| {
+        events.until(WITHIN, |name, d| {
+            let c = client::channel(d, 1).filter(|_| name == "status")?;
+            c["block_n"].as_u64()
+        })
+    };
+    let n = first_block(&mut Events::open(addr));
+    assert!(n >= 40, "the run starts at N40, not N{n}");
+    assert_eq!(client::control(addr, 1, "reset", "").status, 200);
+    channels.wait_for(1, WITHIN, |s| s.state == State::Ready);
+    // The channel has the text now: line 6 of the listing is N50.
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\n6").status,
+        200
+    );
+    let n = first_block(&mut Events::open(addr));
+    assert!(n >= 50, "the run starts at N50, not N{n}");
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\n0").status,
+        400
+    );
+}

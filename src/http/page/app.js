@@ -277,11 +277,13 @@ function onListing(l) {
   const ol = $(v.node, ".listing");
   ol.textContent = "";
   const frag = document.createDocumentFragment();
-  for (const text of l.lines) {
+  l.lines.forEach((text, i) => {
     const li = document.createElement("li");
     li.textContent = text;
+    // A click picks the line to run from.
+    li.addEventListener("click", () => { $(v.node, ".from-line").value = String(i + 1); });
     frag.appendChild(li);
-  }
+  });
   if (l.lines_left_out) {
     const li = document.createElement("li");
     li.className = "left-out";
@@ -382,7 +384,14 @@ function wireControls(v) {
   for (const b of form.querySelectorAll("button[data-action]")) {
     b.addEventListener("click", () => {
       const a = b.dataset.action;
-      send(a, a === "start" ? $(form, ".program").value : "");
+      const program = $(form, ".program").value.trim();
+      if (a === "run-from-line") {
+        // The program named in the field, else the one listed.
+        const listed = $(v.node, ".program-name").textContent;
+        send(a, (program || listed) + "\n" + $(form, ".from-line").value.trim());
+      } else {
+        send(a, a === "start" ? program : "");
+      }
     });
   }
   const range = $(form, ".override");
