@@ -190,12 +190,14 @@ pub(super) fn start_at_first_tick(
     }
 }
 
-/// `--http`: the live web view over its own backend into the same runtime as ADS.
+/// `--http`: the live web view over its own backend into the same runtime as ADS, with
+/// `previews` of whole programs when given.
 pub(crate) fn spawn_web<C: crate::runtime::Cycle>(
     args: &ServeArgs,
     rt: &mut Runtime<C>,
     requests: crossbeam_channel::Sender<crate::machine::Request>,
     channels: u16,
+    previews: Option<crate::http::preview::Previewer>,
 ) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
     let Some(bind) = args.http else {
         return Ok(None);
@@ -214,6 +216,9 @@ pub(crate) fn spawn_web<C: crate::runtime::Cycle>(
     let backend = Arc::new(ChannelBackend::new(requests, channels));
     match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
         Ok(h) => {
+            if let Some(p) = previews {
+                h.set_previewer(p);
+            }
             say(format_args!(
                 "web view on http://{}/ (controls {})",
                 h.local_addr(),
@@ -293,7 +298,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
-    let web = match spawn_web(&args, &mut rt, requests.clone(), nch) {
+    let previews = crate::http::preview::previewer(config.clone(), loader.clone());
+    let web = match spawn_web(&args, &mut rt, requests.clone(), nch, Some(previews)) {
         Ok(w) => w,
         Err(code) => return code,
     };

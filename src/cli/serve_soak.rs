@@ -45,7 +45,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     } = soak;
     let net_id = server_config.net_id;
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let web = match super::serve::spawn_web(&args, &mut rt, requests.clone(), nch) {
+    let web = match super::serve::spawn_web(&args, &mut rt, requests.clone(), nch, None) {
         Ok(w) => w,
         Err(code) => return code,
     };

@@ -13,6 +13,7 @@ pub mod controls;
 pub mod feed;
 pub mod page;
 pub mod path;
+pub mod preview;
 pub mod server;
 pub mod snapshot;
 pub mod sse;

@@ -92,6 +92,9 @@ async function withControls(context, url, seen) {
   seen.current_line = await page.textContent("#ch1 .listing li.current");
   seen.block = await page.textContent("#ch1 .block");
   seen.listing_lines = await page.locator("#ch1 .listing li").count();
+  // The whole program's preview under the path so far.
+  await page.waitForFunction(() => Number(document.querySelector("#ch1 .plot").dataset.previewPoints) > 1);
+  seen.preview_points = Number(await page.getAttribute("#ch1 .plot", "data-preview-points"));
   // The update rate the page measured, after it has had two seconds of updates.
   await page.waitForTimeout(2500);
   seen.update_hz = Number(await page.getAttribute("#rate", "data-hz"));

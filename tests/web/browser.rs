@@ -36,6 +36,11 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
         allow_hosts: Vec::new(),
     };
     let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
+    let lists = ncchannel::params::load(&channels.params.startup()).unwrap();
+    with_controls.set_previewer(ncchannel::http::preview::previewer(
+        lists,
+        ncchannel::Loader::start(),
+    ));
     channels.command(2, Op::Start("streaming.nc".into()));
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/node/live_view_test.js");
     let args = [
@@ -73,6 +78,7 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
     // (the page reads them one after the other while the program runs).
     let (n_line, n_block) = (n_number(line).unwrap(), n_number(block).unwrap());
     assert!(n_line.abs_diff(n_block) <= 10, "{line} / {block}");
+    assert!(seen["preview_points"].as_u64().unwrap() >= 2, "{seen}");
     assert_eq!(seen["held"], true);
     assert_eq!(channels.status(1).state, State::Hold);
     let error = seen["error"].as_str().unwrap();

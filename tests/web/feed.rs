@@ -170,3 +170,32 @@ fn a_late_page_gets_the_path_since_the_start_and_scripts_a_snapshot() {
         .collect();
     assert!(g.contains(&"G90") && g.contains(&"G17"), "{g:?}");
 }
+
+/// The whole-program preview of a file program before it runs: the square's corners, its
+/// channel time, and nothing started on the channel.
+#[test]
+fn a_file_program_is_previewed_before_it_runs() {
+    let (web, channels) = view(ControlAccess::Refused);
+    let r = client::get(web.local_addr(), "/preview/1/square.nc");
+    assert_eq!(r.status, 200, "{}", r.body);
+    let p: serde_json::Value = serde_json::from_str(&r.body).unwrap();
+    assert_eq!(p["complete"], true, "{p}");
+    // 40 + 10 + 30 + 50 + 40 mm and a quarter circle at 10 mm/s: about 17 s.
+    let seconds = p["seconds"].as_f64().unwrap();
+    assert!((15.0..20.0).contains(&seconds), "{seconds}");
+    let points = p["points"].as_array().unwrap();
+    let xs: Vec<f64> = points.iter().map(|q| q[0].as_f64().unwrap()).collect();
+    let ys: Vec<f64> = points.iter().map(|q| q[1].as_f64().unwrap()).collect();
+    let max = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+    assert!(
+        (max(&xs) - 50.0).abs() < 0.05 && (max(&ys) - 40.0).abs() < 0.05,
+        "{p}"
+    );
+    assert_eq!(
+        channels.status(1).state,
+        State::Ready,
+        "the channel itself ran nothing"
+    );
+    let missing = client::get(web.local_addr(), "/preview/1/nothing.nc");
+    assert_eq!(missing.status, 409, "{}", missing.body);
+}

@@ -291,6 +291,7 @@ function onListing(l) {
     frag.appendChild(li);
   }
   v.streamListing = !l.lines.length;
+  if (!v.streamListing && l.program) askPreview(v, l.program);
   ol.classList.toggle("streamed", v.streamListing);
   if (v.streamListing) {
     const li = document.createElement("li");
@@ -394,9 +395,27 @@ function wireControls(v) {
       }
     });
   }
+  $(form, ".program").addEventListener("change", () => askPreview(v, $(form, ".program").value.trim()));
   const range = $(form, ".override");
   range.addEventListener("input", () => { $(form, ".override-value").textContent = range.value; });
   range.addEventListener("change", () => send("override", range.value));
+}
+
+// ---- whole-program preview: the program run on a private copy of the channel ----
+
+async function askPreview(v, program) {
+  if (!program || v.previewOf === program) return;
+  v.previewOf = program;
+  try {
+    const r = await fetch("/preview/" + v.ch + "/" + encodeURIComponent(program));
+    if (!r.ok) { if (r.status === 503) v.previewOf = null; return; }
+    const p = await r.json();
+    if (v.previewOf !== program) return;
+    v.preview = p;
+    schedulePlot(v);
+  } catch (err) {
+    v.previewOf = null;
+  }
 }
 
 // ---- backplot: the channel's path since its program started (1:1, rapids dashed) ----
@@ -452,7 +471,8 @@ function drawPlot(v) {
   const pts = v.path.map((p) => project(view, p));
   const tail = v.tail ? project(view, v.tail) : null;
   const origin = project(view, v.origin);
-  const fitPts = pts.concat(tail ? [tail] : [], [origin]);
+  const pre = v.preview ? v.preview.points.map((p) => project(view, p)) : [];
+  const fitPts = pts.concat(tail ? [tail] : [], [origin], pre);
   let [x0, y0, x1, y1] = [Infinity, Infinity, -Infinity, -Infinity];
   for (const [x, y] of fitPts) { x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); }
   const span = Math.max(x1 - x0, y1 - y0, 1);
@@ -474,6 +494,14 @@ function drawPlot(v) {
     g.stroke();
     g.setLineDash([]);
   }
+  // The whole program's preview, light, beneath the path so far.
+  if (pre.length > 1) {
+    g.strokeStyle = "#c5d3e8"; g.lineWidth = 3; g.setLineDash([]);
+    g.beginPath();
+    pre.forEach(([x, y], k) => (k ? g.lineTo(sx(x), sy(y)) : g.moveTo(sx(x), sy(y))));
+    g.stroke();
+  }
+  canvas.dataset.previewPoints = pre.length;
   // The work origin (the active zero offset) as a cross.
   g.strokeStyle = "#2b8a3e"; g.lineWidth = 1.5;
   g.beginPath();
@@ -523,7 +551,8 @@ function drawPlot(v) {
   }
   const labels = { xy: "X → / Y ↑", xz: "X → / Z ↑", yz: "Y → / Z ↑", iso: "3-D isometric" };
   $(v.node, ".plot-scale").textContent = labels[view] + " machine mm · grid " + step + " mm · 1:1 · "
-    + v.path.length + " points within " + fmt(v.tolerance || 0, 3) + " mm · rapids dashed · + work origin";
+    + v.path.length + " points within " + fmt(v.tolerance || 0, 3) + " mm · rapids dashed · + work origin"
+    + (v.preview ? " · light: the whole of " + v.preview.program + " (" + duration(v.preview.seconds) + (v.preview.complete ? "" : ", cut") + ")" : "");
 }
 
 function drawGrid(g, w, h, step, sx, sy, scale, cx, cy) {
