@@ -219,6 +219,9 @@ pub struct Status {
     pub(crate) stream_writes_full: u64,
     /// Program and line of the last error, where known.
     pub(crate) last_error_at: Option<(Option<String>, Option<u64>)>,
+    /// The streaming program (`streaming_prog_file`), if streaming is on: what the live
+    /// view's MDI and jog start.
+    pub(crate) streaming_program: Option<String>,
 }
 
 /// The file names of a channel's tool list (`werkz_data[i]` or `tools.lis`) and zero-offset
@@ -418,6 +421,7 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         modal: Box::new(c.decoder.modal().clone()),
         stream_writes_full: c.stream.counters().writes_full,
         last_error_at: c.log.last_error().map(|e| (e.prog.clone(), e.line)),
+        streaming_program: c.store.streaming_program().map(str::to_string),
     }
 }
 

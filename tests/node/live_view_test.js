@@ -51,6 +51,8 @@ async function readOnly(context, url, seen) {
   await page.locator("#access.off").waitFor();
   // The controls look disabled, and a start sent anyway is refused with the server's reason.
   check(await page.locator("#ch1 button[data-action=start]").isDisabled(), "start disabled");
+  check(await page.locator("#ch1 button[data-action=mdi]").isDisabled(), "MDI disabled");
+  check(await page.locator("#ch1 button[data-jog=X]").isDisabled(), "jog disabled");
   seen.refused = await page.evaluate(async () => {
     const r = await fetch("/control/1/start", {
       method: "POST",
@@ -78,6 +80,15 @@ async function withControls(context, url, seen) {
   watchRequests(page, new URL(url).origin, seen.foreign);
   await page.goto(url);
   await page.locator("#access.on").waitFor();
+  // MDI and jog move the axes (through the channel's stream), and the DRO shows it.
+  await page.fill("#ch1 .mdi", "G01 X5 F3000");
+  await page.click("#ch1 button[data-action=mdi]");
+  await page.locator("#ch1 .dro tr[data-axis=X] .mcs").filter({ hasText: /^5\.000$/ }).waitFor();
+  await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
+  await page.click("#ch1 button[data-jog=Y]");
+  await page.locator("#ch1 .dro tr[data-axis=Y] .mcs").filter({ hasText: /^1\.000$/ }).waitFor();
+  await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
+  seen.mdi_jog = await page.textContent("#ch1 .dro tbody");
   await page.fill("#ch1 .program", "square.nc");
   await page.click("#ch1 button[data-action=start]");
   await page.locator("#ch1 .control-answer.ok").waitFor();

@@ -79,6 +79,9 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
     let (n_line, n_block) = (n_number(line).unwrap(), n_number(block).unwrap());
     assert!(n_line.abs_diff(n_block) <= 10, "{line} / {block}");
     assert!(seen["preview_points"].as_u64().unwrap() >= 2, "{seen}");
+    // MDI X5 and a jog of Y by 1 mm moved the axes (the read-only page could not).
+    let dro = seen["mdi_jog"].as_str().unwrap();
+    assert!(dro.contains("5.000") && dro.contains("1.000"), "{dro}");
     assert_eq!(seen["held"], true);
     assert_eq!(channels.status(1).state, State::Hold);
     let error = seen["error"].as_str().unwrap();

@@ -359,7 +359,7 @@ let controlsOn = null; // unknown until /controls answers
 // Read-only: every control is disabled (and looks it); the server refuses them anyway.
 function setControlsEnabled(v) {
   const form = $(v.node, ".controls");
-  for (const el of form.querySelectorAll("button, input")) el.disabled = controlsOn !== true;
+  for (const el of form.querySelectorAll("button, input, select")) el.disabled = controlsOn !== true;
   form.classList.toggle("disabled", controlsOn !== true);
   form.title = controlsOn === false ? "read-only: serve --http-controls enables the controls" : "";
 }
@@ -386,13 +386,22 @@ function wireControls(v) {
     b.addEventListener("click", () => {
       const a = b.dataset.action;
       const program = $(form, ".program").value.trim();
-      if (a === "run-from-line") {
+      if (a === "mdi") {
+        send(a, $(form, ".mdi").value.trim());
+      } else if (a === "run-from-line") {
         // The program named in the field, else the one listed.
         const listed = $(v.node, ".program-name").textContent;
         send(a, (program || listed) + "\n" + $(form, ".from-line").value.trim());
       } else {
         send(a, a === "start" ? program : "");
       }
+    });
+  }
+  // Jog: an incremental move by the chosen step, through the channel's stream (as MDI).
+  for (const b of form.querySelectorAll("button[data-jog]")) {
+    b.addEventListener("click", () => {
+      const j = b.dataset.jog, step = $(form, ".jog-step").value;
+      send("jog", j[0] + (j.endsWith("-") ? "-" : "") + step);
     });
   }
   $(form, ".program").addEventListener("change", () => askPreview(v, $(form, ".program").value.trim()));
