@@ -52,11 +52,11 @@ pub struct ServeArgs {
     #[arg(long, value_name = "SECONDS")]
     pub(crate) ads_idle_timeout: Option<f64>,
     /// Serve the live web view on this address (default 127.0.0.1:8080; loopback unless
-    /// --allow-non-loopback). Port 0 picks one.
+    /// --allow-non-loopback). Port 0 picks one. With --soak it shows the soak's counters too.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub http: Option<SocketAddr>,
-    /// Let the web view's operator controls (start, hold, resume, reset, override) command the
-    /// channels; without it they are refused (HTTP 403).
+    /// Let the web view's operator controls (start, hold, resume, reset, override, run from
+    /// line, MDI, jog) command the channels; without it they are refused (HTTP 403).
     #[arg(long, requires = "http")]
     pub http_controls: bool,
     /// A further `Host` name the web view answers (repeatable), e.g. the name a reverse proxy
