@@ -271,7 +271,7 @@ impl<C: Cycle> Runtime<C> {
                 self.stats.overruns += u64::from(overrun);
             }
             if let Some(live) = &self.live {
-                live.publish(late, overrun);
+                live.publish(work, late, overrun);
             }
             self.next_index += 1;
             if flow == Flow::Stop {

@@ -79,6 +79,9 @@ pub enum Op {
     /// [`Reply::Done`] when it is active, `Reply::Value(None)` when the machine's watches
     /// are full. Served by the machine, not by a channel.
     Watch(WatchSlot),
+    /// The live view's record of the channel since the last drain ([`Reply::Live`]); the
+    /// first drain turns the record on (`machine::live`). Served by the machine.
+    DrainLive,
 }
 
 /// What `run` asks of the motion trace.
@@ -203,6 +206,22 @@ pub struct Status {
     /// Technology functions output and acknowledged so far, and which units hold a function
     /// still open (not yet acknowledged): `techno.std` then `techno.late`, by index.
     pub techno_open: TechnoOpen,
+    /// The executing motion block's programmed feed, mm/min, and whether it is a rapid
+    /// (`None` between moves): the live view's feed, where `feed_mm_per_min` is the
+    /// decoder's, ahead by the lookahead.
+    pub(crate) executing_feed_mm_per_min: Option<f64>,
+    pub(crate) executing_rapid: bool,
+    /// The decoder's modal state (spindle, tool, G groups, zero offset), ahead of execution
+    /// by the lookahead.
+    pub(crate) modal: Box<crate::decoder::modal::Modal>,
+    /// Stream writes refused because the buffer had no room (11012), since the channel was
+    /// built.
+    pub(crate) stream_writes_full: u64,
+    /// Program and line of the last error, where known.
+    pub(crate) last_error_at: Option<(Option<String>, Option<u64>)>,
+    /// The streaming program (`streaming_prog_file`), if streaming is on: what the live
+    /// view's MDI and jog start.
+    pub(crate) streaming_program: Option<String>,
 }
 
 /// The file names of a channel's tool list (`werkz_data[i]` or `tools.lis`) and zero-offset
@@ -337,6 +356,8 @@ pub enum Reply {
         seen: Vec<TechnoSeen>,
         lost: u64,
     },
+    /// What [`Op::DrainLive`] asked for.
+    Live(Box<crate::machine::live::LiveDrain>),
 }
 
 /// An error as the ADS objects carry it: number and text.
@@ -392,6 +413,15 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         distance_to_go_mm: c.motion.distance_to_go_mm(),
         techno,
         techno_open,
+        executing_feed_mm_per_min: c.motion.executing_move().map(|m| m.feed_mm_per_min),
+        executing_rapid: c
+            .motion
+            .executing_move()
+            .is_some_and(|m| m.kind == crate::queue::MoveKind::Rapid),
+        modal: Box::new(c.decoder.modal().clone()),
+        stream_writes_full: c.stream.counters().writes_full,
+        last_error_at: c.log.last_error().map(|e| (e.prog.clone(), e.line)),
+        streaming_program: c.store.streaming_program().map(str::to_string),
     }
 }
 

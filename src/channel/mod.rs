@@ -163,8 +163,8 @@ impl Channel {
             Op::ReadExternalTyped(name) => {
                 Reply::External(self.decoder.vars().external_value(&name))
             }
-            // Served by the machine (`machine::watch`), never by a channel.
-            Op::Watch(_) => Reply::NoChannel,
+            // Served by the machine (`machine::watch`, `machine::live`), never by a channel.
+            Op::Watch(_) | Op::DrainLive => Reply::NoChannel,
             Op::Status => {
                 let mut s = self.status();
                 s.tick = tick.index;
@@ -298,6 +298,30 @@ impl Channel {
     /// where `status()` would allocate.
     pub(crate) fn position(&self) -> Position {
         self.motion.position()
+    }
+    /// Whether the executing motion block is a rapid (G0); for the live view's path record
+    /// (`machine::live`), read every tick where `status()` would allocate.
+    pub(crate) fn executing_rapid(&self) -> bool {
+        self.motion
+            .executing_move()
+            .is_some_and(|m| m.kind == crate::queue::MoveKind::Rapid)
+    }
+    /// Bytes the stream interface holds and bytes taken from it so far; for the live view's
+    /// stream record (`machine::live`).
+    pub(crate) fn stream_fill(&self) -> (usize, u64) {
+        (self.stream.used(), self.stream.counters().bytes_taken)
+    }
+    /// Bytes the stream interface accepted since the channel was built.
+    pub(crate) fn stream_written(&self) -> u64 {
+        self.stream.counters().bytes_written
+    }
+    /// The block that took effect last since the program start.
+    pub(crate) fn active_block(&self) -> Option<&ActiveBlock> {
+        self.run.active_block()
+    }
+    /// The configured axes' limits (software limits, rates).
+    pub(crate) fn axis_limits(&self) -> &[crate::motion::AxisLimits] {
+        self.motion.axes()
     }
     /// How the last program run finished, taken once.
     pub fn take_finish(&mut self) -> Option<Finish> {

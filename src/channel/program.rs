@@ -23,6 +23,8 @@ pub(crate) struct ActiveBlock {
     /// ISG block counter of the block.
     pub counter: u64,
     pub n: Option<u32>,
+    /// The block came from the stream interface (its offset counts from the stream start).
+    pub stream: bool,
 }
 
 /// The run of the last started main program.
@@ -107,6 +109,7 @@ impl ProgramRun {
                 a.offset = info.offset;
                 a.counter = info.counter;
                 a.n = info.n;
+                a.stream = info.stream;
             }
             _ => {
                 self.active = Some(ActiveBlock {
@@ -114,6 +117,7 @@ impl ProgramRun {
                     offset: info.offset,
                     counter: info.counter,
                     n: info.n,
+                    stream: info.stream,
                 })
             }
         }

@@ -161,6 +161,7 @@ pub fn execute(b: &LiveBench<'_>) -> Result<ExitCode, String> {
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::Never);
+    machine.record_live();
     if let Err(e) = super::serve::start_at_first_tick(&mut machine, period, PROGRAM) {
         return Ok(fail(format!("starting the generated program: {e}")));
     }

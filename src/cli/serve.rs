@@ -52,11 +52,11 @@ pub struct ServeArgs {
     #[arg(long, value_name = "SECONDS")]
     pub(crate) ads_idle_timeout: Option<f64>,
     /// Serve the live web view on this address (default 127.0.0.1:8080; loopback unless
-    /// --allow-non-loopback). Port 0 picks one.
-    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080", conflicts_with = "soak")]
+    /// --allow-non-loopback). Port 0 picks one. With --soak it shows the soak's counters too.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub http: Option<SocketAddr>,
-    /// Let the web view's operator controls (start, hold, resume, reset, override) command the
-    /// channels; without it they are refused (HTTP 403).
+    /// Let the web view's operator controls (start, hold, resume, reset, override, run from
+    /// line, MDI, jog) command the channels; without it they are refused (HTTP 403).
     #[arg(long, requires = "http")]
     pub http_controls: bool,
     /// A further `Host` name the web view answers (repeatable), e.g. the name a reverse proxy
@@ -196,12 +196,14 @@ pub(super) fn start_at_first_tick(
     }
 }
 
-/// `--http`: the live web view over its own backend into the same runtime as ADS.
-fn spawn_web(
+/// `--http`: the live web view over its own backend into the same runtime as ADS, with
+/// `previews` of whole programs when given.
+pub(crate) fn spawn_web<C: crate::runtime::Cycle>(
     args: &ServeArgs,
-    rt: &mut Runtime<Machine>,
+    rt: &mut Runtime<C>,
     requests: crossbeam_channel::Sender<crate::machine::Request>,
     channels: u16,
+    previews: Option<crate::http::preview::Previewer>,
 ) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
     let Some(bind) = args.http else {
         return Ok(None);
@@ -220,6 +222,9 @@ fn spawn_web(
     let backend = Arc::new(ChannelBackend::new(requests, channels));
     match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
         Ok(h) => {
+            if let Some(p) = previews {
+                h.set_previewer(p);
+            }
             super::logger::line(format_args!(
                 "web view on http://{}/ (controls {})",
                 h.local_addr(),
@@ -231,29 +236,34 @@ fn spawn_web(
     }
 }
 
+/// The checks of `serve`'s arguments before anything starts: `--ads-idle-timeout`, the
+/// `--soak` scenario (whose lists replace `--params`) and where the lists are.
+fn checked_scenario(args: &mut ServeArgs) -> Result<Option<Scenario>, String> {
+    if let Some(s) = args.ads_idle_timeout {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(format!("--ads-idle-timeout {s}: not a positive time"));
+        }
+    }
+    let scenario = match &args.soak {
+        None => None,
+        Some(p) => {
+            let s = load_scenario(p)?;
+            args.params = s.params_path();
+            Some(s)
+        }
+    };
+    args.params = crate::params::shipped::locate(&args.params).map_err(|e| e.to_string())?;
+    Ok(scenario)
+}
+
 pub fn execute(mut args: ServeArgs) -> ExitCode {
     let limit = match run_limit(args.seconds) {
         Ok(l) => l,
         Err(msg) => return usage(msg),
     };
-    if let Some(s) = args.ads_idle_timeout {
-        if !(s.is_finite() && s > 0.0) {
-            return usage(format!("--ads-idle-timeout {s}: not a positive time"));
-        }
-    }
-    let scenario = match &args.soak {
-        None => None,
-        Some(p) => match load_scenario(p) {
-            Ok(s) => {
-                args.params = s.params_path();
-                Some(s)
-            }
-            Err(msg) => return usage(msg),
-        },
-    };
-    args.params = match crate::params::shipped::locate(&args.params) {
-        Ok(p) => p,
-        Err(e) => return usage(e.to_string()),
+    let scenario = match checked_scenario(&mut args) {
+        Ok(s) => s,
+        Err(msg) => return usage(msg),
     };
     // The program loader of the served channels: large program files are read, and large
     // texts freed, off the runtime thread.
@@ -270,6 +280,9 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     let nch = channels.len() as u16;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, log, StopWhen::Never);
+    if args.http.is_some() {
+        machine.record_live();
+    }
     if let Err(msg) = super::run::attach_plcs(&mut machine, config.runtime.plc.as_ref()) {
         return usage(msg);
     }
@@ -282,6 +295,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     if let Some(sc) = scenario {
         let cycle = supervised(machine, &sc, &config);
         let soak = super::serve_soak::SoakServe {
+            args: args.clone(),
             server_config: server_config(&args, &config),
             limit,
             report: args.report.clone(),
@@ -293,7 +307,8 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
-    let web = match spawn_web(&args, &mut rt, requests.clone(), nch) {
+    let previews = crate::http::preview::previewer(config.clone(), loader.clone());
+    let web = match spawn_web(&args, &mut rt, requests.clone(), nch, Some(previews)) {
         Ok(w) => w,
         Err(code) => return code,
     };

@@ -21,6 +21,8 @@ use super::out::say;
 /// What `serve` settled before handing over: the ADS endpoint, the run limit, the report
 /// file, the cycle time and the channel count.
 pub struct SoakServe {
+    /// The command line, for `--http` (the live view beside the soak).
+    pub args: super::serve::ServeArgs,
     pub(crate) server_config: ServerConfig,
     pub limit: Option<Duration>,
     pub report: Option<PathBuf>,
@@ -35,6 +37,7 @@ pub struct SoakServe {
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
     let SoakServe {
+        args,
         server_config,
         limit,
         report: report_path,
@@ -51,6 +54,10 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         return ExitCode::from(exit::USAGE);
     }
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
+    let web = match super::serve::spawn_web(&args, &mut rt, requests.clone(), nch, None) {
+        Ok(w) => w,
+        Err(code) => return code,
+    };
     let backend = ChannelBackend::new(requests, nch).with_reply_timeout(reply_timeout);
     let server = match crate::ads::spawn(server_config, Arc::new(backend)) {
         Ok(s) => s,
@@ -69,32 +76,14 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     let warmup = limit.map_or(Duration::from_secs(10), |l| {
         l.mul_f64(scenario.invariants.warmup)
     });
-    let chunk = ((0.05 / period.as_secs_f64()) as u64).max(1);
     if let Err(code) = super::enter_realtime(&realtime, "serve", say) {
         server.shutdown();
         return code;
     }
-    let live = std::io::stderr().is_terminal();
     let start = Instant::now();
-    let mut last_status = start;
-    let mut warm_kib = None;
-    loop {
-        let s = rt.run(Some(chunk));
-        let wall = start.elapsed();
-        if warm_kib.is_none() && wall >= warmup {
-            warm_kib = resident();
-        }
-        announce_resets(&mut rt, period, live);
-        if s.end == RunEnd::StopRequested || limit.is_some_and(|l| wall >= l) {
-            break;
-        }
-        let every = if live { 500 } else { 5_000 };
-        if last_status.elapsed() >= Duration::from_millis(every) {
-            last_status = Instant::now();
-            status_line(&rt, wall, live);
-        }
-    }
+    let warm_kib = serve_until_stopped(&mut rt, web.as_ref(), (period, limit, warmup), start);
     server.shutdown();
+    drop(web); // the web view stops polling and ends its pages' streams
     let wall = start.elapsed().as_secs_f64();
     let ticks = rt.ticks();
     let sim_seconds = rt.time().as_secs_f64();
@@ -129,6 +118,40 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
     } else {
         exit::CHANNEL_ERROR
     })
+}
+
+/// Runs the soak in chunks of 50 ms of ticks until a stop or the limit
+/// (`timing`: period, limit, warm-up), announcing resets, publishing to the web view and
+/// printing the status line; the resident memory (KiB) once the warm-up is over.
+fn serve_until_stopped(
+    rt: &mut Runtime<Supervised>,
+    web: Option<&crate::http::HttpHandle>,
+    timing: (Duration, Option<Duration>, Duration),
+    start: Instant,
+) -> Option<u64> {
+    let (period, limit, warmup) = timing;
+    let chunk = ((0.05 / period.as_secs_f64()) as u64).max(1);
+    let live = std::io::stderr().is_terminal();
+    let mut last_status = start;
+    let mut warm_kib = None;
+    let mut last_published = start;
+    loop {
+        let s = rt.run(Some(chunk));
+        let wall = start.elapsed();
+        if warm_kib.is_none() && wall >= warmup {
+            warm_kib = resident();
+        }
+        announce_resets(rt, period, live);
+        if s.end == RunEnd::StopRequested || limit.is_some_and(|l| wall >= l) {
+            return warm_kib;
+        }
+        publish_soak(web, rt, wall, &mut last_published);
+        let every = if live { 500 } else { 5_000 };
+        if last_status.elapsed() >= Duration::from_millis(every) {
+            last_status = Instant::now();
+            status_line(rt, wall, live);
+        }
+    }
 }
 
 /// The soak's report of a `serve --soak` run (`times`: ticks, channel seconds, wall seconds).
@@ -197,6 +220,37 @@ fn announce_resets(rt: &mut Runtime<Supervised>, period: Duration, live: bool) {
             super::out::now()
         );
     }
+}
+
+/// How often `serve --soak --http` hands the soak's counters to the live view: the
+/// invariants' verdicts are worked out on the runtime's thread between ticks, so not at the
+/// view's 20 Hz.
+const SOAK_VIEW_PERIOD: Duration = Duration::from_millis(500);
+
+/// Hand the soak to the live view when [`SOAK_VIEW_PERIOD`] has passed since `last`.
+fn publish_soak(
+    web: Option<&crate::http::HttpHandle>,
+    rt: &Runtime<Supervised>,
+    wall: Duration,
+    last: &mut Instant,
+) {
+    if let Some(w) = web {
+        if last.elapsed() >= SOAK_VIEW_PERIOD {
+            *last = Instant::now();
+            w.publish_soak(soak_view(rt, wall));
+        }
+    }
+}
+
+/// The soak as the live view shows it: run time, each channel's counters and the
+/// invariants' verdicts so far (the report's words).
+fn soak_view(rt: &Runtime<Supervised>, wall: Duration) -> serde_json::Value {
+    serde_json::json!({
+        "seconds": wall.as_secs_f64(),
+        "blocks": rt.cycle().blocks(),
+        "channels": rt.cycle().counters(),
+        "invariants": rt.cycle().verdicts(None, 0),
+    })
 }
 
 fn status_line(rt: &Runtime<Supervised>, wall: Duration, live: bool) {

@@ -4,14 +4,18 @@
 //! Parts, one per file: [`server`] accepts page connections (at most
 //! [`MAX_PAGE_CONNECTIONS`]) and routes requests; [`feed`] polls every channel through
 //! [`CncBackend`] at [`FEED_PERIOD`] on a thread of its own and hands each update to the
-//! connected pages; [`snapshot`] is what one update says; [`sse`] writes the updates to one
-//! page; [`controls`] turns an operator's POST into an [`crate::machine::Op`]; [`page`] holds
-//! the embedded page. Nothing here runs on the runtime's thread: a poll is an ordinary
+//! connected pages; [`snapshot`] is what one update says; [`path`] keeps each channel's path
+//! since its program started and cuts the stream's text into lines; [`preview`] runs a whole
+//! program on a private copy of the channels; [`sse`] writes the updates to one page;
+//! [`controls`] turns an operator's POST into [`crate::machine::Op`]s; [`page`] holds the
+//! embedded page. Nothing here runs on the runtime's thread: a poll is an ordinary
 //! request the tick serves, as an ADS read is, and a page that reads too slowly is dropped.
 
 pub mod controls;
 pub mod feed;
 pub mod page;
+pub mod path;
+pub mod preview;
 pub mod server;
 pub mod snapshot;
 pub mod sse;
@@ -48,7 +52,8 @@ pub const MAX_REQUEST_BYTES: usize = 8 * 1024;
 pub enum ControlAccess {
     /// Read-only view: every control request is refused with 403.
     Refused,
-    /// `--http-controls`: start, hold, resume, reset and override go through the door.
+    /// `--http-controls`: start, hold, resume, reset, override, run from line, MDI and jog go
+    /// through the door.
     Allowed,
 }
 

@@ -63,6 +63,9 @@ struct Shared {
     /// clients trickling heads cannot lock pages out (slowloris).
     heads: std::sync::Mutex<std::collections::VecDeque<(u64, TcpStream)>>,
     next_id: std::sync::atomic::AtomicU64,
+    /// Computes whole-program previews (`GET /preview/<channel>/<program>`), one at a time.
+    previewer: std::sync::Mutex<Option<super::preview::Previewer>>,
+    previewing: AtomicBool,
 }
 
 /// The running web view.
@@ -76,6 +79,19 @@ pub struct HttpHandle {
 impl HttpHandle {
     pub fn local_addr(&self) -> SocketAddr {
         self.local_addr
+    }
+
+    /// Answer `GET /preview/<channel>/<program>` with `previewer` (`serve` sets it up from
+    /// its lists; without one the preview is 404).
+    pub fn set_previewer(&self, previewer: super::preview::Previewer) {
+        if let Ok(mut p) = self.shared.previewer.lock() {
+            *p = Some(previewer);
+        }
+    }
+
+    /// Show the soak's counters and invariants on the page from the next update on.
+    pub fn publish_soak(&self, soak: serde_json::Value) {
+        self.shared.pages.publish_soak(soak);
     }
 
     /// Pages whose event stream is open now.
@@ -140,6 +156,8 @@ pub fn spawn(
         streams: AtomicUsize::new(0),
         heads: std::sync::Mutex::new(std::collections::VecDeque::new()),
         next_id: std::sync::atomic::AtomicU64::new(0),
+        previewer: std::sync::Mutex::new(None),
+        previewing: AtomicBool::new(false),
     });
     let accept_shared = Arc::clone(&shared);
     let accept = std::thread::Builder::new()
@@ -345,6 +363,24 @@ fn route(mut socket: TcpStream, req: &Request, shared: &Shared) -> Result<(), Re
             );
             Ok(respond(&mut socket, a.status, text, &a.text)?)
         }
+        ("GET", "/snapshot.json") => match shared.pages.snapshot() {
+            Some(json) => Ok(respond(
+                &mut socket,
+                200,
+                "application/json; charset=utf-8",
+                &json,
+            )?),
+            None => Ok(respond(&mut socket, 503, text, "no update yet")?),
+        },
+        ("GET", p) if p.starts_with("/preview/") => {
+            let (status, body) = preview(shared, &p["/preview/".len()..]);
+            let kind = if status == 200 {
+                "application/json; charset=utf-8"
+            } else {
+                text
+            };
+            Ok(respond(&mut socket, status, kind, &body)?)
+        }
         ("GET", "/controls") => {
             let on = shared.controls == ControlAccess::Allowed;
             Ok(respond(
@@ -360,6 +396,55 @@ fn route(mut socket: TcpStream, req: &Request, shared: &Shared) -> Result<(), Re
         },
         _ => Ok(respond(&mut socket, 405, text, "method not allowed")?),
     }
+}
+
+/// A whole-program preview: `rest` is `<channel>/<program>`; one at a time (each runs the
+/// program on a private copy of the channels), others are answered 503.
+fn preview(shared: &Shared, rest: &str) -> (u16, String) {
+    let Some((ch, program)) = rest.split_once('/') else {
+        return (404, "use /preview/<channel>/<program>".into());
+    };
+    let Ok(ch) = ch.parse::<u16>() else {
+        return (404, format!("no channel '{ch}'"));
+    };
+    let program = percent_decoded(program);
+    let Some(previewer) = shared.previewer.lock().ok().and_then(|p| p.clone()) else {
+        return (404, "no previews in this view".into());
+    };
+    if shared.previewing.swap(true, Ordering::SeqCst) {
+        return (503, "a preview is being computed: ask again".into());
+    }
+    let answer = previewer(ch, &program);
+    shared.previewing.store(false, Ordering::SeqCst);
+    match answer.map(|p| serde_json::to_string(&p)) {
+        Ok(Ok(json)) => (200, json),
+        Ok(Err(e)) => (500, e.to_string()),
+        Err(reason) => (409, reason),
+    }
+}
+
+/// `%XX` escapes of a path segment decoded (a program name with a space); invalid ones kept.
+fn percent_decoded(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = b
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (b[i], hex) {
+            (b'%', Some(v)) => {
+                out.push(v);
+                i += 3;
+            }
+            (c, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
 }
 
 /// Read one request head and its body (both within [`MAX_REQUEST_BYTES`]).

@@ -28,6 +28,9 @@ pub struct ErrorView {
     /// ISG error number.
     pub code: u32,
     pub text: String,
+    /// Program and 1-based line the error is about, where the channel knows them.
+    pub program: Option<String>,
+    pub line: Option<u64>,
 }
 
 /// One channel in one update.
@@ -56,6 +59,80 @@ pub struct ChannelView {
     pub last_error: Option<ErrorView>,
     pub message: Option<String>,
     pub techno: TechnoView,
+    /// The executing motion block's programmed feed, mm/min (`None` between moves), and
+    /// whether it is a rapid; `feed_mm_per_min` is the decoder's, ahead by the lookahead.
+    pub executing_feed_mm_per_min: Option<f64>,
+    pub executing_rapid: bool,
+    /// As the executed M3/M4/M5 and S left it (as decoded before any has run).
+    pub spindle: SpindleView,
+    /// Tool (T) as the executed T left it (as decoded before), and the tool data set (D)
+    /// as decoded.
+    pub tool: u32,
+    pub tool_offset: u32,
+    /// The decoder's modal G codes: motion, plane, dimensions, units, feed mode, radius
+    /// compensation, zero offset (`G53` for none).
+    pub g_codes: Vec<&'static str>,
+    /// The active zero offset's values for X Y Z, mm (0 under G53).
+    pub work_offset_mm: [f64; 3],
+    /// Channel time since the present program started, s (to its end once it stopped).
+    pub elapsed_s: Option<f64>,
+    /// Estimated time left, s: the elapsed time scaled by the share of the program's bytes
+    /// still to execute (file programs only).
+    pub remaining_s: Option<f64>,
+    /// Stream writes refused for a full buffer (11012) since the channel was built.
+    pub stream_refused_full: u64,
+}
+
+/// The spindle: M3 / M4 / M5 and the programmed speed.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpindleView {
+    /// `cw` (M3), `ccw` (M4) or `off` (M5).
+    pub direction: &'static str,
+    pub rpm: f64,
+}
+
+/// What the feed knows from the channel's live record (`machine::live`): the program's
+/// times and the spindle and tool the executed functions set.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Recorded {
+    pub elapsed_s: Option<f64>,
+    pub remaining_s: Option<f64>,
+    pub executed: crate::machine::live::Executed,
+}
+
+/// The modal G codes of `m`, in the order the page lists them.
+fn g_codes(m: &crate::decoder::modal::Modal) -> Vec<&'static str> {
+    use crate::decoder::modal::{FeedMode, MotionMode, RadiusComp, Units};
+    use crate::queue::Plane;
+    let zero = ["G53", "G54", "G55", "G56", "G57", "G58", "G59"];
+    vec![
+        match m.motion {
+            MotionMode::Rapid => "G00",
+            MotionMode::Linear => "G01",
+            MotionMode::ArcCw => "G02",
+            MotionMode::ArcCcw => "G03",
+        },
+        match m.plane {
+            Plane::Xy => "G17",
+            Plane::Zx => "G18",
+            Plane::Yz => "G19",
+        },
+        if m.absolute { "G90" } else { "G91" },
+        match m.units {
+            Units::Metric => "G71",
+            Units::Inch => "G70",
+        },
+        match m.feed_mode {
+            FeedMode::PerMinute => "G94",
+            FeedMode::PerRevolution => "G95",
+        },
+        match m.radius_comp {
+            RadiusComp::Off => "G40",
+            RadiusComp::Left => "G41",
+            RadiusComp::Right => "G42",
+        },
+        zero.get(m.zero_offset).copied().unwrap_or("G54"),
+    ]
 }
 
 /// The HLI technology interface of one channel (README "Technology functions: the PLC half").
@@ -160,13 +237,51 @@ pub struct CycleView {
     pub overruns: u64,
 }
 
-/// One update: the `status` event of the stream.
+/// The cycle statistics over the last seconds (`feed::CYCLE_WINDOW_S`), from the runtime's
+/// live work histogram: quantiles are bucket edges, at most 19 % above the true value.
+#[derive(Debug, Clone, Serialize)]
+pub struct WindowView {
+    /// Seconds the window covers so far.
+    pub seconds: usize,
+    pub ticks: u64,
+    pub work_p50_us: f64,
+    pub work_p99_us: f64,
+    pub work_p999_us: f64,
+    /// Ticks whose lateness and work together exceeded the period, in the window.
+    pub overruns: u64,
+    /// The p99 of each past second, µs, oldest first (at most a minute).
+    pub p99_trend_us: Vec<f64>,
+}
+
+impl WindowView {
+    pub fn new(counts: &[u64], seconds: usize, ticks: u64, overruns: u64, trend: Vec<f64>) -> Self {
+        use crate::vocab::stats::work_quantile_us;
+        WindowView {
+            seconds,
+            ticks,
+            work_p50_us: work_quantile_us(counts, 0.5),
+            work_p99_us: work_quantile_us(counts, 0.99),
+            work_p999_us: work_quantile_us(counts, 0.999),
+            overruns,
+            p99_trend_us: trend,
+        }
+    }
+}
+
+/// One update: the `status` event of the stream, and `GET /snapshot.json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct Update {
     /// Counts the feed's updates, so a page can tell how many it missed.
     pub seq: u64,
+    /// Since the runtime started.
     pub cycle: Option<CycleView>,
+    /// Over the last seconds (`None` without the runtime's live statistics).
+    pub window: Option<WindowView>,
     pub channels: Vec<ChannelView>,
+    /// `serve --soak --http`: the soak's counters per channel and its invariants so far
+    /// (as the soak's report has them), published twice a second.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub soak: Option<serde_json::Value>,
 }
 
 /// A channel's program text for the listing: the `listing` event.
@@ -203,6 +318,12 @@ impl Listing {
             line_starts,
             text,
         }
+    }
+
+    /// Byte offset where 1-based `line` starts.
+    pub fn line_start(&self, line: usize) -> Option<u64> {
+        let i = line.checked_sub(1)?;
+        self.line_starts.get(i).map(|&s| s as u64)
     }
 
     /// 1-based line holding byte `offset`.
@@ -258,8 +379,21 @@ pub fn cycle_view(s: &Status, live: Option<LiveCycleReading>) -> CycleView {
     }
 }
 
+/// Share of the listing's bytes before `offset` (0..=1).
+impl Listing {
+    pub fn share_before(&self, offset: u64) -> f64 {
+        let len = self.text.len().max(1) as f64;
+        (offset as f64 / len).clamp(0.0, 1.0)
+    }
+}
+
 /// One channel's view; `listing` is the text the page shows for it, if any.
-pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>) -> ChannelView {
+pub fn channel_view(
+    ch: u16,
+    s: &Status,
+    listing: Option<&Listing>,
+    recorded: Recorded,
+) -> ChannelView {
     let block = s.active_block.as_ref();
     let line = match (block, listing) {
         (Some(b), Some(l)) if *b.prog == *l.program => Some(l.line_of(b.offset)),
@@ -293,13 +427,44 @@ pub fn channel_view(ch: u16, s: &Status, listing: Option<&Listing>) -> ChannelVi
         stream_free_bytes: s.stream_free,
         blocks: s.blocks,
         errors_total: s.errors_total,
-        last_error: s.last_error.as_ref().map(|(code, text)| ErrorView {
-            index: s.errors_total.saturating_sub(1),
-            code: *code,
-            text: text.clone(),
+        last_error: s.last_error.as_ref().map(|(code, text)| {
+            let (program, line) = s.last_error_at.clone().unwrap_or_default();
+            ErrorView {
+                index: s.errors_total.saturating_sub(1),
+                code: *code,
+                text: text.clone(),
+                program,
+                line,
+            }
         }),
         message: s.message.clone(),
         techno: techno_view(s),
+        executing_feed_mm_per_min: s.executing_feed_mm_per_min,
+        executing_rapid: s.executing_rapid,
+        spindle: SpindleView {
+            direction: match recorded.executed.spindle.unwrap_or(s.modal.spindle) {
+                crate::decoder::modal::Spindle::Cw => "cw",
+                crate::decoder::modal::Spindle::Ccw => "ccw",
+                crate::decoder::modal::Spindle::Off => "off",
+            },
+            rpm: recorded.executed.spindle_rpm.unwrap_or(s.modal.spindle_rpm),
+        },
+        tool: recorded.executed.tool.unwrap_or(s.modal.tool),
+        tool_offset: s.modal.tool_offset,
+        g_codes: g_codes(&s.modal),
+        work_offset_mm: {
+            let o = s
+                .modal
+                .zero_offset
+                .checked_sub(1)
+                .and_then(|i| s.zero_offsets.get(i))
+                .copied()
+                .unwrap_or_default();
+            [o[0], o[1], o[2]]
+        },
+        elapsed_s: recorded.elapsed_s,
+        remaining_s: recorded.remaining_s,
+        stream_refused_full: s.stream_writes_full,
     }
 }
 

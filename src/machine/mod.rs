@@ -4,6 +4,7 @@
 //! One tick: serve requests → feeders write → each channel decodes, executes, reports →
 //! events leave for the log. Nothing here blocks or does I/O.
 
+pub mod live;
 pub mod plc;
 pub mod remote;
 pub mod rng;
@@ -128,6 +129,8 @@ pub struct Machine {
     /// The phases of the tick in progress, and the longest tick so far (`worst`).
     phases: worst::TickPhases,
     worst: Option<worst::WorstTick>,
+    /// Per channel: the live view's record (off until the view drains it).
+    live: Vec<live::ChannelRecord>,
 }
 
 impl Machine {
@@ -151,6 +154,17 @@ impl Machine {
             watches: watch::Watches::default(),
             phases: worst::TickPhases::new(n),
             worst: None,
+            live: std::iter::repeat_with(live::ChannelRecord::default)
+                .take(n)
+                .collect(),
+        }
+    }
+
+    /// Record every channel's path and stream text for the live view from now on
+    /// (`serve --http`, before the first tick: a page that connects late sees everything).
+    pub fn record_live(&mut self) {
+        for (c, r) in self.channels.iter().zip(&mut self.live) {
+            r.turn_on(c);
         }
     }
 
@@ -236,13 +250,27 @@ impl Machine {
             };
         }
         let times = self.cycle_times;
-        let Some(c) = self.channel_mut(channel) else {
+        let i = (channel as usize).wrapping_sub(1);
+        let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
             return Reply::NoChannel;
+        };
+        if op == Op::DrainLive {
+            return Reply::Live(Box::new(record.drain(c)));
+        }
+        let written = match &op {
+            Op::WriteStream(p) => Some(Arc::clone(p)),
+            _ => None,
         };
         match c.apply(tick, op) {
             Reply::Status(mut s) => {
                 s.cycle_times = times;
                 Reply::Status(s)
+            }
+            r @ Reply::Stream(Ok(())) => {
+                if let Some(p) = written {
+                    record.stream_written(&p, c);
+                }
+                r
             }
             r => r,
         }
@@ -274,20 +302,24 @@ impl Cycle for Machine {
             }
         }
         for a in &mut self.feeders {
-            let Some(c) = self.channels.get_mut((a.channel as usize).wrapping_sub(1)) else {
+            let i = (a.channel as usize).wrapping_sub(1);
+            let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
                 continue;
             };
             if let Some(packet) = a.feeder.poll(tick.index) {
                 // Through the door like any client's write; a write the channel cannot take
                 // (ERROR, no streaming program) is a refusal the feeder retries.
                 let reply = c.apply(tick, a.offer.write(packet));
+                if reply == Reply::Stream(Ok(())) {
+                    record.stream_written(packet, c);
+                }
                 a.feeder.result(a.offer.answered(&reply));
             }
         }
-        self.phases.plcs_and_feeders = clock.lap();
-        for (i, c) in self.channels.iter_mut().enumerate() {
+        for ((i, c), record) in self.channels.iter_mut().enumerate().zip(&mut self.live) {
             let stopped = c.step(tick);
             self.clock_stopped += stopped;
+            record.tick(tick, c);
             if let Some(f) = c.take_finish() {
                 self.finishes[i] = Some(f);
             }

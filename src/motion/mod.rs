@@ -195,6 +195,16 @@ impl Motion {
         self.pos
     }
 
+    /// The motion block executing now (the front entry once it has started), if it is a
+    /// move: what the live view shows as the executing block's programmed feed and draws
+    /// dashed when it is a rapid.
+    pub(crate) fn executing_move(&self) -> Option<&Move> {
+        match self.planner.front().map(|e| &e.kind) {
+            Some(EntryKind::Move(seg)) if self.front_started => Some(&seg.mv),
+            _ => None,
+        }
+    }
+
     /// Path velocity of the axes, mm/s: at the end of the last tick, or with the axis filter
     /// on, over the last tick (finite difference of the filtered positions).
     pub fn velocity_mm_per_s(&self) -> f64 {

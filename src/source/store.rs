@@ -235,6 +235,11 @@ impl ProgramStore {
         self.streaming_prog.is_some()
     }
 
+    /// The streaming program's name (`streaming_prog_file`, lower case), if streaming is on.
+    pub(crate) fn streaming_program(&self) -> Option<&str> {
+        self.streaming_prog.as_deref()
+    }
+
     /// Whether `name` is the virtual streaming program (case-insensitive, as program names are).
     pub(crate) fn is_streaming_program(&self, name: &str) -> bool {
         self.streaming_prog

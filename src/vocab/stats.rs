@@ -194,12 +194,62 @@ impl CycleStats {
 /// (the live web view): a few relaxed atomics the tick stores into, so a reader never waits on
 /// the tick nor the tick on a reader. Work times reach readers through the channel door
 /// (`Status::cycle_times`); lateness is only known to the runtime.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct LiveCycleStats {
+    /// Ticks by work time: bucket `b` counts works from `2^((b + WORK_BUCKET_FIRST) / 4)` ns
+    /// (four buckets an octave, about 19 % wide; the first holds everything shorter, the last
+    /// everything longer), so a reader takes quantiles over any window from two readings.
+    work_buckets: [AtomicU64; WORK_BUCKETS],
     ticks: AtomicU64,
     late_last_ns: AtomicU64,
     late_max_ns: AtomicU64,
     overruns: AtomicU64,
+}
+
+impl Default for LiveCycleStats {
+    fn default() -> Self {
+        LiveCycleStats {
+            work_buckets: std::array::from_fn(|_| AtomicU64::new(0)),
+            ticks: AtomicU64::new(0),
+            late_last_ns: AtomicU64::new(0),
+            late_max_ns: AtomicU64::new(0),
+            overruns: AtomicU64::new(0),
+        }
+    }
+}
+
+/// Buckets of [`LiveCycleStats`]' work histogram: 512 ns (2^9) to 32 ms (2^25).
+pub const WORK_BUCKETS: usize = 64;
+const WORK_BUCKET_FIRST: f64 = 36.0;
+
+/// The work-time bucket of `ns`.
+fn work_bucket(ns: u64) -> usize {
+    let b = (ns.max(1) as f64).log2() * 4.0 - WORK_BUCKET_FIRST;
+    // Truncation is the bucket's floor; below the first and above the last are clamped.
+    (b.max(0.0) as usize).min(WORK_BUCKETS - 1)
+}
+
+/// Lower edge of work-time bucket `b`, µs.
+pub fn work_bucket_floor_us(b: usize) -> f64 {
+    2f64.powf((b as f64 + WORK_BUCKET_FIRST) / 4.0) / 1000.0
+}
+
+/// The `q` quantile of bucket counts (differences of two [`LiveCycleStats::work_buckets`]
+/// readings), µs: the upper edge of the bucket it falls in; 0 without ticks.
+pub fn work_quantile_us(counts: &[u64], q: f64) -> f64 {
+    let total: u64 = counts.iter().sum();
+    if total == 0 {
+        return 0.0;
+    }
+    let rank = ((total as f64) * q).ceil().max(1.0) as u64;
+    let mut seen = 0;
+    for (b, &n) in counts.iter().enumerate() {
+        seen += n;
+        if seen >= rank {
+            return work_bucket_floor_us(b + 1);
+        }
+    }
+    work_bucket_floor_us(counts.len())
 }
 
 /// One reading of [`LiveCycleStats`].
@@ -212,8 +262,12 @@ pub struct LiveCycleReading {
 }
 
 impl LiveCycleStats {
-    /// One tick done: its lateness (real time only) and whether it overran.
-    pub(crate) fn publish(&self, late: Option<Duration>, overrun: bool) {
+    /// One tick done: its work, its lateness (real time only) and whether it overran.
+    pub(crate) fn publish(&self, work: Duration, late: Option<Duration>, overrun: bool) {
+        let ns = u64::try_from(work.as_nanos()).unwrap_or(u64::MAX);
+        if let Some(b) = self.work_buckets.get(work_bucket(ns)) {
+            b.fetch_add(1, Ordering::Relaxed);
+        }
         self.ticks.fetch_add(1, Ordering::Relaxed);
         if let Some(late) = late {
             let ns = u64::try_from(late.as_nanos()).unwrap_or(u64::MAX);
@@ -223,6 +277,11 @@ impl LiveCycleStats {
         if overrun {
             self.overruns.fetch_add(1, Ordering::Relaxed);
         }
+    }
+
+    /// The work histogram's counts since the start (see [`work_quantile_us`]).
+    pub fn work_buckets(&self) -> [u64; WORK_BUCKETS] {
+        std::array::from_fn(|b| self.work_buckets[b].load(Ordering::Relaxed))
     }
 
     pub fn read(&self) -> LiveCycleReading {
@@ -238,6 +297,30 @@ impl LiveCycleStats {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn window_quantiles_from_work_buckets() {
+        let live = LiveCycleStats::default();
+        for _ in 0..99 {
+            live.publish(Duration::from_micros(10), None, false);
+        }
+        let before = live.work_buckets();
+        for _ in 0..990 {
+            live.publish(Duration::from_micros(20), None, false);
+        }
+        for _ in 0..10 {
+            live.publish(Duration::from_micros(400), None, false);
+        }
+        let after = live.work_buckets();
+        let window: Vec<u64> = after.iter().zip(before).map(|(a, b)| a - b).collect();
+        // The window holds the 20 µs and 400 µs ticks only: p50 20 µs, p99 just above it,
+        // p99.9 the 400 µs ones, each within a bucket's width (19 %).
+        let p50 = work_quantile_us(&window, 0.5);
+        assert!((20.0..=20.0 * 1.19).contains(&p50), "{p50}");
+        let p999 = work_quantile_us(&window, 0.999);
+        assert!((400.0..=400.0 * 1.19).contains(&p999), "{p999}");
+        assert_eq!(work_quantile_us(&[0; WORK_BUCKETS], 0.99), 0.0);
+    }
 
     #[test]
     fn quantiles_within_resolution() {

@@ -46,4 +46,25 @@ function serverClient(localAdsPort, extra) {
   });
 }
 
-module.exports = { check, sleep, packets, serverClient };
+// Debian's headless chromium (NCCHANNEL_CHROMIUM, else /usr/bin/chromium) with a fresh profile
+// and the given viewport; the caller closes the context and removes the profile.
+async function launchChromium(viewport) {
+  const fs = require("fs");
+  const os = require("os");
+  const path = require("path");
+  const { chromium } = require("playwright-core");
+  const profile = fs.mkdtempSync(path.join(os.tmpdir(), "ncchannel-chromium-"));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: process.env.NCCHANNEL_CHROMIUM || "/usr/bin/chromium",
+    headless: true,
+    viewport,
+    args: [
+      "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+      "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    ],
+  });
+  context.setDefaultTimeout(30000);
+  return { context, profile };
+}
+
+module.exports = { check, sleep, packets, serverClient, launchChromium };

@@ -49,11 +49,18 @@ async function readOnly(context, url, seen) {
   await page.goto(url);
   await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
   await page.locator("#access.off").waitFor();
-  await page.fill("#ch1 .program", "square.nc");
-  await page.click("#ch1 button[data-action=start]");
-  const answer = page.locator("#ch1 .control-answer.refused");
-  await answer.waitFor();
-  seen.refused = await answer.textContent();
+  // The controls look disabled, and a start sent anyway is refused with the server's reason.
+  check(await page.locator("#ch1 button[data-action=start]").isDisabled(), "start disabled");
+  check(await page.locator("#ch1 button[data-action=mdi]").isDisabled(), "MDI disabled");
+  check(await page.locator("#ch1 button[data-jog=X]").isDisabled(), "jog disabled");
+  seen.refused = await page.evaluate(async () => {
+    const r = await fetch("/control/1/start", {
+      method: "POST",
+      headers: { "X-Ncchannel-Control": "1" },
+      body: "square.nc",
+    });
+    return r.status + " " + (await r.text());
+  });
   check(seen.refused.includes("403") && seen.refused.includes("--http-controls"), "refusal shown: " + seen.refused);
   seen.state_after_refusal = await page.textContent("#ch1 .state");
   await page.close();
@@ -73,6 +80,15 @@ async function withControls(context, url, seen) {
   watchRequests(page, new URL(url).origin, seen.foreign);
   await page.goto(url);
   await page.locator("#access.on").waitFor();
+  // MDI and jog move the axes (through the channel's stream), and the DRO shows it.
+  await page.fill("#ch1 .mdi", "G01 X5 F3000");
+  await page.click("#ch1 button[data-action=mdi]");
+  await page.locator("#ch1 .dro tr[data-axis=X] .mcs").filter({ hasText: /^5\.000$/ }).waitFor();
+  await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
+  await page.click("#ch1 button[data-jog=Y]");
+  await page.locator("#ch1 .dro tr[data-axis=Y] .mcs").filter({ hasText: /^1\.000$/ }).waitFor();
+  await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
+  seen.mdi_jog = await page.textContent("#ch1 .dro tbody");
   await page.fill("#ch1 .program", "square.nc");
   await page.click("#ch1 button[data-action=start]");
   await page.locator("#ch1 .control-answer.ok").waitFor();
@@ -87,6 +103,9 @@ async function withControls(context, url, seen) {
   seen.current_line = await page.textContent("#ch1 .listing li.current");
   seen.block = await page.textContent("#ch1 .block");
   seen.listing_lines = await page.locator("#ch1 .listing li").count();
+  // The whole program's preview under the path so far.
+  await page.waitForFunction(() => Number(document.querySelector("#ch1 .plot").dataset.previewPoints) > 1);
+  seen.preview_points = Number(await page.getAttribute("#ch1 .plot", "data-preview-points"));
   // The update rate the page measured, after it has had two seconds of updates.
   await page.waitForTimeout(2500);
   seen.update_hz = Number(await page.getAttribute("#rate", "data-hz"));

@@ -97,11 +97,13 @@ impl Channels {
         let config = ncchannel::params::load(&params.startup()).unwrap();
         let channels = ncchannel::channels(&config, true, &ncchannel::Loader::start()).unwrap();
         let log = LogBytes::default();
-        let machine = Machine::new(
+        let mut machine = Machine::new(
             channels,
             EventLog::to_writer(Box::new(log.clone())),
             StopWhen::Never,
         );
+        // As `serve --http` does: the web view's tests open pages after programs started.
+        machine.record_live();
         let period = Duration::from_micros(config.runtime.cycle_period_us);
         let (backend, ticking) = Ticking::start(machine, period).unwrap();
         Channels {

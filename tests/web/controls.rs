@@ -20,6 +20,9 @@ fn controls_are_refused_without_the_option() {
         ("hold", ""),
         ("reset", ""),
         ("override", "50"),
+        ("mdi", "G01 X10 F1000"),
+        ("jog", "X1"),
+        ("run-from-line", "square.nc\nN40"),
     ] {
         let r = client::control(addr, 1, action, body);
         assert_eq!(r.status, 403, "{action}");
@@ -176,4 +179,66 @@ fn two_content_lengths_are_refused() {
     assert_eq!(r.status, 400, "{}", r.body);
     assert!(r.body.contains("Content-Length"), "{}", r.body);
     assert_eq!(channels.status(1).state, State::Ready);
+}
+
+/// Run from line: by an N number before the program ever ran, by a listing line after; the
+/// first block that runs is the one asked for (block search), and the line is refused with
+/// the reason before the channel has the text.
+#[test]
+fn run_from_line_starts_at_the_block_asked_for() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let addr = web.local_addr();
+    let early = client::control(addr, 1, "run-from-line", "square.nc\n5");
+    assert_eq!(early.status, 409, "{}", early.body);
+    assert!(early.body.contains("N number"), "{}", early.body);
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\nN40").status,
+        200
+    );
+    let first_block = |events: &mut Events| {
+        events.until(WITHIN, |name, d| {
+            let c = client::channel(d, 1).filter(|_| name == "status")?;
+            c["block_n"].as_u64()
+        })
+    };
+    let n = first_block(&mut Events::open(addr));
+    assert!(n >= 40, "the run starts at N40, not N{n}");
+    assert_eq!(client::control(addr, 1, "reset", "").status, 200);
+    channels.wait_for(1, WITHIN, |s| s.state == State::Ready);
+    // The channel has the text now: line 6 of the listing is N50.
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\n6").status,
+        200
+    );
+    let n = first_block(&mut Events::open(addr));
+    assert!(n >= 50, "the run starts at N50, not N{n}");
+    assert_eq!(
+        client::control(addr, 1, "run-from-line", "square.nc\n0").status,
+        400
+    );
+}
+
+/// MDI and jog move the axes through the channel's stream interface (the streaming program
+/// started, the block and M30 written, as a streaming client does), and come back READY.
+#[test]
+fn mdi_and_jog_move_the_axes() {
+    let (web, channels) = view(ControlAccess::Allowed);
+    let addr = web.local_addr();
+    let r = client::control(addr, 1, "mdi", "G01 X10 Y5 F3000");
+    assert_eq!((r.status, r.body.as_str()), (200, "done"));
+    let s = channels.wait_for(1, WITHIN, |s| {
+        s.state == State::Ready && s.positions[0].1 == 10.0
+    });
+    assert_eq!(s.positions[1].1, 5.0);
+    assert_eq!(client::control(addr, 1, "jog", "Y-2").status, 200);
+    let s = channels.wait_for(1, WITHIN, |s| {
+        s.state == State::Ready && (s.positions[1].1 - 3.0).abs() < 1e-9
+    });
+    assert_eq!(s.positions[0].1, 10.0, "a jog moves one axis");
+    // While a program runs, MDI is the channel's refusal.
+    assert_eq!(client::control(addr, 1, "start", "square.nc").status, 200);
+    channels.wait_for(1, WITHIN, |s| s.state == State::Active);
+    let busy = client::control(addr, 1, "mdi", "G01 X0");
+    assert_eq!(busy.status, 409, "{}", busy.body);
+    assert!(busy.body.contains("not possible"), "{}", busy.body);
 }

@@ -117,3 +117,85 @@ fn connected_pages_are_capped_and_a_closed_one_frees_its_place() {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+/// A page that connects while the square runs gets its whole path since the start (its
+/// corner at X40 Y0 included), and `GET /snapshot.json` answers the executing block's F.
+#[test]
+fn a_late_page_gets_the_path_since_the_start_and_scripts_a_snapshot() {
+    let (web, channels) = view(ControlAccess::Refused);
+    let addr = web.local_addr();
+    channels.command(1, Op::Start("square.nc".into()));
+    let mut first = Events::open(addr);
+    // The arc N30 (line 4) runs: the corner at X40 Y0 is behind.
+    first.until(WITHIN, |name, d| {
+        let c = client::channel(d, 1).filter(|_| name == "status")?;
+        (c["line"] == 4).then_some(())
+    });
+    let late = Events::open(addr).until(WITHIN, |name, d| {
+        (name == "path" && d["ch"] == 1).then(|| d.clone())
+    });
+    assert_eq!(late["reset"], true, "a new page gets the whole path");
+    let points: Vec<(f64, f64)> = late["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    // The drawn path passes within the record's tolerance of the start and of the corner.
+    let near = |x: f64, y: f64| {
+        points.windows(2).any(|w| {
+            let ((ax, ay), (bx, by)) = (w[0], w[1]);
+            let (dx, dy) = (bx - ax, by - ay);
+            let t = (((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+            (ax + t * dx - x).hypot(ay + t * dy - y) < 0.02
+        })
+    };
+    assert!(near(0.0, 0.0) && near(40.0, 0.0), "{points:?}");
+    let snapshot = client::get(addr, "/snapshot.json");
+    assert_eq!(snapshot.status, 200);
+    assert!(snapshot
+        .header("content-type")
+        .unwrap()
+        .starts_with("application/json"));
+    let s: serde_json::Value = serde_json::from_str(&snapshot.body).unwrap();
+    let c = client::channel(&s, 1).unwrap();
+    assert_eq!(c["program"], "square.nc");
+    assert_eq!(c["executing_feed_mm_per_min"], 600.0, "{c}");
+    assert!(c["elapsed_s"].as_f64().unwrap() > 0.0, "{c}");
+    let g: Vec<&str> = c["g_codes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(g.contains(&"G90") && g.contains(&"G17"), "{g:?}");
+}
+
+/// The whole-program preview of a file program before it runs: the square's corners, its
+/// channel time, and nothing started on the channel.
+#[test]
+fn a_file_program_is_previewed_before_it_runs() {
+    let (web, channels) = view(ControlAccess::Refused);
+    let r = client::get(web.local_addr(), "/preview/1/square.nc");
+    assert_eq!(r.status, 200, "{}", r.body);
+    let p: serde_json::Value = serde_json::from_str(&r.body).unwrap();
+    assert_eq!(p["complete"], true, "{p}");
+    // 40 + 10 + 30 + 50 + 40 mm and a quarter circle at 10 mm/s: about 17 s.
+    let seconds = p["seconds"].as_f64().unwrap();
+    assert!((15.0..20.0).contains(&seconds), "{seconds}");
+    let points = p["points"].as_array().unwrap();
+    let xs: Vec<f64> = points.iter().map(|q| q[0].as_f64().unwrap()).collect();
+    let ys: Vec<f64> = points.iter().map(|q| q[1].as_f64().unwrap()).collect();
+    let max = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+    assert!(
+        (max(&xs) - 50.0).abs() < 0.05 && (max(&ys) - 40.0).abs() < 0.05,
+        "{p}"
+    );
+    assert_eq!(
+        channels.status(1).state,
+        State::Ready,
+        "the channel itself ran nothing"
+    );
+    let missing = client::get(web.local_addr(), "/preview/1/nothing.nc");
+    assert_eq!(missing.status, 409, "{}", missing.body);
+}

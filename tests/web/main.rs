@@ -36,6 +36,11 @@ pub fn view(controls: ControlAccess) -> (HttpHandle, Channels) {
         allow_hosts: Vec::new(),
     };
     let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
+    let lists = ncchannel::params::load(&channels.params.startup()).expect("lists load");
+    web.set_previewer(ncchannel::http::preview::previewer(
+        lists,
+        ncchannel::Loader::start(),
+    ));
     (web, channels)
 }
 
