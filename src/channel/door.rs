@@ -357,7 +357,7 @@ pub enum Reply {
         lost: u64,
     },
     /// What [`Op::DrainLive`] asked for.
-    Live(Box<crate::machine::live::LiveDrain>),
+    Live(Box<super::live::LiveDrain>),
 }
 
 /// An error as the ADS objects carry it: number and text.

@@ -25,6 +25,7 @@ pub use crate::source::stream::{ERR_NO_LINE_END, WARN_WRITE_REJECTED};
 pub mod door;
 mod hmi;
 mod isg;
+pub mod live;
 mod log;
 mod program;
 mod refusals;

@@ -16,6 +16,7 @@ pub(crate) mod init;
 mod logger;
 pub(crate) mod manual;
 pub(crate) mod out;
+pub mod preview;
 pub(crate) mod receive;
 mod receive_stop;
 pub(crate) mod run;
@@ -25,6 +26,7 @@ pub(crate) mod signal;
 pub(crate) mod soak;
 pub(crate) mod soak_merge;
 pub(crate) mod stream;
+mod web_view;
 
 /// Exit codes of the command-line contract (README "Two commands").
 pub mod exit {

@@ -196,44 +196,20 @@ pub(super) fn start_at_first_tick(
     }
 }
 
-/// `--http`: the live web view over its own backend into the same runtime as ADS, with
-/// `previews` of whole programs when given.
-pub(crate) fn spawn_web<C: crate::runtime::Cycle>(
-    args: &ServeArgs,
-    rt: &mut Runtime<C>,
-    requests: crossbeam_channel::Sender<crate::machine::Request>,
-    channels: u16,
-    previews: Option<crate::http::preview::Previewer>,
-) -> Result<Option<crate::http::HttpHandle>, ExitCode> {
-    let Some(bind) = args.http else {
-        return Ok(None);
-    };
-    let controls = if args.http_controls {
-        crate::http::ControlAccess::Allowed
-    } else {
-        crate::http::ControlAccess::Refused
-    };
-    let config = crate::http::HttpConfig {
+/// The web view's settings from `--http`, `--http-controls`, `--http-allow-host` and
+/// `--allow-non-loopback` (`None` without `--http`).
+fn http_config(args: &ServeArgs) -> Option<crate::http::HttpConfig> {
+    let bind = args.http?;
+    Some(crate::http::HttpConfig {
         bind,
         allow_non_loopback: args.allow_non_loopback,
-        controls,
+        controls: if args.http_controls {
+            crate::http::ControlAccess::Allowed
+        } else {
+            crate::http::ControlAccess::Refused
+        },
         allow_hosts: args.http_allow_host.clone(),
-    };
-    let backend = Arc::new(ChannelBackend::new(requests, channels));
-    match crate::http::spawn(&config, backend, Some(rt.live_stats())) {
-        Ok(h) => {
-            if let Some(p) = previews {
-                h.set_previewer(p);
-            }
-            super::logger::line(format_args!(
-                "web view on http://{}/ (controls {})",
-                h.local_addr(),
-                if args.http_controls { "on" } else { "off" }
-            ));
-            Ok(Some(h))
-        }
-        Err(e) => Err(usage(format!("--http {bind}: {e}"))),
-    }
+    })
 }
 
 /// The checks of `serve`'s arguments before anything starts: `--ads-idle-timeout`, the
@@ -295,7 +271,7 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
     if let Some(sc) = scenario {
         let cycle = supervised(machine, &sc, &config);
         let soak = super::serve_soak::SoakServe {
-            args: args.clone(),
+            web: http_config(&args),
             server_config: server_config(&args, &config),
             limit,
             report: args.report.clone(),
@@ -307,8 +283,14 @@ pub fn execute(mut args: ServeArgs) -> ExitCode {
         return super::serve_soak::run(cycle, &sc, soak);
     }
     let (mut rt, requests) = Runtime::new(machine, period, Clock::RealTime);
-    let previews = crate::http::preview::previewer(config.clone(), loader.clone());
-    let web = match spawn_web(&args, &mut rt, requests.clone(), nch, Some(previews)) {
+    let previews = super::preview::previewer(config.clone(), loader.clone());
+    let web = match super::web_view::spawn(
+        http_config(&args),
+        &mut rt,
+        requests.clone(),
+        nch,
+        Some(previews),
+    ) {
         Ok(w) => w,
         Err(code) => return code,
     };

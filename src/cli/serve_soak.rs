@@ -21,8 +21,8 @@ use super::out::say;
 /// What `serve` settled before handing over: the ADS endpoint, the run limit, the report
 /// file, the cycle time and the channel count.
 pub struct SoakServe {
-    /// The command line, for `--http` (the live view beside the soak).
-    pub args: super::serve::ServeArgs,
+    /// The live view beside the soak (`--http`), if asked for.
+    pub web: Option<crate::http::HttpConfig>,
     pub(crate) server_config: ServerConfig,
     pub limit: Option<Duration>,
     pub report: Option<PathBuf>,
@@ -37,7 +37,7 @@ pub struct SoakServe {
 
 pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode {
     let SoakServe {
-        args,
+        web: web_config,
         server_config,
         limit,
         report: report_path,
@@ -54,7 +54,7 @@ pub fn run(cycle: Supervised, scenario: &Scenario, soak: SoakServe) -> ExitCode 
         return ExitCode::from(exit::USAGE);
     }
     let (mut rt, requests) = Runtime::new(cycle, period, Clock::RealTime);
-    let web = match super::serve::spawn_web(&args, &mut rt, requests.clone(), nch, None) {
+    let web = match super::web_view::spawn(web_config, &mut rt, requests.clone(), nch, None) {
         Ok(w) => w,
         Err(code) => return code,
     };

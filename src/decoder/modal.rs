@@ -41,6 +41,17 @@ pub enum Spindle {
     Ccw,
 }
 
+impl Spindle {
+    /// The direction's name as the live view's snapshot gives it: `cw`, `ccw` or `off`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Spindle::Cw => "cw",
+            Spindle::Ccw => "ccw",
+            Spindle::Off => "off",
+        }
+    }
+}
+
 /// Tool radius compensation (G40 / G41 / G42).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum RadiusComp {
@@ -140,6 +151,41 @@ pub struct Modal {
 }
 
 impl Modal {
+    /// The modal G codes in effect, in the order an HMI lists them: motion, plane,
+    /// absolute/incremental, units, feed mode, radius compensation, zero offset.
+    pub fn g_codes(&self) -> [&'static str; 7] {
+        use crate::queue::Plane;
+        const ZERO_OFFSETS: [&str; 7] = ["G53", "G54", "G55", "G56", "G57", "G58", "G59"];
+        [
+            match self.motion {
+                MotionMode::Rapid => "G00",
+                MotionMode::Linear => "G01",
+                MotionMode::ArcCw => "G02",
+                MotionMode::ArcCcw => "G03",
+            },
+            match self.plane {
+                Plane::Xy => "G17",
+                Plane::Zx => "G18",
+                Plane::Yz => "G19",
+            },
+            if self.absolute { "G90" } else { "G91" },
+            match self.units {
+                Units::Metric => "G71",
+                Units::Inch => "G70",
+            },
+            match self.feed_mode {
+                FeedMode::PerMinute => "G94",
+                FeedMode::PerRevolution => "G95",
+            },
+            match self.radius_comp {
+                RadiusComp::Off => "G40",
+                RadiusComp::Left => "G41",
+                RadiusComp::Right => "G42",
+            },
+            ZERO_OFFSETS.get(self.zero_offset).copied().unwrap_or("G54"),
+        ]
+    }
+
     /// The channel defaults a program start restores; the position is the machine's.
     pub fn defaults(pos: Position) -> Self {
         Modal {

@@ -100,41 +100,6 @@ pub struct Recorded {
     pub executed: crate::machine::live::Executed,
 }
 
-/// The modal G codes of `m`, in the order the page lists them.
-fn g_codes(m: &crate::decoder::modal::Modal) -> Vec<&'static str> {
-    use crate::decoder::modal::{FeedMode, MotionMode, RadiusComp, Units};
-    use crate::queue::Plane;
-    let zero = ["G53", "G54", "G55", "G56", "G57", "G58", "G59"];
-    vec![
-        match m.motion {
-            MotionMode::Rapid => "G00",
-            MotionMode::Linear => "G01",
-            MotionMode::ArcCw => "G02",
-            MotionMode::ArcCcw => "G03",
-        },
-        match m.plane {
-            Plane::Xy => "G17",
-            Plane::Zx => "G18",
-            Plane::Yz => "G19",
-        },
-        if m.absolute { "G90" } else { "G91" },
-        match m.units {
-            Units::Metric => "G71",
-            Units::Inch => "G70",
-        },
-        match m.feed_mode {
-            FeedMode::PerMinute => "G94",
-            FeedMode::PerRevolution => "G95",
-        },
-        match m.radius_comp {
-            RadiusComp::Off => "G40",
-            RadiusComp::Left => "G41",
-            RadiusComp::Right => "G42",
-        },
-        zero.get(m.zero_offset).copied().unwrap_or("G54"),
-    ]
-}
-
 /// The HLI technology interface of one channel (README "Technology functions: the PLC half").
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TechnoView {
@@ -442,16 +407,12 @@ pub fn channel_view(
         executing_feed_mm_per_min: s.executing_feed_mm_per_min,
         executing_rapid: s.executing_rapid,
         spindle: SpindleView {
-            direction: match recorded.executed.spindle.unwrap_or(s.modal.spindle) {
-                crate::decoder::modal::Spindle::Cw => "cw",
-                crate::decoder::modal::Spindle::Ccw => "ccw",
-                crate::decoder::modal::Spindle::Off => "off",
-            },
+            direction: recorded.executed.spindle.unwrap_or(s.modal.spindle).name(),
             rpm: recorded.executed.spindle_rpm.unwrap_or(s.modal.spindle_rpm),
         },
         tool: recorded.executed.tool.unwrap_or(s.modal.tool),
         tool_offset: s.modal.tool_offset,
-        g_codes: g_codes(&s.modal),
+        g_codes: s.modal.g_codes().to_vec(),
         work_offset_mm: {
             let o = s
                 .modal

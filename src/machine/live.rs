@@ -13,8 +13,8 @@
 
 use std::collections::VecDeque;
 
+pub use crate::channel::live::{Executed, LiveDrain, PathPoint, StreamText};
 use crate::channel::Channel;
-use crate::decoder::modal::Spindle;
 use crate::vocab::axis::AXIS_LETTERS;
 use crate::vocab::mode::State;
 use crate::vocab::techno::{TechnoKind, TechnoSeq};
@@ -32,60 +32,6 @@ pub const STREAM_TEXT_BYTES: usize = 256 * 1024;
 /// Stream bytes a drain hands out before and after the executing block's line.
 pub const STREAM_BACK_BYTES: usize = 4 * 1024;
 pub const STREAM_AHEAD_BYTES: usize = 16 * 1024;
-
-/// One recorded point, machine coordinates X Y Z, mm; `rapid`: the segment from the point
-/// before to this one was a rapid (G0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PathPoint {
-    pub xyz_mm: [f64; 3],
-    pub rapid: bool,
-}
-
-/// Stream text around the executing block: `bytes` start at stream byte `from` (counted
-/// from the channel's first accepted stream byte, as `bytes_written` counts them).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct StreamText {
-    pub from: u64,
-    pub bytes: Vec<u8>,
-    /// Where the executing block's line starts, `None` before the first stream block.
-    pub executing: Option<u64>,
-    /// Where the decoder has read to: bytes from here on still wait in the buffer.
-    pub read_to: u64,
-    /// Where the present stream started (its byte 0 in the block offsets).
-    pub stream_start: u64,
-}
-
-/// What one drain hands the view.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct LiveDrain {
-    /// Counts program starts: a new value means the points begin a new program's path.
-    pub program_starts: u64,
-    /// Tick of the present program's start, if one has started.
-    pub started_tick: Option<u64>,
-    /// Tick at which the last program stopped running (end, error, reset), if it has.
-    pub stopped_tick: Option<u64>,
-    /// Path points since the last drain (of the present program).
-    pub points: Vec<PathPoint>,
-    /// The position the path has reached, not yet part of `points` (drawn to, not kept).
-    pub tail: Option<PathPoint>,
-    /// Points that did not fit between drains since the record began.
-    pub points_lost: u64,
-    /// Stream text, when it changed since the last drain.
-    pub stream: Option<StreamText>,
-    /// Software limits of X Y Z, mm (`None`: the axis is not configured).
-    pub soft_limits_mm: [Option<(f64, f64)>; 3],
-    /// What the executed technology functions set (M3/M4/M5, S, T), where one has run
-    /// since the record began; the decoder's modal state runs ahead by the lookahead.
-    pub executed: Executed,
-}
-
-/// The spindle and tool as the executed technology functions left them.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Executed {
-    pub spindle: Option<Spindle>,
-    pub spindle_rpm: Option<f64>,
-    pub tool: Option<u32>,
-}
 
 /// The online decimation, constant work a position: a run of positions from the last kept
 /// point (the anchor) is extended while each new one lies within half the tolerance of the
@@ -297,9 +243,7 @@ impl ChannelRecord {
             }
             newest[slot] = Some(f.seq);
             match (f.kind, f.number) {
-                (TechnoKind::M, 3) => self.executed.spindle = Some(Spindle::Cw),
-                (TechnoKind::M, 4) => self.executed.spindle = Some(Spindle::Ccw),
-                (TechnoKind::M, _) => self.executed.spindle = Some(Spindle::Off),
+                (TechnoKind::M, m) => self.executed.spindle_m(m),
                 (TechnoKind::S, _) => self.executed.spindle_rpm = Some(f64::from(f.add_value)),
                 _ => self.executed.tool = Some(f.number),
             }

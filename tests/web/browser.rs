@@ -37,7 +37,7 @@ fn browser_shows_a_running_channel_its_line_and_its_errors() {
     };
     let with_controls = spawn(&config, Arc::clone(&channels.backend), None).unwrap();
     let lists = ncchannel::params::load(&channels.params.startup()).unwrap();
-    with_controls.set_previewer(ncchannel::http::preview::previewer(
+    with_controls.set_previewer(ncchannel::cli::preview::previewer(
         lists,
         ncchannel::Loader::start(),
     ));

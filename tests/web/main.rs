@@ -37,7 +37,7 @@ pub fn view(controls: ControlAccess) -> (HttpHandle, Channels) {
     };
     let web = spawn(&config, Arc::clone(&channels.backend), None).expect("web view starts");
     let lists = ncchannel::params::load(&channels.params.startup()).expect("lists load");
-    web.set_previewer(ncchannel::http::preview::previewer(
+    web.set_previewer(ncchannel::cli::preview::previewer(
         lists,
         ncchannel::Loader::start(),
     ));
