@@ -150,7 +150,12 @@ fn checked_line(line: &str) -> Result<(&str, bool), SyntaxError> {
 }
 
 /// Skip blanks and comments: `( … )` nesting, an unclosed `(` to block end, `;` to line end.
+#[inline]
 pub(crate) fn gap(mut i: &str) -> &str {
+    // Most calls stand on a word already: answered without the loop.
+    if !matches!(i.as_bytes().first(), Some(b' ' | b'\t' | b';' | b'(')) {
+        return i;
+    }
     loop {
         i = ws(i);
         match i.as_bytes().first() {
