@@ -116,6 +116,30 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Any digits-and-dot text, any length, any bytes after it: the standard library's
+        /// value and the literal's length.
+        #[test]
+        fn any_literal_converts_like_the_standard_library(
+            int in "[0-9]{0,30}",
+            frac in proptest::option::of("[0-9]{0,30}"),
+            tail in "[ XA;(\\-/:é]{0,3}",
+        ) {
+            let lit = match &frac {
+                Some(f) => format!("{int}.{f}"),
+                None => int.clone(),
+            };
+            let text = format!("{lit}{tail}");
+            let got = scan(&text);
+            if int.is_empty() && frac.as_deref().unwrap_or("").is_empty() {
+                proptest::prop_assert_eq!(got, None);
+            } else {
+                let want: f64 = lit.parse().unwrap();
+                proptest::prop_assert_eq!(got, Some((want, lit.len())));
+            }
+        }
+    }
+
     #[test]
     fn stops_at_the_first_non_number_byte() {
         assert_eq!(scan("1.5Y2"), Some((1.5, 3)));
