@@ -117,22 +117,25 @@ pub(crate) fn keyword<'a>(i: &'a str, kw: &'static str) -> Option<&'a str> {
 /// block number comes through here, and the combinator cost ~160 instructions a call.
 pub(crate) fn uint(i: &str) -> PResult<'_, u32> {
     let b = i.as_bytes();
-    let digits = b.iter().take_while(|c| c.is_ascii_digit()).count();
+    // One pass: the value only grows, so it is too large as soon as a prefix of it is.
+    let mut n: u64 = 0;
+    let mut digits = 0;
+    while let Some(&c) = b.get(digits) {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            break;
+        }
+        n = n * 10 + u64::from(d);
+        if n > u64::from(u32::MAX) {
+            return fail(i, SYNTAX, "number too large");
+        }
+        digits += 1;
+    }
     if digits == 0 {
         return Err(nom::Err::Error(PErr::from_error_kind(i, ErrorKind::Digit)));
     }
-    let mut n: u32 = 0;
-    for &d in &b[..digits] {
-        match n
-            .checked_mul(10)
-            .and_then(|m| m.checked_add(u32::from(d - b'0')))
-        {
-            Some(m) => n = m,
-            None => return fail(i, SYNTAX, "number too large"),
-        }
-    }
-    // ASCII digits end on a character boundary.
-    Ok((&i[digits..], n))
+    // ASCII digits end on a character boundary; `n` fits a u32 (checked above).
+    Ok((&i[digits..], n as u32))
 }
 
 /// An identifier `[A-Za-z_][A-Za-z0-9_]*`, upper-cased.

@@ -27,7 +27,22 @@ pub struct RangeError {
 }
 
 /// Check the value `v` of an ordinary word with the upper-case address `letter`.
+#[inline]
 pub fn word_value(letter: u8, v: f64) -> Result<(), RangeError> {
+    // Axes, G, M and most letters take any finite value: answered inline on the hot path.
+    if v.is_finite()
+        && !matches!(
+            letter,
+            b'F' | b'S' | b'T' | b'D' | b'I' | b'J' | b'K' | b'R'
+        )
+    {
+        return Ok(());
+    }
+    ranged_word_value(letter, v)
+}
+
+/// [`word_value`] for the letters with a range, and any value that is not finite.
+fn ranged_word_value(letter: u8, v: f64) -> Result<(), RangeError> {
     let l = char::from(letter);
     let err = |code, message: String| Err(RangeError { code, message });
     if !v.is_finite() {
