@@ -877,15 +877,7 @@ impl Inbox {
     ) -> Result<(), ConnError> {
         let (shared, writer) = (ctx.shared, ctx.writer);
         let max = shared.config.max_frame_bytes;
-        let mut used = 0;
-        while let Some((frame, n)) = frame::decode(&rs.buf[used..], max)? {
-            used += n;
-            rs.last_frame = Instant::now();
-            if !self.push(rs.read_at, frame, n, helper) {
-                return Err(ConnError::Ended);
-            }
-        }
-        rs.buf.drain(..used);
+        let used = self.push_frames(rs, max, helper)?;
         if used > 0 && !helper {
             // Frames to answer first: read more once they are answered.
             return Ok(());
@@ -926,6 +918,13 @@ impl Inbox {
         };
         rs.read_at = Instant::now();
         rs.buf.extend_from_slice(&chunk[..n]);
+        self.push_frames(rs, max, helper)?;
+        Ok(())
+    }
+
+    /// Pushes every whole frame at the front of `rs.buf` and removes their bytes; the number
+    /// of bytes they took. A malformed frame is the decoder's error, a refused push `Ended`.
+    fn push_frames(&self, rs: &mut ReadSide, max: usize, helper: bool) -> Result<usize, ConnError> {
         let mut used = 0;
         while let Some((frame, n)) = frame::decode(&rs.buf[used..], max)? {
             used += n;
@@ -935,7 +934,7 @@ impl Inbox {
             }
         }
         rs.buf.drain(..used);
-        Ok(())
+        Ok(used)
     }
 
     /// Queue a frame of `len` bytes; the helper waits while the inbox is full (the answering
