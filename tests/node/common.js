@@ -46,9 +46,14 @@ function serverClient(localAdsPort, extra) {
   });
 }
 
-// Debian's headless chromium (NCCHANNEL_CHROMIUM, else /usr/bin/chromium) with a fresh profile
-// and the given viewport; the caller closes the context and removes the profile.
-async function launchChromium(viewport) {
+// How long a browser step (a wait, a click) may take before the check fails, ms.
+const BROWSER_TIMEOUT_MS = 30000;
+
+// Runs `body(context)` in Debian's headless chromium (NCCHANNEL_CHROMIUM, else
+// /usr/bin/chromium) with a fresh profile, the given viewport (chromium's default when none)
+// and any further command-line `args`; closes the browser and removes the profile whatever
+// `body` does, and gives back what it returned.
+async function withChromium({ viewport, args = [] }, body) {
   const fs = require("fs");
   const os = require("os");
   const path = require("path");
@@ -61,10 +66,16 @@ async function launchChromium(viewport) {
     args: [
       "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
       "--disable-background-networking", "--disable-component-update", "--disable-sync",
+      ...args,
     ],
   });
-  context.setDefaultTimeout(30000);
-  return { context, profile };
+  context.setDefaultTimeout(BROWSER_TIMEOUT_MS);
+  try {
+    return await body(context);
+  } finally {
+    await context.close();
+    fs.rmSync(profile, { recursive: true, force: true });
+  }
 }
 
-module.exports = { check, sleep, packets, serverClient, launchChromium };
+module.exports = { check, sleep, packets, serverClient, withChromium, BROWSER_TIMEOUT_MS };

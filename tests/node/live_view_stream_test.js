@@ -10,14 +10,12 @@
 // the controls are disabled (read-only view). Prints one JSON line (what it saw); exits
 // non-zero on a failed check.
 "use strict";
-const fs = require("fs");
-const { check, launchChromium } = require("./common");
+const { check, withChromium } = require("./common");
 
 async function main() {
   const url = process.argv[2];
   const seen = {};
-  const { context, profile } = await launchChromium({ width: 1280, height: 800 });
-  try {
+  await withChromium({ viewport: { width: 1280, height: 800 } }, async (context) => {
     const page = await context.newPage();
     await page.goto(url);
     // Channel 4's error, at the top, above the fold.
@@ -57,10 +55,7 @@ async function main() {
     // NCCHANNEL_SCREENSHOT=FILE.png keeps a picture of the page (the README's four channels).
     if (process.env.NCCHANNEL_SCREENSHOT) await page.screenshot({ path: process.env.NCCHANNEL_SCREENSHOT });
     await page.close();
-  } finally {
-    await context.close();
-    fs.rmSync(profile, { recursive: true, force: true });
-  }
+  });
   console.log(JSON.stringify(seen));
 }
 

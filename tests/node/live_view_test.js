@@ -13,28 +13,10 @@
 //
 // takes a picture of the page after SECONDS (the README's docs/live-view.png).
 "use strict";
-const fs = require("fs");
-const os = require("os");
-const path = require("path");
-const { chromium } = require("playwright-core");
-const { check } = require("./common");
+const { check, withChromium, BROWSER_TIMEOUT_MS } = require("./common");
 
-const TIMEOUT_MS = 30000;
-
-async function launch() {
-  const profile = fs.mkdtempSync(path.join(os.tmpdir(), "ncchannel-chromium-"));
-  const context = await chromium.launchPersistentContext(profile, {
-    executablePath: process.env.NCCHANNEL_CHROMIUM || "/usr/bin/chromium",
-    headless: true,
-    viewport: { width: 1400, height: 900 },
-    args: [
-      "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    ],
-  });
-  context.setDefaultTimeout(TIMEOUT_MS);
-  return { context, profile };
-}
+// The browser every check of this script runs in (a large viewport: both pages' panels).
+const VIEWPORT = { viewport: { width: 1400, height: 900 } };
 
 // Every request the page makes must go to the view itself.
 function watchRequests(page, origin, foreign) {
@@ -70,7 +52,7 @@ async function waitForChange(page, selector, before) {
   await page.waitForFunction(
     ([sel, old]) => document.querySelector(sel).textContent !== old,
     [selector, before],
-    { timeout: TIMEOUT_MS },
+    { timeout: BROWSER_TIMEOUT_MS },
   );
   return page.textContent(selector);
 }
@@ -128,12 +110,12 @@ async function withControls(context, url, seen) {
 }
 
 async function screenshot(url, file, seconds) {
-  const { context } = await launch();
-  const page = await context.newPage();
-  await page.goto(url);
-  await page.waitForTimeout(seconds * 1000);
-  await page.screenshot({ path: file, fullPage: true });
-  await context.close();
+  await withChromium(VIEWPORT, async (context) => {
+    const page = await context.newPage();
+    await page.goto(url);
+    await page.waitForTimeout(seconds * 1000);
+    await page.screenshot({ path: file, fullPage: true });
+  });
 }
 
 async function main() {
@@ -143,14 +125,10 @@ async function main() {
   }
   const [readOnlyUrl, controlsUrl] = process.argv.slice(2);
   const seen = { foreign: [] };
-  const { context, profile } = await launch();
-  try {
+  await withChromium(VIEWPORT, async (context) => {
     await readOnly(context, readOnlyUrl, seen);
     await withControls(context, controlsUrl, seen);
-  } finally {
-    await context.close();
-    fs.rmSync(profile, { recursive: true, force: true });
-  }
+  });
   console.log(JSON.stringify(seen));
 }
 

@@ -6,14 +6,12 @@
 // Waits until the page's soak panel shows channel 1's checked blocks and accepted lines
 // growing and the invariants listed. Prints one JSON line (what it saw).
 "use strict";
-const fs = require("fs");
-const { check, launchChromium } = require("./common");
+const { check, withChromium } = require("./common");
 
 async function main() {
   const url = process.argv[2];
   const seen = {};
-  const { context, profile } = await launchChromium({ width: 1280, height: 800 });
-  try {
+  await withChromium({ viewport: { width: 1280, height: 800 } }, async (context) => {
     const page = await context.newPage();
     await page.goto(url);
     await page.locator("#soak").waitFor();
@@ -29,10 +27,7 @@ async function main() {
     check(seen.invariants.length > 0, "invariants listed");
     seen.title = await page.textContent("#soak h2");
     await page.close();
-  } finally {
-    await context.close();
-    fs.rmSync(profile, { recursive: true, force: true });
-  }
+  });
   console.log(JSON.stringify(seen));
 }
 

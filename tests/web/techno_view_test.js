@@ -1,5 +1,5 @@
 // The live view's technology panel in a real headless browser (Debian's chromium driven by
-// playwright-core from tests/node/node_modules): run by tests/web/techno.rs.
+// playwright-core from tests/node/node_modules, through tests/node/common.js): run by tests/web/techno.rs.
 //
 //   node tests/web/techno_view_test.js URL
 //
@@ -9,27 +9,12 @@
 // after its process time (no PLC). Prints one JSON line (what it saw); exits non-zero on a
 // failed check.
 "use strict";
-const fs = require("fs");
-const os = require("os");
 const path = require("path");
-const { chromium } = require(path.join(__dirname, "../node/node_modules/playwright-core"));
-
-const TIMEOUT_MS = 30000;
+const { withChromium } = require(path.join(__dirname, "../node/common"));
 
 async function main(url) {
-  const profile = fs.mkdtempSync(path.join(os.tmpdir(), "ncchannel-chromium-"));
-  const context = await chromium.launchPersistentContext(profile, {
-    executablePath: process.env.NCCHANNEL_CHROMIUM || "/usr/bin/chromium",
-    headless: true,
-    viewport: { width: 1400, height: 900 },
-    args: [
-      "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    ],
-  });
-  context.setDefaultTimeout(TIMEOUT_MS);
   const seen = {};
-  try {
+  await withChromium({ viewport: { width: 1400, height: 900 } }, async (context) => {
     const page = await context.newPage();
     await page.goto(url);
     await page.locator("#ch1 .state").filter({ hasText: "READY" }).waitFor();
@@ -48,10 +33,7 @@ async function main(url) {
     seen.none_shown_after = await page.locator("#ch1 .techno-none").isVisible();
     seen.counts_after = await page.textContent("#ch1 .techno-counts");
     await page.close();
-  } finally {
-    await context.close();
-    fs.rmSync(profile, { recursive: true, force: true });
-  }
+  });
   console.log(JSON.stringify(seen));
 }
 
