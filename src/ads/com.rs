@@ -643,7 +643,7 @@ fn platform_from_status(
 fn read_channel(v: &Status, ch: u16, def: &Def, length: u32) -> Result<Vec<u8>, AdsResult> {
     let h = &v.hmi;
     let active = v.active_block.as_ref();
-    let programmed_um_s = v.feed_mm_per_min * UM_PER_S_PER_MM_PER_MIN;
+    let programmed_um_s = v.modal.feed_mm_per_min * UM_PER_S_PER_MM_PER_MIN;
     let bytes = match def.field {
         Field::SingleBlockCommand => vec![u8::from(h.single_block)],
         Field::SingleBlockActive => vec![u8::from(h.single_block)],

@@ -387,7 +387,7 @@ pub(crate) fn encoder(
 }
 
 fn value(v: &Status, class: Class, field: Field) -> Result<Vec<u8>, AdsResult> {
-    let feed_um_s = v.feed_mm_per_min * 1000.0 / 60.0;
+    let feed_um_s = v.modal.feed_mm_per_min * 1000.0 / 60.0;
     let active = v.active_block.as_ref();
     let tenths = (v.override_pct * 10.0).round().clamp(0.0, 2000.0) as u16;
     Ok(match field {

@@ -168,8 +168,6 @@ pub struct Status {
     /// The main program running, if any.
     pub program: Option<String>,
     pub(crate) active_block: Option<ActiveBlock>,
-    /// Modal programmed feed as decoded, mm/min (0 = none yet).
-    pub feed_mm_per_min: f64,
     /// Path velocity, mm/s.
     pub velocity_mm_per_s: f64,
     pub(crate) hmi: HmiCommands,
@@ -207,13 +205,13 @@ pub struct Status {
     /// still open (not yet acknowledged): `techno.std` then `techno.late`, by index.
     pub techno_open: TechnoOpen,
     /// The executing motion block's programmed feed, mm/min, and whether it is a rapid
-    /// (`None` between moves): the live view's feed, where `feed_mm_per_min` is the
+    /// (`None` between moves): the live view's feed, where `modal.feed_mm_per_min` is the
     /// decoder's, ahead by the lookahead.
     pub(crate) executing_feed_mm_per_min: Option<f64>,
     pub(crate) executing_rapid: bool,
-    /// The decoder's modal state (spindle, tool, G groups, zero offset), ahead of execution
-    /// by the lookahead.
-    pub(crate) modal: Box<crate::decoder::modal::Modal>,
+    /// The decoder's modal state (programmed feed, mm/min, 0 = none yet; spindle, tool,
+    /// G groups, zero offset), ahead of execution by the lookahead.
+    pub modal: Box<crate::decoder::modal::Modal>,
     /// Stream writes refused because the buffer had no room (11012), since the channel was
     /// built.
     pub(crate) stream_writes_full: u64,
@@ -397,7 +395,6 @@ pub(crate) fn status_of(c: &Channel) -> Status {
         cycle_times: CycleTimes::default(),
         program: c.run.running().map(String::from),
         active_block: c.run.active_block().cloned(),
-        feed_mm_per_min: c.decoder.modal().feed_mm_per_min,
         velocity_mm_per_s: c.motion.velocity_mm_per_s(),
         hmi: c.hmi.commands(),
         searching: c.decoder.searching(),

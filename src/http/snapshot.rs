@@ -380,7 +380,7 @@ pub fn channel_view(
         state: s.state,
         axes,
         distance_to_go_mm: s.distance_to_go_mm,
-        feed_mm_per_min: s.feed_mm_per_min,
+        feed_mm_per_min: s.modal.feed_mm_per_min,
         velocity_mm_per_s: s.velocity_mm_per_s,
         override_pct: s.override_pct,
         program: s.program.clone(),

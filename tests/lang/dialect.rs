@@ -329,7 +329,7 @@ fn each_dwell_form_dwells_its_time() {
         assert!((t - 2.5).abs() < 0.01, "{form}: dwelled {t} s");
         // The time word is no feed: the modal feed stays unset.
         let c = &r.machine.channels()[0];
-        assert_eq!(c.status().feed_mm_per_min, 0.0, "{form}");
+        assert_eq!(c.status().modal.feed_mm_per_min, 0.0, "{form}");
     }
 }
 
