@@ -6,13 +6,13 @@ use std::path::Path;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use ncchannel::runtime::{Cycle, Tick};
-use ncchannel::soak::load::streaming_channels;
+use ncchannel::soak::load::{streaming_channels, Mix};
 
 fn soak(c: &mut Criterion) {
     let params = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
     for n in [1u32, 4] {
         let (mut cycle, period) =
-            streaming_channels(&params, n, 1, &ncchannel::Loader::start()).unwrap();
+            streaming_channels(&params, n, 1, Mix::Params, &ncchannel::Loader::start()).unwrap();
         let mut index = 0u64;
         c.bench_function(&format!("soak_tick_{n}_channels"), |b| {
             b.iter(|| {

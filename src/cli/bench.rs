@@ -15,7 +15,7 @@ use std::time::Duration;
 use super::out::{say, Stdout};
 use crate::runtime::realtime::{RealtimeArgs, RealtimeConfig, ThreadSched};
 use crate::runtime::{bare_loop, Clock, Runtime};
-use crate::soak::load::streaming_channels;
+use crate::soak::load::{streaming_channels, Mix};
 use crate::vocab::stats::Histogram;
 
 use super::bench_ads::{AdsBench, LineKind};
@@ -62,6 +62,9 @@ pub struct BenchArgs {
     /// into the binary).
     #[arg(long)]
     pub params: Option<PathBuf>,
+    /// --load cycle: what the channels' generated programs hold.
+    #[arg(long, value_enum, default_value_t = Mix::Params)]
+    pub mix: Mix,
     /// --load ads-stream: what the streamed 17-byte lines do.
     #[arg(long, value_enum, default_value_t = LineKind::Params)]
     pub lines: LineKind,
@@ -231,7 +234,7 @@ fn add_watches(
 /// on a shared machine (another build starting) hits all alike.
 fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let loader = crate::source::loader::Loader::start();
-    let (cycle, _) = match streaming_channels(params, args.channels, args.seed, &loader) {
+    let (cycle, _) = match streaming_channels(params, args.channels, args.seed, args.mix, &loader) {
         Ok(c) => c,
         Err(e) => return usage(format!("{}: {e}", params.display())),
     };
@@ -243,9 +246,13 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     let mut out = Stdout::new();
     let cyclictest = super::bench_cyclictest::find();
     out.line(format_args!(
-        "bench: period {} µs, {} channels streaming, {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop{}, taking turns in {slices} slices",
+        "bench: period {} µs, {} channels streaming ({}), {ticks} ticks runtime + {ticks} ticks bare spin_sleep loop{}, taking turns in {slices} slices",
         args.period_us,
         args.channels,
+        match args.mix {
+            Mix::Params => "parameter blocks",
+            Mix::Soak => "the soak's mix of moves, arcs and M8/M9",
+        },
         if cyclictest.is_some() { format!(" + {ticks} cyclictest loops") } else { String::new() }
     ));
     let samples = Arc::new(AtomicU64::new(0));

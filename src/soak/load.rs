@@ -14,27 +14,42 @@ use crate::report::event::EventLog;
 use crate::source::loader::Loader;
 use crate::source::stream::MAX_PROGRAM_STREAM_INPUT_SIZE;
 
-/// The generated program of the load: parameter blocks only. The soak's mix of 0.05 mm moves
-/// in random directions stops at nearly every corner and waits 20 ms for each M8/M9
-/// acknowledgement, so a channel ran about 45 blocks a second and its stream stood full: the
-/// writer had a packet taken every few hundred ticks. Blocks that do not move are decoded as
-/// fast as they arrive, so every tick takes about one 992-byte packet per channel.
-fn load_program() -> ProgramSpec {
-    ProgramSpec {
-        moves: 0,
-        arcs: 0,
-        params: 1,
-        m_functions: 0,
-        ..ProgramSpec::default()
+/// What the load's generated programs hold (`bench --load cycle --mix`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Mix {
+    /// Parameter blocks only: blocks that do not move are decoded as fast as they arrive, so
+    /// every tick takes about one 992-byte packet per channel: the decoder at full rate.
+    #[default]
+    Params,
+    /// The soak's mix: 0.05 mm moves in random directions, arcs, parameter blocks and M8/M9.
+    /// The moves stop at nearly every corner and each M8/M9 waits 20 ms for its
+    /// acknowledgement, so a channel runs about 45 blocks a second and its stream stands full:
+    /// the tick is the planner, the interpolator and a refused write, not decoding.
+    Soak,
+}
+
+impl Mix {
+    fn program(self) -> ProgramSpec {
+        match self {
+            Mix::Params => ProgramSpec {
+                moves: 0,
+                arcs: 0,
+                params: 1,
+                m_functions: 0,
+                ..ProgramSpec::default()
+            },
+            Mix::Soak => ProgramSpec::default(),
+        }
     }
 }
 
-/// `n` channels built from the start-up list, each fed its own endless generated program by
+/// `n` channels built from the start-up list, each fed its own endless generated program of `mix` by
 /// a client writing 992-byte packets every tick: the soak cycle without faults.
 pub fn streaming_channels(
     params: &Path,
     n: u32,
     seed: u64,
+    mix: Mix,
     loader: &Loader,
 ) -> Result<(SoakCycle, Duration), String> {
     // `ParamError` displays every diagnostic, rendered, one a line.
@@ -62,7 +77,7 @@ pub fn streaming_channels(
                 ..FeederSpec::default()
             },
             r.fork(2),
-            Source::Generated(Generator::new(load_program(), r.fork(1))),
+            Source::Generated(Generator::new(mix.program(), r.fork(1))),
         );
         channels.push(crate::channel::Channel::new(
             settings,
@@ -87,7 +102,7 @@ pub fn streaming_channels(
 
 #[cfg(test)]
 mod tests {
-    use super::streaming_channels;
+    use super::{streaming_channels, Mix};
     use crate::runtime::{Clock, Runtime};
     use crate::source::loader::Loader;
 
@@ -97,7 +112,8 @@ mod tests {
     fn the_load_takes_a_packet_nearly_every_tick() {
         let params =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
-        let (cycle, period) = streaming_channels(&params, 2, 1, &Loader::start()).unwrap();
+        let (cycle, period) =
+            streaming_channels(&params, 2, 1, Mix::Params, &Loader::start()).unwrap();
         let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
         rt.run(Some(1000));
         let (cycle, _) = rt.into_inner();
@@ -113,5 +129,27 @@ mod tests {
             "{} blocks",
             cycle.total_blocks
         );
+    }
+
+    /// The soak's mix stands the stream full: its moves stop at corners and its M8/M9 wait
+    /// for the PLC, so a packet is taken only every so many ticks (the load the tick-work
+    /// figures of earlier rounds were measured on).
+    #[test]
+    fn the_soak_mix_leaves_the_stream_standing_full() {
+        let params =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
+        let (cycle, period) =
+            streaming_channels(&params, 2, 1, Mix::Soak, &Loader::start()).unwrap();
+        let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
+        rt.run(Some(1000));
+        let (cycle, _) = rt.into_inner();
+        for c in cycle.feed_counters() {
+            assert!(
+                c.writes_ok < 100,
+                "{} packets taken in 1000 ticks",
+                c.writes_ok
+            );
+            assert!(c.writes_ok > 0, "the stream never started");
+        }
     }
 }
