@@ -253,6 +253,11 @@ impl ChannelLog {
         }
     }
 
+    /// Whether stream blocks executed since the last [`ChannelLog::drain_executed`].
+    pub(super) fn executed_pending(&self) -> bool {
+        !self.executed.is_empty()
+    }
+
     /// The stream blocks executed since the last call, in execution order.
     pub(super) fn drain_executed(&mut self) -> std::vec::Drain<'_, ExecutedBlock> {
         self.executed.drain(..)

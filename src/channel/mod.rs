@@ -289,6 +289,12 @@ impl Channel {
     pub(crate) fn state(&self) -> State {
         self.isg.state()
     }
+    /// Whether [`Op::DrainExecuted`] and [`Op::DrainTechno`] would hand anything over; the
+    /// soak's per-tick checks (`src/soak/driver.rs`) skip a drain of nothing, two requests in
+    /// most ticks.
+    pub(crate) fn drains_pending(&self) -> (bool, bool) {
+        (self.log.executed_pending(), self.techno.seen_pending())
+    }
     /// The first `MAX_LISTED_ERRORS` errors of the channel's life, oldest first; for the
     /// soak's per-tick check of new errors (`src/soak/driver.rs`), where `report()` would copy
     /// the list every tick.

@@ -273,6 +273,13 @@ impl TechnoUnits {
         self.observation.is_some()
     }
 
+    /// Whether [`TechnoUnits::drain_seen`] has anything to hand over.
+    pub fn seen_pending(&self) -> bool {
+        self.observation
+            .as_ref()
+            .is_some_and(|o| !o.seen.is_empty() || o.lost > 0)
+    }
+
     /// The observations since the last drain, and how many did not fit.
     pub fn drain_seen(&mut self) -> (Vec<TechnoSeen>, u64) {
         match &mut self.observation {

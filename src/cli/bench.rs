@@ -257,6 +257,7 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     ));
     let samples = Arc::new(AtomicU64::new(0));
     let mut cycle = cycle;
+    cycle.machine_mut().keep_worst_tick();
     if let Err(msg) = add_watches(args, &mut cycle, &samples) {
         return usage(msg);
     }

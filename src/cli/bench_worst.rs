@@ -185,6 +185,7 @@ fn run_input(
     let channels = crate::setup::channels(&config, false, loader).map_err(|e| e.to_string())?;
     let period = Duration::from_micros(config.runtime.cycle_period_us);
     let mut machine = Machine::new(channels, EventLog::disabled(), StopWhen::ProgramsFinished);
+    machine.keep_worst_tick();
     let samples = Arc::new(AtomicU64::new(0));
     for _ in 0..input.watches {
         let w = crate::ads::objects::bench_watch(1, Arc::clone(&samples))

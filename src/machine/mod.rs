@@ -126,7 +126,9 @@ pub struct Machine {
     clock_stopped: Duration,
     /// Notification watches evaluated after every tick (`watch`).
     watches: watch::Watches,
-    /// The phases of the tick in progress, and the longest tick so far (`worst`).
+    /// The phases of the tick in progress, and the longest tick so far (`worst`), when
+    /// `timing` is on.
+    timing: worst::PhaseTiming,
     phases: worst::TickPhases,
     worst: Option<worst::WorstTick>,
     /// Per channel: the live view's record (off until the view drains it).
@@ -152,6 +154,7 @@ impl Machine {
             cycle_times: CycleTimes::default(),
             clock_stopped: Duration::ZERO,
             watches: watch::Watches::default(),
+            timing: worst::PhaseTiming::Off,
             phases: worst::TickPhases::new(n),
             worst: None,
             live: std::iter::repeat_with(live::ChannelRecord::default)
@@ -203,7 +206,14 @@ impl Machine {
         self.channels.get_mut((number as usize).checked_sub(1)?)
     }
 
-    /// The longest tick so far, split into its phases, with what its slowest channel did.
+    /// Split every tick into its phases from now on and keep the longest one
+    /// ([`Machine::worst_tick`]).
+    pub fn keep_worst_tick(&mut self) {
+        self.timing = worst::PhaseTiming::On;
+    }
+
+    /// The longest tick since [`Machine::keep_worst_tick`], split into its phases, with what
+    /// its slowest channel did.
     pub fn worst_tick(&self) -> Option<&worst::WorstTick> {
         self.worst.as_ref()
     }
@@ -235,7 +245,9 @@ impl Machine {
     /// cycle-time statistics are the machine's, so their reset and the times in a status are
     /// filled in here.
     pub fn apply(&mut self, tick: &Tick, channel: u32, op: Op) -> Reply {
-        if op == Op::Hmi(HmiOp::ResetCycleTimes) {
+        // `matches!`, not `==`: comparing builds an `Op` to compare with and drops it, on
+        // every request of every tick.
+        if matches!(op, Op::Hmi(HmiOp::ResetCycleTimes)) {
             self.cycle_times = CycleTimes::default();
             return Reply::Done;
         }
@@ -249,12 +261,11 @@ impl Machine {
                 Reply::Value(None)
             };
         }
-        let times = self.cycle_times;
         let i = (channel as usize).wrapping_sub(1);
         let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
             return Reply::NoChannel;
         };
-        if op == Op::DrainLive {
+        if matches!(op, Op::DrainLive) {
             return Reply::Live(Box::new(record.drain(c)));
         }
         let written = match &op {
@@ -263,7 +274,7 @@ impl Machine {
         };
         match c.apply(tick, op) {
             Reply::Status(mut s) => {
-                s.cycle_times = times;
+                s.cycle_times = self.cycle_times;
                 Reply::Status(s)
             }
             r @ Reply::Stream(Ok(())) => {
@@ -291,7 +302,7 @@ impl Cycle for Machine {
     }
 
     fn step(&mut self, tick: &Tick) -> Flow {
-        let mut clock = worst::PhaseClock::start();
+        let mut clock = worst::PhaseClock::start(self.timing);
         // The PLCs answer before the channels step, as the requests of the tick are served.
         for p in &mut self.plcs {
             if let Some(c) = self
@@ -328,13 +339,17 @@ impl Cycle for Machine {
                 *d = clock.lap().saturating_sub(stopped);
             }
         }
-        let mut watches = std::mem::take(&mut self.watches);
-        watches.evaluate(tick, self.channels.len(), |ch, op| self.apply(tick, ch, op));
-        self.watches = watches;
+        if !self.watches.is_empty() {
+            let mut watches = std::mem::take(&mut self.watches);
+            watches.evaluate(tick, self.channels.len(), |ch, op| self.apply(tick, ch, op));
+            self.watches = watches;
+        }
         self.phases.watches = clock.lap();
         self.publish();
         self.phases.events = clock.lap();
-        worst::WorstTick::consider(&mut self.worst, tick.index, &self.phases, &self.channels);
+        if self.timing == worst::PhaseTiming::On {
+            worst::WorstTick::consider(&mut self.worst, tick.index, &self.phases, &self.channels);
+        }
         match self.stop_when {
             StopWhen::Never => Flow::Continue,
             StopWhen::ProgramsFinished => {
@@ -358,5 +373,25 @@ impl Cycle for Machine {
 
     fn record_work(&mut self, work: Duration) {
         self.cycle_times.record(work);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Machine, StopWhen};
+    use crate::report::event::EventLog;
+    use crate::runtime::{Clock, Cycle, Tick};
+    use std::time::Duration;
+
+    /// The phases are timed only once asked for: a soak or a run reads no clock for them.
+    #[test]
+    fn the_worst_tick_is_kept_only_after_keep_worst_tick() {
+        let mut m = Machine::new(Vec::new(), EventLog::disabled(), StopWhen::Never);
+        let tick = Tick::first(Duration::from_millis(1), Clock::Virtual);
+        m.step(&tick);
+        assert!(m.worst_tick().is_none());
+        m.keep_worst_tick();
+        m.step(&tick);
+        assert_eq!(m.worst_tick().map(|w| w.tick), Some(tick.index));
     }
 }

@@ -55,6 +55,10 @@ impl Watches {
         true
     }
 
+    pub(crate) fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
     /// Evaluate every watch due at `tick`; `apply` answers a read-only request of channel
     /// `ch` in this tick (a status is asked at most once per channel per tick).
     pub(crate) fn evaluate(

@@ -43,20 +43,33 @@ impl TickPhases {
     }
 }
 
+/// Whether the machine splits its ticks into phases and keeps the worst one. A split costs a
+/// clock read per channel and phase, a fifth of a virtual-time tick's work, so only `bench`,
+/// which reports the worst tick, turns it on ([`super::Machine::keep_worst_tick`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum PhaseTiming {
+    #[default]
+    Off,
+    On,
+}
+
 /// A running split of one tick into phases: each [`PhaseClock::lap`] is the time since the
-/// last.
+/// last (zero when the timing is off: no clock is read).
 #[derive(Debug)]
-pub(super) struct PhaseClock(Instant);
+pub(super) struct PhaseClock(Option<Instant>);
 
 impl PhaseClock {
-    pub(super) fn start() -> Self {
-        PhaseClock(Instant::now())
+    pub(super) fn start(timing: PhaseTiming) -> Self {
+        PhaseClock((timing == PhaseTiming::On).then(Instant::now))
     }
 
     pub(super) fn lap(&mut self) -> Duration {
+        let Some(last) = &mut self.0 else {
+            return Duration::ZERO;
+        };
         let now = Instant::now();
-        let d = now.saturating_duration_since(self.0);
-        self.0 = now;
+        let d = now.saturating_duration_since(*last);
+        *last = now;
         d
     }
 }
@@ -81,6 +94,8 @@ pub struct WorstTick {
     /// The tick's number.
     pub tick: u64,
     pub phases: TickPhases,
+    /// The phases' sum, kept to compare each tick with.
+    total: Duration,
     pub slowest: Option<ChannelAt>,
 }
 
@@ -93,10 +108,8 @@ impl WorstTick {
         phases: &TickPhases,
         channels: &[Channel],
     ) {
-        if worst
-            .as_ref()
-            .is_some_and(|w| w.phases.total() >= phases.total())
-        {
+        let total = phases.total();
+        if worst.as_ref().is_some_and(|w| w.total >= total) {
             return;
         }
         let slowest = phases.slowest().and_then(|(i, _)| {
@@ -114,6 +127,7 @@ impl WorstTick {
         *worst = Some(WorstTick {
             tick,
             phases: phases.clone(),
+            total,
             slowest,
         });
     }
@@ -129,7 +143,7 @@ impl fmt::Display for WorstTick {
     /// µs, events 0.4 µs`
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let p = &self.phases;
-        write!(f, "tick {}: {:.1} µs", self.tick, us(p.total()))?;
+        write!(f, "tick {}: {:.1} µs", self.tick, us(self.total))?;
         if let (Some((i, d)), Some(c)) = (p.slowest(), &self.slowest) {
             write!(f, "; channel {} {:.1} µs ({:?}", i + 1, us(d), c.state)?;
             if let Some(prog) = &c.program {

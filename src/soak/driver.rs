@@ -444,8 +444,9 @@ impl SoakChannel {
         expected_errors: &[u32],
     ) -> u64 {
         let (t, number) = (tick.index, self.counters.number);
-        let executed = match door.apply(tick, Op::DrainExecuted) {
-            Reply::Executed(e) => e,
+        let (executed_pending, techno_pending) = door.channel().drains_pending();
+        let executed = match executed_pending.then(|| door.apply(tick, Op::DrainExecuted)) {
+            Some(Reply::Executed(e)) => e,
             _ => Vec::new(),
         };
         if self.numbers_rise {
@@ -458,7 +459,7 @@ impl SoakChannel {
                 self.last_n = Some(n);
             }
         }
-        if let Some(tc) = &mut self.techno {
+        if let Some(tc) = self.techno.as_mut().filter(|_| techno_pending) {
             if let Reply::TechnoSeen { seen, lost } = door.apply(tick, Op::DrainTechno) {
                 for s in seen {
                     tc.see(number, s, &mut tallies.techno, &mut tallies.techno_motion);
