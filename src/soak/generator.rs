@@ -127,6 +127,8 @@ pub struct Generator {
     params_set: u16,
     /// Indices into `cache_files` loaded this epoch (a reset clears the cache).
     cached: Vec<usize>,
+    /// The line being written, kept between lines for its capacity.
+    line: String,
 }
 
 impl Generator {
@@ -141,6 +143,7 @@ impl Generator {
             position_unknown: true,
             params_set: 0,
             cached: Vec::new(),
+            line: String::with_capacity(MAX_LINE_BYTES),
         }
     }
 
@@ -174,7 +177,8 @@ impl Generator {
     pub(crate) fn next_line(&mut self, out: &mut Vec<u8>) -> u32 {
         let n = self.next_n;
         self.next_n = self.next_n.wrapping_add(1).max(1);
-        let mut s = String::with_capacity(MAX_LINE_BYTES);
+        let mut s = std::mem::take(&mut self.line);
+        s.clear();
         if n == 1 {
             let f = self.feed();
             let _ = write!(s, "N{n} G90 G17 G01 F{f}");
@@ -265,6 +269,7 @@ impl Generator {
         s.truncate(MAX_LINE_BYTES - 2);
         out.extend_from_slice(s.as_bytes());
         out.extend_from_slice(b"\r\n");
+        self.line = s;
         n
     }
 
