@@ -315,3 +315,46 @@ impl StreamReader {
         n
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{LineMeta, LineRead, StreamReader};
+    use crate::source::stream::StreamBuffer;
+
+    /// Every line of the stream with its number and offset, one segment per packet.
+    fn lines(packets: &[&[u8]]) -> Vec<(String, LineMeta)> {
+        let mut buf = StreamBuffer::new();
+        let mut r = StreamReader::default();
+        let mut out = Vec::new();
+        let mut line = String::new();
+        for p in packets {
+            buf.write(p).unwrap();
+            let mut note = None;
+            while let LineRead::Line(meta) = r.next_line(&mut buf, &mut line, &mut note) {
+                out.push((line.clone(), meta));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn stream_lines_keep_their_text_and_byte_offsets_whether_a_segment_is_utf8_or_not() {
+        // A segment in UTF-8 (a comment with ä) and one with a byte that is not (0xE4, ä in
+        // Latin-1): the same lines, numbers and byte offsets, the stray byte replaced.
+        let got = lines(&[
+            "N10 P1=1 (Maß ä)\r\nN20 P2=2\r\n".as_bytes(),
+            b"N30 P3=3 (\xE4)\r\nN40 P4=4\r\n",
+        ]);
+        let want = [
+            ("N10 P1=1 (Maß ä)", 1, 0),
+            ("N20 P2=2", 2, 20),
+            ("N30 P3=3 (\u{FFFD})", 3, 30),
+            ("N40 P4=4", 4, 44),
+        ];
+        assert_eq!(got.len(), want.len(), "{got:?}");
+        for ((text, meta), (w_text, w_line, w_offset)) in got.iter().zip(want) {
+            assert_eq!(text, w_text);
+            assert_eq!((meta.line, meta.offset), (w_line, w_offset));
+        }
+    }
+}
