@@ -15,7 +15,7 @@ use super::flow::Flow;
 use super::labels::LabelIndex;
 pub(crate) use super::line::LinePos;
 pub use super::line::MAX_LINE_BYTES;
-use super::line::{cut_line, LineMeta, LineRead, LineTooLong};
+use super::line::{cut_line, cut_str_line, LineMeta, LineRead, LineTooLong};
 
 /// What kind of program level a frame is; decides which end blocks are allowed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -199,13 +199,20 @@ pub(crate) fn read_file_line(frame: &mut Frame, out: &mut String) -> LineRead {
 }
 
 /// The channel's reader of its stream interface: the current segment and where we are in it.
+///
+/// A segment is checked for UTF-8 once, when it is taken: a valid one is kept as `text` and
+/// its lines are cut without checking each again; one that is not stays as bytes in `seg`,
+/// each line read as [`cut_line`] reads a file's.
 #[derive(Debug, Default)]
 pub(crate) struct StreamReader {
+    /// The current segment, when it is not UTF-8 (else empty: `text` holds it).
     seg: Vec<u8>,
+    /// The current segment, when it is UTF-8 (else empty).
+    text: String,
     /// Reused buffer the stream buffer empties into.
     scratch: Vec<u8>,
     pos: usize,
-    /// Stream offset of `seg[0]`, bytes since stream start.
+    /// Stream offset of the segment's first byte, bytes since stream start.
     seg_base: u64,
     line_no: u32,
     /// Segments extracted since stream start.
@@ -222,15 +229,32 @@ impl StreamReader {
     /// Start a new stream: forget everything read before.
     pub(crate) fn restart(&mut self) {
         self.seg.clear();
+        self.text.clear();
         self.pos = 0;
         self.seg_base = 0;
         self.line_no = 0;
         self.segments = 0;
     }
 
+    /// Length of the current segment, bytes (one of `seg` and `text` is empty).
+    fn seg_len(&self) -> usize {
+        self.seg.len() + self.text.len()
+    }
+
     /// Bytes of the current segment not yet decoded.
     pub(crate) fn remaining(&self) -> usize {
-        self.seg.len() - self.pos
+        self.seg_len() - self.pos
+    }
+
+    /// The next complete line of the current segment into `out`: the offset after it.
+    fn cut(&self, out: &mut String) -> Option<usize> {
+        // A segment holds at most one buffer's worth of lines: never too long.
+        let cut = if self.seg.is_empty() {
+            cut_str_line(&self.text, self.pos, out, false)
+        } else {
+            cut_line(&self.seg, self.pos, out, false)
+        };
+        cut.ok().flatten()
     }
 
     /// Next line; pulls a new segment from `buf` only when the current one is used up.
@@ -241,8 +265,7 @@ impl StreamReader {
         note: &mut Option<StreamNote>,
     ) -> LineRead {
         loop {
-            // A segment holds at most one buffer's worth of lines: never too long.
-            if let Ok(Some(next)) = cut_line(&self.seg, self.pos, out, false) {
+            if let Some(next) = self.cut(out) {
                 let meta = LineMeta {
                     line: self.line_no + 1,
                     offset: self.seg_base + self.pos as u64,
@@ -257,6 +280,10 @@ impl StreamReader {
             let consumed = self.pos;
             self.seg_base += consumed as u64;
             self.pos = 0;
+            // Back to bytes (no copy: the string's buffer), the new segment in, checked once.
+            if self.seg.is_empty() {
+                self.seg = std::mem::take(&mut self.text).into_bytes();
+            }
             let bytes = if consumed == self.seg.len() {
                 // The usual case: the segment is used up; the next one replaces it in place.
                 buf.take_segment(&mut self.seg)
@@ -268,6 +295,10 @@ impl StreamReader {
                 self.seg.extend_from_slice(&self.scratch);
                 n
             };
+            match String::from_utf8(std::mem::take(&mut self.seg)) {
+                Ok(text) => self.text = text,
+                Err(e) => self.seg = e.into_bytes(),
+            }
             self.segments += 1;
             *note = Some(StreamNote::Segment { bytes });
         }
@@ -277,9 +308,53 @@ impl StreamReader {
     /// Data still in the stream buffer stays. Returns the bytes dropped.
     pub(crate) fn discard_rest(&mut self) -> usize {
         let n = self.remaining();
-        self.seg_base += self.seg.len() as u64;
+        self.seg_base += self.seg_len() as u64;
         self.seg.clear();
+        self.text.clear();
         self.pos = 0;
         n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LineMeta, LineRead, StreamReader};
+    use crate::source::stream::StreamBuffer;
+
+    /// Every line of the stream with its number and offset, one segment per packet.
+    fn lines(packets: &[&[u8]]) -> Vec<(String, LineMeta)> {
+        let mut buf = StreamBuffer::new();
+        let mut r = StreamReader::default();
+        let mut out = Vec::new();
+        let mut line = String::new();
+        for p in packets {
+            buf.write(p).unwrap();
+            let mut note = None;
+            while let LineRead::Line(meta) = r.next_line(&mut buf, &mut line, &mut note) {
+                out.push((line.clone(), meta));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn stream_lines_keep_their_text_and_byte_offsets_whether_a_segment_is_utf8_or_not() {
+        // A segment in UTF-8 (a comment with ä) and one with a byte that is not (0xE4, ä in
+        // Latin-1): the same lines, numbers and byte offsets, the stray byte replaced.
+        let got = lines(&[
+            "N10 P1=1 (Maß ä)\r\nN20 P2=2\r\n".as_bytes(),
+            b"N30 P3=3 (\xE4)\r\nN40 P4=4\r\n",
+        ]);
+        let want = [
+            ("N10 P1=1 (Maß ä)", 1, 0),
+            ("N20 P2=2", 2, 20),
+            ("N30 P3=3 (\u{FFFD})", 3, 30),
+            ("N40 P4=4", 4, 44),
+        ];
+        assert_eq!(got.len(), want.len(), "{got:?}");
+        for ((text, meta), (w_text, w_line, w_offset)) in got.iter().zip(want) {
+            assert_eq!(text, w_text);
+            assert_eq!((meta.line, meta.offset), (w_line, w_offset));
+        }
     }
 }

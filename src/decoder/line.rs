@@ -62,6 +62,35 @@ impl LineTooLong {
     }
 }
 
+/// Where the line starting at `pos` of `text` ends: the end of its text (without its line
+/// end) and the offset after its line end, or `None` when no complete line is there. Looks at
+/// most [`MAX_LINE_BYTES`] bytes ahead.
+fn line_end(
+    text: &[u8],
+    pos: usize,
+    at_eof_ok: bool,
+) -> Result<Option<(usize, usize)>, LineTooLong> {
+    let Some(rest) = text.get(pos..) else {
+        return Ok(None);
+    };
+    if rest.is_empty() {
+        return Ok(None);
+    }
+    let window = &rest[..rest.len().min(MAX_LINE_BYTES + 1)];
+    let (len, next) = match memchr::memchr(b'\n', window) {
+        Some(i) => (i, pos + i + 1),
+        None if window.len() > MAX_LINE_BYTES => return Err(LineTooLong),
+        None if at_eof_ok => (rest.len(), text.len()),
+        None => return Ok(None),
+    };
+    let len = if rest[..len].ends_with(b"\r") {
+        len - 1
+    } else {
+        len
+    };
+    Ok(Some((pos + len, next)))
+}
+
 /// Copy the line starting at `pos` of `text` into `out` (without its line end). Returns the
 /// offset after the line end, or `None` when no complete line is there. Looks at most
 /// [`MAX_LINE_BYTES`] bytes ahead.
@@ -71,24 +100,31 @@ pub(crate) fn cut_line(
     out: &mut String,
     at_eof_ok: bool,
 ) -> Result<Option<usize>, LineTooLong> {
-    let Some(rest) = text.get(pos..) else {
+    let Some((end, next)) = line_end(text, pos, at_eof_ok)? else {
         return Ok(None);
     };
-    if rest.is_empty() {
-        return Ok(None);
-    }
-    let window = &rest[..rest.len().min(MAX_LINE_BYTES + 1)];
-    let (line, next) = match memchr::memchr(b'\n', window) {
-        Some(i) => (&rest[..i], pos + i + 1),
-        None if window.len() > MAX_LINE_BYTES => return Err(LineTooLong),
-        None if at_eof_ok => (rest, text.len()),
-        None => return Ok(None),
-    };
-    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let line = &text[pos..end];
     out.clear();
     match std::str::from_utf8(line) {
         Ok(s) => out.push_str(s),
         Err(_) => out.push_str(&String::from_utf8_lossy(line)),
     }
+    Ok(Some(next))
+}
+
+/// [`cut_line`] over a text already known to be UTF-8 (a stream segment checked once when it
+/// was taken): the line is copied without checking it again. A line end is ASCII, so it never
+/// falls inside a character and the cut is a character boundary.
+pub(crate) fn cut_str_line(
+    text: &str,
+    pos: usize,
+    out: &mut String,
+    at_eof_ok: bool,
+) -> Result<Option<usize>, LineTooLong> {
+    let Some((end, next)) = line_end(text.as_bytes(), pos, at_eof_ok)? else {
+        return Ok(None);
+    };
+    out.clear();
+    out.push_str(text.get(pos..end).unwrap_or_default());
     Ok(Some(next))
 }

@@ -60,6 +60,13 @@ impl Interpreter {
         for it in items {
             self.collect(it, w)?;
         }
+        if w.is_empty() {
+            // Assignments only (`P1=12345`): no modal change, move, function or call, so
+            // the steps below would do nothing but queue the block; it is queued directly.
+            let info = self.info(rd, at, io);
+            self.emit(info, Action::None, false, io);
+            return Ok(());
+        }
         if w.gs().iter().any(|&(g, _)| g == 160) {
             self.axis_zero_offsets(w, notes)?;
         }
