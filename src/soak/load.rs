@@ -104,19 +104,24 @@ pub fn streaming_channels(
 mod tests {
     use super::{streaming_channels, Mix};
     use crate::runtime::{Clock, Runtime};
+    use crate::soak::driver::SoakCycle;
     use crate::source::loader::Loader;
+
+    /// Two channels of `params/soak/startup4.lis` streaming `mix` for 1000 virtual ticks.
+    fn run_1000_ticks(mix: Mix) -> SoakCycle {
+        let params =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
+        let (cycle, period) = streaming_channels(&params, 2, 1, mix, &Loader::start()).unwrap();
+        let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
+        rt.run(Some(1000));
+        rt.into_inner().0
+    }
 
     /// The bench's load streams: each channel takes a packet nearly every tick, where the
     /// soak's program left the buffer standing full (a packet taken every few hundred ticks).
     #[test]
     fn the_load_takes_a_packet_nearly_every_tick() {
-        let params =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
-        let (cycle, period) =
-            streaming_channels(&params, 2, 1, Mix::Params, &Loader::start()).unwrap();
-        let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
-        rt.run(Some(1000));
-        let (cycle, _) = rt.into_inner();
+        let cycle = run_1000_ticks(Mix::Params);
         for c in cycle.feed_counters() {
             assert!(
                 c.writes_ok >= 800,
@@ -136,14 +141,7 @@ mod tests {
     /// figures of earlier rounds were measured on).
     #[test]
     fn the_soak_mix_leaves_the_stream_standing_full() {
-        let params =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("params/soak/startup4.lis");
-        let (cycle, period) =
-            streaming_channels(&params, 2, 1, Mix::Soak, &Loader::start()).unwrap();
-        let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
-        rt.run(Some(1000));
-        let (cycle, _) = rt.into_inner();
-        for c in cycle.feed_counters() {
+        for c in run_1000_ticks(Mix::Soak).feed_counters() {
             assert!(
                 c.writes_ok < 100,
                 "{} packets taken in 1000 ticks",
