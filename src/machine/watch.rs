@@ -55,6 +55,7 @@ impl Watches {
         true
     }
 
+    /// No watch is active: the machine skips the evaluation.
     pub(crate) fn is_empty(&self) -> bool {
         self.list.is_empty()
     }

@@ -72,24 +72,6 @@ impl Words {
         self.call = None;
     }
 
-    /// Nothing collected: the block held assignments only (they take effect as they are
-    /// collected), so it has no G, axis, feed, function or call to apply.
-    pub(super) fn is_empty(&self) -> bool {
-        self.n_gs == 0
-            && self.axes_set == 0
-            && self.unconfigured_x_col.is_none()
-            && self.ijk == [None; 3]
-            && self.radius.is_none()
-            && self.feed.is_none()
-            && self.spindle_rpm.is_none()
-            && self.tool.is_none()
-            && self.tool_offset.is_none()
-            && self.dwell_s.is_none()
-            && self.n_ms == 0
-            && self.n_hs == 0
-            && self.call.is_none()
-    }
-
     pub(super) fn gs(&self) -> &[(u32, u32)] {
         &self.gs[..self.n_gs]
     }

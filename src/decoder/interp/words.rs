@@ -60,9 +60,10 @@ impl Interpreter {
         for it in items {
             self.collect(it, w)?;
         }
-        if w.is_empty() {
-            // Assignments only (`P1=12345`): no modal change, move, function or call, so
-            // the steps below would do nothing but queue the block; it is queued directly.
+        if items.iter().all(|it| matches!(it, Item::Assign { .. })) {
+            // Assignments only (`P1=12345`): they took effect as they were collected, and
+            // there is no modal change, move, function or call, so the steps below would do
+            // nothing but queue the block; it is queued directly.
             let info = self.info(rd, at, io);
             self.emit(info, Action::None, false, io);
             return Ok(());
