@@ -227,6 +227,10 @@ impl<C: Cycle> Runtime<C> {
         let base = self.resume_at.take().unwrap_or(wall_start);
         let first = self.next_index;
         let mut requests = 0u64;
+        // Virtual time: ticks run back to back, so one clock read per tick is both the end
+        // of one tick's work and the start of the next one's (the loop's own steps between
+        // them count as work). A clock read is a tenth of a virtual-time tick.
+        let mut mark = wall_start;
         let end = loop {
             let k = self.next_index - first;
             if max_ticks.is_some_and(|m| k >= m) {
@@ -247,7 +251,7 @@ impl<C: Cycle> Runtime<C> {
                 clock: self.clock,
             };
             let (started, late) = match self.clock {
-                Clock::Virtual => (Instant::now(), None),
+                Clock::Virtual => (mark, None),
                 Clock::RealTime => {
                     let ideal = base + mul_duration(self.period, k);
                     requests += self.serve_until(ideal, &tick);
@@ -262,7 +266,10 @@ impl<C: Cycle> Runtime<C> {
             // simulated file system's time, counted apart, not the tick's work.
             let stopped = self.cycle.take_clock_stopped();
             self.stats.clock_stopped += stopped;
-            let work = started.elapsed().saturating_sub(stopped);
+            mark = Instant::now();
+            let work = mark
+                .saturating_duration_since(started)
+                .saturating_sub(stopped);
             self.stats.work.record(work);
             self.cycle.record_work(work);
             let overrun = late.is_some_and(|late| late + work > self.period);

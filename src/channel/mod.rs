@@ -127,18 +127,24 @@ pub struct Channel {
 }
 
 impl Channel {
+    /// [`Op::WriteStream`] of a packet the writer keeps: a built-in client offers the same
+    /// packet again after a refusal, and lends it rather than give a reference away.
+    pub fn write_packet(&mut self, tick: &Tick, packet: &std::sync::Arc<[u8]>) -> Reply {
+        // ERROR: nothing drains the buffer before a reset; no streaming program: nothing
+        // ever will.
+        if self.isg.state() == State::Error || !self.store.streaming_enabled() {
+            return Reply::StreamNotReady;
+        }
+        Reply::Stream(self.write_stream(tick, packet))
+    }
+
     /// The one door into a channel: every command and read a client, a feeder, the soak or
     /// the CLI makes is an [`Op`] applied here, in the tick that serves it.
     pub fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
         match op {
             // ERROR: nothing drains the buffer before a reset; no streaming program: nothing
             // ever will.
-            Op::WriteStream(_)
-                if self.isg.state() == State::Error || !self.store.streaming_enabled() =>
-            {
-                Reply::StreamNotReady
-            }
-            Op::WriteStream(data) => Reply::Stream(self.write_stream(tick, &data)),
+            Op::WriteStream(data) => self.write_packet(tick, &data),
             Op::CommandMode(v) => Reply::Command(self.isg.command_mode(tick, v, &mut self.log)),
             Op::CommandState(v) => Reply::Command(self.command_state(tick, v)),
             Op::SetProgram(name) => {

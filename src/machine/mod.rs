@@ -74,9 +74,11 @@ impl Claim {
 pub(crate) struct Offer(Option<Arc<[u8]>>);
 
 impl Offer {
-    /// The stream write of `packet`, copied at its first attempt only.
-    pub(crate) fn write(&mut self, packet: &[u8]) -> Op {
-        Op::WriteStream(Arc::clone(self.0.get_or_insert_with(|| Arc::from(packet))))
+    /// The packet to write: `packet`, copied at its first attempt only. It is lent to the
+    /// write ([`Machine::write_stream`], [`Channel::write_packet`]), not cloned into an
+    /// [`Op`]: a refused attempt then costs no reference count.
+    pub(crate) fn packet(&mut self, packet: &[u8]) -> &Arc<[u8]> {
+        self.0.get_or_insert_with(|| Arc::from(packet))
     }
 
     /// The channel's answer to the write: true when it took the packet (the next offer is a
@@ -268,24 +270,41 @@ impl Machine {
         if matches!(op, Op::DrainLive) {
             return Reply::Live(Box::new(record.drain(c)));
         }
-        let written = match &op {
-            Op::WriteStream(p) => Some(Arc::clone(p)),
-            _ => None,
-        };
-        match c.apply(tick, op) {
-            Reply::Status(mut s) => {
-                s.cycle_times = self.cycle_times;
-                Reply::Status(s)
-            }
-            r @ Reply::Stream(Ok(())) => {
-                if let Some(p) = written {
-                    record.stream_written(&p, c);
+        match op {
+            Op::WriteStream(p) => write_packet(tick, c, record, &p),
+            op => match c.apply(tick, op) {
+                Reply::Status(mut s) => {
+                    s.cycle_times = self.cycle_times;
+                    Reply::Status(s)
                 }
-                r
-            }
-            r => r,
+                r => r,
+            },
         }
     }
+
+    /// A stream write of a packet the caller keeps (a built-in client offering it again
+    /// after a refusal): [`Machine::apply`] of [`Op::WriteStream`] without giving it away.
+    pub fn write_stream(&mut self, tick: &Tick, channel: u32, packet: &Arc<[u8]>) -> Reply {
+        let i = (channel as usize).wrapping_sub(1);
+        match (self.channels.get_mut(i), self.live.get_mut(i)) {
+            (Some(c), Some(record)) => write_packet(tick, c, record, packet),
+            _ => Reply::NoChannel,
+        }
+    }
+}
+
+/// A stream write through the channel's door, and into the live record when taken.
+fn write_packet(
+    tick: &Tick,
+    c: &mut Channel,
+    record: &mut live::ChannelRecord,
+    packet: &Arc<[u8]>,
+) -> Reply {
+    let reply = c.write_packet(tick, packet);
+    if reply == Reply::Stream(Ok(())) {
+        record.stream_written(packet, c);
+    }
+    reply
 }
 
 impl Cycle for Machine {
@@ -320,10 +339,7 @@ impl Cycle for Machine {
             if let Some(packet) = a.feeder.poll(tick.index) {
                 // Through the door like any client's write; a write the channel cannot take
                 // (ERROR, no streaming program) is a refusal the feeder retries.
-                let reply = c.apply(tick, a.offer.write(packet));
-                if reply == Reply::Stream(Ok(())) {
-                    record.stream_written(packet, c);
-                }
+                let reply = write_packet(tick, c, record, a.offer.packet(packet));
                 a.feeder.result(a.offer.answered(&reply));
             }
         }

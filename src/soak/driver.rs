@@ -11,6 +11,7 @@
 
 use std::collections::{BTreeMap, VecDeque};
 use std::convert::Infallible;
+use std::sync::Arc;
 use std::time::Duration;
 
 use serde::Serialize;
@@ -28,6 +29,9 @@ use crate::runtime::{Clock, Cycle, Flow, Tick};
 pub trait Door {
     /// Apply one operation in this tick, as a client's request would be.
     fn apply(&mut self, tick: &Tick, op: Op) -> Reply;
+    /// A stream write of a packet the caller keeps offering until it is taken
+    /// ([`Machine::write_stream`]).
+    fn write_stream(&mut self, tick: &Tick, packet: &Arc<[u8]>) -> Reply;
     /// The channel, read-only (state, position, errors for the checks).
     fn channel(&self) -> &Channel;
 }
@@ -55,6 +59,9 @@ impl<'a> MachineDoor<'a> {
 impl Door for MachineDoor<'_> {
     fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
         self.machine.apply(tick, self.number, op)
+    }
+    fn write_stream(&mut self, tick: &Tick, packet: &Arc<[u8]>) -> Reply {
+        self.machine.write_stream(tick, self.number, packet)
     }
     fn channel(&self) -> &Channel {
         // `new` checked the index, and a machine's channels never change.
@@ -699,7 +706,7 @@ impl Cycle for SoakCycle {
             if slot.core.rejecting(t) {
                 slot.feeder.skip(t);
             } else if let Some(packet) = slot.feeder.poll(t) {
-                let reply = door.apply(tick, slot.offer.write(packet));
+                let reply = door.write_stream(tick, slot.offer.packet(packet));
                 slot.feeder.result(t, slot.offer.answered(&reply));
             }
         }
