@@ -184,6 +184,16 @@ fn bench_without_cyclictest_says_how_to_install_it() {
         out.contains("lateness ratio runtime / bare loop: p99"),
         "{out}"
     );
+    // The warm figure runs the same ticks back to back: as many ticks as the real-time one.
+    let ticks = |name: &str| {
+        out.lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.rsplit_once("(n = "))
+            .map(|(_, n)| n.trim_end_matches(')').to_string())
+            .unwrap_or_else(|| panic!("no {name:?} line: {out}"))
+    };
+    assert_eq!(ticks("tick work   "), ticks("tick work, warm"), "{out}");
+    assert_eq!(ticks("tick work, warm"), "50", "{out}");
 }
 
 #[test]
