@@ -634,6 +634,9 @@ impl Channel {
 
     /// The decoder's notes of this tick as events; an error note stops the channel.
     fn drain_decoder_notes(&mut self, tick: &Tick) {
+        if !self.decoder.has_notes() {
+            return;
+        }
         let mut notes = std::mem::take(&mut self.decoder_notes);
         self.decoder.take_notes(&mut notes);
         for n in notes.drain(..) {

@@ -194,6 +194,11 @@ impl Decoder {
         }
     }
 
+    /// Whether the decoder has notes for the channel: most ticks it has none.
+    pub(crate) fn has_notes(&self) -> bool {
+        !self.notes.is_empty()
+    }
+
     /// Notes since the last call, oldest first.
     pub(crate) fn take_notes(&mut self, into: &mut Vec<Note>) {
         // A swap: both vectors keep their allocations from tick to tick.

@@ -301,7 +301,8 @@ fn write_packet(
     packet: &Arc<[u8]>,
 ) -> Reply {
     let reply = c.write_packet(tick, packet);
-    if reply == Reply::Stream(Ok(())) {
+    // `matches!`, not `==`: no reply built to compare with, on every attempt.
+    if matches!(reply, Reply::Stream(Ok(()))) {
         record.stream_written(packet, c);
     }
     reply
