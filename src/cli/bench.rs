@@ -323,8 +323,8 @@ fn cycle(args: &BenchArgs, params: &Path) -> ExitCode {
     ExitCode::from(super::exit::OK)
 }
 
-/// The tick work of the same load run back to back (virtual time): the same channels, seed
-/// and ticks, so the same work in each tick, with the caches kept warm by the tick before.
+/// The tick work of the same load run back to back (virtual time): the same channels, seed,
+/// notification handles and ticks, so the same work in each tick, with the caches kept warm by the tick before.
 /// Set beside the real-time tick work, it tells the work itself from the cost of coming
 /// back to caches that other processes (or other guests of the host) used in between: a
 /// tick that takes a block runs code and data unused for many ticks, which on a shared
@@ -336,7 +336,9 @@ fn warm_work(
     period: Duration,
     ticks: u64,
 ) -> Result<Histogram, String> {
-    let (cycle, _) = streaming_channels(params, args.channels, args.seed, args.mix, loader)?;
+    let (mut cycle, _) = streaming_channels(params, args.channels, args.seed, args.mix, loader)?;
+    // The same notification handles too: their evaluation is part of each tick's work.
+    add_watches(args, &mut cycle, &Arc::new(AtomicU64::new(0)))?;
     let (mut rt, _tx) = Runtime::new(cycle, period, Clock::Virtual);
     rt.run(Some(ticks));
     Ok(rt.take_stats().work)
