@@ -294,6 +294,30 @@ fn combined_assignments_compute_on_the_old_value_and_divide_by_zero_is_20574() {
     }
 }
 
+/// `P7=2.5`, a constant parameter and a literal, is stored where every other way of
+/// naming the parameter reads and writes it (the decoder takes such a block on a shorter
+/// path than an expression's).
+#[test]
+fn a_literal_assignment_is_read_back_by_every_way_of_naming_the_parameter() {
+    let rig = Rig::new();
+    rig.program(
+        "lit.nc",
+        "P7=2.5
+P8=-0.125
+P9=P7+P[8]
+P[10]=[P9*2]
+P10+=1
+X[P7] Y[P8] Z[P10] F100
+M30
+",
+    );
+    let r = rig.run("lit.nc", None, 1_000_000);
+    assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
+    assert!((r.position('X') - 2.5).abs() < 1e-12, "{}", r.position('X'));
+    assert!((r.position('Y') + 0.125).abs() < 1e-12, "{}", r.position('Y'));
+    assert!((r.position('Z') - 5.75).abs() < 1e-12, "{}", r.position('Z'));
+}
+
 /// Channel time from the start of the block `text` to the start of the next block.
 fn block_duration(r: &common::RunResult, text: &str) -> f64 {
     let blocks = r.of("block");

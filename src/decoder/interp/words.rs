@@ -229,6 +229,27 @@ impl Interpreter {
     /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
     /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
     fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
+        use crate::lang::block::{Expr, Index};
+        // `P1=12345`, the commonest assignment of a stream: its slot and value taken as they
+        // are written, where the general resolver and evaluator (through `dyn Vars`) give the
+        // same for a constant number without indices and a finite literal.
+        if let (
+            VarRef::P {
+                number: Index::Const(n),
+                indices,
+            },
+            Expr::Num(v),
+        ) = (target, value)
+        {
+            if indices.is_empty() && v.is_finite() {
+                let slot = vars::VarSlot::P {
+                    number: *n,
+                    indices: Default::default(),
+                    dims: 0,
+                };
+                return self.set_var(slot, *v);
+            }
+        }
         if matches!(target, VarRef::ToolData { .. }) {
             // The emulator's tool data come from the tool list at start-up.
             return Err(DecodeError::new(
