@@ -94,7 +94,7 @@ pub(crate) fn digit_run(s: &[u8]) -> (u64, usize) {
 /// Up to seven integer and seven fraction digits, the common literal, are read by
 /// [`digit_run`]; their mantissa (below 10^14) is exact in an `f64`, so it is converted as
 /// by [`scan_long`], which takes every longer literal.
-#[inline]
+#[inline(always)]
 pub(crate) fn scan_unsigned(s: &[u8]) -> Option<(f64, usize)> {
     let (int, int_digits) = digit_run(s);
     if int_digits == RUN {

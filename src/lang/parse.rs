@@ -232,6 +232,30 @@ fn prefix<'a>(mut i: &'a str) -> PResult<'a, (Option<u8>, Option<u32>, Option<La
     Ok((i, (skip, n, label)))
 }
 
+/// The common prefix, `N123 ` and no block skip nor label: the number and the rest from the
+/// next word (past blanks and comments), read in one step. `None` for anything else,
+/// which [`prefix`] reads.
+#[inline]
+fn block_number_only(line: &str) -> Option<(&str, u32)> {
+    let b = line.as_bytes();
+    if !matches!(b.first(), Some(b'N' | b'n')) {
+        return None;
+    }
+    let (n, digits) = super::number::digit_run(&b[1..]);
+    // One to seven digits (below 10^7, a u32), then a blank: not `N40:`, not a long number.
+    if !(1..super::number::RUN).contains(&digits)
+        || !matches!(b.get(1 + digits), Some(b' ' | b'\t'))
+    {
+        return None;
+    }
+    // ASCII digits and a blank end on a character boundary.
+    let rest = gap(line.get(1 + digits..)?);
+    if rest.starts_with('[') {
+        return None;
+    }
+    Some((rest, n as u32))
+}
+
 /// `[NAME]`: a string label or `$GOTO` target, upper-cased.
 fn bracket_name(i: &str) -> PResult<'_, String> {
     let (r, _) = ch('[')(i)?;
@@ -248,7 +272,11 @@ fn bracket_name(i: &str) -> PResult<'_, String> {
 }
 
 fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> {
-    let (i, (skip_level, n, label)) = prefix(ws(line))?;
+    let line = ws(line);
+    let (i, (skip_level, n, label)) = match block_number_only(line) {
+        Some((i, n)) => (i, (None, Some(n), None)),
+        None => prefix(line)?,
+    };
     let i = gap(i);
     let body = match i.as_bytes().first() {
         None => Body::Items(Vec::new()),
@@ -2084,8 +2112,58 @@ fn init_list<'a>(ctx: &Ctx<'a>, i: &'a str, elements: u64) -> PResult<'a, Vec<Ex
 
 #[cfg(test)]
 mod tests {
-    use super::item_capacity;
+    use super::{block_number_only, gap, item_capacity, prefix};
     use proptest::prelude::*;
+
+    /// The one-step block number reads as [`prefix`] does, and leaves the rest (labels,
+    /// block skips, long numbers, errors) to it.
+    #[test]
+    fn block_number_only_reads_as_the_prefix() {
+        let mut taken = Vec::new();
+        for line in [
+            "N10 G01 X1",
+            "n10\tX1",
+            "N10",
+            "N10 ",
+            "N10:",
+            "N10: X1",
+            "N10 [LOOP]",
+            "N10 (c) X1",
+            "N10(c) X1",
+            "N1234567 X1",
+            "N12345678 X1",
+            "N99999999999 X1",
+            "N X1",
+            "N-1 X1",
+            "/N10 X1",
+            "/2 N10 X1",
+            "N10 ;c",
+            "N0 M30",
+            "N10 é",
+            "X1",
+            "",
+        ] {
+            if let Some((rest, n)) = block_number_only(line) {
+                taken.push(line);
+                let (i, (skip, pn, label)) = prefix(line).unwrap();
+                assert_eq!((skip, pn, label), (None, Some(n), None), "{line}");
+                assert_eq!(gap(i), rest, "{line}");
+            }
+        }
+        assert_eq!(
+            taken,
+            [
+                "N10 G01 X1",
+                "n10\tX1",
+                "N10 ",
+                "N10 (c) X1",
+                "N1234567 X1",
+                "N10 ;c",
+                "N0 M30",
+                "N10 é"
+            ]
+        );
+    }
 
     /// The definition, a byte at a time: bytes with bit 0x40 before the first `(` or `;`.
     fn item_capacity_bytewise(i: &str) -> usize {
