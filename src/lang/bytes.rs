@@ -8,7 +8,7 @@ const HIGHS: u64 = 0x8080_8080_8080_8080;
 /// A word with a high bit in each byte of `w` that equals `x` (exact for the first such
 /// byte, which is all a yes/no answer needs).
 #[inline]
-fn equal_bytes(w: u64, x: u8) -> u64 {
+pub(crate) fn equal_bytes(w: u64, x: u8) -> u64 {
     let v = w ^ (ONES * u64::from(x));
     v.wrapping_sub(ONES) & !v & HIGHS
 }

@@ -117,6 +117,12 @@ pub(crate) fn keyword<'a>(i: &'a str, kw: &'static str) -> Option<&'a str> {
 /// block number comes through here, and the combinator cost ~160 instructions a call.
 pub(crate) fn uint(i: &str) -> PResult<'_, u32> {
     let b = i.as_bytes();
+    // Up to seven digits, the common number, read eight bytes at once.
+    let (n, digits) = super::number::digit_run(b);
+    if (1..super::number::RUN).contains(&digits) {
+        // ASCII digits end on a character boundary; below 10^7, `n` fits a u32.
+        return Ok((&i[digits..], n as u32));
+    }
     // One pass: the value only grows, so it is too large as soon as a prefix of it is.
     let mut n: u64 = 0;
     let mut digits = 0;
@@ -1162,6 +1168,44 @@ pub(crate) fn verbatim_options<'a>(i: &'a str, none: &'a str) -> PResult<'a, Str
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every length of digits, below and above `u32::MAX`, with a tail: the value and rest
+    /// of a digit-by-digit reading, and "too large" at the number's start past `u32::MAX`.
+    #[test]
+    fn uint_reads_every_length_of_digits() {
+        for text in [
+            "0",
+            "7 X",
+            "12:",
+            "1234567",
+            "12345678",
+            "123456789",
+            "0000000012",
+            "4294967295",
+            "4294967296",
+            "99999999999",
+            "12345678901234567890",
+            "N1",
+            "",
+            "9/",
+            "65535=",
+        ] {
+            let digits = text.bytes().take_while(u8::is_ascii_digit).count();
+            let value = text[..digits].parse::<u64>().ok();
+            match uint(text) {
+                Ok((rest, n)) => {
+                    assert_eq!(rest, &text[digits..], "{text}");
+                    assert_eq!(Some(u64::from(n)), value, "{text}");
+                }
+                Err(nom::Err::Error(_)) => assert_eq!(digits, 0, "{text}"),
+                Err(nom::Err::Failure(e)) => {
+                    assert!(value.is_none_or(|v| v > u64::from(u32::MAX)), "{text}");
+                    assert_eq!(e.input, text, "{text}");
+                }
+                Err(nom::Err::Incomplete(_)) => panic!("{text}"),
+            }
+        }
+    }
 
     /// The printer's levels are the parser's: every operator is found at its own level.
     #[test]
