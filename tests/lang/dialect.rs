@@ -314,8 +314,16 @@ M30
     let r = rig.run("lit.nc", None, 1_000_000);
     assert_eq!(r.finish, Some(Finish::Ended), "{}", r.log);
     assert!((r.position('X') - 2.5).abs() < 1e-12, "{}", r.position('X'));
-    assert!((r.position('Y') + 0.125).abs() < 1e-12, "{}", r.position('Y'));
-    assert!((r.position('Z') - 5.75).abs() < 1e-12, "{}", r.position('Z'));
+    assert!(
+        (r.position('Y') + 0.125).abs() < 1e-12,
+        "{}",
+        r.position('Y')
+    );
+    assert!(
+        (r.position('Z') - 5.75).abs() < 1e-12,
+        "{}",
+        r.position('Z')
+    );
 }
 
 /// Channel time from the start of the block `text` to the start of the next block.
