@@ -142,8 +142,6 @@ impl Channel {
     /// the CLI makes is an [`Op`] applied here, in the tick that serves it.
     pub fn apply(&mut self, tick: &Tick, op: Op) -> Reply {
         match op {
-            // ERROR: nothing drains the buffer before a reset; no streaming program: nothing
-            // ever will.
             Op::WriteStream(data) => self.write_packet(tick, &data),
             Op::CommandMode(v) => Reply::Command(self.isg.command_mode(tick, v, &mut self.log)),
             Op::CommandState(v) => Reply::Command(self.command_state(tick, v)),
