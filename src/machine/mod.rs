@@ -263,8 +263,8 @@ impl Machine {
                 Reply::Value(None)
             };
         }
-        let i = (channel as usize).wrapping_sub(1);
-        let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
+        let Some((c, record)) = channel_and_record(&mut self.channels, &mut self.live, channel)
+        else {
             return Reply::NoChannel;
         };
         if matches!(op, Op::DrainLive) {
@@ -285,12 +285,21 @@ impl Machine {
     /// A stream write of a packet the caller keeps (a built-in client offering it again
     /// after a refusal): [`Machine::apply`] of [`Op::WriteStream`] without giving it away.
     pub fn write_stream(&mut self, tick: &Tick, channel: u32, packet: &Arc<[u8]>) -> Reply {
-        let i = (channel as usize).wrapping_sub(1);
-        match (self.channels.get_mut(i), self.live.get_mut(i)) {
-            (Some(c), Some(record)) => write_packet(tick, c, record, packet),
-            _ => Reply::NoChannel,
+        match channel_and_record(&mut self.channels, &mut self.live, channel) {
+            Some((c, record)) => write_packet(tick, c, record, packet),
+            None => Reply::NoChannel,
         }
     }
+}
+
+/// Channel `number` (1-based) and its live record, when the machine has it.
+fn channel_and_record<'a>(
+    channels: &'a mut [Channel],
+    live: &'a mut [live::ChannelRecord],
+    number: u32,
+) -> Option<(&'a mut Channel, &'a mut live::ChannelRecord)> {
+    let i = (number as usize).wrapping_sub(1);
+    Some((channels.get_mut(i)?, live.get_mut(i)?))
 }
 
 /// A stream write through the channel's door, and into the live record when taken.
@@ -333,8 +342,9 @@ impl Cycle for Machine {
             }
         }
         for a in &mut self.feeders {
-            let i = (a.channel as usize).wrapping_sub(1);
-            let (Some(c), Some(record)) = (self.channels.get_mut(i), self.live.get_mut(i)) else {
+            let Some((c, record)) =
+                channel_and_record(&mut self.channels, &mut self.live, a.channel)
+            else {
                 continue;
             };
             if let Some(packet) = a.feeder.poll(tick.index) {
