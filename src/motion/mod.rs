@@ -763,3 +763,130 @@ impl Motion {
         self.dwell_done_s = 0.0;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::arc::{arc_move, ArcSpec};
+    use crate::queue::{Action, PathMode, Plane, QueuedBlock};
+    use crate::vocab::techno::NoUnits;
+
+    /// A fixed-seed generator in [0, 1).
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    fn block(line: u32, action: Action) -> QueuedBlock {
+        QueuedBlock {
+            info: BlockInfo {
+                prog: Arc::from("t.nc"),
+                line,
+                offset: 0,
+                counter: u64::from(line),
+                n: None,
+                text: None,
+                stream: false,
+            },
+            action,
+            silent: false,
+        }
+    }
+
+    /// The plan that stops early among blocks planned before gives every block the exit a
+    /// plan of the whole window gives, bit for bit: on short steps, reversals, arcs, plain
+    /// blocks, dwells, flushes and override changes, at every tick.
+    #[test]
+    fn the_plan_that_stops_early_equals_the_whole_plan() {
+        let axes: Vec<AxisLimits> = (0..3)
+            .map(|index| AxisLimits {
+                index,
+                max_velocity_mm_per_min: 30_000.0,
+                max_accel_mm_per_s2: 2_000.0,
+                max_jerk_mm_per_s3: None,
+                rapid_mm_per_min: 30_000.0,
+                min_mm: -10_000.0,
+                max_mm: 10_000.0,
+            })
+            .collect();
+        let settings = PlannerSettings {
+            lookahead_blocks: 8,
+            corner_smoothing_s: 0.0,
+        };
+        let mut m = Motion::with_planner(axes, settings);
+        let mut rng = Lcg(7);
+        let mut q = BlockQueue::new(64);
+        let mut notes = Vec::new();
+        let (mut at, mut before) = ([0.0; MAX_AXES], [0.0; MAX_AXES]);
+        let mut line = 0u32;
+        for tick in 0..1_000_000u32 {
+            while line < 5_000 && q.len() < 16 {
+                line += 1;
+                let feed = 500.0 + rng.next() * 20_000.0;
+                let r = rng.next();
+                let action = if r < 0.05 {
+                    Action::None
+                } else if r < 0.10 {
+                    Action::Dwell { seconds: 0.002 }
+                } else if r < 0.12 {
+                    Action::Flush(FlushKind::Continue)
+                } else if r < 0.15 {
+                    let spec = ArcSpec {
+                        plane: Plane::Xy,
+                        ijk: [Some(1.0 + rng.next()), Some(0.0), None],
+                        radius: None,
+                        cw: rng.next() < 0.5,
+                    };
+                    let mut to = at;
+                    to[0] += 2.0 * spec.ijk[0].unwrap_or(1.0);
+                    match arc_move(&spec, at, to, feed, 1e-6) {
+                        Ok(mv) => {
+                            (before, at) = (at, to);
+                            Action::Move(mv)
+                        }
+                        Err(_) => Action::None,
+                    }
+                } else {
+                    // A short step, now and then straight back (a reversal).
+                    let to = if rng.next() < 0.2 {
+                        before
+                    } else {
+                        let mut to = at;
+                        for x in to.iter_mut().take(3) {
+                            *x += (rng.next() - 0.5) * 4.0 * rng.next();
+                        }
+                        to
+                    };
+                    let mv = Move {
+                        kind: MoveKind::Line,
+                        start: at,
+                        end: to,
+                        feed_mm_per_min: feed,
+                        path: PathMode::default(),
+                    };
+                    (before, at) = (at, to);
+                    Action::Move(mv)
+                };
+                q.push(block(line, action));
+            }
+            if line == 5_000 && q.is_empty() && m.planner.is_empty() {
+                break;
+            }
+            if tick % 997 == 0 {
+                m.set_override(50.0 + rng.next() * 100.0);
+            }
+            m.step(0.001, &mut q, &mut notes, &NoUnits);
+            notes.clear();
+            // The plan this tick made (it stops early where it may), against the whole window's.
+            let (planned, whole) = m.planner.plan_both_ways(m.override_pct, m.dt_s);
+            assert_eq!(planned, whole, "tick {tick}");
+        }
+        assert!(line == 5_000 && m.planner.is_empty(), "ran {line} blocks");
+    }
+}

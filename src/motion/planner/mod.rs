@@ -518,3 +518,33 @@ impl Planner {
         }
     }
 }
+
+#[cfg(test)]
+impl Planner {
+    /// The plan as it stands (made incrementally by the ticks), then the plan of the whole
+    /// window: each as every released motion block's exit velocity (its bits), front first.
+    pub(crate) fn plan_both_ways(&mut self, override_pct: f64, dt_s: f64) -> (Vec<u64>, Vec<u64>) {
+        self.plan_if_needed(override_pct, dt_s);
+        let planned = self.exits();
+        // No exit left to compare with: this plan cannot stop early.
+        for e in self.window.iter_mut() {
+            if let EntryKind::Move(seg) = &mut e.kind {
+                seg.exit_mm_per_s = f64::NAN;
+            }
+        }
+        self.mark_dirty();
+        self.plan_if_needed(override_pct, dt_s);
+        (planned, self.exits())
+    }
+
+    fn exits(&self) -> Vec<u64> {
+        self.window
+            .iter()
+            .take(self.window.released())
+            .filter_map(|e| match &e.kind {
+                EntryKind::Move(seg) => Some(seg.exit_mm_per_s.to_bits()),
+                _ => None,
+            })
+            .collect()
+    }
+}

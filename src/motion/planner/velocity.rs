@@ -24,13 +24,24 @@ const ARC_CENTRIPETAL_SHARE: f64 = 0.5;
 
 /// Backward pass over the released blocks: the last one ends at rest; each block's exit is
 /// the next block's admissible entry velocity (`corner_s`: the corner filter's window, s).
+///
+/// Blocks released before the last plan whose inputs are unchanged stop the pass early: the
+/// first of them (from the back) whose exit comes out as before enters as before, and so does
+/// everything ahead of it. A window that releases one block at a time then replans a few
+/// blocks, not all of them.
 pub(super) fn plan(window: &mut Window, corner_s: f64, override_pct: f64, dt_s: f64) {
+    let plan_for = [corner_s.to_bits(), override_pct.to_bits(), dt_s.to_bits()];
+    let fresh = window.plan_fresh(plan_for);
     let mut next_entry = 0.0_f64;
     let mut stop = true;
-    for e in window.released_mut().rev() {
+    for (i, e) in window.released_mut().enumerate().rev() {
         match &mut e.kind {
             EntryKind::Move(seg) => {
-                seg.exit_mm_per_s = if stop { 0.0 } else { next_entry };
+                let exit = if stop { 0.0 } else { next_entry };
+                if i < fresh && exit.to_bits() == seg.exit_mm_per_s.to_bits() {
+                    break;
+                }
+                seg.exit_mm_per_s = exit;
                 let entry_limit = match seg.junction {
                     None => 0.0,
                     Some(j) => {
@@ -58,6 +69,7 @@ pub(super) fn plan(window: &mut Window, corner_s: f64, override_pct: f64, dt_s: 
             _ => {}
         }
     }
+    window.planned(plan_for);
 }
 
 /// A motion block's nominal velocity, velocity limit, path acceleration and (not yet linked)

@@ -39,6 +39,13 @@ pub(super) struct Window {
     release_next_move: bool,
     /// The plan must be recomputed (new releases, override change).
     dirty: bool,
+    /// Released entries at the front whose plan inputs have not changed since the last plan
+    /// (only ever entries appended or released behind them): the next plan may stop among
+    /// them (see [`Window::plan_fresh`]).
+    fresh: usize,
+    /// The corner window, override and cycle time the last plan was made for (their bits):
+    /// a plan for others recomputes every block.
+    plan_for: [u64; 3],
 }
 
 impl Window {
@@ -53,6 +60,8 @@ impl Window {
             moves: 0,
             release_next_move: false,
             dirty: false,
+            fresh: 0,
+            plan_for: [0; 3],
         }
     }
 
@@ -76,13 +85,17 @@ impl Window {
     pub(super) fn front(&self) -> Option<&Entry> {
         self.entries.front()
     }
+    /// The front entry. Its plan inputs may change without a replan of the others: no block
+    /// lies before it, and its exit is the next block's entry.
     pub(super) fn front_mut(&mut self) -> Option<&mut Entry> {
         self.entries.front_mut()
     }
     pub(super) fn iter(&self) -> std::collections::vec_deque::Iter<'_, Entry> {
         self.entries.iter()
     }
+    /// Every entry, to change: the next plan recomputes every block.
     pub(super) fn iter_mut(&mut self) -> std::collections::vec_deque::IterMut<'_, Entry> {
+        self.fresh = 0;
         self.entries.iter_mut()
     }
     /// The released entries, front first.
@@ -100,8 +113,12 @@ impl Window {
         }
     }
 
-    /// The motion block at index `i`, if that entry is one.
+    /// The motion block at index `i`, if that entry is one, to change: the next plan
+    /// recomputes it and every block after it.
     pub(super) fn segment_mut(&mut self, i: usize) -> Option<&mut Segment> {
+        if i > 0 {
+            self.fresh = self.fresh.min(i);
+        }
         match self.entries.get_mut(i).map(|e| &mut e.kind) {
             Some(EntryKind::Move(seg)) => Some(seg),
             _ => None,
@@ -139,9 +156,28 @@ impl Window {
         self.moves >= self.lookahead || self.entries.len() >= self.max_entries
     }
 
-    /// The plan must be recomputed before the next tick's interpolation.
+    /// The plan must be recomputed before the next tick's interpolation, every block of it.
     pub(super) fn mark_dirty(&mut self) {
         self.dirty = true;
+        self.fresh = 0;
+    }
+
+    /// A plan for the corner window, override and cycle time `plan_for` (their bits) starts:
+    /// the released entries at the front it may stop among, because their inputs are the last
+    /// plan's. Among them, a motion block whose exit comes out as the last plan gave it has
+    /// the same entry as then too, and so has every block before it: the plan may stop there.
+    pub(super) fn plan_fresh(&self, plan_for: [u64; 3]) -> usize {
+        if plan_for == self.plan_for {
+            self.fresh
+        } else {
+            0
+        }
+    }
+
+    /// The plan of every released entry is current, for `plan_for`.
+    pub(super) fn planned(&mut self, plan_for: [u64; 3]) {
+        self.plan_for = plan_for;
+        self.fresh = self.released;
     }
 
     /// The plan was stale; it is taken as recomputed from now on.
@@ -206,6 +242,7 @@ impl Window {
             self.moves -= 1;
         }
         self.released = self.released.saturating_sub(1);
+        self.fresh = self.fresh.saturating_sub(1);
         Some(e)
     }
 
@@ -216,6 +253,7 @@ impl Window {
         self.moves = 0;
         self.release_next_move = false;
         self.dirty = false;
+        self.fresh = 0;
     }
 
     /// The last motion entry before index `i`, unless a barrier lies between.
