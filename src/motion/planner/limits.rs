@@ -44,7 +44,12 @@ impl LimitCheck {
 
     /// A block with its event entered the window: errors name it from now on.
     pub(super) fn entered(&mut self, info: &BlockInfo) {
-        self.last_block = Some((info.prog.clone(), info.line));
+        // Blocks of the same program share its name: only the line changes, and no
+        // reference count is taken and given back (two locked operations a block).
+        match &mut self.last_block {
+            Some((prog, line)) if Arc::ptr_eq(prog, &info.prog) => *line = info.line,
+            last => *last = Some((info.prog.clone(), info.line)),
+        }
     }
 
     /// Software limits on the path the axes follow (21897): a move entering the window —
