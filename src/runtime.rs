@@ -325,8 +325,8 @@ impl<C: Cycle> Runtime<C> {
     }
 
     fn serve_pending(&mut self, tick: &Tick) -> u64 {
-        // Most ticks find the queue empty: a look at it is a tenth of a `try_recv`'s
-        // instructions (about 110 of a soak tick's 2,400).
+        // Most ticks find the queue empty: a look at it costs about 40 instructions fewer
+        // than a `try_recv` that finds nothing (callgrind, a soak tick of about 2,400).
         if self.requests.is_empty() {
             return 0;
         }

@@ -768,20 +768,9 @@ impl Motion {
 mod tests {
     use super::*;
     use crate::geometry::arc::{arc_move, ArcSpec};
+    use crate::machine::rng::SplitMix64;
     use crate::queue::{Action, PathMode, Plane, QueuedBlock};
     use crate::vocab::techno::NoUnits;
-
-    /// A fixed-seed generator in [0, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     fn block(line: u32, action: Action) -> QueuedBlock {
         QueuedBlock {
@@ -820,7 +809,7 @@ mod tests {
             corner_smoothing_s: 0.0,
         };
         let mut m = Motion::with_planner(axes, settings);
-        let mut rng = Lcg(7);
+        let mut rng = SplitMix64::new(7);
         let mut q = BlockQueue::new(64);
         let mut notes = Vec::new();
         let (mut at, mut before) = ([0.0; MAX_AXES], [0.0; MAX_AXES]);
@@ -828,8 +817,8 @@ mod tests {
         for tick in 0..1_000_000u32 {
             while line < 5_000 && q.len() < 16 {
                 line += 1;
-                let feed = 500.0 + rng.next() * 20_000.0;
-                let r = rng.next();
+                let feed = 500.0 + rng.unit() * 20_000.0;
+                let r = rng.unit();
                 let action = if r < 0.05 {
                     Action::None
                 } else if r < 0.10 {
@@ -839,9 +828,9 @@ mod tests {
                 } else if r < 0.15 {
                     let spec = ArcSpec {
                         plane: Plane::Xy,
-                        ijk: [Some(1.0 + rng.next()), Some(0.0), None],
+                        ijk: [Some(1.0 + rng.unit()), Some(0.0), None],
                         radius: None,
-                        cw: rng.next() < 0.5,
+                        cw: rng.unit() < 0.5,
                     };
                     let mut to = at;
                     to[0] += 2.0 * spec.ijk[0].unwrap_or(1.0);
@@ -854,12 +843,12 @@ mod tests {
                     }
                 } else {
                     // A short step, now and then straight back (a reversal).
-                    let to = if rng.next() < 0.2 {
+                    let to = if rng.unit() < 0.2 {
                         before
                     } else {
                         let mut to = at;
                         for x in to.iter_mut().take(3) {
-                            *x += (rng.next() - 0.5) * 4.0 * rng.next();
+                            *x += (rng.unit() - 0.5) * 4.0 * rng.unit();
                         }
                         to
                     };
@@ -879,7 +868,7 @@ mod tests {
                 break;
             }
             if tick % 997 == 0 {
-                m.set_override(50.0 + rng.next() * 100.0);
+                m.set_override(50.0 + rng.unit() * 100.0);
             }
             m.step(0.001, &mut q, &mut notes, &NoUnits);
             notes.clear();
