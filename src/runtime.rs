@@ -6,6 +6,7 @@
 //! the synthetic load of `ncchannel bench`).
 
 pub mod realtime;
+mod stopwatch;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -58,6 +59,10 @@ pub trait Cycle {
     /// cycle-time statistics (the machine's, read through the CNC's time objects) records it
     /// here instead of reading the clock a second time; the default ignores it.
     fn record_work(&mut self, _work: Duration) {}
+
+    /// Whether other threads send this cycle requests. A cycle that takes none (the soak's
+    /// `Infallible`) says so, and the runtime does not look at its empty queue every tick.
+    const TAKES_REQUESTS: bool = true;
 }
 
 /// Why [`Runtime::run`] returned.
@@ -117,6 +122,8 @@ pub struct Runtime<C: Cycle> {
     stats: CycleStats,
     /// Lateness and overruns for readers on other threads, once one asked for them.
     live: Option<Arc<LiveCycleStats>>,
+    /// Virtual time's work clock, kept across runs (its laps decide when to calibrate).
+    stopwatch: stopwatch::Stopwatch,
 }
 
 impl<C: Cycle> Runtime<C> {
@@ -140,6 +147,7 @@ impl<C: Cycle> Runtime<C> {
             next_index: 0,
             stats: CycleStats::default(),
             live: None,
+            stopwatch: stopwatch::Stopwatch::start(),
         };
         (rt, tx)
     }
@@ -229,14 +237,18 @@ impl<C: Cycle> Runtime<C> {
         let mut requests = 0u64;
         // Virtual time: ticks run back to back, so one clock read per tick is both the end
         // of one tick's work and the start of the next one's (the loop's own steps between
-        // them count as work). A clock read was 6-8 % of a soak tick's wall time (perf).
-        let mut mark = wall_start;
+        // them count as work).
+        self.stopwatch.restart();
+        // Channel time advanced by one period a tick: `index × period` without a 128-bit
+        // product every tick.
+        let mut time = channel_time(self.period, self.next_index);
         let end = loop {
             let k = self.next_index - first;
             if max_ticks.is_some_and(|m| k >= m) {
                 break RunEnd::MaxTicks;
             }
-            if self.stop.swap(false, Ordering::AcqRel)
+            // Looked at before it is consumed: a swap every tick is a locked instruction.
+            if (self.stop.load(Ordering::Relaxed) && self.stop.swap(false, Ordering::AcqRel))
                 || self
                     .external_stop
                     .as_ref()
@@ -247,29 +259,32 @@ impl<C: Cycle> Runtime<C> {
             let tick = Tick {
                 index: self.next_index,
                 period: self.period,
-                time: channel_time(self.period, self.next_index),
+                time,
                 clock: self.clock,
             };
             let (started, late) = match self.clock {
-                Clock::Virtual => (mark, None),
+                Clock::Virtual => (None, None),
                 Clock::RealTime => {
                     let ideal = base + mul_duration(self.period, k);
                     requests += self.serve_until(ideal, &tick);
                     spin_sleep::sleep_until(ideal);
                     let now = Instant::now();
-                    (now, Some(now.saturating_duration_since(ideal)))
+                    (Some(now), Some(now.saturating_duration_since(ideal)))
                 }
             };
-            requests += self.serve_pending(&tick);
+            if C::TAKES_REQUESTS {
+                requests += self.serve_pending(&tick);
+            }
             let flow = self.cycle.step(&tick);
-            // Virtual time: a wait for the program loader stops the clock; it is the
-            // simulated file system's time, counted apart, not the tick's work.
             let stopped = self.cycle.take_clock_stopped();
             self.stats.clock_stopped += stopped;
-            mark = Instant::now();
-            let work = mark
-                .saturating_duration_since(started)
-                .saturating_sub(stopped);
+            let elapsed = match started {
+                Some(started) => started.elapsed(),
+                None => self.stopwatch.lap(),
+            };
+            // Virtual time: a wait for the program loader stops the clock; it is the
+            // simulated file system's time, counted apart, not the tick's work.
+            let work = elapsed.saturating_sub(stopped);
             self.stats.work.record(work);
             self.cycle.record_work(work);
             let overrun = late.is_some_and(|late| late + work > self.period);
@@ -281,6 +296,7 @@ impl<C: Cycle> Runtime<C> {
                 live.publish(work, late, overrun);
             }
             self.next_index += 1;
+            time = time.saturating_add(self.period);
             if flow == Flow::Stop {
                 break RunEnd::Stopped;
             }

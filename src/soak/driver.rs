@@ -677,6 +677,7 @@ impl SoakCycle {
 impl Cycle for SoakCycle {
     /// The soak takes no requests from other threads.
     type Request = Infallible;
+    const TAKES_REQUESTS: bool = false;
 
     fn serve(&mut self, req: Infallible, _tick: &Tick) {
         match req {}
