@@ -2,9 +2,10 @@
 //! tick's start (ticks run back to back).
 //!
 //! Why not `Instant::now` throughout: the OS clock's read (the vDSO's `clock_gettime`) cost
-//! about 46 ns on a KVM guest with clocksource `tsc`, against about 16 ns for the time stamp
-//! counter read directly (`quanta::Clock::raw`): a tenth of a soak's tick against a
-//! thirtieth (measured on an AMD EPYC guest). But quanta calibrates the counter against the
+//! about 46 ns on a KVM guest with clocksource `tsc`, against about 20 ns for the time stamp
+//! counter read directly and converted (`quanta::Clock::raw` and `delta`): a tenth of a
+//! soak's tick against a twentieth (measured on an AMD EPYC guest, where perf put the OS
+//! clock's read at 7-8 % of a soak's wall time). But quanta calibrates the counter against the
 //! OS clock before its first read, spinning until the two agree: 0.6 to 2 ms, and up to
 //! 200 ms by its own bound on a noisy machine. A short run (every `ncchannel run` of a small
 //! program, most tests) would pay that for nothing. So a run reads the OS clock for its first
