@@ -374,10 +374,14 @@ pub fn run_client(
         .output()
         .unwrap_or_else(|e| panic!("{program} runs: {e}"));
     let (_, events) = served.finish();
+    // The exit status too: a client killed by a signal (a crash inside its C library)
+    // leaves no message on stderr.
     assert!(
         out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        "{} ({}; stdout: {})",
+        String::from_utf8_lossy(&out.stderr),
+        out.status,
+        String::from_utf8_lossy(&out.stdout)
     );
     let seen = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
     (seen, events)
