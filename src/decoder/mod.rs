@@ -22,9 +22,10 @@ pub mod vars;
 use std::sync::Arc;
 use std::time::Duration;
 
+use crate::lang::block::Item;
 use crate::lang::block::{AxisName, Block, Body, Call};
 use crate::lang::codes;
-use crate::lang::{continuation, is_comment_end, parse_block, parse_var_line, VarLine};
+use crate::lang::{continuation, is_comment_end, parse_block_reusing, parse_var_line, VarLine};
 use crate::source::loader::Loader;
 use crate::source::store::{Opened, ProgramKind, ProgramStore};
 use crate::vocab::axis::{Position, MAX_AXES};
@@ -91,6 +92,9 @@ pub struct Decoder {
     notes: Vec<Note>,
     /// Counters for the report (blocks and label scans are counted by the parts).
     stats: DecoderStats,
+    /// The last block's item list, emptied, for the next line's parse: one allocation kept
+    /// from line to line rather than one taken and freed a block.
+    spare_items: Vec<Item>,
 }
 
 /// Whether the decoder may read its next line in this tick.
@@ -112,6 +116,7 @@ impl Decoder {
             state: DecoderState::Idle,
             notes: Vec::new(),
             stats: DecoderStats::default(),
+            spare_items: Vec::new(),
         }
     }
 
@@ -473,8 +478,8 @@ impl Decoder {
         r
     }
 
-    /// The steps of one line: comment and `#VAR` blocks, parse, the flow's skipping and
-    /// labels, block search, `/n` skipping, then the block's body.
+    /// The steps of one line: comment and `#VAR` blocks, the skip's unparsed lines, parse,
+    /// then [`Self::run_block`]; the block's item list is kept for the next line.
     fn run_line(&mut self, text: &str, meta: LineMeta, io: &mut DecoderIo<'_>) -> Res {
         let top = self.reader.top();
         if top.in_comment_block() {
@@ -506,7 +511,7 @@ impl Decoder {
         {
             return Ok(());
         }
-        let block = match parse_block(text) {
+        let block = match parse_block_reusing(text, std::mem::take(&mut self.spare_items)) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error; but the skip
             // reads every `$` statement to find its structure's end, so a malformed one is
@@ -515,23 +520,35 @@ impl Decoder {
             Err(e) if skipping && !codes::is_control_statement_fault(e.code) => return Ok(()),
             Err(e) => return Err(e.into()),
         };
+        let r = self.run_block(&block, text, meta, stream, io);
+        self.spare_items = block.into_items();
+        r
+    }
+
+    /// The steps of one parsed block: the stream's limits, the flow's skipping and labels,
+    /// block search, `/n` skipping, then the block's body.
+    fn run_block(
+        &mut self,
+        block: &Block,
+        text: &str,
+        meta: LineMeta,
+        stream: bool,
+        io: &mut DecoderIo<'_>,
+    ) -> Res {
+        let skipping = self.reader.top().flow().skipping();
         if stream {
-            stream_allows(&block)?;
+            stream_allows(block)?;
         }
         if skipping {
             let flow = self.reader.top().flow_mut();
-            let run_it = flow.skip_line(&block, stream, &self.interp)?;
+            let run_it = flow.skip_line(block, stream, &self.interp)?;
             if !run_it {
                 return Ok(());
             }
         } else if let Some(l) = &block.label {
             self.reader.top().flow_mut().note_label(l, stream)?;
         }
-        let at = BlockAt {
-            block: &block,
-            text,
-            meta,
-        };
+        let at = BlockAt { block, text, meta };
         if self.interp.searching() {
             self.interp
                 .search_block(at, &mut self.reader, &mut self.notes, io);

@@ -20,6 +20,24 @@ pub struct Block {
     pub body: Body,
 }
 
+impl Block {
+    /// Most items a kept list may hold room for: a longer block's list (a 4000-character
+    /// line of single letters holds about 2000) is freed rather than kept for the next line.
+    const KEPT_ITEMS: usize = 64;
+
+    /// This block's item list, emptied, for the next `parse_block_reusing`: an empty list
+    /// for a block of another kind, or one whose list grew past [`Self::KEPT_ITEMS`].
+    pub fn into_items(self) -> Vec<Item> {
+        match self.body {
+            Body::Items(mut items) if items.capacity() <= Self::KEPT_ITEMS => {
+                items.clear();
+                items
+            }
+            _ => Vec::new(),
+        }
+    }
+}
+
 /// A jump target: `N40:` defines `Label::Number(40)`, `[LOOP_1]` defines `Label::Name`.
 /// Names are stored upper-case: labels are case-insensitive. Ordered, so label tables can be
 /// B-trees (which never rehash a whole table in one tick).
@@ -56,14 +74,14 @@ pub enum Body {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Item {
     Word(Word),
-    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`. The target is boxed to keep `Item` at 48 bytes:
-    /// plain word blocks are the hot path and their item lists are allocated per block.
+    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`. The target is an [`AssignTarget`]: `P<n>` inline,
+    /// any other variable boxed, so `Item` stays at 48 bytes.
     ///
     /// `op` is the operator of a combined assignment, `P2/=P1` (TF5200 diagnosis ID 20574
     /// names "the combined assignment operator /="): `+=`, `-=`, `*=` or `/=`; the new value
     /// is the target's old one with `value` by `op`. `None` for a plain `=`.
     Assign {
-        target: Box<VarRef>,
+        target: AssignTarget,
         value: Expr,
         col: u32,
         op: Option<BinOp>,
@@ -208,6 +226,42 @@ pub struct Word {
 pub enum Value {
     Num(f64),
     Expr(Expr),
+}
+
+/// The target of an assignment ([`Item::Assign`]). `P<n>` with a constant number and no
+/// indices, the target of nearly every streamed assignment (`P1=12345`), is held inline: a
+/// block of them takes no allocation besides its item list. Any other variable is boxed, so
+/// `Item` stays at 48 bytes. [`AssignTarget::new`] picks the form, so one target has one
+/// representation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AssignTarget {
+    /// `P<n>`.
+    P(u32),
+    Var(Box<VarRef>),
+}
+
+impl AssignTarget {
+    pub fn new(v: VarRef) -> Self {
+        match v {
+            VarRef::P {
+                number: Index::Const(n),
+                indices,
+            } if indices.is_empty() => AssignTarget::P(n),
+            v => AssignTarget::Var(Box::new(v)),
+        }
+    }
+
+    /// The target as a variable reference: `P<n>`'s is built here (an empty index list
+    /// allocates nothing).
+    pub fn var_ref(&self) -> std::borrow::Cow<'_, VarRef> {
+        match self {
+            AssignTarget::P(n) => std::borrow::Cow::Owned(VarRef::P {
+                number: Index::Const(*n),
+                indices: Vec::new(),
+            }),
+            AssignTarget::Var(v) => std::borrow::Cow::Borrowed(v),
+        }
+    }
 }
 
 /// A reference to a parameter or variable, indices not yet evaluated.

@@ -15,8 +15,9 @@
 use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
-    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Index, Item,
-    Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AssignTarget, AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget,
+    Index, Item, Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType,
+    Word,
 };
 use crate::vocab::flush::FlushKind;
 
@@ -84,6 +85,15 @@ impl Display for Label {
         match self {
             Label::Number(n) => write!(f, "N{n}:"),
             Label::Name(s) => write!(f, "[{s}]"),
+        }
+    }
+}
+
+impl Display for AssignTarget {
+    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
+        match self {
+            AssignTarget::P(n) => write!(f, "P{n}"),
+            AssignTarget::Var(v) => v.fmt(f),
         }
     }
 }

@@ -33,5 +33,6 @@ pub use eval::{
 pub use expr::parse_expr;
 pub use join::{continuation, Joiner};
 pub use parse::{
-    is_blank_line, is_comment_end, parse_block, parse_var_declaration, parse_var_line, VarLine,
+    is_blank_line, is_comment_end, parse_block, parse_block_reusing, parse_var_declaration,
+    parse_var_line, VarLine,
 };

@@ -9,8 +9,9 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Item,
-    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
+    AssignTarget, AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions,
+    GotoTarget, Item, Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType,
+    Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -31,9 +32,17 @@ use crate::vocab::flush::FlushKind;
 /// Parse one NC line. A trailing CR, LF or CR LF is ignored; any other line end inside the
 /// line, or more than 4000 characters, is error 20200.
 pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
+    parse_block_reusing(line, Vec::new())
+}
+
+/// [`parse_block`] that puts an ordinary block's items into `items` (cleared first), so a
+/// caller that parses one line after another keeps one item list's allocation instead of
+/// taking and freeing one a block (the decoder gets it back with [`Block::into_items`]).
+pub fn parse_block_reusing(line: &str, mut items: Vec<Item>) -> Result<Block, SyntaxError> {
+    items.clear();
     let (line, ascii) = checked_line(line)?;
     let ctx = Ctx::with_ascii(line, ascii);
-    block(&ctx, line).map_err(|e| ctx.to_error(e))
+    block(&ctx, line, items).map_err(|e| ctx.to_error(e))
 }
 
 /// Is this line `#COMMENT END` (case-insensitive, optionally after a block skip and block
@@ -271,7 +280,11 @@ fn bracket_name(i: &str) -> PResult<'_, String> {
     }
 }
 
-fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> {
+fn block<'a>(
+    ctx: &Ctx<'a>,
+    line: &'a str,
+    items_list: Vec<Item>,
+) -> Result<Block, nom::Err<PErr<'a>>> {
     let line = ws(line);
     let (i, (skip_level, n, label)) = match block_number_only(line) {
         Some((i, n)) => (i, (None, Some(n), None)),
@@ -279,7 +292,7 @@ fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> 
     };
     let i = gap(i);
     let body = match i.as_bytes().first() {
-        None => Body::Items(Vec::new()),
+        None => Body::Items(items_list),
         Some(b'#') => {
             let (r, c) = command(ctx, i)?;
             end_of_block(r, "nothing may follow a # command in its block")?;
@@ -301,7 +314,7 @@ fn block<'a>(ctx: &Ctx<'a>, line: &'a str) -> Result<Block, nom::Err<PErr<'a>>> 
             end_of_block(r, "nothing may follow L, LL or L CYCLE in its block")?;
             Body::Call(c)
         }
-        Some(_) => Body::Items(items(ctx, i)?),
+        Some(_) => Body::Items(items(ctx, i, items_list)?),
     };
     Ok(Block {
         skip_level,
@@ -370,8 +383,13 @@ fn item_capacity(i: &str) -> usize {
     (n + count(tail).0).min(CAP)
 }
 
-fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
-    let mut items = Vec::with_capacity(item_capacity(i));
+/// The items of an ordinary block, pushed onto `items` (empty; its capacity is reused).
+fn items<'a>(
+    ctx: &Ctx<'a>,
+    mut i: &'a str,
+    mut items: Vec<Item>,
+) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
+    items.reserve_exact(item_capacity(i));
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
     // The block's own M words: with two or more, each number once (20765), checked at the
@@ -410,8 +428,14 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             }
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
-            let (r, target) = ctx.var_ref(i)?;
-            writable(&target, i)?;
+            let (r, target) = match ctx.const_p(i) {
+                Some((r, n)) => (r, AssignTarget::P(n)),
+                None => {
+                    let (r, target) = ctx.var_ref(i)?;
+                    writable(&target, i)?;
+                    (r, AssignTarget::new(target))
+                }
+            };
             let r = ws(r);
             let (r, op) = match r.strip_prefix('=') {
                 Some(r) => (r, None),
@@ -422,7 +446,7 @@ fn items<'a>(ctx: &Ctx<'a>, mut i: &'a str) -> Result<Vec<Item>, nom::Err<PErr<'
             };
             let (r, value) = ctx.expr(ws(r))?;
             items.push(Item::Assign {
-                target: Box::new(target),
+                target,
                 value,
                 col,
                 op,

@@ -232,27 +232,42 @@ fn assignments() {
         unreachable!()
     };
     assert_eq!(items.len(), 7);
-    let targets: Vec<(&VarRef, &Expr, u32)> = items
+    let targets: Vec<(VarRef, &Expr, u32)> = items
         .iter()
         .map(|i| match i {
             Item::Assign {
                 target, value, col, ..
-            } => (target.as_ref(), value, *col),
+            } => (target.var_ref().into_owned(), value, *col),
             other => panic!("{other:?}"),
         })
         .collect();
+    // `P<n>` is held inline, every other target boxed.
+    assert!(matches!(
+        items[0],
+        Item::Assign {
+            target: AssignTarget::P(1),
+            ..
+        }
+    ));
+    assert!(matches!(
+        items[2],
+        Item::Assign {
+            target: AssignTarget::Var(_),
+            ..
+        }
+    ));
     assert!(
-        matches!(targets[0], (VarRef::P { number: Index::Const(1), indices }, Expr::Num(v), 1) if indices.is_empty() && *v == 10.0)
+        matches!(&targets[0], (VarRef::P { number: Index::Const(1), indices }, Expr::Num(v), 1) if indices.is_empty() && *v == 10.0)
     );
     assert!(matches!(
-        targets[3].0,
+        &targets[3].0,
         VarRef::P {
             number: Index::Expr(_),
             ..
         }
     ));
     assert!(
-        matches!(targets[5].0, VarRef::V { scope: VScope::Program, name, indices } if name == "ARR" && indices.len() == 2)
+        matches!(&targets[5].0, VarRef::V { scope: VScope::Program, name, indices } if name == "ARR" && indices.len() == 2)
     );
     assert!(matches!(targets[6].0, VarRef::CycleParam(1)));
     assert_eq!(

@@ -21,7 +21,7 @@ use crate::decoder::reader::Reader;
 use crate::decoder::vars;
 use crate::geometry::arc;
 use crate::lang::block::VarRef;
-use crate::lang::block::{Item, Value};
+use crate::lang::block::{AssignTarget, Item, Value};
 use crate::lang::codes;
 use crate::lang::eval::Val;
 use crate::lang::range::whole_u32 as whole;
@@ -228,20 +228,13 @@ impl Interpreter {
 
     /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
     /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
-    fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
-        use crate::lang::block::{Expr, Index};
+    fn assign(&mut self, target: &AssignTarget, value: &crate::lang::block::Expr, col: u32) -> Res {
+        use crate::lang::block::Expr;
         // `P1=12345`, the commonest assignment of a stream: its slot and value taken as they
         // are written, where the general resolver and evaluator (through `dyn Vars`) give the
         // same for a constant number without indices and a finite literal.
-        if let (
-            VarRef::P {
-                number: Index::Const(n),
-                indices,
-            },
-            Expr::Num(v),
-        ) = (target, value)
-        {
-            if indices.is_empty() && v.is_finite() {
+        if let (AssignTarget::P(n), Expr::Num(v)) = (target, value) {
+            if v.is_finite() {
                 let slot = vars::VarSlot::P {
                     number: *n,
                     indices: Default::default(),
@@ -250,6 +243,8 @@ impl Interpreter {
                 return self.set_var(slot, *v);
             }
         }
+        let target = target.var_ref();
+        let target = &*target;
         if matches!(target, VarRef::ToolData { .. }) {
             // The emulator's tool data come from the tool list at start-up.
             return Err(DecodeError::new(
@@ -306,7 +301,7 @@ impl Interpreter {
     /// ID 20574 "Division by 0.", of "the combined assignment operator /=").
     fn combined_assign(
         &mut self,
-        target: &VarRef,
+        target: &AssignTarget,
         op: crate::lang::block::BinOp,
         value: &crate::lang::block::Expr,
         col: u32,
@@ -320,7 +315,7 @@ impl Interpreter {
             )
             .at(col));
         }
-        let old = Expr::Var(Box::new(target.clone()));
+        let old = Expr::Var(Box::new(target.var_ref().into_owned()));
         let new = Expr::Binary(op, Box::new(old), Box::new(Expr::Num(operand)));
         self.assign(target, &new, col)
     }
