@@ -204,6 +204,11 @@ impl Interpreter {
         self.vars.set(k, v).map_err(var_error)
     }
 
+    /// [`Self::set_var`] of `P<number>` without indices.
+    pub(super) fn set_p(&mut self, number: u32, v: f64) -> Res {
+        self.vars.set_p(number, v).map_err(var_error)
+    }
+
     /// A variable's value (`None`: not defined).
     pub(super) fn var(&self, k: &VarSlot) -> Option<f64> {
         self.vars.get(k)

@@ -580,6 +580,26 @@ impl VarStore {
 
     /// Assign a value. A V. scalar not yet there is created (in its scope; V.L. in the
     /// current level); an element needs its array declared, and its indices inside it.
+    /// `P<number>` without indices set to `v`: [`Self::set`] of that slot, the commonest
+    /// assignment of a stream, without building the slot when it lies in the flat table (a
+    /// P parameter has no V.E. type to check).
+    pub fn set_p(&mut self, number: u32, v: f64) -> Result<(), VarError> {
+        match self.p_flat.get_mut(number as usize) {
+            Some(slot) => {
+                *slot = v;
+                Ok(())
+            }
+            None => self.set(
+                VarSlot::P {
+                    number,
+                    indices: Indices::default(),
+                    dims: 0,
+                },
+                v,
+            ),
+        }
+    }
+
     pub fn set(&mut self, k: VarSlot, v: f64) -> Result<(), VarError> {
         let v = self.typed(&k, v, true)?;
         self.set_typed(k, v)

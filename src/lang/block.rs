@@ -74,14 +74,25 @@ pub enum Body {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Item {
     Word(Word),
-    /// `P1=10`, `V.L.X=[..]`, `P[P1+5]=3`. The target is an [`AssignTarget`]: `P<n>` inline,
-    /// any other variable boxed, so `Item` stays at 48 bytes.
+    /// `V.L.X=[..]`, `P[P1+5]=3`, `P1[2]=4`: an assignment to any variable but a plain
+    /// `P<n>` ([`Item::AssignP`]). The target is boxed to keep `Item` at 48 bytes: plain word
+    /// blocks are the hot path and their item lists are kept by the thousand.
     ///
     /// `op` is the operator of a combined assignment, `P2/=P1` (TF5200 diagnosis ID 20574
     /// names "the combined assignment operator /="): `+=`, `-=`, `*=` or `/=`; the new value
     /// is the target's old one with `value` by `op`. `None` for a plain `=`.
     Assign {
-        target: AssignTarget,
+        target: Box<VarRef>,
+        value: Expr,
+        col: u32,
+        op: Option<BinOp>,
+    },
+    /// `P1=10`: an assignment to `P<n>` with a constant number and no indices, the commonest
+    /// of a streamed program, its target held inline so that a block of them takes no
+    /// allocation besides its item list. `value`, `col` and `op` as for [`Item::Assign`].
+    /// [`Item::assign`] makes this of every such target, so one assignment has one form.
+    AssignP {
+        number: u32,
         value: Expr,
         col: u32,
         op: Option<BinOp>,
@@ -116,6 +127,30 @@ pub enum Item {
     /// the spindle (TF5200 programming manual, "Programming in spindle-specific syntax").
     /// Boxed, as [`Item::GCall`].
     Functions(Box<Functions>),
+}
+
+impl Item {
+    /// The assignment of `value` to `target`: [`Item::AssignP`] for `P<n>` without indices,
+    /// [`Item::Assign`] for any other target.
+    pub fn assign(target: VarRef, value: Expr, col: u32, op: Option<BinOp>) -> Item {
+        match target {
+            VarRef::P {
+                number: Index::Const(number),
+                indices,
+            } if indices.is_empty() => Item::AssignP {
+                number,
+                value,
+                col,
+                op,
+            },
+            target => Item::Assign {
+                target: Box::new(target),
+                value,
+                col,
+                op,
+            },
+        }
+    }
 }
 
 /// The functions in an axis's or the spindle's brackets ([`Item::Functions`]).
@@ -226,42 +261,6 @@ pub struct Word {
 pub enum Value {
     Num(f64),
     Expr(Expr),
-}
-
-/// The target of an assignment ([`Item::Assign`]). `P<n>` with a constant number and no
-/// indices, the target of nearly every streamed assignment (`P1=12345`), is held inline: a
-/// block of them takes no allocation besides its item list. Any other variable is boxed, so
-/// `Item` stays at 48 bytes. [`AssignTarget::new`] picks the form, so one target has one
-/// representation.
-#[derive(Debug, Clone, PartialEq)]
-pub enum AssignTarget {
-    /// `P<n>`.
-    P(u32),
-    Var(Box<VarRef>),
-}
-
-impl AssignTarget {
-    pub fn new(v: VarRef) -> Self {
-        match v {
-            VarRef::P {
-                number: Index::Const(n),
-                indices,
-            } if indices.is_empty() => AssignTarget::P(n),
-            v => AssignTarget::Var(Box::new(v)),
-        }
-    }
-
-    /// The target as a variable reference: `P<n>`'s is built here (an empty index list
-    /// allocates nothing).
-    pub fn var_ref(&self) -> std::borrow::Cow<'_, VarRef> {
-        match self {
-            AssignTarget::P(n) => std::borrow::Cow::Owned(VarRef::P {
-                number: Index::Const(*n),
-                indices: Vec::new(),
-            }),
-            AssignTarget::Var(v) => std::borrow::Cow::Borrowed(v),
-        }
-    }
 }
 
 /// A reference to a parameter or variable, indices not yet evaluated.

@@ -15,9 +15,8 @@
 use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
-    AssignTarget, AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget,
-    Index, Item, Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType,
-    Word,
+    AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Index, Item,
+    Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
 };
 use crate::vocab::flush::FlushKind;
 
@@ -89,15 +88,6 @@ impl Display for Label {
     }
 }
 
-impl Display for AssignTarget {
-    fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
-        match self {
-            AssignTarget::P(n) => write!(f, "P{n}"),
-            AssignTarget::Var(v) => v.fmt(f),
-        }
-    }
-}
-
 impl Display for Item {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
         match self {
@@ -107,6 +97,12 @@ impl Display for Item {
             } => {
                 let op = op.map_or("", BinOp::symbol);
                 write!(f, "{target}{op}={value}")
+            }
+            Item::AssignP {
+                number, value, op, ..
+            } => {
+                let op = op.map_or("", BinOp::symbol);
+                write!(f, "P{number}{op}={value}")
             }
             Item::GValue { g, value, .. } => match value {
                 Value::Num(v) => write!(f, "G{g}={}", Num(*v)),

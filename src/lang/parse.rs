@@ -9,9 +9,9 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    AssignTarget, AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions,
-    GotoTarget, Item, Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType,
-    Word, AXIS_NAME_MAX,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Index,
+    Item, Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -429,11 +429,18 @@ fn items<'a>(
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
             let col = ctx.col(i);
             let (r, target) = match ctx.const_p(i) {
-                Some((r, n)) => (r, AssignTarget::P(n)),
+                // An empty index list allocates nothing.
+                Some((r, number)) => (
+                    r,
+                    VarRef::P {
+                        number: Index::Const(number),
+                        indices: Vec::new(),
+                    },
+                ),
                 None => {
                     let (r, target) = ctx.var_ref(i)?;
                     writable(&target, i)?;
-                    (r, AssignTarget::new(target))
+                    (r, target)
                 }
             };
             let r = ws(r);
@@ -445,12 +452,7 @@ fn items<'a>(
                 },
             };
             let (r, value) = ctx.expr(ws(r))?;
-            items.push(Item::Assign {
-                target,
-                value,
-                col,
-                op,
-            });
+            items.push(Item::assign(target, value, col, op));
             i = r;
         } else {
             let (code, msg) = match b {
@@ -566,6 +568,7 @@ fn is_dwell(it: &Item) -> bool {
         Item::GValue { g, .. } => *g == 4,
         Item::Word(w) => w.letter == b'G' && w.value == Value::Num(4.0),
         Item::Assign { .. }
+        | Item::AssignP { .. }
         | Item::FunctionValue { .. }
         | Item::GCall(_)
         | Item::NamedAxis(_)
@@ -645,7 +648,9 @@ fn dwell_alone<'a>(ctx: &Ctx<'a>, items: &[Item]) -> Result<(), nom::Err<PErr<'a
             }
             Item::NamedAxis(_) => continue,
             Item::Word(w) => (w.col, format!("{}", w.letter as char)),
-            Item::Assign { col, .. } => (*col, "an assignment".to_string()),
+            Item::Assign { col, .. } | Item::AssignP { col, .. } => {
+                (*col, "an assignment".to_string())
+            }
             Item::GValue { g, col, .. } => (*col, format!("G{g}")),
             Item::FunctionValue {
                 letter,

@@ -169,7 +169,7 @@ fn variables_and_indices_resolve() {
         panic!()
     };
     assert_eq!(
-        resolve(&target.var_ref(), &vars),
+        resolve(target, &vars),
         Ok(VarKey::P {
             number: 7,
             indices: vec![2]

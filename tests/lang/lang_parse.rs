@@ -237,25 +237,23 @@ fn assignments() {
         .map(|i| match i {
             Item::Assign {
                 target, value, col, ..
-            } => (target.var_ref().into_owned(), value, *col),
+            } => ((**target).clone(), value, *col),
+            Item::AssignP {
+                number, value, col, ..
+            } => (
+                VarRef::P {
+                    number: Index::Const(*number),
+                    indices: Vec::new(),
+                },
+                value,
+                *col,
+            ),
             other => panic!("{other:?}"),
         })
         .collect();
     // `P<n>` is held inline, every other target boxed.
-    assert!(matches!(
-        items[0],
-        Item::Assign {
-            target: AssignTarget::P(1),
-            ..
-        }
-    ));
-    assert!(matches!(
-        items[2],
-        Item::Assign {
-            target: AssignTarget::Var(_),
-            ..
-        }
-    ));
+    assert!(matches!(items[0], Item::AssignP { number: 1, .. }));
+    assert!(matches!(items[2], Item::Assign { .. }));
     assert!(
         matches!(&targets[0], (VarRef::P { number: Index::Const(1), indices }, Expr::Num(v), 1) if indices.is_empty() && *v == 10.0)
     );
@@ -542,7 +540,7 @@ fn deep_nesting_is_an_error_not_a_crash() {
     let Body::Items(items) = &b.body else {
         unreachable!()
     };
-    let Item::Assign { value, .. } = &items[0] else {
+    let Item::AssignP { value, .. } = &items[0] else {
         unreachable!()
     };
     struct NoVars;

@@ -208,7 +208,7 @@ fn item() -> impl Strategy<Value = Item> {
         1 => prop::sample::select(gs).prop_map(|g| Item::Word(Word { letter: b'G', value: Value::Num(f64::from(g)), col: 0 })),
         1 => (0u32..100).prop_map(|m| Item::Word(Word { letter: b'M', value: Value::Num(f64::from(m)), col: 0 })),
         1 => (0u32..=65_535).prop_map(|h| Item::Word(Word { letter: b'H', value: Value::Num(f64::from(h)), col: 0 })),
-        1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::Assign { target: AssignTarget::new(target), value, col: 0, op: None }),
+        1 => (var_ref(expr()), expr()).prop_map(|(target, value)| Item::assign(target, value, 0, None)),
         1 => (800u32..=819, prop::collection::vec(prop::option::of(expr()), 0..4))
             .prop_map(|(g, mut args)| {
                 // The parser drops trailing gaps: they define nothing.
@@ -381,6 +381,7 @@ pub(crate) fn without_cols(mut b: Block) -> Block {
             match item {
                 Item::Word(w) => w.col = 0,
                 Item::Assign { col, .. }
+                | Item::AssignP { col, .. }
                 | Item::GValue { col, .. }
                 | Item::FunctionValue { col, .. } => *col = 0,
                 Item::GCall(c) => c.col = 0,

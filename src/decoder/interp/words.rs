@@ -21,7 +21,7 @@ use crate::decoder::reader::Reader;
 use crate::decoder::vars;
 use crate::geometry::arc;
 use crate::lang::block::VarRef;
-use crate::lang::block::{AssignTarget, Item, Value};
+use crate::lang::block::{Item, Value};
 use crate::lang::codes;
 use crate::lang::eval::Val;
 use crate::lang::range::whole_u32 as whole;
@@ -60,7 +60,10 @@ impl Interpreter {
         for it in items {
             self.collect(it, w)?;
         }
-        if items.iter().all(|it| matches!(it, Item::Assign { .. })) {
+        if items
+            .iter()
+            .all(|it| matches!(it, Item::Assign { .. } | Item::AssignP { .. }))
+        {
             // Assignments only (`P1=12345`): they took effect as they were collected, and
             // there is no modal change, move, function or call, so the steps below would do
             // nothing but queue the block; it is queued directly.
@@ -151,6 +154,12 @@ impl Interpreter {
                 col,
                 op: Some(op),
             } => self.combined_assign(target, *op, value, *col),
+            Item::AssignP {
+                number,
+                value,
+                col,
+                op,
+            } => self.assign_p(*number, value, *col, *op),
             Item::GValue { g, value, col } => {
                 // G132..G134 weight ramps (no effect here); G04's value is its time.
                 let v = match value {
@@ -228,23 +237,7 @@ impl Interpreter {
 
     /// `P1=…`, `V.L.S=…`, `@P1=…`: at once, in written order. A V. variable or `@P` may take
     /// a string (docs/nc-language.md, "Strings"); P parameters hold numbers.
-    fn assign(&mut self, target: &AssignTarget, value: &crate::lang::block::Expr, col: u32) -> Res {
-        use crate::lang::block::Expr;
-        // `P1=12345`, the commonest assignment of a stream: its slot and value taken as they
-        // are written, where the general resolver and evaluator (through `dyn Vars`) give the
-        // same for a constant number without indices and a finite literal.
-        if let (AssignTarget::P(n), Expr::Num(v)) = (target, value) {
-            if v.is_finite() {
-                let slot = vars::VarSlot::P {
-                    number: *n,
-                    indices: Default::default(),
-                    dims: 0,
-                };
-                return self.set_var(slot, *v);
-            }
-        }
-        let target = target.var_ref();
-        let target = &*target;
+    fn assign(&mut self, target: &VarRef, value: &crate::lang::block::Expr, col: u32) -> Res {
         if matches!(target, VarRef::ToolData { .. }) {
             // The emulator's tool data come from the tool list at start-up.
             return Err(DecodeError::new(
@@ -296,12 +289,38 @@ impl Interpreter {
         }
     }
 
+    /// `P<n>=…`, `P<n>+=…` ([`Item::AssignP`]). `P1=12345`, the commonest assignment of a
+    /// stream, is stored as written: the general resolver and evaluator (through `dyn Vars`)
+    /// give the same slot and value for a finite literal.
+    fn assign_p(
+        &mut self,
+        number: u32,
+        value: &crate::lang::block::Expr,
+        col: u32,
+        op: Option<crate::lang::block::BinOp>,
+    ) -> Res {
+        use crate::lang::block::{Expr, Index};
+        if let (None, Expr::Num(v)) = (op, value) {
+            if v.is_finite() {
+                return self.set_p(number, *v);
+            }
+        }
+        let target = VarRef::P {
+            number: Index::Const(number),
+            indices: Vec::new(),
+        };
+        match op {
+            None => self.assign(&target, value, col),
+            Some(op) => self.combined_assign(&target, op, value, col),
+        }
+    }
+
     /// `P2/=P1`, `P1+=2`: the target's value with the operand by `op`, assigned as `P2=P2/P1`
     /// would be. The operand is a number; `/=` by 0 is the kernel's 20574 (TF5200 diagnosis
     /// ID 20574 "Division by 0.", of "the combined assignment operator /=").
     fn combined_assign(
         &mut self,
-        target: &AssignTarget,
+        target: &VarRef,
         op: crate::lang::block::BinOp,
         value: &crate::lang::block::Expr,
         col: u32,
@@ -315,7 +334,7 @@ impl Interpreter {
             )
             .at(col));
         }
-        let old = Expr::Var(Box::new(target.var_ref().into_owned()));
+        let old = Expr::Var(Box::new(target.clone()));
         let new = Expr::Binary(op, Box::new(old), Box::new(Expr::Num(operand)));
         self.assign(target, &new, col)
     }
