@@ -93,7 +93,7 @@ pub struct Decoder {
     /// Counters for the report (blocks and label scans are counted by the parts).
     stats: DecoderStats,
     /// The last block's item list, emptied, for the next line's parse: one allocation kept
-    /// from line to line rather than one taken and freed a block.
+    /// from line to line rather than one taken and freed a block ([`Self::item_list`]).
     spare_items: Vec<Item>,
 }
 
@@ -511,7 +511,7 @@ impl Decoder {
         {
             return Ok(());
         }
-        let block = match parse_block_reusing(text, std::mem::take(&mut self.spare_items)) {
+        let mut block = match parse_block_reusing(text, self.item_list()) {
             Ok(b) => b,
             // A syntax error in a skipped line never runs, so it is no error; but the skip
             // reads every `$` statement to find its structure's end, so a malformed one is
@@ -521,8 +521,19 @@ impl Decoder {
             Err(e) => return Err(e.into()),
         };
         let r = self.run_block(&block, text, meta, stream, io);
-        self.spare_items = block.into_items();
+        if let Some(items) = block.take_items() {
+            self.spare_items = items;
+        }
         r
+    }
+
+    /// The kept item list for the next parse, or a new one when the last line kept none (a
+    /// command, a control statement, an error).
+    fn item_list(&mut self) -> Vec<Item> {
+        match std::mem::take(&mut self.spare_items) {
+            list if list.capacity() == 0 => Vec::with_capacity(crate::lang::ITEM_LIST_CAPACITY),
+            list => list,
+        }
     }
 
     /// The steps of one parsed block: the stream's limits, the flow's skipping and labels,

@@ -25,15 +25,17 @@ impl Block {
     /// line of single letters holds about 2000) is freed rather than kept for the next line.
     const KEPT_ITEMS: usize = 64;
 
-    /// This block's item list, emptied, for the next `parse_block_reusing`: an empty list
-    /// for a block of another kind, or one whose list grew past [`Self::KEPT_ITEMS`].
-    pub fn into_items(self) -> Vec<Item> {
-        match self.body {
-            Body::Items(mut items) if items.capacity() <= Self::KEPT_ITEMS => {
+    /// This block's item list, taken out and emptied, for the next `parse_block_reusing`;
+    /// `None` for a block of another kind, or one whose list grew past
+    /// [`Self::KEPT_ITEMS`].
+    pub fn take_items(&mut self) -> Option<Vec<Item>> {
+        match &mut self.body {
+            Body::Items(items) if items.capacity() <= Self::KEPT_ITEMS => {
+                let mut items = std::mem::take(items);
                 items.clear();
-                items
+                Some(items)
             }
-            _ => Vec::new(),
+            _ => None,
         }
     }
 }

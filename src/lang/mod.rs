@@ -34,5 +34,5 @@ pub use expr::parse_expr;
 pub use join::{continuation, Joiner};
 pub use parse::{
     is_blank_line, is_comment_end, parse_block, parse_block_reusing, parse_var_declaration,
-    parse_var_line, VarLine,
+    parse_var_line, VarLine, ITEM_LIST_CAPACITY,
 };

@@ -9,9 +9,8 @@ use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
 
 use super::block::{
-    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Index,
-    Item, Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
-    AXIS_NAME_MAX,
+    AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Item,
+    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -344,6 +343,10 @@ fn starts_call(i: &str) -> bool {
 // Ordinary blocks: words and assignments
 // ---------------------------------------------------------------------------------------
 
+/// The items a list made for [`parse_block_reusing`] holds without growing: most blocks have
+/// fewer, and a list this large is not sized again for each line.
+pub const ITEM_LIST_CAPACITY: usize = 32;
+
 /// An upper bound on the items in the rest of a block: the bytes before the first comment
 /// that have bit 0x40, which every letter and `@` has and no digit, point, sign, blank or
 /// `=` (capped; a longer block grows its list). Sizing the list once keeps the hot path at
@@ -352,7 +355,7 @@ fn starts_call(i: &str) -> bool {
 /// Eight bytes a step (callgrind: counting letters and `@` exactly, a 16-byte chunk at a
 /// time, cost about 135 instructions a line of the 3-axis benchmark program).
 fn item_capacity(i: &str) -> usize {
-    const CAP: usize = 32;
+    const CAP: usize = ITEM_LIST_CAPACITY;
     const BIT6: u64 = 0x4040_4040_4040_4040;
     // The item starts in one word, and whether a comment starts in it.
     let count = |w: u64| {
@@ -389,7 +392,9 @@ fn items<'a>(
     mut i: &'a str,
     mut items: Vec<Item>,
 ) -> Result<Vec<Item>, nom::Err<PErr<'a>>> {
-    items.reserve_exact(item_capacity(i));
+    if items.capacity() < ITEM_LIST_CAPACITY {
+        items.reserve_exact(item_capacity(i));
+    }
     // Letters seen so far (bit = letter - 'A'): a second F, S, axis … is double programming.
     let mut seen = 0u32;
     // The block's own M words: with two or more, each number once (20765), checked at the
@@ -427,32 +432,8 @@ fn items<'a>(
                 }
             }
         } else if up == b'P' || b == b'@' || (up == b'V' && dot_follows) {
-            let col = ctx.col(i);
-            let (r, target) = match ctx.const_p(i) {
-                // An empty index list allocates nothing.
-                Some((r, number)) => (
-                    r,
-                    VarRef::P {
-                        number: Index::Const(number),
-                        indices: Vec::new(),
-                    },
-                ),
-                None => {
-                    let (r, target) = ctx.var_ref(i)?;
-                    writable(&target, i)?;
-                    (r, target)
-                }
-            };
-            let r = ws(r);
-            let (r, op) = match r.strip_prefix('=') {
-                Some(r) => (r, None),
-                None => match combined_assignment(r) {
-                    Some((r, op)) => (r, Some(op)),
-                    None => return Err(perr(r, SYNTAX, "`=` expected after the parameter")),
-                },
-            };
-            let (r, value) = ctx.expr(ws(r))?;
-            items.push(Item::assign(target, value, col, op));
+            let (r, item) = assignment(ctx, i)?;
+            items.push(item);
             i = r;
         } else {
             let (code, msg) = match b {
@@ -472,6 +453,43 @@ fn items<'a>(
             return Err(perr(i, code, msg));
         }
     }
+}
+
+/// `P1=10`, `P1[2]+=P3`, `V.L.X=…`, `@P1=…` at `i`: the item and the rest. `P<n>`, the
+/// commonest target, is read without the general variable reader ([`Ctx::const_p`]).
+fn assignment<'a>(ctx: &Ctx<'a>, i: &'a str) -> PResult<'a, Item> {
+    let col = ctx.col(i);
+    if let Some((r, number)) = ctx.const_p(i) {
+        let (r, op, value) = assigned(ctx, r)?;
+        let item = Item::AssignP {
+            number,
+            value,
+            col,
+            op,
+        };
+        return Ok((r, item));
+    }
+    let (r, target) = ctx.var_ref(i)?;
+    writable(&target, i)?;
+    let (r, op, value) = assigned(ctx, r)?;
+    Ok((r, Item::assign(target, value, col, op)))
+}
+
+/// What follows an assignment's target: `=` or a combined operator, then the value.
+fn assigned<'a>(
+    ctx: &Ctx<'a>,
+    r: &'a str,
+) -> Result<(&'a str, Option<super::block::BinOp>, Expr), nom::Err<PErr<'a>>> {
+    let r = ws(r);
+    let (r, op) = match r.strip_prefix('=') {
+        Some(r) => (r, None),
+        None => match combined_assignment(r) {
+            Some((r, op)) => (r, Some(op)),
+            None => return Err(perr(r, SYNTAX, "`=` expected after the parameter")),
+        },
+    };
+    let (r, value) = ctx.expr(ws(r))?;
+    Ok((r, op, value))
 }
 
 /// A combined assignment operator at `i`, `+=` `-=` `*=` `/=` (TF5200 diagnosis ID 20574:

@@ -558,3 +558,47 @@ fn deep_nesting_is_an_error_not_a_crash() {
     let funcs = format!("P1={}1{}", "ABS[".repeat(700), "]".repeat(700));
     assert_eq!(parse_block(&funcs).unwrap_err().code, 20200);
 }
+
+#[test]
+fn a_reused_item_list_parses_as_a_new_one() {
+    let lines = [
+        "N10 G01 X1 Y2 Z3 F1000",
+        "P1=5 P2=[P1*2] P3[1]+=2 V.L.A=1",
+        "#FLUSH",
+        "",
+        "( a comment only )",
+        "$IF P1 == 5",
+        "X1",
+    ];
+    let long = (0..40)
+        .map(|k| format!("P{k}={k}"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let longer = (0..70)
+        .map(|k| format!("P{k}={k}"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    // A list left over from another block, with items still in it and room for few or many.
+    let dirty = || {
+        let Body::Items(items) = parse_block("X1 Y2 Z3").unwrap().body else {
+            unreachable!()
+        };
+        items
+    };
+    for line in lines
+        .iter()
+        .copied()
+        .chain([long.as_str(), longer.as_str()])
+    {
+        let fresh = parse_block(line);
+        for spare in [Vec::new(), dirty(), Vec::with_capacity(ITEM_LIST_CAPACITY)] {
+            assert_eq!(parse_block_reusing(line, spare), fresh, "{line}");
+        }
+    }
+    // A list grown past what is kept is given up; an ordinary one comes back empty.
+    let mut b = parse_block(&longer).unwrap();
+    assert!(b.take_items().is_none());
+    let mut b = parse_block("X1 Y2").unwrap();
+    assert_eq!(b.take_items().map(|l| l.len()), Some(0));
+    assert!(parse_block("#FLUSH").unwrap().take_items().is_none());
+}
