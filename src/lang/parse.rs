@@ -2,8 +2,9 @@
 //! one `$` statement, `#` command, call or program head (TF5200 programming manual).
 //!
 //! The hot path — ordinary words with literal numbers, `N123 G01 X12.345 Y-6.789` — is a
-//! byte-level scan with one allocation per block (its item list); everything rarer (commands,
-//! expressions, variable references) goes through the nom parsers in [`super::expr`].
+//! byte-level scan with one allocation per block (its item list, none when the caller lends
+//! a kept one, [`parse_block_reusing`]); everything rarer (commands, expressions, variable
+//! references) goes through the nom parsers in [`super::expr`].
 
 use nom::bytes::complete::take_while1;
 use nom::character::complete::char as ch;
