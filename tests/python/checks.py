@@ -32,3 +32,20 @@ def open_connections(netid, addr):
     for c in conns:
         c.open()
     return conns
+
+
+# pyads frees a notification's C callback as soon as it has deleted the notification
+# (pyads_ex.adsSyncDelDeviceNotificationReqEx pops it from callback_store), while AdsLib's
+# dispatcher thread may still call it: the thread finds the notification under its lock and
+# calls it after letting go (Beckhoff/ADS AdsLib/NotificationDispatcher.cpp, Run). A sample
+# that arrived then crashed the interpreter with SIGSEGV, seen with 1 ms notifications about
+# once in tens of runs. The callbacks are kept for the rest of the process.
+_KEPT_CALLBACKS = []
+
+
+def delete_notification(conn, handles):
+    """`conn.del_device_notification(*handles)`, pyads' C callbacks kept alive after it."""
+    import pyads
+
+    _KEPT_CALLBACKS.extend(pyads.pyads_ex.callback_store.values())
+    conn.del_device_notification(*handles)

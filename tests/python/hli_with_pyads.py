@@ -20,7 +20,7 @@ import time
 
 import pyads
 
-from checks import check, wait_for
+from checks import check, delete_notification, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -139,7 +139,7 @@ def main():
     wait_for("program end", lambda: plc.read_by_name(MS + ".state_r.state", pyads.PLCTYPE_UDINT) == 3)
     check(com.read(CH, 0x0D, pyads.PLCTYPE_UDINT) == len(lines), "mc_block_count_r counts every line")
     time.sleep(0.1)
-    plc.del_device_notification(*state_handles)
+    delete_notification(plc, state_handles)
     with lock:
         seen["states"] = list(states)
     check(seen["states"][:2] == [3, 4] and seen["states"][-1] == 3,
@@ -195,7 +195,7 @@ def main():
     check(second_id == int(second.split()[0]), "second error_id %d = %r" % (second_id, second))
     plc.write_by_name(ERR + ".semaphor_rw", False, pyads.PLCTYPE_BOOL)
     check(plc.read_by_name(ERR + ".semaphor_rw", pyads.PLCTYPE_BOOL) is False, "no third error")
-    plc.del_device_notification(*sem_handles)
+    delete_notification(plc, sem_handles)
     seen["errors"] = [21476, second_id]
 
     # Reset through the HLI: to_state 15 ("Resetting").

@@ -19,6 +19,8 @@ import time
 
 import pyads
 
+from checks import delete_notification
+
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
 GROUP = 0x20101
@@ -95,7 +97,7 @@ def main():
                     time.sleep(0.01)
                 else:
                     raise
-    plc.del_device_notification(*handle)
+    delete_notification(plc, handle)
     plc.close()
     # Times the channel was seen entering READY (the first sample counts when it is READY).
     ready_seen = sum(1 for i, st in enumerate(states)

@@ -13,6 +13,8 @@ import time
 
 import pyads
 
+from checks import delete_notification
+
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
 GROUP = 0x20101
@@ -71,7 +73,7 @@ def main():
             raise SystemExit("program did not end")
         time.sleep(0.005)
     time.sleep(0.05)
-    plc.del_device_notification(*handle)
+    delete_notification(plc, handle)
     plc.close()
     pyads.close_port()
     print(json.dumps({"writes": writes, "busy": busy, "notifications": notes}))

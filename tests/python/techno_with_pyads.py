@@ -21,7 +21,7 @@ import time
 
 import pyads
 
-from checks import check, wait_for
+from checks import check, delete_notification, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -104,7 +104,7 @@ def main():
     plc.write_by_name(P + ".techno_unit_std_sync[0].done_w", True, pyads.PLCTYPE_BOOL)
     wait_for("program end", lambda: plc.read_by_name(MS + ".state_r.state", pyads.PLCTYPE_UDINT) == 3)
     seen["used_after"] = plc.read_by_name(P + ".used_units_std_sync_r", pyads.PLCTYPE_UINT)
-    plc.del_device_notification(*handles)
+    delete_notification(plc, handles)
     plc.close()
     print(json.dumps(seen))
 

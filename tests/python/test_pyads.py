@@ -19,6 +19,8 @@ import unittest
 
 import pyads
 
+from checks import delete_notification
+
 ADDR = os.environ.get("NCCHANNEL_ADS_ADDR")
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
 PORT_CNC = 553
@@ -144,7 +146,7 @@ class PyadsAgainstNcchannel(unittest.TestCase):
                 got.wait(0.1)
             self.assertEqual(seen[-1][0], new_mode)
         finally:
-            self.plc.del_device_notification(*handles)
+            delete_notification(self.plc, handles)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ import threading
 
 import pyads
 
-from checks import check, wait_for
+from checks import check, delete_notification, wait_for
 
 ADDR = os.environ["NCCHANNEL_ADS_ADDR"]
 NETID = os.environ.get("NCCHANNEL_ADS_NETID", "127.0.0.1.1.1")
@@ -61,8 +61,8 @@ def main():
             return len(on_change) >= SAMPLES and len(cyclic) >= SAMPLES
 
     wait_for("500 samples of each handle", enough)
-    com.del_device_notification(*on_change_handles)
-    geo.del_device_notification(*cyclic_handles)
+    delete_notification(com, on_change_handles)
+    delete_notification(geo, cyclic_handles)
     with lock:
         seen_change, seen_cyclic = on_change[:SAMPLES], cyclic[:SAMPLES]
     check(not gaps(seen_change),
