@@ -22,8 +22,7 @@ pub mod vars;
 use std::sync::Arc;
 use std::time::Duration;
 
-use crate::lang::block::Item;
-use crate::lang::block::{AxisName, Block, Body, Call};
+use crate::lang::block::{AxisName, Block, Body, Call, Item};
 use crate::lang::codes;
 use crate::lang::{continuation, is_comment_end, parse_block_reusing, parse_var_line, VarLine};
 use crate::source::loader::Loader;
