@@ -519,7 +519,7 @@ impl Decoder {
             Err(e) if skipping && !codes::is_control_statement_fault(e.code) => return Ok(()),
             Err(e) => return Err(e.into()),
         };
-        let r = self.run_block(&block, text, meta, stream, io);
+        let r = self.run_block(&block, text, meta, stream, skipping, io);
         if let Some(items) = block.take_items() {
             self.spare_items = items;
         }
@@ -536,16 +536,17 @@ impl Decoder {
     }
 
     /// The steps of one parsed block: the stream's limits, the flow's skipping and labels,
-    /// block search, `/n` skipping, then the block's body.
+    /// block search, `/n` skipping, then the block's body. `stream` and `skipping` as
+    /// [`Self::run_line`] found them for the line.
     fn run_block(
         &mut self,
         block: &Block,
         text: &str,
         meta: LineMeta,
         stream: bool,
+        skipping: bool,
         io: &mut DecoderIo<'_>,
     ) -> Res {
-        let skipping = self.reader.top().flow().skipping();
         if stream {
             stream_allows(block)?;
         }

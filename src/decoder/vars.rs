@@ -578,8 +578,6 @@ impl VarStore {
         }
     }
 
-    /// Assign a value. A V. scalar not yet there is created (in its scope; V.L. in the
-    /// current level); an element needs its array declared, and its indices inside it.
     /// `P<number>` without indices set to `v`: [`Self::set`] of that slot, the commonest
     /// assignment of a stream, without building the slot when it lies in the flat table (a
     /// P parameter has no V.E. type to check).
@@ -600,6 +598,8 @@ impl VarStore {
         }
     }
 
+    /// Assign a value. A V. scalar not yet there is created (in its scope; V.L. in the
+    /// current level); an element needs its array declared, and its indices inside it.
     pub fn set(&mut self, k: VarSlot, v: f64) -> Result<(), VarError> {
         let v = self.typed(&k, v, true)?;
         self.set_typed(k, v)

@@ -37,7 +37,7 @@ pub fn parse_block(line: &str) -> Result<Block, SyntaxError> {
 
 /// [`parse_block`] that puts an ordinary block's items into `items` (cleared first), so a
 /// caller that parses one line after another keeps one item list's allocation instead of
-/// taking and freeing one a block (the decoder gets it back with [`Block::into_items`]).
+/// taking and freeing one a block (the decoder gets it back with [`Block::take_items`]).
 pub fn parse_block_reusing(line: &str, mut items: Vec<Item>) -> Result<Block, SyntaxError> {
     items.clear();
     let (line, ascii) = checked_line(line)?;
