@@ -433,8 +433,8 @@ fn check_start_file(path: &Path, limits: &StartLimits) -> Vec<Diagnostic> {
             return false;
         }
         let items = match &block.body {
-            Body::ProgramHead { .. } => return !std::mem::replace(&mut started, true),
-            Body::Command(Command::Msg(_) | Command::Time(_)) => {
+            Body::ProgramHead(_) => return !std::mem::replace(&mut started, true),
+            Body::Command(c) if matches!(**c, Command::Msg(_) | Command::Time(_)) => {
                 started = true;
                 return true;
             }
@@ -562,9 +562,9 @@ fn walk_blocks(
         let Ok(block) = parse_block(raw) else {
             return true;
         };
-        match block.body {
-            Body::Command(Command::CommentBegin) => state.in_comment = true,
-            Body::Command(Command::Var) => state.in_var = true,
+        match &block.body {
+            Body::Command(c) if **c == Command::CommentBegin => state.in_comment = true,
+            Body::Command(c) if **c == Command::Var => state.in_var = true,
             _ => return visit(&block, line, joined),
         }
         true

@@ -192,7 +192,7 @@ impl Flow {
             match &block.body {
                 Body::Items(items) if items_have_m(items, &[17, 29]) => self.skip = None,
                 // A section without M17/M29 ends at the next main program head, which runs.
-                Body::ProgramHead { local: false, .. } => {
+                Body::ProgramHead(head) if !head.local => {
                     self.skip = None;
                     return Ok(true);
                 }
@@ -222,7 +222,7 @@ impl Flow {
         if let Body::Control(c) = &block.body {
             // Structures opened or closed between jump and label keep the stack right.
             let top = self;
-            match c {
+            match &**c {
                 Control::If(_) => top.stack.push(FlowEntry::If { taken: true }),
                 Control::Switch(_) => top.stack.push(FlowEntry::Switch { value: f64::NAN }),
                 Control::EndIf if matches!(top.stack.last(), Some(FlowEntry::If { .. })) => {

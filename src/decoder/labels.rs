@@ -281,10 +281,9 @@ impl LabelScan {
             }
         }
         match &block.body {
-            Body::Command(Command::CommentBegin) => self.comment = true,
-            Body::ProgramHead {
-                name, local: true, ..
-            } => {
+            Body::Command(c) if **c == Command::CommentBegin => self.comment = true,
+            Body::ProgramHead(head) if head.local => {
+                let name = &head.name;
                 let after = LinePos {
                     pos: self.pos,
                     line_no: self.line_no,

@@ -587,18 +587,18 @@ impl Decoder {
             }
             Body::Command(c) => ip.exec_command(c, at, rd, notes, io),
             Body::Call(c) => ip.exec_call(c, at, rd, notes, io),
-            Body::ProgramHead { .. } if rd.current().kind() == FrameKind::Local => {
+            Body::ProgramHead(_) if rd.current().kind() == FrameKind::Local => {
                 // A local subroutine without M17/M29 ends where the next program begins.
                 rd.top().flow().warn_open_flow(notes);
                 ip.return_from_subroutine(rd, notes);
                 ip.resume_held_end(rd, notes, io)
             }
-            Body::ProgramHead { local: true, .. } => {
+            Body::ProgramHead(head) if head.local => {
                 // A local subroutine section met while running: it runs only when called.
                 rd.top().flow_mut().begin_skip(SkipUntil::LocalSubroutine);
                 Ok(())
             }
-            Body::ProgramHead { local: false, .. } => Ok(()),
+            Body::ProgramHead(_) => Ok(()),
         }
     }
 
@@ -658,10 +658,12 @@ fn stream_allows(block: &Block) -> Res {
             codes::STREAM_LOOP,
             "loop statement in streaming program; streaming aborted",
         )),
-        Body::Call(Call::Local { .. } | Call::Cycle { local: true, .. }) => Err(DecodeError::new(
-            codes::STREAM_LOCAL_CALL,
-            "local subroutine call (LL) in streaming program",
-        )),
+        Body::Call(c) if matches!(**c, Call::Local { .. } | Call::Cycle { local: true, .. }) => {
+            Err(DecodeError::new(
+                codes::STREAM_LOCAL_CALL,
+                "local subroutine call (LL) in streaming program",
+            ))
+        }
         _ => Ok(()),
     }
 }

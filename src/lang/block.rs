@@ -51,25 +51,34 @@ pub enum Label {
 
 /// What the block does. `#` commands, `$` statements, calls and program heads stand alone
 /// in their block (only `/`, `N` and a label may precede them).
+///
+/// Every kind but the ordinary block is boxed: a kept program holds a `Block` per line, most
+/// of them ordinary, and the unboxed `Call` and `Control` made every block 104 bytes where
+/// it is now 64.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Body {
     /// An ordinary block: words and assignments in written order. Empty for a blank or
     /// comment-only line.
     Items(Vec<Item>),
     /// A `$` control statement.
-    Control(Control),
+    Control(Box<Control>),
     /// A `#` command.
-    Command(Command),
+    Command(Box<Command>),
     /// `L file`, `LL name`, `L CYCLE [...]`.
-    Call(Call),
-    /// `%name` (main program head) or `%L name` (local subroutine head). A blank may stand
-    /// between `%` and the name (`% 100`); text after the name up to a comment is the
-    /// program's `title` (`% TestProgram for streaming mode`), empty when there is none.
-    ProgramHead {
-        name: String,
-        local: bool,
-        title: String,
-    },
+    Call(Box<Call>),
+    /// `%name` (main program head) or `%L name` (local subroutine head).
+    ProgramHead(Box<ProgramHead>),
+}
+
+/// A program head: `%name` or `%L name`. A blank may stand between `%` and the name
+/// (`% 100`); text after the name up to a comment is the program's `title`
+/// (`% TestProgram for streaming mode`), empty when there is none.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProgramHead {
+    pub name: String,
+    /// `%L`: a local subroutine's head.
+    pub local: bool,
+    pub title: String,
 }
 
 /// One element of an ordinary block.
@@ -730,5 +739,18 @@ impl VarType {
             VarType::Real => "REAL64",
             VarType::String(_) => "STRING",
         }
+    }
+}
+
+#[cfg(all(test, target_pointer_width = "64"))]
+mod tests {
+    use super::{Block, Item};
+
+    /// A kept program holds one `Block` a line and its items: a variant that grows either
+    /// makes every program larger (the boxed variants above are boxed for this).
+    #[test]
+    fn blocks_and_items_keep_their_size() {
+        assert_eq!(std::mem::size_of::<Block>(), 64);
+        assert_eq!(std::mem::size_of::<Item>(), 48);
     }
 }

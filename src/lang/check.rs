@@ -363,29 +363,32 @@ impl Checker {
             }
         }
         match &block.body {
-            Body::Command(Command::CommentBegin) => self.comment_from = Some(line),
-            Body::Command(Command::Var) => {
-                self.var_from = Some(place(line, col_of(raw, "#"), joined));
-            }
-            Body::Command(Command::EndVar) => {
-                let msg = "#ENDVAR without #VAR".to_string();
-                self.push(line, col_of(raw, "#"), joined, SYNTAX, msg);
-            }
-            Body::ProgramHead { .. } => {
+            Body::Command(c) => match &**c {
+                Command::CommentBegin => self.comment_from = Some(line),
+                Command::Var => {
+                    self.var_from = Some(place(line, col_of(raw, "#"), joined));
+                }
+                Command::EndVar => {
+                    let msg = "#ENDVAR without #VAR".to_string();
+                    self.push(line, col_of(raw, "#"), joined, SYNTAX, msg);
+                }
+                Command::Time(v) => {
+                    if let Some(Err(e)) = literal(v).map(|s| dwell_time(s, DWELL_RANGE_TIME)) {
+                        self.push(line, col_of(raw, "#"), joined, e.code, e.message);
+                    }
+                }
+                _ => {}
+            },
+            Body::ProgramHead(_) => {
                 std::mem::take(&mut self.level).finish(&mut self.diags);
             }
             Body::Control(c) => {
-                let col = match c {
+                let col = match &**c {
                     Control::IfGoto(..) => col_of(raw, "$GOTO"),
                     _ => col_of(raw, "$"),
                 };
                 let (line, col) = place(line, col, joined);
                 self.level.control(c, line, col, &mut self.diags);
-            }
-            Body::Command(Command::Time(v)) => {
-                if let Some(Err(e)) = literal(v).map(|s| dwell_time(s, DWELL_RANGE_TIME)) {
-                    self.push(line, col_of(raw, "#"), joined, e.code, e.message);
-                }
             }
             Body::Items(items) => {
                 if let Some((col, Err(e))) =

@@ -16,7 +16,8 @@ use std::fmt::{self, Display, Formatter, Write};
 
 use super::block::{
     AxisSel, BinOp, Block, Body, Call, Command, Control, CycleArg, Expr, GotoTarget, Index, Item,
-    Label, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType, Word,
+    Label, ProgramHead, SplineCommand, ToolField, UnOp, VScope, Value, VarDecl, VarRef, VarType,
+    Word,
 };
 use crate::vocab::flush::FlushKind;
 
@@ -60,7 +61,8 @@ impl Display for Block {
             Body::Control(c) => write!(f, "{sep}{c}"),
             Body::Command(c) => write!(f, "{sep}{c}"),
             Body::Call(c) => write!(f, "{sep}{c}"),
-            Body::ProgramHead { name, local, title } => {
+            Body::ProgramHead(head) => {
+                let ProgramHead { name, local, title } = &**head;
                 if *local {
                     write!(f, "{sep}%L {}", FileName(name))?;
                 } else if name.eq_ignore_ascii_case("L") && !title.is_empty() {

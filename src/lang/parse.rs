@@ -11,7 +11,8 @@ use nom::character::complete::char as ch;
 
 use super::block::{
     AxisName, Block, Body, Call, Command, Control, CycleArg, Expr, Functions, GotoTarget, Item,
-    Label, NamedAxis, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word, AXIS_NAME_MAX,
+    Label, NamedAxis, ProgramHead, SplineCommand, VScope, Value, VarDecl, VarRef, VarType, Word,
+    AXIS_NAME_MAX,
 };
 use super::codes::{
     is_known_g, is_known_m, is_word_letter, word_twice, AXIS_TWICE, CACHE_DOUBLE, CACHE_SYNTAX,
@@ -296,23 +297,23 @@ fn block<'a>(
         Some(b'#') => {
             let (r, c) = command(ctx, i)?;
             end_of_block(r, "nothing may follow a # command in its block")?;
-            Body::Command(c)
+            Body::Command(Box::new(c))
         }
         Some(b'$') => {
             let (r, c) = control(ctx, i)?;
             end_of_block(r, "nothing may follow a $ statement in its block")?;
-            Body::Control(c)
+            Body::Control(Box::new(c))
         }
         Some(b'%') => {
             let (r, (name, local)) = program_head(i)?;
             let (r, title) = program_title(r);
             end_of_block(r, "nothing may follow a program head in its block")?;
-            Body::ProgramHead { name, local, title }
+            Body::ProgramHead(Box::new(ProgramHead { name, local, title }))
         }
         Some(b'L' | b'l') if starts_call(i) => {
             let (r, c) = call(ctx, i)?;
             end_of_block(r, "nothing may follow L, LL or L CYCLE in its block")?;
-            Body::Call(c)
+            Body::Call(Box::new(c))
         }
         Some(_) => Body::Items(items(ctx, i, items_list)?),
     };

@@ -89,13 +89,14 @@ fn program_heads_with_a_blank_or_a_title() {
         ("%L UP1   title words ; comment", "UP1", "title words"),
     ] {
         let b = parse_block(line).unwrap_or_else(|e| panic!("{line}: {e}"));
-        let Body::ProgramHead {
-            name: n, title: t, ..
-        } = &b.body
-        else {
+        let Body::ProgramHead(head) = &b.body else {
             panic!("{line}: {b:?}")
         };
-        assert_eq!((n.as_str(), t.as_str()), (name, title), "{line}");
+        assert_eq!(
+            (head.name.as_str(), head.title.as_str()),
+            (name, title),
+            "{line}"
+        );
         assert_eq!(parse_block(&b.to_string()).unwrap(), b, "{line}");
     }
     let rig = Rig::new();

@@ -307,15 +307,15 @@ fn control_statements() {
     ];
     for (line, want) in cases {
         let b = p(&format!("N5 {line} ; comment"));
-        assert_eq!(b.body, Body::Control(want), "{line}");
+        assert_eq!(b.body, Body::Control(Box::new(want)), "{line}");
         canon(line);
     }
     let b = p("$FOR P1 = 0, 10, 2");
-    assert!(matches!(b.body, Body::Control(For { step: Some(_), .. })));
+    assert!(matches!(&b.body, Body::Control(c) if matches!(**c, For { step: Some(_), .. })));
     assert_eq!(b.to_string(), "$FOR P1=0, 10, 2");
     assert!(matches!(
-        p("$FOR V.L.I=1,P2").body,
-        Body::Control(For { step: None, .. })
+        &p("$FOR V.L.I=1,P2").body,
+        Body::Control(c) if matches!(**c, For { step: None, .. })
     ));
     assert_eq!(err("$FOOBAR"), (20209, 1));
     assert_eq!(err("N10 $IF P1 G1"), (20200, 12));
@@ -377,7 +377,7 @@ fn hash_commands() {
     ];
     for (line, want) in cases {
         let b = p(&format!("N1260 {line} ; refresh cache"));
-        assert_eq!(b.body, Body::Command(want), "{line}");
+        assert_eq!(b.body, Body::Command(Box::new(want)), "{line}");
         canon(line);
     }
     assert_eq!(err("#FOO"), (20209, 1));
@@ -409,22 +409,25 @@ fn cache_errors() {
 fn calls_and_heads() {
     assert_eq!(
         p("N40 L streaming.nc").body,
-        Body::Call(Call::Global {
+        Body::Call(Box::new(Call::Global {
             file: "streaming.nc".into()
-        })
+        }))
     );
     assert_eq!(
         p("LL Sub_1").body,
-        Body::Call(Call::Local {
+        Body::Call(Box::new(Call::Local {
             name: "SUB_1".into()
-        })
+        }))
     );
     let b = p("N3021 L CYCLE [NAME=Laser_on.cyc @P1=0 @P2=[P5*2]]");
-    let Body::Call(Call::Cycle {
+    let Body::Call(call) = &b.body else {
+        panic!("{b:?}")
+    };
+    let Call::Cycle {
         name,
         local: false,
         params,
-    }) = &b.body
+    } = &**call
     else {
         panic!("{b:?}")
     };
@@ -437,19 +440,19 @@ fn calls_and_heads() {
     );
     assert_eq!(
         p("%streaming-spline").body,
-        Body::ProgramHead {
+        Body::ProgramHead(Box::new(ProgramHead {
             name: "streaming-spline".into(),
             local: false,
             title: String::new()
-        }
+        }))
     );
     assert_eq!(
         p("%L sub1").body,
-        Body::ProgramHead {
+        Body::ProgramHead(Box::new(ProgramHead {
             name: "SUB1".into(),
             local: true,
             title: String::new()
-        }
+        }))
     );
     canon("%L SUB1");
     canon("%main (head)");

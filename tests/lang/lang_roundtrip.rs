@@ -351,11 +351,11 @@ fn title() -> impl Strategy<Value = String> {
 fn body() -> impl Strategy<Value = Body> {
     prop_oneof![
         4 => prop::collection::vec(item(), 0..6).prop_map(|items| Body::Items(once_per_letter(items))),
-        2 => control().prop_map(Body::Control),
-        1 => command().prop_map(Body::Command),
-        1 => call().prop_map(Body::Call),
-        1 => ("[A-Za-z0-9_.-]{0,10}", title()).prop_map(|(name, title)| Body::ProgramHead { name, local: false, title }),
-        1 => (ident(), title()).prop_map(|(name, title)| Body::ProgramHead { name, local: true, title }),
+        2 => control().prop_map(|c| Body::Control(Box::new(c))),
+        1 => command().prop_map(|c| Body::Command(Box::new(c))),
+        1 => call().prop_map(|c| Body::Call(Box::new(c))),
+        1 => ("[A-Za-z0-9_.-]{0,10}", title()).prop_map(|(name, title)| Body::ProgramHead(Box::new(ProgramHead { name, local: false, title }))),
+        1 => (ident(), title()).prop_map(|(name, title)| Body::ProgramHead(Box::new(ProgramHead { name, local: true, title }))),
     ]
 }
 
