@@ -162,13 +162,13 @@ impl Bench {
         info.counter = self.n;
         self.queue.push(QueuedBlock {
             info,
-            action: Action::Move(Move {
+            action: Action::Move(Box::new(Move {
                 kind: MoveKind::Line,
                 start: self.at,
                 end: to,
                 feed_mm_per_min: 6000.0,
                 path: self.path,
-            }),
+            })),
             silent: false,
         });
         self.at = to;

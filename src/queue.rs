@@ -219,22 +219,18 @@ impl Move {
 pub enum Action {
     /// Takes effect without motion: assignments, M/S/T functions, modal changes.
     None,
-    Move(Move),
+    /// Boxed: a queued block is copied at every hop, and most blocks of a streamed
+    /// program do not move (the 168-byte move made every queued block 240 bytes).
+    Move(Box<Move>),
     /// G4: wait, seconds.
-    Dwell {
-        seconds: f64,
-    },
+    Dwell { seconds: f64 },
     /// `#FLUSH …`: release the held blocks (the planner's release rules, `motion::planner`).
     Flush(FlushKind),
     /// M00 (programmed stop) or M01 (optional stop): the axes come to rest, then the channel
     /// holds until the next start; M01 only while the operator's M01 switch is on.
-    Stop {
-        optional: bool,
-    },
+    Stop { optional: bool },
     /// M30/M2 of the main program: the program ends when everything before it has run.
-    End {
-        m: u32,
-    },
+    End { m: u32 },
     /// A technology function step around the block's motion (always a silent part).
     Techno(TechnoStep),
     /// `#MSG SYN` / `#MSG SYN_ACK`: an operator message reported when execution reaches its

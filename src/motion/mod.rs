@@ -837,7 +837,7 @@ mod tests {
                     match arc_move(&spec, at, to, feed, 1e-6) {
                         Ok(mv) => {
                             (before, at) = (at, to);
-                            Action::Move(mv)
+                            Action::Move(Box::new(mv))
                         }
                         Err(_) => Action::None,
                     }
@@ -860,7 +860,7 @@ mod tests {
                         path: PathMode::default(),
                     };
                     (before, at) = (at, to);
-                    Action::Move(mv)
+                    Action::Move(Box::new(mv))
                 };
                 q.push(block(line, action));
             }

@@ -57,13 +57,13 @@ fn axes(vmax_mm_per_min: f64, accel: f64) -> Vec<AxisLimits> {
 }
 
 fn line(start: Position, end: Position, feed: f64) -> Action {
-    Action::Move(Move {
+    Action::Move(Box::new(Move {
         kind: MoveKind::Line,
         start,
         end,
         feed_mm_per_min: feed,
         path: PathMode::default(),
-    })
+    }))
 }
 
 fn p(x: f64, y: f64, z: f64) -> Position {
@@ -189,7 +189,7 @@ fn arc_ends_exactly_at_its_end_point_and_stays_on_the_circle() {
         let mut m = Motion::new(axes(30000.0, 2000.0));
         m.set_position(start);
         let mut q = BlockQueue::new(8);
-        q.push(block(1, Action::Move(mv)));
+        q.push(block(1, Action::Move(Box::new(mv))));
         q.push(block(2, Action::End { m: 30 }));
         let (_, positions) = run(&mut m, &mut q, 100_000);
         assert_eq!(m.position(), end, "{plane:?}");
@@ -531,16 +531,16 @@ fn velocity_and_acceleration_stay_within_the_axis_limits_on_every_tick() {
         let action = if kind < 0.1 {
             let mv = random_path::rapid(&mut rng, at);
             at = mv.end;
-            Action::Move(mv)
+            Action::Move(Box::new(mv))
         } else if kind < 0.55 {
             // Short and long lines, some nearly collinear chains of tiny segments.
             let mv = random_path::line(&mut rng, at, feed);
             at = mv.end;
-            Action::Move(mv)
+            Action::Move(Box::new(mv))
         } else if kind < 0.9 {
             let mv = random_path::arc(&mut rng, at, feed);
             at = mv.end;
-            Action::Move(mv)
+            Action::Move(Box::new(mv))
         } else if kind < 0.95 {
             Action::None
         } else {

@@ -40,13 +40,13 @@ fn p(x: f64, y: f64, z: f64) -> Position {
 }
 
 fn line(start: Position, end: Position, feed: f64) -> Action {
-    Action::Move(Move {
+    Action::Move(Box::new(Move {
         kind: MoveKind::Line,
         start,
         end,
         feed_mm_per_min: feed,
         path: PathMode::default(),
-    })
+    }))
 }
 
 /// Run until the program end; every tick's position into `check` (if any). Returns the ticks
@@ -269,11 +269,11 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
         if kind < 0.1 {
             let mv = random_path::rapid(rng, at);
             at = mv.end;
-            q.push(block(n, Action::Move(mv)));
+            q.push(block(n, Action::Move(Box::new(mv))));
         } else if kind < 0.4 {
             let mv = random_path::line(rng, at, feed);
             at = mv.end;
-            q.push(block(n, contoured(Action::Move(mv), rng)));
+            q.push(block(n, contoured(Action::Move(Box::new(mv)), rng)));
         } else if kind < 0.6 {
             // A CAM polyline: 20..200 chords of a circle, radius 5..60 mm.
             let chords = (rng.range(20.0, 200.0)) as usize;
@@ -325,13 +325,13 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
             for to in &pts {
                 q.push(block(
                     n,
-                    Action::Move(Move {
+                    Action::Move(Box::new(Move {
                         kind: MoveKind::Line,
                         start: from,
                         end: *to,
                         feed_mm_per_min: feed,
                         path: comp,
-                    }),
+                    })),
                 ));
                 from = *to;
             }
@@ -341,7 +341,7 @@ fn random_program(rng: &mut Rng, q: &mut BlockQueue, blocks: u32) -> Position {
         } else if kind < 0.95 {
             let mv = random_path::arc(rng, at, feed);
             at = mv.end;
-            q.push(block(n, Action::Move(mv)));
+            q.push(block(n, Action::Move(Box::new(mv))));
         } else {
             q.push(block(
                 n,

@@ -27,13 +27,13 @@ fn p(x: f64, y: f64) -> Position {
 }
 
 fn line(start: Position, end: Position, feed: f64, path: PathMode) -> Action {
-    Action::Move(Move {
+    Action::Move(Box::new(Move {
         kind: MoveKind::Line,
         start,
         end,
         feed_mm_per_min: feed,
         path,
-    })
+    }))
 }
 
 /// What one run showed: seconds to the program end, every tick's position and path velocity.

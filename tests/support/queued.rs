@@ -42,7 +42,7 @@ pub fn r50_circle(q: &mut BlockQueue, chords: usize, path: PathMode) -> Position
             cw: false,
         };
         let mv = arc_move(&spec, start, start, 6000.0, 1e-6).unwrap();
-        q.push(block(1, Action::Move(mv)));
+        q.push(block(1, Action::Move(Box::new(mv))));
     } else {
         let mut at = start;
         for k in 1..=chords {
@@ -59,7 +59,7 @@ pub fn r50_circle(q: &mut BlockQueue, chords: usize, path: PathMode) -> Position
                 feed_mm_per_min: 6000.0,
                 path,
             };
-            q.push(block(k as u32, Action::Move(mv)));
+            q.push(block(k as u32, Action::Move(Box::new(mv))));
             at = to;
         }
     }

@@ -53,7 +53,7 @@ impl Interpreter {
                 feed_mm_per_min: 0.0,
                 path: Default::default(),
             };
-            self.emit(info, Action::Move(mv), true, io);
+            self.emit(info, Action::Move(Box::new(mv)), true, io);
         }
     }
 }

@@ -127,7 +127,7 @@ impl Interpreter {
             self.set_reference(w);
         } else if let Some(mv) = mv {
             self.modal.pos = mv.end;
-            self.emit(info.clone(), Action::Move(mv), false, io);
+            self.emit(info.clone(), Action::Move(Box::new(mv)), false, io);
             queued = true;
         }
         if let Some(t) = techno.as_mut() {

@@ -220,7 +220,7 @@ impl Planner {
         }
         if let Action::Move(mv) = &action {
             if comp_move {
-                self.comp_move(info, *mv);
+                self.comp_move(info, **mv);
                 return;
             }
             if let (true, Some(kind)) = (spline_move, mv.path.spline) {
@@ -252,7 +252,7 @@ impl Planner {
                 if let Some(arc) = blend::blend_corner(&mut self.window, &mut mv, self.front_busy) {
                     self.push_move(None, arc);
                 }
-                EntryKind::Move(Box::new(velocity::segment(&self.axes, mv)))
+                EntryKind::Move(Box::new(velocity::segment(&self.axes, *mv)))
             }
         };
         self.push_entry(info, kind, true);
